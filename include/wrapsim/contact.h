@@ -1,0 +1,46 @@
+/**
+ * @file contact.h
+ * @brief Contact reports: what touched what in the last step, with which forces.
+ */
+#ifndef WRAPSIM_CONTACT_H
+#define WRAPSIM_CONTACT_H
+
+#include <wrapsim/world.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How a contact was found (Goyal). */
+typedef enum ws_contact_kind {
+    WS_CONTACT_POINT_FACE = 0, /**< a point of body_b in a face of body_a (eq. 14-15) */
+    WS_CONTACT_EDGE_EDGE = 1   /**< an edge of body_a against an edge of body_b (eq. 16-17) */
+} ws_contact_kind;
+
+/** One active contact. The normal points from body_a to body_b; the forces are those on body_b
+ *  (body_a gets the opposite). */
+typedef struct ws_contact_info {
+    ws_body_id body_a;
+    ws_body_id body_b;
+    ws_vec3 point;          /**< where the force acts, m (mid-layer) */
+    ws_vec3 normal;         /**< unit, from a to b */
+    double overlap;         /**< layer overlap delta_a + delta_b - distance, m (> 0) */
+    double normal_force;    /**< N (>= 0, never pulling) */
+    ws_vec3 friction_force; /**< N, tangential */
+    ws_vec3 slip_velocity;  /**< tangential velocity of b relative to a, m/s */
+    int32_t kind;           /**< ws_contact_kind */
+    int32_t slipping;       /**< 1 if |v_t| >= v_lim (regularised) or the anchor slid (stick) */
+} ws_contact_info;
+
+/** Number of active contacts after the last step. */
+WS_API ws_status ws_world_get_contact_count(const ws_world *world, size_t *count);
+/** Copy the active contacts. With buf NULL and capacity 0 only the count is written. When
+ *  capacity < count, the first `capacity` are copied and WS_ERR_BUFFER_TOO_SMALL returned. */
+WS_API ws_status ws_world_copy_contacts(const ws_world *world, ws_contact_info *buf,
+                                        size_t capacity, size_t *count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,78 @@
+/**
+ * @file shape.h
+ * @brief Shapes: closed triangle meshes in their body frame, shared by bodies.
+ *
+ * A shape is re-centred on its volume centroid when it is created, so a body's position is its
+ * centre of gravity (for uniform density). Points, feature edges (between faces that are not
+ * coplanar) and faces (coplanar groups of triangles) are derived once and used by the contact
+ * checks.
+ */
+#ifndef WRAPSIM_SHAPE_H
+#define WRAPSIM_SHAPE_H
+
+#include <wrapsim/world.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A closed triangle mesh. Fill with ws_mesh_def_init(). */
+typedef struct ws_mesh_def {
+    uint32_t size;  /**< set by ws_mesh_def_init() */
+    uint32_t magic; /**< set by ws_mesh_def_init() */
+    const double *vertices;    /**< xyz triples, m, in any frame; copied */
+    size_t vertex_count;       /**< number of vertices (>= 4) */
+    const uint32_t *triangles; /**< index triples, counter-clockwise seen from outside; copied */
+    size_t triangle_count;     /**< number of triangles (>= 4) */
+} ws_mesh_def;
+
+/** What a shape is made of, after creation. */
+typedef struct ws_shape_info {
+    double volume;        /**< m^3 */
+    ws_vec3 centroid;     /**< the volume centroid in the frame the vertices were given in, m;
+                               subtracted from every vertex */
+    ws_vec3 aabb_min;     /**< bounding box in the body frame, m */
+    ws_vec3 aabb_max;
+    ws_mat3 inertia_unit; /**< inertia about the centroid for density 1 kg/m^3, kg m^2 */
+    uint32_t point_count;
+    uint32_t edge_count;     /**< feature edges (used by line-to-line contact) */
+    uint32_t face_count;     /**< coplanar groups of triangles */
+    uint32_t triangle_count;
+    int convex;              /**< 1 if the mesh is convex */
+} ws_shape_info;
+
+/** Fill a mesh Def with defaults (no vertices). */
+WS_API void ws_mesh_def_init(ws_mesh_def *def);
+
+/** A box with full edge lengths lx, ly, lz (m, each > 0), centred on the origin.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_OUT_OF_MEMORY, WS_ERR_STALE_HANDLE never. */
+WS_API ws_status ws_shape_create_box(ws_world *world, double lx, double ly, double lz,
+                                     ws_shape_id *out);
+/** A right prism approximating a cylinder of radius r and height h (m) along z with `segments`
+ *  sides (3..1024), centred on the origin. */
+WS_API ws_status ws_shape_create_cylinder(ws_world *world, double radius, double height,
+                                          int segments, ws_shape_id *out);
+/** A closed mesh. Validated: indices in range, finite coordinates, no degenerate triangle, every
+ *  edge shared by exactly two triangles wound oppositely, positive volume.
+ *  @return WS_OK, WS_ERR_BAD_MESH (with the reason in the last error), WS_ERR_INVALID_ARGUMENT,
+ *          WS_ERR_UNINITIALIZED_DEF, WS_ERR_OUT_OF_MEMORY. */
+WS_API ws_status ws_shape_create_mesh(ws_world *world, const ws_mesh_def *def,
+                                      ws_shape_id *out);
+/** Destroy a shape no body uses. @return WS_ERR_IN_USE while a body uses it. */
+WS_API ws_status ws_shape_destroy(ws_world *world, ws_shape_id id);
+/** 1 if the id names a live shape of this world, else 0. */
+WS_API int ws_shape_is_valid(const ws_world *world, ws_shape_id id);
+/** Volume, centroid, inertia and feature counts. */
+WS_API ws_status ws_shape_get_info(const ws_world *world, ws_shape_id id, ws_shape_info *info);
+/** Copy the re-centred vertices (xyz, m) and triangles; either buffer may be NULL with capacity 0
+ *  to ask for the counts. */
+WS_API ws_status ws_shape_copy_mesh(const ws_world *world, ws_shape_id id, double *vertices,
+                                    size_t vertex_capacity, size_t *vertex_count,
+                                    uint32_t *triangles, size_t triangle_capacity,
+                                    size_t *triangle_count);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

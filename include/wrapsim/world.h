@@ -1,0 +1,177 @@
+/**
+ * @file world.h
+ * @brief The world: owner of every shape, body and material; its parameters; the step.
+ */
+#ifndef WRAPSIM_WORLD_H
+#define WRAPSIM_WORLD_H
+
+#include <wrapsim/common.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Opaque world. One world belongs to one thread at a time; different worlds are independent. */
+typedef struct ws_world ws_world;
+
+/** Time integrators. */
+typedef enum ws_integrator {
+    /** Semi-implicit (symplectic) Euler: v += a dt, then x += v dt; rotations through the angular
+     *  momentum and the exact quaternion exponential. The default. */
+    WS_INTEGRATOR_SYMPLECTIC_EULER = 0,
+    /** The paper's explicit scheme (eq. 8-11): x += v dt + a dt^2/2, v += a dt, omega' += dt J^-1
+     *  (M' - omega' x J omega'), p += dt L^T omega' / 2, p renormalised. For reproducing it. */
+    WS_INTEGRATOR_PAPER_EXPLICIT = 1
+} ws_integrator;
+
+/** World parameters. Fill with ws_world_def_init(), then change what you need. */
+typedef struct ws_world_def {
+    uint32_t size;  /**< set by ws_world_def_init(); do not change */
+    uint32_t magic; /**< set by ws_world_def_init(); do not change */
+    ws_vec3 gravity;           /**< m/s^2; default (0, 0, -9.81) */
+    double dt;                 /**< time step, s; default 2.5e-4 */
+    ws_integrator integrator;  /**< default WS_INTEGRATOR_SYMPLECTIC_EULER */
+    /** Full contact detection every step while t < this time (s); default 0. */
+    double full_detection_until;
+    /** Afterwards, full detection every Nth step (>= 1); the cached candidate pairs are
+     *  re-checked on the steps between. Default 1 (every step). */
+    int detection_interval;
+    /** Extra distance (m) beyond the contact layers within which feature pairs are kept as
+     *  candidates between full detections. Must exceed how far bodies move relative to each other
+     *  in detection_interval steps. Default 2e-3. */
+    double contact_margin;
+    /** Runaway guard: a dynamic body faster than this (m/s) fails the step. Default 1000. */
+    double max_speed;
+    /** Runaway guard for angular speed (rad/s). Default 1e5. */
+    double max_angular_speed;
+    /** Use the libccd gate when built in (1, default) or not (0). Results are the same. */
+    int use_ccd;
+    ws_allocator allocator; /**< memory hooks; default malloc/realloc/free */
+    ws_log_fn log;          /**< optional log hook; NULL for none */
+    void *log_user;         /**< passed to log */
+    void *user_data;        /**< yours; see ws_world_get_user_data() */
+} ws_world_def;
+
+/** Friction laws for a pair of materials. */
+typedef enum ws_friction_model {
+    /** Coulomb with the paper's regularisation (eq. 13): F = mu N p(v/v_lim), p(s) = 2s - s^2
+     *  below v_lim, 1 above. Creeps at a few mm/s under a static tangential load. */
+    WS_FRICTION_REGULARIZED = 0,
+    /** Stick model: a tangential spring anchored where the contact began, its force capped at
+     *  mu N; the anchor slides when the cap is reached. No creep below tan(theta) = mu. */
+    WS_FRICTION_STICK = 1
+} ws_friction_model;
+
+/** Contact parameters of a pair of materials. Fill with ws_contact_def_init(). */
+typedef struct ws_contact_def {
+    uint32_t size;  /**< set by ws_contact_def_init() */
+    uint32_t magic; /**< set by ws_contact_def_init() */
+    double stiffness;     /**< normal penalty stiffness, N/m per contact point; default 2e5 */
+    double damping;       /**< normal damping, N s/m (kg/s) per contact point; default 10 */
+    double friction;      /**< Coulomb coefficient mu (>= 0); default 0.3 */
+    double friction_vlim; /**< regularisation speed v_lim, m/s (> 0); default 0.01 */
+    ws_friction_model friction_model; /**< default WS_FRICTION_REGULARIZED */
+    double stick_stiffness; /**< tangential spring of the stick model, N/m; default 2e5 */
+    double stick_damping;   /**< tangential damping of the stick model, kg/s; default 10 */
+} ws_contact_def;
+
+/** A material: only a name for now; contact parameters belong to pairs of materials. */
+typedef struct ws_material_def {
+    uint32_t size;  /**< set by ws_material_def_init() */
+    uint32_t magic; /**< set by ws_material_def_init() */
+    const char *name; /**< optional, copied; NULL for none */
+} ws_material_def;
+
+/** Counters and figures of a world. Filled by ws_world_get_stats(). */
+typedef struct ws_world_stats {
+    double time;               /**< simulated time, s */
+    uint64_t steps;            /**< steps taken */
+    uint64_t full_detections;  /**< steps with full contact detection */
+    uint64_t narrow_checks;    /**< feature-pair tests (point-face, edge-edge), in all */
+    uint64_t body_pairs_tested; /**< body pairs that reached the narrow phase, in all */
+    uint64_t body_pairs_gated; /**< body pairs the libccd gate skipped, in all */
+    uint64_t contacts;         /**< contacts active after the last step */
+    uint64_t candidates;       /**< cached candidate feature pairs after the last step */
+    uint64_t numerical_errors; /**< steps refused with WS_ERR_NUMERICAL */
+    uint64_t bytes_in_use;     /**< bytes allocated through the allocator, now */
+    uint64_t bytes_peak;       /**< most bytes in use at once */
+    uint64_t bodies;           /**< bodies alive */
+    uint64_t reserved[8];      /**< zero; room to grow */
+} ws_world_stats;
+
+/** Mechanical energy of the dynamic bodies, J. */
+typedef struct ws_energy {
+    double kinetic;       /**< translational + rotational */
+    double potential;     /**< gravity, -m g . r summed (zero at the origin) */
+    double contact;       /**< elastic energy stored in the penalty springs, k overlap^2 / 2 */
+} ws_energy;
+
+/** Fill a world Def with defaults. `def` must not be NULL. */
+WS_API void ws_world_def_init(ws_world_def *def);
+/** Fill a contact Def with defaults. */
+WS_API void ws_contact_def_init(ws_contact_def *def);
+/** Fill a material Def with defaults. */
+WS_API void ws_material_def_init(ws_material_def *def);
+
+/** Create a world. On error *out is NULL.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, dt <= 0, NaN...), WS_ERR_UNINITIALIZED_DEF,
+ *          WS_ERR_OUT_OF_MEMORY. Without a world there is no last error: see the status. */
+WS_API ws_status ws_world_create(const ws_world_def *def, ws_world **out);
+/** Destroy a world and everything in it. NULL is allowed and does nothing. */
+WS_API void ws_world_destroy(ws_world *world);
+
+/** Advance one step dt. On WS_ERR_NUMERICAL (or a callback error) the world is left exactly as it
+ *  was before the call and ws_world_last_error() says which body and what to change. */
+WS_API ws_status ws_world_step(ws_world *world);
+/** Take up to `steps` steps, stopping at the first error. */
+WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);
+
+/** Simulated time, s. */
+WS_API ws_status ws_world_get_time(const ws_world *world, double *time);
+/** Time step, s. */
+WS_API ws_status ws_world_get_dt(const ws_world *world, double *dt);
+/** Change the time step (s, > 0) between steps. */
+WS_API ws_status ws_world_set_dt(ws_world *world, double dt);
+/** Gravity, m/s^2. */
+WS_API ws_status ws_world_set_gravity(ws_world *world, const ws_vec3 *gravity);
+/** Counters and figures. */
+WS_API ws_status ws_world_get_stats(const ws_world *world, ws_world_stats *stats);
+/** Energy of the dynamic bodies (contact energy from the last step's contacts). */
+WS_API ws_status ws_world_get_energy(const ws_world *world, ws_energy *energy);
+/** A 64-bit hash of the whole dynamic state (time, every body's pose and velocities, friction
+ *  anchors). Equal hashes after equal inputs: the determinism check. */
+WS_API ws_status ws_world_get_state_hash(const ws_world *world, uint64_t *hash);
+/** The detail of the last error in this world ("body 'top': mass must be > 0, got -1"); ""
+ *  when there was none. Valid until the next call on the world. NULL world gives a static text. */
+WS_API const char *ws_world_last_error(const ws_world *world);
+/** The user pointer of the Def. */
+WS_API void *ws_world_get_user_data(const ws_world *world);
+
+/** Estimate the largest stable dt (s) for the bodies and contact pairs now in the world: the
+ *  explicit limit 2/omega of the stiffest contact on the lightest body, with a safety factor for
+ *  several simultaneous contacts (see docs/theory.md). */
+WS_API ws_status ws_world_estimate_stable_dt(const ws_world *world, double *dt);
+
+/** The material every body has unless its Def names another. */
+WS_API ws_status ws_world_get_default_material(const ws_world *world, ws_material_id *out);
+/** Create a material. */
+WS_API ws_status ws_material_create(ws_world *world, const ws_material_def *def,
+                                    ws_material_id *out);
+/** 1 if the id names a live material of this world, else 0. */
+WS_API int ws_material_is_valid(const ws_world *world, ws_material_id id);
+
+/** Contact parameters between two materials (in either order). Pairs never set use the
+ *  default set by ws_world_set_default_contact() (ws_contact_def_init() values at first). */
+WS_API ws_status ws_world_set_contact(ws_world *world, ws_material_id a, ws_material_id b,
+                                      const ws_contact_def *def);
+/** Read the parameters that apply between two materials. `def` is filled whole. */
+WS_API ws_status ws_world_get_contact(const ws_world *world, ws_material_id a, ws_material_id b,
+                                      ws_contact_def *def);
+/** Parameters for every pair not set explicitly. */
+WS_API ws_status ws_world_set_default_contact(ws_world *world, const ws_contact_def *def);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

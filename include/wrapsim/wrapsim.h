@@ -1,0 +1,16 @@
+/**
+ * @file wrapsim.h
+ * @brief libwrapsim: simulation of stretch-wrapped loads. Include this one header.
+ */
+#ifndef WRAPSIM_WRAPSIM_H
+#define WRAPSIM_WRAPSIM_H
+
+#include <wrapsim/version.h>
+#include <wrapsim/common.h>
+#include <wrapsim/world.h>
+#include <wrapsim/shape.h>
+#include <wrapsim/body.h>
+#include <wrapsim/contact.h>
+#include <wrapsim/io.h>
+
+#endif

@@ -1,0 +1,204 @@
+#include "base/base.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void *default_alloc(void *user, size_t bytes)
+{
+    (void)user;
+    return malloc(bytes);
+}
+
+static void *default_realloc(void *user, void *ptr, size_t old_bytes, size_t new_bytes)
+{
+    (void)user;
+    (void)old_bytes;
+    return realloc(ptr, new_bytes);
+}
+
+static void default_free(void *user, void *ptr, size_t bytes)
+{
+    (void)user;
+    (void)bytes;
+    free(ptr);
+}
+
+void ws_mem_init(ws_mem *mem, const ws_allocator *hooks)
+{
+    memset(mem, 0, sizeof *mem);
+    if (hooks && hooks->alloc && hooks->realloc && hooks->free) {
+        mem->hooks = *hooks;
+    } else {
+        mem->hooks.alloc = default_alloc;
+        mem->hooks.realloc = default_realloc;
+        mem->hooks.free = default_free;
+        mem->hooks.user = NULL;
+    }
+}
+
+void *ws_mem_alloc(ws_mem *mem, size_t bytes)
+{
+    if (bytes == 0)
+        bytes = 1;
+    void *p = mem->hooks.alloc(mem->hooks.user, bytes);
+    if (p) {
+        mem->in_use += bytes;
+        if (mem->in_use > mem->peak)
+            mem->peak = mem->in_use;
+    }
+    return p;
+}
+
+void *ws_mem_calloc(ws_mem *mem, size_t count, size_t size)
+{
+    if (size != 0 && count > SIZE_MAX / size)
+        return NULL;
+    void *p = ws_mem_alloc(mem, count * size);
+    if (p)
+        memset(p, 0, count * size > 0 ? count * size : 1);
+    return p;
+}
+
+void *ws_mem_realloc(ws_mem *mem, void *ptr, size_t old_bytes, size_t new_bytes)
+{
+    if (!ptr)
+        return ws_mem_alloc(mem, new_bytes);
+    if (new_bytes == 0)
+        new_bytes = 1;
+    if (old_bytes == 0)
+        old_bytes = 1;
+    void *p = mem->hooks.realloc(mem->hooks.user, ptr, old_bytes, new_bytes);
+    if (p) {
+        mem->in_use = mem->in_use - old_bytes + new_bytes;
+        if (mem->in_use > mem->peak)
+            mem->peak = mem->in_use;
+    }
+    return p;
+}
+
+void ws_mem_free(ws_mem *mem, void *ptr, size_t bytes)
+{
+    if (!ptr)
+        return;
+    if (bytes == 0)
+        bytes = 1;
+    mem->hooks.free(mem->hooks.user, ptr, bytes);
+    mem->in_use -= bytes;
+}
+
+char *ws_mem_strdup(ws_mem *mem, const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s) + 1;
+    char *p = ws_mem_alloc(mem, n);
+    if (p)
+        memcpy(p, s, n);
+    return p;
+}
+
+void ws_mem_free_str(ws_mem *mem, char *s)
+{
+    if (s)
+        ws_mem_free(mem, s, strlen(s) + 1);
+}
+
+int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, size_t elem)
+{
+    if (need <= *capacity)
+        return 0;
+    size_t cap = *capacity ? *capacity : 8;
+    while (cap < need) {
+        if (cap > SIZE_MAX / 2 / elem)
+            return -1;
+        cap *= 2;
+    }
+    void *p = ws_mem_realloc(mem, *array, *capacity * elem, cap * elem);
+    if (!p)
+        return -1;
+    *array = p;
+    *capacity = cap;
+    return 0;
+}
+
+int ws_def_check(const void *def, size_t min_size)
+{
+    const uint32_t *hdr = def;
+    if (!def)
+        return -1;
+    if (hdr[1] != WS_DEF_MAGIC || hdr[0] < min_size)
+        return -1;
+    return 0;
+}
+
+void ws_slots_destroy(ws_mem *mem, ws_slot_table *t)
+{
+    ws_mem_free(mem, t->dense, t->capacity * sizeof *t->dense);
+    ws_mem_free(mem, t->generation, t->capacity * sizeof *t->generation);
+    ws_mem_free(mem, t->free_list, t->capacity * sizeof *t->free_list);
+    memset(t, 0, sizeof *t);
+}
+
+int ws_slots_take(ws_mem *mem, ws_slot_table *t, uint32_t *slot)
+{
+    if (t->free_count > 0) {
+        *slot = t->free_list[--t->free_count];
+        return 0;
+    }
+    if (t->slot_count >= WS_ID_MAX_SLOTS)
+        return -1;
+    if (t->slot_count == t->capacity) {
+        size_t cap = t->capacity ? 2 * t->capacity : 16;
+        uint32_t *d = ws_mem_alloc(mem, cap * sizeof *d);
+        uint32_t *g = ws_mem_alloc(mem, cap * sizeof *g);
+        uint32_t *f = ws_mem_alloc(mem, cap * sizeof *f);
+        if (!d || !g || !f) {
+            ws_mem_free(mem, d, d ? cap * sizeof *d : 0);
+            ws_mem_free(mem, g, g ? cap * sizeof *g : 0);
+            ws_mem_free(mem, f, f ? cap * sizeof *f : 0);
+            return -1;
+        }
+        if (t->capacity) {
+            memcpy(d, t->dense, t->capacity * sizeof *d);
+            memcpy(g, t->generation, t->capacity * sizeof *g);
+            memcpy(f, t->free_list, t->free_count * sizeof *f);
+        }
+        ws_mem_free(mem, t->dense, t->capacity * sizeof *d);
+        ws_mem_free(mem, t->generation, t->capacity * sizeof *g);
+        ws_mem_free(mem, t->free_list, t->capacity * sizeof *f);
+        t->dense = d;
+        t->generation = g;
+        t->free_list = f;
+        t->capacity = cap;
+    }
+    *slot = (uint32_t)t->slot_count;
+    t->generation[*slot] = 1;
+    t->dense[*slot] = UINT32_MAX;
+    t->slot_count++;
+    return 0;
+}
+
+void ws_slots_release(ws_slot_table *t, uint32_t slot)
+{
+    t->dense[slot] = UINT32_MAX;
+    t->generation[slot] = (t->generation[slot] + 1u) & 0xFFFFFu;
+    if (t->generation[slot] == 0)
+        t->generation[slot] = 1;
+    t->free_list[t->free_count++] = slot;
+}
+
+uint64_t ws_hash_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+int ws_is_finite3(const ws_vec3 *v)
+{
+    return isfinite(v->x) && isfinite(v->y) && isfinite(v->z);
+}

@@ -1,0 +1,80 @@
+/* Base services every module may use: allocation through the world's hooks with byte accounting,
+ * Def checking, id packing, growable arrays. Knows nothing of physics. */
+#ifndef WS_BASE_H
+#define WS_BASE_H
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <wrapsim/common.h>
+
+/* Written by every ws_*_def_init(); an uninitialised Def almost never carries it. */
+#define WS_DEF_MAGIC 0x57534446u /* "WSDF" */
+
+/* Memory accounting around the user's allocator hooks. */
+typedef struct ws_mem {
+    ws_allocator hooks;
+    uint64_t in_use;
+    uint64_t peak;
+} ws_mem;
+
+void ws_mem_init(ws_mem *mem, const ws_allocator *hooks);
+void *ws_mem_alloc(ws_mem *mem, size_t bytes);
+void *ws_mem_calloc(ws_mem *mem, size_t count, size_t size);
+/* Returns NULL on failure and leaves *ptr untouched. */
+void *ws_mem_realloc(ws_mem *mem, void *ptr, size_t old_bytes, size_t new_bytes);
+void ws_mem_free(ws_mem *mem, void *ptr, size_t bytes);
+char *ws_mem_strdup(ws_mem *mem, const char *s);
+void ws_mem_free_str(ws_mem *mem, char *s);
+
+/* Grow an array of `elem` bytes so it holds at least `need` elements; capacity doubles.
+ * Returns 0 on success, -1 when out of memory (array unchanged). */
+int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, size_t elem);
+
+/* Checks the size/magic header of a Def: 0 when good. `min_size` is the size of the first
+ * released layout; `full` the current one. */
+int ws_def_check(const void *def, size_t min_size);
+
+/* Ids: [tag:16][kind:4][generation:20][slot+1:24]; zero is the null id. */
+enum { WS_KIND_BODY = 1, WS_KIND_SHAPE = 2, WS_KIND_MATERIAL = 3 };
+#define WS_ID_SLOT_BITS 24
+#define WS_ID_GEN_BITS 20
+#define WS_ID_MAX_SLOTS ((1u << WS_ID_SLOT_BITS) - 2u)
+
+static inline uint64_t ws_id_pack(uint16_t tag, unsigned kind, uint32_t gen, uint32_t slot)
+{
+    return ((uint64_t)tag << 48) | ((uint64_t)(kind & 0xFu) << 44) |
+           ((uint64_t)(gen & 0xFFFFFu) << 24) | (uint64_t)((slot + 1u) & 0xFFFFFFu);
+}
+static inline uint16_t ws_id_tag(uint64_t bits) { return (uint16_t)(bits >> 48); }
+static inline unsigned ws_id_kind(uint64_t bits) { return (unsigned)((bits >> 44) & 0xFu); }
+static inline uint32_t ws_id_gen(uint64_t bits) { return (uint32_t)((bits >> 24) & 0xFFFFFu); }
+/* Slot index, or UINT32_MAX for the null id. */
+static inline uint32_t ws_id_slot(uint64_t bits)
+{
+    return (uint32_t)(bits & 0xFFFFFFu) - 1u;
+}
+
+/* A generational slot table: maps id slots to dense indices of a pool. */
+typedef struct ws_slot_table {
+    uint32_t *dense;      /* slot -> dense index, UINT32_MAX when free */
+    uint32_t *generation; /* slot -> generation of the live (or last) occupant */
+    uint32_t *free_list;  /* free slots, used as a stack */
+    size_t free_count;
+    size_t slot_count;
+    size_t capacity;
+} ws_slot_table;
+
+void ws_slots_destroy(ws_mem *mem, ws_slot_table *t);
+/* Take a slot; returns 0 and the slot, -1 on out of memory or too many slots. */
+int ws_slots_take(ws_mem *mem, ws_slot_table *t, uint32_t *slot);
+void ws_slots_release(ws_slot_table *t, uint32_t slot);
+
+/* FNV-1a over bytes, continuing from h. */
+uint64_t ws_hash_bytes(uint64_t h, const void *data, size_t n);
+#define WS_HASH_SEED 0xcbf29ce484222325ull
+
+int ws_is_finite3(const ws_vec3 *v);
+
+#endif

@@ -1,0 +1,88 @@
+/* Contact: broad phase over bodies, Goyal narrow phase (point-to-face eq. 14-15, edge-to-edge
+ * eq. 16-17) in a contact layer, a cache of candidate feature pairs, penalty normal force and
+ * Coulomb friction (regularised, eq. 13, or stick). Knows shape and body. */
+#ifndef WS_CONTACT_H
+#define WS_CONTACT_H
+
+#include <wrapsim/contact.h>
+#include <wrapsim/world.h>
+
+#include "base/base.h"
+#include "body/body.h"
+#include "shape/shape.h"
+
+/* Barycentric and edge-parameter tolerance: a point on a shared edge of two triangles is inside
+ * both (then only one contact is kept per face), an edge pair meeting at an end is left to the
+ * point-face contacts. */
+#define WS_FEATURE_TOL 1e-9
+
+/* A candidate feature pair, kept between full detections. Point-face: a owns face fa, b owns
+ * point fb. Edge-edge: a owns edge fa, b owns edge fb. The anchors (body frames) belong to the
+ * stick friction model. */
+typedef struct ws_cand {
+    uint32_t a, b, fa, fb;
+    uint32_t kind;
+    uint32_t anchored;
+    v3 anchor_a, anchor_b;
+} ws_cand;
+
+/* An active contact of the last step. Normal from a to b; forces those on b. */
+typedef struct ws_contact_rec {
+    uint32_t a, b, kind, slipping;
+    v3 x, n, ft, vt;
+    double overlap, fn, energy;
+} ws_contact_rec;
+
+/* Contact parameters resolved for evaluation. */
+typedef struct ws_pair_params {
+    double k, c, mu, vlim, kt, ct;
+    int model;
+} ws_pair_params;
+
+/* Everything a contact evaluation reads. */
+typedef struct ws_contact_ctx {
+    ws_body_store *b;
+    int cur;
+    double margin;
+    const ws_pair_params *params; /* indexed by pair_index[ma * nmat + mb] */
+    const uint32_t *pair_index;
+    uint32_t nmat;
+    uint64_t narrow_checks;
+} ws_contact_ctx;
+
+static inline const ws_pair_params *ws_contact_params(const ws_contact_ctx *x, uint32_t a,
+                                                      uint32_t b)
+{
+    return &x->params[x->pair_index[x->b->material[a] * x->nmat + x->b->material[b]]];
+}
+
+/* Candidates of one body pair (i, j), appended to *cand. Returns 0, or -1 out of memory. */
+int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j, ws_cand **cand,
+                          size_t *n, size_t *cap);
+
+/* Point s (frame of shape sa) against face f: 1 and the signed distance if its projection lies in
+ * the face and the distance is within (lo, hi). */
+int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist);
+
+/* Geometry of a candidate at the committed state: contact point and normal (global, a to b) and
+ * the signed distance; 1 when the layers overlap. */
+int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist);
+
+/* Evaluate one candidate at the committed state: 1 when in contact, with the record filled, the
+ * forces added to both bodies' accumulators and the stick anchors of *c updated. */
+int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
+
+/* Sort candidates by key and carry stick anchors over from the previous list (also sorted). */
+void ws_contact_sort(ws_cand *c, size_t n);
+void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, size_t n_old);
+
+/* Body pairs whose inflated boxes overlap and not both kinematic, by sweep and prune along x.
+ * `order` keeps the sweep order between calls (insertion sort on nearly sorted data). */
+int ws_broad_pairs(ws_mem *mem, const ws_body_store *b, uint32_t **order, size_t *order_cap,
+                   uint32_t **pairs, size_t *npairs, size_t *pairs_cap);
+
+/* libccd gate: 1 if the convex hulls of bodies i and j, inflated by their layers + margin/2, may
+ * touch (or if the gate cannot tell: non-convex shapes, no libccd). */
+int ws_ccd_may_touch_at(const ws_body_store *b, int cur, uint32_t i, uint32_t j, double margin);
+
+#endif

@@ -1,0 +1,88 @@
+/* Contact forces: penalty normal force on the layer overlap (never pulling) and Coulomb friction,
+ * regularised (eq. 13) or with a stick anchor. Forces and their moments act on both bodies. */
+#include "contact/contact.h"
+
+static v3 point_velocity(const ws_body_store *b, int cur, uint32_t i, v3 xg)
+{
+    const ws_body_state *st = &b->st[cur];
+    return v3_add(st->v[i], v3_cross(b->wg[i], v3_sub(xg, st->r[i])));
+}
+
+static void apply(ws_body_store *b, int cur, uint32_t i, v3 xg, v3 F)
+{
+    b->f[i] = v3_add(b->f[i], F);
+    b->m[i] = v3_add(b->m[i], v3_cross(v3_sub(xg, b->st[cur].r[i]), F));
+}
+
+int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
+{
+    v3 xg, n;
+    double d;
+    if (!ws_contact_geometry(x, c, &xg, &n, &d)) {
+        c->anchored = 0;
+        return 0;
+    }
+    ws_body_store *b = x->b;
+    uint32_t ia = c->a, ib = c->b;
+    const ws_pair_params *pp = ws_contact_params(x, ia, ib);
+    double overlap = b->layer[ia] + b->layer[ib] - d;
+    v3 vrel = v3_sub(point_velocity(b, x->cur, ib, xg), point_velocity(b, x->cur, ia, xg));
+    double vn = v3_dot(vrel, n);
+    /* Spring on the overlap and damper on its rate; a contact never pulls. */
+    double fn = pp->k * overlap - pp->c * vn;
+    if (fn < 0.0)
+        fn = 0.0;
+    v3 vt = v3_madd(vrel, n, -vn);
+    double vts = v3_norm(vt);
+    v3 ft = v3_make(0, 0, 0);
+    int slipping = 0;
+    if (pp->model == WS_FRICTION_REGULARIZED) {
+        /* eq. 13 with p(s) = 2s - s^2: below v_lim, F = -mu N (2 - s) vt / v_lim, which is smooth
+         * and needs no division by |vt| at rest. */
+        double s = vts / pp->vlim;
+        if (s < 1.0) {
+            ft = v3_scale(vt, -pp->mu * fn * (2.0 - s) / pp->vlim);
+        } else {
+            ft = v3_scale(vt, -pp->mu * fn / vts);
+            slipping = 1;
+        }
+        c->anchored = 0;
+    } else {
+        const ws_body_state *st = &b->st[x->cur];
+        if (!c->anchored) {
+            c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xg, st->r[ia]));
+            c->anchor_b = m3_tmul_v(&b->A[ib], v3_sub(xg, st->r[ib]));
+            c->anchored = 1;
+        }
+        v3 xa = v3_add(st->r[ia], m3_mul_v(&b->A[ia], c->anchor_a));
+        v3 xb = v3_add(st->r[ib], m3_mul_v(&b->A[ib], c->anchor_b));
+        v3 dd = v3_sub(xb, xa);
+        v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
+        ft = v3_add(v3_scale(dt, -pp->kt), v3_scale(vt, -pp->ct));
+        double cap = pp->mu * fn, fts = v3_norm(ft);
+        if (fts > cap) {
+            ft = fts > 0.0 ? v3_scale(ft, cap / fts) : ft;
+            /* The anchor slides so the spring alone carries the capped force. */
+            v3 dt_new = v3_scale(ft, -1.0 / pp->kt);
+            v3 xa_new = v3_sub(xb, dt_new);
+            c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
+            slipping = 1;
+        }
+    }
+    v3 F = v3_add(v3_scale(n, fn), ft);
+    apply(b, x->cur, ib, xg, F);
+    apply(b, x->cur, ia, xg, v3_neg(F));
+    rec->a = ia;
+    rec->b = ib;
+    rec->kind = c->kind;
+    rec->slipping = (uint32_t)slipping;
+    rec->x = xg;
+    rec->n = n;
+    rec->ft = ft;
+    rec->vt = vt;
+    rec->overlap = overlap;
+    rec->fn = fn;
+    rec->energy = 0.5 * pp->k * overlap * overlap;
+    return 1;
+}
+

@@ -1,0 +1,269 @@
+/* Goyal narrow phase. Everything is done in the frame of body a, where its features were prepared
+ * once: the 3x3 solve of eq. 14 reduces to k3 = n . d and a 2x2 solve precomputed per triangle,
+ * because n is orthogonal to w and v. */
+#include "contact/contact.h"
+
+#include <stdlib.h>
+
+int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist)
+{
+    const ws_face *fc = &sa->faces[f];
+    double d = v3_dot(fc->normal, s) - fc->offset; /* k3 */
+    if (!(d > lo && d < hi))
+        return 0;
+    /* One contact per point and face: the first triangle of the face that holds the projection
+     * settles it, so a point on an edge shared by two triangles of a face is counted once. */
+    for (uint32_t t = fc->first_tri; t < fc->first_tri + fc->tri_count; t++) {
+        const ws_tri *q = &sa->tris[t];
+        v3 r = v3_sub(s, q->p);
+        double b1 = v3_dot(r, q->w), b2 = v3_dot(r, q->v);
+        double k1 = q->g00 * b1 + q->g01 * b2, k2 = q->g01 * b1 + q->g11 * b2;
+        if (k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL) {
+            *dist = d;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* n in the normal cone of an edge whose faces have outward normals n1, n2 (all orthogonal to the
+ * edge): n = a n1 + b n2 with a, b >= 0. */
+static int in_cone(v3 n, v3 n1, v3 n2)
+{
+    double c = v3_dot(n1, n2), r1 = v3_dot(n, n1), r2 = v3_dot(n, n2);
+    double den = 1.0 - c * c;
+    if (den < 1e-12)
+        return r1 > -WS_FEATURE_TOL;
+    double a = (r1 - c * r2) / den, b = (r2 - c * r1) / den;
+    return a >= -WS_FEATURE_TOL && b >= -WS_FEATURE_TOL;
+}
+
+/* Edge pi-qi of a against edge pj-qj of b, all in a's frame (eq. 16-17): closest points
+ * pi + s u and pj + t w, separation k3 along the unit common normal. n is oriented out of a (in
+ * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
+ * the parameters, the oriented normal and the signed distance; 0 for parallel edges (the system
+ * is singular: point-face contacts carry that case) or when the closest points are not interior
+ * to both edges (within `slack` of the ends, in parameter units) or the cones disagree. */
+static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double slack,
+                     int check_cones, double *s_out, double *t_out, v3 *n_out, double *d_out)
+{
+    v3 u = v3_sub(qi, pi), w = v3_sub(qj, pj);
+    v3 n = v3_cross(u, w);
+    double uu = v3_dot(u, u), ww = v3_dot(w, w), uw = v3_dot(u, w), nn = v3_dot(n, n);
+    if (nn < 1e-8 * uu * ww)
+        return 0;
+    v3 r = v3_sub(pj, pi);
+    double ru = v3_dot(r, u), rw = v3_dot(r, w);
+    double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
+    double lo = WS_FEATURE_TOL - slack, hi = 1.0 - WS_FEATURE_TOL + slack;
+    if (!(s > lo && s < hi && t > lo && t < hi))
+        return 0;
+    n = v3_scale(n, 1.0 / sqrt(nn));
+    if (check_cones) {
+        if (!in_cone(n, n1i, n2i)) {
+            n = v3_neg(n);
+            if (!in_cone(n, n1i, n2i))
+                return 0;
+        }
+        if (!in_cone(v3_neg(n), n1j, n2j))
+            return 0;
+    } else if (v3_dot(n, v3_add(n1i, n2i)) < 0.0) {
+        n = v3_neg(n);
+    }
+    *s_out = s;
+    *t_out = t;
+    *n_out = n;
+    *d_out = v3_dot(r, n);
+    return 1;
+}
+
+/* Relative transform of b into a's frame: s_a = R s_b + t. */
+static void relative(const ws_body_store *b, int cur, uint32_t ia, uint32_t ib, m3 *R, v3 *t)
+{
+    const m3 *Aa = &b->A[ia], *Ab = &b->A[ib];
+    m3 At = m3_transpose(Aa);
+    *R = m3_mul(&At, Ab);
+    *t = m3_tmul_v(Aa, v3_sub(b->st[cur].r[ib], b->st[cur].r[ia]));
+}
+
+static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a, uint32_t b,
+                uint32_t fa, uint32_t fb, uint32_t kind)
+{
+    if (ws_array_reserve(mem, (void **)cand, cap, *n + 1, sizeof **cand) != 0)
+        return -1;
+    ws_cand *c = &(*cand)[(*n)++];
+    c->a = a;
+    c->b = b;
+    c->fa = fa;
+    c->fb = fb;
+    c->kind = kind;
+    c->anchored = 0;
+    c->anchor_a = c->anchor_b = v3_make(0, 0, 0);
+    return 0;
+}
+
+static int inside_box(v3 p, v3 lo, v3 hi, double e)
+{
+    return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
+           p.z > lo.z - e && p.z < hi.z + e;
+}
+
+/* Points of body pb against faces of body pa. */
+static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb, ws_cand **cand,
+                        size_t *n, size_t *cap)
+{
+    const ws_body_store *b = x->b;
+    const ws_shape *sa = b->shape[pa], *sb = b->shape[pb];
+    double reach = b->layer[pa] + b->layer[pb] + x->margin;
+    m3 R;
+    v3 t;
+    relative(b, x->cur, pa, pb, &R, &t);
+    for (uint32_t k = 0; k < sb->vertex_count; k++) {
+        v3 s = v3_add(m3_mul_v(&R, sb->vertices[k]), t);
+        if (!inside_box(s, sa->lo, sa->hi, reach))
+            continue;
+        for (uint32_t f = 0; f < sa->face_count; f++) {
+            const ws_face *fc = &sa->faces[f];
+            x->narrow_checks++;
+            double d = v3_dot(fc->normal, s) - fc->offset;
+            if (d > -reach && d < reach && inside_box(s, fc->lo, fc->hi, reach))
+                if (push(mem, cand, n, cap, pa, pb, f, k, WS_CONTACT_POINT_FACE) != 0)
+                    return -1;
+        }
+    }
+    return 0;
+}
+
+static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib, ws_cand **cand,
+                       size_t *n, size_t *cap)
+{
+    const ws_body_store *b = x->b;
+    const ws_shape *sa = b->shape[ia], *sb = b->shape[ib];
+    double reach = b->layer[ia] + b->layer[ib] + x->margin;
+    m3 R;
+    v3 t;
+    relative(b, x->cur, ia, ib, &R, &t);
+    for (uint32_t eb = 0; eb < sb->edge_count; eb++) {
+        const ws_edge *E = &sb->edges[eb];
+        v3 pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
+        v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
+        v3 lo = v3_min(pj, qj), hi = v3_max(pj, qj);
+        if (hi.x < sa->lo.x - reach || lo.x > sa->hi.x + reach || hi.y < sa->lo.y - reach ||
+            lo.y > sa->hi.y + reach || hi.z < sa->lo.z - reach || lo.z > sa->hi.z + reach)
+            continue;
+        double lj = v3_norm(v3_sub(qj, pj));
+        for (uint32_t ea = 0; ea < sa->edge_count; ea++) {
+            const ws_edge *F = &sa->edges[ea];
+            v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
+            x->narrow_checks++;
+            double li = v3_norm(v3_sub(qi, pi));
+            double slack = reach / fmin(li, lj);
+            double s, u, d;
+            v3 nrm;
+            if (edge_edge(pi, qi, F->n1, F->n2, pj, qj, v3_make(0, 0, 0), v3_make(0, 0, 0),
+                          slack, 0, &s, &u, &nrm, &d) &&
+                fabs(d) < reach)
+                if (push(mem, cand, n, cap, ia, ib, ea, eb, WS_CONTACT_EDGE_EDGE) != 0)
+                    return -1;
+        }
+    }
+    return 0;
+}
+
+int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j, ws_cand **cand,
+                          size_t *n, size_t *cap)
+{
+    if (points_faces(mem, x, i, j, cand, n, cap) != 0)
+        return -1;
+    if (points_faces(mem, x, j, i, cand, n, cap) != 0)
+        return -1;
+    return edges_edges(mem, x, i, j, cand, n, cap);
+}
+
+/* Geometry of one candidate at the committed state: contact point (global), normal (global, a to
+ * b) and signed distance. Returns 1 when the layers overlap. */
+int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist)
+{
+    const ws_body_store *b = x->b;
+    const ws_body_state *st = &b->st[x->cur];
+    uint32_t ia = c->a, ib = c->b;
+    const ws_shape *sa = b->shape[ia], *sb = b->shape[ib];
+    double reach = b->layer[ia] + b->layer[ib];
+    const m3 *Aa = &b->A[ia], *Ab = &b->A[ib];
+    x->narrow_checks++;
+    if (c->kind == WS_CONTACT_POINT_FACE) {
+        v3 pg = v3_add(st->r[ib], m3_mul_v(Ab, sb->vertices[c->fb]));
+        v3 s = m3_tmul_v(Aa, v3_sub(pg, st->r[ia]));
+        double d;
+        if (!ws_point_in_face(sa, c->fa, s, -reach, reach, &d))
+            return 0;
+        *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
+        *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */
+        *dist = d;
+        return 1;
+    }
+    const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
+    m3 R;
+    v3 t;
+    relative(b, x->cur, ia, ib, &R, &t);
+    v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
+    v3 pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
+    v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
+    double s, u, d;
+    v3 n;
+    if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), 0.0,
+                   1, &s, &u, &n, &d))
+        return 0;
+    if (!(d > -reach && d < reach))
+        return 0;
+    v3 xi = v3_madd(pi, v3_sub(qi, pi), s), xj = v3_madd(pj, v3_sub(qj, pj), u);
+    v3 mid = v3_scale(v3_add(xi, xj), 0.5);
+    *xg = v3_add(st->r[ia], m3_mul_v(Aa, mid));
+    *ng = m3_mul_v(Aa, n);
+    *dist = d;
+    return 1;
+}
+
+static int cand_cmp(const ws_cand *p, const ws_cand *q)
+{
+    if (p->a != q->a)
+        return p->a < q->a ? -1 : 1;
+    if (p->b != q->b)
+        return p->b < q->b ? -1 : 1;
+    if (p->kind != q->kind)
+        return p->kind < q->kind ? -1 : 1;
+    if (p->fa != q->fa)
+        return p->fa < q->fa ? -1 : 1;
+    if (p->fb != q->fb)
+        return p->fb < q->fb ? -1 : 1;
+    return 0;
+}
+
+static int cand_qcmp(const void *p, const void *q)
+{
+    return cand_cmp(p, q);
+}
+
+void ws_contact_sort(ws_cand *c, size_t n)
+{
+    qsort(c, n, sizeof *c, cand_qcmp);
+}
+
+void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, size_t n_old)
+{
+    size_t i = 0, j = 0;
+    while (i < n_new && j < n_old) {
+        int k = cand_cmp(&nw[i], &old[j]);
+        if (k == 0) {
+            nw[i].anchored = old[j].anchored;
+            nw[i].anchor_a = old[j].anchor_a;
+            nw[i].anchor_b = old[j].anchor_b;
+            i++;
+            j++;
+        } else if (k < 0) {
+            i++;
+        } else {
+            j++;
+        }
+    }
+}

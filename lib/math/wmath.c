@@ -1,0 +1,128 @@
+#include "math/wmath.h"
+
+m3 m3_identity(void)
+{
+    m3 r = {{1, 0, 0, 0, 1, 0, 0, 0, 1}};
+    return r;
+}
+
+m3 m3_mul(const m3 *a, const m3 *b)
+{
+    m3 r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[3 * i + j] = a->m[3 * i] * b->m[j] + a->m[3 * i + 1] * b->m[3 + j] +
+                             a->m[3 * i + 2] * b->m[6 + j];
+    return r;
+}
+
+m3 m3_transpose(const m3 *a)
+{
+    m3 r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[3 * i + j] = a->m[3 * j + i];
+    return r;
+}
+
+double m3_det(const m3 *a)
+{
+    const double *m = a->m;
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+           m[2] * (m[3] * m[7] - m[4] * m[6]);
+}
+
+int m3_inverse(const m3 *a, m3 *out)
+{
+    const double *m = a->m;
+    double scale = 0.0;
+    for (int i = 0; i < 9; i++)
+        scale = fmax(scale, fabs(m[i]));
+    double det = m3_det(a);
+    if (!(scale > 0.0) || !(fabs(det) > 1e-14 * scale * scale * scale))
+        return -1;
+    double inv = 1.0 / det;
+    out->m[0] = (m[4] * m[8] - m[5] * m[7]) * inv;
+    out->m[1] = (m[2] * m[7] - m[1] * m[8]) * inv;
+    out->m[2] = (m[1] * m[5] - m[2] * m[4]) * inv;
+    out->m[3] = (m[5] * m[6] - m[3] * m[8]) * inv;
+    out->m[4] = (m[0] * m[8] - m[2] * m[6]) * inv;
+    out->m[5] = (m[2] * m[3] - m[0] * m[5]) * inv;
+    out->m[6] = (m[3] * m[7] - m[4] * m[6]) * inv;
+    out->m[7] = (m[1] * m[6] - m[0] * m[7]) * inv;
+    out->m[8] = (m[0] * m[4] - m[1] * m[3]) * inv;
+    return 0;
+}
+
+int m3_is_spd(const m3 *a)
+{
+    const double *m = a->m;
+    double scale = 0.0;
+    for (int i = 0; i < 9; i++) {
+        if (!isfinite(m[i]))
+            return 0;
+        scale = fmax(scale, fabs(m[i]));
+    }
+    if (!(scale > 0.0))
+        return 0;
+    double tol = 1e-9 * scale;
+    if (fabs(m[1] - m[3]) > tol || fabs(m[2] - m[6]) > tol || fabs(m[5] - m[7]) > tol)
+        return 0;
+    /* Cholesky: every pivot must be positive (relative to the scale). */
+    double l00 = m[0];
+    if (!(l00 > 1e-12 * scale))
+        return 0;
+    double l10 = m[3] / sqrt(l00), l20 = m[6] / sqrt(l00);
+    double d1 = m[4] - l10 * l10;
+    if (!(d1 > 1e-12 * scale))
+        return 0;
+    double l21 = (m[7] - l20 * l10) / sqrt(d1);
+    double d2 = m[8] - l20 * l20 - l21 * l21;
+    return d2 > 1e-12 * scale;
+}
+
+qt qt_from_axis_angle(v3 u, double angle)
+{
+    double s = sin(0.5 * angle);
+    qt q = {cos(0.5 * angle), u.x * s, u.y * s, u.z * s};
+    return q;
+}
+
+qt qt_from_rotvec(v3 phi)
+{
+    double a = v3_norm(phi);
+    if (a < 1e-8) {
+        /* Series of sin(a/2)/a keeps the small-angle update exact to round-off. */
+        double k = 0.5 - a * a / 48.0;
+        qt q = {1.0 - a * a / 8.0, phi.x * k, phi.y * k, phi.z * k};
+        return qt_normalize(q);
+    }
+    return qt_from_axis_angle(v3_scale(phi, 1.0 / a), a);
+}
+
+m3 qt_to_m3(qt q)
+{
+    double e0 = q.e0, e1 = q.e1, e2 = q.e2, e3 = q.e3;
+    double d = 2.0 * e0 * e0 - 1.0;
+    m3 a = {{d + 2.0 * e1 * e1, 2.0 * (e1 * e2 - e0 * e3), 2.0 * (e1 * e3 + e0 * e2),
+             2.0 * (e2 * e1 + e0 * e3), d + 2.0 * e2 * e2, 2.0 * (e2 * e3 - e0 * e1),
+             2.0 * (e3 * e1 - e0 * e2), 2.0 * (e3 * e2 + e0 * e1), d + 2.0 * e3 * e3}};
+    return a;
+}
+
+qt qt_rate_local(qt p, v3 w)
+{
+    /* L (eq. 12) transposed times omega', halved. */
+    qt r;
+    r.e0 = 0.5 * (-p.e1 * w.x - p.e2 * w.y - p.e3 * w.z);
+    r.e1 = 0.5 * (p.e0 * w.x - p.e3 * w.y + p.e2 * w.z);
+    r.e2 = 0.5 * (p.e3 * w.x + p.e0 * w.y - p.e1 * w.z);
+    r.e3 = 0.5 * (-p.e2 * w.x + p.e1 * w.y + p.e0 * w.z);
+    return r;
+}
+
+m3 m3_skew(v3 a)
+{
+    m3 r = {{0, -a.z, a.y, a.z, 0, -a.x, -a.y, a.x, 0}};
+    return r;
+}

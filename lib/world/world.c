@@ -1,0 +1,521 @@
+/* World lifecycle, errors, materials and contact parameters, statistics. */
+#include "world/world_internal.h"
+
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+static void vlog(const ws_world *w, ws_log_level level, const char *fmt, va_list ap)
+{
+    char buf[WS_ERR_LEN];
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    if (w->def.log)
+        w->def.log(w->def.log_user, level, buf);
+}
+
+ws_status ws_fail(const ws_world *w, ws_status s, const char *fmt, ...)
+{
+    ws_world *mw = (ws_world *)w; /* the error text is the one thing a reading call writes */
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(mw->err, sizeof mw->err, fmt, ap);
+    va_end(ap);
+    if (w->def.log)
+        w->def.log(w->def.log_user, WS_LOG_ERROR, mw->err);
+    return s;
+}
+
+void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
+{
+    if (!w->def.log)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vlog(w, level, fmt, ap);
+    va_end(ap);
+}
+
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
+                      const char *what)
+{
+    if (!src)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: the Def pointer is NULL", what);
+    if (ws_def_check(src, min_size) != 0)
+        return ws_fail(w, WS_ERR_UNINITIALIZED_DEF,
+                       "%s: the Def was not filled by ws_%s_def_init() (size/magic header wrong)",
+                       what, what);
+    uint32_t size = ((const uint32_t *)src)[0];
+    memcpy(dst, src, size < full ? size : full);
+    ((uint32_t *)dst)[0] = (uint32_t)full;
+    return WS_OK;
+}
+
+void ws_world_def_init(ws_world_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+    def->gravity = v3_make(0.0, 0.0, -9.81);
+    def->dt = 2.5e-4;
+    def->integrator = WS_INTEGRATOR_SYMPLECTIC_EULER;
+    def->full_detection_until = 0.0;
+    def->detection_interval = 1;
+    def->contact_margin = 2e-3;
+    def->max_speed = 1000.0;
+    def->max_angular_speed = 1e5;
+    def->use_ccd = 1;
+}
+
+void ws_contact_def_init(ws_contact_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+    def->stiffness = 2e5;
+    def->damping = 10.0;
+    def->friction = 0.3;
+    def->friction_vlim = 0.01;
+    def->friction_model = WS_FRICTION_REGULARIZED;
+    def->stick_stiffness = 2e5;
+    def->stick_damping = 10.0;
+}
+
+void ws_material_def_init(ws_material_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+}
+
+static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)
+{
+    if (!(isfinite(c->stiffness) && c->stiffness > 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "contact: stiffness must be > 0 N/m, got %g",
+                       c->stiffness);
+    if (!(isfinite(c->damping) && c->damping >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "contact: damping must be >= 0 kg/s, got %g",
+                       c->damping);
+    if (!(isfinite(c->friction) && c->friction >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "contact: friction mu must be >= 0, got %g",
+                       c->friction);
+    if (!(isfinite(c->friction_vlim) && c->friction_vlim > 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "contact: friction_vlim must be > 0 m/s, got %g",
+                       c->friction_vlim);
+    if (c->friction_model != WS_FRICTION_REGULARIZED && c->friction_model != WS_FRICTION_STICK)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "contact: unknown friction_model %d",
+                       (int)c->friction_model);
+    if (!(isfinite(c->stick_stiffness) && c->stick_stiffness > 0.0) ||
+        !(isfinite(c->stick_damping) && c->stick_damping >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "contact: stick_stiffness must be > 0 N/m and stick_damping >= 0 kg/s");
+    return WS_OK;
+}
+
+static ws_pair_params to_params(const ws_contact_def *c)
+{
+    ws_pair_params p = {c->stiffness, c->damping,       c->friction,     c->friction_vlim,
+                        c->stick_stiffness, c->stick_damping, (int)c->friction_model};
+    return p;
+}
+
+static ws_contact_def from_params(const ws_pair_params *p)
+{
+    ws_contact_def c;
+    ws_contact_def_init(&c);
+    c.stiffness = p->k;
+    c.damping = p->c;
+    c.friction = p->mu;
+    c.friction_vlim = p->vlim;
+    c.stick_stiffness = p->kt;
+    c.stick_damping = p->ct;
+    c.friction_model = (ws_friction_model)p->model;
+    return c;
+}
+
+static ws_status create_material(ws_world *w, const char *name, ws_material_id *out);
+
+ws_status ws_world_create(const ws_world_def *def, ws_world **out)
+{
+    if (!out)
+        return WS_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!def)
+        return WS_ERR_INVALID_ARGUMENT;
+    if (ws_def_check(def, sizeof *def) != 0)
+        return WS_ERR_UNINITIALIZED_DEF;
+    ws_world_def d = *def;
+    if (!(isfinite(d.dt) && d.dt > 0.0) || !ws_is_finite3(&d.gravity) ||
+        !(isfinite(d.full_detection_until)) || d.detection_interval < 1 ||
+        !(isfinite(d.contact_margin) && d.contact_margin >= 0.0) ||
+        !(d.max_speed > 0.0) || !(d.max_angular_speed > 0.0) ||
+        (d.integrator != WS_INTEGRATOR_SYMPLECTIC_EULER &&
+         d.integrator != WS_INTEGRATOR_PAPER_EXPLICIT))
+        return WS_ERR_INVALID_ARGUMENT;
+    int hooks = (d.allocator.alloc != NULL) + (d.allocator.realloc != NULL) +
+                (d.allocator.free != NULL);
+    if (hooks != 0 && hooks != 3)
+        return WS_ERR_INVALID_ARGUMENT;
+
+    ws_mem mem;
+    ws_mem_init(&mem, &d.allocator);
+    ws_world *w = ws_mem_calloc(&mem, 1, sizeof *w);
+    if (!w)
+        return WS_ERR_OUT_OF_MEMORY;
+    w->mem = mem;
+    w->def = d;
+    /* A per-world tag in every id, so an id of another world is refused. Mixed from the address
+     * and the clock: no global counter is needed. */
+    uintptr_t mix = (uintptr_t)w ^ ((uintptr_t)&mix >> 4) ^ (uintptr_t)time(NULL) ^
+                    (uintptr_t)clock();
+    uint64_t h = ws_hash_bytes(WS_HASH_SEED, &mix, sizeof mix);
+    w->tag = (uint16_t)(h ^ (h >> 16) ^ (h >> 32) ^ (h >> 48));
+    if (w->tag == 0)
+        w->tag = 1;
+
+    w->params = ws_mem_alloc(&w->mem, 4 * sizeof *w->params);
+    if (!w->params) {
+        ws_world_destroy(w);
+        return WS_ERR_OUT_OF_MEMORY;
+    }
+    w->params_cap = 4;
+    ws_contact_def c;
+    ws_contact_def_init(&c);
+    w->params[0] = to_params(&c);
+    w->nparams = 1;
+    ws_material_id def_mat;
+    if (create_material(w, "default", &def_mat) != WS_OK) {
+        ws_world_destroy(w);
+        return WS_ERR_OUT_OF_MEMORY;
+    }
+    w->stats.bytes_in_use = w->mem.in_use;
+    *out = w;
+    return WS_OK;
+}
+
+void ws_world_destroy(ws_world *w)
+{
+    if (!w)
+        return;
+    ws_mem *m = &w->mem;
+    ws_bodies_free(m, &w->bodies);
+    ws_slots_destroy(m, &w->body_slots);
+    for (size_t i = 0; i < w->shape_slots.slot_count; i++) {
+        if (w->shapes[i]) {
+            ws_shape_free(m, w->shapes[i]);
+            ws_mem_free(m, w->shapes[i], sizeof *w->shapes[i]);
+        }
+    }
+    ws_mem_free(m, w->shapes, w->shape_cap * sizeof *w->shapes);
+    ws_slots_destroy(m, &w->shape_slots);
+    for (size_t i = 0; i < w->mat_slots.slot_count; i++)
+        ws_mem_free_str(m, w->mat_name[i]);
+    ws_mem_free(m, w->mat_name, w->mat_cap * sizeof *w->mat_name);
+    ws_slots_destroy(m, &w->mat_slots);
+    ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);
+    ws_mem_free(m, w->pair_index, w->pair_dim * w->pair_dim * sizeof *w->pair_index);
+    for (int k = 0; k < 2; k++) {
+        ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
+        ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
+    }
+    ws_mem_free(m, w->sweep, w->sweep_cap * sizeof *w->sweep);
+    ws_mem_free(m, w->pairs, w->pairs_cap * sizeof *w->pairs);
+    ws_mem local = *m;
+    ws_mem_free(&local, w, sizeof *w);
+}
+
+const char *ws_world_last_error(const ws_world *w)
+{
+    if (!w)
+        return "no world (NULL)";
+    return w->err;
+}
+
+void *ws_world_get_user_data(const ws_world *w)
+{
+    return w ? w->def.user_data : NULL;
+}
+
+#define NEED_WORLD(w)                                                                             \
+    do {                                                                                          \
+        if (!(w))                                                                                 \
+            return WS_ERR_INVALID_ARGUMENT;                                                       \
+    } while (0)
+#define NEED_OUT(w, p, fn)                                                                        \
+    do {                                                                                          \
+        if (!(p))                                                                                 \
+            return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
+    } while (0)
+
+ws_status ws_world_get_time(const ws_world *w, double *t)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, t, "ws_world_get_time");
+    *t = w->time;
+    return WS_OK;
+}
+
+ws_status ws_world_get_dt(const ws_world *w, double *dt)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, dt, "ws_world_get_dt");
+    *dt = w->def.dt;
+    return WS_OK;
+}
+
+ws_status ws_world_set_dt(ws_world *w, double dt)
+{
+    NEED_WORLD(w);
+    if (!(isfinite(dt) && dt > 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_dt: dt must be > 0 s, got %g", dt);
+    w->def.dt = dt;
+    return WS_OK;
+}
+
+ws_status ws_world_set_gravity(ws_world *w, const ws_vec3 *g)
+{
+    NEED_WORLD(w);
+    if (!g || !ws_is_finite3(g))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_gravity: gravity must be finite");
+    w->def.gravity = *g;
+    return WS_OK;
+}
+
+ws_status ws_world_get_stats(const ws_world *w, ws_world_stats *s)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, s, "ws_world_get_stats");
+    *s = w->stats;
+    s->time = w->time;
+    s->steps = w->steps;
+    s->contacts = w->nrec[w->cur];
+    s->candidates = w->ncand[w->cur];
+    s->bytes_in_use = w->mem.in_use;
+    s->bytes_peak = w->mem.peak;
+    s->bodies = w->bodies.alive_count;
+    return WS_OK;
+}
+
+ws_status ws_world_get_energy(const ws_world *w, ws_energy *e)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, e, "ws_world_get_energy");
+    const ws_body_store *b = &w->bodies;
+    const ws_body_state *st = &b->st[w->cur];
+    e->kinetic = e->potential = e->contact = 0.0;
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+            continue;
+        v3 Jw = m3_mul_v(&b->J[i], st->w[i]);
+        e->kinetic += 0.5 * b->mass[i] * v3_norm2(st->v[i]) + 0.5 * v3_dot(st->w[i], Jw);
+        e->potential -= b->mass[i] * v3_dot(w->def.gravity, st->r[i]);
+    }
+    for (size_t k = 0; k < w->nrec[w->cur]; k++)
+        e->contact += w->rec[w->cur][k].energy;
+    return WS_OK;
+}
+
+ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, hash, "ws_world_get_state_hash");
+    const ws_body_store *b = &w->bodies;
+    const ws_body_state *st = &b->st[w->cur];
+    uint64_t h = ws_hash_bytes(WS_HASH_SEED, &w->time, sizeof w->time);
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
+            continue;
+        h = ws_hash_bytes(h, &st->r[i], sizeof st->r[i]);
+        h = ws_hash_bytes(h, &st->p[i], sizeof st->p[i]);
+        h = ws_hash_bytes(h, &st->v[i], sizeof st->v[i]);
+        h = ws_hash_bytes(h, &st->w[i], sizeof st->w[i]);
+    }
+    for (size_t k = 0; k < w->ncand[w->cur]; k++) {
+        const ws_cand *c = &w->cand[w->cur][k];
+        if (c->anchored) {
+            h = ws_hash_bytes(h, &c->anchor_a, sizeof c->anchor_a);
+            h = ws_hash_bytes(h, &c->anchor_b, sizeof c->anchor_b);
+        }
+    }
+    *hash = h;
+    return WS_OK;
+}
+
+/* ---- materials and contact pairs ---- */
+
+static ws_status create_material(ws_world *w, const char *name, ws_material_id *out)
+{
+    uint32_t slot;
+    if (ws_slots_take(&w->mem, &w->mat_slots, &slot) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
+    if (ws_array_reserve(&w->mem, (void **)&w->mat_name, &w->mat_cap, slot + 1,
+                         sizeof *w->mat_name) != 0) {
+        ws_slots_release(&w->mat_slots, slot);
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
+    }
+    if (slot + 1 > w->pair_dim) {
+        size_t dim = w->pair_dim ? 2 * w->pair_dim : 4;
+        while (dim < slot + 1)
+            dim *= 2;
+        uint32_t *pi = ws_mem_calloc(&w->mem, dim * dim, sizeof *pi);
+        if (!pi) {
+            ws_slots_release(&w->mat_slots, slot);
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
+        }
+        for (size_t a = 0; a < w->pair_dim; a++)
+            for (size_t b = 0; b < w->pair_dim; b++)
+                pi[a * dim + b] = w->pair_index[a * w->pair_dim + b];
+        ws_mem_free(&w->mem, w->pair_index, w->pair_dim * w->pair_dim * sizeof *pi);
+        w->pair_index = pi;
+        w->pair_dim = dim;
+    }
+    char *nm = NULL;
+    if (name && !(nm = ws_mem_strdup(&w->mem, name))) {
+        ws_slots_release(&w->mat_slots, slot);
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
+    }
+    w->mat_name[slot] = nm;
+    w->mat_slots.dense[slot] = slot;
+    for (size_t k = 0; k < w->pair_dim; k++)
+        w->pair_index[slot * w->pair_dim + k] = w->pair_index[k * w->pair_dim + slot] = 0;
+    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[slot], slot);
+    return WS_OK;
+}
+
+ws_status ws_material_create(ws_world *w, const ws_material_def *def, ws_material_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_material_create");
+    out->bits = 0;
+    ws_material_def d;
+    ws_material_def_init(&d);
+    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "material");
+    if (s != WS_OK)
+        return s;
+    return create_material(w, d.name, out);
+}
+
+ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot)
+{
+    uint32_t s = ws_id_slot(id.bits);
+    if (id.bits == 0)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id is null");
+    if (ws_id_tag(id.bits) != w->tag || ws_id_kind(id.bits) != WS_KIND_MATERIAL)
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "material id 0x%016llx is not a material of this world",
+                       (unsigned long long)id.bits);
+    if (s >= w->mat_slots.slot_count || w->mat_slots.dense[s] == UINT32_MAX ||
+        w->mat_slots.generation[s] != ws_id_gen(id.bits))
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id 0x%016llx was destroyed",
+                       (unsigned long long)id.bits);
+    *slot = s;
+    return WS_OK;
+}
+
+int ws_material_is_valid(const ws_world *w, ws_material_id id)
+{
+    if (!w)
+        return 0;
+    char keep[WS_ERR_LEN];
+    memcpy(keep, w->err, sizeof keep);
+    uint32_t s;
+    int ok = ws_lookup_material(w, id, &s) == WS_OK;
+    memcpy(((ws_world *)w)->err, keep, sizeof keep);
+    return ok;
+}
+
+ws_status ws_world_get_default_material(const ws_world *w, ws_material_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_world_get_default_material");
+    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[0], 0);
+    return WS_OK;
+}
+
+ws_status ws_world_set_contact(ws_world *w, ws_material_id a, ws_material_id b,
+                               const ws_contact_def *def)
+{
+    NEED_WORLD(w);
+    uint32_t sa, sb;
+    ws_status s;
+    if ((s = ws_lookup_material(w, a, &sa)) != WS_OK || (s = ws_lookup_material(w, b, &sb)) != WS_OK)
+        return s;
+    ws_contact_def d;
+    ws_contact_def_init(&d);
+    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+        return s;
+    if ((s = check_contact_def(w, &d)) != WS_OK)
+        return s;
+    uint32_t idx = w->pair_index[sa * w->pair_dim + sb];
+    if (idx == 0) {
+        if (ws_array_reserve(&w->mem, (void **)&w->params, &w->params_cap, w->nparams + 1,
+                             sizeof *w->params) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_world_set_contact: out of memory");
+        idx = (uint32_t)w->nparams++;
+    }
+    w->params[idx] = to_params(&d);
+    w->pair_index[sa * w->pair_dim + sb] = w->pair_index[sb * w->pair_dim + sa] = idx;
+    return WS_OK;
+}
+
+ws_status ws_world_get_contact(const ws_world *w, ws_material_id a, ws_material_id b,
+                               ws_contact_def *def)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, def, "ws_world_get_contact");
+    uint32_t sa, sb;
+    ws_status s;
+    if ((s = ws_lookup_material(w, a, &sa)) != WS_OK || (s = ws_lookup_material(w, b, &sb)) != WS_OK)
+        return s;
+    *def = from_params(&w->params[w->pair_index[sa * w->pair_dim + sb]]);
+    return WS_OK;
+}
+
+ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
+{
+    NEED_WORLD(w);
+    ws_contact_def d;
+    ws_contact_def_init(&d);
+    ws_status s;
+    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+        return s;
+    if ((s = check_contact_def(w, &d)) != WS_OK)
+        return s;
+    w->params[0] = to_params(&d);
+    return WS_OK;
+}
+
+double ws_world_stable_dt(const ws_world *w)
+{
+    /* Explicit limit 2/omega for a mass on several penalty springs: omega^2 = n k / m with n = 8
+     * simultaneous contacts (a box face on another: 4 corners each way), reduced by damping:
+     * dt < 2/omega (sqrt(1 + z^2) - z), z = n c / (2 m omega). */
+    const ws_body_store *b = &w->bodies;
+    double best = INFINITY;
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+            continue;
+        for (size_t p = 0; p < w->nparams; p++) {
+            const ws_pair_params *pp = &w->params[p];
+            double n = 8.0, om = sqrt(n * pp->k / b->mass[i]);
+            double z = n * pp->c / (2.0 * b->mass[i] * om);
+            double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
+            if (dt < best)
+                best = dt;
+        }
+    }
+    return best;
+}
+
+ws_status ws_world_estimate_stable_dt(const ws_world *w, double *dt)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, dt, "ws_world_estimate_stable_dt");
+    *dt = ws_world_stable_dt(w);
+    return WS_OK;
+}

@@ -1,0 +1,667 @@
+/* Public calls on shapes, bodies and contact reports: validation, id lookup, delegation. */
+#include "world/world_internal.h"
+
+#include <string.h>
+
+#define NEED_WORLD(w)                                                                             \
+    do {                                                                                          \
+        if (!(w))                                                                                 \
+            return WS_ERR_INVALID_ARGUMENT;                                                       \
+    } while (0)
+#define NEED_OUT(w, p, fn)                                                                        \
+    do {                                                                                          \
+        if (!(p))                                                                                 \
+            return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
+    } while (0)
+
+/* ---- ids ---- */
+
+static ws_status lookup(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t,
+                        const char *what, uint32_t *slot)
+{
+    if (bits == 0)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id is null", what);
+    if (ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx does not belong to this world",
+                       what, (unsigned long long)bits);
+    uint32_t s = ws_id_slot(bits);
+    if (s >= t->slot_count || t->dense[s] == UINT32_MAX || t->generation[s] != ws_id_gen(bits))
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx was destroyed", what,
+                       (unsigned long long)bits);
+    *slot = s;
+    return WS_OK;
+}
+
+ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot)
+{
+    return lookup(w, id.bits, WS_KIND_BODY, &w->body_slots, "body", slot);
+}
+
+ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot)
+{
+    return lookup(w, id.bits, WS_KIND_SHAPE, &w->shape_slots, "shape", slot);
+}
+
+ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot)
+{
+    ws_body_id id = {ws_id_pack(w->tag, WS_KIND_BODY, w->body_slots.generation[slot], slot)};
+    return id;
+}
+
+/* is_valid must not disturb the last error: it is a question, not a failure. */
+static int quiet_valid(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t)
+{
+    if (!w || bits == 0 || ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
+        return 0;
+    uint32_t s = ws_id_slot(bits);
+    return s < t->slot_count && t->dense[s] != UINT32_MAX && t->generation[s] == ws_id_gen(bits);
+}
+
+int ws_body_is_valid(const ws_world *w, ws_body_id id)
+{
+    return w ? quiet_valid(w, id.bits, WS_KIND_BODY, &w->body_slots) : 0;
+}
+
+int ws_shape_is_valid(const ws_world *w, ws_shape_id id)
+{
+    return w ? quiet_valid(w, id.bits, WS_KIND_SHAPE, &w->shape_slots) : 0;
+}
+
+/* ---- shapes ---- */
+
+void ws_mesh_def_init(ws_mesh_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+}
+
+static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
+                           size_t nt, const char *fn, ws_shape_id *out)
+{
+    char why[256] = "";
+    ws_shape *s = ws_mem_alloc(&w->mem, sizeof *s);
+    if (!s)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    ws_status st = ws_shape_build(&w->mem, xyz, nv, tri, nt, s, why, sizeof why);
+    if (st != WS_OK) {
+        ws_mem_free(&w->mem, s, sizeof *s);
+        return ws_fail(w, st, "%s: %s", fn, why);
+    }
+    uint32_t slot;
+    if (ws_slots_take(&w->mem, &w->shape_slots, &slot) != 0 ||
+        ws_array_reserve(&w->mem, (void **)&w->shapes, &w->shape_cap, slot + 1,
+                         sizeof *w->shapes) != 0) {
+        ws_shape_free(&w->mem, s);
+        ws_mem_free(&w->mem, s, sizeof *s);
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    }
+    w->shapes[slot] = s;
+    w->shape_slots.dense[slot] = slot;
+    out->bits = ws_id_pack(w->tag, WS_KIND_SHAPE, w->shape_slots.generation[slot], slot);
+    return WS_OK;
+}
+
+ws_status ws_shape_create_box(ws_world *w, double lx, double ly, double lz, ws_shape_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_shape_create_box");
+    out->bits = 0;
+    if (!(isfinite(lx) && isfinite(ly) && isfinite(lz) && lx > 0.0 && ly > 0.0 && lz > 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_create_box: edge lengths must be > 0 m, got %g x %g x %g", lx, ly,
+                       lz);
+    double xyz[24];
+    uint32_t tri[36];
+    ws_shape_box_mesh(lx, ly, lz, xyz, tri);
+    return add_shape(w, xyz, 8, tri, 12, "ws_shape_create_box", out);
+}
+
+ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments,
+                                   ws_shape_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_shape_create_cylinder");
+    out->bits = 0;
+    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_create_cylinder: need radius > 0, height > 0 and 3..1024 "
+                       "segments, got %g, %g, %d",
+                       r, h, segments);
+    size_t nv = 2 * (size_t)segments, nt = 4 * (size_t)segments - 4;
+    double *xyz = ws_mem_alloc(&w->mem, 3 * nv * sizeof *xyz);
+    uint32_t *tri = ws_mem_alloc(&w->mem, 3 * nt * sizeof *tri);
+    ws_status st;
+    if (!xyz || !tri) {
+        st = ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_shape_create_cylinder: out of memory");
+    } else {
+        ws_shape_cylinder_mesh(r, h, segments, xyz, tri);
+        st = add_shape(w, xyz, nv, tri, nt, "ws_shape_create_cylinder", out);
+    }
+    ws_mem_free(&w->mem, xyz, 3 * nv * sizeof *xyz);
+    ws_mem_free(&w->mem, tri, 3 * nt * sizeof *tri);
+    return st;
+}
+
+ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_shape_create_mesh");
+    out->bits = 0;
+    ws_mesh_def d;
+    ws_mesh_def_init(&d);
+    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "mesh");
+    if (s != WS_OK)
+        return s;
+    return add_shape(w, d.vertices, d.vertex_count, d.triangles, d.triangle_count,
+                     "ws_shape_create_mesh", out);
+}
+
+ws_status ws_shape_destroy(ws_world *w, ws_shape_id id)
+{
+    NEED_WORLD(w);
+    uint32_t slot;
+    ws_status s = ws_lookup_shape(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    ws_shape *sh = w->shapes[slot];
+    if (sh->users)
+        return ws_fail(w, WS_ERR_IN_USE, "ws_shape_destroy: %u bodies still use this shape",
+                       sh->users);
+    ws_shape_free(&w->mem, sh);
+    ws_mem_free(&w->mem, sh, sizeof *sh);
+    w->shapes[slot] = NULL;
+    ws_slots_release(&w->shape_slots, slot);
+    return WS_OK;
+}
+
+ws_status ws_shape_get_info(const ws_world *w, ws_shape_id id, ws_shape_info *info)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, info, "ws_shape_get_info");
+    uint32_t slot;
+    ws_status s = ws_lookup_shape(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    const ws_shape *sh = w->shapes[slot];
+    info->volume = sh->volume;
+    info->centroid = sh->centroid;
+    info->aabb_min = sh->lo;
+    info->aabb_max = sh->hi;
+    info->inertia_unit = sh->inertia_unit;
+    info->point_count = sh->vertex_count;
+    info->edge_count = sh->edge_count;
+    info->face_count = sh->face_count;
+    info->triangle_count = sh->triangle_count;
+    info->convex = sh->convex;
+    return WS_OK;
+}
+
+ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices, size_t vcap,
+                             size_t *vcount, uint32_t *triangles, size_t tcap, size_t *tcount)
+{
+    NEED_WORLD(w);
+    uint32_t slot;
+    ws_status s = ws_lookup_shape(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    const ws_shape *sh = w->shapes[slot];
+    if (vcount)
+        *vcount = sh->vertex_count;
+    if (tcount)
+        *tcount = sh->triangle_count;
+    if ((vcap && !vertices) || (tcap && !triangles))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_copy_mesh: a buffer is NULL but its capacity is not 0");
+    size_t nv = vcap < sh->vertex_count ? vcap : sh->vertex_count;
+    size_t nt = tcap < sh->triangle_count ? tcap : sh->triangle_count;
+    for (size_t i = 0; i < nv; i++)
+        v3_store(vertices + 3 * i, sh->vertices[i]);
+    if (nt)
+        memcpy(triangles, sh->triangles, 3 * nt * sizeof *triangles);
+    if ((vertices && vcap < sh->vertex_count) || (triangles && tcap < sh->triangle_count))
+        return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
+                       "ws_shape_copy_mesh: room for %zu vertices and %zu triangles, the shape "
+                       "has %u and %u",
+                       vcap, tcap, sh->vertex_count, sh->triangle_count);
+    return WS_OK;
+}
+
+/* ---- bodies ---- */
+
+void ws_body_def_init(ws_body_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+    def->type = WS_BODY_DYNAMIC;
+    def->density = 1000.0;
+    def->contact_layer = 1e-3;
+    def->orientation = qt_identity();
+}
+
+void ws_drive_def_init(ws_drive_def *def)
+{
+    if (!def)
+        return;
+    memset(def, 0, sizeof *def);
+    def->size = sizeof *def;
+    def->magic = WS_DEF_MAGIC;
+    def->type = WS_DRIVE_STATIC;
+    def->ramp_time = 0.05;
+    def->axis = v3_make(0, 1, 0);
+    def->direction = v3_make(1, 0, 0);
+}
+
+static const char *label(const ws_body_def *d)
+{
+    return d->name ? d->name : "(unnamed)";
+}
+
+ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_body_create");
+    out->bits = 0;
+    ws_body_def d;
+    ws_body_def_init(&d);
+    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "body");
+    if (s != WS_OK)
+        return s;
+    const char *nm = label(&d);
+    if (d.type != WS_BODY_DYNAMIC && d.type != WS_BODY_KINEMATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "body '%s': unknown type %d", nm, (int)d.type);
+    uint32_t shape_slot, mat_slot = 0;
+    if ((s = ws_lookup_shape(w, d.shape, &shape_slot)) != WS_OK)
+        return ws_fail(w, s, "body '%s': %s", nm, w->err);
+    if (d.material.bits != 0 && (s = ws_lookup_material(w, d.material, &mat_slot)) != WS_OK)
+        return ws_fail(w, s, "body '%s': %s", nm, w->err);
+    const ws_shape *sh = w->shapes[shape_slot];
+    if (!ws_is_finite3(&d.position) || !ws_is_finite3(&d.velocity) ||
+        !ws_is_finite3(&d.angular_velocity))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "body '%s': position and velocities must be finite", nm);
+    double qn = qt_norm(d.orientation);
+    if (!(isfinite(qn) && qn > 1e-12))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "body '%s': orientation must be a non-zero finite quaternion, |q| = %g", nm,
+                       qn);
+    if (!(isfinite(d.contact_layer) && d.contact_layer >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "body '%s': contact_layer must be >= 0 m, got %g",
+                       nm, d.contact_layer);
+    double mass = 0.0;
+    m3 J = m3_identity(), Jinv = m3_identity();
+    if (d.type == WS_BODY_DYNAMIC) {
+        if (!isfinite(d.mass) || d.mass < 0.0)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': mass must be > 0 kg (or 0 to use density), got %g", nm,
+                           d.mass);
+        if (d.mass == 0.0) {
+            if (!(isfinite(d.density) && d.density > 0.0))
+                return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                               "body '%s': mass is 0, so density must be > 0 kg/m^3, got %g", nm,
+                               d.density);
+            mass = d.density * sh->volume;
+        } else {
+            mass = d.mass;
+        }
+        int zero = 1;
+        for (int k = 0; k < 9; k++) {
+            if (!isfinite(d.inertia.m[k]))
+                return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "body '%s': inertia is not finite", nm);
+            if (d.inertia.m[k] != 0.0)
+                zero = 0;
+        }
+        J = zero ? ws_body_inertia_from_shape(sh, mass) : d.inertia;
+        if (!m3_is_spd(&J) || m3_inverse(&J, &Jinv) != 0)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': inertia must be symmetric positive definite "
+                           "(diagonal %g, %g, %g kg m^2)",
+                           nm, J.m[0], J.m[4], J.m[8]);
+    }
+
+    uint32_t slot;
+    if (ws_slots_take(&w->mem, &w->body_slots, &slot) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "body '%s': out of memory", nm);
+    char *name_copy = NULL;
+    if (ws_bodies_reserve(&w->mem, &w->bodies, slot + 1) != 0 ||
+        (d.name && !(name_copy = ws_mem_strdup(&w->mem, d.name)))) {
+        ws_slots_release(&w->body_slots, slot);
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "body '%s': out of memory", nm);
+    }
+    ws_body_store *b = &w->bodies;
+    if (slot >= b->slots)
+        b->slots = slot + 1;
+    b->alive[slot] = 1;
+    b->alive_count++;
+    b->type[slot] = (uint8_t)d.type;
+    b->shape[slot] = w->shapes[shape_slot];
+    w->shapes[shape_slot]->users++;
+    b->material[slot] = mat_slot;
+    b->layer[slot] = d.contact_layer;
+    b->mass[slot] = mass;
+    b->inv_mass[slot] = d.type == WS_BODY_DYNAMIC ? 1.0 / mass : 0.0;
+    b->J[slot] = J;
+    b->Jinv[slot] = Jinv;
+    b->has_drive[slot] = 0;
+    b->name[slot] = name_copy;
+    b->user[slot] = d.user_data;
+    ws_body_state *st = &b->st[w->cur];
+    qt p = qt_normalize(d.orientation);
+    m3 A = qt_to_m3(p);
+    st->r[slot] = d.position;
+    st->p[slot] = p;
+    if (d.type == WS_BODY_DYNAMIC) {
+        st->v[slot] = d.velocity;
+        st->w[slot] = m3_tmul_v(&A, d.angular_velocity);
+    } else {
+        st->v[slot] = v3_make(0, 0, 0);
+        st->w[slot] = v3_make(0, 0, 0);
+    }
+    w->body_slots.dense[slot] = slot;
+    w->cand_valid = 0;
+    *out = ws_make_body_id(w, slot);
+    return WS_OK;
+}
+
+void ws_world_forget_body(ws_world *w, uint32_t slot)
+{
+    for (int k = 0; k < 2; k++) {
+        size_t m = 0;
+        for (size_t i = 0; i < w->ncand[k]; i++)
+            if (w->cand[k][i].a != slot && w->cand[k][i].b != slot)
+                w->cand[k][m++] = w->cand[k][i];
+        w->ncand[k] = m;
+        m = 0;
+        for (size_t i = 0; i < w->nrec[k]; i++)
+            if (w->rec[k][i].a != slot && w->rec[k][i].b != slot)
+                w->rec[k][m++] = w->rec[k][i];
+        w->nrec[k] = m;
+    }
+    w->cand_valid = 0;
+}
+
+ws_status ws_body_destroy(ws_world *w, ws_body_id id)
+{
+    NEED_WORLD(w);
+    uint32_t slot;
+    ws_status s = ws_lookup_body(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    ws_body_store *b = &w->bodies;
+    ws_world_forget_body(w, slot);
+    b->shape[slot]->users--;
+    b->shape[slot] = NULL;
+    ws_mem_free_str(&w->mem, b->name[slot]);
+    b->name[slot] = NULL;
+    b->alive[slot] = 0;
+    b->alive_count--;
+    ws_slots_release(&w->body_slots, slot);
+    return WS_OK;
+}
+
+ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
+{
+    NEED_WORLD(w);
+    uint32_t slot;
+    ws_status s = ws_lookup_body(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    ws_body_store *b = &w->bodies;
+    const char *nm = b->name[slot] ? b->name[slot] : "(unnamed)";
+    if (b->type[slot] != WS_BODY_KINEMATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "body '%s': only kinematic bodies (world elements) take a drive", nm);
+    ws_drive_def d;
+    ws_drive_def_init(&d);
+    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "drive")) != WS_OK)
+        return s;
+    ws_body_state *st = &b->st[w->cur];
+    ws_pose base = {st->r[slot], st->p[slot]};
+    if (b->has_drive[slot]) /* the motion is relative to where the old drive started */
+        base = b->drive[slot].base;
+    char why[256] = "";
+    ws_drive drv;
+    if ((s = ws_drive_setup(&drv, &d, &base, why, sizeof why)) != WS_OK)
+        return ws_fail(w, s, "body '%s': %s", nm, why);
+    ws_pose pose;
+    v3 v, om;
+    if (ws_drive_eval(&drv, w->time, &pose, &v, &om) != 0)
+        return ws_fail(w, WS_ERR_CALLBACK, "body '%s': the drive callback failed at t = %g s", nm,
+                       w->time);
+    b->drive[slot] = drv;
+    b->has_drive[slot] = 1;
+    st->r[slot] = pose.position;
+    st->p[slot] = pose.orientation;
+    st->v[slot] = v;
+    m3 A = qt_to_m3(pose.orientation);
+    st->w[slot] = m3_tmul_v(&A, om);
+    w->cand_valid = 0;
+    return WS_OK;
+}
+
+#define BODY_GETTER(fn, T, what, expr)                                                            \
+    ws_status fn(const ws_world *w, ws_body_id id, T *out)                                        \
+    {                                                                                             \
+        NEED_WORLD(w);                                                                            \
+        NEED_OUT(w, out, #fn);                                                                    \
+        uint32_t i;                                                                               \
+        ws_status s = ws_lookup_body(w, id, &i);                                                  \
+        if (s != WS_OK)                                                                           \
+            return s;                                                                             \
+        const ws_body_store *b = &w->bodies;                                                      \
+        const ws_body_state *st = &b->st[w->cur];                                                 \
+        (void)st;                                                                                 \
+        *out = (expr);                                                                            \
+        return WS_OK;                                                                             \
+    }
+
+BODY_GETTER(ws_body_get_type, ws_body_type, "type", (ws_body_type)b->type[i])
+BODY_GETTER(ws_body_get_position, ws_vec3, "position", st->r[i])
+BODY_GETTER(ws_body_get_orientation, ws_quat, "orientation", st->p[i])
+BODY_GETTER(ws_body_get_rotation, ws_mat3, "rotation", qt_to_m3(st->p[i]))
+BODY_GETTER(ws_body_get_velocity, ws_vec3, "velocity", st->v[i])
+BODY_GETTER(ws_body_get_angular_velocity_local, ws_vec3, "angular velocity", st->w[i])
+BODY_GETTER(ws_body_get_mass, double, "mass", b->mass[i])
+BODY_GETTER(ws_body_get_inertia, ws_mat3, "inertia", b->J[i])
+
+ws_status ws_body_get_angular_velocity(const ws_world *w, ws_body_id id, ws_vec3 *out)
+{
+    ws_status s = ws_body_get_angular_velocity_local(w, id, out);
+    if (s != WS_OK)
+        return s;
+    uint32_t i;
+    ws_lookup_body(w, id, &i);
+    m3 A = qt_to_m3(w->bodies.st[w->cur].p[i]);
+    *out = m3_mul_v(&A, *out);
+    return WS_OK;
+}
+
+ws_status ws_body_get_point_velocity(const ws_world *w, ws_body_id id, const ws_vec3 *point,
+                                     ws_vec3 *v)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, v, "ws_body_get_point_velocity");
+    if (!point || !ws_is_finite3(point))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_body_get_point_velocity: point must be finite");
+    uint32_t i;
+    ws_status s = ws_lookup_body(w, id, &i);
+    if (s != WS_OK)
+        return s;
+    const ws_body_state *st = &w->bodies.st[w->cur];
+    m3 A = qt_to_m3(st->p[i]);
+    v3 om = m3_mul_v(&A, st->w[i]);
+    *v = v3_add(st->v[i], v3_cross(om, v3_sub(*point, st->r[i]))); /* eq. 3 */
+    return WS_OK;
+}
+
+ws_status ws_body_get_world_point(const ws_world *w, ws_body_id id, const ws_vec3 *local,
+                                  ws_vec3 *global)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, global, "ws_body_get_world_point");
+    if (!local || !ws_is_finite3(local))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_body_get_world_point: point must be finite");
+    uint32_t i;
+    ws_status s = ws_lookup_body(w, id, &i);
+    if (s != WS_OK)
+        return s;
+    const ws_body_state *st = &w->bodies.st[w->cur];
+    m3 A = qt_to_m3(st->p[i]);
+    *global = v3_add(st->r[i], m3_mul_v(&A, *local)); /* eq. 2 */
+    return WS_OK;
+}
+
+ws_status ws_body_get_contact_force(const ws_world *w, ws_body_id id, ws_vec3 *force,
+                                    ws_vec3 *moment)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, force, "ws_body_get_contact_force");
+    uint32_t i;
+    ws_status s = ws_lookup_body(w, id, &i);
+    if (s != WS_OK)
+        return s;
+    v3 F = {0, 0, 0}, M = {0, 0, 0};
+    v3 r = w->bodies.st[w->cur].r[i];
+    for (size_t k = 0; k < w->nrec[w->cur]; k++) {
+        const ws_contact_rec *c = &w->rec[w->cur][k];
+        v3 f = v3_add(v3_scale(c->n, c->fn), c->ft);
+        if (c->a == i)
+            f = v3_neg(f);
+        else if (c->b != i)
+            continue;
+        F = v3_add(F, f);
+        M = v3_add(M, v3_cross(v3_sub(c->x, r), f));
+    }
+    *force = F;
+    if (moment)
+        *moment = M;
+    return WS_OK;
+}
+
+ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
+{
+    NEED_WORLD(w);
+    uint32_t i;
+    ws_status s = ws_lookup_body(w, id, &i);
+    if (s != WS_OK)
+        return s;
+    double qn = pose ? qt_norm(pose->orientation) : 0.0;
+    if (!pose || !ws_is_finite3(&pose->position) || !(isfinite(qn) && qn > 1e-12))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_body_set_pose: position must be finite and orientation non-zero");
+    if (w->bodies.type[i] != WS_BODY_DYNAMIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_body_set_pose: a kinematic body is placed by its drive");
+    ws_body_state *st = &w->bodies.st[w->cur];
+    /* Keep the global angular velocity: omega' is re-expressed in the new orientation. */
+    m3 A = qt_to_m3(st->p[i]);
+    v3 om = m3_mul_v(&A, st->w[i]);
+    st->r[i] = pose->position;
+    st->p[i] = qt_normalize(pose->orientation);
+    A = qt_to_m3(st->p[i]);
+    st->w[i] = m3_tmul_v(&A, om);
+    w->cand_valid = 0;
+    return WS_OK;
+}
+
+ws_status ws_body_set_velocity(ws_world *w, ws_body_id id, const ws_vec3 *v, const ws_vec3 *om)
+{
+    NEED_WORLD(w);
+    uint32_t i;
+    ws_status s = ws_lookup_body(w, id, &i);
+    if (s != WS_OK)
+        return s;
+    if (!v || !om || !ws_is_finite3(v) || !ws_is_finite3(om))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_body_set_velocity: velocities must be finite");
+    if (w->bodies.type[i] != WS_BODY_DYNAMIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_body_set_velocity: a kinematic body moves by its drive");
+    ws_body_state *st = &w->bodies.st[w->cur];
+    m3 A = qt_to_m3(st->p[i]);
+    st->v[i] = *v;
+    st->w[i] = m3_tmul_v(&A, *om);
+    return WS_OK;
+}
+
+const char *ws_body_get_name(const ws_world *w, ws_body_id id)
+{
+    if (!ws_body_is_valid(w, id))
+        return "";
+    const char *n = w->bodies.name[ws_id_slot(id.bits)];
+    return n ? n : "";
+}
+
+void *ws_body_get_user_data(const ws_world *w, ws_body_id id)
+{
+    if (!ws_body_is_valid(w, id))
+        return NULL;
+    return w->bodies.user[ws_id_slot(id.bits)];
+}
+
+ws_status ws_world_copy_body_ids(const ws_world *w, ws_body_id *buf, size_t cap, size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_world_copy_body_ids");
+    if (cap && !buf)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_world_copy_body_ids: buffer is NULL but capacity is not 0");
+    size_t n = 0;
+    for (size_t i = 0; i < w->bodies.slots; i++) {
+        if (!w->bodies.alive[i])
+            continue;
+        if (n < cap)
+            buf[n] = ws_make_body_id(w, (uint32_t)i);
+        n++;
+    }
+    *count = n;
+    if (buf && cap < n)
+        return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
+                       "ws_world_copy_body_ids: room for %zu ids, there are %zu", cap, n);
+    return WS_OK;
+}
+
+/* ---- contact reports ---- */
+
+ws_status ws_world_get_contact_count(const ws_world *w, size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_world_get_contact_count");
+    *count = w->nrec[w->cur];
+    return WS_OK;
+}
+
+ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t cap,
+                                 size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_world_copy_contacts");
+    if (cap && !buf)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_world_copy_contacts: buffer is NULL but capacity is not 0");
+    size_t n = w->nrec[w->cur];
+    *count = n;
+    size_t m = cap < n ? cap : n;
+    for (size_t k = 0; k < m; k++) {
+        const ws_contact_rec *c = &w->rec[w->cur][k];
+        ws_contact_info *o = &buf[k];
+        o->body_a = ws_make_body_id(w, c->a);
+        o->body_b = ws_make_body_id(w, c->b);
+        o->point = c->x;
+        o->normal = c->n;
+        o->overlap = c->overlap;
+        o->normal_force = c->fn;
+        o->friction_force = c->ft;
+        o->slip_velocity = c->vt;
+        o->kind = (int32_t)c->kind;
+        o->slipping = (int32_t)c->slipping;
+    }
+    if (buf && cap < n)
+        return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
+                       "ws_world_copy_contacts: room for %zu contacts, there are %zu", cap, n);
+    return WS_OK;
+}

@@ -1,0 +1,84 @@
+/* The world: owner of all pools, and the one orchestrator of a step. Reaches every module. */
+#ifndef WS_WORLD_INTERNAL_H
+#define WS_WORLD_INTERNAL_H
+
+#include <wrapsim/wrapsim.h>
+
+#include "base/base.h"
+#include "body/body.h"
+#include "contact/contact.h"
+#include "drive/drive.h"
+#include "math/wmath.h"
+#include "shape/shape.h"
+
+#define WS_ERR_LEN 512
+
+struct ws_world {
+    ws_mem mem;
+    ws_world_def def;
+    uint16_t tag;
+    double time;
+    uint64_t steps;
+    uint64_t last_full_step;
+    int cand_valid; /* 0 forces a full detection on the next step */
+    int cur;        /* committed buffer: bodies, candidates, contact records */
+    char err[WS_ERR_LEN];
+
+    ws_body_store bodies;
+    ws_slot_table body_slots;
+
+    ws_shape **shapes;
+    size_t shape_cap;
+    ws_slot_table shape_slots;
+
+    char **mat_name;
+    size_t mat_cap;
+    ws_slot_table mat_slots;
+    ws_pair_params *params; /* [0] is the default */
+    size_t nparams, params_cap;
+    uint32_t *pair_index; /* dim x dim, indices into params */
+    size_t pair_dim;
+
+    ws_cand *cand[2];
+    size_t ncand[2], capcand[2];
+    ws_contact_rec *rec[2];
+    size_t nrec[2], caprec[2];
+    uint32_t *sweep;
+    size_t sweep_cap;
+    uint32_t *pairs;
+    size_t pairs_cap, npairs;
+
+    ws_world_stats stats;
+};
+
+/* Record an error (and log it) and return the status. The world may be const for callers that
+ * only read: the error text is the one field such calls write. */
+ws_status ws_fail(const ws_world *w, ws_status s, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);
+ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot);
+ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot);
+ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
+
+/* Copy a caller's Def (of the size it says) over a default one; WS_ERR_UNINITIALIZED_DEF or
+ * WS_ERR_INVALID_ARGUMENT (NULL) with the message set. */
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
+                      const char *what);
+
+/* Body bookkeeping after a change of the committed state outside a step. */
+void ws_world_refresh_body(ws_world *w, uint32_t slot);
+/* Drop cached candidates that refer to a body slot (before the slot is reused). */
+void ws_world_forget_body(ws_world *w, uint32_t slot);
+/* Largest stable dt for the current bodies and parameters (see ws_world_estimate_stable_dt). */
+double ws_world_stable_dt(const ws_world *w);
+
+#endif

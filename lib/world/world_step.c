@@ -1,0 +1,194 @@
+/* ws_world_step(): the one orchestrator. Data flows one way:
+ *   (1) state at t -> rotation matrices, global angular velocities, inflated boxes;
+ *   (2) contact detection: full (broad phase, optional libccd gate, candidate feature pairs) or
+ *       the cached candidates carried over;
+ *   (3) forces: gravity, then every candidate evaluated (penalty + friction on both bodies);
+ *   (4) integration into the other state buffer; world elements from their drives at t + dt;
+ *   (5) health check; (6) commit by swapping buffers and t += dt.
+ * Nothing is committed before (6), so a failed step leaves the world as it was. */
+#include "world/world_internal.h"
+
+#include <string.h>
+
+static void prepare(ws_world *w)
+{
+    ws_body_store *b = &w->bodies;
+    const ws_body_state *st = &b->st[w->cur];
+    v3 g = w->def.gravity;
+    double half_margin = 0.5 * w->def.contact_margin;
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
+            continue;
+        m3 A = qt_to_m3(st->p[i]);
+        b->A[i] = A;
+        b->wg[i] = m3_mul_v(&A, st->w[i]);
+        b->f[i] = b->type[i] == WS_BODY_DYNAMIC ? v3_scale(g, b->mass[i]) : v3_make(0, 0, 0);
+        b->m[i] = v3_make(0, 0, 0);
+        /* Global box of the rotated local box: centre moved, half extents through |A|. */
+        const ws_shape *s = b->shape[i];
+        v3 c = v3_scale(v3_add(s->lo, s->hi), 0.5), e = v3_scale(v3_sub(s->hi, s->lo), 0.5);
+        v3 cg = v3_add(st->r[i], m3_mul_v(&A, c));
+        const double *a = A.m;
+        double pad = b->layer[i] + half_margin;
+        v3 eg = v3_make(fabs(a[0]) * e.x + fabs(a[1]) * e.y + fabs(a[2]) * e.z + pad,
+                        fabs(a[3]) * e.x + fabs(a[4]) * e.y + fabs(a[5]) * e.z + pad,
+                        fabs(a[6]) * e.x + fabs(a[7]) * e.y + fabs(a[8]) * e.z + pad);
+        b->lo[i] = v3_sub(cg, eg);
+        b->hi[i] = v3_add(cg, eg);
+    }
+}
+
+static ws_status detect_full(ws_world *w, ws_contact_ctx *x, int nxt)
+{
+    ws_mem *mem = &w->mem;
+    if (ws_broad_pairs(mem, &w->bodies, &w->sweep, &w->sweep_cap, &w->pairs, &w->npairs,
+                       &w->pairs_cap) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
+    w->ncand[nxt] = 0;
+    for (size_t k = 0; k < w->npairs; k++) {
+        uint32_t i = w->pairs[2 * k], j = w->pairs[2 * k + 1];
+        if (w->def.use_ccd && !ws_ccd_may_touch_at(&w->bodies, w->cur, i, j, w->def.contact_margin)) {
+            w->stats.body_pairs_gated++;
+            continue;
+        }
+        w->stats.body_pairs_tested++;
+        if (ws_contact_candidates(mem, x, i, j, &w->cand[nxt], &w->ncand[nxt], &w->capcand[nxt]) !=
+            0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+    }
+    ws_contact_sort(w->cand[nxt], w->ncand[nxt]);
+    ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[w->cur], w->ncand[w->cur]);
+    return WS_OK;
+}
+
+static const char *body_label(const ws_world *w, size_t i)
+{
+    return w->bodies.name[i] ? w->bodies.name[i] : "(unnamed)";
+}
+
+static ws_status health(ws_world *w, int nxt)
+{
+    const ws_body_store *b = &w->bodies;
+    const ws_body_state *n = &b->st[nxt];
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+            continue;
+        double sp = v3_norm(n->v[i]), om = v3_norm(n->w[i]);
+        int finite = ws_is_finite3(&n->r[i]) && isfinite(sp) && isfinite(om) &&
+                     isfinite(qt_norm(n->p[i]));
+        if (finite && sp <= w->def.max_speed && om <= w->def.max_angular_speed)
+            continue;
+        w->stats.numerical_errors++;
+        double dts = ws_world_stable_dt(w);
+        const char *what = !finite ? "its state became NaN or infinite"
+                           : sp > w->def.max_speed ? "it ran away (speed above max_speed)"
+                                                   : "it ran away (spin above max_angular_speed)";
+        return ws_fail(w, WS_ERR_NUMERICAL,
+                       "step at t = %.6g s: body '%s' (index %zu): %s; speed %.3g m/s, spin "
+                       "%.3g rad/s. The step was undone. dt = %.3g s; the explicit limit for the "
+                       "stiffest contact on the lightest body is about %.3g s: reduce dt (or the "
+                       "contact stiffness, or raise the mass).",
+                       w->time, body_label(w, i), i, what, sp, om, w->def.dt, dts);
+    }
+    return WS_OK;
+}
+
+ws_status ws_world_step(ws_world *w)
+{
+    if (!w)
+        return WS_ERR_INVALID_ARGUMENT;
+    ws_body_store *b = &w->bodies;
+    const int cur = w->cur, nxt = cur ^ 1;
+    const double dt = w->def.dt, t = w->time;
+
+    prepare(w);
+
+    ws_contact_ctx x = {b, cur, w->def.contact_margin, w->params, w->pair_index,
+                        (uint32_t)w->pair_dim, 0};
+    int full = !w->cand_valid || t < w->def.full_detection_until ||
+               w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval;
+    ws_status s;
+    if (full) {
+        if ((s = detect_full(w, &x, nxt)) != WS_OK)
+            return s;
+    } else {
+        if (ws_array_reserve(&w->mem, (void **)&w->cand[nxt], &w->capcand[nxt], w->ncand[cur],
+                             sizeof *w->cand[nxt]) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+        if (w->ncand[cur])
+            memcpy(w->cand[nxt], w->cand[cur], w->ncand[cur] * sizeof *w->cand[nxt]);
+        w->ncand[nxt] = w->ncand[cur];
+    }
+    /* Every candidate can be one contact: reserve now so evaluation cannot fail half-way. */
+    if (ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
+                         sizeof *w->rec[nxt]) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact records");
+
+    size_t nrec = 0;
+    for (size_t k = 0; k < w->ncand[nxt]; k++)
+        if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
+            nrec++;
+
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
+            continue;
+        if (b->type[i] == WS_BODY_DYNAMIC) {
+            if (w->def.integrator == WS_INTEGRATOR_PAPER_EXPLICIT)
+                ws_body_integrate_paper(b, i, cur, nxt, dt);
+            else
+                ws_body_integrate_symplectic(b, i, cur, nxt, dt);
+            continue;
+        }
+        ws_body_state *n = &b->st[nxt];
+        if (!b->has_drive[i]) {
+            n->r[i] = b->st[cur].r[i];
+            n->p[i] = b->st[cur].p[i];
+            n->v[i] = v3_make(0, 0, 0);
+            n->w[i] = v3_make(0, 0, 0);
+            continue;
+        }
+        ws_pose pose;
+        v3 v, om;
+        if (ws_drive_eval(&b->drive[i], t + dt, &pose, &v, &om) != 0)
+            return ws_fail(w, WS_ERR_CALLBACK,
+                           "step at t = %.6g s: the drive of body '%s' (index %zu) failed or gave "
+                           "a non-finite pose; the step was undone",
+                           t, body_label(w, i), i);
+        m3 A = qt_to_m3(pose.orientation);
+        n->r[i] = pose.position;
+        n->p[i] = pose.orientation;
+        n->v[i] = v;
+        n->w[i] = m3_tmul_v(&A, om);
+    }
+
+    w->stats.narrow_checks += x.narrow_checks;
+    if ((s = health(w, nxt)) != WS_OK)
+        return s;
+
+    /* Commit. */
+    w->nrec[nxt] = nrec;
+    w->cur = nxt;
+    w->time = t + dt;
+    if (full) {
+        w->last_full_step = w->steps;
+        w->cand_valid = 1;
+        w->stats.full_detections++;
+    }
+    w->steps++;
+    return WS_OK;
+}
+
+ws_status ws_world_step_n(ws_world *w, int64_t steps)
+{
+    if (!w)
+        return WS_ERR_INVALID_ARGUMENT;
+    if (steps < 0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_step_n: steps must be >= 0, got %lld",
+                       (long long)steps);
+    for (int64_t k = 0; k < steps; k++) {
+        ws_status s = ws_world_step(w);
+        if (s != WS_OK)
+            return s;
+    }
+    return WS_OK;
+}
