@@ -1,0 +1,424 @@
+/*
+ * tilt_table.c: the reference case of the source paper, unwrapped.
+ *
+ * Two cubes (a = 0.25 m, 5 kg each) stacked on a plane. The plane is static for 1 s, then tilts
+ * at 0.1 rad/s about a horizontal axis. Friction box-box and box-plane mu = 0.3, so theory says
+ * the boxes start to slide at tan(theta) = 0.3, theta = 16.70 deg, t = 3.915 s.
+ *   Variant P (paper): as above, 6 s.
+ *   Variant R (reference): plus a stop bar (20 mm x 20 mm) on the plane along the downhill face
+ *   of the bottom box, 7 s. The top box slides off at 16.70 deg; the bottom box rests on the stop.
+ *
+ * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
+ * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] [--no-ccd]
+ *                      [--paper-integrator] [--duration S] [--quiet]
+ *
+ * Copy this file as the start of your own load: build the scene in tilt_build(), read results
+ * in tilt_run(). Compile with -DTILT_TABLE_NO_MAIN to use the two functions from another file.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <wrapsim/wrapsim.h>
+
+#define TILT_PI 3.14159265358979323846
+#define DEG(x) ((x) * 180.0 / TILT_PI)
+
+typedef struct tilt_options {
+    char variant;         /* 'P' or 'R' */
+    int stick;            /* 1: stick friction model instead of the paper's regularised law */
+    int use_ccd;          /* 1: libccd gate (when built in) */
+    int paper_integrator; /* 1: the paper's explicit scheme */
+    double duration;      /* s; 0 = 6 s for P, 7 s for R */
+    const char *csv;      /* time series file, or NULL */
+    const char *vtk_dir;  /* directory for VTK frames, or NULL */
+    int quiet;            /* no progress, no summary */
+} tilt_options;
+
+typedef struct tilt_scene {
+    ws_world *world;
+    ws_body_id plane, stop, box[2]; /* box[0] bottom, box[1] top; stop is null in variant P */
+    double dt, duration, vlim;
+} tilt_scene;
+
+typedef struct tilt_result {
+    ws_status status;
+    char error[512];
+    long steps;
+    double wall_seconds;
+    double slide_time[2], slide_angle[2]; /* s, deg: onset of gross slip that lasted 10 ms;
+                                              NaN when it never slid */
+    int slide_confirmed[2];
+    double tip_time[2], tip_angle[2];     /* first time a box leans > 2 deg on its support */
+    double final_slip[2];                 /* m along the platform, downhill positive */
+    double cog_distance_start, cog_distance_end; /* m */
+    double final_angle;                   /* plane angle at the end, deg */
+    uint64_t hash;
+} tilt_result;
+
+static void tilt_default_options(tilt_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->variant = 'R';
+    o->use_ccd = 1;
+}
+
+/* Build the reference case. Returns WS_OK or the first error (the world is then destroyed). */
+static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
+{
+    const double a = 0.25, m = 5.0, layer = 1e-3, gap = 2 * layer;
+    memset(sc, 0, sizeof *sc);
+    sc->dt = 2.5e-4;
+    sc->duration = o->duration > 0 ? o->duration : (o->variant == 'P' ? 6.0 : 7.0);
+    sc->vlim = 0.01;
+
+    ws_world_def wd;
+    ws_world_def_init(&wd);
+    wd.dt = sc->dt;
+    wd.full_detection_until = 0.5; /* full detection every step for 0.5 s ... */
+    wd.detection_interval = 5;     /* ... then every 5th step */
+    wd.use_ccd = o->use_ccd;
+    wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
+                                        : WS_INTEGRATOR_SYMPLECTIC_EULER;
+    ws_status s = ws_world_create(&wd, &sc->world);
+    if (s != WS_OK)
+        return s;
+    ws_world *w = sc->world;
+
+    /* Materials and the contact parameters of each pair. */
+    ws_material_def md;
+    ws_material_id box_mat, plane_mat;
+    ws_material_def_init(&md);
+    md.name = "cardboard";
+    if ((s = ws_material_create(w, &md, &box_mat)) != WS_OK)
+        goto fail;
+    md.name = "platform";
+    if ((s = ws_material_create(w, &md, &plane_mat)) != WS_OK)
+        goto fail;
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 2e5;  /* N/m */
+    cd.damping = 10.0;   /* kg/s */
+    cd.friction = 0.3;
+    cd.friction_vlim = sc->vlim;
+    cd.friction_model = o->stick ? WS_FRICTION_STICK : WS_FRICTION_REGULARIZED;
+    /* Stick model: the anchor spring is a numerical device; damp it near critically for a 5 kg
+     * box on 4 corners (c_t ~ sqrt(k_t m) / 4) so it does not ring when contacts come and go. */
+    cd.stick_stiffness = 2e5;
+    cd.stick_damping = 250.0;
+    if ((s = ws_world_set_contact(w, box_mat, box_mat, &cd)) != WS_OK ||
+        (s = ws_world_set_contact(w, box_mat, plane_mat, &cd)) != WS_OK)
+        goto fail;
+
+    /* The platform: a kinematic slab whose top face is z = 0, tilting about the y axis through
+     * the origin. A positive rate lowers +x: downhill is +x. */
+    ws_shape_id slab, cube, bar;
+    if ((s = ws_shape_create_box(w, 1.5, 1.5, 0.05, &slab)) != WS_OK ||
+        (s = ws_shape_create_box(w, a, a, a, &cube)) != WS_OK ||
+        (s = ws_shape_create_box(w, 0.02, 0.5, 0.02, &bar)) != WS_OK)
+        goto fail;
+    ws_drive_def tilt;
+    ws_drive_def_init(&tilt);
+    tilt.type = WS_DRIVE_TILT;
+    tilt.axis = (ws_vec3){0, 1, 0};
+    tilt.point = (ws_vec3){0, 0, 0};
+    tilt.start_time = 1.0;
+    tilt.rate = 0.1; /* rad/s */
+
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = slab;
+    bd.material = plane_mat;
+    bd.contact_layer = layer;
+    bd.position = (ws_vec3){0, 0, -0.025};
+    bd.name = "platform";
+    if ((s = ws_body_create(w, &bd, &sc->plane)) != WS_OK ||
+        (s = ws_body_set_drive(w, sc->plane, &tilt)) != WS_OK)
+        goto fail;
+    if (o->variant == 'R') {
+        /* The stop: 20 mm high, 20 mm thick, its uphill face one layer gap from the box. */
+        bd.shape = bar;
+        bd.position = (ws_vec3){a / 2 + gap + 0.01, 0, 0.01};
+        bd.name = "stop";
+        if ((s = ws_body_create(w, &bd, &sc->stop)) != WS_OK ||
+            (s = ws_body_set_drive(w, sc->stop, &tilt)) != WS_OK)
+            goto fail;
+    }
+
+    /* The boxes, placed with their layers just touching; they settle in the first second. */
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.material = box_mat;
+    bd.mass = m; /* inertia from the shape: m a^2 / 6 */
+    bd.contact_layer = layer;
+    bd.position = (ws_vec3){0, 0, gap + a / 2};
+    bd.name = "bottom";
+    if ((s = ws_body_create(w, &bd, &sc->box[0])) != WS_OK)
+        goto fail;
+    bd.position = (ws_vec3){0, 0, gap + a + gap + a / 2};
+    bd.name = "top";
+    if ((s = ws_body_create(w, &bd, &sc->box[1])) != WS_OK)
+        goto fail;
+    return WS_OK;
+fail:
+    ws_world_destroy(w);
+    sc->world = NULL;
+    return s;
+}
+
+/* Plane angle about y from its Euler parameters. */
+static double plane_angle(ws_world *w, ws_body_id plane)
+{
+    ws_quat q;
+    ws_body_get_orientation(w, plane, &q);
+    return 2.0 * atan2(q.e2, q.e0);
+}
+
+/* Position of a point in the plane's frame (x downhill along the platform). */
+static ws_vec3 in_plane_frame(ws_world *w, ws_body_id plane, ws_vec3 p)
+{
+    ws_vec3 r;
+    ws_mat3 A;
+    ws_body_get_position(w, plane, &r);
+    ws_body_get_rotation(w, plane, &A);
+    ws_vec3 d = {p.x - r.x, p.y - r.y, p.z - r.z};
+    ws_vec3 s = {A.m[0] * d.x + A.m[3] * d.y + A.m[6] * d.z,
+                 A.m[1] * d.x + A.m[4] * d.y + A.m[7] * d.z,
+                 A.m[2] * d.x + A.m[5] * d.y + A.m[8] * d.z};
+    return s;
+}
+
+/* Angle (rad) of the rotation between two bodies. */
+static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
+{
+    ws_quat p, q;
+    ws_body_get_orientation(w, a, &p);
+    ws_body_get_orientation(w, b, &q);
+    double dot = p.e0 * q.e0 + p.e1 * q.e1 + p.e2 * q.e2 + p.e3 * q.e3;
+    return 2.0 * acos(fmin(1.0, fabs(dot)));
+}
+
+/* Gross slip of body b on its support: 1 when every contact between them slips (tangential
+ * speed at or above v_lim under the regularised law, anchor sliding under the stick law), from the
+ * contact reports. */
+static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *buf, size_t n)
+{
+    int count = 0, slipping = 0;
+    for (size_t k = 0; k < n; k++) {
+        const ws_contact_info *c = &buf[k];
+        if ((c->body_a.bits == support.bits && c->body_b.bits == b.bits) ||
+            (c->body_a.bits == b.bits && c->body_b.bits == support.bits)) {
+            count++;
+            slipping += c->slipping != 0;
+        }
+    }
+    return count > 0 && slipping == count;
+}
+
+static double distance(ws_world *w, ws_body_id a, ws_body_id b)
+{
+    ws_vec3 p, q;
+    ws_body_get_position(w, a, &p);
+    ws_body_get_position(w, b, &q);
+    return sqrt((p.x - q.x) * (p.x - q.x) + (p.y - q.y) * (p.y - q.y) + (p.z - q.z) * (p.z - q.z));
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Run the case and fill the result. Returns the last status (WS_OK when it ran to the end). */
+static ws_status tilt_run(const tilt_options *o, tilt_result *res)
+{
+    memset(res, 0, sizeof *res);
+    for (int k = 0; k < 2; k++)
+        res->slide_time[k] = res->slide_angle[k] = res->tip_time[k] = res->tip_angle[k] = NAN;
+    tilt_scene sc;
+    ws_status s = tilt_build(o, &sc);
+    if (s != WS_OK) {
+        snprintf(res->error, sizeof res->error, "building the scene: %s", ws_status_string(s));
+        return res->status = s;
+    }
+    ws_world *w = sc.world;
+    FILE *csv = NULL;
+    ws_vtk_series *vtk = NULL;
+    if (o->csv && !(csv = fopen(o->csv, "w"))) {
+        snprintf(res->error, sizeof res->error, "cannot write %s", o->csv);
+        ws_world_destroy(w);
+        return res->status = WS_ERR_IO;
+    }
+    if (csv)
+        fprintf(csv, "t,plane_angle_deg,"
+                     "bottom_x,bottom_y,bottom_z,bottom_vx,bottom_vy,bottom_vz,bottom_tilt_deg,"
+                     "bottom_slip,top_x,top_y,top_z,top_vx,top_vy,top_vz,top_tilt_deg,top_slip,"
+                     "cog_distance\n");
+    if (o->vtk_dir && (s = ws_vtk_series_create(w, o->vtk_dir, "tilt_table", &vtk)) != WS_OK) {
+        snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
+        if (csv)
+            fclose(csv);
+        ws_world_destroy(w);
+        return res->status = s;
+    }
+
+    long steps = lround(sc.duration / sc.dt);
+    long csv_every = lround(0.01 / sc.dt), vtk_every = lround(0.05 / sc.dt);
+    ws_vec3 start[2];
+    for (int k = 0; k < 2; k++) {
+        ws_vec3 r;
+        ws_body_get_position(w, sc.box[k], &r);
+        start[k] = in_plane_frame(w, sc.plane, r);
+    }
+    res->cog_distance_start = distance(w, sc.box[0], sc.box[1]);
+    double t0 = now(), next_report = t0 + 1.0;
+    ws_body_id support[2] = {sc.plane, sc.box[0]};
+    ws_contact_info contacts[256];
+    long slipping_steps[2] = {0, 0};
+    const long sustained = lround(0.01 / sc.dt); /* gross slip must last 10 ms */
+    for (long n = 0; n <= steps; n++) {
+        double t, theta = plane_angle(w, sc.plane);
+        ws_world_get_time(w, &t);
+        double slip[2], tilt[2];
+        size_t nc = 0;
+        ws_world_copy_contacts(w, contacts, 256, &nc); /* the first 256 are plenty here */
+        if (nc > 256)
+            nc = 256;
+        ws_vec3 r[2], v[2];
+        for (int k = 0; k < 2; k++) {
+            ws_body_get_position(w, sc.box[k], &r[k]);
+            ws_body_get_velocity(w, sc.box[k], &v[k]);
+            slip[k] = in_plane_frame(w, sc.plane, r[k]).x - start[k].x;
+            tilt[k] = relative_tilt(w, sc.box[k], support[k]);
+            /* Sliding: every contact with its support slips, for 10 ms in a row. */
+            slipping_steps[k] = slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
+            if (isnan(res->slide_time[k]) && t > 1.0 && slipping_steps[k] == 1)
+                res->slide_time[k] = t, res->slide_angle[k] = DEG(theta); /* candidate onset */
+            if (isnan(res->slide_angle[k]) == 0 && slipping_steps[k] == 0 &&
+                !res->slide_confirmed[k])
+                res->slide_time[k] = res->slide_angle[k] = NAN; /* it did not last */
+            if (slipping_steps[k] >= sustained)
+                res->slide_confirmed[k] = 1;
+            if (isnan(res->tip_time[k]) && tilt[k] > 2.0 * TILT_PI / 180) {
+                res->tip_time[k] = t;
+                res->tip_angle[k] = DEG(theta);
+            }
+        }
+        if (csv && n % csv_every == 0)
+            fprintf(csv, "%.4f,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,"
+                         "%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f\n",
+                    t, DEG(theta), r[0].x, r[0].y, r[0].z, v[0].x, v[0].y, v[0].z, DEG(tilt[0]),
+                    slip[0], r[1].x, r[1].y, r[1].z, v[1].x, v[1].y, v[1].z, DEG(tilt[1]),
+                    slip[1], distance(w, sc.box[0], sc.box[1]));
+        if (vtk && n % vtk_every == 0 && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
+            break;
+        if (n == steps) {
+            res->final_slip[0] = slip[0];
+            res->final_slip[1] = slip[1];
+            res->final_angle = DEG(theta);
+            break;
+        }
+        if ((s = ws_world_step(w)) != WS_OK)
+            break;
+        res->steps++;
+        if (!o->quiet && now() > next_report) {
+            fprintf(stderr, "\r  t = %.2f s of %.2f s", t, sc.duration);
+            next_report = now() + 0.5;
+        }
+    }
+    res->wall_seconds = now() - t0;
+    if (!o->quiet && res->wall_seconds > 1.0)
+        fprintf(stderr, "\r  t = %.2f s of %.2f s: done\n", sc.duration, sc.duration);
+    res->cog_distance_end = distance(w, sc.box[0], sc.box[1]);
+    ws_world_get_state_hash(w, &res->hash);
+    if (s != WS_OK)
+        snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
+    res->status = s;
+    ws_vtk_series_destroy(vtk);
+    if (csv)
+        fclose(csv);
+    ws_world_destroy(w);
+    return s;
+}
+
+#ifndef TILT_TABLE_NO_MAIN
+static void usage(void)
+{
+    fprintf(stderr, "usage: tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] "
+                    "[--no-ccd] [--paper-integrator] [--duration S] [--quiet]\n");
+}
+
+static void print_box(const char *name, const tilt_result *r, int k)
+{
+    if (isnan(r->slide_time[k]))
+        printf("  %-6s box: did not slide on its support\n", name);
+    else
+        printf("  %-6s box: starts to slide at %.2f deg (t = %.3f s)\n", name, r->slide_angle[k],
+               r->slide_time[k]);
+    if (!isnan(r->tip_time[k]))
+        printf("  %-6s box: leans > 2 deg on its support from %.2f deg (t = %.3f s)\n", name,
+               r->tip_angle[k], r->tip_time[k]);
+    printf("  %-6s box: slip along the platform at the end %.1f mm\n", name,
+           1e3 * r->final_slip[k]);
+}
+
+int main(int argc, char **argv)
+{
+    tilt_options o;
+    tilt_default_options(&o);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--variant") && i + 1 < argc) {
+            o.variant = (char)(argv[++i][0] & ~0x20); /* upper case */
+            if (o.variant != 'P' && o.variant != 'R')
+                return usage(), 2;
+        } else if (!strcmp(a, "--stick")) {
+            o.stick = 1;
+        } else if (!strcmp(a, "--no-ccd")) {
+            o.use_ccd = 0;
+        } else if (!strcmp(a, "--paper-integrator")) {
+            o.paper_integrator = 1;
+        } else if (!strcmp(a, "--csv") && i + 1 < argc) {
+            o.csv = argv[++i];
+        } else if (!strcmp(a, "--vtk") && i + 1 < argc) {
+            o.vtk_dir = argv[++i];
+        } else if (!strcmp(a, "--duration") && i + 1 < argc) {
+            o.duration = atof(argv[++i]);
+        } else if (!strcmp(a, "--quiet")) {
+            o.quiet = 1;
+        } else {
+            return usage(), 2;
+        }
+    }
+    double theory = DEG(atan(0.3));
+    if (!o.quiet)
+        printf("libwrapsim %s - tilt table, variant %c, unwrapped, %s friction\n"
+               "  theory: sliding starts at tan(theta) = mu = 0.3, theta = %.2f deg, t = %.3f s\n",
+               ws_version_string(), o.variant, o.stick ? "stick" : "regularised (paper)", theory,
+               1.0 + atan(0.3) / 0.1);
+    tilt_result r;
+    ws_status s = tilt_run(&o, &r);
+    if (s != WS_OK) {
+        fprintf(stderr, "tilt_table: %s\n  %s\n", ws_status_string(s), r.error);
+        return 1;
+    }
+    if (!o.quiet) {
+        print_box("bottom", &r, 0);
+        print_box("top", &r, 1);
+        printf("  distance between the CoGs: %.1f mm at the start, %.1f mm at the end\n",
+               1e3 * r.cog_distance_start, 1e3 * r.cog_distance_end);
+        printf("  plane angle at the end %.2f deg; %ld steps in %.3f s (%.0f steps/s)\n",
+               r.final_angle, r.steps, r.wall_seconds, r.steps / r.wall_seconds);
+        if (o.csv)
+            printf("  time series: %s\n", o.csv);
+        if (o.vtk_dir)
+            printf("  VTK frames: %s/tilt_table.pvd (open in ParaView)\n", o.vtk_dir);
+    }
+    return 0;
+}
+#endif

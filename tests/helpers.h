@@ -1,0 +1,133 @@
+/* Shared helpers of the Check suites: scene builders, a counting/failing allocator, runner. */
+#ifndef WS_TEST_HELPERS_H
+#define WS_TEST_HELPERS_H
+
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <wrapsim/wrapsim.h>
+
+#define G0 9.81
+
+/* Assert a status with the world's last error in the message. */
+#define ck_ok(w, call)                                                                            \
+    do {                                                                                          \
+        ws_status s_ = (call);                                                                    \
+        ck_assert_msg(s_ == WS_OK, "%s -> %s (%s)", #call, ws_status_string(s_),                  \
+                      ws_world_last_error(w));                                                    \
+    } while (0)
+
+/* A counting allocator that can be told to fail after N allocations. */
+typedef struct test_alloc {
+    long allocs_left; /* < 0: never fail */
+    long live;        /* blocks alive */
+    long long bytes;  /* bytes alive by the sizes the library reports */
+} test_alloc;
+
+static inline void *ta_alloc(void *u, size_t n)
+{
+    test_alloc *a = u;
+    if (a->allocs_left == 0)
+        return NULL;
+    if (a->allocs_left > 0)
+        a->allocs_left--;
+    void *p = malloc(n);
+    if (p) {
+        a->live++;
+        a->bytes += (long long)n;
+    }
+    return p;
+}
+static inline void *ta_realloc(void *u, void *p, size_t o, size_t n)
+{
+    test_alloc *a = u;
+    if (a->allocs_left == 0)
+        return NULL;
+    if (a->allocs_left > 0)
+        a->allocs_left--;
+    void *q = realloc(p, n);
+    if (q)
+        a->bytes += (long long)n - (long long)o;
+    return q;
+}
+static inline void ta_free(void *u, void *p, size_t n)
+{
+    test_alloc *a = u;
+    if (p) {
+        a->live--;
+        a->bytes -= (long long)n;
+    }
+    free(p);
+}
+static inline void test_alloc_install(ws_world_def *d, test_alloc *a)
+{
+    d->allocator.alloc = ta_alloc;
+    d->allocator.realloc = ta_realloc;
+    d->allocator.free = ta_free;
+    d->allocator.user = a;
+}
+
+static inline ws_world *new_world(double dt)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = dt;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    return w;
+}
+
+/* A static (kinematic) box whose top face is the plane z = 0, large in x and y. */
+static inline ws_body_id add_ground(ws_world *w, double half, ws_material_id mat)
+{
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, 2 * half, 2 * half, 0.05, &s));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = s;
+    bd.material = mat;
+    bd.position.z = -0.025;
+    bd.name = "ground";
+    ws_body_id id;
+    ck_ok(w, ws_body_create(w, &bd, &id));
+    return id;
+}
+
+/* A dynamic box of edge lengths lx, ly, lz and mass m with its bottom face at height z0. */
+static inline ws_body_id add_box(ws_world *w, double lx, double ly, double lz, double m,
+                                 ws_vec3 centre, ws_material_id mat, const char *name)
+{
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, lx, ly, lz, &s));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = s;
+    bd.mass = m;
+    bd.position = centre;
+    bd.material = mat;
+    bd.name = name;
+    ws_body_id id;
+    ck_ok(w, ws_body_create(w, &bd, &id));
+    return id;
+}
+
+static inline ws_material_id no_material(void)
+{
+    ws_material_id m = {0};
+    return m;
+}
+
+/* Run the suite; CK_FORK=no is honoured (valgrind). Returns the process exit code. */
+static inline int run_suite(Suite *s)
+{
+    SRunner *r = srunner_create(s);
+    srunner_run_all(r, CK_NORMAL);
+    int failed = srunner_ntests_failed(r);
+    srunner_free(r);
+    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
+#endif

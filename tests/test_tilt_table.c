@@ -1,0 +1,106 @@
+/* The reference case (DESIGN.md), unwrapped, run through the example program's own code so the
+ * template users copy is what is validated.
+ *
+ * Theory: a block on a plane tilting slowly starts to slide when tan(theta) = mu = 0.3, i.e.
+ * theta_c = 16.699 deg (t = 1 + 0.2915/0.1 = 3.915 s). Tolerance 0.3 deg (the issue's): the
+ * regularised law creeps and reaches v_lim exactly at theta_c in the quasi-static limit; what
+ * remains is the dynamic lag of a 5 kg box starting to slip while the plane turns at 0.1 rad/s
+ * (measured ~0.15 deg), and the 10 ms the example requires gross slip to last (0.06 deg). */
+#define TILT_TABLE_NO_MAIN
+#include "../examples/tilt_table.c"
+
+#include "helpers.h"
+
+static const double theta_c = 16.699244233993621; /* atan(0.3) in degrees */
+
+static void run(char variant, int stick, int use_ccd, tilt_result *r)
+{
+    tilt_options o;
+    tilt_default_options(&o);
+    o.variant = variant;
+    o.stick = stick;
+    o.use_ccd = use_ccd;
+    o.quiet = 1;
+    ws_status s = tilt_run(&o, r);
+    ck_assert_msg(s == WS_OK, "tilt_run: %s: %s", ws_status_string(s), r->error);
+}
+
+START_TEST(variant_r_unwrapped_regularised)
+{
+    tilt_result r;
+    run('R', 0, 1, &r);
+    ck_assert_msg(fabs(r.slide_angle[1] - theta_c) < 0.3, "top box slid at %.3f deg, theory %.3f",
+                  r.slide_angle[1], theta_c);
+    /* The bottom box rests on the stop: no gross slip, and it moves less than a layer (2 mm). */
+    ck_assert_msg(isnan(r.slide_angle[0]), "bottom box slid at %.3f deg", r.slide_angle[0]);
+    ck_assert_msg(fabs(r.final_slip[0]) < 2e-3, "bottom slip %.4f m", r.final_slip[0]);
+    /* The top box leaves the bottom one: it slid off by more than its own width. */
+    ck_assert_msg(r.final_slip[1] > 0.25, "top slip %.4f m", r.final_slip[1]);
+}
+END_TEST
+
+START_TEST(variant_r_unwrapped_stick)
+{
+    tilt_result r;
+    run('R', 1, 1, &r);
+    ck_assert_msg(fabs(r.slide_angle[1] - theta_c) < 0.3, "top box slid at %.3f deg, theory %.3f",
+                  r.slide_angle[1], theta_c);
+    ck_assert_msg(isnan(r.slide_angle[0]), "bottom box slid at %.3f deg", r.slide_angle[0]);
+}
+END_TEST
+
+START_TEST(variant_p_unwrapped)
+{
+    /* Same mu on both interfaces: both boxes start to slide at theta_c (P says little about film:
+     * the stack slides as one, see DESIGN.md). */
+    tilt_result r;
+    run('P', 0, 1, &r);
+    for (int k = 0; k < 2; k++)
+        ck_assert_msg(fabs(r.slide_angle[k] - theta_c) < 0.3, "box %d slid at %.3f deg", k,
+                      r.slide_angle[k]);
+}
+END_TEST
+
+START_TEST(creep_before_slip_is_small)
+{
+    /* The regularised law creeps below v_lim: the top box moves a few mm before theta_c; before
+     * the tilt ramp begins (flat, t < 0.975 s) it must not slide: only settling moves it, by far
+     * less than 1e-5 m along the plane (a 10 um tolerance, 100x the settling overlap change). */
+    tilt_options o;
+    tilt_default_options(&o);
+    o.quiet = 1;
+    o.duration = 3.9; /* theta = 16.6 deg, just before theta_c */
+    tilt_result r;
+    ck_assert_int_eq(tilt_run(&o, &r), WS_OK);
+    ck_assert_msg(r.final_slip[1] > 1e-3 && r.final_slip[1] < 2e-2,
+                  "creep of the top box before theta_c: %.4f m", r.final_slip[1]);
+    o.duration = 0.9;
+    ck_assert_int_eq(tilt_run(&o, &r), WS_OK);
+    ck_assert_msg(fabs(r.final_slip[1]) < 1e-5, "drift on the flat plane %.2e m", r.final_slip[1]);
+}
+END_TEST
+
+START_TEST(same_result_with_and_without_ccd)
+{
+    if (!(ws_build_features() & WS_FEATURE_CCD))
+        return; /* nothing to compare in a build without libccd */
+    tilt_result a, b;
+    run('R', 0, 1, &a);
+    run('R', 0, 0, &b);
+    ck_assert_msg(a.hash == b.hash, "state hash differs with and without the libccd gate");
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("tilt_table");
+    TCase *tc = tcase_create("reference_case");
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, variant_r_unwrapped_regularised);
+    tcase_add_test(tc, variant_r_unwrapped_stick);
+    tcase_add_test(tc, variant_p_unwrapped);
+    tcase_add_test(tc, creep_before_slip_is_small);
+    tcase_add_test(tc, same_result_with_and_without_ccd);
+    suite_add_tcase(s, tc);
+    return run_suite(s);
+}
