@@ -91,6 +91,33 @@ START_TEST(same_result_with_and_without_ccd)
 }
 END_TEST
 
+START_TEST(steady_state_steps_allocate_nothing)
+{
+    /* Buffers grow while the contact set grows, then stay: after warm-up a step must make no
+     * call to the allocator (STYLE.md: no heap allocation inside a step). */
+    test_alloc ta = {1000000000L, 0, 0};
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.full_detection_until = 0.1;
+    d.detection_interval = 5;
+    test_alloc_install(&d, &ta);
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    add_ground(w, 1.0, no_material());
+    ws_vec3 c = {0, 0, 0.127};
+    add_box(w, 0.25, 0.25, 0.25, 5.0, c, no_material(), "bottom");
+    c.z = 0.381;
+    add_box(w, 0.25, 0.25, 0.25, 5.0, c, no_material(), "top");
+    ck_ok(w, ws_world_step_n(w, 2000));
+    long before = ta.allocs_left;
+    ck_ok(w, ws_world_step_n(w, 10000));
+    ck_assert_msg(ta.allocs_left == before, "%ld allocator calls in 10000 steady steps",
+                  before - ta.allocs_left);
+    ws_world_destroy(w);
+    ck_assert_int_eq(ta.live, 0);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("tilt_table");
@@ -101,6 +128,7 @@ int main(void)
     tcase_add_test(tc, variant_p_unwrapped);
     tcase_add_test(tc, creep_before_slip_is_small);
     tcase_add_test(tc, same_result_with_and_without_ccd);
+    tcase_add_test(tc, steady_state_steps_allocate_nothing);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }
