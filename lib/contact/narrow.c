@@ -77,6 +77,19 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     return 1;
 }
 
+/* A point inside the solid (d < 0 under face f) is pushed out by one face only: the one it is
+ * least deep under among the faces it projects into. Otherwise a deep corner would be pushed
+ * sideways out of a near side face as well as up out of the face it came through. */
+static int shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d)
+{
+    for (uint32_t g = 0; g < sa->face_count; g++) {
+        double e;
+        if (g != f && ws_point_in_face(sa, g, s, d, 0.0, &e) && e > d)
+            return 0;
+    }
+    return 1;
+}
+
 /* Relative transform of b into a's frame: s_a = R s_b + t. */
 static void relative(const ws_body_store *b, int cur, uint32_t ia, uint32_t ib, m3 *R, v3 *t)
 {
@@ -126,7 +139,10 @@ static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb
             const ws_face *fc = &sa->faces[f];
             x->narrow_checks++;
             double d = v3_dot(fc->normal, s) - fc->offset;
-            if (d > -reach && d < reach && inside_box(s, fc->lo, fc->hi, reach))
+            /* The face box is flat: inflate it by the inner depth too, or a deep point fails
+             * here before the deep window can see it. */
+            if (d > -reach - sa->inner && d < reach &&
+                inside_box(s, fc->lo, fc->hi, reach + sa->inner))
                 if (push(mem, cand, n, cap, pa, pb, f, k, WS_CONTACT_POINT_FACE) != 0)
                     return -1;
         }
@@ -154,6 +170,10 @@ static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib,
         double lj = v3_norm(v3_sub(qj, pj));
         for (uint32_t ea = 0; ea < sa->edge_count; ea++) {
             const ws_edge *F = &sa->edges[ea];
+            /* Edge boxes first: most pairs are far apart. */
+            if (hi.x < F->lo.x - reach || lo.x > F->hi.x + reach || hi.y < F->lo.y - reach ||
+                lo.y > F->hi.y + reach || hi.z < F->lo.z - reach || lo.z > F->hi.z + reach)
+                continue;
             v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
             x->narrow_checks++;
             double li = v3_norm(v3_sub(qi, pi));
@@ -162,7 +182,7 @@ static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib,
             v3 nrm;
             if (edge_edge(pi, qi, F->n1, F->n2, pj, qj, v3_make(0, 0, 0), v3_make(0, 0, 0),
                           slack, 0, &s, &u, &nrm, &d) &&
-                fabs(d) < reach)
+                fabs(d) < reach + fmin(sa->inner, sb->inner))
                 if (push(mem, cand, n, cap, ia, ib, ea, eb, WS_CONTACT_EDGE_EDGE) != 0)
                     return -1;
         }
@@ -195,7 +215,9 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         v3 pg = v3_add(st->r[ib], m3_mul_v(Ab, sb->vertices[c->fb]));
         v3 s = m3_tmul_v(Aa, v3_sub(pg, st->r[ia]));
         double d;
-        if (!ws_point_in_face(sa, c->fa, s, -reach, reach, &d))
+        if (!ws_point_in_face(sa, c->fa, s, -reach - sa->inner, reach, &d))
+            return 0;
+        if (d < 0.0 && !shallowest_face(sa, c->fa, s, d))
             return 0;
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
         *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */
@@ -214,7 +236,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), 0.0,
                    1, &s, &u, &n, &d))
         return 0;
-    if (!(d > -reach && d < reach))
+    if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
         return 0;
     v3 xi = v3_madd(pi, v3_sub(qi, pi), s), xj = v3_madd(pj, v3_sub(qj, pj), u);
     v3 mid = v3_scale(v3_add(xi, xj), 0.5);
@@ -246,7 +268,8 @@ static int cand_qcmp(const void *p, const void *q)
 
 void ws_contact_sort(ws_cand *c, size_t n)
 {
-    qsort(c, n, sizeof *c, cand_qcmp);
+    if (n > 1) /* qsort must not see a NULL array, even with n = 0 */
+        qsort(c, n, sizeof *c, cand_qcmp);
 }
 
 void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, size_t n_old)

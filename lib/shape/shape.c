@@ -217,6 +217,7 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
     out->lo = v3_sub(lo, cg);
     out->hi = v3_sub(hi, cg);
     out->radius = 0.0;
+    out->inner = 0.25 * fmin(hi.x - lo.x, fmin(hi.y - lo.y, hi.z - lo.z));
     for (size_t i = 0; i < nv; i++) {
         out->vertices[i] = v3_sub(out->vertices[i], cg);
         out->radius = fmax(out->radius, v3_norm(out->vertices[i]));
@@ -304,6 +305,8 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         e->b = he[i].hi;
         e->n1 = tn[t0];
         e->n2 = tn[t1];
+        e->lo = v3_min(out->vertices[e->a], out->vertices[e->b]);
+        e->hi = v3_max(out->vertices[e->a], out->vertices[e->b]);
     }
 
     /* Triangles sorted by face, faces with their plane and box. */

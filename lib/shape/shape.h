@@ -30,6 +30,7 @@ typedef struct ws_face {
 typedef struct ws_edge {
     uint32_t a, b;
     v3 n1, n2;
+    v3 lo, hi; /* bounding box of the edge */
 } ws_edge;
 
 typedef struct ws_shape {
@@ -42,6 +43,8 @@ typedef struct ws_shape {
     ws_edge *edges;
     v3 lo, hi;       /* bounding box */
     double radius;   /* bounding sphere about the origin */
+    double inner;    /* how deep inside the solid a contact is still seen: 1/4 of the smallest
+                        extent of its box */
     double volume;
     m3 inertia_unit; /* about the centroid, density 1 */
     v3 centroid;     /* where the given vertices had their centroid */

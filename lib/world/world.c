@@ -16,10 +16,13 @@ static void vlog(const ws_world *w, ws_log_level level, const char *fmt, va_list
 ws_status ws_fail(const ws_world *w, ws_status s, const char *fmt, ...)
 {
     ws_world *mw = (ws_world *)w; /* the error text is the one thing a reading call writes */
+    /* Format into a copy first: callers may pass the previous message as an argument. */
+    char buf[WS_ERR_LEN];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(mw->err, sizeof mw->err, fmt, ap);
+    vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
+    memcpy(mw->err, buf, sizeof buf);
     if (w->def.log)
         w->def.log(w->def.log_user, WS_LOG_ERROR, mw->err);
     return s;
@@ -205,7 +208,8 @@ void ws_world_destroy(ws_world *w)
     ws_mem *m = &w->mem;
     ws_bodies_free(m, &w->bodies);
     ws_slots_destroy(m, &w->body_slots);
-    for (size_t i = 0; i < w->shape_slots.slot_count; i++) {
+    /* A slot may have been taken while growing the array failed: walk the array, not slots. */
+    for (size_t i = 0; i < w->shape_cap && i < w->shape_slots.slot_count; i++) {
         if (w->shapes[i]) {
             ws_shape_free(m, w->shapes[i]);
             ws_mem_free(m, w->shapes[i], sizeof *w->shapes[i]);
@@ -213,7 +217,7 @@ void ws_world_destroy(ws_world *w)
     }
     ws_mem_free(m, w->shapes, w->shape_cap * sizeof *w->shapes);
     ws_slots_destroy(m, &w->shape_slots);
-    for (size_t i = 0; i < w->mat_slots.slot_count; i++)
+    for (size_t i = 0; i < w->mat_cap && i < w->mat_slots.slot_count; i++)
         ws_mem_free_str(m, w->mat_name[i]);
     ws_mem_free(m, w->mat_name, w->mat_cap * sizeof *w->mat_name);
     ws_slots_destroy(m, &w->mat_slots);

@@ -21,6 +21,7 @@ struct ws_world {
     uint64_t steps;
     uint64_t last_full_step;
     int cand_valid; /* 0 forces a full detection on the next step */
+    double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
     char err[WS_ERR_LEN];
 

@@ -38,6 +38,23 @@ static void prepare(ws_world *w)
     }
 }
 
+/* Largest distance any body point moves in one step from state buffer k: (|v| + |omega| r) dt
+ * (|omega'| = |omega|). */
+static double max_step_travel(const ws_world *w, int k)
+{
+    const ws_body_store *b = &w->bodies;
+    const ws_body_state *st = &b->st[k];
+    double most = 0.0;
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
+            continue;
+        double s = v3_norm(st->v[i]) + v3_norm(st->w[i]) * b->shape[i]->radius;
+        if (s > most)
+            most = s;
+    }
+    return most * w->def.dt;
+}
+
 static ws_status detect_full(ws_world *w, ws_contact_ctx *x, int nxt)
 {
     ws_mem *mem = &w->mem;
@@ -105,8 +122,12 @@ ws_status ws_world_step(ws_world *w)
 
     ws_contact_ctx x = {b, cur, w->def.contact_margin, w->params, w->pair_index,
                         (uint32_t)w->pair_dim, 0};
+    /* Cached candidates hold every feature pair within the layers + margin at the last full
+     * detection. Two bodies can close that margin only if each has moved by half of it, so a
+     * full detection is forced early when the travel bound says so, whatever the interval. */
     int full = !w->cand_valid || t < w->def.full_detection_until ||
-               w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval;
+               w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval ||
+               2.0 * w->travel >= w->def.contact_margin;
     ws_status s;
     if (full) {
         if ((s = detect_full(w, &x, nxt)) != WS_OK)
@@ -151,8 +172,9 @@ ws_status ws_world_step(ws_world *w)
         v3 v, om;
         if (ws_drive_eval(&b->drive[i], t + dt, &pose, &v, &om) != 0)
             return ws_fail(w, WS_ERR_CALLBACK,
-                           "step at t = %.6g s: the drive of body '%s' (index %zu) failed or gave "
-                           "a non-finite pose; the step was undone",
+                           "step at t = %.6g s: the drive of body '%s' (index %zu) failed: its "
+                           "callback returned non-zero or gave a non-finite pose; the step was "
+                           "undone",
                            t, body_label(w, i), i);
         m3 A = qt_to_m3(pose.orientation);
         n->r[i] = pose.position;
@@ -173,7 +195,9 @@ ws_status ws_world_step(ws_world *w)
         w->last_full_step = w->steps;
         w->cand_valid = 1;
         w->stats.full_detections++;
+        w->travel = 0.0;
     }
+    w->travel += max_step_travel(w, w->cur); /* the step just taken moved with these speeds */
     w->steps++;
     return WS_OK;
 }

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Build libwrapsim from a fresh Debian machine and run the tilt-table example or every test.
+#
+#   tools/quickstart.sh example [ARGS...]   install, build, run build/examples/tilt_table ARGS
+#   tools/quickstart.sh test [ARGS...]      install, build, meson test ARGS; last line
+#                                           "N passed, N failed"
+#
+# The build directory is build/ (reconfigured when it exists). MESON_EXTRA adds options to
+# `meson setup`, e.g. MESON_EXTRA="-Dwerror=true -Dccd=disabled"; a reconfigured build keeps
+# the options it was given before unless they are given again.
+set -euo pipefail
+
+usage() {
+    awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "${BASH_SOURCE[0]}"
+    exit "${1:-2}"
+}
+
+(($# >= 1)) || usage
+mode=$1
+shift
+case $mode in
+example | test) ;;
+-h | --help) usage 0 ;;
+*) usage ;;
+esac
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+# shellcheck source=tools/count_tests.sh
+source tools/count_tests.sh
+# shellcheck source=tools/ensure_packages.sh
+source tools/ensure_packages.sh
+
+packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev)
+if [[ $mode == test ]]; then
+    packages+=(valgrind)
+fi
+ensure_packages "${packages[@]}"
+
+read -r -a extra <<<"${MESON_EXTRA:-}"
+if [[ -f build/meson-private/coredata.dat ]]; then
+    meson setup --reconfigure build "${extra[@]}"
+else
+    meson setup build "${extra[@]}"
+fi
+meson compile -C build
+
+if [[ $mode == example ]]; then
+    exe=build/examples/tilt_table
+    if [[ ! -x $exe ]]; then
+        echo "$exe was not built (is examples/tilt_table.c there?)" >&2
+        exit 1
+    fi
+    exec "$exe" "$@"
+fi
+
+log=build/meson-logs/testlog.json
+rm -f "$log"
+rc=0
+meson test -C build --print-errorlogs "$@" || rc=$?
+read -r passed failed skipped < <(count_testlog "$log")
+# meson test can fail without a test failing (a rebuild error): report that as one failure.
+if ((rc != 0 && failed == 0)); then
+    echo "meson test exited with status $rc" >&2
+    failed=1
+fi
+format_counts "$passed" "$failed" "$skipped"
+((failed == 0))
