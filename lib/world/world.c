@@ -210,7 +210,7 @@ void ws_world_destroy(ws_world *w)
     ws_slots_destroy(m, &w->body_slots);
     /* A slot may have been taken while growing the array failed: walk the array, not slots. */
     for (size_t i = 0; i < w->shape_cap && i < w->shape_slots.slot_count; i++) {
-        if (w->shapes[i]) {
+        if (w->shape_slots.dense[i] != UINT32_MAX && w->shapes[i]) {
             ws_shape_free(m, w->shapes[i]);
             ws_mem_free(m, w->shapes[i], sizeof *w->shapes[i]);
         }
@@ -218,7 +218,8 @@ void ws_world_destroy(ws_world *w)
     ws_mem_free(m, w->shapes, w->shape_cap * sizeof *w->shapes);
     ws_slots_destroy(m, &w->shape_slots);
     for (size_t i = 0; i < w->mat_cap && i < w->mat_slots.slot_count; i++)
-        ws_mem_free_str(m, w->mat_name[i]);
+        if (w->mat_slots.dense[i] != UINT32_MAX) /* only live slots have a name set */
+            ws_mem_free_str(m, w->mat_name[i]);
     ws_mem_free(m, w->mat_name, w->mat_cap * sizeof *w->mat_name);
     ws_slots_destroy(m, &w->mat_slots);
     ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);

@@ -91,9 +91,11 @@ static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint
         return ws_fail(w, st, "%s: %s", fn, why);
     }
     uint32_t slot;
-    if (ws_slots_take(&w->mem, &w->shape_slots, &slot) != 0 ||
-        ws_array_reserve(&w->mem, (void **)&w->shapes, &w->shape_cap, slot + 1,
-                         sizeof *w->shapes) != 0) {
+    int taken = ws_slots_take(&w->mem, &w->shape_slots, &slot) == 0;
+    if (!taken || ws_array_reserve(&w->mem, (void **)&w->shapes, &w->shape_cap, slot + 1,
+                                   sizeof *w->shapes) != 0) {
+        if (taken)
+            ws_slots_release(&w->shape_slots, slot);
         ws_shape_free(&w->mem, s);
         ws_mem_free(&w->mem, s, sizeof *s);
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
