@@ -54,6 +54,8 @@ typedef struct tilt_result {
     int slide_confirmed[2];
     double tip_time[2], tip_angle[2];     /* first time a box leans > 2 deg on its support */
     double final_slip[2];                 /* m along the platform, downhill positive */
+    double off_time[2];                   /* when its CoG went below the platform's surface:
+                                             it left the platform (NaN: never) */
     double cog_distance_start, cog_distance_end; /* m */
     double final_angle;                   /* plane angle at the end, deg */
     uint64_t hash;
@@ -239,7 +241,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
 {
     memset(res, 0, sizeof *res);
     for (int k = 0; k < 2; k++)
-        res->slide_time[k] = res->slide_angle[k] = res->tip_time[k] = res->tip_angle[k] = NAN;
+        res->slide_time[k] = res->slide_angle[k] = res->tip_time[k] = res->tip_angle[k] =
+            res->off_time[k] = NAN;
     tilt_scene sc;
     ws_status s = tilt_build(o, &sc);
     if (s != WS_OK) {
@@ -293,7 +296,10 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         for (int k = 0; k < 2; k++) {
             ws_body_get_position(w, sc.box[k], &r[k]);
             ws_body_get_velocity(w, sc.box[k], &v[k]);
-            slip[k] = in_plane_frame(w, sc.plane, r[k]).x - start[k].x;
+            ws_vec3 local = in_plane_frame(w, sc.plane, r[k]);
+            slip[k] = local.x - start[k].x;
+            if (isnan(res->off_time[k]) && local.z < 0.0)
+                res->off_time[k] = t;
             tilt[k] = relative_tilt(w, sc.box[k], support[k]);
             /* Sliding: every contact with its support slips, for 10 ms in a row. */
             slipping_steps[k] = slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
@@ -363,8 +369,11 @@ static void print_box(const char *name, const tilt_result *r, int k)
     if (!isnan(r->tip_time[k]))
         printf("  %-6s box: leans > 2 deg on its support from %.2f deg (t = %.3f s)\n", name,
                r->tip_angle[k], r->tip_time[k]);
-    printf("  %-6s box: slip along the platform at the end %.1f mm\n", name,
-           1e3 * r->final_slip[k]);
+    if (!isnan(r->off_time[k]))
+        printf("  %-6s box: left the platform at t = %.3f s\n", name, r->off_time[k]);
+    else
+        printf("  %-6s box: slip along the platform at the end %.1f mm\n", name,
+               1e3 * r->final_slip[k]);
 }
 
 int main(int argc, char **argv)
