@@ -288,14 +288,12 @@ static tf_result run_torque_free(ws_integrator integ, int axis, double dt, doubl
  *   minor axis 3:  |L|^2 - J3 2T = J1 (J1 - J3) w1^2 + J2 (J2 - J3) w2^2 = C
  * so each perturbation component is bounded by sqrt(C / its coefficient) with C from the
  * initial perturbation eps Omega: it stays O(eps Omega) for ever and the spin never reverses.
- * The default integrator keeps |L| to round-off but gains energy (test_torque_free_energy):
- * dT = sum dt^2/2 |w x L'|^2_{J^-1} >= 0, which changes C by +2 J1 dT (major) or -2 J3 dT
- * (minor). C itself is O(eps^2) and so is |w x L'|^2 here, so this is not negligible: over
- * 10 s at Omega dt = 1e-3 it raises C by ~15 % on the major axis. The asserted bound is the
- * invariant bound with C + 2 J_axis |dT| (dT summed along the run), plus 5 % for the O(dt^3)
- * terms and the discrete sampling. Without that correction the major-axis perturbation would
- * exceed the exact bound by ~7 %: the drift is real and first order. The intermediate axis
- * reaches O(Omega), 1000 times these bounds, so the test separates the cases widely. */
+ * The default integrator keeps |L| to round-off and its energy error is bounded with no drift
+ * (test_torque_free_energy); near an axis that error scales with the same eps^2 as C, so the
+ * exact invariant bound must hold to 1 % (measured: to 1e-6). A first-order rotation would gain
+ * energy steadily and break it: ~7 % above the bound on the major axis after 10 s. The
+ * intermediate axis reaches O(Omega), 1000 times these bounds, so the test separates the cases
+ * widely. */
 static void check_stable_axis(int axis)
 {
     tf_result r = run_torque_free(WS_INTEGRATOR_SYMPLECTIC_EULER, axis, TF_DT, TF_T);
@@ -305,17 +303,15 @@ static void check_stable_axis(int axis)
         if (i != axis)
             C += coef[i] * e * e;
     }
-    double dC = 2.0 * TF_J[axis] * r.pred_dT_rel * r.T0;
     for (int i = 0; i < 3; i++) {
         if (i == axis)
             continue;
-        double exact = sqrt(C / coef[i]), bound = sqrt((C + dC) / coef[i]);
-        report("%s axis: max |w%d| = %.6g rad/s, invariant bound %.6g, with the energy drift "
-               "%.6g (initial %.3g)",
-               axis == 0 ? "major" : "minor", i + 1, r.max_perp[i], exact, bound, e);
-        ck_assert_msg(r.max_perp[i] <= 1.05 * bound,
-                      "axis %d: perturbation w%d grew to %.4g rad/s > 1.05 x bound %.4g", axis,
-                      i + 1, r.max_perp[i], bound);
+        double exact = sqrt(C / coef[i]);
+        report("%s axis: max |w%d| = %.6g rad/s, invariant bound %.6g (initial %.3g)",
+               axis == 0 ? "major" : "minor", i + 1, r.max_perp[i], exact, e);
+        ck_assert_msg(r.max_perp[i] <= 1.01 * exact,
+                      "axis %d: perturbation w%d grew to %.4g rad/s > 1.01 x bound %.4g", axis,
+                      i + 1, r.max_perp[i], exact);
     }
     ck_assert_msg(r.first_flip_t < 0, "spin about stable axis %d reversed at t = %g s", axis,
                   r.first_flip_t);
@@ -377,32 +373,29 @@ START_TEST(test_torque_free_momentum_conserved)
 }
 END_TEST
 
-/* Energy. One step of the default scheme rotates the body-frame momentum L' = A^T H by the
- * frozen omega' = J^-1 L' over dt: L'+ = exp(-dt w~) L' = L' - dt w x L' + dt^2/2 w x (w x L').
- * With T(L') = L'.J^-1 L'/2 and w = J^-1 L':
- *   dT = w.dL' + dL'.J^-1 dL'/2 = 0 (first order: w.(w x L') = 0)
- *        + 0 (second order: w.(w x (w x L')) = 0) + dt^2/2 |w x L'|^2_{J^-1} + O(dt^3),
- * a gain of order (Omega dt)^2 T per step, always upward: a secular relative drift of order
- * (Omega dt)(Omega t) over the run (so the rotational part is first order, not symplectic: a
- * symplectic scheme's energy error would stay bounded). Summing dt^2/2 |w x L'|^2_{J^-1} / T0
- * along the run gives the predicted drift (pred_dT_rel); the O(dt^3) terms change it by a
- * relative O(Omega dt) = 1e-3. Asserted: |T_end - T0|/T0 <= 1.2 pred (20 % margin for those
- * terms and round-off), and <= the a-priori bound (Omega dt)(Omega t) ((J1 - J3)/J3)^2 -- from
- * |w x Jw|_i <= (J1 - J3)|w|^2/2 and 2T >= J3 |w|^2 -- which does not use the trajectory.
- * Run on the intermediate axis (the most violent motion) for 10 s at dt = 1e-4 s. */
+/* Energy. The default scheme's rotational drift is the free rotor split symmetrically into exact
+ * rotations about the principal axes (R1(dt/2) R2(dt/2) R3(dt) R2(dt/2) R1(dt/2)). Each factor
+ * is the exact flow of a part of the Hamiltonian, so the step is symplectic and time-reversible:
+ * it conserves a modified energy T~ = T + O((Omega dt)^2) T exactly, hence |T - T0|/T0 stays
+ * bounded by C (Omega dt)^2 for all time, with C of order one set by the inertia ratios -- no
+ * secular drift. A first-order explicit rotation (exp(-dt w~) on L' with w frozen) would instead
+ * gain dt^2/2 |w x L'|^2_{J^-1} every step, always upward; summed along the run that is
+ * pred_dT_rel (about 3e-3 here). Asserted, on the intermediate-axis flip (the most violent
+ * motion) for 10 s at dt = 1e-4 s, Omega dt = 1e-3:
+ *  - max |T - T0|/T0 <= (Omega dt)^2 = 1e-6 (C <= 1);
+ *  - and below 1e-3 of the explicit drift pred_dT_rel, which shows there is no secular term. */
 START_TEST(test_torque_free_energy)
 {
     tf_result d = run_torque_free(WS_INTEGRATOR_SYMPLECTIC_EULER, 1, TF_DT, TF_T);
-    double apriori = (TF_OMEGA * TF_DT) * (TF_OMEGA * TF_T) *
-                     pow((TF_J[0] - TF_J[2]) / TF_J[2], 2.0);
-    report("torque-free energy, default: dT/T0 = %.4g at %g s (max %.4g), predicted %.4g, "
-           "a-priori bound %.3g",
-           d.dT_rel_end, TF_T, d.max_dT_rel, d.pred_dT_rel, apriori);
-    ck_assert_msg(fabs(d.dT_rel_end) <= 1.2 * d.pred_dT_rel,
-                  "default energy drift %.4g above the predicted %.4g (+20 %%)", d.dT_rel_end,
+    double bound = (TF_OMEGA * TF_DT) * (TF_OMEGA * TF_DT);
+    report("torque-free energy, default: dT/T0 = %.4g at %g s (max %.4g), bound (Omega dt)^2 = "
+           "%.3g; a first-order explicit rotation would drift by %.4g",
+           d.dT_rel_end, TF_T, d.max_dT_rel, bound, d.pred_dT_rel);
+    ck_assert_msg(d.max_dT_rel <= bound, "default energy error %.4g above (Omega dt)^2 = %.4g",
+                  d.max_dT_rel, bound);
+    ck_assert_msg(d.max_dT_rel <= 1e-3 * d.pred_dT_rel,
+                  "default energy error %.4g not far below the explicit drift %.4g", d.max_dT_rel,
                   d.pred_dT_rel);
-    ck_assert_msg(d.max_dT_rel <= apriori, "default energy drift %.4g above a-priori %.4g",
-                  d.max_dT_rel, apriori);
 }
 END_TEST
 
@@ -411,16 +404,14 @@ END_TEST
  *   T gains dt^2/2 |w x L'|^2_{J^-1}: the SAME leading term as the default scheme, and
  *   |L'|^2 gains dt^2 |w x L'|^2 (the cross term L'.(w x L') vanishes): |H| = |L'| drifts up
  *   by dt^2/2 |w x L'|^2 / |L| per step, where the default keeps H to round-off.
- * So its energy drift is not larger than the default's by construction: on the same motion the
- * two differ only through their O(dt)-different trajectories. Measured on the intermediate-axis
- * flip (where the trajectories separate, the flip times shift) the paper's drift is even
- * smaller; on a generic tumble far from the separatrix both agree to a relative
- * O((Omega dt)(Omega t)). What is larger is its angular-momentum drift. Asserted:
+ * The default scheme's energy error is bounded (test_torque_free_energy), so the paper's scheme
+ * drifts far more in energy, and in |H|, which the default keeps to round-off. Asserted:
  *  - p stays unit (renormalised) -- checked in test_euler_parameter_invariants_paper;
- *  - energy drift within 20 % of its own leading-term sum (as for the default);
+ *  - energy drift within 20 % of its own leading-term sum (the O(dt^3) terms are a relative
+ *    O(Omega dt) = 1e-3 of it);
  *  - |H| drift within 20 % of its leading-term sum, and > 1e4 times the default's;
- *  - generic tumble w0 = (3, -7, 5) rad/s: |dT_paper - dT_default| <= (|w0| dt)(|w0| t) times
- *    the larger drift (the trajectories' relative separation). */
+ *  - energy drift > 1e3 times the default's energy error, on the flip and on a generic tumble
+ *    w0 = (3, -7, 5) rad/s. */
 START_TEST(test_torque_free_paper_scheme)
 {
     tf_result p = run_torque_free(WS_INTEGRATOR_PAPER_EXPLICIT, 1, TF_DT, TF_T);
@@ -436,19 +427,18 @@ START_TEST(test_torque_free_paper_scheme)
     ck_assert_msg(p.max_dH_rel > 1e4 * d.max_dH_rel, "paper |H| drift %.3g vs default %.3g",
                   p.max_dH_rel, d.max_dH_rel);
 
+    ck_assert_msg(fabs(p.dT_rel_end) > 1e3 * d.max_dT_rel,
+                  "paper energy drift %.4g not above 1e3 x the default's %.4g", p.dT_rel_end,
+                  d.max_dT_rel);
+
     const double w0[3] = {3.0, -7.0, 5.0};
     tf_result pg = run_torque_free_w(WS_INTEGRATOR_PAPER_EXPLICIT, w0, 1, TF_DT, TF_T);
     tf_result dg = run_torque_free_w(WS_INTEGRATOR_SYMPLECTIC_EULER, w0, 1, TF_DT, TF_T);
-    double om = sqrt(9.0 + 49.0 + 25.0);
-    double sep = (om * TF_DT) * (om * TF_T);
-    report("torque-free, generic tumble |w| = %.3g rad/s: dT/T0 paper %.5g, default %.5g "
-           "(relative difference %.3g, allowed %.3g)",
-           om, pg.dT_rel_end, dg.dT_rel_end,
-           fabs(pg.dT_rel_end - dg.dT_rel_end) / fmax(pg.dT_rel_end, dg.dT_rel_end), sep);
-    ck_assert_msg(fabs(pg.dT_rel_end - dg.dT_rel_end) <=
-                      sep * fmax(fabs(pg.dT_rel_end), fabs(dg.dT_rel_end)),
-                  "energy drifts paper %.5g and default %.5g differ by more than %.3g relative",
-                  pg.dT_rel_end, dg.dT_rel_end, sep);
+    report("torque-free, generic tumble: dT/T0 paper %.5g, default %.5g (max %.3g)",
+           pg.dT_rel_end, dg.dT_rel_end, dg.max_dT_rel);
+    ck_assert_msg(fabs(pg.dT_rel_end) > 1e3 * dg.max_dT_rel,
+                  "generic tumble: paper drift %.5g not above 1e3 x the default's %.5g",
+                  pg.dT_rel_end, dg.max_dT_rel);
 }
 END_TEST
 

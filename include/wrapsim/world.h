@@ -16,8 +16,10 @@ typedef struct ws_world ws_world;
 
 /** Time integrators. */
 typedef enum ws_integrator {
-    /** Semi-implicit (symplectic) Euler: v += a dt, then x += v dt; rotations through the angular
-     *  momentum and the exact quaternion exponential. The default. */
+    /** Symplectic Euler: the forces kick the momenta (v += a dt, H += M dt), then the bodies
+     *  drift with the new momenta: x += v dt, and the free rigid rotor split symmetrically into
+     *  exact rotations about the principal axes. Angular momentum is kept to round-off and the
+     *  energy error stays bounded when no moment acts. The default. */
     WS_INTEGRATOR_SYMPLECTIC_EULER = 0,
     /** The paper's explicit scheme (eq. 8-11): x += v dt + a dt^2/2, v += a dt, omega' += dt J^-1
      *  (M' - omega' x J omega'), p += dt L^T omega' / 2, p renormalised. For reproducing it. */

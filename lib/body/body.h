@@ -29,6 +29,8 @@ typedef struct ws_body_store {
     double *layer;
     double *mass, *inv_mass;
     m3 *J, *Jinv;
+    m3 *Q;  /* principal axes of J in the body frame (columns): J = Q diag(Ip) Q^T */
+    v3 *Ip; /* principal moments */
     ws_body_state st[2];
     /* Per-step scratch, from the committed state at t. */
     m3 *A;    /* rotation */

@@ -126,3 +126,52 @@ m3 m3_skew(v3 a)
     m3 r = {{0, -a.z, a.y, a.z, 0, -a.x, -a.y, a.x, 0}};
     return r;
 }
+
+void m3_sym_eigen(const m3 *a, m3 *vectors, v3 *values)
+{
+    /* Cyclic Jacobi: rotate away the largest off-diagonal entries until they vanish. For 3x3
+     * it converges in a handful of sweeps to round-off. */
+    double s[9];
+    for (int i = 0; i < 9; i++)
+        s[i] = a->m[i];
+    m3 v = m3_identity();
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = fabs(s[1]) + fabs(s[2]) + fabs(s[5]);
+        double scale = fabs(s[0]) + fabs(s[4]) + fabs(s[8]);
+        if (off <= 1e-300 || off < 1e-17 * scale)
+            break;
+        for (int p = 0; p < 2; p++) {
+            for (int q = p + 1; q < 3; q++) {
+                double apq = s[3 * p + q];
+                if (apq == 0.0)
+                    continue;
+                double app = s[4 * p], aqq = s[4 * q];
+                double theta = 0.5 * (aqq - app) / apq;
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
+                /* s <- J^T s J with J the rotation in the (p, q) plane. */
+                for (int k = 0; k < 3; k++) {
+                    double skp = s[3 * k + p], skq = s[3 * k + q];
+                    s[3 * k + p] = c * skp - sn * skq;
+                    s[3 * k + q] = sn * skp + c * skq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double spk = s[3 * p + k], sqk = s[3 * q + k];
+                    s[3 * p + k] = c * spk - sn * sqk;
+                    s[3 * q + k] = sn * spk + c * sqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v.m[3 * k + p], vkq = v.m[3 * k + q];
+                    v.m[3 * k + p] = c * vkp - sn * vkq;
+                    v.m[3 * k + q] = sn * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    /* A right-handed frame, so the columns can serve as a rotation. */
+    if (m3_det(&v) < 0.0)
+        for (int k = 0; k < 3; k++)
+            v.m[3 * k + 2] = -v.m[3 * k + 2];
+    *vectors = v;
+    *values = v3_make(s[0], s[4], s[8]);
+}

@@ -114,6 +114,10 @@ m3 qt_to_m3(qt q);
 /* p_dot = 1/2 L^T omega' (eq. 11-12), omega' in the body frame. */
 qt qt_rate_local(qt p, v3 omega_local);
 
+/* Eigen-decomposition of a symmetric matrix: a = V diag(values) V^T, V a rotation (columns are
+ * the unit eigenvectors, right-handed). */
+void m3_sym_eigen(const m3 *a, m3 *vectors, v3 *values);
+
 /* Skew form: a~ b = a x b. */
 m3 m3_skew(v3 a);
 

@@ -349,6 +349,7 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
     b->inv_mass[slot] = d.type == WS_BODY_DYNAMIC ? 1.0 / mass : 0.0;
     b->J[slot] = J;
     b->Jinv[slot] = Jinv;
+    m3_sym_eigen(&J, &b->Q[slot], &b->Ip[slot]);
     b->has_drive[slot] = 0;
     b->name[slot] = name_copy;
     b->user[slot] = d.user_data;
