@@ -246,16 +246,6 @@ void *ws_world_get_user_data(const ws_world *w)
     return w ? w->def.user_data : NULL;
 }
 
-#define NEED_WORLD(w)                                                                             \
-    do {                                                                                          \
-        if (!(w))                                                                                 \
-            return WS_ERR_INVALID_ARGUMENT;                                                       \
-    } while (0)
-#define NEED_OUT(w, p, fn)                                                                        \
-    do {                                                                                          \
-        if (!(p))                                                                                 \
-            return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
-    } while (0)
 
 ws_status ws_world_get_time(const ws_world *w, double *t)
 {

@@ -3,16 +3,6 @@
 
 #include <string.h>
 
-#define NEED_WORLD(w)                                                                             \
-    do {                                                                                          \
-        if (!(w))                                                                                 \
-            return WS_ERR_INVALID_ARGUMENT;                                                       \
-    } while (0)
-#define NEED_OUT(w, p, fn)                                                                        \
-    do {                                                                                          \
-        if (!(p))                                                                                 \
-            return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
-    } while (0)
 
 /* ---- ids ---- */
 
@@ -484,19 +474,29 @@ ws_status ws_body_get_angular_velocity(const ws_world *w, ws_body_id id, ws_vec3
     return WS_OK;
 }
 
+/* Common part of the calls that take a point: checks, then the body's slot and rotation. */
+static ws_status point_call(const ws_world *w, ws_body_id id, const ws_vec3 *point, void *out,
+                            const char *fn, uint32_t *slot, m3 *A)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, fn);
+    if (!point || !ws_is_finite3(point))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: point must be finite", fn);
+    ws_status s = ws_lookup_body(w, id, slot);
+    if (s == WS_OK)
+        *A = qt_to_m3(w->bodies.st[w->cur].p[*slot]);
+    return s;
+}
+
 ws_status ws_body_get_point_velocity(const ws_world *w, ws_body_id id, const ws_vec3 *point,
                                      ws_vec3 *v)
 {
-    NEED_WORLD(w);
-    NEED_OUT(w, v, "ws_body_get_point_velocity");
-    if (!point || !ws_is_finite3(point))
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_body_get_point_velocity: point must be finite");
     uint32_t i;
-    ws_status s = ws_lookup_body(w, id, &i);
+    m3 A;
+    ws_status s = point_call(w, id, point, v, "ws_body_get_point_velocity", &i, &A);
     if (s != WS_OK)
         return s;
     const ws_body_state *st = &w->bodies.st[w->cur];
-    m3 A = qt_to_m3(st->p[i]);
     v3 om = m3_mul_v(&A, st->w[i]);
     *v = v3_add(st->v[i], v3_cross(om, v3_sub(*point, st->r[i]))); /* eq. 3 */
     return WS_OK;
@@ -505,17 +505,12 @@ ws_status ws_body_get_point_velocity(const ws_world *w, ws_body_id id, const ws_
 ws_status ws_body_get_world_point(const ws_world *w, ws_body_id id, const ws_vec3 *local,
                                   ws_vec3 *global)
 {
-    NEED_WORLD(w);
-    NEED_OUT(w, global, "ws_body_get_world_point");
-    if (!local || !ws_is_finite3(local))
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_body_get_world_point: point must be finite");
     uint32_t i;
-    ws_status s = ws_lookup_body(w, id, &i);
+    m3 A;
+    ws_status s = point_call(w, id, local, global, "ws_body_get_world_point", &i, &A);
     if (s != WS_OK)
         return s;
-    const ws_body_state *st = &w->bodies.st[w->cur];
-    m3 A = qt_to_m3(st->p[i]);
-    *global = v3_add(st->r[i], m3_mul_v(&A, *local)); /* eq. 2 */
+    *global = v3_add(w->bodies.st[w->cur].r[i], m3_mul_v(&A, *local)); /* eq. 2 */
     return WS_OK;
 }
 

@@ -65,6 +65,18 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
 #endif
     ;
 
+/* Argument guards of the public calls: a NULL world has no last error, a NULL output does. */
+#define NEED_WORLD(w)                                                                             \
+    do {                                                                                          \
+        if (!(w))                                                                                 \
+            return WS_ERR_INVALID_ARGUMENT;                                                       \
+    } while (0)
+#define NEED_OUT(w, p, fn)                                                                        \
+    do {                                                                                          \
+        if (!(p))                                                                                 \
+            return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
+    } while (0)
+
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);
 ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot);
 ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot);
