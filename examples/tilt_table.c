@@ -7,10 +7,15 @@
  *   Variant P (paper): as above, 6 s.
  *   Variant R (reference): plus a stop bar (20 mm x 20 mm) on the plane along the downhill face
  *   of the bottom box, 7 s. The top box slides off at 16.70 deg; the bottom box rests on the stop.
+ *   --wrapped: a band of stretch film around both boxes (96 x 61 nodes, pre-stretch 40 %
+ *   around and 20 % up, springs of 2000 N/m, film-box contact 4000 N/m, mu 0.9). The film holds
+ *   the top box; in R the stack then tips as one over the stop when its centre of mass passes
+ *   the stop's edge: tan(theta) = (a/2) / (a - 0.02), theta = 28.52 deg, t = 5.978 s.
  *
  * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
  * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] [--no-ccd]
  *                      [--paper-integrator] [--duration S] [--quiet]
+ *                      [--wrapped [--film-mass KG] [--substeps N]]
  *
  * Copy this file as the start of your own load: build the scene in tilt_build(), read results
  * in tilt_run(). Compile with -DTILT_TABLE_NO_MAIN to use the two functions from another file.
@@ -36,11 +41,15 @@ typedef struct tilt_options {
     const char *csv;      /* time series file, or NULL */
     const char *vtk_dir;  /* directory for VTK frames, or NULL */
     int quiet;            /* no progress, no summary */
+    int wrapped;          /* 1: stretch film around the stack */
+    double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
+    int substeps;         /* film sub-steps per step; 0 = 1 */
 } tilt_options;
 
 typedef struct tilt_scene {
     ws_world *world;
     ws_body_id plane, stop, box[2]; /* box[0] bottom, box[1] top; stop is null in variant P */
+    ws_web_id film;                 /* null when unwrapped */
     double dt, duration, vlim;
 } tilt_scene;
 
@@ -58,6 +67,8 @@ typedef struct tilt_result {
                                              it left the platform (NaN: never) */
     double cog_distance_start, cog_distance_end; /* m */
     double final_angle;                   /* plane angle at the end, deg */
+    double max_relative_slip;             /* m, largest move of the top box on the bottom one */
+    double peak_strain, peak_tension;     /* film, largest over the run (wrapped) */
     uint64_t hash;
 } tilt_result;
 
@@ -66,6 +77,76 @@ static void tilt_default_options(tilt_options *o)
     memset(o, 0, sizeof *o);
     o->variant = 'R';
     o->use_ccd = 1;
+}
+
+/* The film of the reference case: a band from 30 mm above the plane to 20 mm below the top,
+ * 96 around x 61 up, pre-stretched 40 % around and 20 % up. The paper gives its springs as
+ * 2000 N/m and 0.1 kg/s; a law is per unit strain, so EA = k l0 and eta = c l0 with the rest
+ * lengths that follow from the outline and the pre-stretch. */
+static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id box_mat,
+                           ws_material_id plane_mat)
+{
+    ws_world *w = sc->world;
+    const double a = 0.25, layer = 1e-3, k = 2000.0, c = 0.1;
+    const int n_around = 96, n_up = 61;
+    const double z0 = 0.030, z1 = 2 * a + 2 * 2 * layer - 0.020;
+    /* Outline: the square footprint pushed out by the box and node layers. */
+    double perimeter = 4 * a + 2 * TILT_PI * 2 * layer;
+    double l0_around = perimeter / n_around / 1.4, l0_up = (z1 - z0) / (n_up - 1) / 1.2;
+    ws_status s;
+    ws_law_def ld;
+    ws_law_id around, up;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_TENSION_COMPRESSION; /* film buckles: 1 % stiffness in compression */
+    ld.stiffness = k * l0_around;
+    ld.compression_stiffness = 0.01 * ld.stiffness;
+    ld.damping = c * l0_around;
+    ld.name = "film around";
+    if ((s = ws_law_create(w, &ld, &around)) != WS_OK)
+        return s;
+    ld.stiffness = k * l0_up;
+    ld.compression_stiffness = 0.01 * ld.stiffness;
+    ld.damping = c * l0_up;
+    ld.name = "film up";
+    if ((s = ws_law_create(w, &ld, &up)) != WS_OK)
+        return s;
+
+    ws_material_def md;
+    ws_material_id film_mat;
+    ws_material_def_init(&md);
+    md.name = "film";
+    if ((s = ws_material_create(w, &md, &film_mat)) != WS_OK)
+        return s;
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0; /* N/m per node */
+    cd.damping = 1.0;
+    cd.friction = 0.9; /* film sticks to cardboard */
+    cd.friction_vlim = sc->vlim;
+    if ((s = ws_world_set_contact(w, film_mat, box_mat, &cd)) != WS_OK ||
+        (s = ws_world_set_contact(w, film_mat, plane_mat, &cd)) != WS_OK)
+        return s;
+
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = o->film_mass > 0 ? o->film_mass : 1e-3;
+    wd.contact_layer = layer;
+    wd.material = film_mat;
+    wd.law = around;
+    wd.law_cross = up;
+    wd.substeps = o->substeps > 0 ? o->substeps : 1;
+    wd.name = "film";
+    ws_band_def bd;
+    ws_band_def_init(&bd);
+    bd.bodies = sc->box;
+    bd.body_count = 2;
+    bd.z_bottom = z0;
+    bd.z_top = z1;
+    bd.n_around = n_around;
+    bd.n_up = n_up;
+    bd.prestretch_around = 0.4;
+    bd.prestretch_up = 0.2;
+    return ws_web_create_band(w, &wd, &bd, &sc->film);
 }
 
 /* Build the reference case. Returns WS_OK or the first error (the world is then destroyed). */
@@ -165,6 +246,8 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     bd.name = "top";
     if ((s = ws_body_create(w, &bd, &sc->box[1])) != WS_OK)
         goto fail;
+    if (o->wrapped && (s = tilt_wrap(o, sc, box_mat, plane_mat)) != WS_OK)
+        goto fail;
     return WS_OK;
 fail:
     ws_world_destroy(w);
@@ -219,6 +302,22 @@ static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *bu
         }
     }
     return count > 0 && slipping == count;
+}
+
+/* CoG of body b in the frame of body a. */
+static ws_vec3 box_local(ws_world *w, ws_body_id a, ws_body_id b)
+{
+    ws_vec3 p;
+    ws_body_get_position(w, b, &p);
+    ws_vec3 ra;
+    ws_mat3 A;
+    ws_body_get_position(w, a, &ra);
+    ws_body_get_rotation(w, a, &A);
+    ws_vec3 d = {p.x - ra.x, p.y - ra.y, p.z - ra.z};
+    ws_vec3 s = {A.m[0] * d.x + A.m[3] * d.y + A.m[6] * d.z,
+                 A.m[1] * d.x + A.m[4] * d.y + A.m[7] * d.z,
+                 A.m[2] * d.x + A.m[5] * d.y + A.m[8] * d.z};
+    return s;
 }
 
 static double distance(ws_world *w, ws_body_id a, ws_body_id b)
@@ -279,6 +378,21 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         start[k] = in_plane_frame(w, sc.plane, r);
     }
     res->cog_distance_start = distance(w, sc.box[0], sc.box[1]);
+    ws_vec3 top_on_bottom0 = box_local(w, sc.box[0], sc.box[1]);
+    size_t nspr = 0;
+    double *tension = NULL, *strain = NULL;
+    if (sc.film.bits) {
+        ws_web_copy_springs(w, sc.film, NULL, 0, &nspr);
+        tension = malloc(nspr * sizeof *tension);
+        strain = malloc(nspr * sizeof *strain);
+        if (!tension || !strain) {
+            free(tension);
+            free(strain);
+            ws_world_destroy(w);
+            snprintf(res->error, sizeof res->error, "out of memory");
+            return res->status = WS_ERR_OUT_OF_MEMORY;
+        }
+    }
     double t0 = now(), next_report = t0 + 1.0;
     ws_body_id support[2] = {sc.plane, sc.box[0]};
     ws_contact_info contacts[256];
@@ -315,6 +429,19 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                 res->tip_angle[k] = DEG(theta);
             }
         }
+        ws_vec3 rel = box_local(w, sc.box[0], sc.box[1]);
+        double dx = rel.x - top_on_bottom0.x, dy = rel.y - top_on_bottom0.y;
+        if (t < 3.0 * sc.duration) /* the stack may fall apart at the very end: keep the max */
+            res->max_relative_slip = fmax(res->max_relative_slip, sqrt(dx * dx + dy * dy));
+        if (sc.film.bits && n % csv_every == 0) {
+            size_t m;
+            ws_web_copy_spring_tensions(w, sc.film, tension, nspr, &m);
+            ws_web_copy_spring_strains(w, sc.film, strain, nspr, &m);
+            for (size_t q = 0; q < m; q++) {
+                res->peak_tension = fmax(res->peak_tension, tension[q]);
+                res->peak_strain = fmax(res->peak_strain, strain[q]);
+            }
+        }
         if (csv && n % csv_every == 0)
             fprintf(csv, "%.4f,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,"
                          "%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f\n",
@@ -345,6 +472,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     if (s != WS_OK)
         snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
     res->status = s;
+    free(tension);
+    free(strain);
     ws_vtk_series_destroy(vtk);
     if (csv)
         fclose(csv);
@@ -356,7 +485,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
 static void usage(void)
 {
     fprintf(stderr, "usage: tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] "
-                    "[--no-ccd] [--paper-integrator] [--duration S] [--quiet]\n");
+                    "[--no-ccd] [--paper-integrator] [--duration S] [--quiet]\n"
+                    "                  [--wrapped [--film-mass KG] [--substeps N]]\n");
 }
 
 static void print_box(const char *name, const tilt_result *r, int k)
@@ -400,16 +530,26 @@ int main(int argc, char **argv)
             o.duration = atof(argv[++i]);
         } else if (!strcmp(a, "--quiet")) {
             o.quiet = 1;
+        } else if (!strcmp(a, "--wrapped")) {
+            o.wrapped = 1;
+        } else if (!strcmp(a, "--film-mass") && i + 1 < argc) {
+            o.film_mass = atof(argv[++i]);
+        } else if (!strcmp(a, "--substeps") && i + 1 < argc) {
+            o.substeps = atoi(argv[++i]);
         } else {
             return usage(), 2;
         }
     }
     double theory = DEG(atan(0.3));
     if (!o.quiet)
-        printf("libwrapsim %s - tilt table, variant %c, unwrapped, %s friction\n"
+        printf("libwrapsim %s - tilt table, variant %c, %s, %s friction\n"
                "  theory: sliding starts at tan(theta) = mu = 0.3, theta = %.2f deg, t = %.3f s\n",
-               ws_version_string(), o.variant, o.stick ? "stick" : "regularised (paper)", theory,
-               1.0 + atan(0.3) / 0.1);
+               ws_version_string(), o.variant, o.wrapped ? "wrapped" : "unwrapped",
+               o.stick ? "stick" : "regularised (paper)", theory, 1.0 + atan(0.3) / 0.1);
+    if (!o.quiet && o.wrapped && o.variant == 'R')
+        printf("  theory, wrapped: the stack tips as one over the stop at tan(theta) = "
+               "0.125/0.23, theta = %.2f deg, t = %.3f s\n",
+               DEG(atan(0.125 / 0.23)), 1.0 + atan(0.125 / 0.23) / 0.1);
     tilt_result r;
     ws_status s = tilt_run(&o, &r);
     if (s != WS_OK) {
@@ -421,6 +561,10 @@ int main(int argc, char **argv)
         print_box("top", &r, 1);
         printf("  distance between the CoGs: %.1f mm at the start, %.1f mm at the end\n",
                1e3 * r.cog_distance_start, 1e3 * r.cog_distance_end);
+        printf("  top box on the bottom one: largest move %.1f mm\n", 1e3 * r.max_relative_slip);
+        if (o.wrapped)
+            printf("  film: peak strain %.3f, peak spring tension %.2f N\n", r.peak_strain,
+                   r.peak_tension);
         printf("  plane angle at the end %.2f deg; %ld steps in %.3f s (%.0f steps/s)\n",
                r.final_angle, r.steps, r.wall_seconds, r.steps / r.wall_seconds);
         if (o.csv)

@@ -11,6 +11,8 @@
 #include <wrapsim/shape.h>
 #include <wrapsim/body.h>
 #include <wrapsim/contact.h>
+#include <wrapsim/law.h>
+#include <wrapsim/web.h>
 #include <wrapsim/io.h>
 
 #endif

@@ -64,6 +64,10 @@ int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j
  * the face and the distance is within (lo, hi). */
 int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist);
 
+/* A point inside the solid (d < 0 under face f): 1 if f is the face it is least deep under among
+ * the faces it projects into, so only that face pushes it out. */
+int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d);
+
 /* Geometry of a candidate at the committed state: contact point and normal (global, a to b) and
  * the signed distance; 1 when the layers overlap. */
 int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist);

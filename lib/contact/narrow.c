@@ -80,7 +80,7 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
 /* A point inside the solid (d < 0 under face f) is pushed out by one face only: the one it is
  * least deep under among the faces it projects into. Otherwise a deep corner would be pushed
  * sideways out of a near side face as well as up out of the face it came through. */
-static int shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d)
+int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d)
 {
     for (uint32_t g = 0; g < sa->face_count; g++) {
         double e;
@@ -217,7 +217,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         double d;
         if (!ws_point_in_face(sa, c->fa, s, -reach - sa->inner, reach, &d))
             return 0;
-        if (d < 0.0 && !shallowest_face(sa, c->fa, s, d))
+        if (d < 0.0 && !ws_shallowest_face(sa, c->fa, s, d))
             return 0;
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
         *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */

@@ -206,6 +206,7 @@ void ws_world_destroy(ws_world *w)
     if (!w)
         return;
     ws_mem *m = &w->mem;
+    ws_world_free_webs(w);
     ws_bodies_free(m, &w->bodies);
     ws_slots_destroy(m, &w->body_slots);
     /* A slot may have been taken while growing the array failed: walk the array, not slots. */
@@ -269,6 +270,7 @@ ws_status ws_world_set_dt(ws_world *w, double dt)
     if (!(isfinite(dt) && dt > 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_dt: dt must be > 0 s, got %g", dt);
     w->def.dt = dt;
+    w->web_check = 1;
     return WS_OK;
 }
 
@@ -455,6 +457,7 @@ ws_status ws_world_set_contact(ws_world *w, ws_material_id a, ws_material_id b,
     }
     w->params[idx] = to_params(&d);
     w->pair_index[sa * w->pair_dim + sb] = w->pair_index[sb * w->pair_dim + sa] = idx;
+    w->web_check = 1;
     return WS_OK;
 }
 
@@ -482,6 +485,7 @@ ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
     if ((s = check_contact_def(w, &d)) != WS_OK)
         return s;
     w->params[0] = to_params(&d);
+    w->web_check = 1;
     return WS_OK;
 }
 

@@ -6,8 +6,8 @@
 
 /* ---- ids ---- */
 
-static ws_status lookup(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t,
-                        const char *what, uint32_t *slot)
+ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t,
+                         const char *what, uint32_t *slot)
 {
     if (bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id is null", what);
@@ -24,12 +24,12 @@ static ws_status lookup(const ws_world *w, uint64_t bits, unsigned kind, const w
 
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot)
 {
-    return lookup(w, id.bits, WS_KIND_BODY, &w->body_slots, "body", slot);
+    return ws_lookup_slot(w, id.bits, WS_KIND_BODY, &w->body_slots, "body", slot);
 }
 
 ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot)
 {
-    return lookup(w, id.bits, WS_KIND_SHAPE, &w->shape_slots, "shape", slot);
+    return ws_lookup_slot(w, id.bits, WS_KIND_SHAPE, &w->shape_slots, "shape", slot);
 }
 
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot)
@@ -357,6 +357,7 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
     }
     w->body_slots.dense[slot] = slot;
     w->cand_valid = 0;
+    w->web_check = 1; /* a new material may meet the webs */
     *out = ws_make_body_id(w, slot);
     return WS_OK;
 }

@@ -7,9 +7,12 @@
 #include "base/base.h"
 #include "body/body.h"
 #include "contact/contact.h"
+#include "contact/node.h"
 #include "drive/drive.h"
+#include "law/law.h"
 #include "math/wmath.h"
 #include "shape/shape.h"
+#include "web/web.h"
 
 #define WS_ERR_LEN 512
 
@@ -39,6 +42,17 @@ struct ws_world {
     size_t nparams, params_cap;
     uint32_t *pair_index; /* dim x dim, indices into params */
     size_t pair_dim;
+
+    ws_law1d **laws;
+    size_t law_cap;
+    ws_slot_table law_slots;
+
+    ws_web **webs;
+    size_t web_cap;
+    ws_slot_table web_slots;
+    int web_check; /* 1: re-check the webs' stable step before the next step */
+    ws_node_params *node_par; /* node contact parameters by body material, scratch */
+    size_t node_par_cap;
 
     ws_cand *cand[2];
     size_t ncand[2], capcand[2];
@@ -80,6 +94,17 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);
 ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot);
 ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot);
+ws_status ws_lookup_law(const ws_world *w, ws_law_id id, uint32_t *slot);
+ws_status ws_lookup_web(const ws_world *w, ws_web_id id, uint32_t *slot);
+/* Generic id lookup for a slot table (kind: WS_KIND_*). */
+ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t,
+                         const char *what, uint32_t *slot);
+/* Free the webs and laws of a world (world destroy). */
+void ws_world_free_webs(ws_world *w);
+/* Node contact parameters of a web's material against every body material (into w->nparams). */
+int ws_world_node_params(ws_world *w, uint32_t web_material);
+/* The stable sub-step of a web with the stiffest contact its material can have. */
+double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
 
 /* Copy a caller's Def (of the size it says) over a default one; WS_ERR_UNINITIALIZED_DEF or

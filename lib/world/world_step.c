@@ -8,6 +8,7 @@
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
 #include "world/world_internal.h"
 
+#include <stdio.h>
 #include <string.h>
 
 static void prepare(ws_world *w)
@@ -75,6 +76,116 @@ static ws_status detect_full(ws_world *w, ws_contact_ctx *x, int nxt)
     }
     ws_contact_sort(w->cand[nxt], w->ncand[nxt]);
     ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[w->cur], w->ncand[w->cur]);
+    return WS_OK;
+}
+
+static const char *web_label(const ws_web *web)
+{
+    return web->name ? web->name : "(unnamed)";
+}
+
+/* What would make a web stable at sub-step h: sub-steps for the world's dt, or node mass. */
+static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double stable,
+                              const char *what)
+{
+    double mmin, kmax;
+    ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
+    double r = h / stable;
+    int need = (int)ceil(w->def.dt / stable);
+    return ws_fail(w, WS_ERR_NUMERICAL,
+                   "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
+                   "(smallest node mass %.3g kg). Use substeps >= %d (ws_web_set_substeps), or "
+                   "node mass >= %.3g kg, or a smaller dt.",
+                   web_label(web), what, h, stable, mmin, need, mmin * fmax(r * r, r));
+}
+
+/* Every web before the step: stable for its sub-step, and room for per-body forces. */
+static ws_status webs_ready(ws_world *w)
+{
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        ws_web *web = w->webs[k];
+        if (web->bcap < w->bodies.slots) {
+            size_t cap = w->bodies.capacity;
+            for (int b = 0; b < 2; b++) {
+                v3 *f = ws_mem_realloc(&w->mem, web->bforce[b], web->bcap * sizeof(v3),
+                                       cap * sizeof(v3));
+                if (f)
+                    web->bforce[b] = f;
+                v3 *m = f ? ws_mem_realloc(&w->mem, web->bmoment[b], web->bcap * sizeof(v3),
+                                           cap * sizeof(v3))
+                          : NULL;
+                if (m)
+                    web->bmoment[b] = m;
+                if (!f || !m) {
+                    /* Keep the sizes consistent: shrink what grew back is not possible, so
+                     * record the smaller capacity for both by re-growing next time. */
+                    return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                                   web_label(web));
+                }
+                for (size_t i = web->bcap; i < cap; i++)
+                    web->bforce[b][i] = web->bmoment[b][i] = v3_make(0, 0, 0);
+            }
+            web->bcap = cap;
+        }
+        if (w->web_check) {
+            double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
+            if (h > stable)
+                return web_unstable(w, web, h, stable, "refused before the step");
+        }
+    }
+    w->web_check = 0;
+    return WS_OK;
+}
+
+/* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration.
+ * Forces on the bodies go into their accumulators, averaged over the sub-steps. */
+static ws_status step_webs(ws_world *w, int full, int cur, int nxt, double *vmax_all)
+{
+    ws_body_store *b = &w->bodies;
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        ws_web *web = w->webs[k];
+        int list = web->list;
+        if (full) {
+            list ^= 1;
+            if (ws_node_candidates(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin,
+                                   &web->cand[list], &web->ncand[list], &web->capcand[list],
+                                   &w->stats.narrow_checks) != 0)
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                               web_label(web));
+        }
+        web->next_list = list;
+        if (ws_world_node_params(w, web->material) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        for (uint32_t i = 0; i < web->n; i++)
+            web->fc[nxt][i] = v3_make(0, 0, 0);
+        for (size_t i = 0; i < web->bcap; i++)
+            web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
+        int n = web->substeps;
+        double h = w->def.dt / n, share = 1.0 / n;
+        for (int s = 0; s < n; s++) {
+            int src = s == 0 ? cur : nxt;
+            ws_web_internal_forces(web, web->x[src], web->v[src], w->def.gravity);
+            ws_node_contacts(b, cur, web, web->x[src], web->v[src], web->cand[list],
+                             web->ncand[list], w->node_par, h, share, web->fc[nxt],
+                             web->bforce[nxt], web->bmoment[nxt], &w->stats.narrow_checks);
+            double vmax = ws_web_integrate(web, web->x[src], web->v[src], web->x[nxt],
+                                           web->v[nxt], h);
+            if (!(vmax <= w->def.max_speed)) {
+                w->stats.numerical_errors++;
+                char what[160];
+                snprintf(what, sizeof what,
+                         "a node ran away at t = %.6g s (speed %.3g m/s above max_speed %.3g)",
+                         w->time, vmax, w->def.max_speed);
+                return web_unstable(w, web, h, ws_world_web_stable_dt(w, web), what);
+            }
+            if (vmax > *vmax_all)
+                *vmax_all = vmax;
+        }
+    }
     return WS_OK;
 }
 
@@ -150,6 +261,12 @@ ws_status ws_world_step(ws_world *w)
         if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
             nrec++;
 
+    double web_speed = 0.0;
+    if (w->web_slots.slot_count) {
+        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, full, cur, nxt, &web_speed)) != WS_OK)
+            return s;
+    }
+
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
@@ -197,7 +314,10 @@ ws_status ws_world_step(ws_world *w)
         w->stats.full_detections++;
         w->travel = 0.0;
     }
-    w->travel += max_step_travel(w, w->cur); /* the step just taken moved with these speeds */
+    w->travel += max_step_travel(w, w->cur) + web_speed * dt; /* this step's motion bound */
+    for (size_t k = 0; k < w->web_slots.slot_count; k++)
+        if (w->web_slots.dense[k] != UINT32_MAX)
+            w->webs[k]->list = w->webs[k]->next_list;
     w->steps++;
     return WS_OK;
 }

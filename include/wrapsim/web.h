@@ -1,0 +1,179 @@
+/**
+ * @file web.h
+ * @brief The film: a web of point masses joined by springs, pre-stretched, touching the bodies.
+ *
+ * Nodes carry position and velocity only. Springs join grid neighbours (and optionally the
+ * diagonals); each spring's force comes from a 1D law (law.h) of its strain eps = l/l0 - 1 and
+ * strain rate, so a measured film curve can replace the linear one. Pre-stretch is set by the
+ * rest lengths. Nodes touch bodies point-to-face (eq. 14) in their contact layer, with the
+ * penalty and friction of the pair (web material, body material). A web may take several
+ * sub-steps inside one world step so a film of its real mass runs stable.
+ */
+#ifndef WRAPSIM_WEB_H
+#define WRAPSIM_WEB_H
+
+#include <wrapsim/law.h>
+#include <wrapsim/world.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A web (film). */
+typedef struct ws_web_id {
+    uint64_t bits;
+} ws_web_id;
+
+/** Which law a spring follows. */
+typedef enum ws_spring_kind {
+    WS_SPRING_AROUND = 0, /**< first grid direction (around a band, x of a sheet): `law` */
+    WS_SPRING_UP = 1,     /**< second grid direction (up a band, y of a sheet): `law_cross` */
+    WS_SPRING_SHEAR = 2   /**< diagonals: `law_shear` */
+} ws_spring_kind;
+
+/** What every web has. Fill with ws_web_def_init(). */
+typedef struct ws_web_def {
+    uint32_t size;  /**< set by ws_web_def_init() */
+    uint32_t magic; /**< set by ws_web_def_init() */
+    double node_mass;       /**< kg per node (> 0); 0 = from areal_density (grid webs) */
+    double areal_density;   /**< kg/m^2 of unstretched film, used when node_mass is 0: a node
+                                 gets the rest area it stands for; 0.018 for 20 um LLDPE */
+    double contact_layer;   /**< delta of every node, m (>= 0); default 1e-3 */
+    ws_material_id material; /**< node-body contact pairs; null id: the default material */
+    double node_damping;    /**< drag on each node's absolute velocity, kg/s (>= 0); default 0 */
+    ws_law_id law;          /**< law of WS_SPRING_AROUND springs; required */
+    ws_law_id law_cross;    /**< law of WS_SPRING_UP springs; null id: `law` */
+    ws_law_id law_shear;    /**< law of WS_SPRING_SHEAR springs; required when there are any */
+    int substeps;           /**< web sub-steps per world step (>= 1); default 1 */
+    const char *name;       /**< optional, copied; used in error messages */
+} ws_web_def;
+
+/** A rectangular sheet: nx x ny nodes at origin + i spacing_x axis_x + j spacing_y axis_y. */
+typedef struct ws_sheet_def {
+    uint32_t size;  /**< set by ws_sheet_def_init() */
+    uint32_t magic; /**< set by ws_sheet_def_init() */
+    int nx, ny;              /**< nodes along each direction (>= 2 and >= 1; nx * ny >= 2) */
+    ws_vec3 origin;          /**< m, node (0, 0) */
+    ws_vec3 axis_x, axis_y;  /**< directions of the grid (normalised); default x and y */
+    double spacing_x, spacing_y; /**< node spacing as placed, m (> 0) */
+    double prestretch_x, prestretch_y; /**< rest length = spacing / (1 + prestretch) (> -1) */
+    int shear;               /**< 1: add both diagonals of every cell */
+    const uint32_t *pinned;  /**< node indices (i + nx j) held fixed; may be NULL */
+    size_t pinned_count;
+} ws_sheet_def;
+
+/** A band wrapped around a stack: around the convex outline of the bodies' footprint (their
+ *  vertices projected along z), pushed out by the layers so the film just touches, from
+ *  z_bottom to z_top (m, global), n_around x n_up nodes, closed around. */
+typedef struct ws_band_def {
+    uint32_t size;  /**< set by ws_band_def_init() */
+    uint32_t magic; /**< set by ws_band_def_init() */
+    const ws_body_id *bodies; /**< the stack */
+    size_t body_count;
+    double z_bottom, z_top;   /**< m */
+    int n_around, n_up;       /**< nodes (>= 3, >= 1) */
+    double prestretch_around; /**< e.g. 0.4 */
+    double prestretch_up;     /**< e.g. 0.2 */
+    double gap;               /**< extra distance beyond the touching layers, m; default 0 */
+    int shear;                /**< 1: add the diagonals */
+} ws_band_def;
+
+/** Anything else: nodes and springs as given. */
+typedef struct ws_web_mesh_def {
+    uint32_t size;  /**< set by ws_web_mesh_def_init() */
+    uint32_t magic; /**< set by ws_web_mesh_def_init() */
+    const double *positions;     /**< xyz per node, m */
+    size_t node_count;
+    const double *node_masses;   /**< kg per node; NULL: the web Def's node_mass */
+    const uint32_t *springs;     /**< node index pairs */
+    size_t spring_count;
+    const double *rest_lengths;  /**< m per spring (> 0); NULL: the lengths as placed */
+    const uint8_t *kinds;        /**< ws_spring_kind per spring; NULL: all WS_SPRING_AROUND */
+    const uint32_t *pinned;      /**< node indices held fixed; may be NULL */
+    size_t pinned_count;
+} ws_web_mesh_def;
+
+/** Facts of a web. */
+typedef struct ws_web_info {
+    uint32_t node_count;
+    uint32_t spring_count;
+    int nx, ny;       /**< grid size (0 for a mesh web) */
+    int closed;       /**< 1 for a band (closed around) */
+    int substeps;
+    double mass;      /**< kg, all nodes */
+    double min_node_mass; /**< kg */
+} ws_web_info;
+
+/** One height band of a containment profile. */
+typedef struct ws_containment_band {
+    double z_low, z_high;  /**< m, the band (global z of its rows' mean height) */
+    double hoop_tension;   /**< mean tension of the around-springs of its rows, N */
+    double line_load;      /**< hoop tension per unit height, N/m */
+    double contact_force;  /**< total normal force of the bodies on its nodes, N */
+} ws_containment_band;
+
+WS_API void ws_web_def_init(ws_web_def *def);
+WS_API void ws_sheet_def_init(ws_sheet_def *def);
+WS_API void ws_band_def_init(ws_band_def *def);
+WS_API void ws_web_mesh_def_init(ws_web_mesh_def *def);
+
+/** Create a sheet. @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF,
+ *  WS_ERR_STALE_HANDLE (a law or material), WS_ERR_OUT_OF_MEMORY. */
+WS_API ws_status ws_web_create_sheet(ws_world *world, const ws_web_def *def,
+                                     const ws_sheet_def *sheet, ws_web_id *out);
+/** Wrap a band around bodies (as they are now). */
+WS_API ws_status ws_web_create_band(ws_world *world, const ws_web_def *def,
+                                    const ws_band_def *band, ws_web_id *out);
+/** A web from raw nodes and springs. */
+WS_API ws_status ws_web_create_mesh(ws_world *world, const ws_web_def *def,
+                                    const ws_web_mesh_def *mesh, ws_web_id *out);
+WS_API ws_status ws_web_destroy(ws_world *world, ws_web_id id);
+WS_API int ws_web_is_valid(const ws_world *world, ws_web_id id);
+WS_API ws_status ws_web_get_info(const ws_world *world, ws_web_id id, ws_web_info *info);
+
+/** The largest stable sub-step of the web, s: the explicit limit 2/omega_max with omega_max^2
+ *  bounded by (2 sum of spring stiffnesses + contact stiffness) / node mass over the nodes.
+ *  ws_world_step refuses to run (WS_ERR_NUMERICAL, saying the node mass or the sub-steps that
+ *  would do) when dt / substeps exceeds it. */
+WS_API ws_status ws_web_get_stable_dt(const ws_world *world, ws_web_id id, double *dt);
+/** Sub-steps per world step (>= 1). */
+WS_API ws_status ws_web_set_substeps(ws_world *world, ws_web_id id, int substeps);
+
+/* Bulk read-out: each copies min(capacity, count) items and writes count; buf NULL with
+ * capacity 0 asks for the count; a short buffer gives WS_ERR_BUFFER_TOO_SMALL. Capacities count
+ * items (nodes or springs), not doubles. */
+/** Node positions, xyz, m. */
+WS_API ws_status ws_web_copy_positions(const ws_world *world, ws_web_id id, double *xyz,
+                                       size_t capacity, size_t *count);
+/** Node velocities, xyz, m/s. */
+WS_API ws_status ws_web_copy_velocities(const ws_world *world, ws_web_id id, double *xyz,
+                                        size_t capacity, size_t *count);
+/** Force of the bodies on each node in the last step (normal + friction), xyz, N. */
+WS_API ws_status ws_web_copy_contact_forces(const ws_world *world, ws_web_id id, double *xyz,
+                                            size_t capacity, size_t *count);
+/** Spring end nodes, pairs. */
+WS_API ws_status ws_web_copy_springs(const ws_world *world, ws_web_id id, uint32_t *pairs,
+                                     size_t capacity, size_t *count);
+/** Spring strains l/l0 - 1 now. */
+WS_API ws_status ws_web_copy_spring_strains(const ws_world *world, ws_web_id id, double *strain,
+                                            size_t capacity, size_t *count);
+/** Spring tensions now (the law's force, N; negative in compression). */
+WS_API ws_status ws_web_copy_spring_tensions(const ws_world *world, ws_web_id id,
+                                             double *tension, size_t capacity, size_t *count);
+/** Total force (N, global) and moment about the CoG (N m) the web put on a body in the last
+ *  step. `moment` may be NULL. */
+WS_API ws_status ws_web_get_body_force(const ws_world *world, ws_web_id web, ws_body_id body,
+                                       ws_vec3 *force, ws_vec3 *moment);
+/** Containment profile of a grid web: its rows split into `count` equal bands from bottom to
+ *  top. WS_ERR_INVALID_ARGUMENT for a mesh web or count outside 1..rows. */
+WS_API ws_status ws_web_get_containment(const ws_world *world, ws_web_id id,
+                                        ws_containment_band *bands, size_t count);
+/** Energy of the web, J: kinetic, elastic (springs), and gravitational (-m g . x summed). */
+WS_API ws_status ws_web_get_energy(const ws_world *world, ws_web_id id, double *kinetic,
+                                   double *elastic, double *gravity);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

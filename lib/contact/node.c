@@ -1,0 +1,117 @@
+/* Web nodes against body faces: point-to-face only (eq. 14), one contact per node and face,
+ * penalty normal force and friction, forces and moments on the body. */
+#include "contact/contact.h"
+#include "contact/node.h"
+
+static int inside_box(v3 p, v3 lo, v3 hi, double e)
+{
+    return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
+           p.z > lo.z - e && p.z < hi.z + e;
+}
+
+int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, const v3 *x,
+                       double margin, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+{
+    *n = 0;
+    if (web->n == 0)
+        return 0;
+    /* The web's box, to skip bodies far from it. */
+    v3 lo = x[0], hi = x[0];
+    for (uint32_t i = 1; i < web->n; i++) {
+        lo = v3_min(lo, x[i]);
+        hi = v3_max(hi, x[i]);
+    }
+    double pad = web->layer + 0.5 * margin;
+    for (uint32_t k = 0; k < b->slots; k++) {
+        if (!b->alive[k])
+            continue;
+        if (b->lo[k].x > hi.x + pad || b->hi[k].x < lo.x - pad || b->lo[k].y > hi.y + pad ||
+            b->hi[k].y < lo.y - pad || b->lo[k].z > hi.z + pad || b->hi[k].z < lo.z - pad)
+            continue;
+        const ws_shape *sh = b->shape[k];
+        const m3 *A = &b->A[k];
+        v3 r = b->st[cur].r[k];
+        double reach = b->layer[k] + web->layer + margin;
+        for (uint32_t i = 0; i < web->n; i++) {
+            v3 p = x[i];
+            if (p.x < b->lo[k].x - pad || p.x > b->hi[k].x + pad || p.y < b->lo[k].y - pad ||
+                p.y > b->hi[k].y + pad || p.z < b->lo[k].z - pad || p.z > b->hi[k].z + pad)
+                continue;
+            v3 s = m3_tmul_v(A, v3_sub(p, r));
+            if (!inside_box(s, sh->lo, sh->hi, reach))
+                continue;
+            for (uint32_t f = 0; f < sh->face_count; f++) {
+                const ws_face *fc = &sh->faces[f];
+                (*checks)++;
+                double d = v3_dot(fc->normal, s) - fc->offset;
+                if (d > -reach - sh->inner && d < reach &&
+                    inside_box(s, fc->lo, fc->hi, reach + sh->inner)) {
+                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
+                        return -1;
+                    (*out)[(*n)++] = (ws_ncand){i, k, f};
+                }
+            }
+        }
+    }
+    return 0;
+}
+
+void ws_node_contacts(ws_body_store *b, int cur, ws_web *web, const v3 *x, const v3 *v,
+                      const ws_ncand *cand, size_t n, const ws_node_params *pp, double h,
+                      double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
+{
+    const ws_body_state *st = &b->st[cur];
+    for (size_t k = 0; k < n; k++) {
+        const ws_ncand *c = &cand[k];
+        uint32_t i = c->node, bi = c->body;
+        const ws_shape *sh = b->shape[bi];
+        const m3 *A = &b->A[bi];
+        v3 r = st->r[bi];
+        v3 s = m3_tmul_v(A, v3_sub(x[i], r));
+        double reach = b->layer[bi] + web->layer, d;
+        (*checks)++;
+        if (!ws_point_in_face(sh, c->face, s, -reach - sh->inner, reach, &d))
+            continue;
+        if (d < 0.0 && !ws_shallowest_face(sh, c->face, s, d))
+            continue;
+        const ws_node_params *p = &pp[b->material[bi]];
+        v3 nrm = m3_mul_v(A, sh->faces[c->face].normal); /* from the body to the node */
+        v3 xc = v3_madd(x[i], nrm, -0.5 * d);
+        v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
+        v3 vrel = v3_sub(v[i], vb);
+        double vn = v3_dot(vrel, nrm);
+        double fn = p->k * (reach - d) - p->c * vn;
+        if (fn < 0.0)
+            fn = 0.0;
+        /* Friction: eq. 13, limited to the force that stops the node's slip within this
+         * sub-step. Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for
+         * an explicit step of a light node (it would reverse the slip and chatter), so the slip
+         * is predicted at the end of the sub-step with the other forces on the node, and the
+         * friction is the smaller of what stops that slip (m |v_pred| / h) and what eq. 13 gives
+         * for it, against it. Sticking nodes then hold their tangential load exactly; sliding
+         * ones get mu N; for heavy masses this is eq. 13 itself. */
+        v3 vt = v3_madd(vrel, nrm, -vn);
+        v3 ft = v3_make(0, 0, 0);
+        if (fn > 0.0 && web->inv_m[i] != 0.0) {
+            v3 fo = web->f[i];
+            fo = v3_madd(fo, nrm, -v3_dot(fo, nrm)); /* tangential part of the other forces */
+            v3 vp = v3_madd(vt, fo, h * web->inv_m[i]);
+            double vps = v3_norm(vp);
+            if (vps > 0.0) {
+                double sr = vps / p->vlim;
+                double law = p->mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+                double stop = web->m[i] * vps / h;
+                ft = v3_scale(vp, -(law < stop ? law : stop) / vps);
+            }
+        }
+        v3 F = v3_add(v3_scale(nrm, fn), ft); /* on the node */
+        web->f[i] = v3_add(web->f[i], F);
+        fc[i] = v3_madd(fc[i], F, share);
+        v3 Fb = v3_scale(F, -share); /* on the body, averaged over the sub-steps */
+        b->f[bi] = v3_add(b->f[bi], Fb);
+        v3 mb = v3_cross(v3_sub(xc, r), Fb);
+        b->m[bi] = v3_add(b->m[bi], mb);
+        bforce[bi] = v3_add(bforce[bi], Fb);
+        bmoment[bi] = v3_add(bmoment[bi], mb);
+    }
+}
