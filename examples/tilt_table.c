@@ -62,6 +62,8 @@ typedef struct tilt_result {
                                               NaN when it never slid */
     int slide_confirmed[2];
     double tip_time[2], tip_angle[2];     /* first time a box leans > 2 deg on its support */
+    double lift_time, lift_angle;         /* the bottom box's uphill edge lifts off the
+                                             platform: the stack starts to tip (NaN: never) */
     double final_slip[2];                 /* m along the platform, downhill positive */
     double off_time[2];                   /* when its CoG went below the platform's surface:
                                              it left the platform (NaN: never) */
@@ -304,6 +306,24 @@ static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *bu
     return count > 0 && slipping == count;
 }
 
+/* 1 when body b touches the platform only on the downhill half of its bottom (x in the
+ * platform's frame greater than its CoG's) or not at all: its uphill edge has lifted. */
+static int uphill_lifted(ws_world *w, ws_body_id plane, ws_body_id b, const ws_contact_info *buf,
+                         size_t n)
+{
+    ws_vec3 r;
+    ws_body_get_position(w, b, &r);
+    double xc = in_plane_frame(w, plane, r).x;
+    for (size_t k = 0; k < n; k++) {
+        const ws_contact_info *c = &buf[k];
+        int pair = (c->body_a.bits == plane.bits && c->body_b.bits == b.bits) ||
+                   (c->body_a.bits == b.bits && c->body_b.bits == plane.bits);
+        if (pair && in_plane_frame(w, plane, c->point).x < xc)
+            return 0;
+    }
+    return 1;
+}
+
 /* CoG of body b in the frame of body a. */
 static ws_vec3 box_local(ws_world *w, ws_body_id a, ws_body_id b)
 {
@@ -342,6 +362,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     for (int k = 0; k < 2; k++)
         res->slide_time[k] = res->slide_angle[k] = res->tip_time[k] = res->tip_angle[k] =
             res->off_time[k] = NAN;
+    res->lift_time = res->lift_angle = NAN;
     tilt_scene sc;
     ws_status s = tilt_build(o, &sc);
     if (s != WS_OK) {
@@ -398,6 +419,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     ws_contact_info contacts[256];
     long slipping_steps[2] = {0, 0};
     const long sustained = lround(0.01 / sc.dt); /* gross slip must last 10 ms */
+    long lifted_steps = 0;
+    int lift_confirmed = 0;
     for (long n = 0; n <= steps; n++) {
         double t, theta = plane_angle(w, sc.plane);
         ws_world_get_time(w, &t);
@@ -429,9 +452,22 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                 res->tip_angle[k] = DEG(theta);
             }
         }
+        /* Tipping: the uphill edge stays off for 50 ms (a knock lifts it for less). */
+        if (!lift_confirmed) {
+            if (t > 1.0 && uphill_lifted(w, sc.plane, sc.box[0], contacts, nc)) {
+                if (lifted_steps++ == 0) {
+                    res->lift_time = t;
+                    res->lift_angle = DEG(theta);
+                }
+                lift_confirmed = lifted_steps >= lround(0.05 / sc.dt);
+            } else {
+                lifted_steps = 0;
+                res->lift_time = res->lift_angle = NAN;
+            }
+        }
         ws_vec3 rel = box_local(w, sc.box[0], sc.box[1]);
         double dx = rel.x - top_on_bottom0.x, dy = rel.y - top_on_bottom0.y;
-        if (t < 3.0 * sc.duration) /* the stack may fall apart at the very end: keep the max */
+        if (!lift_confirmed) /* while the stack stands: once it tips anything goes */
             res->max_relative_slip = fmax(res->max_relative_slip, sqrt(dx * dx + dy * dy));
         if (sc.film.bits && n % csv_every == 0) {
             size_t m;
@@ -561,7 +597,13 @@ int main(int argc, char **argv)
         print_box("top", &r, 1);
         printf("  distance between the CoGs: %.1f mm at the start, %.1f mm at the end\n",
                1e3 * r.cog_distance_start, 1e3 * r.cog_distance_end);
-        printf("  top box on the bottom one: largest move %.1f mm\n", 1e3 * r.max_relative_slip);
+        if (!isnan(r.lift_time))
+            printf("  the bottom box's uphill edge lifts off the platform at %.2f deg (t = %.3f s);\n"
+                   "    a rigid stack unloads it at tan(theta) = (a/2) / CoG height = 0.125/0.252, "
+                   "%.2f deg\n",
+                   r.lift_angle, r.lift_time, DEG(atan(0.125 / 0.252)));
+        printf("  top box on the bottom one: largest move %.1f mm while the stack stands\n",
+               1e3 * r.max_relative_slip);
         if (o.wrapped)
             printf("  film: peak strain %.3f, peak spring tension %.2f N\n", r.peak_strain,
                    r.peak_tension);

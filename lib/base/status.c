@@ -8,7 +8,7 @@ const char *ws_status_string(ws_status status)
     case WS_ERR_UNINITIALIZED_DEF: return "WS_ERR_UNINITIALIZED_DEF: the Def was not filled by its ws_*_def_init()";
     case WS_ERR_STALE_HANDLE: return "WS_ERR_STALE_HANDLE: the id is null, destroyed or from another world";
     case WS_ERR_OUT_OF_MEMORY: return "WS_ERR_OUT_OF_MEMORY: the allocator returned NULL";
-    case WS_ERR_NUMERICAL: return "WS_ERR_NUMERICAL: the step produced NaN, inf or runaway energy and was undone";
+    case WS_ERR_NUMERICAL: return "WS_ERR_NUMERICAL: the step produced NaN, inf or runaway energy and was undone, or was refused as unstable";
     case WS_ERR_BAD_MESH: return "WS_ERR_BAD_MESH: the mesh is not closed, consistent and non-degenerate";
     case WS_ERR_IN_USE: return "WS_ERR_IN_USE: the object is still used";
     case WS_ERR_CALLBACK: return "WS_ERR_CALLBACK: a user callback reported failure";

@@ -9,8 +9,9 @@ static int inside_box(v3 p, v3 lo, v3 hi, double e)
            p.z > lo.z - e && p.z < hi.z + e;
 }
 
-int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, const v3 *x,
-                       double margin, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
+                       ws_web *web, const v3 *x, double margin, ws_ncand **out, size_t *n,
+                       size_t *cap, uint64_t *checks)
 {
     *n = 0;
     if (web->n == 0)
@@ -32,6 +33,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web
         const m3 *A = &b->A[k];
         v3 r = b->st[cur].r[k];
         double reach = b->layer[k] + web->layer + margin;
+        double hi_k = b->layer[k] + web->layer, lo_k = -hi_k - sh->inner;
         for (uint32_t i = 0; i < web->n; i++) {
             v3 p = x[i];
             if (p.x < b->lo[k].x - pad || p.x > b->hi[k].x + pad || p.y < b->lo[k].y - pad ||
@@ -48,7 +50,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web
                     inside_box(s, fc->lo, fc->hi, reach + sh->inner)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, f};
+                    (*out)[(*n)++] = (ws_ncand){i, k, f, g->face_base[k] + f, lo_k, hi_k};
                 }
             }
         }
@@ -56,26 +58,109 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web
     return 0;
 }
 
-void ws_node_contacts(ws_body_store *b, int cur, ws_web *web, const v3 *x, const v3 *v,
-                      const ws_ncand *cand, size_t n, const ws_node_params *pp, double h,
-                      double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
+int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
+{
+    size_t nf = 0, nt = 0;
+    for (size_t k = 0; k < b->slots; k++)
+        if (b->alive[k]) {
+            nf += b->shape[k]->face_count;
+            nt += b->shape[k]->triangle_count;
+        }
+    if (ws_array_reserve(mem, (void **)&g->face, &g->face_cap, nf + 1, sizeof *g->face) != 0 ||
+        ws_array_reserve(mem, (void **)&g->tri, &g->tri_cap, nt + 1, sizeof *g->tri) != 0)
+        return -1;
+    if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
+                         sizeof(uint32_t)) != 0 ||
+        ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
+                         sizeof(uint32_t)) != 0)
+        return -1;
+    uint32_t fo = 0, to = 0;
+    for (size_t k = 0; k < b->slots; k++) {
+        if (!b->alive[k])
+            continue;
+        const ws_shape *sh = b->shape[k];
+        const m3 *A = &b->A[k];
+        v3 r = b->st[cur].r[k];
+        g->face_base[k] = fo;
+        g->tri_base[k] = to;
+        for (uint32_t f = 0; f < sh->face_count; f++) {
+            const ws_face *F = &sh->faces[f];
+            ws_wface *o = &g->face[fo + f];
+            o->n = m3_mul_v(A, F->normal);
+            o->off = F->offset + v3_dot(o->n, r); /* n . (r + A s) = n' . s + n . r */
+            o->first_tri = to + F->first_tri;
+            o->tri_count = F->tri_count;
+        }
+        for (uint32_t t = 0; t < sh->triangle_count; t++) {
+            const ws_tri *T = &sh->tris[t];
+            ws_wtri *o = &g->tri[to + t];
+            o->p = v3_add(r, m3_mul_v(A, T->p));
+            o->w = m3_mul_v(A, T->w);
+            o->v = m3_mul_v(A, T->v);
+            o->g00 = T->g00; /* the Gram matrix does not change under rotation */
+            o->g01 = T->g01;
+            o->g11 = T->g11;
+        }
+        fo += sh->face_count;
+        to += sh->triangle_count;
+    }
+    return 0;
+}
+
+void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
+{
+    ws_mem_free(mem, g->face, g->face_cap * sizeof *g->face);
+    ws_mem_free(mem, g->tri, g->tri_cap * sizeof *g->tri);
+    ws_mem_free(mem, g->face_base, g->face_base_cap * sizeof *g->face_base);
+    ws_mem_free(mem, g->tri_base, g->tri_base_cap * sizeof *g->tri_base);
+}
+
+/* Eq. 14 in the global frame for a prepared face: 1 and the signed distance when the point
+ * projects into the face and lies within (lo, hi) of its plane. */
+static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, double lo, double hi,
+                           double *dist)
+{
+    double d = v3_dot(F->n, x) - F->off;
+    if (!(d > lo && d < hi))
+        return 0;
+    for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
+        const ws_wtri *q = &g->tri[t];
+        v3 r = v3_sub(x, q->p);
+        double b1 = v3_dot(r, q->w), b2 = v3_dot(r, q->v);
+        double k1 = q->g00 * b1 + q->g01 * b2, k2 = q->g01 * b1 + q->g11 * b2;
+        if (k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL) {
+            *dist = d;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, const v3 *x,
+                      const v3 *v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
+                      double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
 {
     const ws_body_state *st = &b->st[cur];
+    *checks += n;
     for (size_t k = 0; k < n; k++) {
         const ws_ncand *c = &cand[k];
-        uint32_t i = c->node, bi = c->body;
-        const ws_shape *sh = b->shape[bi];
-        const m3 *A = &b->A[bi];
-        v3 r = st->r[bi];
-        v3 s = m3_tmul_v(A, v3_sub(x[i], r));
-        double reach = b->layer[bi] + web->layer, d;
-        (*checks)++;
-        if (!ws_point_in_face(sh, c->face, s, -reach - sh->inner, reach, &d))
+        uint32_t i = c->node;
+        /* Most candidates lie flat beside a face without pressing it: reject them on the
+         * plane distance alone before anything else is loaded. */
+        const ws_wface *F = &g->face[c->wface];
+        double d = v3_dot(F->n, x[i]) - F->off;
+        if (!(d > c->lo && d < c->hi))
             continue;
-        if (d < 0.0 && !ws_shallowest_face(sh, c->face, s, d))
+        if (!in_wface(g, F, x[i], c->lo, c->hi, &d))
+            continue;
+        uint32_t bi = c->body;
+        const ws_shape *sh = b->shape[bi];
+        double reach = c->hi;
+        v3 r = st->r[bi];
+        if (d < 0.0 && !ws_shallowest_face(sh, c->face, m3_tmul_v(&b->A[bi], v3_sub(x[i], r)), d))
             continue;
         const ws_node_params *p = &pp[b->material[bi]];
-        v3 nrm = m3_mul_v(A, sh->faces[c->face].normal); /* from the body to the node */
+        v3 nrm = F->n; /* from the body to the node */
         v3 xc = v3_madd(x[i], nrm, -0.5 * d);
         v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
         v3 vrel = v3_sub(v[i], vb);
@@ -104,10 +189,10 @@ void ws_node_contacts(ws_body_store *b, int cur, ws_web *web, const v3 *x, const
                 ft = v3_scale(vp, -(law < stop ? law : stop) / vps);
             }
         }
-        v3 F = v3_add(v3_scale(nrm, fn), ft); /* on the node */
-        web->f[i] = v3_add(web->f[i], F);
-        fc[i] = v3_madd(fc[i], F, share);
-        v3 Fb = v3_scale(F, -share); /* on the body, averaged over the sub-steps */
+        v3 Fnode = v3_add(v3_scale(nrm, fn), ft);
+        web->f[i] = v3_add(web->f[i], Fnode);
+        fc[i] = v3_madd(fc[i], Fnode, share);
+        v3 Fb = v3_scale(Fnode, -share); /* on the body, averaged over the sub-steps */
         b->f[bi] = v3_add(b->f[bi], Fb);
         v3 mb = v3_cross(v3_sub(xc, r), Fb);
         b->m[bi] = v3_add(b->m[bi], mb);

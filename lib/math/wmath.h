@@ -39,13 +39,15 @@ static inline void v3_store(double *p, v3 a)
     p[1] = a.y;
     p[2] = a.z;
 }
+/* Plain compares, not fmin/fmax: those are library calls on hot paths (NaN never reaches
+ * here: inputs are checked). */
 static inline v3 v3_min(v3 a, v3 b)
 {
-    return v3_make(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z));
+    return v3_make(a.x < b.x ? a.x : b.x, a.y < b.y ? a.y : b.y, a.z < b.z ? a.z : b.z);
 }
 static inline v3 v3_max(v3 a, v3 b)
 {
-    return v3_make(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z));
+    return v3_make(a.x > b.x ? a.x : b.x, a.y > b.y ? a.y : b.y, a.z > b.z ? a.z : b.z);
 }
 
 static inline v3 m3_mul_v(const m3 *a, v3 v)

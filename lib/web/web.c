@@ -55,18 +55,36 @@ void ws_web_internal_forces(ws_web *web, const v3 *x, const v3 *v, v3 g)
     const double c = web->damping;
     for (uint32_t i = 0; i < web->n; i++)
         f[i] = v3_madd(v3_scale(g, web->m[i]), v[i], -c);
+    /* The laws' parameters by spring kind, hoisted out of the loop. Linear laws have
+     * kc = k, so their ramp term vanishes and one formula serves every law type:
+     * F = kc eps + (k - kc) g(eps) + c eps_dot (lib/law/law.h). */
+    double K[3] = {0}, DK[3] = {0}, W[3] = {1, 1, 1}, C[3] = {0};
+    for (int k = 0; k < 3; k++) {
+        const ws_law1d *L = web->law[k];
+        if (!L)
+            continue;
+        K[k] = L->kc;
+        DK[k] = L->k - L->kc;
+        W[k] = L->w;
+        C[k] = L->c;
+    }
     for (uint32_t s = 0; s < web->ns; s++) {
         uint32_t a = web->sa[s], b = web->sb[s];
         v3 d = v3_sub(x[b], x[a]);
-        double l = v3_norm(d);
-        if (!(l > 0.0))
+        double l2 = v3_dot(d, d);
+        if (!(l2 > 0.0))
             continue; /* coincident ends: no direction to pull along */
-        v3 u = v3_scale(d, 1.0 / l);
-        double il0 = web->inv_l0[s];
+        double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
         double eps = l * il0 - 1.0;
-        double epsd = v3_dot(v3_sub(v[b], v[a]), u) * il0;
-        double F = ws_law1d_eval(web->law[web->kind[s]], eps, epsd, NULL, NULL);
-        v3 fu = v3_scale(u, F); /* tension pulls the ends together */
+        double epsd = v3_dot(v3_sub(v[b], v[a]), d) * il * il0;
+        int kd = web->kind[s];
+        double ramp = 0.0;
+        if (DK[kd] != 0.0) {
+            double w = W[kd];
+            ramp = eps >= w ? eps : eps <= -w ? 0.0 : (eps + w) * (eps + w) / (4.0 * w);
+        }
+        double F = K[kd] * eps + DK[kd] * ramp + C[kd] * epsd;
+        v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
         f[a] = v3_add(f[a], fu);
         f[b] = v3_sub(f[b], fu);
     }

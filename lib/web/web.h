@@ -10,9 +10,12 @@
 #include "law/law.h"
 #include "math/wmath.h"
 
-/* A node-face candidate: node `node` of the web against face `face` of body `body`. */
+/* A node-face candidate: node `node` of the web against face `face` of body `body`; wface
+ * indexes the face prepared in the global frame, (lo, hi) the contact window of its plane
+ * distance: hi = the two layers, lo = -(hi + the body's inner depth). */
 typedef struct ws_ncand {
-    uint32_t node, body, face;
+    uint32_t node, body, face, wface;
+    double lo, hi;
 } ws_ncand;
 
 typedef struct ws_web {
@@ -39,7 +42,10 @@ typedef struct ws_web {
     /* Force and moment on each body in the last step (global, moment about the CoG). */
     v3 *bforce[2], *bmoment[2];
     size_t bcap;
-    double max_speed_step; /* largest node speed in the last step, m/s */
+    /* Node candidates stay valid while nothing has moved half the contact margin since they
+     * were found: travel bounds that, refresh says they must be found again. */
+    double travel, next_travel;
+    int refresh;
 } ws_web;
 
 /* Allocate a web of n nodes and ns springs (zeroed). */

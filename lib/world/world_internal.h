@@ -52,6 +52,7 @@ struct ws_world {
     ws_slot_table web_slots;
     int web_check; /* 1: re-check the webs' stable step before the next step */
     ws_node_params *node_par; /* node contact parameters by body material, scratch */
+    ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
     size_t node_par_cap;
 
     ws_cand *cand[2];

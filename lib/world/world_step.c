@@ -141,17 +141,27 @@ static ws_status webs_ready(ws_world *w)
 
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration.
  * Forces on the bodies go into their accumulators, averaged over the sub-steps. */
-static ws_status step_webs(ws_world *w, int full, int cur, int nxt, double *vmax_all)
+static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
 {
     ws_body_store *b = &w->bodies;
+    double body_speed = max_step_travel(w, cur) / w->def.dt; /* bound on any body point's speed */
+    if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
     for (size_t k = 0; k < w->web_slots.slot_count; k++) {
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
+        /* Node candidates are found again when the cache is invalid or when nodes or bodies may
+         * have moved half the margin since: then the cache holds every node-face pair that can
+         * touch, and the result is the same as finding them every step (tests/test_detection.c
+         * shows it for body pairs). The world's detection schedule governs the body pairs. */
         int list = web->list;
-        if (full) {
+        int again = web->refresh || !w->cand_valid || 2.0 * web->travel >= w->def.contact_margin;
+        web->next_travel = again ? 0.0 : web->travel;
+        if (again) {
             list ^= 1;
-            if (ws_node_candidates(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin,
+            if (ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
+                                   w->def.contact_margin,
                                    &web->cand[list], &web->ncand[list], &web->capcand[list],
                                    &w->stats.narrow_checks) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
@@ -169,7 +179,7 @@ static ws_status step_webs(ws_world *w, int full, int cur, int nxt, double *vmax
         for (int s = 0; s < n; s++) {
             int src = s == 0 ? cur : nxt;
             ws_web_internal_forces(web, web->x[src], web->v[src], w->def.gravity);
-            ws_node_contacts(b, cur, web, web->x[src], web->v[src], web->cand[list],
+            ws_node_contacts(b, cur, &w->node_geom, web, web->x[src], web->v[src], web->cand[list],
                              web->ncand[list], w->node_par, h, share, web->fc[nxt],
                              web->bforce[nxt], web->bmoment[nxt], &w->stats.narrow_checks);
             double vmax = ws_web_integrate(web, web->x[src], web->v[src], web->x[nxt],
@@ -184,6 +194,7 @@ static ws_status step_webs(ws_world *w, int full, int cur, int nxt, double *vmax
             }
             if (vmax > *vmax_all)
                 *vmax_all = vmax;
+            web->next_travel += (vmax + body_speed) * h;
         }
     }
     return WS_OK;
@@ -263,7 +274,7 @@ ws_status ws_world_step(ws_world *w)
 
     double web_speed = 0.0;
     if (w->web_slots.slot_count) {
-        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, full, cur, nxt, &web_speed)) != WS_OK)
+        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, cur, nxt, &web_speed)) != WS_OK)
             return s;
     }
 
@@ -314,10 +325,15 @@ ws_status ws_world_step(ws_world *w)
         w->stats.full_detections++;
         w->travel = 0.0;
     }
-    w->travel += max_step_travel(w, w->cur) + web_speed * dt; /* this step's motion bound */
-    for (size_t k = 0; k < w->web_slots.slot_count; k++)
-        if (w->web_slots.dense[k] != UINT32_MAX)
-            w->webs[k]->list = w->webs[k]->next_list;
+    w->travel += max_step_travel(w, w->cur); /* this step's motion bound */
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        ws_web *web = w->webs[k];
+        web->list = web->next_list;
+        web->travel = web->next_travel;
+        web->refresh = 0;
+    }
     w->steps++;
     return WS_OK;
 }

@@ -298,6 +298,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->damping = c->d.node_damping;
     web->substeps = c->d.substeps;
     web->list = 0;
+    web->refresh = 1;
     /* Both buffers start equal, so the world's committed index (0 or 1) finds the web. */
     for (uint32_t i = 0; i < web->n; i++)
         web->x[1][i] = web->x[0][i];
@@ -526,6 +527,7 @@ void ws_world_free_webs(ws_world *w)
     ws_mem_free(&w->mem, w->laws, w->law_cap * sizeof *w->laws);
     ws_slots_destroy(&w->mem, &w->law_slots);
     ws_mem_free(&w->mem, w->node_par, w->node_par_cap * sizeof *w->node_par);
+    ws_node_geometry_free(&w->mem, &w->node_geom);
 }
 
 static ws_status get_web(const ws_world *w, ws_web_id id, const ws_web **web)
@@ -748,6 +750,14 @@ ws_status ws_web_get_containment(const ws_world *w, ws_web_id id, ws_containment
                        web->ny, count);
     const v3 *x = web->x[w->cur], *v = web->v[w->cur], *fc = web->fc[w->cur];
     int cols = web->closed ? web->nx : web->nx - 1;
+    /* Row pitch from the mean heights of the first and last rows (not one column, which may
+     * sag or lean). */
+    double zfirst = 0.0, zlast = 0.0;
+    for (int i = 0; i < web->nx; i++) {
+        zfirst += x[i].z;
+        zlast += x[(size_t)i + (size_t)web->nx * (size_t)(web->ny - 1)].z;
+    }
+    double pitch = web->ny > 1 ? (zlast - zfirst) / web->nx / (web->ny - 1) : 0.0;
     for (size_t k = 0; k < count; k++) {
         int j0 = (int)(k * (size_t)web->ny / count), j1 = (int)((k + 1) * (size_t)web->ny / count);
         double zlo = INFINITY, zhi = -INFINITY, tsum = 0.0, nsum = 0.0;
@@ -770,10 +780,6 @@ ws_status ws_web_get_containment(const ws_world *w, ws_web_id id, ws_containment
         o->z_low = zlo;
         o->z_high = zhi;
         o->hoop_tension = rows ? tsum / (rows * cols) : 0.0;
-        /* Line load: row tension over the height each row stands for. */
-        double pitch = web->ny > 1 ? (x[(size_t)web->nx * (size_t)(web->ny - 1)].z - x[0].z) /
-                                         (web->ny - 1)
-                                   : 0.0;
         o->line_load = pitch != 0.0 ? o->hoop_tension / fabs(pitch) : 0.0;
         o->contact_force = nsum;
     }
