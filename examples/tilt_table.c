@@ -44,6 +44,7 @@ typedef struct tilt_options {
     int wrapped;          /* 1: stretch film around the stack */
     double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
     int substeps;         /* film sub-steps per step; 0 = 1 */
+    int profile;          /* 1: the library times its phases (ws_world_stats) */
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -166,6 +167,7 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.full_detection_until = 0.5; /* full detection every step for 0.5 s ... */
     wd.detection_interval = 5;     /* ... then every 5th step */
     wd.use_ccd = o->use_ccd;
+    wd.profile = o->profile;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
     ws_status s = ws_world_create(&wd, &sc->world);

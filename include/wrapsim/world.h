@@ -48,6 +48,8 @@ typedef struct ws_world_def {
     double max_angular_speed;
     /** Use the libccd gate when built in (1, default) or not (0). Results are the same. */
     int use_ccd;
+    /** 1: time the phases of each step (wall clock, see ws_world_stats); 0 (default): not. */
+    int profile;
     ws_allocator allocator; /**< memory hooks; default malloc/realloc/free */
     ws_log_fn log;          /**< optional log hook; NULL for none */
     void *log_user;         /**< passed to log */
@@ -98,7 +100,12 @@ typedef struct ws_world_stats {
     uint64_t bytes_in_use;     /**< bytes allocated through the allocator, now */
     uint64_t bytes_peak;       /**< most bytes in use at once */
     uint64_t bodies;           /**< bodies alive */
-    uint64_t reserved[8];      /**< zero; room to grow */
+    /* With ws_world_def.profile = 1, wall-clock seconds spent in, over all steps: */
+    double seconds_detection;  /**< finding candidate pairs (bodies and film nodes) */
+    double seconds_contacts;   /**< evaluating body-body contacts */
+    double seconds_web;        /**< film: springs, node contacts, node integration */
+    double seconds_total;      /**< whole steps */
+    uint64_t reserved[4];      /**< zero; room to grow */
 } ws_world_stats;
 
 /** Mechanical energy of the dynamic bodies, J. */

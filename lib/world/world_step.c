@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, for the optional phase timing */
 /* ws_world_step(): the one orchestrator. Data flows one way:
  *   (1) state at t -> rotation matrices, global angular velocities, inflated boxes;
  *   (2) contact detection: full (broad phase, optional libccd gate, candidate feature pairs) or
@@ -10,6 +11,17 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
+
+/* Wall clock for the optional phase timing (0 when profiling is off, so nothing is asked). */
+static double clock_now(const ws_world *w)
+{
+    if (!w->def.profile)
+        return 0.0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 static void prepare(ws_world *w)
 {
@@ -159,6 +171,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
         int again = web->refresh || !w->cand_valid || 2.0 * web->travel >= w->def.contact_margin;
         web->next_travel = again ? 0.0 : web->travel;
         if (again) {
+            double t0 = clock_now(w);
             list ^= 1;
             if (ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
                                    w->def.contact_margin,
@@ -166,6 +179,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                                    &w->stats.narrow_checks) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
+            w->stats.seconds_detection += clock_now(w) - t0;
+            w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
         web->next_list = list;
         if (ws_world_node_params(w, web->material) != 0)
@@ -239,6 +254,7 @@ ws_status ws_world_step(ws_world *w)
     ws_body_store *b = &w->bodies;
     const int cur = w->cur, nxt = cur ^ 1;
     const double dt = w->def.dt, t = w->time;
+    const double t_start = clock_now(w);
 
     prepare(w);
 
@@ -251,6 +267,7 @@ ws_status ws_world_step(ws_world *w)
                w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval ||
                2.0 * w->travel >= w->def.contact_margin;
     ws_status s;
+    double t_mark = clock_now(w);
     if (full) {
         if ((s = detect_full(w, &x, nxt)) != WS_OK)
             return s;
@@ -267,15 +284,20 @@ ws_status ws_world_step(ws_world *w)
                          sizeof *w->rec[nxt]) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact records");
 
+    double t_eval = clock_now(w);
+    w->stats.seconds_detection += t_eval - t_mark;
     size_t nrec = 0;
     for (size_t k = 0; k < w->ncand[nxt]; k++)
         if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
             nrec++;
 
+    double t_web = clock_now(w);
+    w->stats.seconds_contacts += t_web - t_eval;
     double web_speed = 0.0;
     if (w->web_slots.slot_count) {
         if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, cur, nxt, &web_speed)) != WS_OK)
             return s;
+        w->stats.seconds_web += clock_now(w) - t_web;
     }
 
     for (size_t i = 0; i < b->slots; i++) {
@@ -335,6 +357,7 @@ ws_status ws_world_step(ws_world *w)
         web->refresh = 0;
     }
     w->steps++;
+    w->stats.seconds_total += clock_now(w) - t_start;
     return WS_OK;
 }
 
