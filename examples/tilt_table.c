@@ -281,14 +281,15 @@ static ws_vec3 in_plane_frame(ws_world *w, ws_body_id plane, ws_vec3 p)
     return s;
 }
 
-/* Angle (rad) of the rotation between two bodies. */
+/* Lean (rad) of body b on body a: the angle between their z axes. A twist about the vertical
+ * is not a lean. */
 static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 {
-    ws_quat p, q;
-    ws_body_get_orientation(w, a, &p);
-    ws_body_get_orientation(w, b, &q);
-    double dot = p.e0 * q.e0 + p.e1 * q.e1 + p.e2 * q.e2 + p.e3 * q.e3;
-    return 2.0 * acos(fmin(1.0, fabs(dot)));
+    ws_mat3 A, B;
+    ws_body_get_rotation(w, a, &A);
+    ws_body_get_rotation(w, b, &B);
+    double dot = A.m[2] * B.m[2] + A.m[5] * B.m[5] + A.m[8] * B.m[8]; /* third columns */
+    return acos(fmax(-1.0, fmin(1.0, dot)));
 }
 
 /* Gross slip of body b on its support: 1 when every contact between them slips (tangential

@@ -50,7 +50,21 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                     inside_box(s, fc->lo, fc->hi, reach + sh->inner)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, f, g->face_base[k] + f, lo_k, hi_k};
+                    (*out)[(*n)++] = (ws_ncand){i, k, f, g->face_base[k] + f, 0, lo_k, hi_k};
+                }
+            }
+            /* Convex edges within reach of the node: the rounded rim of the contact layer. */
+            for (uint32_t e = 0; e < sh->edge_count; e++) {
+                const ws_edge *E = &sh->edges[e];
+                (*checks)++;
+                v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+                double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
+                if (t < 0.0 || t > 1.0)
+                    continue;
+                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach) {
+                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
+                        return -1;
+                    (*out)[(*n)++] = (ws_ncand){i, k, e, g->edge_base[k] + e, 1, lo_k, hi_k};
                 }
             }
         }
@@ -60,21 +74,25 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
 
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
 {
-    size_t nf = 0, nt = 0;
+    size_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++)
         if (b->alive[k]) {
             nf += b->shape[k]->face_count;
             nt += b->shape[k]->triangle_count;
+            ne += b->shape[k]->edge_count;
         }
     if (ws_array_reserve(mem, (void **)&g->face, &g->face_cap, nf + 1, sizeof *g->face) != 0 ||
-        ws_array_reserve(mem, (void **)&g->tri, &g->tri_cap, nt + 1, sizeof *g->tri) != 0)
+        ws_array_reserve(mem, (void **)&g->tri, &g->tri_cap, nt + 1, sizeof *g->tri) != 0 ||
+        ws_array_reserve(mem, (void **)&g->edge, &g->edge_cap, ne + 1, sizeof *g->edge) != 0 ||
+        ws_array_reserve(mem, (void **)&g->edge_base, &g->edge_base_cap, b->slots + 1,
+                         sizeof(uint32_t)) != 0)
         return -1;
     if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
                          sizeof(uint32_t)) != 0 ||
         ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
                          sizeof(uint32_t)) != 0)
         return -1;
-    uint32_t fo = 0, to = 0;
+    uint32_t fo = 0, to = 0, eo = 0;
     for (size_t k = 0; k < b->slots; k++) {
         if (!b->alive[k])
             continue;
@@ -101,8 +119,20 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
             o->g01 = T->g01;
             o->g11 = T->g11;
         }
+        g->edge_base[k] = eo;
+        for (uint32_t e = 0; e < sh->edge_count; e++) {
+            const ws_edge *E = &sh->edges[e];
+            ws_wedge *o = &g->edge[eo + e];
+            v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+            o->p = v3_add(r, m3_mul_v(A, a));
+            o->e = m3_mul_v(A, d);
+            o->n1 = m3_mul_v(A, E->n1);
+            o->n2 = m3_mul_v(A, E->n2);
+            o->inv_e2 = 1.0 / v3_dot(d, d);
+        }
         fo += sh->face_count;
         to += sh->triangle_count;
+        eo += sh->edge_count;
     }
     return 0;
 }
@@ -113,6 +143,8 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->tri, g->tri_cap * sizeof *g->tri);
     ws_mem_free(mem, g->face_base, g->face_base_cap * sizeof *g->face_base);
     ws_mem_free(mem, g->tri_base, g->tri_base_cap * sizeof *g->tri_base);
+    ws_mem_free(mem, g->edge, g->edge_cap * sizeof *g->edge);
+    ws_mem_free(mem, g->edge_base, g->edge_base_cap * sizeof *g->edge_base);
 }
 
 /* Eq. 14 in the global frame for a prepared face: 1 and the signed distance when the point
@@ -136,65 +168,113 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, doubl
     return 0;
 }
 
+/* A node against the rounded rim of a convex edge: only in the edge's own region, where the
+ * direction from the edge to the node lies strictly between the normals of its two faces
+ * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
+ * to the node and the distance. */
+static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *dist)
+{
+    v3 rp = v3_sub(x, E->p);
+    double t = v3_dot(rp, E->e) * E->inv_e2;
+    if (!(t > 0.0 && t < 1.0))
+        return 0;
+    v3 r = v3_madd(rp, E->e, -t);
+    double l2 = v3_dot(r, r);
+    if (!(l2 < hi * hi) || !(l2 > 0.0))
+        return 0;
+    /* Outside both faces' planes: in the wedge between them. */
+    if (!(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
+        return 0;
+    /* And not over either face: r = a n1 + b n2 with a, b > 0. */
+    double c = v3_dot(E->n1, E->n2), r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
+    double den = 1.0 - c * c;
+    if (den < 1e-12 || !(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+        return 0;
+    double l = sqrt(l2);
+    *nrm = v3_scale(r, 1.0 / l);
+    *dist = l;
+    return 1;
+}
+
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, const v3 *x,
                       const v3 *v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
                       double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
 {
     const ws_body_state *st = &b->st[cur];
+    ws_nact *act = web->act; /* room for n: reserved with the candidates */
+    size_t na = 0;
     *checks += n;
+    /* Pass 1: normal forces. A node at a corner touches two faces; doing every normal force
+     * before any friction makes the result independent of the order of the faces (which
+     * differs from corner to corner and would twist a symmetric load). */
     for (size_t k = 0; k < n; k++) {
         const ws_ncand *c = &cand[k];
-        uint32_t i = c->node;
-        /* Most candidates lie flat beside a face without pressing it: reject them on the
-         * plane distance alone before anything else is loaded. */
-        const ws_wface *F = &g->face[c->wface];
-        double d = v3_dot(F->n, x[i]) - F->off;
-        if (!(d > c->lo && d < c->hi))
-            continue;
-        if (!in_wface(g, F, x[i], c->lo, c->hi, &d))
-            continue;
-        uint32_t bi = c->body;
-        const ws_shape *sh = b->shape[bi];
-        double reach = c->hi;
-        v3 r = st->r[bi];
-        if (d < 0.0 && !ws_shallowest_face(sh, c->face, m3_tmul_v(&b->A[bi], v3_sub(x[i], r)), d))
-            continue;
+        uint32_t i = c->node, bi = c->body;
+        v3 nrm, r = st->r[bi];
+        double d;
+        if (c->edge) {
+            if (!in_wedge(&g->edge[c->wface], x[i], c->hi, &nrm, &d))
+                continue;
+        } else {
+            /* Most candidates lie flat beside a face without pressing it: reject them on the
+             * plane distance alone before anything else is loaded. */
+            const ws_wface *F = &g->face[c->wface];
+            d = v3_dot(F->n, x[i]) - F->off;
+            if (!(d > c->lo && d < c->hi))
+                continue;
+            if (!in_wface(g, F, x[i], c->lo, c->hi, &d))
+                continue;
+            if (d < 0.0 && !ws_shallowest_face(b->shape[bi], c->face,
+                                               m3_tmul_v(&b->A[bi], v3_sub(x[i], r)), d))
+                continue;
+            nrm = F->n; /* from the body to the node */
+        }
         const ws_node_params *p = &pp[b->material[bi]];
-        v3 nrm = F->n; /* from the body to the node */
         v3 xc = v3_madd(x[i], nrm, -0.5 * d);
         v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
         v3 vrel = v3_sub(v[i], vb);
         double vn = v3_dot(vrel, nrm);
-        double fn = p->k * (reach - d) - p->c * vn;
-        if (fn < 0.0)
-            fn = 0.0;
-        /* Friction: eq. 13, limited to the force that stops the node's slip within this
-         * sub-step. Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for
-         * an explicit step of a light node (it would reverse the slip and chatter), so the slip
-         * is predicted at the end of the sub-step with the other forces on the node, and the
-         * friction is the smaller of what stops that slip (m |v_pred| / h) and what eq. 13 gives
-         * for it, against it. Sticking nodes then hold their tangential load exactly; sliding
-         * ones get mu N; for heavy masses this is eq. 13 itself. */
-        v3 vt = v3_madd(vrel, nrm, -vn);
-        v3 ft = v3_make(0, 0, 0);
-        if (fn > 0.0 && web->inv_m[i] != 0.0) {
-            v3 fo = web->f[i];
-            fo = v3_madd(fo, nrm, -v3_dot(fo, nrm)); /* tangential part of the other forces */
-            v3 vp = v3_madd(vt, fo, h * web->inv_m[i]);
-            double vps = v3_norm(vp);
-            if (vps > 0.0) {
-                double sr = vps / p->vlim;
-                double law = p->mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-                double stop = web->m[i] * vps / h;
-                ft = v3_scale(vp, -(law < stop ? law : stop) / vps);
-            }
+        double fn = p->k * (c->hi - d) - p->c * vn;
+        if (!(fn > 0.0))
+            continue; /* a contact never pulls */
+        web->f[i] = v3_madd(web->f[i], nrm, fn);
+        act[na++] = (ws_nact){i, bi, nrm, xc, v3_madd(vrel, nrm, -vn), v3_make(0, 0, 0), fn,
+                              p->mu, p->vlim};
+    }
+    /* Pass 2: friction: eq. 13, limited to the force that stops the node's slip within this
+     * sub-step. Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an
+     * explicit step of a light node (it would reverse the slip and chatter), so the slip is
+     * predicted at the end of the sub-step with the other forces on the node (springs, gravity
+     * and every normal force, none of the frictions: again order-free), and the friction is the
+     * smaller of what stops that slip (m |v_pred| / h) and what eq. 13 gives for it, against it.
+     * Sticking nodes hold their tangential load; sliding ones get mu N; for heavy masses this is
+     * eq. 13 itself. */
+    for (size_t k = 0; k < na; k++) {
+        ws_nact *a = &act[k];
+        uint32_t i = a->node;
+        if (web->inv_m[i] == 0.0)
+            continue;
+        v3 fo = web->f[i];
+        fo = v3_madd(fo, a->n, -v3_dot(fo, a->n)); /* tangential part of the other forces */
+        v3 vp = v3_madd(a->vt, fo, h * web->inv_m[i]);
+        double vps = v3_norm(vp);
+        if (vps > 0.0) {
+            double sr = vps / a->vlim;
+            double law = a->mu * a->fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+            double stop = web->m[i] * vps / h;
+            a->ft = v3_scale(vp, -(law < stop ? law : stop) / vps);
         }
-        v3 Fnode = v3_add(v3_scale(nrm, fn), ft);
-        web->f[i] = v3_add(web->f[i], Fnode);
+    }
+    /* Pass 3: apply; the bodies get the opposite, averaged over the sub-steps. */
+    for (size_t k = 0; k < na; k++) {
+        const ws_nact *a = &act[k];
+        uint32_t i = a->node, bi = a->body;
+        web->f[i] = v3_add(web->f[i], a->ft);
+        v3 Fnode = v3_madd(a->ft, a->n, a->fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
-        v3 Fb = v3_scale(Fnode, -share); /* on the body, averaged over the sub-steps */
+        v3 Fb = v3_scale(Fnode, -share);
         b->f[bi] = v3_add(b->f[bi], Fb);
-        v3 mb = v3_cross(v3_sub(xc, r), Fb);
+        v3 mb = v3_cross(v3_sub(a->xc, st->r[bi]), Fb);
         b->m[bi] = v3_add(b->m[bi], mb);
         bforce[bi] = v3_add(bforce[bi], Fb);
         bmoment[bi] = v3_add(bmoment[bi], mb);

@@ -23,11 +23,19 @@ typedef struct ws_wtri {
     double g00, g01, g11;
 } ws_wtri;
 
+/* A convex edge in the global frame: from p along e (|e| = length), with the outward normals of
+ * its two faces; inv_e2 = 1 / |e|^2. */
+typedef struct ws_wedge {
+    v3 p, e, n1, n2;
+    double inv_e2;
+} ws_wedge;
+
 typedef struct ws_node_geom {
     ws_wface *face;
     ws_wtri *tri;
-    uint32_t *face_base, *tri_base;
-    size_t face_cap, tri_cap, face_base_cap, tri_base_cap;
+    ws_wedge *edge;
+    uint32_t *face_base, *tri_base, *edge_base;
+    size_t face_cap, tri_cap, edge_cap, face_base_cap, tri_base_cap, edge_base_cap;
 } ws_node_geom;
 
 /* Fill g for the bodies at state cur. 0, or -1 when out of memory (only when bodies were

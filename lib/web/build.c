@@ -125,44 +125,44 @@ int ws_web_place_band(ws_web *web, const double *pts_in, size_t n, uint32_t *hul
     double total = per + 2.0 * WS_PI * offset;
     int na = web->nx, nu = web->ny;
     double step = total / na;
-    /* Walk the outline: edge k then the arc at its end corner. Node i at arc length i step. */
-    size_t k = 0;
-    double seg_start = 0.0; /* arc length where the current piece starts */
-    int on_arc = 0;
+    /* Node 0 sits at the middle of the first edge and the others follow at equal arc length, so
+     * a symmetric outline gets a mirror-symmetric band (starting at a corner would give every
+     * side the same handedness, and a band that twists the load when it snaps on). */
+    const double *e0a = pts + 2 * hull_idx[0], *e0b = pts + 2 * hull_idx[1 % h];
+    double start = 0.5 * hypot(e0b[0] - e0a[0], e0b[1] - e0a[1]);
     for (int i = 0; i < na; i++) {
-        double s = i * step, px = 0, py = 0;
-        for (;;) {
+        double s = fmod(start + i * step, total), px = 0, py = 0;
+        /* Walk the outline from its start: edge k, then the arc at its end corner. */
+        double seg = 0.0;
+        for (size_t k = 0; k < h; k++) {
             const double *a = pts + 2 * hull_idx[k], *b = pts + 2 * hull_idx[(k + 1) % h];
+            const double *c = pts + 2 * hull_idx[(k + 2) % h];
             double ex = b[0] - a[0], ey = b[1] - a[1], el = hypot(ex, ey);
             double nx = ey / el, ny = -ex / el; /* outward normal of a CCW edge */
-            if (!on_arc) {
-                if (s <= seg_start + el || k == h) {
-                    double t = (s - seg_start) / el;
+            if (s <= seg + el || k + 1 == h) {
+                double t = (s - seg) / el;
+                if (t <= 1.0 || offset <= 0.0) {
+                    t = t > 1.0 ? 1.0 : t;
                     px = a[0] + t * ex + offset * nx;
                     py = a[1] + t * ey + offset * ny;
                     break;
                 }
-                seg_start += el;
-                on_arc = 1;
-            } else {
-                /* Arc at corner b from this edge's normal to the next edge's normal. */
-                const double *c = pts + 2 * hull_idx[(k + 2) % h];
-                double fx = c[0] - b[0], fy = c[1] - b[1], fl = hypot(fx, fy);
-                double a0 = atan2(ny, nx), a1 = atan2(-fx / fl, fy / fl);
-                double turn = a1 - a0;
-                while (turn < 0.0)
-                    turn += 2.0 * WS_PI;
-                double arc = turn * offset;
-                if (s <= seg_start + arc || k + 1 == h) {
-                    double ang = a0 + (arc > 0.0 ? (s - seg_start) / offset : 0.0);
-                    px = b[0] + offset * cos(ang);
-                    py = b[1] + offset * sin(ang);
-                    break;
-                }
-                seg_start += arc;
-                on_arc = 0;
-                k++;
             }
+            seg += el;
+            /* Arc at corner b from this edge's normal to the next edge's normal. */
+            double fx = c[0] - b[0], fy = c[1] - b[1], fl = hypot(fx, fy);
+            double a0 = atan2(ny, nx), a1 = atan2(-fx / fl, fy / fl);
+            double turn = a1 - a0;
+            while (turn < 0.0)
+                turn += 2.0 * WS_PI;
+            double arc = turn * offset;
+            if (s <= seg + arc || k + 1 == h) {
+                double ang = a0 + (offset > 0.0 ? (s - seg) / offset : 0.0);
+                px = b[0] + offset * cos(ang);
+                py = b[1] + offset * sin(ang);
+                break;
+            }
+            seg += arc;
         }
         for (int j = 0; j < nu; j++) {
             double z = nu > 1 ? z0 + (z1 - z0) * j / (nu - 1) : z0;

@@ -35,6 +35,8 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->v[k], n * sizeof(v3));
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
+        if (k == 0)
+            ws_mem_free(mem, web->act, web->act_cap * sizeof(ws_nact));
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }

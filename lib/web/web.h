@@ -14,9 +14,17 @@
  * indexes the face prepared in the global frame, (lo, hi) the contact window of its plane
  * distance: hi = the two layers, lo = -(hi + the body's inner depth). */
 typedef struct ws_ncand {
-    uint32_t node, body, face, wface;
+    uint32_t node, body, face, wface; /* for an edge candidate: edge and wedge */
+    uint32_t edge;                    /* 1: node against a convex edge of the body */
     double lo, hi;
 } ws_ncand;
+
+/* A node contact of the current sub-step, between the normal and the friction passes. */
+typedef struct ws_nact {
+    uint32_t node, body;
+    v3 n, xc, vt, ft;
+    double fn, mu, vlim;
+} ws_nact;
 
 typedef struct ws_web {
     char *name;
@@ -37,6 +45,8 @@ typedef struct ws_web {
     /* Node-face candidates: changed only by full detection, into the other list. */
     ws_ncand *cand[2];
     size_t ncand[2], capcand[2];
+    ws_nact *act;  /* active contacts, scratch sized with the candidates */
+    size_t act_cap;
     int list;      /* the committed list */
     int next_list; /* the list this step used, committed with it */
     /* Force and moment on each body in the last step (global, moment about the CoG). */

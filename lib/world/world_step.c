@@ -179,6 +179,10 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                                    &w->stats.narrow_checks) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
+            if (ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
+                                 web->ncand[list] + 1, sizeof *web->act) != 0)
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                               web_label(web));
             w->stats.seconds_detection += clock_now(w) - t0;
             w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
