@@ -30,7 +30,8 @@ typedef enum ws_law_type {
     WS_LAW_LINEAR_VISCOELASTIC = 1,
     /** Film: F = k_c eps + (k - k_c) g(eps) + c eps_dot, where g is a smooth (C1) ramp from 0
      *  for eps <= -w to eps for eps >= w, quadratic between (w = transition): stiffness k in
-     *  tension, k_c in compression, joined smoothly. A film buckles rather than pushes: k_c << k. */
+     *  tension, k_c in compression, joined smoothly. A film buckles rather than pushes: k_c << k.
+     *  The join is centred on eps = 0, so F(0) = (k - k_c) w / 4: keep w small. */
     WS_LAW_TENSION_COMPRESSION = 2
 } ws_law_type;
 

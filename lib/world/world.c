@@ -339,6 +339,14 @@ ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
             h = ws_hash_bytes(h, &c->anchor_b, sizeof c->anchor_b);
         }
     }
+    /* The film is state too. */
+    for (size_t k = 0; k < w->web_cap && k < w->web_slots.slot_count; k++) {
+        const ws_web *web = w->webs[k];
+        if (w->web_slots.dense[k] == UINT32_MAX || !web)
+            continue;
+        h = ws_hash_bytes(h, web->x[w->cur], web->n * sizeof *web->x[w->cur]);
+        h = ws_hash_bytes(h, web->v[w->cur], web->n * sizeof *web->v[w->cur]);
+    }
     *hash = h;
     return WS_OK;
 }

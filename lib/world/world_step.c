@@ -101,6 +101,7 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
                               const char *what)
 {
     double mmin, kmax;
+    w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
     double r = h / stable;
     int need = (int)ceil(w->def.dt / stable);
@@ -204,7 +205,6 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
             double vmax = ws_web_integrate(web, web->x[src], web->v[src], web->x[nxt],
                                            web->v[nxt], h);
             if (!(vmax <= w->def.max_speed)) {
-                w->stats.numerical_errors++;
                 char what[160];
                 snprintf(what, sizeof what,
                          "a node ran away at t = %.6g s (speed %.3g m/s above max_speed %.3g)",

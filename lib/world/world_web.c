@@ -205,11 +205,11 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c)
         return s;
     const ws_web_def *d = &c->d;
     c->label = d->name ? d->name : "(unnamed)";
+    /* Which mass source is needed depends on the generator: each checks its own. */
     if (!(isfinite(d->node_mass) && d->node_mass >= 0.0) ||
-        !(isfinite(d->areal_density) && d->areal_density >= 0.0) ||
-        (d->node_mass == 0.0 && d->areal_density == 0.0))
+        !(isfinite(d->areal_density) && d->areal_density >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2 (got %g, %g)",
+                       "web '%s': node_mass and areal_density must be >= 0 (got %g, %g)",
                        c->label, d->node_mass, d->areal_density);
     if (!(isfinite(d->contact_layer) && d->contact_layer >= 0.0) ||
         !(isfinite(d->node_damping) && d->node_damping >= 0.0))
@@ -337,6 +337,9 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
     ws_status s = take_common(w, def, &c);
     if (s != WS_OK)
         return s;
+    if (c.d.node_mass == 0.0 && c.d.areal_density == 0.0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2", c.label);
     ws_sheet_def g;
     ws_sheet_def_init(&g);
     if ((s = ws_def_take(w, &g, sizeof g, sheet, sizeof g, "sheet")) != WS_OK)
@@ -376,6 +379,9 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
     ws_status s = take_common(w, def, &c);
     if (s != WS_OK)
         return s;
+    if (c.d.node_mass == 0.0 && c.d.areal_density == 0.0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2", c.label);
     ws_band_def g;
     ws_band_def_init(&g);
     if ((s = ws_def_take(w, &g, sizeof g, band, sizeof g, "band")) != WS_OK)
