@@ -139,10 +139,10 @@ static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb
             const ws_face *fc = &sa->faces[f];
             x->narrow_checks++;
             double d = v3_dot(fc->normal, s) - fc->offset;
-            /* The face box is flat: inflate it by the inner depth too, or a deep point fails
-             * here before the deep window can see it. */
+            /* Depth counts along the normal only: the point's projection on the face's plane
+             * must lie within reach of the face (its box is flat along the normal). */
             if (d > -reach - sa->inner && d < reach &&
-                inside_box(s, fc->lo, fc->hi, reach + sa->inner))
+                inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
                 if (push(mem, cand, n, cap, pa, pb, f, k, WS_CONTACT_POINT_FACE) != 0)
                     return -1;
         }

@@ -46,8 +46,10 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 const ws_face *fc = &sh->faces[f];
                 (*checks)++;
                 double d = v3_dot(fc->normal, s) - fc->offset;
+                /* Depth counts along the normal only: the point's projection on the face's
+                 * plane must lie within reach of the face. */
                 if (d > -reach - sh->inner && d < reach &&
-                    inside_box(s, fc->lo, fc->hi, reach + sh->inner)) {
+                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
                     (*out)[(*n)++] = (ws_ncand){i, k, f, g->face_base[k] + f, 0, lo_k, hi_k};
@@ -56,6 +58,8 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
             /* Convex edges within reach of the node: the rounded rim of the contact layer. */
             for (uint32_t e = 0; e < sh->edge_count; e++) {
                 const ws_edge *E = &sh->edges[e];
+                if (!inside_box(s, E->lo, E->hi, reach))
+                    continue;
                 (*checks)++;
                 v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
                 double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
@@ -210,7 +214,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     for (size_t k = 0; k < n; k++) {
         const ws_ncand *c = &cand[k];
         uint32_t i = c->node, bi = c->body;
-        v3 nrm, r = st->r[bi];
+        v3 nrm;
         double d;
         if (c->edge) {
             if (!in_wedge(&g->edge[c->wface], x[i], c->hi, &nrm, &d))
@@ -225,11 +229,12 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
             if (!in_wface(g, F, x[i], c->lo, c->hi, &d))
                 continue;
             if (d < 0.0 && !ws_shallowest_face(b->shape[bi], c->face,
-                                               m3_tmul_v(&b->A[bi], v3_sub(x[i], r)), d))
+                                               m3_tmul_v(&b->A[bi], v3_sub(x[i], st->r[bi])), d))
                 continue;
             nrm = F->n; /* from the body to the node */
         }
         const ws_node_params *p = &pp[b->material[bi]];
+        v3 r = st->r[bi];
         v3 xc = v3_madd(x[i], nrm, -0.5 * d);
         v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
         v3 vrel = v3_sub(v[i], vb);
