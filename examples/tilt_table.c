@@ -59,7 +59,7 @@ typedef struct tilt_result {
     char error[512];
     long steps;
     double wall_seconds;
-    double slide_time[2], slide_angle[2]; /* s, deg: onset of gross slip that lasted 10 ms;
+    double slide_time[2], slide_angle[2]; /* s, deg: onset of gross slip that lasted 0.2 s;
                                               NaN when it never slid */
     int slide_confirmed[2];
     double tip_time[2], tip_angle[2];     /* first time a box leans > 2 deg on its support */
@@ -292,21 +292,29 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
     return acos(fmax(-1.0, fmin(1.0, dot)));
 }
 
-/* Gross slip of body b on its support: 1 when every contact between them slips (tangential
- * speed at or above v_lim under the regularised law, anchor sliding under the stick law), from the
- * contact reports. */
+/* Gross slip of body b on its support: every contact between them slips (tangential speed at
+ * or above v_lim under the regularised law, anchor sliding under the stick law), and they slip
+ * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
+ * support, as when the platform starts to tilt, slips at every corner but is not sliding. */
 static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *buf, size_t n)
 {
     int count = 0, slipping = 0;
+    double sx = 0, sy = 0, sz = 0, size = 0;
     for (size_t k = 0; k < n; k++) {
         const ws_contact_info *c = &buf[k];
         if ((c->body_a.bits == support.bits && c->body_b.bits == b.bits) ||
             (c->body_a.bits == b.bits && c->body_b.bits == support.bits)) {
+            const ws_vec3 *v = &c->slip_velocity;
+            double sg = c->body_b.bits == b.bits ? 1.0 : -1.0; /* b's slip on its support */
+            sx += sg * v->x;
+            sy += sg * v->y;
+            sz += sg * v->z;
+            size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
             count++;
             slipping += c->slipping != 0;
         }
     }
-    return count > 0 && slipping == count;
+    return count > 0 && slipping == count && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;
 }
 
 /* 1 when body b touches the platform only on the downhill half of its bottom (x in the
@@ -421,7 +429,9 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     ws_body_id support[2] = {sc.plane, sc.box[0]};
     ws_contact_info contacts[256];
     long slipping_steps[2] = {0, 0};
-    const long sustained = lround(0.01 / sc.dt); /* gross slip must last 10 ms */
+    /* Gross slip must last 0.2 s: the stack rocking as the platform starts to turn slips its
+     * bottom face for a while (longer when wrapped, the film adding inertia); a slide goes on. */
+    const long sustained = lround(0.2 / sc.dt);
     long lifted_steps = 0;
     int lift_confirmed = 0;
     for (long n = 0; n <= steps; n++) {
@@ -441,7 +451,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
             if (isnan(res->off_time[k]) && local.z < 0.0)
                 res->off_time[k] = t;
             tilt[k] = relative_tilt(w, sc.box[k], support[k]);
-            /* Sliding: every contact with its support slips, for 10 ms in a row. */
+            /* Sliding: every contact with its support slips the same way, for 0.2 s in a row. */
             slipping_steps[k] = slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
             if (isnan(res->slide_time[k]) && t > 1.0 && slipping_steps[k] == 1)
                 res->slide_time[k] = t, res->slide_angle[k] = DEG(theta); /* candidate onset */
