@@ -16,6 +16,14 @@
  * point-face contacts. */
 #define WS_FEATURE_TOL 1e-9
 
+/* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
+ * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
+static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
+{
+    double k1 = g00 * b1 + g01 * b2, k2 = g01 * b1 + g11 * b2;
+    return k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL;
+}
+
 /* A candidate feature pair, kept between full detections. Point-face: a owns face fa, b owns
  * point fb. Edge-edge: a owns edge fa, b owns edge fb. The anchors (body frames) belong to the
  * stick friction model. */

@@ -16,9 +16,7 @@ int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi,
     for (uint32_t t = fc->first_tri; t < fc->first_tri + fc->tri_count; t++) {
         const ws_tri *q = &sa->tris[t];
         v3 r = v3_sub(s, q->p);
-        double b1 = v3_dot(r, q->w), b2 = v3_dot(r, q->v);
-        double k1 = q->g00 * b1 + q->g01 * b2, k2 = q->g01 * b1 + q->g11 * b2;
-        if (k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL) {
+        if (ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11)) {
             *dist = d;
             return 1;
         }

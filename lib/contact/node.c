@@ -162,9 +162,7 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, doubl
     for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
         const ws_wtri *q = &g->tri[t];
         v3 r = v3_sub(x, q->p);
-        double b1 = v3_dot(r, q->w), b2 = v3_dot(r, q->v);
-        double k1 = q->g00 * b1 + q->g01 * b2, k2 = q->g01 * b1 + q->g11 * b2;
-        if (k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL) {
+        if (ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11)) {
             *dist = d;
             return 1;
         }

@@ -197,7 +197,9 @@ typedef struct web_common {
     const char *label;
 } web_common;
 
-static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c)
+/* grid: 1 for the sheet and band generators, which can take their masses from an areal
+ * density; a mesh web checks its own mass source. */
+static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, int grid)
 {
     ws_web_def_init(&c->d);
     ws_status s = ws_def_take(w, &c->d, sizeof c->d, def, sizeof c->d, "web");
@@ -211,6 +213,9 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': node_mass and areal_density must be >= 0 (got %g, %g)",
                        c->label, d->node_mass, d->areal_density);
+    if (grid && d->node_mass == 0.0 && d->areal_density == 0.0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2", c->label);
     if (!(isfinite(d->contact_layer) && d->contact_layer >= 0.0) ||
         !(isfinite(d->node_damping) && d->node_damping >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
@@ -334,12 +339,9 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
     NEED_OUT(w, out, "ws_web_create_sheet");
     out->bits = 0;
     web_common c;
-    ws_status s = take_common(w, def, &c);
+    ws_status s = take_common(w, def, &c, 1);
     if (s != WS_OK)
         return s;
-    if (c.d.node_mass == 0.0 && c.d.areal_density == 0.0)
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2", c.label);
     ws_sheet_def g;
     ws_sheet_def_init(&g);
     if ((s = ws_def_take(w, &g, sizeof g, sheet, sizeof g, "sheet")) != WS_OK)
@@ -376,12 +378,9 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
     NEED_OUT(w, out, "ws_web_create_band");
     out->bits = 0;
     web_common c;
-    ws_status s = take_common(w, def, &c);
+    ws_status s = take_common(w, def, &c, 1);
     if (s != WS_OK)
         return s;
-    if (c.d.node_mass == 0.0 && c.d.areal_density == 0.0)
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "web '%s': give node_mass > 0 kg or areal_density > 0 kg/m^2", c.label);
     ws_band_def g;
     ws_band_def_init(&g);
     if ((s = ws_def_take(w, &g, sizeof g, band, sizeof g, "band")) != WS_OK)
@@ -457,7 +456,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
     NEED_OUT(w, out, "ws_web_create_mesh");
     out->bits = 0;
     web_common c;
-    ws_status s = take_common(w, def, &c);
+    ws_status s = take_common(w, def, &c, 0);
     if (s != WS_OK)
         return s;
     ws_web_mesh_def g;
