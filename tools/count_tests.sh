@@ -35,3 +35,56 @@ format_counts() {
     fi
     echo "$line"
 }
+
+# count_junit FILE: print "PASSED FAILED SKIPPED" for a JUnit XML file as pytest --junitxml
+# writes it (one <testsuite tests= failures= errors= skipped=> per suite, summed); "0 0 0" when
+# FILE does not exist. Errors count as failures.
+count_junit() {
+    local xml=$1
+    if [[ ! -f $xml ]]; then
+        echo "0 0 0"
+        return 0
+    fi
+    awk '
+        function attr(s, name,    r) {
+            if (match(s, name "=\"[0-9]+\"")) {
+                r = substr(s, RSTART, RLENGTH)
+                gsub(/[^0-9]/, "", r)
+                return r + 0
+            }
+            return 0
+        }
+        {
+            s = $0
+            while (match(s, /<testsuite[ \t][^>]*>/)) {
+                tag = substr(s, RSTART, RLENGTH)
+                s = substr(s, RSTART + RLENGTH)
+                n += attr(tag, "tests"); f += attr(tag, "failures") + attr(tag, "errors")
+                k += attr(tag, "skipped")
+            }
+        }
+        END { printf "%d %d %d\n", n - f - k, f, k }
+    ' "$xml"
+}
+
+# python_for_tests: print the interpreter that sees Debian's python3-numpy and python3-pytest:
+# /usr/bin/python3 when it exists (the python3 first on PATH may be another one), else python3.
+python_for_tests() {
+    if [[ -x /usr/bin/python3 ]]; then
+        echo /usr/bin/python3
+    else
+        command -v python3
+    fi
+}
+
+# run_pytest BUILDDIR: run the Python binding's tests against BUILDDIR/lib/libwrapsim.so.0, with
+# a JUnit report in BUILDDIR/python-junit.xml; print nothing else than pytest does. Returns
+# pytest's status.
+run_pytest() {
+    local dir=$1 py
+    py=$(python_for_tests)
+    rm -f "$dir/python-junit.xml"
+    WRAPSIM_LIBRARY="$PWD/$dir/lib/libwrapsim.so.0" PYTHONPATH="$PWD/bindings/python" \
+        "$py" -m pytest -q -p no:cacheprovider bindings/python/tests \
+        --junitxml="$dir/python-junit.xml"
+}

@@ -2,8 +2,12 @@
 # Build libwrapsim from a fresh Debian machine and run the tilt-table example or every test.
 #
 #   tools/quickstart.sh example [ARGS...]   install, build, run build/examples/tilt_table ARGS
-#   tools/quickstart.sh test [ARGS...]      install, build, meson test ARGS; last line
-#                                           "N passed, N failed"
+#   tools/quickstart.sh test [ARGS...]      install, build, meson test ARGS, then the Python
+#                                           binding's pytest suite; last line
+#                                           "N passed, N failed" over both
+#
+# The Python tests run with Debian's /usr/bin/python3 (which sees python3-numpy and
+# python3-pytest) against build/lib; WS_PYTHON_TESTS=0 leaves them out.
 #
 # The build directory is build/ (reconfigured when it exists). MESON_EXTRA adds options to
 # `meson setup`, e.g. MESON_EXTRA="-Dwerror=true -Dccd=disabled"; a reconfigured build keeps
@@ -32,8 +36,13 @@ source tools/count_tests.sh
 source tools/ensure_packages.sh
 
 packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev)
+python_tests=0
 if [[ $mode == test ]]; then
     packages+=(valgrind)
+    if [[ ${WS_PYTHON_TESTS:-1} != 0 ]]; then
+        python_tests=1
+        packages+=(python3 python3-numpy python3-pytest python3-tqdm)
+    fi
 fi
 ensure_packages "${packages[@]}"
 
@@ -63,6 +72,19 @@ read -r passed failed skipped < <(count_testlog "$log")
 if ((rc != 0 && failed == 0)); then
     echo "meson test exited with status $rc" >&2
     failed=1
+fi
+if ((python_tests)); then
+    echo "Python binding: pytest bindings/python/tests"
+    rc=0
+    run_pytest build || rc=$?
+    read -r py_passed py_failed py_skipped < <(count_junit build/python-junit.xml)
+    if ((rc != 0 && py_failed == 0)); then
+        echo "pytest exited with status $rc" >&2
+        py_failed=1
+    fi
+    passed=$((passed + py_passed))
+    failed=$((failed + py_failed))
+    skipped=$((skipped + py_skipped))
 fi
 format_counts "$passed" "$failed" "$skipped"
 ((failed == 0))

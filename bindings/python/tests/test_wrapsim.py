@@ -1,0 +1,611 @@
+"""Tests of the Python binding. Run from the repository:
+
+    WRAPSIM_LIBRARY=$PWD/build/lib/libwrapsim.so.0 PYTHONPATH=bindings/python \
+        /usr/bin/python3 -m pytest -q bindings/python/tests
+
+Every function of the table is called at least once over the module (checked by the last test);
+the tilt-table comparison compiles examples/tilt_table.c with the system C compiler (skipped
+without one).
+"""
+
+import ctypes
+import math
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import wrapsim as ws
+from wrapsim import _lib as L
+
+REPO = pathlib.Path(__file__).resolve().parents[3]
+HEADERS = sorted((REPO / "include" / "wrapsim").glob("*.h"))
+LIB = L.lib()
+LIB_PATH = LIB._wrapsim_path.split(" (")[0]
+
+# --- count the calls of every function of the table -----------------------------------------------
+CALLED = {name: 0 for name, _, _ in L.FUNCTIONS}
+
+
+def _counting(name, fn):
+    def call(*args):
+        CALLED[name] += 1
+        return fn(*args)
+    call.argtypes, call.restype = fn.argtypes, fn.restype
+    return call
+
+
+for _name, _, _ in L.FUNCTIONS:
+    setattr(LIB, _name, _counting(_name, getattr(LIB, _name)))
+
+TESTS_RUN = set()
+
+
+@pytest.fixture(autouse=True)
+def _note_test(request):
+    yield
+    TESTS_RUN.add(request.node.name)
+
+
+def header_functions():
+    names = set()
+    for h in HEADERS:
+        text = h.read_text()
+        text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+        for m in re.finditer(r"\bWS_API\b([^;{]*?)\b(ws_[a-z0-9_]+)\s*\(", text):
+            names.add(m.group(2))
+    return names
+
+
+def c_compiler():
+    for cc in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if cc and shutil.which(cc):
+            return cc
+    return None
+
+
+def include_dirs():
+    """The public headers and the generated version.h next to the library in use."""
+    dirs = [REPO / "include"]
+    libdir = pathlib.Path(LIB_PATH).resolve().parent
+    for cand in (libdir.parent / "include", REPO / "build" / "include"):
+        if (cand / "wrapsim" / "version.h").exists():
+            dirs.append(cand)
+            return dirs
+    return None
+
+
+def compile_c(tmp_path, source, name="prog"):
+    cc = c_compiler()
+    incs = include_dirs()
+    if cc is None or incs is None or not os.path.exists(LIB_PATH):
+        pytest.skip("no C compiler, generated headers or library file")
+    src = tmp_path / f"{name}.c"
+    src.write_text(source)
+    exe = tmp_path / name
+    libdir = str(pathlib.Path(LIB_PATH).resolve().parent)
+    cmd = [cc, "-std=c11", "-O1", "-o", str(exe), str(src)] + \
+          [f"-I{d}" for d in incs] + [f"-I{REPO / 'examples'}", LIB_PATH, "-lm",
+                                      f"-Wl,-rpath,{libdir}"]
+    subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return exe
+
+
+def run_c(exe, *args):
+    env = dict(os.environ, LD_LIBRARY_PATH=str(pathlib.Path(LIB_PATH).resolve().parent))
+    r = subprocess.run([str(exe), *map(str, args)], check=True, capture_output=True, text=True,
+                       env=env)
+    return r.stdout
+
+
+# --- the table -----------------------------------------------------------------------------------
+def test_table_covers_every_header_function():
+    in_headers = header_functions()
+    in_table = {name for name, _, _ in L.FUNCTIONS}
+    assert len(in_headers) > 80
+    assert in_headers - in_table == set(), "not wrapped"
+    assert in_table - in_headers == set(), "not in the headers"
+    assert len(in_table) == len(L.FUNCTIONS), "a function twice in the table"
+
+
+STRUCTS = {
+    "ws_vec3": L.Vec3, "ws_quat": L.Quat, "ws_mat3": L.Mat3, "ws_pose": L.Pose,
+    "ws_body_id": L.BodyId, "ws_shape_id": L.ShapeId, "ws_material_id": L.MaterialId,
+    "ws_law_id": L.LawId, "ws_web_id": L.WebId, "ws_allocator": L.Allocator,
+    "ws_world_def": L.WorldDef, "ws_contact_def": L.ContactDef,
+    "ws_material_def": L.MaterialDef, "ws_world_stats": L.WorldStats, "ws_energy": L.Energy,
+    "ws_mesh_def": L.MeshDef, "ws_shape_info": L.ShapeInfo, "ws_body_def": L.BodyDef,
+    "ws_drive_def": L.DriveDef, "ws_contact_info": L.ContactInfo, "ws_law_def": L.LawDef,
+    "ws_web_def": L.WebDef, "ws_sheet_def": L.SheetDef, "ws_band_def": L.BandDef,
+    "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo,
+    "ws_containment_band": L.ContainmentBand,
+}
+
+
+def test_struct_layouts_match_c(tmp_path):
+    """sizeof and offsetof of every field of every struct, from the C compiler."""
+    lines = ["#include <stddef.h>", "#include <stdio.h>", "#include <wrapsim/wrapsim.h>",
+             "int main(void) {"]
+    expect = []
+    for cname, st in STRUCTS.items():
+        lines.append(f'printf("{cname} %zu\\n", sizeof({cname}));')
+        expect.append(f"{cname} {ctypes.sizeof(st)}")
+        for fname, _ in st._fields_:
+            lines.append(f'printf("{cname}.{fname} %zu\\n", offsetof({cname}, {fname}));')
+            expect.append(f"{cname}.{fname} {getattr(st, fname).offset}")
+    lines += ["return 0;", "}"]
+    exe = compile_c(tmp_path, "\n".join(lines), "layout")
+    assert run_c(exe).split("\n")[:-1] == expect
+
+
+def test_struct_fields_match_headers():
+    """Every field named in a header's struct is in the ctypes mirror, in the same order."""
+    text = "\n".join(re.sub(r"/\*.*?\*/", "", h.read_text(), flags=re.S) for h in HEADERS)
+    for cname, st in STRUCTS.items():
+        m = re.search(r"typedef struct " + cname + r"\s*\{(.*?)\}\s*" + cname + ";", text, re.S)
+        assert m, cname
+        names = []
+        for decl in m.group(1).split(";"):
+            decl = decl.strip()
+            if not decl:
+                continue
+            fp = re.search(r"\(\s*\*\s*(\w+)\s*\)", decl)
+            if fp:
+                names.append(fp.group(1))
+                continue
+            decl = re.sub(r"\[[^\]]*\]", "", decl)
+            parts = [p.strip() for p in decl.split(",")]
+            names.append(re.findall(r"\w+", parts[0])[-1])
+            names += [re.findall(r"\w+", p)[-1] for p in parts[1:]]
+        assert names == [f for f, _ in st._fields_], cname
+
+
+# --- loader --------------------------------------------------------------------------------------
+def test_version_and_features():
+    assert ws.version_number() >= L.REQUIRED_VERSION
+    assert ws.version().count(".") == 2
+    assert ws.build_features() & ~ws.WS_FEATURE_CCD == 0
+    assert ws.status_string(ws.WS_ERR_STALE_HANDLE).startswith("WS_ERR_STALE_HANDLE")
+
+
+def test_loader_honours_env(monkeypatch, tmp_path):
+    monkeypatch.setenv("WRAPSIM_LIBRARY", str(tmp_path / "no-such-libwrapsim.so"))
+    with pytest.raises(ws.LibraryError, match="WRAPSIM_LIBRARY"):
+        L.load()
+    monkeypatch.setenv("WRAPSIM_LIBRARY", LIB_PATH)
+    assert L.load().ws_version_number() == ws.version_number()
+
+
+def test_loader_refuses_older_library(monkeypatch):
+    monkeypatch.setattr(L, "REQUIRED_VERSION", ws.version_number() + 1)
+    with pytest.raises(ws.LibraryError, match="or newer"):
+        L.load(LIB_PATH)
+
+
+# --- errors --------------------------------------------------------------------------------------
+def test_world_create_error():
+    with pytest.raises(ws.WrapsimError) as e:
+        ws.World(dt=-1.0)
+    assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
+
+
+def test_errors_carry_last_error_text():
+    with ws.World() as w:
+        cube = w.box(0.1, 0.1, 0.1)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.body(cube, mass=-1.0, name="top")
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
+        assert e.value.detail and e.value.detail == w.last_error
+        assert "mass" in str(e.value)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.box(0.1, -1, 0.1)
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
+        # an open mesh: three faces of a tetrahedron
+        v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.mesh(v, [[0, 2, 1], [0, 1, 3], [0, 3, 2]])
+        assert e.value.status == ws.WS_ERR_BAD_MESH and e.value.detail
+        b = w.body(cube, mass=1.0)
+        with pytest.raises(ws.WrapsimError) as e:
+            cube.destroy()
+        assert e.value.status == ws.WS_ERR_IN_USE
+        with pytest.raises(ws.WrapsimError):
+            b.set_drive("tilt", rate=0.1)  # a dynamic body has no drive
+        with pytest.raises(TypeError):
+            w.body(cube, no_such_field=1)
+        with pytest.raises(ValueError):
+            w.body(cube, type="floating")
+
+
+def test_buffer_too_small_raw():
+    with ws.World() as w:
+        ground = w.box(1, 1, 0.1)
+        w.body(ground, type="kinematic", position=(0, 0, -0.05))
+        w.body(w.box(0.1, 0.1, 0.1), mass=1.0, position=(0, 0, 0.052))
+        w.step(10)
+        assert w.contact_count() == 4
+        buf = (L.ContactInfo * 1)()
+        n = ctypes.c_size_t()
+        assert LIB.ws_world_copy_contacts(w.ptr, buf, 1, ctypes.byref(n)) == \
+            ws.WS_ERR_BUFFER_TOO_SMALL
+        assert n.value == 4
+
+
+def test_stale_ids_raise_never_crash():
+    with ws.World() as w, ws.World() as other:
+        cube = w.box(0.1, 0.1, 0.1)
+        b = w.body(cube, mass=1.0, name="gone")
+        assert b.valid and b.name == "gone"
+        b.destroy()
+        assert not b.valid
+        for get in (lambda: b.position, lambda: b.velocity, lambda: b.orientation,
+                    lambda: b.name, lambda: b.user_data, lambda: b.mass, b.destroy,
+                    lambda: b.set_velocity((1, 0, 0))):
+            with pytest.raises(ws.WrapsimError) as e:
+                get()
+            assert e.value.status == ws.WS_ERR_STALE_HANDLE
+        with pytest.raises(ws.WrapsimError) as e:
+            b.position
+        assert "destroyed" in e.value.detail
+        # an id of another world, a null id, a made-up id
+        c = w.body(cube, mass=1.0)
+        for bad in (other.body_by_id(c.id), w.body_by_id(0), w.body_by_id(0x1234567890abcdef)):
+            with pytest.raises(ws.WrapsimError) as e:
+                bad.position
+            assert e.value.status == ws.WS_ERR_STALE_HANDLE
+        law = w.law(stiffness=10.0)
+        law.destroy()
+        assert not law.valid
+        with pytest.raises(ws.WrapsimError):
+            law.evaluate(0.1)
+        m = w.material("x")
+        assert m.valid and not other.body_by_id(0).valid
+    # the world itself closed: every handle raises
+    with pytest.raises(ws.WrapsimError) as e:
+        c.position
+    assert e.value.status == ws.WS_ERR_STALE_HANDLE
+    assert not c.valid and w.closed
+    with pytest.raises(ws.WrapsimError):
+        w.step()
+
+
+# --- physics -------------------------------------------------------------------------------------
+def test_box_rests_at_layer_gap():
+    k, m, delta, g = 2e5, 5.0, 1e-3, 9.81
+    with ws.World(gravity=(0, 0, -g)) as w:
+        ground_mat, box_mat = w.material("ground"), w.material("box")
+        w.set_contact(ground_mat, box_mat, stiffness=k, damping=50.0)
+        slab = w.body(w.box(1.0, 1.0, 0.05), type="kinematic", material=ground_mat,
+                      contact_layer=delta, position=(0, 0, -0.025))
+        box = w.body(w.box(0.25, 0.25, 0.25), mass=m, material=box_mat, contact_layer=delta,
+                     position=(0, 0, 0.125 + 2 * delta))
+        rec = ws.run(w, 1.0, record={"z": lambda: box.position[2]}, every=0.1, progress=False)
+        gap = rec["z"][-1] - 0.125
+        assert gap == pytest.approx(2 * delta - m * g / (4 * k), abs=1e-7)
+        assert rec["t"][-1] == pytest.approx(1.0)
+        assert len(rec["t"]) == len(rec["z"]) == 11
+        c = w.contacts()
+        assert len(c) == 4
+        assert np.allclose(c["normal_force"].sum(), m * g, rtol=1e-4)
+        assert set(c["body_a"]) | set(c["body_b"]) == {slab.id, box.id}
+        assert w.body_by_id(c["body_b"][0]) in (slab, box)
+        f, _ = box.contact_force()
+        assert f[2] == pytest.approx(m * g, rel=1e-4)
+        assert w.energy()["kinetic"] < 1e-9
+        assert w.stats()["contacts"] == 4
+
+
+def test_sheet_tensions_are_ea_times_prestretch():
+    ea, pre, nx, ny = 500.0, 0.1, 6, 5
+    with ws.World(gravity=(0, 0, 0)) as w:
+        law = w.law("linear_elastic", stiffness=ea, name="film")
+        edge = [i + nx * j for j in range(ny) for i in range(nx)
+                if i in (0, nx - 1) or j in (0, ny - 1)]
+        web = w.web_sheet(law, nx=nx, ny=ny, spacing_x=0.01, spacing_y=0.01, prestretch_x=pre,
+                          prestretch_y=pre, node_mass=1e-3, substeps=4, pinned=edge, name="sheet")
+        info = web.info()
+        assert (info["nx"], info["ny"], info["closed"]) == (nx, ny, 0)
+        assert web.node_count == nx * ny
+        assert web.spring_count == (nx - 1) * ny + nx * (ny - 1)
+        w.step(200)
+        assert np.allclose(web.strains(), pre, rtol=1e-9)
+        t = np.empty(web.spring_count)
+        assert web.tensions(out=t) is t
+        assert np.allclose(t, ea * pre, rtol=1e-9)
+        assert law.evaluate(pre)[0] == pytest.approx(ea * pre)
+        assert law.evaluate(pre)[1] == pytest.approx(ea)
+        assert law.energy(pre) == pytest.approx(ea * pre ** 2 / 2)
+        p = web.positions()
+        assert p.shape == (nx * ny, 3) and p[1, 0] - p[0, 0] == pytest.approx(0.01)
+        assert np.abs(web.velocities()).max() < 1e-9
+        assert not web.contact_forces().any()
+        s = web.springs()
+        assert s.dtype == np.uint32 and s.shape == (web.spring_count, 2)
+        assert web.energy()["elastic"] > 0
+        with pytest.raises(ValueError):
+            web.tensions(out=np.empty(3))
+
+
+def test_drive_callback_and_its_errors():
+    with ws.World(gravity=(0, 0, 0)) as w:
+        b = w.body(w.box(0.1, 0.1, 0.1), type="kinematic", position=(1, 0, 0))
+        assert b.type == ws.WS_BODY_KINEMATIC and b.mass == 0.0
+        b.set_drive("callback", callback=lambda t: ((t, 0, 0), (1, 0, 0, 0), (1, 0, 0)))
+        w.step(100)
+        assert b.position[0] == pytest.approx(w.time)
+        assert b.velocity[0] == pytest.approx(1.0)
+
+        t_fail = w.time + 0.001
+
+        def bad(t):
+            if t > t_fail:
+                raise KeyError("from the drive")
+            return (0, 0, 0), (1, 0, 0, 0)
+        b.set_drive("callback", callback=bad)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.step(10)
+        assert e.value.status == ws.WS_ERR_CALLBACK and "callback" in e.value.detail
+        assert isinstance(e.value.__cause__, KeyError)
+        b.set_drive("sine", direction=(0, 0, 1), amplitude=0.01, frequency=2.0)
+        w.step(10)
+        b.set_drive("static")
+        with pytest.raises(ValueError):
+            b.set_drive("callback")
+
+
+# --- the tilt table: Python against C ------------------------------------------------------------
+def build_tilt(wrapped=False):
+    """examples/tilt_table.c's tilt_build() with the default options (variant R)."""
+    a, m, layer = 0.25, 5.0, 1e-3
+    gap = 2 * layer
+    w = ws.World(dt=2.5e-4, full_detection_until=0.5, detection_interval=5, use_ccd=1,
+                 profile=0, integrator="symplectic_euler")
+    box_mat = w.material("cardboard")
+    plane_mat = w.material("platform")
+    cd = dict(stiffness=2e5, damping=10.0, friction=0.3, friction_vlim=0.01,
+              friction_model="regularized", stick_stiffness=2e5, stick_damping=250.0)
+    w.set_contact(box_mat, box_mat, **cd)
+    w.set_contact(box_mat, plane_mat, **cd)
+    slab = w.box(1.5, 1.5, 0.05)
+    cube = w.box(a, a, a)
+    bar = w.box(0.02, 0.5, 0.02)
+    tilt = dict(axis=(0, 1, 0), point=(0, 0, 0), start_time=1.0, rate=0.1)
+    plane = w.body(slab, type="kinematic", material=plane_mat, contact_layer=layer,
+                   position=(0, 0, -0.025), name="platform")
+    plane.set_drive("tilt", **tilt)
+    stop = w.body(bar, type="kinematic", material=plane_mat, contact_layer=layer,
+                  position=(a / 2 + gap + 0.01, 0, 0.01), name="stop")
+    stop.set_drive("tilt", **tilt)
+    bottom = w.body(cube, material=box_mat, mass=m, contact_layer=layer,
+                    position=(0, 0, gap + a / 2), name="bottom")
+    top = w.body(cube, material=box_mat, mass=m, contact_layer=layer,
+                 position=(0, 0, gap + a + gap + a / 2), name="top")
+    film = None
+    if wrapped:  # tilt_wrap()
+        k, c, n_around, n_up = 2000.0, 0.1, 96, 61
+        z0, z1 = 0.030, 2 * a + 2 * 2 * layer - 0.020
+        perimeter = 4 * a + 2 * math.pi * 2 * layer
+        l0_around = perimeter / n_around / 1.4
+        l0_up = (z1 - z0) / (n_up - 1) / 1.2
+        around = w.law("tension_compression", stiffness=k * l0_around,
+                       compression_stiffness=0.01 * k * l0_around, damping=c * l0_around,
+                       name="film around")
+        up = w.law("tension_compression", stiffness=k * l0_up,
+                   compression_stiffness=0.01 * k * l0_up, damping=c * l0_up, name="film up")
+        film_mat = w.material("film")
+        fc = dict(stiffness=4000.0, damping=1.0, friction=0.9, friction_vlim=0.01)
+        w.set_contact(film_mat, box_mat, **fc)
+        w.set_contact(film_mat, plane_mat, **fc)
+        film = w.web_band(around, [bottom, top], law_cross=up, node_mass=1e-3,
+                          contact_layer=layer, material=film_mat, substeps=1, name="film",
+                          z_bottom=z0, z_top=z1, n_around=n_around, n_up=n_up,
+                          prestretch_around=0.4, prestretch_up=0.2)
+    return w, plane, stop, bottom, top, film
+
+
+TILT_MAIN = r"""
+#define TILT_TABLE_NO_MAIN
+#include "tilt_table.c"
+int main(int argc, char **argv)
+{
+    tilt_options o;
+    tilt_scene sc;
+    uint64_t h = 0;
+    tilt_default_options(&o);
+    o.wrapped = argc > 2 && argv[2][0] == 'w';
+    if (tilt_build(&o, &sc) != WS_OK)
+        return 1;
+    if (ws_world_step_n(sc.world, atol(argv[1])) != WS_OK)
+        return 2;
+    ws_world_get_state_hash(sc.world, &h);
+    printf("%llu\n", (unsigned long long)h);
+    ws_world_destroy(sc.world);
+    (void)tilt_run;
+    return 0;
+}
+"""
+
+
+@pytest.fixture(scope="module")
+def tilt_exe(tmp_path_factory):
+    return compile_c(tmp_path_factory.mktemp("tilt"), TILT_MAIN, "tilt_hash")
+
+
+def test_tilt_table_matches_c(tilt_exe):
+    steps = 28000  # 7 s, variant R unwrapped: the top box slides off, the bottom one stays
+    c_hash = int(run_c(tilt_exe, steps))
+    w, plane, stop, bottom, top, _ = build_tilt()
+    with w:
+        w.step(steps)
+        assert w.state_hash() == c_hash
+        assert w.time == pytest.approx(7.0)
+        # and the physics the example reports: the top box has left the bottom one
+        assert np.linalg.norm(top.position - bottom.position) > 0.5
+
+
+def test_tilt_table_wrapped_matches_c(tilt_exe):
+    steps = 400
+    c_hash = int(run_c(tilt_exe, steps, "wrapped"))
+    w, plane, stop, bottom, top, film = build_tilt(wrapped=True)
+    with w:
+        w.step(steps)
+        assert w.state_hash() == c_hash
+        info = film.info()
+        assert (info["nx"], info["ny"], info["closed"]) == (96, 61, 1)
+        assert film.stable_dt > 0
+        film.substeps = 2
+        assert film.substeps == 2
+        prof = film.containment(4)
+        assert prof.shape == (4,) and (prof["z_high"] > prof["z_low"]).all()
+        assert (prof["hoop_tension"] > 0).all()
+        f, mom = film.body_force(top)
+        assert np.isfinite(f).all() and np.isfinite(mom).all()
+        assert film.contact_forces().shape == (96 * 61, 3)
+        assert film.velocities().shape == (96 * 61, 3)
+
+
+# --- the rest of the API -------------------------------------------------------------------------
+def test_world_and_body_api(tmp_path):
+    messages = []
+    with ws.World(dt=1e-4, user_data=1234, profile=1,
+                  log=lambda level, text: messages.append((level, text))) as w:
+        assert w.dt == pytest.approx(1e-4)
+        w.dt = 2e-4
+        assert w.dt == pytest.approx(2e-4)
+        w.set_gravity((0, 0, -9.81))
+        w.gravity = (0, 0, -9.81)
+        assert w.user_data == 1234
+        assert w.last_error == ""
+        d = w.default_material
+        assert d.valid
+        w.set_default_contact(stiffness=1e5, damping=20.0)
+        assert w.get_contact(d, d)["stiffness"] == pytest.approx(1e5)
+        rubber = w.material("rubber")
+        w.set_contact(rubber, d, friction=0.8, friction_model="stick")
+        cd = w.get_contact(d, rubber)
+        assert cd["friction"] == pytest.approx(0.8) and cd["friction_model"] == 1
+        cyl = w.cylinder(0.05, 0.2, 24)
+        ci = cyl.info()
+        assert ci["volume"] == pytest.approx(24 / 2 * 0.05 ** 2 * math.sin(2 * math.pi / 24)
+                                             * 0.2)
+        assert cyl.valid
+        cyl.destroy()
+        assert not cyl.valid
+        box = w.box(0.2, 0.2, 0.2)
+        v, t = box.copy_mesh()
+        assert v.shape == (8, 3) and t.shape == (12, 3)
+        meshed = w.mesh(v + 5.0, t)  # re-centred on its centroid
+        mi = meshed.info()
+        assert mi["volume"] == pytest.approx(0.008) and mi["convex"] == 1
+        assert np.allclose(mi["centroid"], 5.0)
+        ground = w.body(w.box(2, 2, 0.1), type="kinematic", position=(0, 0, -0.05),
+                        material=rubber)
+        body = w.body(meshed, mass=2.0, position=(0, 0, 0.102), user_data=77, name="b",
+                      orientation=(1, 0, 0, 0), velocity=(0.1, 0, 0), inertia=np.eye(3) * 0.02)
+        assert body.user_data == 77 and body.mass == 2.0
+        assert np.allclose(body.inertia, np.eye(3) * 0.02)
+        assert [b.name for b in w.bodies()] == ["", "b"]
+        assert w.estimate_stable_dt() > 0
+        w.step()
+        w.step(50)
+        assert w.stats()["steps"] == 51
+        assert w.time == pytest.approx(51 * 2e-4)
+        body.set_pose((0, 0, 0.2), (math.cos(0.1), 0, 0, math.sin(0.1)))
+        body.set_velocity((0, 0, 0), (0, 0, 1.0))
+        assert np.allclose(body.angular_velocity, (0, 0, 1))
+        assert np.allclose(body.angular_velocity_local, (0, 0, 1))
+        assert np.allclose(body.point_velocity(body.position + (1, 0, 0)), (0, 1, 0))
+        assert np.allclose(body.world_point((0, 0, 0)), (0, 0, 0.2))
+        assert np.allclose(body.rotation @ body.rotation.T, np.eye(3))
+        assert body.orientation[0] == pytest.approx(math.cos(0.1))
+        assert body.type == ws.WS_BODY_DYNAMIC
+        e = w.energy()
+        assert set(e) == {"kinetic", "potential", "contact"}
+        assert isinstance(w.state_hash(), int)
+        w.write_vtp(tmp_path / "bodies.vtp")
+        assert (tmp_path / "bodies.vtp").stat().st_size > 0
+        with pytest.raises(ws.WrapsimError) as err:
+            w.write_vtp(tmp_path / "no" / "such" / "dir.vtp")
+        assert err.value.status == ws.WS_ERR_IO and "dir.vtp" in err.value.detail
+        ground.destroy()
+        assert not ground.valid
+
+
+def test_webs_laws_and_vtk_series(tmp_path):
+    with ws.World(gravity=(0, 0, -9.81)) as w:
+        law = w.law("linear_viscoelastic", stiffness=100.0, damping=0.1)
+        shear = w.law(stiffness=10.0)
+        tc = w.law(ws.WS_LAW_TENSION_COMPRESSION, stiffness=100.0, compression_stiffness=1.0,
+                   transition=1e-3)
+        assert tc.evaluate(-0.1)[1] == pytest.approx(1.0)
+        assert law.evaluate(0.0, 2.0)[0] == pytest.approx(0.2)
+        assert law.evaluate(0.0, 2.0)[2] == pytest.approx(0.1)
+        sheet = w.web_sheet(law, law_shear=shear, nx=4, ny=3, spacing_x=0.05, spacing_y=0.05,
+                            shear=1, node_mass=0.01, pinned=[0, 3])
+        pos = np.array([[0, 0, 1], [0.1, 0, 1], [0.2, 0, 1]], float)
+        rope = w.web_mesh(law, pos, [[0, 1], [1, 2]], node_masses=[1e-2] * 3,
+                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3)
+        assert rope.node_count == 3 and rope.info()["nx"] == 0
+        assert np.allclose(rope.strains(), 0.1 / 0.09 - 1)
+        crate = w.body(w.box(0.2, 0.2, 0.2), mass=1.0, position=(1, 1, 0.1))
+        band = w.web_band(law, [crate], node_mass=1e-3, substeps=8, z_bottom=0.02, z_top=0.18,
+                          n_around=12, n_up=4, prestretch_around=0.2, prestretch_up=0.1)
+        assert band.info()["closed"] == 1
+        assert band.containment(2)["hoop_tension"].min() > 0
+        assert np.isfinite(np.concatenate(band.body_force(crate))).all()
+        with pytest.raises(ws.WrapsimError):
+            rope.containment(1)  # a mesh web has no rows
+        with w.vtk_series(tmp_path, "run") as series:
+            for _ in range(3):
+                w.step(10)
+                series.write_frame()
+            assert series.frame_count == 3
+        with pytest.raises(ws.WrapsimError):
+            series.write_frame()
+        assert (tmp_path / "run.pvd").exists()
+        sheet.write_vtp(tmp_path / "sheet.vtp")
+        assert (tmp_path / "sheet.vtp").exists()
+        open_series = w.vtk_series(tmp_path, "left-open")  # closed with the world
+        open_series.write_frame()
+        with pytest.raises(ws.WrapsimError) as err:
+            law.destroy()
+        assert err.value.status == ws.WS_ERR_IN_USE
+        rope.destroy()
+        band.destroy()
+        sheet.destroy()
+        assert not sheet.valid
+        law.destroy()
+        assert not law.valid
+    assert open_series._ptr is None
+
+
+def test_run_progress_text_without_tqdm(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm now raises ImportError
+    with ws.World() as w:
+        out = ws.run(w, 0.01, progress=True, desc="plain")
+        assert out["t"].size == 0 and w.time == pytest.approx(0.01)
+        rec = ws.run(w, 0.02, record={"t2": lambda: [w.time, 2 * w.time]}, progress=True)
+    assert "plain: done (40 steps)" in capsys.readouterr().err
+    assert rec["t2"].shape == (41, 2)
+    assert np.allclose(rec["t2"][:, 1], 2 * rec["t"])
+
+
+def test_run_with_tqdm_when_present():
+    pytest.importorskip("tqdm")
+    with ws.World() as w:
+        out = ws.run(w, 0.005, record={"t": lambda: w.time}, every=0.001)
+        assert len(out["t"]) == 6
+
+
+# --- last: the whole table was exercised ---------------------------------------------------------
+def test_zz_every_function_was_called():
+    others = {n for n in globals() if n.startswith("test_") and n != "test_zz_every_function_was_called"}
+    if not others <= TESTS_RUN:
+        pytest.skip("only meaningful after the whole module ran")
+    never = sorted(n for n, k in CALLED.items() if k == 0)
+    assert never == [], f"never called: {never}"

@@ -1,0 +1,910 @@
+"""Python binding of libwrapsim (ctypes, no compiled extension).
+
+Thin classes over the C API with its names and SI units: World, Shape, Material, Body, Law,
+Web, VtkSeries; bulk data (web nodes and springs, contacts) as numpy arrays filled by the
+library's bulk-copy calls. Every failing call raises WrapsimError with the world's last-error
+text. See README.md next to this package.
+"""
+
+import ctypes
+from ctypes import byref, c_double, c_int, c_size_t, c_uint32, c_uint64, POINTER
+
+import numpy as np
+
+from . import _lib as L
+from ._lib import LibraryError, BINDING_VERSION as __version__  # noqa: F401
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE,
+    WS_ERR_OUT_OF_MEMORY, WS_ERR_NUMERICAL, WS_ERR_BAD_MESH, WS_ERR_IN_USE, WS_ERR_CALLBACK,
+    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_LOG_DEBUG, WS_LOG_INFO,
+    WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD, WS_INTEGRATOR_SYMPLECTIC_EULER,
+    WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
+    WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
+    WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_LAW_LINEAR_ELASTIC,
+    WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_SPRING_AROUND, WS_SPRING_UP,
+    WS_SPRING_SHEAR)
+from ._run import run  # noqa: F401
+
+__all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
+           "LibraryError", "run", "version", "version_number", "build_features",
+           "status_string", "CONTACT_DTYPE", "CONTAINMENT_DTYPE"]
+
+
+class WrapsimError(RuntimeError):
+    """A ws_status other than WS_OK. `status` is the code, `detail` the world's last-error
+    text ("" when there was no world or no detail)."""
+
+    def __init__(self, status, detail=""):
+        self.status = int(status)
+        self.detail = detail
+        text = status_string(self.status)
+        super().__init__(f"{text}: {detail}" if detail else text)
+
+
+def _c():
+    return L.lib()
+
+
+def status_string(status):
+    """The library's text for a status, e.g. "WS_ERR_STALE_HANDLE: ..."."""
+    return _c().ws_status_string(int(status)).decode()
+
+
+def version():
+    """Runtime library version as text, e.g. "0.1.0"."""
+    return _c().ws_version_string().decode()
+
+
+def version_number():
+    """Runtime library version as major*10000 + minor*100 + patch."""
+    return _c().ws_version_number()
+
+
+def build_features():
+    """Bit set of WS_FEATURE_* compiled into the library."""
+    return _c().ws_build_features()
+
+
+# --- Def filling ---------------------------------------------------------------------------------
+_ENUMS = {
+    (L.WorldDef, "integrator"): {"symplectic_euler": 0, "paper_explicit": 1},
+    (L.ContactDef, "friction_model"): {"regularized": 0, "stick": 1},
+    (L.BodyDef, "type"): {"dynamic": 0, "kinematic": 1},
+    (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3},
+    (L.LawDef, "type"): {"linear_elastic": 0, "linear_viscoelastic": 1,
+                         "tension_compression": 2},
+}
+
+
+def _vec3(v):
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.shape != (3,):
+        raise ValueError(f"expected 3 numbers, got {v!r}")
+    return L.Vec3(*a)
+
+
+def _quat(v):
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.shape != (4,):
+        raise ValueError(f"expected 4 numbers (e0, e1, e2, e3), got {v!r}")
+    return L.Quat(*a)
+
+
+def _mat3(v):
+    a = np.asarray(v, dtype=float).reshape(-1)
+    if a.shape != (9,):
+        raise ValueError(f"expected a 3x3 matrix, got {v!r}")
+    m = L.Mat3()
+    m.m[:] = list(a)
+    return m
+
+
+def _id_of(v, idtype):
+    if v is None:
+        return idtype(0)
+    if isinstance(v, _Handle):
+        return idtype(v._id.bits)
+    if isinstance(v, L._Id):
+        return idtype(v.bits)
+    return idtype(int(v))
+
+
+def _convert(struct, name, ftype, value):
+    if ftype is L.Vec3:
+        return _vec3(value)
+    if ftype is L.Quat:
+        return _quat(value)
+    if ftype is L.Mat3:
+        return _mat3(value)
+    if isinstance(ftype, type) and issubclass(ftype, L._Id):
+        return _id_of(value, ftype)
+    if ftype is ctypes.c_char_p:
+        return None if value is None else str(value).encode()
+    if ftype is c_double:
+        return float(value)
+    if isinstance(value, str):
+        names = _ENUMS.get((type(struct), name))
+        if not names or value.lower() not in names:
+            raise ValueError(f"{type(struct).__name__}.{name}: unknown value {value!r}"
+                             + (f" (one of {', '.join(names)})" if names else ""))
+        return names[value.lower()]
+    return int(value)
+
+
+def _fill(struct, kwargs):
+    """Set the fields of a Def (already filled by its C init) from keyword arguments."""
+    fields = dict(struct._fields_)
+    for k, v in kwargs.items():
+        if k in ("size", "magic") or k not in fields:
+            raise TypeError(f"{type(struct).__name__} has no parameter {k!r}")
+        setattr(struct, k, _convert(struct, k, fields[k], v))
+    return struct
+
+
+def _make(struct_type, kwargs):
+    d = struct_type()
+    init = {s: n for n, s in L.DEF_INITS}[struct_type]
+    getattr(_c(), init)(byref(d))
+    return _fill(d, kwargs)
+
+
+def _split(kwargs, *struct_types):
+    """Route keyword arguments to the Def that has a field of that name."""
+    out = [dict() for _ in struct_types]
+    for k, v in kwargs.items():
+        for i, st in enumerate(struct_types):
+            if k in dict(st._fields_) and k not in ("size", "magic"):
+                out[i][k] = v
+                break
+        else:
+            raise TypeError(f"unknown parameter {k!r}")
+    return out
+
+
+def _struct_dict(s, skip=()):
+    out = {}
+    for name, _ in s._fields_:
+        if name in skip:
+            continue
+        v = getattr(s, name)
+        if isinstance(v, L.Vec3):
+            v = np.array([v.x, v.y, v.z])
+        elif isinstance(v, L.Quat):
+            v = np.array([v.e0, v.e1, v.e2, v.e3])
+        elif isinstance(v, L.Mat3):
+            v = np.array(v.m[:]).reshape(3, 3)
+        elif isinstance(v, L._Id):
+            v = v.bits
+        elif isinstance(v, bytes):
+            v = v.decode()
+        out[name] = v
+    return out
+
+
+def _np(v):
+    return np.array([v.x, v.y, v.z])
+
+
+def _ptr(a, ctype):
+    return a.ctypes.data_as(POINTER(ctype))
+
+
+#: numpy layout of ws_contact_info (body ids as their 64 bits).
+CONTACT_DTYPE = np.dtype([
+    ("body_a", np.uint64), ("body_b", np.uint64), ("point", np.float64, 3),
+    ("normal", np.float64, 3), ("overlap", np.float64), ("normal_force", np.float64),
+    ("friction_force", np.float64, 3), ("slip_velocity", np.float64, 3), ("kind", np.int32),
+    ("slipping", np.int32)])
+assert CONTACT_DTYPE.itemsize == ctypes.sizeof(L.ContactInfo)
+
+#: numpy layout of ws_containment_band.
+CONTAINMENT_DTYPE = np.dtype([
+    ("z_low", np.float64), ("z_high", np.float64), ("hoop_tension", np.float64),
+    ("line_load", np.float64), ("contact_force", np.float64)])
+assert CONTAINMENT_DTYPE.itemsize == ctypes.sizeof(L.ContainmentBand)
+
+
+# --- World ---------------------------------------------------------------------------------------
+class World:
+    """A world: owner of every shape, body, material, law and web. Use as a context manager, or
+    call close(). Keyword arguments are the fields of ws_world_def (dt, gravity, integrator,
+    full_detection_until, detection_interval, contact_margin, max_speed, max_angular_speed,
+    use_ccd, profile, user_data); `log` may be a callable(level, message)."""
+
+    def __init__(self, log=None, **kwargs):
+        self._ptr = None
+        self._callbacks = {}  # body id bits -> the ctypes drive callbacks, kept alive
+        self._series = []
+        self._bodies = {}
+        self._pending = None  # an exception raised inside a callback
+        d = _make(L.WorldDef, kwargs)
+        if log is not None:
+            def _log(user, level, message, _fn=log):
+                try:
+                    _fn(int(level), message.decode(errors="replace"))
+                except Exception:  # noqa: BLE001 - never let an exception cross into C
+                    pass
+            self._log = L.LogFn(_log)
+            d.log = self._log
+        p = L.World_p()
+        s = _c().ws_world_create(byref(d), byref(p))
+        if s != WS_OK:
+            raise WrapsimError(s, "ws_world_create")
+        self._ptr = p
+
+    # lifetime
+    def close(self):
+        """Destroy the world and everything in it (open VTK series first)."""
+        for series in self._series:
+            series.close()
+        self._series = []
+        if self._ptr:
+            _c().ws_world_destroy(self._ptr)
+        self._ptr = None
+        self._callbacks.clear()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+    @property
+    def closed(self):
+        return not self._ptr
+
+    @property
+    def ptr(self):
+        """The ws_world pointer; WrapsimError once the world is closed."""
+        if not self._ptr:
+            raise WrapsimError(WS_ERR_STALE_HANDLE, "the world was closed")
+        return self._ptr
+
+    def _call(self, name, *args):
+        s = getattr(_c(), name)(self.ptr, *args)
+        if s != WS_OK:
+            detail = _c().ws_world_last_error(self._ptr).decode(errors="replace")
+            pending, self._pending = self._pending, None
+            err = WrapsimError(s, detail)
+            if pending is not None:
+                raise err from pending
+            raise err
+        return s
+
+    @property
+    def last_error(self):
+        """The detail of the last error in this world ("" when none)."""
+        return _c().ws_world_last_error(self.ptr).decode(errors="replace")
+
+    @property
+    def user_data(self):
+        """The user_data pointer of the Def, as an int (or None)."""
+        return _c().ws_world_get_user_data(self.ptr)
+
+    # stepping and state
+    def step(self, n=1):
+        """Take n steps of dt (one ws_world_step for n == 1, else ws_world_step_n)."""
+        if n == 1:
+            self._call("ws_world_step")
+        else:
+            self._call("ws_world_step_n", int(n))
+
+    @property
+    def time(self):
+        """Simulated time, s."""
+        t = c_double()
+        self._call("ws_world_get_time", byref(t))
+        return t.value
+
+    @property
+    def dt(self):
+        """Time step, s (settable between steps)."""
+        t = c_double()
+        self._call("ws_world_get_dt", byref(t))
+        return t.value
+
+    @dt.setter
+    def dt(self, value):
+        self._call("ws_world_set_dt", float(value))
+
+    def set_gravity(self, g):
+        """Gravity, m/s^2."""
+        self._call("ws_world_set_gravity", byref(_vec3(g)))
+
+    gravity = property(None, set_gravity)
+
+    def stats(self):
+        """Counters and figures (ws_world_stats) as a dict."""
+        st = L.WorldStats()
+        self._call("ws_world_get_stats", byref(st))
+        return _struct_dict(st, skip=("reserved",))
+
+    def energy(self):
+        """Energy of the dynamic bodies, J: dict of kinetic, potential, contact."""
+        e = L.Energy()
+        self._call("ws_world_get_energy", byref(e))
+        return _struct_dict(e)
+
+    def state_hash(self):
+        """64-bit hash of the whole dynamic state."""
+        h = c_uint64()
+        self._call("ws_world_get_state_hash", byref(h))
+        return h.value
+
+    def estimate_stable_dt(self):
+        """Largest stable dt (s) estimated for the bodies and contact pairs now in the world."""
+        t = c_double()
+        self._call("ws_world_estimate_stable_dt", byref(t))
+        return t.value
+
+    # materials and contact pairs
+    @property
+    def default_material(self):
+        out = L.MaterialId()
+        self._call("ws_world_get_default_material", byref(out))
+        return Material(self, out, "default")
+
+    def material(self, name=None):
+        """Create a material (only a name; parameters belong to pairs)."""
+        d = _make(L.MaterialDef, {"name": name})
+        out = L.MaterialId()
+        self._call("ws_material_create", byref(d), byref(out))
+        return Material(self, out, name)
+
+    def set_contact(self, a, b, **params):
+        """Contact parameters between materials a and b: ws_contact_def fields (stiffness N/m,
+        damping kg/s, friction, friction_vlim m/s, friction_model, stick_stiffness,
+        stick_damping); the others keep ws_contact_def_init's defaults."""
+        d = _make(L.ContactDef, params)
+        self._call("ws_world_set_contact", _id_of(a, L.MaterialId), _id_of(b, L.MaterialId),
+                   byref(d))
+
+    def get_contact(self, a, b):
+        """The parameters that apply between materials a and b, as a dict."""
+        d = L.ContactDef()
+        self._call("ws_world_get_contact", _id_of(a, L.MaterialId), _id_of(b, L.MaterialId),
+                   byref(d))
+        return _struct_dict(d, skip=("size", "magic"))
+
+    def set_default_contact(self, **params):
+        """Parameters for every pair not set explicitly."""
+        d = _make(L.ContactDef, params)
+        self._call("ws_world_set_default_contact", byref(d))
+
+    # shapes
+    def box(self, lx, ly, lz):
+        """A box shape with full edge lengths lx, ly, lz (m), centred on the origin."""
+        out = L.ShapeId()
+        self._call("ws_shape_create_box", float(lx), float(ly), float(lz), byref(out))
+        return Shape(self, out)
+
+    shape_box = box
+
+    def cylinder(self, radius, height, segments=32):
+        """A prism approximating a cylinder along z (m), `segments` sides."""
+        out = L.ShapeId()
+        self._call("ws_shape_create_cylinder", float(radius), float(height), int(segments),
+                   byref(out))
+        return Shape(self, out)
+
+    def mesh(self, vertices, triangles):
+        """A closed mesh shape: vertices (n, 3) in m, triangles (m, 3) indices, counter-
+        clockwise seen from outside."""
+        v = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
+        t = np.ascontiguousarray(triangles, dtype=np.uint32).reshape(-1, 3)
+        d = _make(L.MeshDef, {})
+        d.vertices = _ptr(v, c_double)
+        d.vertex_count = len(v)
+        d.triangles = _ptr(t, c_uint32)
+        d.triangle_count = len(t)
+        out = L.ShapeId()
+        self._call("ws_shape_create_mesh", byref(d), byref(out))
+        return Shape(self, out)
+
+    # bodies
+    def body(self, shape, **kwargs):
+        """Create a body: ws_body_def fields as keywords (type 'dynamic'/'kinematic', material,
+        mass kg, density kg/m^3, inertia 3x3, contact_layer m, position m, orientation
+        (e0..e3), velocity m/s, angular_velocity rad/s, name, user_data)."""
+        kwargs["shape"] = shape
+        d = _make(L.BodyDef, kwargs)
+        out = L.BodyId()
+        self._call("ws_body_create", byref(d), byref(out))
+        b = Body(self, out)
+        self._bodies[out.bits] = b
+        return b
+
+    def bodies(self):
+        """Every live body, in creation order."""
+        n = c_size_t()
+        self._call("ws_world_copy_body_ids", None, 0, byref(n))
+        buf = (L.BodyId * max(n.value, 1))()
+        self._call("ws_world_copy_body_ids", buf, n.value, byref(n))
+        return [self.body_by_id(buf[i].bits) for i in range(n.value)]
+
+    def body_by_id(self, bits):
+        """The Body for a body id's 64 bits (e.g. from contacts()['body_a'])."""
+        bits = int(bits)
+        b = self._bodies.get(bits)
+        if b is None:
+            b = self._bodies[bits] = Body(self, L.BodyId(bits))
+        return b
+
+    # contacts
+    def contact_count(self):
+        n = c_size_t()
+        self._call("ws_world_get_contact_count", byref(n))
+        return n.value
+
+    def contacts(self):
+        """Active contacts of the last step as a numpy structured array (CONTACT_DTYPE): body_a,
+        body_b (id bits; see body_by_id), point, normal, overlap, normal_force, friction_force,
+        slip_velocity, kind, slipping. Forces are those on body_b."""
+        n = c_size_t()
+        self._call("ws_world_copy_contacts", None, 0, byref(n))
+        buf = np.zeros(n.value, dtype=CONTACT_DTYPE)
+        if n.value:
+            self._call("ws_world_copy_contacts", _ptr(buf, L.ContactInfo), len(buf), byref(n))
+        return buf[: n.value]
+
+    # laws and webs
+    def law(self, type="linear_elastic", **kwargs):
+        """A constitutive law: ws_law_def fields (type, stiffness N, compression_stiffness N,
+        damping N s, transition, name)."""
+        kwargs["type"] = type
+        d = _make(L.LawDef, kwargs)
+        out = L.LawId()
+        self._call("ws_law_create", byref(d), byref(out))
+        return Law(self, out)
+
+    def _web_def(self, kw):
+        return _make(L.WebDef, kw)
+
+    def web_sheet(self, law, pinned=None, **kwargs):
+        """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
+        areal_density, contact_layer, material, node_damping, substeps, name) and ws_sheet_def
+        fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
+        prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""
+        wk, sk = _split(kwargs, L.WebDef, L.SheetDef)
+        wk["law"] = law
+        wd = self._web_def(wk)
+        sd = _make(L.SheetDef, sk)
+        pins = None
+        if pinned is not None and len(pinned):
+            pins = np.ascontiguousarray(pinned, dtype=np.uint32).reshape(-1)
+            sd.pinned = _ptr(pins, c_uint32)
+            sd.pinned_count = len(pins)
+        out = L.WebId()
+        self._call("ws_web_create_sheet", byref(wd), byref(sd), byref(out))
+        return Web(self, out)
+
+    def web_band(self, law, bodies, **kwargs):
+        """A band wrapped around `bodies` (as they are now): ws_web_def fields and ws_band_def
+        fields (z_bottom, z_top m, n_around, n_up, prestretch_around, prestretch_up, gap m,
+        shear)."""
+        wk, bk = _split(kwargs, L.WebDef, L.BandDef)
+        wk["law"] = law
+        wd = self._web_def(wk)
+        bd = _make(L.BandDef, bk)
+        ids = (L.BodyId * max(len(bodies), 1))(*[_id_of(b, L.BodyId) for b in bodies])
+        bd.bodies = ctypes.cast(ids, POINTER(L.BodyId))
+        bd.body_count = len(bodies)
+        out = L.WebId()
+        self._call("ws_web_create_band", byref(wd), byref(bd), byref(out))
+        return Web(self, out)
+
+    def web_mesh(self, law, positions, springs, node_masses=None, rest_lengths=None,
+                 kinds=None, pinned=None, **kwargs):
+        """A web of raw nodes (positions (n, 3) m) and springs ((m, 2) node indices), with
+        optional node_masses (kg), rest_lengths (m), kinds (ws_spring_kind) and pinned nodes;
+        other keywords are ws_web_def fields."""
+        kwargs["law"] = law
+        wd = self._web_def(kwargs)
+        md = _make(L.WebMeshDef, {})
+        keep = []
+
+        def arr(a, dtype, ctype, cols=None):
+            a = np.ascontiguousarray(a, dtype=dtype)
+            a = a.reshape(-1, cols) if cols else a.reshape(-1)
+            keep.append(a)
+            return a, _ptr(a, ctype)
+
+        pos, md.positions = arr(positions, np.float64, c_double, 3)
+        md.node_count = len(pos)
+        spr, md.springs = arr(springs, np.uint32, c_uint32, 2)
+        md.spring_count = len(spr)
+        if node_masses is not None:
+            _, md.node_masses = arr(node_masses, np.float64, c_double)
+        if rest_lengths is not None:
+            _, md.rest_lengths = arr(rest_lengths, np.float64, c_double)
+        if kinds is not None:
+            _, md.kinds = arr(kinds, np.uint8, ctypes.c_uint8)
+        if pinned is not None and len(pinned):
+            pins, md.pinned = arr(pinned, np.uint32, c_uint32)
+            md.pinned_count = len(pins)
+        out = L.WebId()
+        self._call("ws_web_create_mesh", byref(wd), byref(md), byref(out))
+        return Web(self, out)
+
+    # output
+    def write_vtp(self, path):
+        """Write the bodies as one VTK PolyData file."""
+        self._call("ws_world_write_vtp", str(path).encode())
+
+    def vtk_series(self, directory, basename):
+        """Start a .vtp/.pvd time series in `directory` (must exist). A context manager."""
+        p = L.Series_p()
+        self._call("ws_vtk_series_create", str(directory).encode(), str(basename).encode(),
+                   byref(p))
+        s = VtkSeries(self, p)
+        self._series.append(s)
+        return s
+
+
+# --- handles -------------------------------------------------------------------------------------
+class _Handle:
+    _valid_fn = None
+
+    def __init__(self, world, id_):
+        self.world = world
+        self._id = id_
+
+    @property
+    def id(self):
+        """The id's 64 bits."""
+        return self._id.bits
+
+    def _call(self, name, *args):
+        return self.world._call(name, self._id, *args)
+
+    @property
+    def valid(self):
+        """True while the id names a live object of its world."""
+        if self.world.closed:
+            return False
+        return bool(getattr(_c(), self._valid_fn)(self.world.ptr, self._id))
+
+    def __eq__(self, other):
+        return type(other) is type(self) and other.world is self.world and other.id == self.id
+
+    def __hash__(self):
+        return hash((type(self), self.id))
+
+    def __repr__(self):
+        return f"<{type(self).__name__} 0x{self.id:016x}>"
+
+
+class Material(_Handle):
+    """A contact material."""
+    _valid_fn = "ws_material_is_valid"
+
+    def __init__(self, world, id_, name=None):
+        super().__init__(world, id_)
+        self.name = name
+
+
+class Shape(_Handle):
+    """A closed triangle mesh in its body frame."""
+    _valid_fn = "ws_shape_is_valid"
+
+    def info(self):
+        """Volume (m^3), centroid, aabb_min/max (m), inertia_unit, feature counts, convex."""
+        i = L.ShapeInfo()
+        self._call("ws_shape_get_info", byref(i))
+        return _struct_dict(i)
+
+    def copy_mesh(self):
+        """The re-centred vertices (n, 3) m and triangles (m, 3)."""
+        nv, nt = c_size_t(), c_size_t()
+        self._call("ws_shape_copy_mesh", None, 0, byref(nv), None, 0, byref(nt))
+        v = np.empty((nv.value, 3))
+        t = np.empty((nt.value, 3), dtype=np.uint32)
+        self._call("ws_shape_copy_mesh", _ptr(v, c_double), nv.value, byref(nv),
+                   _ptr(t, c_uint32), nt.value, byref(nt))
+        return v, t
+
+    def destroy(self):
+        """Destroy the shape (WrapsimError WS_ERR_IN_USE while a body uses it)."""
+        self._call("ws_shape_destroy")
+
+
+class Law(_Handle):
+    """A constitutive law: force (N) of strain and strain rate."""
+    _valid_fn = "ws_law_is_valid"
+
+    def evaluate(self, eps, eps_dot=0.0):
+        """(F N, dF/deps N, dF/deps_dot N s) at strain eps and strain rate eps_dot (1/s)."""
+        f, k, c = c_double(), c_double(), c_double()
+        self._call("ws_law_evaluate", float(eps), float(eps_dot), byref(f), byref(k), byref(c))
+        return f.value, k.value, c.value
+
+    def energy(self, eps):
+        """Elastic energy per unit rest length (J/m) at strain eps."""
+        e = c_double()
+        self._call("ws_law_energy", float(eps), byref(e))
+        return e.value
+
+    def destroy(self):
+        self._call("ws_law_destroy")
+
+
+def _vec_getter(fn, doc):
+    def get(self):
+        v = L.Vec3()
+        self._call(fn, byref(v))
+        return _np(v)
+    return property(get, doc=doc)
+
+
+class Body(_Handle):
+    """A rigid body or a kinematic world element. Vectors are numpy arrays, global frame."""
+    _valid_fn = "ws_body_is_valid"
+
+    position = _vec_getter("ws_body_get_position", "CoG position, m.")
+    velocity = _vec_getter("ws_body_get_velocity", "CoG velocity, m/s.")
+    angular_velocity = _vec_getter("ws_body_get_angular_velocity",
+                                   "Angular velocity, global frame, rad/s.")
+    angular_velocity_local = _vec_getter("ws_body_get_angular_velocity_local",
+                                         "Angular velocity, body frame, rad/s.")
+
+    @property
+    def orientation(self):
+        """Euler parameters (e0, e1, e2, e3)."""
+        q = L.Quat()
+        self._call("ws_body_get_orientation", byref(q))
+        return np.array([q.e0, q.e1, q.e2, q.e3])
+
+    @property
+    def rotation(self):
+        """Rotation matrix A (body to global), 3x3."""
+        m = L.Mat3()
+        self._call("ws_body_get_rotation", byref(m))
+        return np.array(m.m[:]).reshape(3, 3)
+
+    @property
+    def inertia(self):
+        """Inertia about the CoG in the body frame, kg m^2, 3x3."""
+        m = L.Mat3()
+        self._call("ws_body_get_inertia", byref(m))
+        return np.array(m.m[:]).reshape(3, 3)
+
+    @property
+    def mass(self):
+        """kg (0 for kinematic bodies)."""
+        m = c_double()
+        self._call("ws_body_get_mass", byref(m))
+        return m.value
+
+    @property
+    def type(self):
+        """WS_BODY_DYNAMIC or WS_BODY_KINEMATIC."""
+        t = c_int()
+        self._call("ws_body_get_type", byref(t))
+        return t.value
+
+    def _check_live(self):
+        if not self.valid:
+            raise WrapsimError(WS_ERR_STALE_HANDLE, f"body id 0x{self.id:016x} is not live")
+
+    @property
+    def name(self):
+        """The name given when created ("" if none)."""
+        self._check_live()
+        n = _c().ws_body_get_name(self.world.ptr, self._id)
+        return n.decode() if n else ""
+
+    @property
+    def user_data(self):
+        """The user_data pointer of the Def, as an int (or None)."""
+        self._check_live()
+        return _c().ws_body_get_user_data(self.world.ptr, self._id)
+
+    def point_velocity(self, point):
+        """Velocity (m/s) of the body point now at global `point` (m)."""
+        v = L.Vec3()
+        self._call("ws_body_get_point_velocity", byref(_vec3(point)), byref(v))
+        return _np(v)
+
+    def world_point(self, local):
+        """Global position (m) of a point given in the body frame."""
+        v = L.Vec3()
+        self._call("ws_body_get_world_point", byref(_vec3(local)), byref(v))
+        return _np(v)
+
+    def contact_force(self):
+        """(force N, moment N m about the CoG) of the last step's contacts, global."""
+        f, m = L.Vec3(), L.Vec3()
+        self._call("ws_body_get_contact_force", byref(f), byref(m))
+        return _np(f), _np(m)
+
+    def set_pose(self, position, orientation=(1.0, 0.0, 0.0, 0.0)):
+        """Set the pose of a dynamic body between steps."""
+        pose = L.Pose(_vec3(position), _quat(orientation))
+        self._call("ws_body_set_pose", byref(pose))
+
+    def set_velocity(self, velocity, angular_velocity=(0.0, 0.0, 0.0)):
+        """Set the velocities (m/s, rad/s global) of a dynamic body between steps."""
+        self._call("ws_body_set_velocity", byref(_vec3(velocity)), byref(_vec3(angular_velocity)))
+
+    def set_drive(self, type="static", callback=None, **kwargs):
+        """Set the drive of a kinematic body: type 'static', 'tilt' (axis, point, rate rad/s,
+        start_time s, ramp_time s, max_angle rad), 'sine' (direction, amplitude m, frequency Hz,
+        phase rad, start_time, ramp_time) or 'callback' with `callback(t)` returning
+        (position, orientation[, velocity[, angular_velocity]]) in the global frame. An exception
+        in the callback fails the step with WS_ERR_CALLBACK and is chained to the WrapsimError."""
+        kwargs["type"] = type
+        d = _make(L.DriveDef, kwargs)
+        cfn = None
+        if callback is not None:
+            world = self.world
+
+            def _drive(user, t, pose, vel, omega, _fn=callback):
+                try:
+                    r = _fn(t)
+                    pose[0].position = _vec3(r[0])
+                    pose[0].orientation = _quat(r[1])
+                    vel[0] = _vec3(r[2]) if len(r) > 2 else L.Vec3()
+                    omega[0] = _vec3(r[3]) if len(r) > 3 else L.Vec3()
+                    return 0
+                except Exception as e:  # noqa: BLE001 - reported through the step's error
+                    world._pending = e
+                    return 1
+            cfn = L.DriveFn(_drive)
+            d.callback = cfn
+        elif d.type == WS_DRIVE_CALLBACK:
+            raise ValueError("a 'callback' drive needs callback=")
+        if cfn is not None:
+            # Kept until the body or the world goes: the library calls it from now on (and may
+            # have kept it even when the call below fails).
+            self.world._callbacks.setdefault(self.id, []).append(cfn)
+        self._call("ws_body_set_drive", byref(d))
+
+    def destroy(self):
+        """Destroy the body; its contacts go with it."""
+        self._call("ws_body_destroy")
+        self.world._callbacks.pop(self.id, None)
+
+
+class Web(_Handle):
+    """A film: nodes joined by springs. Bulk read-outs fill numpy arrays in one C call each;
+    pass `out` (preallocated, right shape and dtype, C-contiguous) to reuse a buffer."""
+    _valid_fn = "ws_web_is_valid"
+
+    def __init__(self, world, id_):
+        super().__init__(world, id_)
+        i = self.info()
+        self.node_count = i["node_count"]
+        self.spring_count = i["spring_count"]
+
+    def info(self):
+        """node_count, spring_count, nx, ny, closed, substeps, mass kg, min_node_mass kg."""
+        i = L.WebInfo()
+        self._call("ws_web_get_info", byref(i))
+        return _struct_dict(i)
+
+    @property
+    def stable_dt(self):
+        """Largest stable sub-step, s."""
+        t = c_double()
+        self._call("ws_web_get_stable_dt", byref(t))
+        return t.value
+
+    @property
+    def substeps(self):
+        return self.info()["substeps"]
+
+    @substeps.setter
+    def substeps(self, n):
+        self._call("ws_web_set_substeps", int(n))
+
+    def _bulk(self, fn, n, shape, dtype, ctype, out):
+        if out is None:
+            out = np.empty(shape, dtype=dtype)
+        elif (out.shape != shape or out.dtype != dtype or not out.flags.c_contiguous
+              or not out.flags.writeable):
+            raise ValueError(f"out must be a writeable C-contiguous {dtype} array {shape}")
+        count = c_size_t()
+        self._call(fn, _ptr(out, ctype), n, byref(count))
+        return out
+
+    def positions(self, out=None):
+        """Node positions (n, 3), m."""
+        return self._bulk("ws_web_copy_positions", self.node_count, (self.node_count, 3),
+                          np.float64, c_double, out)
+
+    def velocities(self, out=None):
+        """Node velocities (n, 3), m/s."""
+        return self._bulk("ws_web_copy_velocities", self.node_count, (self.node_count, 3),
+                          np.float64, c_double, out)
+
+    def contact_forces(self, out=None):
+        """Force of the bodies on each node in the last step (n, 3), N."""
+        return self._bulk("ws_web_copy_contact_forces", self.node_count, (self.node_count, 3),
+                          np.float64, c_double, out)
+
+    def springs(self, out=None):
+        """Spring end nodes (m, 2), uint32."""
+        return self._bulk("ws_web_copy_springs", self.spring_count, (self.spring_count, 2),
+                          np.uint32, c_uint32, out)
+
+    def strains(self, out=None):
+        """Spring strains l/l0 - 1 (m,)."""
+        return self._bulk("ws_web_copy_spring_strains", self.spring_count,
+                          (self.spring_count,), np.float64, c_double, out)
+
+    def tensions(self, out=None):
+        """Spring tensions (m,), N; negative in compression."""
+        return self._bulk("ws_web_copy_spring_tensions", self.spring_count,
+                          (self.spring_count,), np.float64, c_double, out)
+
+    def body_force(self, body):
+        """(force N, moment N m about the CoG) the web put on `body` in the last step."""
+        f, m = L.Vec3(), L.Vec3()
+        self._call("ws_web_get_body_force", _id_of(body, L.BodyId), byref(f), byref(m))
+        return _np(f), _np(m)
+
+    def containment(self, bands):
+        """Containment profile in `bands` equal height bands: structured array
+        (CONTAINMENT_DTYPE: z_low, z_high m, hoop_tension N, line_load N/m, contact_force N)."""
+        out = np.zeros(int(bands), dtype=CONTAINMENT_DTYPE)
+        self._call("ws_web_get_containment", _ptr(out, L.ContainmentBand), int(bands))
+        return out
+
+    def energy(self):
+        """dict of kinetic, elastic and gravity energy of the web, J."""
+        k, e, g = c_double(), c_double(), c_double()
+        self._call("ws_web_get_energy", byref(k), byref(e), byref(g))
+        return {"kinetic": k.value, "elastic": e.value, "gravity": g.value}
+
+    def write_vtp(self, path):
+        """Write the web as a VTK PolyData file."""
+        self._call("ws_web_write_vtp", str(path).encode())
+
+    def destroy(self):
+        self._call("ws_web_destroy")
+
+
+class VtkSeries:
+    """A time series of .vtp frames with a .pvd collection. Context manager; closed with its
+    world at the latest."""
+
+    def __init__(self, world, ptr):
+        self.world = world
+        self._ptr = ptr
+
+    def _check(self, s):
+        if s != WS_OK:
+            raise WrapsimError(s, _c().ws_world_last_error(self.world.ptr).decode())
+
+    def write_frame(self):
+        """Write the world now as the next frame."""
+        if not self._ptr:
+            raise WrapsimError(WS_ERR_STALE_HANDLE, "the VTK series was closed")
+        self._check(_c().ws_vtk_series_write_frame(self._ptr))
+
+    @property
+    def frame_count(self):
+        if not self._ptr:
+            raise WrapsimError(WS_ERR_STALE_HANDLE, "the VTK series was closed")
+        n = c_size_t()
+        self._check(_c().ws_vtk_series_get_frame_count(self._ptr, byref(n)))
+        return n.value
+
+    def close(self):
+        if self._ptr:
+            _c().ws_vtk_series_destroy(self._ptr)
+        self._ptr = None
+        if self in self.world._series:
+            self.world._series.remove(self)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -1,0 +1,563 @@
+"""Low level: the ctypes mirror of include/wrapsim/*.h and the loader of libwrapsim.
+
+Every struct below mirrors its C struct field by field (same order, same types); every public
+function of the library is in FUNCTIONS, one row (name, argtypes, restype) each. Enums cross the
+boundary as C int.
+"""
+
+import ctypes
+import ctypes.util
+import os
+import pathlib
+import sys
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_int32,
+                    c_int64, c_size_t, c_uint, c_uint8, c_uint32, c_uint64, c_void_p)
+
+#: The oldest library this binding works with: major * 10000 + minor * 100 + patch.
+REQUIRED_VERSION = 100  # 0.1.0
+#: The binding's own version.
+BINDING_VERSION = "0.1.0"
+
+# --- enums (common.h, world.h, body.h, contact.h, law.h, web.h) -------------------------------
+WS_OK = 0
+WS_ERR_INVALID_ARGUMENT = 1
+WS_ERR_UNINITIALIZED_DEF = 2
+WS_ERR_STALE_HANDLE = 3
+WS_ERR_OUT_OF_MEMORY = 4
+WS_ERR_NUMERICAL = 5
+WS_ERR_BAD_MESH = 6
+WS_ERR_IN_USE = 7
+WS_ERR_CALLBACK = 8
+WS_ERR_BUFFER_TOO_SMALL = 9
+WS_ERR_IO = 10
+WS_ERR_UNSUPPORTED = 11
+
+WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
+WS_FEATURE_CCD = 1
+WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
+WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
+WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
+WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK = 0, 1, 2, 3
+WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE = 0, 1
+WS_LAW_LINEAR_ELASTIC, WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION = 0, 1, 2
+WS_SPRING_AROUND, WS_SPRING_UP, WS_SPRING_SHEAR = 0, 1, 2
+
+c_enum = c_int
+
+
+# --- common.h ------------------------------------------------------------------------------------
+class Vec3(Structure):
+    _fields_ = [("x", c_double), ("y", c_double), ("z", c_double)]
+
+
+class Quat(Structure):
+    _fields_ = [("e0", c_double), ("e1", c_double), ("e2", c_double), ("e3", c_double)]
+
+
+class Mat3(Structure):
+    _fields_ = [("m", c_double * 9)]
+
+
+class Pose(Structure):
+    _fields_ = [("position", Vec3), ("orientation", Quat)]
+
+
+class _Id(Structure):
+    _fields_ = [("bits", c_uint64)]
+
+
+class BodyId(_Id):
+    pass
+
+
+class ShapeId(_Id):
+    pass
+
+
+class MaterialId(_Id):
+    pass
+
+
+class LawId(_Id):
+    pass
+
+
+class WebId(_Id):
+    pass
+
+
+AllocFn = CFUNCTYPE(c_void_p, c_void_p, c_size_t)
+ReallocFn = CFUNCTYPE(c_void_p, c_void_p, c_void_p, c_size_t, c_size_t)
+FreeFn = CFUNCTYPE(None, c_void_p, c_void_p, c_size_t)
+
+
+class Allocator(Structure):
+    _fields_ = [("alloc", AllocFn), ("realloc", ReallocFn), ("free", FreeFn), ("user", c_void_p)]
+
+
+LogFn = CFUNCTYPE(None, c_void_p, c_enum, c_char_p)
+
+
+# --- world.h -------------------------------------------------------------------------------------
+class WorldDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("gravity", Vec3),
+        ("dt", c_double),
+        ("integrator", c_enum),
+        ("full_detection_until", c_double),
+        ("detection_interval", c_int),
+        ("contact_margin", c_double),
+        ("max_speed", c_double),
+        ("max_angular_speed", c_double),
+        ("use_ccd", c_int),
+        ("profile", c_int),
+        ("allocator", Allocator),
+        ("log", LogFn),
+        ("log_user", c_void_p),
+        ("user_data", c_void_p),
+    ]
+
+
+class ContactDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("stiffness", c_double),
+        ("damping", c_double),
+        ("friction", c_double),
+        ("friction_vlim", c_double),
+        ("friction_model", c_enum),
+        ("stick_stiffness", c_double),
+        ("stick_damping", c_double),
+    ]
+
+
+class MaterialDef(Structure):
+    _fields_ = [("size", c_uint32), ("magic", c_uint32), ("name", c_char_p)]
+
+
+class WorldStats(Structure):
+    _fields_ = [
+        ("time", c_double),
+        ("steps", c_uint64),
+        ("full_detections", c_uint64),
+        ("narrow_checks", c_uint64),
+        ("body_pairs_tested", c_uint64),
+        ("body_pairs_gated", c_uint64),
+        ("contacts", c_uint64),
+        ("candidates", c_uint64),
+        ("numerical_errors", c_uint64),
+        ("bytes_in_use", c_uint64),
+        ("bytes_peak", c_uint64),
+        ("bodies", c_uint64),
+        ("seconds_detection", c_double),
+        ("seconds_contacts", c_double),
+        ("seconds_web", c_double),
+        ("seconds_total", c_double),
+        ("reserved", c_uint64 * 4),
+    ]
+
+
+class Energy(Structure):
+    _fields_ = [("kinetic", c_double), ("potential", c_double), ("contact", c_double)]
+
+
+# --- shape.h -------------------------------------------------------------------------------------
+class MeshDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("vertices", POINTER(c_double)),
+        ("vertex_count", c_size_t),
+        ("triangles", POINTER(c_uint32)),
+        ("triangle_count", c_size_t),
+    ]
+
+
+class ShapeInfo(Structure):
+    _fields_ = [
+        ("volume", c_double),
+        ("centroid", Vec3),
+        ("aabb_min", Vec3),
+        ("aabb_max", Vec3),
+        ("inertia_unit", Mat3),
+        ("point_count", c_uint32),
+        ("edge_count", c_uint32),
+        ("face_count", c_uint32),
+        ("triangle_count", c_uint32),
+        ("convex", c_int),
+    ]
+
+
+# --- body.h --------------------------------------------------------------------------------------
+class BodyDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("type", c_enum),
+        ("shape", ShapeId),
+        ("material", MaterialId),
+        ("mass", c_double),
+        ("density", c_double),
+        ("inertia", Mat3),
+        ("contact_layer", c_double),
+        ("position", Vec3),
+        ("orientation", Quat),
+        ("velocity", Vec3),
+        ("angular_velocity", Vec3),
+        ("name", c_char_p),
+        ("user_data", c_void_p),
+    ]
+
+
+DriveFn = CFUNCTYPE(c_int, c_void_p, c_double, POINTER(Pose), POINTER(Vec3), POINTER(Vec3))
+
+
+class DriveDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("type", c_enum),
+        ("start_time", c_double),
+        ("ramp_time", c_double),
+        ("axis", Vec3),
+        ("point", Vec3),
+        ("rate", c_double),
+        ("max_angle", c_double),
+        ("direction", Vec3),
+        ("amplitude", c_double),
+        ("frequency", c_double),
+        ("phase", c_double),
+        ("callback", DriveFn),
+        ("callback_user", c_void_p),
+    ]
+
+
+# --- contact.h -----------------------------------------------------------------------------------
+class ContactInfo(Structure):
+    _fields_ = [
+        ("body_a", BodyId),
+        ("body_b", BodyId),
+        ("point", Vec3),
+        ("normal", Vec3),
+        ("overlap", c_double),
+        ("normal_force", c_double),
+        ("friction_force", Vec3),
+        ("slip_velocity", Vec3),
+        ("kind", c_int32),
+        ("slipping", c_int32),
+    ]
+
+
+# --- law.h ---------------------------------------------------------------------------------------
+class LawDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("type", c_enum),
+        ("stiffness", c_double),
+        ("compression_stiffness", c_double),
+        ("damping", c_double),
+        ("transition", c_double),
+        ("name", c_char_p),
+    ]
+
+
+# --- web.h ---------------------------------------------------------------------------------------
+class WebDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("node_mass", c_double),
+        ("areal_density", c_double),
+        ("contact_layer", c_double),
+        ("material", MaterialId),
+        ("node_damping", c_double),
+        ("law", LawId),
+        ("law_cross", LawId),
+        ("law_shear", LawId),
+        ("substeps", c_int),
+        ("name", c_char_p),
+    ]
+
+
+class SheetDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("nx", c_int), ("ny", c_int),
+        ("origin", Vec3),
+        ("axis_x", Vec3), ("axis_y", Vec3),
+        ("spacing_x", c_double), ("spacing_y", c_double),
+        ("prestretch_x", c_double), ("prestretch_y", c_double),
+        ("shear", c_int),
+        ("pinned", POINTER(c_uint32)),
+        ("pinned_count", c_size_t),
+    ]
+
+
+class BandDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("bodies", POINTER(BodyId)),
+        ("body_count", c_size_t),
+        ("z_bottom", c_double), ("z_top", c_double),
+        ("n_around", c_int), ("n_up", c_int),
+        ("prestretch_around", c_double),
+        ("prestretch_up", c_double),
+        ("gap", c_double),
+        ("shear", c_int),
+    ]
+
+
+class WebMeshDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("positions", POINTER(c_double)),
+        ("node_count", c_size_t),
+        ("node_masses", POINTER(c_double)),
+        ("springs", POINTER(c_uint32)),
+        ("spring_count", c_size_t),
+        ("rest_lengths", POINTER(c_double)),
+        ("kinds", POINTER(c_uint8)),
+        ("pinned", POINTER(c_uint32)),
+        ("pinned_count", c_size_t),
+    ]
+
+
+class WebInfo(Structure):
+    _fields_ = [
+        ("node_count", c_uint32),
+        ("spring_count", c_uint32),
+        ("nx", c_int), ("ny", c_int),
+        ("closed", c_int),
+        ("substeps", c_int),
+        ("mass", c_double),
+        ("min_node_mass", c_double),
+    ]
+
+
+class ContainmentBand(Structure):
+    _fields_ = [
+        ("z_low", c_double), ("z_high", c_double),
+        ("hoop_tension", c_double),
+        ("line_load", c_double),
+        ("contact_force", c_double),
+    ]
+
+
+# Opaque handles.
+World_p = c_void_p
+Series_p = c_void_p
+
+P = POINTER
+_st = c_enum  # ws_status
+
+#: Every public function of libwrapsim: (name, argtypes, restype).
+FUNCTIONS = [
+    # common.h
+    ("ws_status_string", [c_enum], c_char_p),
+    ("ws_version_number", [], c_int),
+    ("ws_version_string", [], c_char_p),
+    ("ws_build_features", [], c_uint),
+    # world.h
+    ("ws_world_def_init", [P(WorldDef)], None),
+    ("ws_contact_def_init", [P(ContactDef)], None),
+    ("ws_material_def_init", [P(MaterialDef)], None),
+    ("ws_world_create", [P(WorldDef), P(World_p)], _st),
+    ("ws_world_destroy", [World_p], None),
+    ("ws_world_step", [World_p], _st),
+    ("ws_world_step_n", [World_p, c_int64], _st),
+    ("ws_world_get_time", [World_p, P(c_double)], _st),
+    ("ws_world_get_dt", [World_p, P(c_double)], _st),
+    ("ws_world_set_dt", [World_p, c_double], _st),
+    ("ws_world_set_gravity", [World_p, P(Vec3)], _st),
+    ("ws_world_get_stats", [World_p, P(WorldStats)], _st),
+    ("ws_world_get_energy", [World_p, P(Energy)], _st),
+    ("ws_world_get_state_hash", [World_p, P(c_uint64)], _st),
+    ("ws_world_last_error", [World_p], c_char_p),
+    ("ws_world_get_user_data", [World_p], c_void_p),
+    ("ws_world_estimate_stable_dt", [World_p, P(c_double)], _st),
+    ("ws_world_get_default_material", [World_p, P(MaterialId)], _st),
+    ("ws_material_create", [World_p, P(MaterialDef), P(MaterialId)], _st),
+    ("ws_material_is_valid", [World_p, MaterialId], c_int),
+    ("ws_world_set_contact", [World_p, MaterialId, MaterialId, P(ContactDef)], _st),
+    ("ws_world_get_contact", [World_p, MaterialId, MaterialId, P(ContactDef)], _st),
+    ("ws_world_set_default_contact", [World_p, P(ContactDef)], _st),
+    # shape.h
+    ("ws_mesh_def_init", [P(MeshDef)], None),
+    ("ws_shape_create_box", [World_p, c_double, c_double, c_double, P(ShapeId)], _st),
+    ("ws_shape_create_cylinder", [World_p, c_double, c_double, c_int, P(ShapeId)], _st),
+    ("ws_shape_create_mesh", [World_p, P(MeshDef), P(ShapeId)], _st),
+    ("ws_shape_destroy", [World_p, ShapeId], _st),
+    ("ws_shape_is_valid", [World_p, ShapeId], c_int),
+    ("ws_shape_get_info", [World_p, ShapeId, P(ShapeInfo)], _st),
+    ("ws_shape_copy_mesh", [World_p, ShapeId, P(c_double), c_size_t, P(c_size_t), P(c_uint32),
+                            c_size_t, P(c_size_t)], _st),
+    # body.h
+    ("ws_body_def_init", [P(BodyDef)], None),
+    ("ws_drive_def_init", [P(DriveDef)], None),
+    ("ws_body_create", [World_p, P(BodyDef), P(BodyId)], _st),
+    ("ws_body_destroy", [World_p, BodyId], _st),
+    ("ws_body_is_valid", [World_p, BodyId], c_int),
+    ("ws_body_set_drive", [World_p, BodyId, P(DriveDef)], _st),
+    ("ws_body_get_type", [World_p, BodyId, P(c_enum)], _st),
+    ("ws_body_get_position", [World_p, BodyId, P(Vec3)], _st),
+    ("ws_body_get_orientation", [World_p, BodyId, P(Quat)], _st),
+    ("ws_body_get_rotation", [World_p, BodyId, P(Mat3)], _st),
+    ("ws_body_get_velocity", [World_p, BodyId, P(Vec3)], _st),
+    ("ws_body_get_angular_velocity", [World_p, BodyId, P(Vec3)], _st),
+    ("ws_body_get_angular_velocity_local", [World_p, BodyId, P(Vec3)], _st),
+    ("ws_body_get_point_velocity", [World_p, BodyId, P(Vec3), P(Vec3)], _st),
+    ("ws_body_get_world_point", [World_p, BodyId, P(Vec3), P(Vec3)], _st),
+    ("ws_body_get_mass", [World_p, BodyId, P(c_double)], _st),
+    ("ws_body_get_inertia", [World_p, BodyId, P(Mat3)], _st),
+    ("ws_body_get_contact_force", [World_p, BodyId, P(Vec3), P(Vec3)], _st),
+    ("ws_body_set_pose", [World_p, BodyId, P(Pose)], _st),
+    ("ws_body_set_velocity", [World_p, BodyId, P(Vec3), P(Vec3)], _st),
+    ("ws_body_get_name", [World_p, BodyId], c_char_p),
+    ("ws_body_get_user_data", [World_p, BodyId], c_void_p),
+    ("ws_world_copy_body_ids", [World_p, P(BodyId), c_size_t, P(c_size_t)], _st),
+    # contact.h
+    ("ws_world_get_contact_count", [World_p, P(c_size_t)], _st),
+    ("ws_world_copy_contacts", [World_p, P(ContactInfo), c_size_t, P(c_size_t)], _st),
+    # law.h
+    ("ws_law_def_init", [P(LawDef)], None),
+    ("ws_law_create", [World_p, P(LawDef), P(LawId)], _st),
+    ("ws_law_destroy", [World_p, LawId], _st),
+    ("ws_law_is_valid", [World_p, LawId], c_int),
+    ("ws_law_evaluate", [World_p, LawId, c_double, c_double, P(c_double), P(c_double),
+                         P(c_double)], _st),
+    ("ws_law_energy", [World_p, LawId, c_double, P(c_double)], _st),
+    # web.h
+    ("ws_web_def_init", [P(WebDef)], None),
+    ("ws_sheet_def_init", [P(SheetDef)], None),
+    ("ws_band_def_init", [P(BandDef)], None),
+    ("ws_web_mesh_def_init", [P(WebMeshDef)], None),
+    ("ws_web_create_sheet", [World_p, P(WebDef), P(SheetDef), P(WebId)], _st),
+    ("ws_web_create_band", [World_p, P(WebDef), P(BandDef), P(WebId)], _st),
+    ("ws_web_create_mesh", [World_p, P(WebDef), P(WebMeshDef), P(WebId)], _st),
+    ("ws_web_destroy", [World_p, WebId], _st),
+    ("ws_web_is_valid", [World_p, WebId], c_int),
+    ("ws_web_get_info", [World_p, WebId, P(WebInfo)], _st),
+    ("ws_web_get_stable_dt", [World_p, WebId, P(c_double)], _st),
+    ("ws_web_set_substeps", [World_p, WebId, c_int], _st),
+    ("ws_web_copy_positions", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
+    ("ws_web_copy_velocities", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
+    ("ws_web_copy_contact_forces", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
+    ("ws_web_copy_springs", [World_p, WebId, P(c_uint32), c_size_t, P(c_size_t)], _st),
+    ("ws_web_copy_spring_strains", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
+    ("ws_web_copy_spring_tensions", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
+    ("ws_web_get_body_force", [World_p, WebId, BodyId, P(Vec3), P(Vec3)], _st),
+    ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
+    ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
+    # io.h
+    ("ws_world_write_vtp", [World_p, c_char_p], _st),
+    ("ws_web_write_vtp", [World_p, WebId, c_char_p], _st),
+    ("ws_vtk_series_create", [World_p, c_char_p, c_char_p, P(Series_p)], _st),
+    ("ws_vtk_series_write_frame", [Series_p], _st),
+    ("ws_vtk_series_get_frame_count", [Series_p, P(c_size_t)], _st),
+    ("ws_vtk_series_destroy", [Series_p], None),
+]
+
+#: The Defs whose ws_*_def_init writes `size`: checked against ctypes.sizeof when loading.
+DEF_INITS = [
+    ("ws_world_def_init", WorldDef),
+    ("ws_contact_def_init", ContactDef),
+    ("ws_material_def_init", MaterialDef),
+    ("ws_mesh_def_init", MeshDef),
+    ("ws_body_def_init", BodyDef),
+    ("ws_drive_def_init", DriveDef),
+    ("ws_law_def_init", LawDef),
+    ("ws_web_def_init", WebDef),
+    ("ws_sheet_def_init", SheetDef),
+    ("ws_band_def_init", BandDef),
+    ("ws_web_mesh_def_init", WebMeshDef),
+]
+
+
+class LibraryError(ImportError):
+    """libwrapsim could not be found, or is not one this binding can use."""
+
+
+def _candidates():
+    """Where to look for the library, in order: (path or name, how it was found)."""
+    env = os.environ.get("WRAPSIM_LIBRARY")
+    if env:
+        return [(env, "WRAPSIM_LIBRARY")]
+    out = []
+    # The build tree: <repo>/bindings/python/wrapsim/_lib.py -> <repo>/build/lib.
+    repo = pathlib.Path(__file__).resolve().parents[3]
+    names = {"darwin": ["libwrapsim.dylib", "libwrapsim.0.dylib"],
+             "win32": ["wrapsim.dll", "libwrapsim.dll"]}.get(sys.platform,
+                                                            ["libwrapsim.so.0", "libwrapsim.so"])
+    for name in names:
+        p = repo / "build" / "lib" / name
+        if p.exists():
+            out.append((str(p), "the build tree"))
+    found = ctypes.util.find_library("wrapsim")
+    if found:
+        out.append((found, "the installed library"))
+    out.append((names[0], "the dynamic loader's search path"))
+    return out
+
+
+def _check_defs(lib, path):
+    """Refuse a library whose Def structs differ in size from the ones above."""
+    for name, struct in DEF_INITS:
+        buf = ctypes.create_string_buffer(max(4096, 4 * ctypes.sizeof(struct)))
+        getattr(lib, name)(ctypes.cast(buf, POINTER(struct)))
+        size = c_uint32.from_buffer(buf).value
+        if size != ctypes.sizeof(struct):
+            raise LibraryError(
+                f"{path}: {name} fills {size} bytes but the binding's {struct.__name__} has "
+                f"{ctypes.sizeof(struct)}: the library and the binding disagree on the headers")
+
+
+def load(path=None):
+    """Load libwrapsim (from `path`, else WRAPSIM_LIBRARY, the build tree, the installed
+    library), declare every function of FUNCTIONS and check the version. Raise LibraryError."""
+    tried = []
+    cands = [(path, "the path given")] if path else _candidates()
+    lib = None
+    for cand, how in cands:
+        try:
+            lib = ctypes.CDLL(cand)
+            where = f"{cand} ({how})"
+            break
+        except OSError as e:
+            tried.append(f"{cand} ({how}): {e}")
+    if lib is None:
+        raise LibraryError("libwrapsim not found; tried:\n  " + "\n  ".join(tried) +
+                           "\nSet WRAPSIM_LIBRARY to the path of libwrapsim.so.0, or build it with "
+                           "`meson setup build && ninja -C build` in the repository.")
+    missing = []
+    for name, argtypes, restype in FUNCTIONS:
+        try:
+            fn = getattr(lib, name)
+        except AttributeError:
+            missing.append(name)
+            continue
+        fn.argtypes = argtypes
+        fn.restype = restype
+    if "ws_version_number" in missing:
+        raise LibraryError(f"{where} is not libwrapsim (no ws_version_number)")
+    version = lib.ws_version_number()
+    if version < REQUIRED_VERSION:
+        raise LibraryError(
+            f"{where} is libwrapsim {lib.ws_version_string().decode()} ({version}); this binding "
+            f"needs {REQUIRED_VERSION // 10000}.{REQUIRED_VERSION // 100 % 100}."
+            f"{REQUIRED_VERSION % 100} or newer")
+    if version // 10000 != REQUIRED_VERSION // 10000:
+        raise LibraryError(f"{where} is libwrapsim {lib.ws_version_string().decode()}, another "
+                           f"major version than the binding's {BINDING_VERSION}")
+    if missing:
+        raise LibraryError(f"{where} lacks {', '.join(missing)}")
+    _check_defs(lib, where)
+    lib._wrapsim_path = where
+    return lib
+
+
+_lib = None
+
+
+def lib():
+    """The loaded library (loaded on first use)."""
+    global _lib
+    if _lib is None:
+        _lib = load()
+    return _lib
