@@ -94,7 +94,9 @@ WS_API ws_status ws_body_destroy(ws_world *world, ws_body_id id);
 WS_API int ws_body_is_valid(const ws_world *world, ws_body_id id);
 /** Set the drive of a kinematic body (WS_ERR_INVALID_ARGUMENT for a dynamic one). The motion is
  *  relative to the pose the body has now; the body moves to the drive's pose at the current
- *  time at once. */
+ *  time at once (a callback is called then). On any error the previous drive stays and nothing
+ *  of the new Def is kept; on success the library keeps the callback pointer and its user
+ *  pointer until the drive is replaced or the body destroyed. */
 WS_API ws_status ws_body_set_drive(ws_world *world, ws_body_id id, const ws_drive_def *def);
 
 WS_API ws_status ws_body_get_type(const ws_world *world, ws_body_id id, ws_body_type *type);

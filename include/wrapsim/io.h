@@ -34,7 +34,8 @@ WS_API ws_status ws_world_write_vtp(ws_world *world, const char *path);
  *  WS_ERR_STALE_HANDLE (web), WS_ERR_IO (the path in the last error). */
 WS_API ws_status ws_web_write_vtp(ws_world *world, ws_web_id web, const char *path);
 
-/** A time series of .vtp frames collected in a .pvd file for ParaView. */
+/** A time series of .vtp frames collected in a .pvd file for ParaView. The series calls report
+ *  their details through ws_world_last_error() of the world the series was created on. */
 typedef struct ws_vtk_series ws_vtk_series;
 
 /** Start a series in `directory` (it must exist). Each frame writes `basename`_NNNNNN.vtp (the
