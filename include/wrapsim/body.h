@@ -60,8 +60,8 @@ typedef enum ws_drive_type {
 typedef int (*ws_drive_fn)(void *user, double t, ws_pose *pose, ws_vec3 *velocity,
                            ws_vec3 *angular_velocity);
 
-/** A drive. Fill with ws_drive_def_init(). Motions are relative to the body's pose when the drive
- *  is set. */
+/** A drive. Fill with ws_drive_def_init(). Tilt and sine motions are relative to the body's pose
+ *  when the drive is set; a callback gives the absolute (global) pose. */
 typedef struct ws_drive_def {
     uint32_t size;  /**< set by ws_drive_def_init() */
     uint32_t magic; /**< set by ws_drive_def_init() */
@@ -92,8 +92,8 @@ WS_API ws_status ws_body_create(ws_world *world, const ws_body_def *def, ws_body
 WS_API ws_status ws_body_destroy(ws_world *world, ws_body_id id);
 /** 1 if the id names a live body of this world, else 0. */
 WS_API int ws_body_is_valid(const ws_world *world, ws_body_id id);
-/** Set the drive of a kinematic body (WS_ERR_INVALID_ARGUMENT for a dynamic one). The motion is
- *  relative to the pose the body has now; the body moves to the drive's pose at the current
+/** Set the drive of a kinematic body (WS_ERR_INVALID_ARGUMENT for a dynamic one). A tilt or sine
+ *  motion is relative to the pose the body has now; the body moves to the drive's pose at the current
  *  time at once (a callback is called then). On any error the previous drive stays and nothing
  *  of the new Def is kept; on success the library keeps the callback pointer and its user
  *  pointer until the drive is replaced or the body destroyed. */

@@ -159,7 +159,8 @@ WS_API void *ws_world_get_user_data(const ws_world *world);
 
 /** Estimate the largest stable dt (s) for the bodies and contact pairs now in the world: the
  *  explicit limit 2/omega of the stiffest contact on the lightest body, with a safety factor for
- *  several simultaneous contacts (see docs/theory.md). */
+ *  several simultaneous contacts (see docs/theory.md). Films are not counted here: each web has
+ *  its own sub-step limit, ws_web_get_stable_dt(). */
 WS_API ws_status ws_world_estimate_stable_dt(const ws_world *world, double *dt);
 
 /** The material every body has unless its Def names another. */
