@@ -452,7 +452,10 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                 res->off_time[k] = t;
             tilt[k] = relative_tilt(w, sc.box[k], support[k]);
             /* Sliding: every contact with its support slips the same way, for 0.2 s in a row. */
-            slipping_steps[k] = slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
+            /* Slides are of a standing stack: not once it has tipped or the box left. */
+            int standing = !lift_confirmed && isnan(res->off_time[k]);
+            slipping_steps[k] =
+                standing && slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
             if (isnan(res->slide_time[k]) && t > 1.0 && slipping_steps[k] == 1)
                 res->slide_time[k] = t, res->slide_angle[k] = DEG(theta); /* candidate onset */
             if (isnan(res->slide_angle[k]) == 0 && slipping_steps[k] == 0 &&
@@ -480,7 +483,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         }
         ws_vec3 rel = box_local(w, sc.box[0], sc.box[1]);
         double dx = rel.x - top_on_bottom0.x, dy = rel.y - top_on_bottom0.y;
-        if (!lift_confirmed) /* while the stack stands: once it tips anything goes */
+        /* While the boxes stand stacked: not once the stack tipped or the top box slid off. */
+        if (!lift_confirmed && !res->slide_confirmed[1])
             res->max_relative_slip = fmax(res->max_relative_slip, sqrt(dx * dx + dy * dy));
         if (sc.film.bits && n % csv_every == 0) {
             size_t m;

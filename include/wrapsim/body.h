@@ -80,7 +80,10 @@ typedef struct ws_drive_def {
     void *callback_user;  /**< passed to callback */
 } ws_drive_def;
 
+/** Fill a body Def with defaults (dynamic, density 1000 kg/m^3, layer 1 mm, identity
+ *  orientation). `def` must not be NULL (NULL is ignored). */
 WS_API void ws_body_def_init(ws_body_def *def);
+/** Fill a drive Def with defaults (static, ramp 0.05 s, axis y, direction x). NULL is ignored. */
 WS_API void ws_drive_def_init(ws_drive_def *def);
 
 /** Create a body.
@@ -99,6 +102,7 @@ WS_API int ws_body_is_valid(const ws_world *world, ws_body_id id);
  *  pointer until the drive is replaced or the body destroyed. */
 WS_API ws_status ws_body_set_drive(ws_world *world, ws_body_id id, const ws_drive_def *def);
 
+/** Dynamic or kinematic. @return WS_OK, WS_ERR_STALE_HANDLE, WS_ERR_INVALID_ARGUMENT (NULL). */
 WS_API ws_status ws_body_get_type(const ws_world *world, ws_body_id id, ws_body_type *type);
 /** CoG position, m. */
 WS_API ws_status ws_body_get_position(const ws_world *world, ws_body_id id, ws_vec3 *position);
@@ -133,6 +137,7 @@ WS_API ws_status ws_body_set_velocity(ws_world *world, ws_body_id id, const ws_v
                                       const ws_vec3 *angular_velocity);
 /** The name given in the Def ("" if none). Valid while the body lives. */
 WS_API const char *ws_body_get_name(const ws_world *world, ws_body_id id);
+/** The user pointer of the Def; NULL for a stale id (check ws_body_is_valid() to tell). */
 WS_API void *ws_body_get_user_data(const ws_world *world, ws_body_id id);
 /** Copy the ids of all live bodies, in creation order. buf may be NULL with capacity 0. */
 WS_API ws_status ws_world_copy_body_ids(const ws_world *world, ws_body_id *buf, size_t capacity,

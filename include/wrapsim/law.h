@@ -47,6 +47,8 @@ typedef struct ws_law_def {
     const char *name;             /**< optional, copied */
 } ws_law_def;
 
+/** Fill a law Def with defaults (linear elastic, no damping, transition 1e-3; the stiffness
+ *  must be set). NULL is ignored. */
 WS_API void ws_law_def_init(ws_law_def *def);
 /** Create a law. @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF,
  *  WS_ERR_OUT_OF_MEMORY. */

@@ -112,9 +112,13 @@ typedef struct ws_containment_band {
     double contact_force;  /**< total normal force of the bodies on its nodes, N */
 } ws_containment_band;
 
+/** Fill a web Def with defaults (layer 1 mm, 1 sub-step; the law and a mass must be set). */
 WS_API void ws_web_def_init(ws_web_def *def);
+/** Fill a sheet Def with defaults (axes x and y; sizes and spacings must be set). */
 WS_API void ws_sheet_def_init(ws_sheet_def *def);
+/** Fill a band Def with defaults (no pre-stretch, no gap; bodies, heights, counts must be set). */
 WS_API void ws_band_def_init(ws_band_def *def);
+/** Fill a mesh-web Def with defaults (empty). */
 WS_API void ws_web_mesh_def_init(ws_web_mesh_def *def);
 
 /** Create a sheet. @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF,
@@ -127,8 +131,11 @@ WS_API ws_status ws_web_create_band(ws_world *world, const ws_web_def *def,
 /** A web from raw nodes and springs. */
 WS_API ws_status ws_web_create_mesh(ws_world *world, const ws_web_def *def,
                                     const ws_web_mesh_def *mesh, ws_web_id *out);
+/** Destroy a web; its laws stay. @return WS_OK, WS_ERR_STALE_HANDLE. */
 WS_API ws_status ws_web_destroy(ws_world *world, ws_web_id id);
+/** 1 if the id names a live web of this world, else 0. */
 WS_API int ws_web_is_valid(const ws_world *world, ws_web_id id);
+/** Node and spring counts, grid size, sub-steps, masses. */
 WS_API ws_status ws_web_get_info(const ws_world *world, ws_web_id id, ws_web_info *info);
 
 /** The largest stable sub-step of the web, s: the explicit limit 2/omega_max with omega_max^2
