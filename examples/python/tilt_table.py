@@ -194,43 +194,43 @@ def plot_distance(results, variant, path):
     plt.close(fig)
 
 
-def plot_velocities(results, variant, path):
+def plot_per_box(results, variant, path, series, scale, ylabel, title, legend, clip=None):
+    """One curve per box and run (solid unwrapped, dashed wrapped) against time; `clip` caps the
+    y axis so a box that left the platform does not flatten the rest."""
     fig, ax = plt.subplots(figsize=(8, 4.5))
     styles = {False: "-", True: "--"}
     colors = ("tab:blue", "tab:orange")
     for r in results:
         for k, name in enumerate(("bottom", "top")):
-            ax.plot(r["t"], r["speed"][:, k], styles[r["wrapped"]], color=colors[k],
+            ax.plot(r["t"], scale * r[series][:, k], styles[r["wrapped"]], color=colors[k],
                     label=f"{name} box, {label(r)}")
     theory_lines(ax, results, variant)
+    top = max(scale * r[series].max() for r in results)
+    if clip is not None and top > clip:
+        low = min(scale * r[series].min() for r in results)
+        ax.set_ylim(min(low, 0.0) - 0.05 * clip, clip)
+        ax.text(0.99, 0.02, f"clipped at {clip:g} (largest {top:.0f})", transform=ax.transAxes,
+                ha="right", va="bottom", fontsize=8, color="0.3")
     ax.set_xlabel("time t [s]")
-    ax.set_ylabel("box speed |v| [m/s]")
-    ax.set_title(f"Tilt table, variant {variant}: speed of the boxes' CoGs")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8)
+    ax.legend(**legend)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def plot_velocities(results, variant, path):
+    plot_per_box(results, variant, path, "speed", 1.0, "box speed |v| [m/s]",
+                 f"Tilt table, variant {variant}: speed of the boxes' CoGs",
+                 dict(loc="upper left", fontsize=8))
 
 
 def plot_slip(results, variant, path):
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    styles = {False: "-", True: "--"}
-    colors = ("tab:blue", "tab:orange")
-    for r in results:
-        for k, name in enumerate(("bottom", "top")):
-            ax.plot(r["t"], 1e3 * r["slip"][:, k], styles[r["wrapped"]], color=colors[k],
-                    label=f"{name} box, {label(r)}")
-    theory_lines(ax, results, variant)
-    ax.set_xlabel("time t [s]")
-    ax.set_ylabel("slip along the platform, downhill + [mm]")
-    ax.set_title(f"Tilt table, variant {variant}: CoG slip in the platform's frame")
-    ax.set_ylim(-20, 400)
-    ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    plot_per_box(results, variant, path, "slip", 1e3, "slip along the platform, downhill + [mm]",
+                 f"Tilt table, variant {variant}: CoG slip in the platform's frame",
+                 dict(loc="upper left", fontsize=8), clip=300.0)
 
 
 def plot_snapshots(results, variant, path):
