@@ -4,6 +4,8 @@
 
 #include <check.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -118,6 +120,23 @@ static inline ws_material_id no_material(void)
 {
     ws_material_id m = {0};
     return m;
+}
+
+/* A measured value, printed as "[measured] ..." for tools/validation_report.py. */
+static inline void report(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+static inline void report(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    printf("[measured] ");
+    vprintf(fmt, ap);
+    printf("\n");
+    fflush(stdout);
+    va_end(ap);
 }
 
 /* Run the suite; CK_FORK=no is honoured (valgrind). Returns the process exit code. */

@@ -17,21 +17,6 @@
 #define DELTA 1e-3 /* default contact layer of every body, m */
 #define DEG (3.14159265358979323846 / 180.0)
 
-static void report(const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 1, 2)))
-#endif
-    ;
-static void report(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    printf("[measured] ");
-    vprintf(fmt, ap);
-    printf("\n");
-    fflush(stdout);
-    va_end(ap);
-}
 
 /* ck_ok for loops: Check's passing assertions cost a system call each (it records the
  * location); this touches Check only when the call fails. */

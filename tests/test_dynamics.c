@@ -12,21 +12,6 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-static void report(const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 1, 2)))
-#endif
-    ;
-static void report(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    printf("[measured] ");
-    vprintf(fmt, ap);
-    printf("\n");
-    fflush(stdout);
-    va_end(ap);
-}
 
 static ws_world *world_with(double dt, ws_integrator integ, double g)
 {
