@@ -45,46 +45,52 @@ typedef enum ws_status {
 
 /** A vector in metres, m/s, newtons ... as the call says. */
 typedef struct ws_vec3 {
-    double x, y, z;
+    double x; /**< first component */
+    double y; /**< second component */
+    double z; /**< third component (up in the examples) */
 } ws_vec3;
 
 /** Euler parameters (a unit quaternion), e0 = cos(phi/2), (e1, e2, e3) = u sin(phi/2) (eq. 4-5). */
 typedef struct ws_quat {
-    double e0, e1, e2, e3;
+    double e0; /**< cos(phi/2) */
+    double e1; /**< u_x sin(phi/2) */
+    double e2; /**< u_y sin(phi/2) */
+    double e3; /**< u_z sin(phi/2) */
 } ws_quat;
 
 /** A 3x3 matrix, row-major: m[3*row + col]. */
 typedef struct ws_mat3 {
-    double m[9];
+    double m[9]; /**< entries, row-major */
 } ws_mat3;
 
 /** Position (m) and orientation of a body frame in the global frame. */
 typedef struct ws_pose {
-    ws_vec3 position;
-    ws_quat orientation;
+    ws_vec3 position;    /**< origin of the body frame (the CoG), m */
+    ws_quat orientation; /**< Euler parameters, unit */
 } ws_pose;
 
 /* Ids: a slot, a generation and a world tag packed into 64 bits; zero is the null id. Each kind
  * has its own type so that a body id cannot be passed where a shape id is expected. */
 /** A rigid body or world element. */
 typedef struct ws_body_id {
-    uint64_t bits;
+    uint64_t bits; /**< opaque; 0 = null */
 } ws_body_id;
 /** A shape (a closed triangle mesh in its body frame), shareable by many bodies. */
 typedef struct ws_shape_id {
-    uint64_t bits;
+    uint64_t bits; /**< opaque; 0 = null */
 } ws_shape_id;
 /** A contact material; contact parameters are set per pair of materials. */
 typedef struct ws_material_id {
-    uint64_t bits;
+    uint64_t bits; /**< opaque; 0 = null */
 } ws_material_id;
 
 /** Memory hooks; all NULL means malloc/realloc/free. Either all three are given or none. */
 typedef struct ws_allocator {
-    void *(*alloc)(void *user, size_t bytes);
+    void *(*alloc)(void *user, size_t bytes); /**< new block, or NULL */
+    /** grow or shrink a block (sizes as allocated), or NULL leaving it as it was */
     void *(*realloc)(void *user, void *ptr, size_t old_bytes, size_t new_bytes);
-    void (*free)(void *user, void *ptr, size_t bytes);
-    void *user;
+    void (*free)(void *user, void *ptr, size_t bytes); /**< release a block of that size */
+    void *user; /**< passed to the three hooks */
 } ws_allocator;
 
 /** Severity of a log message. */

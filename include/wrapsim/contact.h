@@ -20,8 +20,8 @@ typedef enum ws_contact_kind {
 /** One active contact. The normal points from body_a to body_b; the forces are those on body_b
  *  (body_a gets the opposite). */
 typedef struct ws_contact_info {
-    ws_body_id body_a;
-    ws_body_id body_b;
+    ws_body_id body_a; /**< owner of the face, or the first edge */
+    ws_body_id body_b; /**< owner of the point, or the second edge */
     ws_vec3 point;          /**< where the force acts, m (mid-layer) */
     ws_vec3 normal;         /**< unit, from a to b */
     double overlap;         /**< layer overlap delta_a + delta_b - distance, m (> 0) */

@@ -19,7 +19,7 @@ extern "C" {
 
 /** A constitutive law. */
 typedef struct ws_law_id {
-    uint64_t bits;
+    uint64_t bits; /**< opaque; 0 = null */
 } ws_law_id;
 
 /** Kinds of 1D laws. */

@@ -31,13 +31,13 @@ typedef struct ws_shape_info {
     double volume;        /**< m^3 */
     ws_vec3 centroid;     /**< the volume centroid in the frame the vertices were given in, m;
                                subtracted from every vertex */
-    ws_vec3 aabb_min;     /**< bounding box in the body frame, m */
-    ws_vec3 aabb_max;
+    ws_vec3 aabb_min;     /**< bounding box in the body frame, low corner, m */
+    ws_vec3 aabb_max;     /**< high corner, m */
     ws_mat3 inertia_unit; /**< inertia about the centroid for density 1 kg/m^3, kg m^2 */
-    uint32_t point_count;
+    uint32_t point_count;    /**< vertices */
     uint32_t edge_count;     /**< feature edges (used by line-to-line contact) */
     uint32_t face_count;     /**< coplanar groups of triangles */
-    uint32_t triangle_count;
+    uint32_t triangle_count; /**< triangles */
     int convex;              /**< 1 if the mesh is convex */
 } ws_shape_info;
 

@@ -21,7 +21,7 @@ extern "C" {
 
 /** A web (film). */
 typedef struct ws_web_id {
-    uint64_t bits;
+    uint64_t bits; /**< opaque; 0 = null */
 } ws_web_id;
 
 /** Which law a spring follows. */
@@ -52,14 +52,18 @@ typedef struct ws_web_def {
 typedef struct ws_sheet_def {
     uint32_t size;  /**< set by ws_sheet_def_init() */
     uint32_t magic; /**< set by ws_sheet_def_init() */
-    int nx, ny;              /**< nodes along each direction (>= 2 and >= 1; nx * ny >= 2) */
+    int nx;                  /**< nodes along x (>= 1; nx * ny >= 2) */
+    int ny;                  /**< nodes along y (>= 1) */
     ws_vec3 origin;          /**< m, node (0, 0) */
-    ws_vec3 axis_x, axis_y;  /**< directions of the grid (normalised); default x and y */
-    double spacing_x, spacing_y; /**< node spacing as placed, m (> 0) */
-    double prestretch_x, prestretch_y; /**< rest length = spacing / (1 + prestretch) (> -1) */
+    ws_vec3 axis_x;          /**< direction of the grid's x (normalised); default x */
+    ws_vec3 axis_y;          /**< direction of the grid's y (normalised); default y */
+    double spacing_x;        /**< node spacing along x as placed, m (> 0) */
+    double spacing_y;        /**< node spacing along y as placed, m (> 0) */
+    double prestretch_x;     /**< rest length = spacing / (1 + prestretch) (> -1), along x */
+    double prestretch_y;     /**< the same along y */
     int shear;               /**< 1: add both diagonals of every cell */
     const uint32_t *pinned;  /**< node indices (i + nx j) held fixed; may be NULL */
-    size_t pinned_count;
+    size_t pinned_count;     /**< entries in pinned */
 } ws_sheet_def;
 
 /** A band wrapped around a stack: around the convex outline of the bodies' footprint (their
@@ -69,9 +73,11 @@ typedef struct ws_band_def {
     uint32_t size;  /**< set by ws_band_def_init() */
     uint32_t magic; /**< set by ws_band_def_init() */
     const ws_body_id *bodies; /**< the stack */
-    size_t body_count;
-    double z_bottom, z_top;   /**< m */
-    int n_around, n_up;       /**< nodes (>= 3, >= 1) */
+    size_t body_count;        /**< entries in bodies */
+    double z_bottom;          /**< lowest row, global z, m */
+    double z_top;             /**< highest row, global z, m */
+    int n_around;             /**< nodes around (>= 3) */
+    int n_up;                 /**< rows (>= 1) */
     double prestretch_around; /**< e.g. 0.4 */
     double prestretch_up;     /**< e.g. 0.2 */
     double gap;               /**< extra distance beyond the touching layers, m; default 0 */
@@ -83,30 +89,32 @@ typedef struct ws_web_mesh_def {
     uint32_t size;  /**< set by ws_web_mesh_def_init() */
     uint32_t magic; /**< set by ws_web_mesh_def_init() */
     const double *positions;     /**< xyz per node, m */
-    size_t node_count;
+    size_t node_count;           /**< nodes */
     const double *node_masses;   /**< kg per node; NULL: the web Def's node_mass */
     const uint32_t *springs;     /**< node index pairs */
-    size_t spring_count;
+    size_t spring_count;         /**< pairs in springs */
     const double *rest_lengths;  /**< m per spring (> 0); NULL: the lengths as placed */
     const uint8_t *kinds;        /**< ws_spring_kind per spring; NULL: all WS_SPRING_AROUND */
     const uint32_t *pinned;      /**< node indices held fixed; may be NULL */
-    size_t pinned_count;
+    size_t pinned_count;         /**< entries in pinned */
 } ws_web_mesh_def;
 
 /** Facts of a web. */
 typedef struct ws_web_info {
-    uint32_t node_count;
-    uint32_t spring_count;
-    int nx, ny;       /**< grid size (0 for a mesh web) */
+    uint32_t node_count;   /**< nodes */
+    uint32_t spring_count; /**< springs */
+    int nx;           /**< grid nodes around / along x (0 for a mesh web) */
+    int ny;           /**< grid rows (0 for a mesh web) */
     int closed;       /**< 1 for a band (closed around) */
-    int substeps;
+    int substeps;     /**< sub-steps per world step */
     double mass;      /**< kg, all nodes */
     double min_node_mass; /**< kg */
 } ws_web_info;
 
 /** One height band of a containment profile. */
 typedef struct ws_containment_band {
-    double z_low, z_high;  /**< m, the band (global z of its rows' mean height) */
+    double z_low;          /**< m, mean height of its lowest row (global z) */
+    double z_high;         /**< m, mean height of its highest row */
     double hoop_tension;   /**< mean tension of the around-springs of its rows, N */
     double line_load;      /**< hoop tension per unit height, N/m */
     double contact_force;  /**< total normal force of the bodies on its nodes, N */
