@@ -321,6 +321,8 @@ def main():
     ap.add_argument("--output", default=os.path.join("docs", "validation.md"))
     ap.add_argument("--source-dir", default=root, help="project source tree (default: this tree)")
     ap.add_argument("--skip-wrapped", action="store_true", help="leave out the --wrapped runs")
+    ap.add_argument("--skip-figures", action="store_true",
+                    help="do not draw the figures (examples/python/tilt_table.py, matplotlib)")
     args = ap.parse_args()
     src = os.path.abspath(args.source_dir)
     bdir = args.build_dir if os.path.isabs(args.build_dir) else os.path.join(src, args.build_dir)
@@ -442,6 +444,38 @@ def main():
         sec.append("```")
         sec.append("")
     sections.append("\n".join(sec))
+
+    # ---- figures: the paper's plots from the Python example, embedded where they help
+    if not args.skip_figures:
+        img_dir = os.path.join(os.path.dirname(out_path), "img")
+        script = os.path.join(src, "examples", "python", "tilt_table.py")
+        lib = os.path.join(bdir, "lib", "libwrapsim.so.0")
+        env = dict(os.environ, PYTHONPATH=os.path.join(src, "bindings", "python"),
+                   WRAPSIM_LIBRARY=lib)
+        cmd = ["/usr/bin/python3", script, "--variant", "R", "--out", img_dir]
+        sys.stderr.write("running %s\n" % " ".join(cmd))
+        rc, out, err, secs = run(cmd, env=env)
+        sec = ["## Figures (examples/python/tilt_table.py, variant R)", ""]
+        if rc == 0:
+            sec.append("Drawn by `%s` in %.0f s: unwrapped (solid) and wrapped (dashed)."
+                       % (" ".join(["python3", os.path.relpath(script, src)] + cmd[2:4]), secs))
+            sec.append("")
+            for name, what in (("slip.png", "Slip along the platform; the dashed line is the "
+                                "theoretical slide time, the dotted one the wrapped stack's tip."),
+                               ("cog_distance.png", "Distance between the boxes' CoGs (the "
+                                "paper's Fig. 8)."),
+                               ("velocities.png", "Speeds of the boxes (the paper's Fig. 9)."),
+                               ("snapshots.png", "The stack and the film at three times (the "
+                                "paper's Fig. 7).")):
+                if os.path.exists(os.path.join(img_dir, name)):
+                    sec.append("%s" % what)
+                    sec.append("")
+                    sec.append("![%s](img/%s)" % (name, name))
+                    sec.append("")
+        else:
+            sec.append("Not drawn: the script exited with %s (%s)." % (
+                rc, md_escape((err.strip().splitlines() or ["no message"])[-1])))
+        sections.append("\n".join(sec))
 
     # ---- benchmark
     bench = os.path.join(bdir, "bench", "bench_tilt")
