@@ -122,6 +122,17 @@ int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, s
     return 0;
 }
 
+int ws_def_reset(void *def, size_t size)
+{
+    if (!def)
+        return 0;
+    memset(def, 0, size);
+    uint32_t *hdr = def;
+    hdr[0] = (uint32_t)size;
+    hdr[1] = WS_DEF_MAGIC;
+    return 1;
+}
+
 int ws_def_check(const void *def, size_t min_size)
 {
     const uint32_t *hdr = def;

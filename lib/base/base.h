@@ -32,6 +32,10 @@ void ws_mem_free_str(ws_mem *mem, char *s);
  * Returns 0 on success, -1 when out of memory (array unchanged). */
 int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, size_t elem);
 
+/* Start a ws_*_def_init(): zero the Def and write its size/magic header. 0 for a NULL Def (the
+ * init then does nothing), 1 otherwise. */
+int ws_def_reset(void *def, size_t size);
+
 /* Checks the size/magic header of a Def: 0 when good. `min_size` is the size of the first
  * released layout; `full` the current one. */
 int ws_def_check(const void *def, size_t min_size);

@@ -55,11 +55,8 @@ ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src
 
 void ws_world_def_init(ws_world_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->gravity = v3_make(0.0, 0.0, -9.81);
     def->dt = 2.5e-4;
     def->integrator = WS_INTEGRATOR_SYMPLECTIC_EULER;
@@ -73,11 +70,8 @@ void ws_world_def_init(ws_world_def *def)
 
 void ws_contact_def_init(ws_contact_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->stiffness = 2e5;
     def->damping = 10.0;
     def->friction = 0.3;
@@ -89,11 +83,8 @@ void ws_contact_def_init(ws_contact_def *def)
 
 void ws_material_def_init(ws_material_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
 }
 
 static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)

@@ -61,11 +61,8 @@ int ws_shape_is_valid(const ws_world *w, ws_shape_id id)
 
 void ws_mesh_def_init(ws_mesh_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
 }
 
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
@@ -225,11 +222,8 @@ ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices
 
 void ws_body_def_init(ws_body_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->type = WS_BODY_DYNAMIC;
     def->density = 1000.0;
     def->contact_layer = 1e-3;
@@ -238,11 +232,8 @@ void ws_body_def_init(ws_body_def *def)
 
 void ws_drive_def_init(ws_drive_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->type = WS_DRIVE_STATIC;
     def->ramp_time = 0.05;
     def->axis = v3_make(0, 1, 0);

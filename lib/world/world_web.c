@@ -8,11 +8,8 @@
 
 void ws_law_def_init(ws_law_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->type = WS_LAW_LINEAR_ELASTIC;
     def->transition = 1e-3;
 }
@@ -151,42 +148,30 @@ ws_status ws_law_energy(const ws_world *w, ws_law_id id, double eps, double *ene
 
 void ws_web_def_init(ws_web_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->contact_layer = 1e-3;
     def->substeps = 1;
 }
 
 void ws_sheet_def_init(ws_sheet_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
     def->axis_x = v3_make(1, 0, 0);
     def->axis_y = v3_make(0, 1, 0);
 }
 
 void ws_band_def_init(ws_band_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
 }
 
 void ws_web_mesh_def_init(ws_web_mesh_def *def)
 {
-    if (!def)
+    if (!ws_def_reset(def, sizeof *def))
         return;
-    memset(def, 0, sizeof *def);
-    def->size = sizeof *def;
-    def->magic = WS_DEF_MAGIC;
 }
 
 /* What every generator shares: the checked web Def and the laws it names. */
