@@ -198,6 +198,7 @@ void ws_world_destroy(ws_world *w)
         return;
     ws_mem *m = &w->mem;
     ws_world_free_webs(w);
+    ws_world_free_laws(w);
     ws_bodies_free(m, &w->bodies);
     ws_slots_destroy(m, &w->body_slots);
     /* A slot may have been taken while growing the array failed: walk the array, not slots. */
@@ -516,4 +517,18 @@ ws_status ws_world_estimate_stable_dt(const ws_world *w, double *dt)
     NEED_OUT(w, dt, "ws_world_estimate_stable_dt");
     *dt = ws_world_stable_dt(w);
     return WS_OK;
+}
+
+/* Take a slot of a table whose objects live in a pointer array, growing the array. */
+int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, uint32_t *slot)
+{
+    if (ws_slots_take(&w->mem, t, slot) != 0)
+        return -1;
+    if (ws_array_reserve(&w->mem, (void **)arr, cap, *slot + 1, sizeof(void *)) != 0) {
+        ws_slots_release(t, *slot);
+        return -1;
+    }
+    (*arr)[*slot] = NULL;
+    t->dense[*slot] = *slot;
+    return 0;
 }

@@ -100,8 +100,12 @@ ws_status ws_lookup_web(const ws_world *w, ws_web_id id, uint32_t *slot);
 /* Generic id lookup for a slot table (kind: WS_KIND_*). */
 ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t,
                          const char *what, uint32_t *slot);
-/* Free the webs and laws of a world (world destroy). */
+/* Free the webs and then the laws of a world (world destroy; webs first, they use laws). */
 void ws_world_free_webs(ws_world *w);
+void ws_world_free_laws(ws_world *w);
+/* Take a slot of a table whose objects live in a pointer array, growing the array; the entry is
+ * NULL. 0, or -1 when out of memory. */
+int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, uint32_t *slot);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
