@@ -42,13 +42,24 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
             v3 s = m3_tmul_v(A, v3_sub(p, r));
             if (!inside_box(s, sh->lo, sh->hi, reach))
                 continue;
+            /* On a convex body a node touches face f only while f is the face whose plane it
+             * is farthest out of (the largest signed distance D): over a face it projects into,
+             * d_g <= d_f for every other face g, and inside the body the shallowest face is the
+             * one of largest d. Until the next detection nodes and bodies move less than half
+             * the margin each, which changes d_f - D by less than the margin: faces further
+             * behind than that cannot come into contact and are not candidates. On a box this
+             * drops the side faces next to the one a node lies on. */
+            double D = -INFINITY;
+            if (sh->convex)
+                for (uint32_t f = 0; f < sh->face_count; f++)
+                    D = fmax(D, v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset);
             for (uint32_t f = 0; f < sh->face_count; f++) {
                 const ws_face *fc = &sh->faces[f];
                 (*checks)++;
                 double d = v3_dot(fc->normal, s) - fc->offset;
                 /* Depth counts along the normal only: the point's projection on the face's
                  * plane must lie within reach of the face. */
-                if (d > -reach - sh->inner && d < reach &&
+                if (d > -reach - sh->inner && d < reach && d >= D - margin &&
                     inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
