@@ -255,6 +255,132 @@ START_TEST(test_m3_is_spd)
 }
 END_TEST
 
+/* ---- rotation vectors (the deformable elements' strains) ---- */
+
+static double qt_maxdiff_sign(qt a, qt b)
+{
+    /* q and -q are one rotation. */
+    double d1 = fmax(fmax(fabs(a.e0 - b.e0), fabs(a.e1 - b.e1)),
+                     fmax(fabs(a.e2 - b.e2), fabs(a.e3 - b.e3)));
+    double d2 = fmax(fmax(fabs(a.e0 + b.e0), fabs(a.e1 + b.e1)),
+                     fmax(fabs(a.e2 + b.e2), fabs(a.e3 + b.e3)));
+    return fmin(d1, d2);
+}
+
+/* qt_to_rotvec inverts qt_from_rotvec for angles in [0, pi), including 1e-12 rad and pi - 1e-9
+ * (where e0 ~ 5e-10: atan2 stays well conditioned there), to 1e-14 (1 + |phi|): a few flops on
+ * numbers of size 1. q and -q give the same vector; the conjugate gives exactly (bit for bit)
+ * the negated vector, which the elements' swap invariance needs. An angle beyond pi comes back
+ * as the shorter rotation the other way: phi (1 - 2 pi / |phi|). */
+START_TEST(test_rotvec_log)
+{
+    double worst = 0.0;
+    const double special[4] = {1e-12, 1e-6, WS_PI - 1e-9, 0.05};
+    for (int n = 0; n < 2004; n++) {
+        double a = n < 4 ? special[n] : WS_PI * urand() * 0.999999;
+        v3 phi = v3_scale(rand_unit(), a);
+        qt q = qt_from_rotvec(phi), mq = {-q.e0, -q.e1, -q.e2, -q.e3};
+        v3 back = qt_to_rotvec(q), back2 = qt_to_rotvec(mq), neg = qt_to_rotvec(qt_conj(q));
+        worst = fmax(worst, v3_norm(v3_sub(back, phi)) / (1.0 + a));
+        ck_assert(back.x == back2.x && back.y == back2.y && back.z == back2.z);
+        ck_assert(neg.x == -back.x && neg.y == -back.y && neg.z == -back.z);
+    }
+    ck_assert_msg(worst < 1e-14, "log(exp(phi)) != phi by %.3g", worst);
+    v3 big = v3_make(0, 0, 1.5 * WS_PI), got = qt_to_rotvec(qt_from_rotvec(big));
+    ck_assert_msg(fabs(got.z + 0.5 * WS_PI) < 1e-14 && fabs(got.x) + fabs(got.y) == 0.0,
+                  "3 pi / 2 about z came back as %g %g %g", got.x, got.y, got.z);
+    v3 z = qt_to_rotvec(qt_identity());
+    ck_assert(z.x == 0.0 && z.y == 0.0 && z.z == 0.0);
+}
+END_TEST
+
+/* qt_relative(a, b) = conj(a) (x) b to round-off (1e-15), its matrix is A_a^T A_b, and
+ * qt_relative(b, a) is exactly its conjugate (bit for bit). */
+START_TEST(test_quat_relative)
+{
+    double worst = 0.0, worst_m = 0.0;
+    for (int n = 0; n < 1000; n++) {
+        qt a = qt_from_axis_angle(rand_unit(), 2 * WS_PI * srand1());
+        qt b = qt_from_axis_angle(rand_unit(), 2 * WS_PI * srand1());
+        qt r = qt_relative(a, b), ref = qt_mul(qt_conj(a), b), s = qt_relative(b, a);
+        worst = fmax(worst, qt_maxdiff_sign(r, ref));
+        ck_assert(s.e0 == r.e0 && s.e1 == -r.e1 && s.e2 == -r.e2 && s.e3 == -r.e3);
+        m3 ma = qt_to_m3(a), mb = qt_to_m3(b), mat = m3_transpose(&ma), prod = m3_mul(&mat, &mb);
+        m3 mr = qt_to_m3(r);
+        worst_m = fmax(worst_m, m3_maxdiff(&mr, &prod));
+    }
+    ck_assert_msg(worst < 1e-15, "qt_relative != conj(a) b by %.3g", worst);
+    ck_assert_msg(worst_m < 1e-14, "matrix != A_a^T A_b by %.3g", worst_m);
+}
+END_TEST
+
+/* The right Jacobian: log(exp(phi)^-1 exp(phi + d e_k)) = J_r(phi) e_k d + O(d^2). Central
+ * differences with d = 1e-6 cancel the d^2 term: truncation ~ d^2 = 1e-12, round-off ~ eps/d =
+ * 2e-10: asserted 1e-8, at angles from 1e-3 (the series branch) to 3 rad. J_r^-1 is its inverse
+ * to 1e-13 (the condition of J_r stays below 5 for |phi| < 3), and both agree across the switch
+ * at 0.05 rad: the series and the closed forms meet to 1e-14 (the closed forms lose ~eps/a^2
+ * relative to cancellation there, times entries of size a). */
+START_TEST(test_rotvec_jacobian)
+{
+    double worst_fd = 0.0, worst_inv = 0.0;
+    const double d = 1e-6;
+    for (int n = 0; n < 300; n++) {
+        double a = n < 100 ? 0.05 * urand() : 3.0 * urand();
+        v3 phi = v3_scale(rand_unit(), a);
+        m3 J = rotvec_jacobian(phi), Ji = rotvec_jacobian_inv(phi), I = m3_mul(&J, &Ji);
+        m3 id = m3_identity();
+        worst_inv = fmax(worst_inv, m3_maxdiff(&I, &id));
+        qt q0 = qt_conj(qt_from_rotvec(phi));
+        for (int k = 0; k < 3; k++) {
+            v3 e = v3_make(k == 0, k == 1, k == 2);
+            v3 lp = qt_to_rotvec(qt_mul(q0, qt_from_rotvec(v3_madd(phi, e, d))));
+            v3 lm = qt_to_rotvec(qt_mul(q0, qt_from_rotvec(v3_madd(phi, e, -d))));
+            v3 fd = v3_scale(v3_sub(lp, lm), 0.5 / d);
+            v3 col = v3_make(J.m[k], J.m[3 + k], J.m[6 + k]);
+            worst_fd = fmax(worst_fd, v3_norm(v3_sub(fd, col)));
+        }
+    }
+    ck_assert_msg(worst_fd < 1e-8, "J_r differs from finite differences by %.3g", worst_fd);
+    ck_assert_msg(worst_inv < 1e-13, "J_r J_r^-1 != I by %.3g", worst_inv);
+    v3 u = rand_unit();
+    /* 1e-15 rad apart: the functions themselves change by less than that. */
+    m3 lo = rotvec_jacobian(v3_scale(u, 0.05 - 1e-15)), hi = rotvec_jacobian(v3_scale(u, 0.05));
+    m3 lo_i = rotvec_jacobian_inv(v3_scale(u, 0.05 - 1e-15));
+    m3 hi_i = rotvec_jacobian_inv(v3_scale(u, 0.05));
+    ck_assert_msg(m3_maxdiff(&lo, &hi) < 1e-14 && m3_maxdiff(&lo_i, &hi_i) < 1e-14,
+                  "the series and the closed form part at 0.05 rad");
+}
+END_TEST
+
+/* H(theta) x = J_r^-1(theta) exp(-theta/2) x (the mid-frame map), checked against that product
+ * to 1e-13 for |theta| up to 3 rad and down to the series branch; H is symmetric (x . H y =
+ * y . H x), even (H(-theta) = H(theta)), the identity along theta, and scales the plane across
+ * theta by (a/2)/sin(a/2). */
+START_TEST(test_rotvec_mid_map)
+{
+    double worst = 0.0, worst_sym = 0.0;
+    for (int n = 0; n < 1000; n++) {
+        double a = n < 300 ? 0.05 * urand() : 3.0 * urand();
+        v3 th = v3_scale(rand_unit(), a), x = rand_unit(), y = rand_unit();
+        m3 Ji = rotvec_jacobian_inv(th), R = qt_to_m3(qt_from_rotvec(v3_scale(th, -0.5)));
+        m3 P = m3_mul(&Ji, &R);
+        v3 ref = m3_mul_v(&P, x), got = rotvec_mid_map(th, x), neg = rotvec_mid_map(v3_neg(th), x);
+        worst = fmax(worst, v3_norm(v3_sub(ref, got)));
+        ck_assert(got.x == neg.x && got.y == neg.y && got.z == neg.z);
+        worst_sym = fmax(worst_sym, fabs(v3_dot(y, got) - v3_dot(x, rotvec_mid_map(th, y))));
+        if (a > 1e-3) {
+            v3 u = v3_scale(th, 1.0 / a), along = rotvec_mid_map(th, u);
+            v3 across = v3_cross(u, x);
+            double h = 0.5 * a / sin(0.5 * a);
+            ck_assert(v3_norm(v3_sub(along, u)) < 1e-14);
+            ck_assert(v3_norm(v3_sub(rotvec_mid_map(th, across), v3_scale(across, h))) < 1e-14);
+        }
+    }
+    ck_assert_msg(worst < 1e-13, "H != J_r^-1 exp(-theta/2) by %.3g", worst);
+    ck_assert_msg(worst_sym < 1e-14, "H not symmetric: %.3g", worst_sym);
+}
+END_TEST
+
 static Suite *math_suite(void)
 {
     Suite *s = suite_create("math");
@@ -270,6 +396,13 @@ static Suite *math_suite(void)
     tcase_add_test(tc, test_skew_is_cross);
     tcase_add_test(tc, test_m3_inverse);
     tcase_add_test(tc, test_m3_is_spd);
+    suite_add_tcase(s, tc);
+    tc = tcase_create("rotation vectors");
+    tcase_set_timeout(tc, 5);
+    tcase_add_test(tc, test_rotvec_log);
+    tcase_add_test(tc, test_quat_relative);
+    tcase_add_test(tc, test_rotvec_jacobian);
+    tcase_add_test(tc, test_rotvec_mid_map);
     suite_add_tcase(s, tc);
     return s;
 }

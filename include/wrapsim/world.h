@@ -148,8 +148,8 @@ WS_API ws_status ws_world_get_stats(const ws_world *world, ws_world_stats *stats
 /** Energy of the dynamic bodies (contact energy from the last step's contacts). */
 WS_API ws_status ws_world_get_energy(const ws_world *world, ws_energy *energy);
 /** A 64-bit hash of the whole dynamic state (time, every body's pose and velocities, friction
- *  anchors, every film node's position and velocity). Equal hashes after equal inputs: the
- *  determinism check. */
+ *  anchors, every film node's position and velocity, the law histories of the elements). Equal
+ *  hashes after equal inputs: the determinism check. */
 WS_API ws_status ws_world_get_state_hash(const ws_world *world, uint64_t *hash);
 /** The detail of the last error in this world ("body 'top': mass must be > 0, got -1"); ""
  *  when there was none. Valid until the next call on the world. NULL world gives a static text. */
@@ -159,8 +159,9 @@ WS_API void *ws_world_get_user_data(const ws_world *world);
 
 /** Estimate the largest stable dt (s) for the bodies and contact pairs now in the world: the
  *  explicit limit 2/omega of the stiffest contact on the lightest body, with a safety factor for
- *  several simultaneous contacts (see docs/theory.md). Films are not counted here: each web has
- *  its own sub-step limit, ws_web_get_stable_dt(). */
+ *  several simultaneous contacts (see docs/theory.md), and of the deformable elements on the
+ *  bodies they join (docs/elements.md). Films are not counted here: each web has its own
+ *  sub-step limit, ws_web_get_stable_dt(). */
 WS_API ws_status ws_world_estimate_stable_dt(const ws_world *world, double *dt);
 
 /** The material every body has unless its Def names another. */

@@ -13,6 +13,7 @@
 #include <wrapsim/contact.h>
 #include <wrapsim/law.h>
 #include <wrapsim/web.h>
+#include <wrapsim/element.h>
 #include <wrapsim/io.h>
 
 #endif

@@ -41,7 +41,14 @@ int ws_def_reset(void *def, size_t size);
 int ws_def_check(const void *def, size_t min_size);
 
 /* Ids: [tag:16][kind:4][generation:20][slot+1:24]; zero is the null id. */
-enum { WS_KIND_BODY = 1, WS_KIND_SHAPE = 2, WS_KIND_MATERIAL = 3, WS_KIND_LAW = 4, WS_KIND_WEB = 5 };
+enum {
+    WS_KIND_BODY = 1,
+    WS_KIND_SHAPE = 2,
+    WS_KIND_MATERIAL = 3,
+    WS_KIND_LAW = 4,
+    WS_KIND_WEB = 5,
+    WS_KIND_ELEMENT = 6
+};
 #define WS_ID_SLOT_BITS 24
 #define WS_ID_GEN_BITS 20
 #define WS_ID_MAX_SLOTS ((1u << WS_ID_SLOT_BITS) - 2u)

@@ -175,3 +175,69 @@ void m3_sym_eigen(const m3 *a, m3 *vectors, v3 *values)
     *vectors = v;
     *values = v3_make(s[0], s[4], s[8]);
 }
+
+v3 qt_to_rotvec(qt q)
+{
+    /* The shorter of the two rotations q and -q stand for: e0 >= 0. */
+    double c = q.e0 < 0.0 ? -q.e0 : q.e0, sg = q.e0 < 0.0 ? -1.0 : 1.0;
+    v3 e = v3_make(sg * q.e1, sg * q.e2, sg * q.e3);
+    double s = v3_norm(e);
+    if (s == 0.0)
+        return v3_make(0.0, 0.0, 0.0);
+    /* atan2(s, c)/s has no cancellation at small angles (it tends to 1/c) nor near pi. */
+    return v3_scale(e, 2.0 * atan2(s, c) / s);
+}
+
+qt qt_relative(qt a, qt b)
+{
+    /* e0 = a . b and e = a0 b_v - b0 a_v - a_v x b_v: each term changes sign exactly when a and
+     * b trade places, and the sum keeps its order, so the result is the exact conjugate. */
+    v3 av = v3_make(a.e1, a.e2, a.e3), bv = v3_make(b.e1, b.e2, b.e3);
+    v3 e = v3_sub(v3_sub(v3_scale(bv, a.e0), v3_scale(av, b.e0)), v3_cross(av, bv));
+    qt r = {a.e0 * b.e0 + v3_dot(av, bv), e.x, e.y, e.z};
+    return r;
+}
+
+/* phi~^2 x = phi x (phi x x) = phi (phi . x) - |phi|^2 x. */
+static m3 poly_skew(v3 phi, double c1, double c2)
+{
+    m3 k = m3_skew(phi), k2 = m3_mul(&k, &k), r = m3_identity();
+    for (int i = 0; i < 9; i++)
+        r.m[i] += c1 * k.m[i] + c2 * k2.m[i];
+    return r;
+}
+
+m3 rotvec_jacobian(v3 phi)
+{
+    double a2 = v3_norm2(phi), a = sqrt(a2), c1, c2;
+    if (a < 0.05) {
+        /* Taylor series; the next terms are below 1e-15 of the leading ones at a = 0.05. */
+        c1 = -(0.5 - a2 / 24.0 + a2 * a2 / 720.0 - a2 * a2 * a2 / 40320.0);
+        c2 = 1.0 / 6.0 - a2 / 120.0 + a2 * a2 / 5040.0 - a2 * a2 * a2 / 362880.0;
+    } else {
+        c1 = -(1.0 - cos(a)) / a2;
+        c2 = (a - sin(a)) / (a2 * a);
+    }
+    return poly_skew(phi, c1, c2);
+}
+
+m3 rotvec_jacobian_inv(v3 phi)
+{
+    double a2 = v3_norm2(phi), a = sqrt(a2), c2;
+    if (a < 0.05)
+        c2 = 1.0 / 12.0 + a2 / 720.0 + a2 * a2 / 30240.0 + a2 * a2 * a2 / 1209600.0;
+    else
+        c2 = 1.0 / a2 - (1.0 + cos(a)) / (2.0 * a * sin(a));
+    return poly_skew(phi, 0.5, c2);
+}
+
+v3 rotvec_mid_map(v3 theta, v3 x)
+{
+    /* H x = h x + (1 - h)/a^2 theta (theta . x), h = (a/2)/sin(a/2). (1 - h)/a^2 cancels at
+     * small a: its series to a^4 there (the next term adds below 1e-16 of |x| at a = 0.05). */
+    double a2 = v3_norm2(theta), a = sqrt(a2);
+    double h = a > 0.0 ? 0.5 * a / sin(0.5 * a) : 1.0;
+    double c = a < 0.05 ? -(1.0 / 24.0 + 7.0 * a2 / 5760.0 + 31.0 * a2 * a2 / 967680.0)
+                        : (1.0 - h) / a2;
+    return v3_madd(v3_scale(x, h), theta, c * v3_dot(theta, x));
+}

@@ -123,4 +123,25 @@ void m3_sym_eigen(const m3 *a, m3 *vectors, v3 *values);
 /* Skew form: a~ b = a x b. */
 m3 m3_skew(v3 a);
 
+/* ---- Rotation vectors (the deformable elements' strains) ---- */
+
+/* The principal logarithm of a unit quaternion as a rotation vector: the angle in [0, pi] times
+ * the unit axis; q and -q give the same vector. Odd to the last bit: the conjugate of q gives
+ * exactly the negated vector. */
+v3 qt_to_rotvec(qt q);
+/* conj(a) (x) b: the rotation from frame a to frame b, in a's frame (A_a^T A_b). Written out so
+ * that qt_relative(b, a) is exactly the conjugate of qt_relative(a, b) (same e0, the vector part
+ * negated to the last bit), which the elements' invariance to the order of their bodies needs. */
+qt qt_relative(qt a, qt b);
+/* Right Jacobian (tangent map) of the rotation vector: exp(phi + d) = exp(phi) exp(J_r(phi) d)
+ * to first order in d. J_r = I - (1 - cos a)/a^2 phi~ + (a - sin a)/a^3 phi~^2, a = |phi|. */
+m3 rotvec_jacobian(v3 phi);
+/* Its inverse, I + phi~/2 + (1/a^2 - (1 + cos a)/(2 a sin a)) phi~^2 (finite for a < 2 pi). */
+m3 rotvec_jacobian_inv(v3 phi);
+/* H(theta) x: how the relative rotation vector theta between two frames changes per small
+ * rotation of one frame against the other measured in their mid frame (exp(theta/2) from the
+ * first): d theta = H(theta) (d phi_2 - d phi_1)_mid. H = J_r^-1(theta) exp(-theta~/2), which is
+ * symmetric and even in theta: the identity along theta and (a/2)/sin(a/2) across it. */
+v3 rotvec_mid_map(v3 theta, v3 x);
+
 #endif

@@ -197,6 +197,7 @@ void ws_world_destroy(ws_world *w)
     if (!w)
         return;
     ws_mem *m = &w->mem;
+    ws_world_free_elements(w); /* before the laws and bodies they use */
     ws_world_free_webs(w);
     ws_world_free_laws(w);
     ws_bodies_free(m, &w->bodies);
@@ -339,6 +340,7 @@ ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
         h = ws_hash_bytes(h, web->x[w->cur], web->n * sizeof *web->x[w->cur]);
         h = ws_hash_bytes(h, web->v[w->cur], web->n * sizeof *web->v[w->cur]);
     }
+    h = ws_world_hash_elements(w, h); /* their law histories */
     *hash = h;
     return WS_OK;
 }
@@ -508,7 +510,7 @@ double ws_world_stable_dt(const ws_world *w)
                 best = dt;
         }
     }
-    return best;
+    return fmin(best, ws_world_element_stable_dt(w)); /* the elements' springs too */
 }
 
 ws_status ws_world_estimate_stable_dt(const ws_world *w, double *dt)

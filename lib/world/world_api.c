@@ -377,6 +377,8 @@ ws_status ws_body_destroy(ws_world *w, ws_body_id id)
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
         return s;
+    if ((s = ws_world_body_free_of_elements(w, slot)) != WS_OK)
+        return s; /* an element still joins it: WS_ERR_IN_USE */
     ws_body_store *b = &w->bodies;
     ws_world_forget_body(w, slot);
     b->shape[slot]->users--;

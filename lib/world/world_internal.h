@@ -9,6 +9,7 @@
 #include "contact/contact.h"
 #include "contact/node.h"
 #include "drive/drive.h"
+#include "element/element.h"
 #include "law/law.h"
 #include "math/wmath.h"
 #include "shape/shape.h"
@@ -43,7 +44,7 @@ struct ws_world {
     uint32_t *pair_index; /* dim x dim, indices into params */
     size_t pair_dim;
 
-    ws_law1d **laws;
+    ws_law **laws;
     size_t law_cap;
     ws_slot_table law_slots;
 
@@ -54,6 +55,10 @@ struct ws_world {
     ws_node_params *node_par; /* node contact parameters by body material, scratch */
     ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
     size_t node_par_cap;
+
+    ws_element **elements; /* by id slot (world_element.c) */
+    size_t element_cap;
+    ws_slot_table element_slots;
 
     ws_cand *cand[2];
     size_t ncand[2], capcand[2];
@@ -123,5 +128,20 @@ void ws_world_refresh_body(ws_world *w, uint32_t slot);
 void ws_world_forget_body(ws_world *w, uint32_t slot);
 /* Largest stable dt for the current bodies and parameters (see ws_world_estimate_stable_dt). */
 double ws_world_stable_dt(const ws_world *w);
+
+/* Elements (world_element.c). In a step: the loads of every element at state `cur` and time t
+ * into the bodies' accumulators, each element's strain kept for the commit (nothing committed
+ * changes; WS_ERR_CALLBACK or WS_ERR_NUMERICAL when a law fails); after an accepted step, their
+ * law histories committed at t. */
+ws_status ws_world_element_forces(ws_world *w, int cur, double t);
+void ws_world_commit_elements(ws_world *w, double t);
+/* Free every element (world destroy; before the laws and bodies they use). */
+void ws_world_free_elements(ws_world *w);
+/* WS_OK when no element uses body `slot`, else WS_ERR_IN_USE with the message set. */
+ws_status ws_world_body_free_of_elements(const ws_world *w, uint32_t slot);
+/* The elements' explicit step limit on the bodies they join (INFINITY without elements). */
+double ws_world_element_stable_dt(const ws_world *w);
+/* The elements' committed law histories, hashed on from h. */
+uint64_t ws_world_hash_elements(const ws_world *w, uint64_t h);
 
 #endif

@@ -3,7 +3,8 @@
  *   (1) state at t -> rotation matrices, global angular velocities, inflated boxes;
  *   (2) contact detection: full (broad phase, optional libccd gate, candidate feature pairs) or
  *       the cached candidates carried over;
- *   (3) forces: gravity, then every candidate evaluated (penalty + friction on both bodies);
+ *   (3) forces: gravity, then every candidate evaluated (penalty + friction on both bodies),
+ *       then the deformable elements (rods, springs, bushings: world_element.c);
  *   (4) integration into the other state buffer; world elements from their drives at t + dt;
  *   (5) health check; (6) commit by swapping buffers and t += dt.
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
@@ -294,6 +295,8 @@ ws_status ws_world_step(ws_world *w)
     for (size_t k = 0; k < w->ncand[nxt]; k++)
         if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
             nrec++;
+    if ((s = ws_world_element_forces(w, cur, t)) != WS_OK) /* rods, springs, bushings */
+        return s;
 
     double t_web = clock_now(w);
     w->stats.seconds_contacts += t_web - t_eval;
@@ -343,6 +346,7 @@ ws_status ws_world_step(ws_world *w)
 
     /* Commit. */
     w->nrec[nxt] = nrec;
+    ws_world_commit_elements(w, t); /* the law histories of the strains this step used */
     w->cur = nxt;
     w->time = t + dt;
     if (full) {

@@ -122,8 +122,10 @@ STRUCTS = {
     "ws_mesh_def": L.MeshDef, "ws_shape_info": L.ShapeInfo, "ws_body_def": L.BodyDef,
     "ws_drive_def": L.DriveDef, "ws_contact_info": L.ContactInfo, "ws_law_def": L.LawDef,
     "ws_web_def": L.WebDef, "ws_sheet_def": L.SheetDef, "ws_band_def": L.BandDef,
-    "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo,
+    "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo, "ws_law_info": L.LawInfo,
     "ws_containment_band": L.ContainmentBand,
+    "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
+    "ws_element_output": L.ElementOutput,
 }
 
 
@@ -584,6 +586,126 @@ def test_webs_laws_and_vtk_series(tmp_path):
     assert open_series._ptr is None
 
 
+def test_laws_of_every_kind_and_their_history():
+    with ws.World() as w:
+        # A 3D orthotropic Kelvin-Voigt law: F = K u + C ud.
+        K = np.diag([100.0, 200.0, 300.0])
+        C = np.diag([1.0, 2.0, 3.0])
+        kv = w.law("linear_viscoelastic", dim=3, stiffness_matrix=K, damping_matrix=C)
+        info = kv.info()
+        assert info["dim"] == 3 and kv.dim == 3 and info["state_size"] == 0
+        assert info["flags"] == ws.WS_LAW_FLAG_ELASTIC | ws.WS_LAW_FLAG_VISCOUS
+        assert info["max_stiffness"] == pytest.approx(300.0)
+        u, ud = np.array([0.01, 0.02, 0.03]), np.array([1.0, 0.0, -1.0])
+        F, dFdu, dFdud = kv.evaluate_state(u, ud)
+        assert F == pytest.approx(K @ u + C @ ud)
+        assert np.array_equal(dFdu, K) and np.array_equal(dFdud, C)
+        assert kv.energy_state(u) == pytest.approx(0.5 * u @ K @ u)
+        assert kv.state_size == 0 and len(kv.init_state()) == 0
+        kv.commit(None, u)  # no history: nothing to do
+
+        # Relaxation (standard linear solid): a held step decays with tau.
+        sls = w.law("relaxation", stiffness=100.0, prony_stiffness=[400.0], prony_time=[0.3])
+        st = sls.init_state()
+        assert st.shape == (2,) and sls.info()["state_size"] == 2
+        sls.commit(st, [0.1])  # the step, within a step of zero length
+        for k in range(1, 301):
+            before = st.copy()
+            sls.evaluate_state([0.1], t=k * 1e-3, dt=1e-3, state=st)
+            assert np.array_equal(st, before)  # evaluation never changes the state
+            sls.commit(st, [0.1], t=k * 1e-3, dt=1e-3)
+        F, _, _ = sls.evaluate_state([0.1], state=st)
+        # 300 steps of exp(-dt/tau) each: the closed form to round-off.
+        assert F[0] == pytest.approx((100.0 + 400.0 * math.exp(-1.0)) * 0.1, rel=1e-12)
+        assert sls.energy_state([0.1], state=st) > 0.5 * 100.0 * 0.1 ** 2
+        with pytest.raises(ValueError):
+            sls.evaluate_state([0.1], state=np.zeros(3))
+
+        # Table (monotone through its points), cubic, stop, viscous; sum and scaled.
+        table = w.law("table", table_strain=[0.0, 0.01, 0.02, 0.1],
+                      table_force=[0.0, 10.0, 10.1, 10.3])
+        assert table.evaluate(0.01)[0] == 10.0
+        samples = [table.evaluate(x)[0] for x in np.linspace(0.0, 0.1, 501)]
+        assert all(b >= a for a, b in zip(samples, samples[1:]))
+        with pytest.raises(ws.WrapsimError) as e:
+            w.law("table", table_strain=[0.0, 0.1], table_force=[1.0, 0.0])
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT and "table_force" in e.value.detail
+        cubic = w.law("cubic_elastic", stiffness=10.0, cubic_stiffness=1000.0)
+        assert cubic.energy(0.1) == pytest.approx(0.5 * 10 * 0.01 + 0.25 * 1000 * 1e-4)
+        stop = w.law("stop", stiffness=1000.0, stop_high=0.02, transition=0.0)
+        assert stop.evaluate(0.01)[0] == 0.0 and stop.evaluate(0.03)[0] == pytest.approx(10.0)
+        visc = w.law(ws.WS_LAW_LINEAR_VISCOUS, damping=2.0)
+        assert visc.evaluate(0.5, 3.0) == (6.0, 0.0, 2.0)
+        total = w.law("sum", terms=[cubic, stop, visc])
+        assert total.evaluate(0.03, 1.0)[0] == pytest.approx(
+            cubic.evaluate(0.03)[0] + stop.evaluate(0.03)[0] + 2.0)
+        with pytest.raises(ws.WrapsimError) as e:
+            cubic.destroy()
+        assert e.value.status == ws.WS_ERR_IN_USE
+        ramp = w.law("scaled", base=cubic, scale_times=[0.0, 1.0], scale_factors=[0.0, 1.0])
+        assert ramp.evaluate_state([0.1], t=0.5)[0][0] == pytest.approx(
+            0.5 * cubic.evaluate(0.1)[0])
+        wave = w.law("scaled", base=cubic, scale_fn=lambda t: 2.0 + t)
+        assert wave.evaluate_state([0.1], t=1.0)[0][0] == pytest.approx(3 * cubic.evaluate(0.1)[0])
+
+        def broken(t):
+            raise ZeroDivisionError("from the time function")
+        bad = w.law("scaled", base=cubic, scale_fn=broken)
+        with pytest.raises(ws.WrapsimError) as e:
+            bad.evaluate(0.1)
+        assert e.value.status == ws.WS_ERR_CALLBACK
+        assert isinstance(e.value.__cause__, ZeroDivisionError)
+        for law in (bad, wave, ramp, total):
+            law.destroy()
+        cubic.destroy()
+
+
+def test_user_law_written_in_python():
+    """A 3D law from Python through a ctypes callback: its derivatives agree with central
+    differences, it sees the time, and an exception in it becomes WS_ERR_CALLBACK."""
+    seen = []
+
+    def pad(u, ud, t):
+        seen.append(t)
+        F = 50.0 * u + 2e4 * u ** 3 + 0.5 * ud
+        return F, np.diag(50.0 + 6e4 * u ** 2), np.diag([0.5] * 3)
+
+    with ws.World() as w:
+        law = w.law("user", dim=3, user_fn=pad, stiffness=100.0, damping=0.5, name="pad")
+        assert law.info()["type"] == ws.WS_LAW_USER
+        u, ud = np.array([0.01, -0.02, 0.05]), np.array([0.3, 0.0, -0.1])
+        F, K, C = law.evaluate_state(u, ud, t=2.5)
+        assert seen[-1] == 2.5
+        assert F == pytest.approx(50.0 * u + 2e4 * u ** 3 + 0.5 * ud)
+        h = 1e-6
+        for j in range(3):
+            e = np.zeros(3)
+            e[j] = h
+            fd = (law.evaluate_state(u + e, ud)[0] - law.evaluate_state(u - e, ud)[0]) / (2 * h)
+            # The central difference of a cubic errs by h^2 F'''/6 = 1e-12 * 1.2e5 / 6 plus the
+            # round-off eps |F| / h ~ 1e-10: 1e-6 of the stiffness is ample.
+            assert np.abs(fd - K[:, j]).max() < 1e-6 * 100.0
+            fdr = (law.evaluate_state(u, ud + e)[0] - law.evaluate_state(u, ud - e)[0]) / (2 * h)
+            assert np.abs(fdr - C[:, j]).max() < 1e-8
+        with pytest.raises(ws.WrapsimError) as e:
+            law.energy_state(u)
+        assert e.value.status == ws.WS_ERR_UNSUPPORTED
+
+        def broken(u, ud, t):
+            raise RuntimeError("from the law")
+        bad = w.law("user", user_fn=broken, name="broken")
+        with pytest.raises(ws.WrapsimError) as e:
+            bad.evaluate(0.1)
+        assert e.value.status == ws.WS_ERR_CALLBACK and "broken" in e.value.detail
+        assert isinstance(e.value.__cause__, RuntimeError)
+        nan = w.law("user", user_fn=lambda u, ud, t: [float("nan")])
+        with pytest.raises(ws.WrapsimError) as e:
+            nan.evaluate(0.1)
+        assert e.value.status == ws.WS_ERR_NUMERICAL
+        law.destroy()
+        assert not law.valid
+
+
 def test_run_progress_text_without_tqdm(monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "tqdm", None)  # import tqdm now raises ImportError
     with ws.World() as w:
@@ -600,6 +722,97 @@ def test_run_with_tqdm_when_present():
     with ws.World() as w:
         out = ws.run(w, 0.005, record={"t": lambda: w.time}, every=0.001)
         assert len(out["t"]) == 6
+
+
+# --- deformable elements -------------------------------------------------------------------------
+def test_elements_rod_period_and_bulk_outputs():
+    """A 2 kg box on a rod (EA = 250 N, l0 = 0.5 m: k = 500 N/m) to a fixed point: period
+    2 pi sqrt(m/k) within the symplectic scheme's (omega h)^2/24 = 1e-7 and the zero-crossing
+    sampling; bulk read-outs equal the single ones; the loads balance."""
+    m, EA, l0, h = 2.0, 250.0, 0.5, 1e-4
+    with ws.World(gravity=(0, 0, 0), dt=h) as w:
+        box = w.body(w.box(0.1, 0.1, 0.1), mass=m, position=(0, 0, -0.52), name="mass")
+        rod_law = w.law("linear_elastic", stiffness=EA)
+        rod = w.element("rod", None, box, rod_law, point1=(0, 0, 0), rest_length=l0,
+                        name="rod", user_data=42)
+        assert rod.valid and rod.name == "rod" and rod.user_data == 42
+        assert rod.strain == pytest.approx([0.02 / l0])
+        assert rod.force == pytest.approx([0, 0, -EA * 0.02 / l0])  # body 1 pulled down
+        strain = []
+        for _ in range(int(2.0 / h)):
+            w.step()
+            strain.append(rod.strain[0])
+        s = np.array(strain)
+        up = np.nonzero((s[:-1] < 0) & (s[1:] >= 0))[0]
+        tc = (up + s[up] / (s[up] - s[up + 1]) + 1) * h
+        period = (tc[-1] - tc[0]) / (len(tc) - 1)
+        assert period == pytest.approx(2 * math.pi * math.sqrt(m * l0 / EA), rel=1e-6)
+
+        six = w.law("linear_viscoelastic", dim=6, stiffness_matrix=np.diag([2e4, 2e4, 6e4, 30,
+                                                                             30, 20]),
+                    damping=0.5)
+        other = w.body(w.box(0.1, 0.1, 0.1), mass=1.0, position=(0.5, 0, 0))
+        bush = w.element("bushing", box, other, six, global_attachment=1,
+                         point1=(0.25, 0, -0.26), point2=(0.25, 0, -0.26),
+                         formulation="potential")
+        other.set_velocity((0.1, 0.2, 0.0), (1.0, 0.0, 0.5))
+        w.step(50)
+        els = w.elements()
+        assert els == [rod, bush]
+        outs = w.element_outputs()
+        assert outs.dtype == ws.ELEMENT_OUTPUT_DTYPE and outs.shape == (2,)
+        assert w.element_outputs(out=outs) is outs
+        one = bush.output()
+        assert one["dim"] == 6 and one["type"] == ws.WS_ELEMENT_BUSHING
+        assert np.array_equal(outs[1]["strain"], one["strain"])
+        assert np.array_equal(outs[1]["force"], one["force"])
+        assert w.element_energy() == pytest.approx(outs["energy"].sum(), rel=1e-12)
+        # Balance: p1 x f + m1 + p2 x (-f) + m2 = 0.
+        o = outs[1]
+        res = (np.cross(o["point1"], o["force"]) + o["moment"] -
+               np.cross(o["point2"], o["force"]) + o["moment2"])
+        assert np.abs(res).max() < 1e-12 * (1 + np.abs(o["force"]).max())
+        with pytest.raises(ValueError):
+            w.element_outputs(out=np.zeros(3, dtype=ws.ELEMENT_OUTPUT_DTYPE))
+        with pytest.raises(ws.WrapsimError) as e:
+            other.destroy()
+        assert e.value.status == ws.WS_ERR_IN_USE
+        with pytest.raises(ws.WrapsimError) as e:
+            six.destroy()
+        assert e.value.status == ws.WS_ERR_IN_USE
+        with pytest.raises(ws.WrapsimError) as e:
+            w.element("bushing", box, other, rod_law)  # a 1D law for a 6D element
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT and "dim 6" in e.value.detail
+        with pytest.raises(ValueError):
+            w.element("hinge", box, other, six)
+        bush.destroy()
+        assert not bush.valid
+        with pytest.raises(ws.WrapsimError) as e:
+            bush.output()
+        assert e.value.status == ws.WS_ERR_STALE_HANDLE
+        other.destroy()
+        six.destroy()
+        assert len(w.elements()) == 1
+
+
+def test_elements_swap_invariance():
+    """An orthotropic angular spring between two turned, spinning boxes: the invariant form
+    gives the same motion whichever body is first, to the last bit; the attached one does not."""
+    def run(form, swap):
+        with ws.World(gravity=(0, 0, 0), dt=5e-4) as w:
+            a = w.body(w.box(0.2, 0.15, 0.1), mass=2.0)
+            b = w.body(w.box(0.1, 0.25, 0.2), mass=3.0, position=(0.8, 0, 0))
+            law = w.law("linear_elastic", dim=3, stiffness_matrix=np.diag([2.0, 4.0, 8.0]))
+            w.element("angular_spring", *((b, a) if swap else (a, b)), law, formulation=form)
+            b.set_pose((0.8, 0, 0), (math.cos(1.0), 0.6 * math.sin(1.0), 0.0,
+                                     0.8 * math.sin(1.0)))
+            a.set_velocity((0, 0, 0), (1.0, -2.0, 0.5))
+            b.set_velocity((0, 0, 0), (-1.5, 0.7, 2.5))
+            w.step(400)
+            return np.concatenate([a.orientation, b.orientation, a.angular_velocity,
+                                   b.angular_velocity])
+    assert np.array_equal(run("invariant", False), run("invariant", True))
+    assert np.abs(run("attached", False) - run("attached", True)).max() > 1e-3
 
 
 # --- last: the whole table was exercised ---------------------------------------------------------

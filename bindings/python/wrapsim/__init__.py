@@ -21,13 +21,19 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
     WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_LAW_LINEAR_ELASTIC,
-    WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_SPRING_AROUND, WS_SPRING_UP,
-    WS_SPRING_SHEAR)
+    WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_LAW_LINEAR_VISCOUS,
+    WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP, WS_LAW_RELAXATION, WS_LAW_SUM,
+    WS_LAW_SCALED, WS_LAW_USER, WS_LAW_FLAG_ELASTIC, WS_LAW_FLAG_VISCOUS, WS_SPRING_AROUND,
+    WS_SPRING_UP, WS_SPRING_SHEAR)
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_ELEMENT_ROD, WS_ELEMENT_LINEAR_SPRING, WS_ELEMENT_ANGULAR_SPRING, WS_ELEMENT_BUSHING,
+    WS_ELEMENT_INVARIANT, WS_ELEMENT_ATTACHED, WS_ELEMENT_POTENTIAL)
 from ._run import run  # noqa: F401
 
 __all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
            "LibraryError", "run", "version", "version_number", "build_features",
            "status_string", "CONTACT_DTYPE", "CONTAINMENT_DTYPE"]
+__all__ += ["Element", "ELEMENT_OUTPUT_DTYPE"]
 
 
 class WrapsimError(RuntimeError):
@@ -72,7 +78,9 @@ _ENUMS = {
     (L.BodyDef, "type"): {"dynamic": 0, "kinematic": 1},
     (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3},
     (L.LawDef, "type"): {"linear_elastic": 0, "linear_viscoelastic": 1,
-                         "tension_compression": 2},
+                         "tension_compression": 2, "linear_viscous": 3, "cubic_elastic": 4,
+                         "table": 5, "stop": 6, "relaxation": 7, "sum": 8, "scaled": 9,
+                         "user": 10},
 }
 
 
@@ -120,6 +128,8 @@ def _convert(struct, name, ftype, value):
         return _id_of(value, ftype)
     if ftype is ctypes.c_char_p:
         return None if value is None else str(value).encode()
+    if isinstance(ftype, type) and issubclass(ftype, ctypes._Pointer):
+        return value  # a pointer the caller made (arrays kept alive by it), or None
     if ftype is c_double:
         return float(value)
     if isinstance(value, str):
@@ -202,6 +212,21 @@ CONTAINMENT_DTYPE = np.dtype([
     ("z_low", np.float64), ("z_high", np.float64), ("hoop_tension", np.float64),
     ("line_load", np.float64), ("contact_force", np.float64)])
 assert CONTAINMENT_DTYPE.itemsize == ctypes.sizeof(L.ContainmentBand)
+
+# Element types and formulations by name (ws_element_def).
+_ENUMS[(L.ElementDef, "type")] = {"rod": 0, "linear_spring": 1, "angular_spring": 2,
+                                  "bushing": 3}
+_ENUMS[(L.ElementDef, "formulation")] = {"invariant": 0, "attached": 1, "potential": 2}
+
+#: numpy layout of ws_element_output: strain, strain_rate, law_force (6 each, the first `dim`
+#: used), force (on body 1, N), moment (on body 1 about point1, N m), moment2 (on body 2 about
+#: point2), point1, point2 (m), frame (law frame, e0..e3), energy (J); all global.
+ELEMENT_OUTPUT_DTYPE = np.dtype([
+    ("type", np.int32), ("dim", np.int32), ("strain", np.float64, 6),
+    ("strain_rate", np.float64, 6), ("law_force", np.float64, 6), ("force", np.float64, 3),
+    ("moment", np.float64, 3), ("moment2", np.float64, 3), ("point1", np.float64, 3),
+    ("point2", np.float64, 3), ("frame", np.float64, 4), ("energy", np.float64)])
+assert ELEMENT_OUTPUT_DTYPE.itemsize == ctypes.sizeof(L.ElementOutput)
 
 
 # --- World ---------------------------------------------------------------------------------------
@@ -455,12 +480,83 @@ class World:
 
     # laws and webs
     def law(self, type="linear_elastic", **kwargs):
-        """A constitutive law: ws_law_def fields (type, stiffness N, compression_stiffness N,
-        damping N s, transition, name)."""
+        """A constitutive law: ws_law_def fields (type, dim, stiffness N, compression_stiffness
+        N, damping N s, transition, name, cubic_stiffness, stop_low, stop_high, scale,
+        user_flags). Arrays are given as sequences and their counts are set from them:
+        stiffness_matrix and damping_matrix (dim x dim), cubic_stiffnesses (dim), table_strain
+        and table_force, prony_stiffness and prony_time (N, s), terms (Laws of a sum), base (the
+        Law of a scaled law), scale_times and scale_factors. Callables: scale_fn(t) -> factor
+        for a scaled law; user_fn(u, ud, t) -> (F, dF/du, dF/dud) for a user law (numpy arrays
+        of dim, dim x dim; the derivatives may be left out, they are then zero). An exception in
+        a callable fails the evaluation with WS_ERR_CALLBACK, chained to the WrapsimError."""
         kwargs["type"] = type
+        keep = []  # arrays and callbacks that must live through (or beyond) the create call
+
+        def arr(value, ctype=c_double):
+            a = np.ascontiguousarray(np.asarray(value, dtype=float).reshape(-1))
+            keep.append(a)
+            return a, _ptr(a, ctype)
+
+        for name in ("stiffness_matrix", "damping_matrix", "cubic_stiffnesses"):
+            if kwargs.get(name) is not None:
+                kwargs[name] = arr(kwargs[name])[1]
+        for xs, ys, count in (("table_strain", "table_force", "table_count"),
+                              ("prony_stiffness", "prony_time", "prony_count"),
+                              ("scale_times", "scale_factors", "scale_count")):
+            n = None
+            for name in (xs, ys):
+                if kwargs.get(name) is not None:
+                    a, p = arr(kwargs[name])
+                    n = len(a) if n is None else min(n, len(a))
+                    kwargs[name] = p
+            if n is not None:
+                kwargs.setdefault(count, n)
+        if kwargs.get("terms") is not None:
+            ids = (L.LawId * max(1, len(kwargs["terms"])))(
+                *[_id_of(t, L.LawId) for t in kwargs["terms"]])
+            keep.append(ids)
+            kwargs.setdefault("term_count", len(kwargs["terms"]))
+            kwargs["terms"] = ctypes.cast(ids, POINTER(L.LawId))
+        callbacks = []
+        scale_fn = kwargs.pop("scale_fn", None)
+        user_fn = kwargs.pop("user_fn", None)
         d = _make(L.LawDef, kwargs)
+        if scale_fn is not None:
+            def _time(user, t, factor, _fn=scale_fn, _world=self):
+                try:
+                    factor[0] = float(_fn(t))
+                    return 0
+                except Exception as e:  # noqa: BLE001 - reported through the call's error
+                    _world._pending = e
+                    return 1
+            cb = L.LawTimeFn(_time)
+            callbacks.append(cb)
+            d.scale_fn = cb
+        if user_fn is not None:
+            def _user(user, dim, u, ud, t, F, K, C, _fn=user_fn, _world=self):
+                try:
+                    r = _fn(np.ctypeslib.as_array(u, shape=(dim,)).copy(),
+                            np.ctypeslib.as_array(ud, shape=(dim,)).copy(), t)
+                    if not isinstance(r, (tuple, list)):
+                        r = (r,)
+                    np.ctypeslib.as_array(F, shape=(dim,))[:] = np.asarray(
+                        r[0], dtype=float).reshape(dim)
+                    for out, val in zip((K, C), r[1:3]):
+                        if val is not None:
+                            np.ctypeslib.as_array(out, shape=(dim * dim,))[:] = np.asarray(
+                                val, dtype=float).reshape(dim * dim)
+                    return 0
+                except Exception as e:  # noqa: BLE001 - reported through the call's error
+                    _world._pending = e
+                    return 1
+            cb = L.LawUserFn(_user)
+            callbacks.append(cb)
+            d.user_fn = cb
         out = L.LawId()
         self._call("ws_law_create", byref(d), byref(out))
+        if callbacks:
+            # The library calls them for as long as the law lives.
+            self._callbacks.setdefault(out.bits, []).extend(callbacks)
         return Law(self, out)
 
     def _web_def(self, kw):
@@ -531,6 +627,50 @@ class World:
         out = L.WebId()
         self._call("ws_web_create_mesh", byref(wd), byref(md), byref(out))
         return Web(self, out)
+
+    # deformable elements
+    def element(self, type, body1, body2, law, **kwargs):
+        """A deformable element between body1 and body2 (a Body, or None for the fixed world
+        frame): type 'rod', 'linear_spring', 'angular_spring' or 'bushing'; `law` of dim 1, 3
+        or 6 to match. Other keywords are ws_element_def fields: formulation ('invariant'
+        (default), 'attached', 'potential'), point1, point2 (m, in the bodies' frames),
+        frame1, frame2 (e0..e3; zero = automatic), global_attachment (1: points and frames are
+        global, at the poses now), rest_length (m, rods; <= 0: the distance now), name,
+        user_data."""
+        kwargs.update(type=type, body1=body1, body2=body2, law=law)
+        d = _make(L.ElementDef, kwargs)
+        out = L.ElementId()
+        self._call("ws_element_create", byref(d), byref(out))
+        return Element(self, out)
+
+    def elements(self):
+        """Every live element, in the order of element_outputs()."""
+        n = c_size_t()
+        self._call("ws_world_copy_element_ids", None, 0, byref(n))
+        buf = (L.ElementId * max(n.value, 1))()
+        self._call("ws_world_copy_element_ids", buf, n.value, byref(n))
+        return [Element(self, L.ElementId(buf[i].bits)) for i in range(n.value)]
+
+    def element_outputs(self, out=None):
+        """The output of every element now as a numpy structured array (ELEMENT_OUTPUT_DTYPE),
+        one C call; `out` (an array of that dtype, as long as elements()) is reused if given."""
+        n = c_size_t()
+        self._call("ws_world_copy_element_outputs", None, 0, byref(n))
+        if out is None:
+            out = np.zeros(n.value, dtype=ELEMENT_OUTPUT_DTYPE)
+        elif (out.dtype != ELEMENT_OUTPUT_DTYPE or out.shape != (n.value,)
+              or not out.flags.c_contiguous or not out.flags.writeable):
+            raise ValueError(f"out must be a writeable ELEMENT_OUTPUT_DTYPE array ({n.value},)")
+        if n.value:
+            self._call("ws_world_copy_element_outputs", _ptr(out, L.ElementOutput), len(out),
+                       byref(n))
+        return out
+
+    def element_energy(self):
+        """Elastic energy stored in all elements now, J."""
+        e = c_double()
+        self._call("ws_world_get_element_energy", byref(e))
+        return e.value
 
     # output
     def write_vtp(self, path):
@@ -630,8 +770,83 @@ class Law(_Handle):
         self._call("ws_law_energy", float(eps), byref(e))
         return e.value
 
+    def info(self):
+        """type, dim, flags (WS_LAW_FLAG_*), state_size, users, max_stiffness, max_damping."""
+        i = L.LawInfo()
+        self._call("ws_law_get_info", byref(i))
+        return _struct_dict(i)
+
+    @property
+    def dim(self):
+        """1, 3 or 6."""
+        return self.info()["dim"]
+
+    @property
+    def state_size(self):
+        """Doubles of history each user keeps (0: none)."""
+        n = c_size_t()
+        self._call("ws_law_get_state_size", byref(n))
+        return n.value
+
+    def init_state(self):
+        """A new history: the initial state as a numpy array (empty for a law without one)."""
+        st = np.zeros(self.state_size)
+        self._call("ws_law_init_state", _ptr(st, c_double) if len(st) else None)
+        return st
+
+    def _vec(self, v, dim, what):
+        a = np.ascontiguousarray(np.asarray(v, dtype=float).reshape(-1))
+        if a.shape != (dim,):
+            raise ValueError(f"{what}: expected {dim} numbers, got {v!r}")
+        return a
+
+    def _state(self, state, n):
+        if state is None:
+            return None
+        if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and
+                state.flags.c_contiguous and state.shape == (n,)):
+            raise ValueError(f"state: expected a float64 numpy array of {n} (from init_state())")
+        return _ptr(state, c_double) if n else None
+
+    def evaluate_state(self, u, ud=None, t=0.0, dt=0.0, state=None):
+        """(F, dF/du, dF/dud) at strain u (dim values) and rate ud (1/s; None: zero), at time t
+        (s), dt (s) after the committed `state` (None: the initial state), which is not
+        changed. F has dim values (N), the derivatives are dim x dim arrays."""
+        info = self.info()
+        n = info["dim"]
+        uu = self._vec(u, n, "u")
+        uv = None if ud is None else self._vec(ud, n, "ud")
+        F, K, C = np.empty(n), np.empty((n, n)), np.empty((n, n))
+        self._call("ws_law_evaluate_state", self._state(state, info["state_size"]),
+                   _ptr(uu, c_double), None if uv is None else _ptr(uv, c_double), float(t),
+                   float(dt), _ptr(F, c_double), _ptr(K, c_double), _ptr(C, c_double))
+        return F, K, C
+
+    def commit(self, state, u, ud=None, t=0.0, dt=0.0):
+        """Commit a step accepted at strain u and rate ud (None: zero) at time t, dt after the
+        previous commit: `state` (from init_state()) is updated in place."""
+        info = self.info()
+        n = info["dim"]
+        uu = self._vec(u, n, "u")
+        uv = None if ud is None else self._vec(ud, n, "ud")
+        self._call("ws_law_commit_state", self._state(state, info["state_size"]),
+                   _ptr(uu, c_double), None if uv is None else _ptr(uv, c_double), float(t),
+                   float(dt))
+
+    def energy_state(self, u, state=None, t=0.0):
+        """Elastic energy (J per unit of the strain's scale) at strain u from `state` (None:
+        the initial one) at time t."""
+        info = self.info()
+        uu = self._vec(u, info["dim"], "u")
+        e = c_double()
+        self._call("ws_law_energy_state", self._state(state, info["state_size"]),
+                   _ptr(uu, c_double), float(t), byref(e))
+        return e.value
+
     def destroy(self):
+        """Destroy the law (WrapsimError WS_ERR_IN_USE while a web, element or law uses it)."""
         self._call("ws_law_destroy")
+        self.world._callbacks.pop(self.id, None)
 
 
 def _vec_getter(fn, doc):
@@ -769,6 +984,47 @@ class Body(_Handle):
         """Destroy the body; its contacts go with it."""
         self._call("ws_body_destroy")
         self.world._callbacks.pop(self.id, None)
+
+
+class Element(_Handle):
+    """A deformable element (rod, linear spring, angular spring, bushing). Read-outs are at the
+    world's current state: the loads the next step applies."""
+    _valid_fn = "ws_element_is_valid"
+
+    def output(self):
+        """dict: type, dim, strain, strain_rate, law_force (numpy arrays of dim), force (on body
+        1, N), moment (on body 1 about point1, N m), moment2 (on body 2 about point2), point1,
+        point2 (m), frame (law frame, e0..e3), energy (J); vectors global."""
+        o = L.ElementOutput()
+        self._call("ws_element_get_output", byref(o))
+        d = _struct_dict(o)
+        dim = d["dim"]
+        for k in ("strain", "strain_rate", "law_force"):
+            d[k] = np.array(d[k][:dim])
+        return d
+
+    @property
+    def strain(self):
+        """The strain fed to the law (dim values): eps, m, rad."""
+        return self.output()["strain"]
+
+    @property
+    def force(self):
+        """Force on body 1, N, global (body 2 gets the opposite)."""
+        return self.output()["force"]
+
+    @property
+    def name(self):
+        return _c().ws_element_get_name(self.world.ptr, self._id).decode()
+
+    @property
+    def user_data(self):
+        """The user_data pointer of the Def, as an int (or None)."""
+        return _c().ws_element_get_user_data(self.world.ptr, self._id)
+
+    def destroy(self):
+        """Destroy the element (its bodies and law stay)."""
+        self._call("ws_element_destroy")
 
 
 class Web(_Handle):

@@ -18,7 +18,7 @@ REQUIRED_VERSION = 100  # 0.1.0
 #: The binding's own version.
 BINDING_VERSION = "0.1.0"
 
-# --- enums (common.h, world.h, body.h, contact.h, law.h, web.h) -------------------------------
+# --- enums (common.h, world.h, body.h, contact.h, law.h, web.h, element.h) ----------------------
 WS_OK = 0
 WS_ERR_INVALID_ARGUMENT = 1
 WS_ERR_UNINITIALIZED_DEF = 2
@@ -40,7 +40,14 @@ WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
 WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK = 0, 1, 2, 3
 WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE = 0, 1
 WS_LAW_LINEAR_ELASTIC, WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION = 0, 1, 2
+WS_LAW_LINEAR_VISCOUS, WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP = 3, 4, 5, 6
+WS_LAW_RELAXATION, WS_LAW_SUM, WS_LAW_SCALED, WS_LAW_USER = 7, 8, 9, 10
+WS_LAW_FLAG_ELASTIC, WS_LAW_FLAG_VISCOUS = 1, 2
+WS_LAW_MAX_DIM, WS_LAW_MAX_TERMS, WS_LAW_MAX_PRONY = 6, 16, 16
 WS_SPRING_AROUND, WS_SPRING_UP, WS_SPRING_SHEAR = 0, 1, 2
+# element.h
+WS_ELEMENT_ROD, WS_ELEMENT_LINEAR_SPRING, WS_ELEMENT_ANGULAR_SPRING, WS_ELEMENT_BUSHING = 0, 1, 2, 3
+WS_ELEMENT_INVARIANT, WS_ELEMENT_ATTACHED, WS_ELEMENT_POTENTIAL = 0, 1, 2
 
 c_enum = c_int
 
@@ -83,6 +90,10 @@ class LawId(_Id):
 
 
 class WebId(_Id):
+    pass
+
+
+class ElementId(_Id):
     pass
 
 
@@ -247,6 +258,11 @@ class ContactInfo(Structure):
 
 
 # --- law.h ---------------------------------------------------------------------------------------
+LawTimeFn = CFUNCTYPE(c_int, c_void_p, c_double, POINTER(c_double))
+LawUserFn = CFUNCTYPE(c_int, c_void_p, c_int, POINTER(c_double), POINTER(c_double), c_double,
+                      POINTER(c_double), POINTER(c_double), POINTER(c_double))
+
+
 class LawDef(Structure):
     _fields_ = [
         ("size", c_uint32), ("magic", c_uint32),
@@ -256,6 +272,43 @@ class LawDef(Structure):
         ("damping", c_double),
         ("transition", c_double),
         ("name", c_char_p),
+        ("dim", c_int),
+        ("stiffness_matrix", POINTER(c_double)),
+        ("damping_matrix", POINTER(c_double)),
+        ("cubic_stiffness", c_double),
+        ("cubic_stiffnesses", POINTER(c_double)),
+        ("table_strain", POINTER(c_double)),
+        ("table_force", POINTER(c_double)),
+        ("table_count", c_size_t),
+        ("stop_low", c_double),
+        ("stop_high", c_double),
+        ("prony_stiffness", POINTER(c_double)),
+        ("prony_time", POINTER(c_double)),
+        ("prony_count", c_size_t),
+        ("terms", POINTER(LawId)),
+        ("term_count", c_size_t),
+        ("base", LawId),
+        ("scale", c_double),
+        ("scale_times", POINTER(c_double)),
+        ("scale_factors", POINTER(c_double)),
+        ("scale_count", c_size_t),
+        ("scale_fn", LawTimeFn),
+        ("scale_user", c_void_p),
+        ("user_fn", LawUserFn),
+        ("user_data", c_void_p),
+        ("user_flags", c_uint),
+    ]
+
+
+class LawInfo(Structure):
+    _fields_ = [
+        ("type", c_enum),
+        ("dim", c_int),
+        ("flags", c_uint),
+        ("state_size", c_uint32),
+        ("users", c_uint32),
+        ("max_stiffness", c_double),
+        ("max_damping", c_double),
     ]
 
 
@@ -337,6 +390,43 @@ class ContainmentBand(Structure):
         ("hoop_tension", c_double),
         ("line_load", c_double),
         ("contact_force", c_double),
+    ]
+
+
+# --- element.h -----------------------------------------------------------------------------------
+class ElementDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("type", c_enum),
+        ("formulation", c_enum),
+        ("body1", BodyId),
+        ("body2", BodyId),
+        ("law", LawId),
+        ("point1", Vec3),
+        ("point2", Vec3),
+        ("frame1", Quat),
+        ("frame2", Quat),
+        ("global_attachment", c_int),
+        ("rest_length", c_double),
+        ("name", c_char_p),
+        ("user_data", c_void_p),
+    ]
+
+
+class ElementOutput(Structure):
+    _fields_ = [
+        ("type", c_int32),
+        ("dim", c_int32),
+        ("strain", c_double * 6),
+        ("strain_rate", c_double * 6),
+        ("law_force", c_double * 6),
+        ("force", Vec3),
+        ("moment", Vec3),
+        ("moment2", Vec3),
+        ("point1", Vec3),
+        ("point2", Vec3),
+        ("frame", Quat),
+        ("energy", c_double),
     ]
 
 
@@ -423,6 +513,15 @@ FUNCTIONS = [
     ("ws_law_evaluate", [World_p, LawId, c_double, c_double, P(c_double), P(c_double),
                          P(c_double)], _st),
     ("ws_law_energy", [World_p, LawId, c_double, P(c_double)], _st),
+    ("ws_law_get_info", [World_p, LawId, P(LawInfo)], _st),
+    ("ws_law_get_state_size", [World_p, LawId, P(c_size_t)], _st),
+    ("ws_law_init_state", [World_p, LawId, P(c_double)], _st),
+    ("ws_law_evaluate_state", [World_p, LawId, P(c_double), P(c_double), P(c_double), c_double,
+                               c_double, P(c_double), P(c_double), P(c_double)], _st),
+    ("ws_law_commit_state", [World_p, LawId, P(c_double), P(c_double), P(c_double), c_double,
+                             c_double], _st),
+    ("ws_law_energy_state", [World_p, LawId, P(c_double), P(c_double), c_double, P(c_double)],
+     _st),
     # web.h
     ("ws_web_def_init", [P(WebDef)], None),
     ("ws_sheet_def_init", [P(SheetDef)], None),
@@ -445,6 +544,17 @@ FUNCTIONS = [
     ("ws_web_get_body_force", [World_p, WebId, BodyId, P(Vec3), P(Vec3)], _st),
     ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
     ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
+    # element.h
+    ("ws_element_def_init", [P(ElementDef)], None),
+    ("ws_element_create", [World_p, P(ElementDef), P(ElementId)], _st),
+    ("ws_element_destroy", [World_p, ElementId], _st),
+    ("ws_element_is_valid", [World_p, ElementId], c_int),
+    ("ws_element_get_output", [World_p, ElementId, P(ElementOutput)], _st),
+    ("ws_element_get_name", [World_p, ElementId], c_char_p),
+    ("ws_element_get_user_data", [World_p, ElementId], c_void_p),
+    ("ws_world_copy_element_ids", [World_p, P(ElementId), c_size_t, P(c_size_t)], _st),
+    ("ws_world_copy_element_outputs", [World_p, P(ElementOutput), c_size_t, P(c_size_t)], _st),
+    ("ws_world_get_element_energy", [World_p, P(c_double)], _st),
     # io.h
     ("ws_world_write_vtp", [World_p, c_char_p], _st),
     ("ws_web_write_vtp", [World_p, WebId, c_char_p], _st),
@@ -467,6 +577,7 @@ DEF_INITS = [
     ("ws_sheet_def_init", SheetDef),
     ("ws_band_def_init", BandDef),
     ("ws_web_mesh_def_init", WebMeshDef),
+    ("ws_element_def_init", ElementDef),
 ]
 
 
