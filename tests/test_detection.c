@@ -4,8 +4,19 @@
  * re-checked; a full detection is forced early whenever the bodies may have moved by half the
  * margin. So a schedule of "every 50th step" must give the same contacts, hence the same motion,
  * as "every step": the same trajectory to round-off (1e-9 m allows for the different summation
- * order of forces when candidate lists differ). */
+ * order of forces when candidate lists differ). The same holds for film nodes and their
+ * candidates. This suite reaches into the world (world_internal.h) to force detection. */
 #include "helpers.h"
+
+#include "world/world_internal.h"
+
+/* Every film node of every web finds its candidates again before the next step. */
+static void force_node_detection(ws_world *w)
+{
+    for (size_t k = 0; k < w->web_slots.slot_count; k++)
+        if (w->web_slots.dense[k] != UINT32_MAX)
+            w->webs[k]->refresh = 1;
+}
 
 #define WS_TEST_PI 3.14159265358979323846
 
@@ -133,6 +144,187 @@ START_TEST(impact_stays_within_the_layers)
 }
 END_TEST
 
+/* A 0.25 m cube wrapped in a band of film (24 x 6 nodes) on a platform that tilts at 1 rad/s
+ * from the start: the film snaps on, the platform turns the stack, and from about 0.29 s
+ * (tan 16.7 deg = 0.3) box and film slide down it together. */
+static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.detection_interval = 5;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id plane_mat, box_mat, film_mat;
+    md.name = "plane";
+    ck_ok(w, ws_material_create(w, &md, &plane_mat));
+    md.name = "box";
+    ck_ok(w, ws_material_create(w, &md, &box_mat));
+    md.name = "film";
+    ck_ok(w, ws_material_create(w, &md, &film_mat));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 2e5;
+    cd.damping = 10.0;
+    cd.friction = 0.3;
+    ck_ok(w, ws_world_set_contact(w, box_mat, plane_mat, &cd));
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.9;
+    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    ck_ok(w, ws_world_set_contact(w, film_mat, plane_mat, &cd));
+    ws_shape_id slab, cube;
+    ck_ok(w, ws_shape_create_box(w, 1.5, 1.5, 0.05, &slab));
+    ck_ok(w, ws_shape_create_box(w, 0.25, 0.25, 0.25, &cube));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = slab;
+    bd.material = plane_mat;
+    bd.position = (ws_vec3){0, 0, -0.025};
+    bd.name = "platform";
+    ws_body_id plane;
+    ck_ok(w, ws_body_create(w, &bd, &plane));
+    ws_drive_def tilt;
+    ws_drive_def_init(&tilt);
+    tilt.type = WS_DRIVE_TILT;
+    tilt.axis = (ws_vec3){0, 1, 0};
+    tilt.rate = 1.0;
+    if (kind < 2)
+        ck_ok(w, ws_body_set_drive(w, plane, &tilt));
+    else {
+        /* A paddle (2 Hz). Case 2: far from the film at first, it swings in, pokes 7 mm into
+         * the film and the box and swings out: a body that comes near. Case 3: it touches the
+         * film from the start and slides along it, over nodes that need not move to be met. */
+        ws_shape_id pad;
+        ck_ok(w, ws_shape_create_box(w, 0.05, kind == 2 ? 0.3 : 0.1, 0.1, &pad));
+        bd.shape = pad;
+        bd.position = kind == 2 ? (ws_vec3){0.21, 0, 0.12} : (ws_vec3){0.1535, 0, 0.12};
+        bd.name = "paddle";
+        ws_body_id paddle;
+        ck_ok(w, ws_body_create(w, &bd, &paddle));
+        ws_drive_def sine;
+        ws_drive_def_init(&sine);
+        sine.type = WS_DRIVE_SINE;
+        sine.direction = kind == 2 ? (ws_vec3){-1, 0, 0} : (ws_vec3){0, 1, 0};
+        sine.amplitude = kind == 2 ? 0.065 : 0.06;
+        sine.frequency = 2.0;
+        ck_ok(w, ws_body_set_drive(w, paddle, &sine));
+    }
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.mass = 5.0;
+    bd.material = box_mat;
+    bd.position = (ws_vec3){0, 0, 0.127};
+    bd.name = "box";
+    ck_ok(w, ws_body_create(w, &bd, box));
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_TENSION_COMPRESSION;
+    ld.stiffness = 100.0;
+    ld.compression_stiffness = 1.0;
+    ld.damping = 0.01;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.node_damping = 0.05;
+    wd.law = law;
+    wd.material = film_mat;
+    wd.name = "band";
+    if (kind == 1) {
+        /* 14 x 14 nodes, 0.33 m square with shear springs, slack, 3 cm above the box: it falls
+         * onto it, drapes over its edges and slides off with it. */
+        ws_sheet_def sd;
+        ws_sheet_def_init(&sd);
+        sd.nx = sd.ny = 14;
+        sd.spacing_x = sd.spacing_y = 0.025;
+        sd.origin = (ws_vec3){-0.1625, -0.1625, 0.284};
+        sd.shear = 1;
+        wd.law_shear = law;
+        ck_ok(w, ws_web_create_sheet(w, &wd, &sd, web));
+        ck_ok(w, ws_web_set_substeps(w, *web, 2)); /* the shear springs need it */
+        return w;
+    }
+    ws_band_def bdf;
+    ws_band_def_init(&bdf);
+    bdf.bodies = box;
+    bdf.body_count = 1;
+    bdf.z_bottom = 0.03;
+    bdf.z_top = 0.22;
+    bdf.n_around = 24;
+    bdf.n_up = 6;
+    bdf.prestretch_around = 0.3;
+    bdf.prestretch_up = 0.1;
+    ck_ok(w, ws_web_create_band(w, &wd, &bdf, web));
+    return w;
+}
+
+static void film_detection_case(int kind)
+{
+    /* Film nodes find their candidates again only when they (or the bodies near the film)
+     * moved far enough relative to the stack since: every node and feature pair that can
+     * touch is still in the list, so the motion must equal that of a run whose nodes are all
+     * found again every step, to round-off of the force sums (1e-9 m, as above). */
+    ws_web_id wa, wb;
+    ws_body_id ba, bb;
+    ws_world *a = wrapped_world(kind, &wa, &ba), *b = wrapped_world(kind, &wb, &bb);
+    const int steps = 2400; /* 0.6 s: snap-on, the tilt, and 0.3 s of sliding */
+    double max_dev = 0.0;
+    size_t n;
+    ws_web_info info;
+    ck_ok(a, ws_web_get_info(a, wa, &info));
+    double *xa = malloc(6 * info.node_count * sizeof *xa), *xb = xa + 3 * info.node_count;
+    ck_assert(xa);
+    for (int k = 0; k < steps; k++) {
+        force_node_detection(a);
+        ck_ok(a, ws_world_step(a));
+        ck_ok(b, ws_world_step(b));
+        if (k % 20 != 19 && k != steps - 1)
+            continue;
+        ck_ok(a, ws_web_copy_positions(a, wa, xa, info.node_count, &n));
+        ck_ok(b, ws_web_copy_positions(b, wb, xb, info.node_count, &n));
+        for (size_t i = 0; i < 3 * n; i++)
+            max_dev = fmax(max_dev, fabs(xa[i] - xb[i]));
+    }
+    ws_vec3 pa, pb;
+    ws_body_get_position(a, ba, &pa);
+    ws_body_get_position(b, bb, &pb);
+    double slid = hypot(pb.x, pb.y);
+    report("film detection (%s): nodes agree to %.2e m, box to %.2e m; the box slid %.3f m",
+           kind == 1   ? "a sheet falls on the box"
+           : kind == 2 ? "a paddle pokes the band"
+           : kind == 3 ? "a paddle slides along the band"
+                       : "a band around the box",
+           max_dev, fabs(pa.x - pb.x) + fabs(pa.y - pb.y) + fabs(pa.z - pb.z), slid);
+    ck_assert_msg(max_dev < 1e-9, "film nodes differ by %.3e m", max_dev);
+    ck_assert_msg(fabs(pa.x - pb.x) + fabs(pa.y - pb.y) + fabs(pa.z - pb.z) < 1e-9,
+                  "the box differs");
+    if (kind != 3) /* the sliding paddle leaves the box in place */
+        ck_assert_msg(slid > 0.005, "the box did not move (%.4f m): the case tests too little",
+                      slid);
+    ws_world_stats sa, sb;
+    ws_world_get_stats(a, &sa);
+    ws_world_get_stats(b, &sb);
+    report("feature checks: %llu finding every node every step, %llu as scheduled",
+           (unsigned long long)sa.narrow_checks, (unsigned long long)sb.narrow_checks);
+    ck_assert_msg(sb.narrow_checks < sa.narrow_checks / 2, "the schedule saved little");
+    free(xa);
+    ws_world_destroy(a);
+    ws_world_destroy(b);
+}
+
+START_TEST(film_detection_does_not_change_the_motion)
+{
+    film_detection_case(0);
+    film_detection_case(1);
+    film_detection_case(2);
+    film_detection_case(3);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("detection");
@@ -141,6 +333,7 @@ int main(void)
     tcase_add_test(tc, schedule_does_not_change_the_motion);
     tcase_add_test(tc, ccd_gate_does_not_change_the_motion);
     tcase_add_test(tc, impact_stays_within_the_layers);
+    tcase_add_test(tc, film_detection_does_not_change_the_motion);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -1584,6 +1584,142 @@ START_TEST(test_bulk_copies)
 }
 END_TEST
 
+/* ======================================================================================
+ * 10. Springs with any 1D law: history committed after each step, a failing law reported
+ * ====================================================================================== */
+
+/* Two pinned nodes 0.11 m apart joined by one spring of rest length 0.1 m (strain 0.1 held). */
+static ws_web_id held_spring(ws_world *w, ws_law_id law)
+{
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law;
+    wd.node_mass = 1e-3;
+    double p[6] = {0, 0, 0, 0.11, 0, 0}, l0 = 0.1;
+    uint32_t sp[2] = {0, 1}, pin[2] = {0, 1};
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = p;
+    md.node_count = 2;
+    md.springs = sp;
+    md.spring_count = 1;
+    md.rest_lengths = &l0;
+    md.pinned = pin;
+    md.pinned_count = 2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &web));
+    return web;
+}
+
+START_TEST(test_spring_relaxation)
+{
+    /* Film loses tension after wrapping. A spring of a standard linear solid (k_inf = 50 N,
+     * k1 = 100 N, tau = 0.05 s) stretched by 0.1 and held: T(t) = (k_inf + k1 e^(-t/tau)) 0.1,
+     * from 15 N at once down to 5 N. The history is committed once per step with an update
+     * exact for a held strain, so the only error is round-off: 1e-12 relative. */
+    ws_world *w = world_g(1e-3, NO_G);
+    double k1 = 100.0, tau = 0.05;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_RELAXATION;
+    ld.stiffness = 50.0;
+    ld.prony_stiffness = &k1;
+    ld.prony_time = &tau;
+    ld.prony_count = 1;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_id web = held_spring(w, law);
+    double worst = 0.0, T = 0.0;
+    size_t n;
+    for (int k = 0; k <= 200; k++) {
+        ck_ok(w, ws_web_copy_spring_tensions(w, web, &T, 1, &n));
+        double t = k * 1e-3, want = (50.0 + k1 * exp(-t / tau)) * 0.1;
+        worst = fmax(worst, fabs(T - want) / want);
+        ck_ok(w, ws_world_step(w));
+    }
+    report("relaxing spring: tension follows (k_inf + k1 e^(-t/tau)) eps to %.1e relative over "
+           "4 tau",
+           worst);
+    ck_assert_msg(worst < 1e-12, "relaxation off by %.3e", worst);
+    /* The law is in use: it cannot be destroyed under the web. */
+    ck_assert_int_eq(ws_law_destroy(w, law), WS_ERR_IN_USE);
+    ws_world_destroy(w);
+}
+END_TEST
+
+static int failing_law(void *user, int dim, const double *u, const double *ud, double t,
+                       double *F, double *dFdu, double *dFdud)
+{
+    (void)dim;
+    (void)ud;
+    int *calls = user;
+    ++*calls;
+    if (t > 0.0105)
+        return 1; /* gives up after 10 ms */
+    F[0] = 1000.0 * u[0];
+    if (dFdu)
+        dFdu[0] = 1000.0;
+    if (dFdud)
+        dFdud[0] = 0.0;
+    return 0;
+}
+
+START_TEST(test_spring_user_law_and_failure)
+{
+    /* A spring of a user law gives the user's force; when the callback fails the step fails
+     * with WS_ERR_CALLBACK, names the web, and leaves the world as it was. And a 3D law is
+     * refused for springs. */
+    ws_world *w = world_g(1e-3, NO_G);
+    int calls = 0;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_USER;
+    ld.stiffness = 1000.0; /* the bound the stable step uses */
+    ld.user_fn = failing_law;
+    ld.user_data = &calls;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_id web = held_spring(w, law);
+    double T;
+    size_t n;
+    ck_ok(w, ws_web_copy_spring_tensions(w, web, &T, 1, &n));
+    ck_assert_msg(fabs(T - 100.0) < 1e-9, "user law tension %g, want 100 N", T);
+    ws_status s = WS_OK;
+    int k;
+    for (k = 0; k < 20 && s == WS_OK; k++)
+        s = ws_world_step(w);
+    ck_assert_int_eq(s, WS_ERR_CALLBACK);
+    ck_assert_msg(strstr(ws_world_last_error(w), "web 'springs'") ||
+                      strstr(ws_world_last_error(w), "web '(unnamed)'"),
+                  "message: %s", ws_world_last_error(w));
+    double t;
+    ck_ok(w, ws_world_get_time(w, &t));
+    ck_assert_msg(fabs(t - 0.011) < 1e-12, "the failed step moved time to %g", t);
+    ck_assert_msg(calls > 0, "the callback was never called");
+    ws_law_def_init(&ld);
+    ld.dim = 3;
+    ld.stiffness = 10.0;
+    ws_law_id l3;
+    ck_ok(w, ws_law_create(w, &ld, &l3));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = l3;
+    wd.node_mass = 1e-3;
+    double p[6] = {0, 0, 0, 0.1, 0, 0};
+    uint32_t sp[2] = {0, 1};
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = p;
+    md.node_count = 2;
+    md.springs = sp;
+    md.spring_count = 1;
+    ws_web_id bad;
+    ck_assert_int_eq(ws_web_create_mesh(w, &wd, &md, &bad), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "1D law"), "%s", ws_world_last_error(w));
+    ws_world_destroy(w);
+}
+END_TEST
+
 static void add_case(Suite *s, const char *name, const TTest *t, double timeout)
 {
     TCase *tc = tcase_create(name);
@@ -1611,5 +1747,7 @@ int main(void)
     add_case(s, "sheet_generator", test_sheet_generator, 20);
     add_case(s, "mesh_node_masses", test_mesh_node_masses, 10);
     add_case(s, "bulk_copies", test_bulk_copies, 10);
+    add_case(s, "spring_relaxation", test_spring_relaxation, 10);
+    add_case(s, "spring_user_law_and_failure", test_spring_user_law_and_failure, 10);
     return run_suite(s);
 }

@@ -9,6 +9,18 @@
 
 #include <wrapsim/common.h>
 
+/* A hot loop compiled twice, for the baseline x86-64 and for AVX2, the one for the machine
+ * chosen when the library loads. The arithmetic is the same (no FMA: AVX2 alone does not enable
+ * it, and -ffp-contract=off), so the results are too, to the bit. */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__has_attribute) && !defined(__clang__)
+#if __has_attribute(target_clones)
+#define WS_VECTOR_LOOP __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef WS_VECTOR_LOOP
+#define WS_VECTOR_LOOP
+#endif
+
 /* Written by every ws_*_def_init(); an uninitialised Def almost never carries it. */
 #define WS_DEF_MAGIC 0x57534446u /* "WSDF" */
 

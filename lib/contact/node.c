@@ -3,56 +3,335 @@
 #include "contact/contact.h"
 #include "contact/node.h"
 
+#include <string.h>
+
 static int inside_box(v3 p, v3 lo, v3 hi, double e)
 {
     return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
            p.z > lo.z - e && p.z < hi.z + e;
 }
 
+/* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
+static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
+{
+    v3 l = nodes_get(x, 0), h = l;
+    for (uint32_t i = 1; i < web->n; i++) {
+        v3 p = nodes_get(x, i);
+        l = v3_min(l, p);
+        h = v3_max(h, p);
+    }
+    *lo = l;
+    *hi = h;
+}
+
+/* Largest distance from p to a corner of the box (lo, hi). */
+static double far_corner(v3 p, v3 lo, v3 hi)
+{
+    double dx = fmax(fabs(p.x - lo.x), fabs(p.x - hi.x));
+    double dy = fmax(fabs(p.y - lo.y), fabs(p.y - hi.y));
+    double dz = fmax(fabs(p.z - lo.z), fabs(p.z - hi.z));
+    return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/* Body k's box along its own axis j (global, a), grown by its layer and the web's. */
+static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int j, v3 *a,
+                      double *lo, double *hi)
+{
+    const ws_shape *sh = b->shape[k];
+    const double *A = b->A[k].m;
+    double grow = b->layer[k] + web->layer;
+    *a = v3_make(A[j], A[3 + j], A[6 + j]);
+    *lo = (j == 0 ? sh->lo.x : j == 1 ? sh->lo.y : sh->lo.z) - grow;
+    *hi = (j == 0 ? sh->hi.x : j == 1 ? sh->hi.y : sh->hi.z) + grow;
+}
+
+/* How far body k is from every node: the largest gap between the nodes and the body's box
+ * (grown by the layers) along one of the body's three axes, with that axis. A tilted
+ * platform's global box swells over a film it is far from; its own axes tell them apart. */
+static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web,
+                       ws_nodes3 x, ws_track *t)
+{
+    v3 r = b->st[cur].r[k];
+    double best = -INFINITY;
+    for (int j = 0; j < 3; j++) {
+        v3 a;
+        double blo, bhi;
+        body_span(b, k, web, j, &a, &blo, &bhi);
+        double lo = INFINITY, hi = -INFINITY, o = v3_dot(a, r);
+        for (uint32_t i = 0; i < web->n; i++) {
+            double c = a.x * x.x[i] + a.y * x.y[i] + a.z * x.z[i] - o;
+            lo = c < lo ? c : lo;
+            hi = c > hi ? c : hi;
+        }
+        double gap = fmax(lo - bhi, blo - hi);
+        if (gap > best) {
+            best = gap;
+            t->axis = j;
+            t->lo = blo;
+            t->hi = bhi;
+        }
+    }
+    return best;
+}
+
+/* The reference frame of a web's moves: the pose of its reference body in state cur, or the
+ * global frame. Local coordinates of a global point p: A^T (p - r). */
+static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, v3 *r, v3 *v,
+                     v3 *w, qt *p)
+{
+    if (web->ref == UINT32_MAX) {
+        *A = m3_identity();
+        *r = *v = *w = v3_make(0, 0, 0);
+        *p = qt_identity();
+        return;
+    }
+    uint32_t k = web->ref;
+    *A = b->A[k];
+    *r = b->st[cur].r[k];
+    *v = b->st[cur].v[k];
+    *w = b->wg[k];
+    *p = b->st[cur].p[k];
+}
+
+/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet; all of them, or the listed
+ * ones when `only` is set. */
+static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *only,
+                   size_t count)
+{
+    const double *a = A->m;
+    size_t m = only ? count : web->n;
+    for (size_t q = 0; q < m; q++) {
+        size_t i = only ? only[q] : q;
+        double px = x.x[i] - r.x, py = x.y[i] - r.y, pz = x.z[i] - r.z;
+        web->xdet.x[i] = a[0] * px + a[3] * py + a[6] * pz;
+        web->xdet.y[i] = a[1] * px + a[4] * py + a[7] * pz;
+        web->xdet.z[i] = a[2] * px + a[5] * py + a[8] * pz;
+    }
+}
+
+int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
+                  double margin)
+{
+    web->ntrack = 0;
+    web->ref = UINT32_MAX;
+    if (web->n == 0)
+        return 0;
+    if (ws_array_reserve(mem, (void **)&web->track, &web->track_cap, b->slots + 1,
+                         sizeof *web->track) != 0)
+        return -1;
+    web_box(web, x, &web->box_lo, &web->box_hi);
+    /* Near: a body that comes within the distance a node may still go before it is found
+     * again (a quarter of the margin, ws_node_moved) with the layers. */
+    double heaviest = -1.0;
+    for (uint32_t k = 0; k < b->slots; k++) {
+        if (!b->alive[k])
+            continue;
+        ws_track *t = &web->track[web->ntrack++];
+        t->body = k;
+        t->gap = body_gap(b, cur, k, web, x, t);
+        t->near = t->gap <= 0.25 * margin;
+        /* A point of the body touches a node only within its bounding sphere grown by the
+         * layers and the margin, and only in the web's box. */
+        t->lever = fmin(b->shape[k]->radius + b->layer[k] + web->layer + margin,
+                        far_corner(b->st[cur].r[k], web->box_lo, web->box_hi));
+        /* The reference: the heaviest dynamic body near the web (the load the film rides
+         * on), else a kinematic one. */
+        double m = b->type[k] == WS_BODY_DYNAMIC ? b->mass[k] : 0.0;
+        if (t->near && m > heaviest) {
+            heaviest = m;
+            web->ref = k;
+        }
+    }
+    m3 A;
+    v3 r, v, w;
+    qt p;
+    ref_pose(b, cur, web, &A, &r, &v, &w, &p);
+    qt pc = qt_conj(p);
+    for (size_t q = 0; q < web->ntrack; q++) {
+        ws_track *t = &web->track[q];
+        uint32_t k = t->body;
+        t->rho = m3_tmul_v(&A, v3_sub(b->st[cur].r[k], r));
+        t->q = qt_mul(pc, b->st[cur].p[k]);
+    }
+    to_ref(web, x, &A, r, NULL, 0);
+    return 0;
+}
+
+/* The angle a rotation q turns by. */
+static double turn_of(qt q)
+{
+    double vec = sqrt(q.e1 * q.e1 + q.e2 * q.e2 + q.e3 * q.e3);
+    return 2.0 * atan2(vec, fabs(q.e0));
+}
+
+long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                   double dt, double margin)
+{
+    const ws_body_state *st = &b->st[cur];
+    /* A body made since the full detection: find every node again. */
+    for (uint32_t k = 0, q = 0; k < b->slots; k++) {
+        if (q < web->ntrack && web->track[q].body == k) {
+            q++;
+            continue;
+        }
+        if (b->alive[k])
+            return -1;
+    }
+    m3 A;
+    v3 r, vr, wr;
+    qt p;
+    ref_pose(b, cur, web, &A, &r, &vr, &wr, &p);
+    qt pc = qt_conj(p);
+    double reach = far_corner(r, web->box_lo, web->box_hi) + margin;
+    /* The contacts of this step are evaluated with the bodies as they are now (state cur),
+     * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
+     * move relative to the reference counts as it stands: its CoG's move and its turn times
+     * its lever since the full detection. Near ones must stay within margin / 8 of it. A far
+     * one closes on a node by at most its own move (twice: since the node was last found, the
+     * body moved at most its move then plus its move now, which `gap` and `close` count) and
+     * the node's (under a quarter margin): it must not reach the node. */
+    double dev = 0.0;
+    for (size_t q = 0; q < web->ntrack; q++) {
+        ws_track *t = &web->track[q];
+        uint32_t k = t->body;
+        v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
+        double turn = turn_of(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k])));
+        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
+        if (t->near) {
+            dev = d > dev ? d : dev;
+        } else if (d + 0.25 * margin >= t->gap) {
+            return -1;
+        }
+    }
+    if (dev >= margin / 8.0)
+        return -1;
+    /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
+     * the reference frame since it was found, w its velocity relative to the reference body's
+     * point where it is, h_more the time its sub-steps go beyond this state (0 with one
+     * sub-step). Two near bodies' deviations (margin / 4) and the rest (margin / 16, for what
+     * the sub-steps' forces add) keep a node's move relative to any near body under half the
+     * margin: what the candidates were found to cover. */
+    const double lim = 0.1875 * margin, c = 1.5 * dt * (web->substeps - 1) / web->substeps;
+    const double *a = A.m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
+                           *restrict oz = web->xdet.z;
+    uint8_t *restrict redo = web->redo;
+    double *restrict s = web->tmp; /* 3 WS_WEB_CHUNK doubles */
+    const size_t n = web->n, chunk = 3 * WS_WEB_CHUNK;
+    long count = 0;
+    /* In chunks: the measure of each node into the scratch (straight-line code, on vectors),
+     * then the test (NaN flags too). */
+    for (size_t o = 0; o < n; o += chunk) {
+        size_t e = n - o < chunk ? n : o + chunk;
+        const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
+        const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
+        for (size_t i = o; i < e; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+            double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
+            double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
+            double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
+            s[i - o] = sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
+        }
+        for (size_t i = o; i < e; i++) {
+            redo[i] = !(s[i - o] < lim);
+            if (redo[i])
+                web->moved[count++] = (uint32_t)i;
+        }
+    }
+    /* The moved nodes are found again now, from where they are: each far body's gap becomes
+     * the least of what it was and their distances beyond its box now, less its move so far. */
+    for (size_t q = 0; count && q < web->ntrack; q++) {
+        ws_track *t = &web->track[q];
+        if (t->near)
+            continue;
+        uint32_t k = t->body;
+        v3 ax;
+        double blo, bhi;
+        body_span(b, k, web, t->axis, &ax, &blo, &bhi);
+        double o = v3_dot(ax, st->r[k]), least = INFINITY;
+        for (long m = 0; m < count; m++) {
+            uint32_t i = web->moved[m];
+            double cc = ax.x * x.x[i] + ax.y * x.y[i] + ax.z * x.z[i] - o;
+            double g = fmax(cc - bhi, blo - cc);
+            least = g < least ? g : least;
+        }
+        v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
+        double turn = turn_of(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k])));
+        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
+        if (least - d < t->gap)
+            t->gap = least - d;
+        if (d + 0.25 * margin >= t->gap)
+            return -1;
+    }
+    /* Found again now: their moves count from here. */
+    to_ref(web, x, &A, r, web->moved, (size_t)count);
+    return count;
+}
+
+int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
+                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap)
+{
+    if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
+        return -1;
+    ws_ncand *o = *out;
+    size_t k = 0, a = 0, f = 0;
+    while (a < nold || f < nfresh) {
+        if (a < nold && web->redo[old[a].node]) {
+            a++; /* replaced by the fresh ones */
+            continue;
+        }
+        if (f < nfresh && (a == nold || fresh[f].node <= old[a].node))
+            o[k++] = fresh[f++];
+        else
+            o[k++] = old[a++];
+    }
+    *n = k;
+    return 0;
+}
+
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
-                       ws_web *web, const v3 *x, double margin, ws_ncand **out, size_t *n,
-                       size_t *cap, uint64_t *checks)
+                       ws_web *web, ws_nodes3 x, double margin, const uint32_t *nodes,
+                       size_t count, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
 {
     *n = 0;
     if (web->n == 0)
         return 0;
-    /* The web's box, to skip bodies far from it. */
-    v3 lo = x[0], hi = x[0];
-    for (uint32_t i = 1; i < web->n; i++) {
-        lo = v3_min(lo, x[i]);
-        hi = v3_max(hi, x[i]);
-    }
     double pad = web->layer + 0.5 * margin;
-    for (uint32_t k = 0; k < b->slots; k++) {
-        if (!b->alive[k])
-            continue;
-        if (b->lo[k].x > hi.x + pad || b->hi[k].x < lo.x - pad || b->lo[k].y > hi.y + pad ||
-            b->hi[k].y < lo.y - pad || b->lo[k].z > hi.z + pad || b->hi[k].z < lo.z - pad)
-            continue;
-        const ws_shape *sh = b->shape[k];
-        const m3 *A = &b->A[k];
-        v3 r = b->st[cur].r[k];
-        double reach = b->layer[k] + web->layer + margin;
-        double hi_k = b->layer[k] + web->layer, lo_k = -hi_k - sh->inner;
-        for (uint32_t i = 0; i < web->n; i++) {
-            v3 p = x[i];
+    if (!nodes)
+        count = web->n;
+    /* Node by node (the order the sub-steps take them in), against each body near it. */
+    for (size_t q = 0; q < count; q++) {
+        uint32_t i = nodes ? nodes[q] : (uint32_t)q;
+        v3 p = nodes_get(x, i);
+        for (uint32_t k = 0; k < b->slots; k++) {
+            if (!b->alive[k])
+                continue;
             if (p.x < b->lo[k].x - pad || p.x > b->hi[k].x + pad || p.y < b->lo[k].y - pad ||
                 p.y > b->hi[k].y + pad || p.z < b->lo[k].z - pad || p.z > b->hi[k].z + pad)
                 continue;
-            v3 s = m3_tmul_v(A, v3_sub(p, r));
+            const ws_shape *sh = b->shape[k];
+            double reach = b->layer[k] + web->layer + margin;
+            v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
             if (!inside_box(s, sh->lo, sh->hi, reach))
                 continue;
             /* On a convex body a node touches face f only while f is the face whose plane it
              * is farthest out of (the largest signed distance D): over a face it projects into,
              * d_g <= d_f for every other face g, and inside the body the shallowest face is the
              * one of largest d. Until the next detection nodes and bodies move less than half
-             * the margin each, which changes d_f - D by less than the margin: faces further
+             * the margin together, which changes d_f - D by less than the margin: faces further
              * behind than that cannot come into contact and are not candidates. On a box this
              * drops the side faces next to the one a node lies on. */
             double D = -INFINITY;
             if (sh->convex)
-                for (uint32_t f = 0; f < sh->face_count; f++)
-                    D = fmax(D, v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset);
+                for (uint32_t f = 0; f < sh->face_count; f++) {
+                    double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
+                    D = d > D ? d : D;
+                }
             for (uint32_t f = 0; f < sh->face_count; f++) {
                 const ws_face *fc = &sh->faces[f];
                 (*checks)++;
@@ -63,7 +342,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                     inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, f, g->face_base[k] + f, 0, lo_k, hi_k};
+                    (*out)[(*n)++] = (ws_ncand){i, k, g->face_base[k] + f, f};
                 }
             }
             /* Convex edges within reach of the node: the rounded rim of the contact layer. */
@@ -79,7 +358,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, e, g->edge_base[k] + e, 1, lo_k, hi_k};
+                    (*out)[(*n)++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
                 }
             }
         }
@@ -209,8 +488,8 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *
     return 1;
 }
 
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, const v3 *x,
-                      const v3 *v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
+void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
+                      ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
                       double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
 {
     const ws_body_state *st = &b->st[cur];
@@ -225,33 +504,38 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         uint32_t i = c->node, bi = c->body;
         v3 nrm;
         double d;
-        if (c->edge) {
-            if (!in_wedge(&g->edge[c->wface], x[i], c->hi, &nrm, &d))
+        v3 xi = nodes_get(x, i);
+        /* The contact window of the pair: the two layers outside, the body's inner depth in. */
+        double hi = b->layer[bi] + web->layer;
+        if (c->local & WS_NCAND_EDGE) {
+            if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
                 continue;
         } else {
             /* Most candidates lie flat beside a face without pressing it: reject them on the
              * plane distance alone before anything else is loaded. */
-            const ws_wface *F = &g->face[c->wface];
-            d = v3_dot(F->n, x[i]) - F->off;
-            if (!(d > c->lo && d < c->hi))
+            const ws_wface *F = &g->face[c->feat];
+            d = v3_dot(F->n, xi) - F->off;
+            if (!(d < hi))
                 continue;
-            if (!in_wface(g, F, x[i], c->lo, c->hi, &d))
+            const ws_shape *sh = b->shape[bi];
+            double lo = -hi - sh->inner;
+            if (!(d > lo) || !in_wface(g, F, xi, lo, hi, &d))
                 continue;
-            if (d < 0.0 && !ws_shallowest_face(b->shape[bi], c->face,
-                                               m3_tmul_v(&b->A[bi], v3_sub(x[i], st->r[bi])), d))
+            if (d < 0.0 && !ws_shallowest_face(sh, c->local,
+                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])), d))
                 continue;
             nrm = F->n; /* from the body to the node */
         }
         const ws_node_params *p = &pp[b->material[bi]];
         v3 r = st->r[bi];
-        v3 xc = v3_madd(x[i], nrm, -0.5 * d);
+        v3 xc = v3_madd(xi, nrm, -0.5 * d);
         v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
-        v3 vrel = v3_sub(v[i], vb);
+        v3 vrel = v3_sub(nodes_get(v, i), vb);
         double vn = v3_dot(vrel, nrm);
-        double fn = p->k * (c->hi - d) - p->c * vn;
+        double fn = p->k * (hi - d) - p->c * vn;
         if (!(fn > 0.0))
             continue; /* a contact never pulls */
-        web->f[i] = v3_madd(web->f[i], nrm, fn);
+        nodes_add(web->f, i, v3_scale(nrm, fn));
         act[na++] = (ws_nact){i, bi, nrm, xc, v3_madd(vrel, nrm, -vn), v3_make(0, 0, 0), fn,
                               p->mu, p->vlim};
     }
@@ -268,7 +552,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         uint32_t i = a->node;
         if (web->inv_m[i] == 0.0)
             continue;
-        v3 fo = web->f[i];
+        v3 fo = nodes_get(web->f, i);
         fo = v3_madd(fo, a->n, -v3_dot(fo, a->n)); /* tangential part of the other forces */
         v3 vp = v3_madd(a->vt, fo, h * web->inv_m[i]);
         double vps = v3_norm(vp);
@@ -283,7 +567,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     for (size_t k = 0; k < na; k++) {
         const ws_nact *a = &act[k];
         uint32_t i = a->node, bi = a->body;
-        web->f[i] = v3_add(web->f[i], a->ft);
+        nodes_add(web->f, i, a->ft);
         v3 Fnode = v3_madd(a->ft, a->n, a->fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
         v3 Fb = v3_scale(Fnode, -share);

@@ -43,17 +43,37 @@ typedef struct ws_node_geom {
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
-/* Node-face candidates of a web within the layers + margin (full detection). 0, or -1 when out
- * of memory. */
+/* Node candidates of a web: every node-face and node-edge pair within the layers + margin, for
+ * the nodes listed (all when `nodes` is NULL), sorted by node. 0, or -1 when out of memory. */
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
-                       ws_web *web, const v3 *x, double margin, ws_ncand **out, size_t *n,
-                       size_t *cap, uint64_t *checks);
+                       ws_web *web, ws_nodes3 x, double margin, const uint32_t *nodes,
+                       size_t count, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks);
+
+/* A full detection's record (see ws_web): the web's box from x and the bodies whose boxes come
+ * within reach of it, with their pose at state cur; xdet = x. 0, or -1 when out of memory. */
+int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
+                  double margin);
+
+/* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
+ * node whose move relative to the web's reference body, with what its sub-steps may add, could
+ * reach 3/16 of the margin. They go to web->moved (count returned) with web->redo set, and
+ * their xdet is moved to where they are now. -1: every node must be found again (a body came
+ * near the web, or the near bodies moved apart or turned by more than margin / 8 at their
+ * lever). Until a node is found again its move relative to a near body stays under half the
+ * margin, the distance a candidate list is built to cover: see node.c. */
+long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                   double dt, double margin);
+
+/* Candidates of the committed list `old` for the nodes not marked in web->redo and the found
+ * ones `fresh` (of the marked nodes), merged by node into out. 0, or -1 when out of memory. */
+int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
+                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap);
 
 /* Evaluate the candidates at node state (x, v) for a sub-step h: forces into web->f, `share`
  * of them (1 / substeps) into the bodies' accumulators, the node contact forces fc and the
  * per-body totals. pp is indexed by body material. */
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, const v3 *x,
-                      const v3 *v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
+void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
+                      ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
                       double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks);
 
 #endif

@@ -154,31 +154,32 @@ static int web_grid_consistent(const ws_web *web)
 }
 
 /* One scalar of a spring: 0 tension (N), 1 strain. */
-static double web_spring_value(const ws_web *web, const v3 *x, const v3 *v, uint32_t s, int what)
+static double web_spring_value(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
+                               int what)
 {
     return what == 0 ? ws_web_spring_tension(web, x, v, s) : ws_web_spring_strain(web, x, s);
 }
 
-static void write_web_array(FILE *f, ws_web *web, const v3 *x, const v3 *v, int what, int cells)
+static void write_web_array(FILE *f, ws_web *web, ws_nodes3 x, ws_nodes3 v, int what, int cells)
 {
     static const char *const names[2] = {"tension", "strain"};
     fprintf(f, "<DataArray type=\"Float64\" Name=\"%s\" format=\"ascii\">\n", names[what]);
     if (!cells) {
         /* Node means from the force scratch: it holds nothing between steps (see node_bounds in
          * web.c), so the writer needs no allocation. .x: sum, .y: springs at the node. */
-        v3 *acc = web->f;
+        ws_nodes3 acc = web->f;
         for (uint32_t i = 0; i < web->n; i++)
-            acc[i] = v3_make(0, 0, 0);
+            acc.x[i] = acc.y[i] = 0.0;
         for (uint32_t s = 0; s < web->ns; s++) {
             double val = web_spring_value(web, x, v, s, what);
-            acc[web->sa[s]].x += val;
-            acc[web->sb[s]].x += val;
-            acc[web->sa[s]].y += 1.0;
-            acc[web->sb[s]].y += 1.0;
+            acc.x[web->sa[s]] += val;
+            acc.x[web->sb[s]] += val;
+            acc.y[web->sa[s]] += 1.0;
+            acc.y[web->sb[s]] += 1.0;
         }
         for (uint32_t i = 0; i < web->n; i++) {
-            fprintf(f, "%.9g\n", acc[i].y > 0.0 ? acc[i].x / acc[i].y : 0.0);
-            acc[i] = v3_make(0, 0, 0);
+            fprintf(f, "%.9g\n", acc.y[i] > 0.0 ? acc.x[i] / acc.y[i] : 0.0);
+            acc.x[i] = acc.y[i] = 0.0;
         }
     } else {
         /* VTK orders the cells of a PolyData piece verts, lines, polys, strips: the springs
@@ -208,6 +209,16 @@ static void write_v3_array(FILE *f, const char *name, const v3 *a, uint32_t n)
     fprintf(f, "</DataArray>\n");
 }
 
+static void write_nodes_array(FILE *f, const char *name, ws_nodes3 a, uint32_t n)
+{
+    fprintf(f, "<DataArray type=\"Float64\" Name=\"%s\" NumberOfComponents=\"3\" "
+               "format=\"ascii\">\n",
+            name);
+    for (uint32_t i = 0; i < n; i++)
+        fprintf(f, "%.9g %.9g %.9g\n", a.x[i], a.y[i], a.z[i]);
+    fprintf(f, "</DataArray>\n");
+}
+
 static ws_status write_web_vtp(ws_world *w, uint32_t slot, const char *path)
 {
     ws_web *web = w->webs[slot];
@@ -220,15 +231,15 @@ static ws_status write_web_vtp(ws_world *w, uint32_t slot, const char *path)
     FILE *f = fopen(path, "w");
     if (!f)
         return ws_fail(w, WS_ERR_IO, "cannot open '%s' for writing: %s", path, strerror(errno));
-    const v3 *x = web->x[w->cur], *v = web->v[w->cur];
+    const ws_nodes3 x = web->x[w->cur], v = web->v[w->cur];
     fprintf(f, "<?xml version=\"1.0\"?>\n"
                "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
                "<PolyData>\n<Piece NumberOfPoints=\"%u\" NumberOfVerts=\"0\" "
                "NumberOfLines=\"%u\" NumberOfStrips=\"0\" NumberOfPolys=\"%zu\">\n<Points>\n",
             web->n, web->ns, nq);
-    write_v3_array(f, "position", x, web->n);
+    write_nodes_array(f, "position", x, web->n);
     fprintf(f, "</Points>\n<PointData Scalars=\"tension\" Vectors=\"velocity\">\n");
-    write_v3_array(f, "velocity", v, web->n);
+    write_nodes_array(f, "velocity", v, web->n);
     write_v3_array(f, "contact_force", web->fc[w->cur], web->n);
     write_web_array(f, web, x, v, 0, 0);
     write_web_array(f, web, x, v, 1, 0);

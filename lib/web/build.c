@@ -48,9 +48,9 @@ void ws_web_build_grid(ws_web *web, int nx, int ny, int shear, int closed, doubl
             }
     /* Rest lengths from the lengths as placed: the pre-stretch of each direction; a diagonal's
      * rest length follows from its cell's rest sides. */
-    const v3 *x = web->x[0];
+    const ws_nodes3 x = web->x[0];
     for (uint32_t s = 0; s < web->ns; s++) {
-        double l = v3_norm(v3_sub(x[web->sb[s]], x[web->sa[s]]));
+        double l = v3_norm(v3_sub(nodes_get(x, web->sb[s]), nodes_get(x, web->sa[s])));
         double l0;
         if (web->kind[s] == WS_SPRING_AROUND) {
             l0 = l / (1.0 + pre_x);
@@ -61,7 +61,8 @@ void ws_web_build_grid(ws_web *web, int nx, int ny, int shear, int closed, doubl
             uint32_t a = web->sa[s], b = web->sb[s];
             int ja = (int)(a / (uint32_t)nx), ib = (int)(b % (uint32_t)nx);
             uint32_t c = (uint32_t)(ib + nx * ja); /* the corner on a's row below b */
-            double lx = v3_norm(v3_sub(x[c], x[a])), ly = v3_norm(v3_sub(x[b], x[c]));
+            double lx = v3_norm(v3_sub(nodes_get(x, c), nodes_get(x, a)));
+            double ly = v3_norm(v3_sub(nodes_get(x, b), nodes_get(x, c)));
             lx /= 1.0 + pre_x;
             ly /= 1.0 + pre_y;
             l0 = sqrt(lx * lx + ly * ly);
@@ -74,7 +75,8 @@ void ws_web_place_sheet(ws_web *web, v3 o, v3 ax, v3 ay, double hx, double hy)
 {
     for (int j = 0; j < web->ny; j++)
         for (int i = 0; i < web->nx; i++)
-            web->x[0][i + web->nx * j] = v3_madd(v3_madd(o, ax, i * hx), ay, j * hy);
+            nodes_set(web->x[0], (uint32_t)(i + web->nx * j),
+                      v3_madd(v3_madd(o, ax, i * hx), ay, j * hy));
 }
 
 static int cmp_xy(const void *pa, const void *pb)
@@ -166,7 +168,7 @@ int ws_web_place_band(ws_web *web, const double *pts_in, size_t n, uint32_t *hul
         }
         for (int j = 0; j < nu; j++) {
             double z = nu > 1 ? z0 + (z1 - z0) * j / (nu - 1) : z0;
-            web->x[0][i + na * j] = v3_make(px, py, z);
+            nodes_set(web->x[0], (uint32_t)(i + na * j), v3_make(px, py, z));
         }
     }
     return 0;
@@ -176,21 +178,22 @@ void ws_web_grid_masses(ws_web *web, double rho)
 {
     /* Each spring lends half its rest length to each end; a node's rest area is the product of
      * its mean around and up shares (a quarter-cell from each of up to four cells). */
+    ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
-        web->f[i] = v3_make(0, 0, 0);
+        acc.x[i] = acc.y[i] = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
         double half = 0.5 / web->inv_l0[s];
         if (web->kind[s] == WS_SPRING_AROUND) {
-            web->f[web->sa[s]].x += half;
-            web->f[web->sb[s]].x += half;
+            acc.x[web->sa[s]] += half;
+            acc.x[web->sb[s]] += half;
         } else if (web->kind[s] == WS_SPRING_UP) {
-            web->f[web->sa[s]].y += half;
-            web->f[web->sb[s]].y += half;
+            acc.y[web->sa[s]] += half;
+            acc.y[web->sb[s]] += half;
         }
     }
     for (uint32_t i = 0; i < web->n; i++) {
         /* A node on a free edge has half a cell on that side: its shares already say so. */
-        web->m[i] = rho * web->f[i].x * web->f[i].y;
-        web->f[i] = v3_make(0, 0, 0);
+        web->m[i] = rho * acc.x[i] * acc.y[i];
+        acc.x[i] = acc.y[i] = 0.0;
     }
 }

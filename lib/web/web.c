@@ -2,6 +2,21 @@
 
 #include <string.h>
 
+static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+{
+    double *p = ws_mem_calloc(mem, 3 * (size_t)n, sizeof(double));
+    a->x = p;
+    a->y = p ? p + n : NULL;
+    a->z = p ? p + 2 * (size_t)n : NULL;
+    return p != NULL;
+}
+
+static void nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+{
+    ws_mem_free(mem, a->x, 3 * (size_t)n * sizeof(double));
+    a->x = a->y = a->z = NULL;
+}
+
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
 {
     memset(web, 0, sizeof *web);
@@ -9,11 +24,17 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     web->ns = ns;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
-        ok &= (web->x[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
-        ok &= (web->v[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
+        ok &= nodes_alloc(mem, &web->x[k], n);
+        ok &= nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
-    ok &= (web->f = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
+    ok &= nodes_alloc(mem, &web->f, n);
+    ok &= nodes_alloc(mem, &web->xdet, n);
+    ok &= nodes_alloc(mem, &web->xsub, n);
+    ok &= nodes_alloc(mem, &web->vsub, n);
+    ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
+    ok &= (web->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
+    ok &= (web->tmp = ws_mem_calloc(mem, 3 * WS_WEB_CHUNK, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->sa = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
@@ -31,8 +52,8 @@ void ws_web_free(ws_mem *mem, ws_web *web)
 {
     size_t n = web->n, ns = web->ns ? web->ns : 1;
     for (int k = 0; k < 2; k++) {
-        ws_mem_free(mem, web->x[k], n * sizeof(v3));
-        ws_mem_free(mem, web->v[k], n * sizeof(v3));
+        nodes_free(mem, &web->x[k], web->n);
+        nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
         if (k == 0)
@@ -40,72 +61,323 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
-    ws_mem_free(mem, web->f, n * sizeof(v3));
+    nodes_free(mem, &web->f, web->n);
+    nodes_free(mem, &web->xdet, web->n);
+    nodes_free(mem, &web->xsub, web->n);
+    nodes_free(mem, &web->vsub, web->n);
+    ws_mem_free(mem, web->moved, (n ? n : 1) * sizeof(uint32_t));
+    ws_mem_free(mem, web->redo, (n ? n : 1) * sizeof(uint8_t));
+    ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
+    ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
+    ws_mem_free(mem, web->tmp, 3 * WS_WEB_CHUNK * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
     ws_mem_free(mem, web->sa, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->sb, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->inv_l0, ns * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
+    ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free_str(mem, web->name);
     memset(web, 0, sizeof *web);
 }
 
-void ws_web_internal_forces(ws_web *web, const v3 *x, const v3 *v, v3 g)
+/* A spring law in the form every stateless 1D law of the film's kind takes (lib/law/law.h):
+ * F = kc eps + dk g(eps) + c eps_dot, g the C1 ramp of half-width w (qw = 1 / (4 w)). Linear
+ * laws have dk = 0. Any other law (a table, relaxation, a user's) is `gen`, evaluated spring
+ * by spring with the spring's own history, at time t, `since` after it was committed. */
+typedef struct spring_form {
+    double kc, dk, w, qw, c;
+    const ws_law *gen;
+    double t, since;
+} spring_form;
+
+static spring_form form_of(const ws_law *L, double t, double since)
 {
-    v3 *f = web->f;
-    const double c = web->damping;
-    for (uint32_t i = 0; i < web->n; i++)
-        f[i] = v3_madd(v3_scale(g, web->m[i]), v[i], -c);
-    /* The laws' parameters by spring kind, hoisted out of the loop. Linear laws have
-     * kc = k, so their ramp term vanishes and one formula serves every law type:
-     * F = kc eps + (k - kc) g(eps) + c eps_dot (lib/law/law.h). */
-    double K[3] = {0}, DK[3] = {0}, W[3] = {1, 1, 1}, C[3] = {0};
-    for (int k = 0; k < 3; k++) {
-        const ws_law1d *L = web->law[k];
-        if (!L)
-            continue;
-        K[k] = L->kc;
-        DK[k] = L->k - L->kc;
-        W[k] = L->w;
-        C[k] = L->c;
+    spring_form p = {0.0, 0.0, 1.0, 0.25, 0.0, NULL, t, since};
+    if (L && !ws_law_film_form(L, &p.kc, &p.dk, &p.w, &p.c))
+        p.gen = L;
+    else if (L)
+        p.qw = 0.25 / p.w;
+    return p;
+}
+
+/* Strain and strain rate of spring s; 0 when its ends coincide (d is then zero too). */
+static double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *d,
+                        double *rate, double *inv_len)
+{
+    uint32_t a = web->sa[s], b = web->sb[s];
+    *d = v3_sub(nodes_get(x, b), nodes_get(x, a));
+    double l2 = v3_dot(*d, *d);
+    if (!(l2 > 0.0)) {
+        *rate = *inv_len = 0.0;
+        return -1.0;
     }
+    double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
+    *rate = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), *d) * il * il0;
+    *inv_len = il;
+    return l * il0 - 1.0;
+}
+
+int ws_web_law_state(ws_mem *mem, ws_web *web)
+{
+    uint32_t most = 0;
+    for (int k = 0; k < 3; k++)
+        if (web->law[k] && web->law[k]->nstate > most)
+            most = web->law[k]->nstate;
+    web->nstate = most;
+    if (!most || !web->ns)
+        return 0;
+    web->hist = ws_mem_calloc(mem, (size_t)web->ns * most, sizeof(double));
+    if (!web->hist)
+        return -1;
+    /* The film was stretched to its pre-stretch when it was put on: each spring starts with the
+     * history of a strain step to where it is now (committed over no time), from which a
+     * relaxation law relaxes. */
     for (uint32_t s = 0; s < web->ns; s++) {
-        uint32_t a = web->sa[s], b = web->sb[s];
-        v3 d = v3_sub(x[b], x[a]);
-        double l2 = v3_dot(d, d);
-        if (!(l2 > 0.0))
-            continue; /* coincident ends: no direction to pull along */
-        double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
-        double eps = l * il0 - 1.0;
-        double epsd = v3_dot(v3_sub(v[b], v[a]), d) * il * il0;
-        int kd = web->kind[s];
-        double ramp = 0.0;
-        if (DK[kd] != 0.0) {
-            double w = W[kd];
-            ramp = eps >= w ? eps : eps <= -w ? 0.0 : (eps + w) * (eps + w) / (4.0 * w);
-        }
-        double F = K[kd] * eps + DK[kd] * ramp + C[kd] * epsd;
-        v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
-        f[a] = v3_add(f[a], fu);
-        f[b] = v3_sub(f[b], fu);
+        const ws_law *L = web->law[web->kind[s]];
+        double *h = web->hist + (size_t)s * most;
+        ws_law_state_init(L, h);
+        if (!L->nstate)
+            continue;
+        v3 d;
+        double epsd, il, eps = strain_of(web, web->x[0], web->v[0], s, &d, &epsd, &il);
+        ws_law_commit(L, h, &eps, &epsd, 0.0, 0.0);
+    }
+    return 0;
+}
+
+/* A spring of a general law: its history as committed, evaluated at (t, since). A law that
+ * fails (a user callback) marks the web; the step reports it. */
+static void spring_general(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, spring_form p)
+{
+    v3 d;
+    double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+    if (il == 0.0)
+        return;
+    const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
+    double F = 0.0;
+    if (ws_law_eval(p.gen, h, &eps, &epsd, p.t, p.since, &F, NULL, NULL) != 0) {
+        web->law_failed = 1;
+        return;
+    }
+    v3 fu = v3_scale(d, F * il);
+    nodes_add(web->f, web->sa[s], fu);
+    nodes_add(web->f, web->sb[s], v3_scale(fu, -1.0));
+}
+
+void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
+{
+    if (!web->nstate)
+        return;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_law *L = web->law[web->kind[s]];
+        if (!L->nstate)
+            continue;
+        v3 d;
+        double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+        ws_law_commit(L, web->hist + (size_t)s * web->nstate, &eps, &epsd, t, dt);
     }
 }
 
-double ws_web_integrate(ws_web *web, const v3 *xs, const v3 *vs, v3 *xd, v3 *vd, double h)
+/* Springs from node a + i to node a + i + stride, i in [0, m), all of one law, with rest
+ * lengths inv_l0[i]: the force on the first end (the second gets its opposite) into
+ * tx, ty, tz. Straight-line code on contiguous arrays, so the compiler runs it on vectors. A
+ * spring whose ends coincide has no direction to pull along and gets no force. */
+WS_VECTOR_LOOP
+static void spring_run(const double *restrict x, const double *restrict y,
+                       const double *restrict z, const double *restrict vx,
+                       const double *restrict vy, const double *restrict vz, size_t stride,
+                       size_t m, const double *restrict inv_l0, spring_form p,
+                       double *restrict tx, double *restrict ty, double *restrict tz)
 {
-    double most = 0.0;
-    for (uint32_t i = 0; i < web->n; i++) {
-        v3 v = v3_madd(vs[i], web->f[i], h * web->inv_m[i]);
-        if (web->inv_m[i] == 0.0)
-            v = v3_make(0, 0, 0);
-        vd[i] = v;
-        xd[i] = v3_madd(xs[i], v, h);
-        double s = v3_norm2(v);
-        if (!(s <= most)) /* also catches NaN, so the health check sees it */
-            most = s;
+    for (size_t i = 0; i < m; i++) {
+        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
+        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
+               uz = vz[i + stride] - vz[i];
+        double l2 = dx * dx + dy * dy + dz * dz;
+        double l = sqrt(l2);
+        /* Computed unconditionally and then selected, so the loop has no branches. */
+        double inv = 1.0 / l;
+        double il = l2 > 0.0 ? inv : 0.0;
+        double eps = l * inv_l0[i] - 1.0;
+        double epsd = (ux * dx + uy * dy + uz * dz) * il * inv_l0[i];
+        double a = eps + p.w;
+        a = a > 0.0 ? a : 0.0;
+        double quad = a * a * p.qw;
+        double ramp = eps >= p.w ? eps : quad;
+        double s = (p.kc * eps + p.dk * ramp + p.c * epsd) * il; /* tension / length */
+        tx[i] = dx * s;
+        ty[i] = dy * s;
+        tz[i] = dz * s;
     }
-    return sqrt(most);
+}
+
+/* f[a + i] += t[i] and f[a + i + stride] -= t[i]: split in two loops, each on vectors. */
+WS_VECTOR_LOOP
+static void spring_apply(double *restrict f, const double *restrict t, size_t stride, size_t m)
+{
+    for (size_t i = 0; i < m; i++)
+        f[i] += t[i];
+    for (size_t i = 0; i < m; i++)
+        f[i + stride] -= t[i];
+}
+
+/* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs). */
+static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, spring_form p)
+{
+    if (p.gen) {
+        spring_general(web, x, v, s, p);
+        return;
+    }
+    uint32_t a = web->sa[s], b = web->sb[s];
+    v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
+    double l2 = v3_dot(d, d);
+    if (!(l2 > 0.0))
+        return;
+    double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
+    double eps = l * il0 - 1.0;
+    double epsd = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), d) * il * il0;
+    double q = eps + p.w;
+    q = q > 0.0 ? q : 0.0;
+    double ramp = eps >= p.w ? eps : q * q * p.qw;
+    v3 fu = v3_scale(d, (p.kc * eps + p.dk * ramp + p.c * epsd) * il);
+    nodes_add(web->f, a, fu);
+    nodes_add(web->f, b, v3_scale(fu, -1.0));
+}
+
+/* Gravity and node drag on nodes [n0, n1): the start of their force. */
+WS_VECTOR_LOOP
+static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    const double c = web->damping;
+    const double *restrict m = web->m;
+    double *restrict fx = web->f.x, *restrict fy = web->f.y, *restrict fz = web->f.z;
+    /* The arrays into locals: loads through the struct would stay in the loop. */
+    const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
+    for (size_t i = n0; i < n1; i++) {
+        fx[i] = g.x * m[i] - c * vx[i];
+        fy[i] = g.y * m[i] - c * vy[i];
+        fz[i] = g.z * m[i] - c * vz[i];
+    }
+}
+
+/* Springs from node a + i to a + i + stride, i in [0, m), rest lengths il0[i], one law: their
+ * forces, in chunks small enough for the scratch to stay in the first-level cache. */
+static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t stride,
+                         size_t m, size_t s0, spring_form p)
+{
+    if (p.gen) {
+        for (size_t i = 0; i < m; i++)
+            spring_general(web, x, v, (uint32_t)(s0 + i), p);
+        return;
+    }
+    const double *il0 = web->inv_l0 + s0;
+    double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
+    for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
+        size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
+        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, stride, k, il0 + o, p,
+                   tx, ty, tz);
+        spring_apply(web->f.x + q, tx, stride, k);
+        spring_apply(web->f.y + q, ty, stride, k);
+        spring_apply(web->f.z + q, tz, stride, k);
+    }
+}
+
+/* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
+ * by row, cols a row: node nx r + i to the next, and the wrap of a closed band last). */
+static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const spring_form *P)
+{
+    const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
+    base_forces(web, v, g, nx * r, nx * (r + 1));
+    if (!web->law[WS_SPRING_AROUND] || nx < 2)
+        return;
+    spring_block(web, x, v, nx * r, 1, nx - 1, cols * r, P[WS_SPRING_AROUND]);
+    if (web->closed)
+        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), P[WS_SPRING_AROUND]);
+}
+
+uint32_t ws_web_block_count(const ws_web *web)
+{
+    return web->nx > 0 ? (uint32_t)web->ny : 1u;
+}
+
+void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, double since,
+                         uint32_t k, uint32_t *n0, uint32_t *n1)
+{
+    /* The laws' parameters by spring kind, hoisted out of the loops. */
+    spring_form P[3];
+    for (int q = 0; q < 3; q++)
+        P[q] = form_of(web->law[q], t, since);
+    if (web->nx == 0) {
+        base_forces(web, v, g, 0, web->n);
+        for (uint32_t s = 0; s < web->ns; s++)
+            spring_one(web, x, v, s, P[web->kind[s]]);
+        *n0 = 0;
+        *n1 = web->n;
+        return;
+    }
+    /* Row j is complete once the springs to row j + 1 are in: row j + 1 is started (base
+     * forces, its around-springs), then the up-springs and shear pairs between the two. */
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, j = k;
+    const size_t cols = web->closed ? nx : nx - 1;
+    if (j == 0)
+        grid_row(web, x, v, g, 0, P);
+    if (j + 1 < ny) {
+        grid_row(web, x, v, g, j + 1, P);
+        if (web->law[WS_SPRING_UP])
+            spring_block(web, x, v, nx * j, nx, nx, cols * ny + nx * j, P[WS_SPRING_UP]);
+        size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
+        if (shear0 < web->ns)
+            for (size_t s = shear0; s < shear0 + 2 * cols; s++)
+                spring_one(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR]);
+    }
+    *n0 = (uint32_t)(nx * j);
+    *n1 = (uint32_t)(nx * (j + 1));
+}
+
+/* One component of symplectic Euler for m nodes: v1 = (v0 + h f / m) (0 when pinned), x1 = x0
+ * + h v1. Distinct arrays (restrict), so the loop runs on vectors. */
+WS_VECTOR_LOOP
+static void advance(size_t m, double h, const double *restrict im, const double *restrict f,
+                    const double *restrict v0, const double *restrict x0, double *restrict v1,
+                    double *restrict x1)
+{
+    for (size_t i = 0; i < m; i++) {
+        /* Computed, then selected: no branch. */
+        double u = (v0[i] + h * im[i] * f[i]) * (double)(im[i] != 0.0);
+        v1[i] = u;
+        x1[i] = x0[i] + h * u;
+    }
+}
+
+/* The largest of the squared speeds of m nodes; NaN wins (!(s <= most) takes it). */
+WS_VECTOR_LOOP
+static double fastest(size_t m, const double *restrict vx, const double *restrict vy,
+                      const double *restrict vz, double *restrict sp)
+{
+    for (size_t i = 0; i < m; i++)
+        sp[i] = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
+    double most = 0.0;
+    for (size_t i = 0; i < m; i++)
+        most = sp[i] <= most ? most : sp[i];
+    return most;
+}
+
+double ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
+                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1)
+{
+    const double *im = web->inv_m;
+    const ws_nodes3 f = web->f;
+    double most = 0.0;
+    for (size_t o = n0; o < n1; o += WS_WEB_CHUNK) {
+        size_t m = n1 - o < WS_WEB_CHUNK ? n1 - o : WS_WEB_CHUNK;
+        advance(m, h, im + o, f.x + o, vs.x + o, xs.x + o, vd.x + o, xd.x + o);
+        advance(m, h, im + o, f.y + o, vs.y + o, xs.y + o, vd.y + o, xd.y + o);
+        advance(m, h, im + o, f.z + o, vs.z + o, xs.z + o, vd.z + o, xd.z + o);
+        double s = fastest(m, vd.x + o, vd.y + o, vd.z + o, web->tmp);
+        most = s <= most ? most : s;
+    }
+    return most;
 }
 
 /* Per free node, into the force scratch (not state; no step is running when this is asked):
@@ -113,17 +385,17 @@ double ws_web_integrate(ws_web *web, const v3 *xs, const v3 *vs, v3 *xd, v3 *vd,
  * stiffness matrix -- and f.y = 2 sum of their damping / l0. */
 static void node_bounds(const ws_web *web)
 {
-    v3 *acc = ((ws_web *)web)->f;
+    ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
-        acc[i] = v3_make(0, 0, 0);
+        acc.x[i] = acc.y[i] = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_law1d *L = web->law[web->kind[s]];
         double k = 2.0 * ws_law1d_max_stiffness(L) * web->inv_l0[s];
-        double c = 2.0 * L->c * web->inv_l0[s];
-        acc[web->sa[s]].x += k;
-        acc[web->sb[s]].x += k;
-        acc[web->sa[s]].y += c;
-        acc[web->sb[s]].y += c;
+        double c = 2.0 * ws_law_max_damping(L) * web->inv_l0[s];
+        acc.x[web->sa[s]] += k;
+        acc.x[web->sb[s]] += k;
+        acc.y[web->sa[s]] += c;
+        acc.y[web->sb[s]] += c;
     }
 }
 
@@ -136,7 +408,7 @@ double ws_web_stable_dt(const ws_web *web, double kc, double cc)
     for (uint32_t i = 0; i < web->n; i++) {
         if (web->inv_m[i] == 0.0)
             continue;
-        double k = web->f[i].x + kc, c = web->f[i].y + cc + web->damping;
+        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
         double om = sqrt(k * web->inv_m[i]);
         if (!(om > 0.0))
             continue;
@@ -156,33 +428,37 @@ void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double
         if (web->inv_m[i] == 0.0)
             continue;
         mm = fmin(mm, web->m[i]);
-        mk = fmax(mk, web->f[i].x + kc);
+        mk = fmax(mk, web->f.x[i] + kc);
     }
     *min_mass = mm;
     *max_k = mk;
 }
 
-double ws_web_spring_strain(const ws_web *web, const v3 *x, uint32_t s)
+double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)
 {
-    return v3_norm(v3_sub(x[web->sb[s]], x[web->sa[s]])) * web->inv_l0[s] - 1.0;
+    return v3_norm(v3_sub(nodes_get(x, web->sb[s]), nodes_get(x, web->sa[s]))) *
+               web->inv_l0[s] -
+           1.0;
 }
 
-double ws_web_spring_tension(const ws_web *web, const v3 *x, const v3 *v, uint32_t s)
+double ws_web_spring_tension(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s)
 {
-    uint32_t a = web->sa[s], b = web->sb[s];
-    v3 d = v3_sub(x[b], x[a]);
-    double l = v3_norm(d);
-    double eps = l * web->inv_l0[s] - 1.0, epsd = 0.0;
-    if (l > 0.0)
-        epsd = v3_dot(v3_sub(v[b], v[a]), v3_scale(d, 1.0 / l)) * web->inv_l0[s];
-    return ws_law1d_eval(web->law[web->kind[s]], eps, epsd, NULL, NULL);
+    v3 d;
+    double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+    const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
+    double F = 0.0;
+    if (ws_law_eval(web->law[web->kind[s]], h, &eps, &epsd, 0.0, 0.0, &F, NULL, NULL) != 0)
+        return NAN;
+    return F;
 }
 
-double ws_web_elastic_energy(const ws_web *web, const v3 *x)
+double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x)
 {
     double e = 0.0;
-    for (uint32_t s = 0; s < web->ns; s++)
-        e += ws_law1d_energy(web->law[web->kind[s]], ws_web_spring_strain(web, x, s)) /
-             web->inv_l0[s];
+    for (uint32_t s = 0; s < web->ns; s++) {
+        double eps = ws_web_spring_strain(web, x, s);
+        const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
+        e += ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
+    }
     return e;
 }

@@ -10,14 +10,14 @@
 #include "law/law.h"
 #include "math/wmath.h"
 
-/* A node-face candidate: node `node` of the web against face `face` of body `body`; wface
- * indexes the face prepared in the global frame, (lo, hi) the contact window of its plane
- * distance: hi = the two layers, lo = -(hi + the body's inner depth). */
+/* A node candidate: node `node` of the web against a feature of body `body`: a face, or
+ * (local has WS_NCAND_EDGE set) a convex edge. feat indexes the feature prepared in the global
+ * frame, local (without the flag) the feature in the body's shape. Candidates are sorted by
+ * node, so a sub-step can take them block by block with the nodes. */
 typedef struct ws_ncand {
-    uint32_t node, body, face, wface; /* for an edge candidate: edge and wedge */
-    uint32_t edge;                    /* 1: node against a convex edge of the body */
-    double lo, hi;
+    uint32_t node, body, feat, local;
 } ws_ncand;
+#define WS_NCAND_EDGE 0x80000000u
 
 /* A node contact of the current sub-step, between the normal and the friction passes. */
 typedef struct ws_nact {
@@ -26,18 +26,67 @@ typedef struct ws_nact {
     double fn, mu, vlim;
 } ws_nact;
 
+/* Node vectors as structure of arrays: the x, y and z components apart (one allocation of 3 n
+ * doubles), so loops over nodes and over grid springs run on whole vectors. */
+typedef struct ws_nodes3 {
+    double *x, *y, *z;
+} ws_nodes3;
+
+static inline v3 nodes_get(ws_nodes3 a, uint32_t i)
+{
+    return v3_make(a.x[i], a.y[i], a.z[i]);
+}
+
+static inline void nodes_set(ws_nodes3 a, uint32_t i, v3 p)
+{
+    a.x[i] = p.x;
+    a.y[i] = p.y;
+    a.z[i] = p.z;
+}
+
+static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
+{
+    a.x[i] += p.x;
+    a.y[i] += p.y;
+    a.z[i] += p.z;
+}
+
+#define WS_WEB_CHUNK 256 /* springs evaluated at once */
+
+/* A body as a full detection of a web's node candidates saw it, relative to the web's
+ * reference body (see ws_web): its CoG (rho) and orientation (q) in the reference body's
+ * frame; its lever: how far from its CoG a point of it can touch a node. Near the web, or far
+ * from it: then every node lies beyond its box (grown by the layers) along its own axis
+ * `axis` (0, 1, 2), whose interval is (lo, hi), and `gap` is the least distance beyond it that
+ * a node had when last found, less how far the body had moved by then (ws_node_moved). */
+typedef struct ws_track {
+    uint32_t body;
+    int near, axis;
+    v3 rho;
+    qt q;
+    double lo, hi, gap, lever;
+} ws_track;
+
 typedef struct ws_web {
     char *name;
     uint32_t n, ns;          /* nodes, springs */
     int nx, ny, closed;      /* grid: node i + nx j; 0 for a mesh web */
-    v3 *x[2], *v[2];         /* state, double-buffered like the bodies' */
-    v3 *f;                   /* force accumulator (scratch) */
+    ws_nodes3 x[2], v[2];    /* state, double-buffered like the bodies' */
+    ws_nodes3 f;             /* force accumulator (scratch) */
+    ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
+                                the state it reads */
+    double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     double *m, *inv_m;       /* inv_m = 0: pinned */
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
-    ws_law1d *law[3];        /* by kind; NULL when no spring of that kind */
+    ws_law *law[3];          /* by kind; NULL when no spring of that kind */
+    /* Laws with history (relaxation...): each spring's own, nstate doubles a spring, spring s
+     * at hist + s nstate; committed after an accepted step (ws_web_commit), read during it. */
+    double *hist;
+    uint32_t nstate;
+    int law_failed; /* a spring's law failed in this step (scratch) */
     double layer;
     uint32_t material;
     double damping;          /* node drag, kg/s */
@@ -52,31 +101,57 @@ typedef struct ws_web {
     /* Force and moment on each body in the last step (global, moment about the CoG). */
     v3 *bforce[2], *bmoment[2];
     size_t bcap;
-    /* Node candidates stay valid while nothing has moved half the contact margin since they
-     * were found: travel bounds that, refresh says they must be found again. */
-    double travel, next_travel;
+    /* Node candidates stay valid while no node has moved half the contact margin relative to
+     * any body near the web since they were found (contact/node.h, ws_node_moved). Moves are
+     * measured in the frame of a reference body, the heaviest dynamic body near the web (none:
+     * the global frame), so a stack that slides or turns with its film costs nothing. At a full
+     * detection: the web's box (lo, hi) and every body (track: near the web or how far from
+     * it, with its pose then); per node, where it was, in the reference frame, when its
+     * candidates were found (xdet). moved: the nodes to find again (scratch, n). refresh says
+     * every node must be found again before the next step. */
+    ws_nodes3 xdet;
+    v3 box_lo, box_hi;
+    uint32_t ref; /* the reference body's slot, UINT32_MAX for none */
+    ws_track *track; /* every body at the full detection, in slot order */
+    size_t ntrack, track_cap;
+    uint32_t *moved;
+    uint8_t *redo;
+    ws_ncand *fresh; /* candidates of the moved nodes (scratch) */
+    size_t nfresh, fresh_cap;
     int refresh;
 } ws_web;
 
 /* Allocate a web of n nodes and ns springs (zeroed). */
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns);
 void ws_web_free(ws_mem *mem, ws_web *web);
+/* Room for the springs' law histories, initialised as just stretched to the strains the nodes
+ * (x[0]) are placed at (after the laws are set). 0, or -1 when out of memory. */
+int ws_web_law_state(ws_mem *mem, ws_web *web);
+/* After an accepted step ending at t (state x, v), dt long: commit the springs' histories. */
+void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 
-/* Spring forces of the laws + node drag + gravity into f, from state (x, v). */
-void ws_web_internal_forces(ws_web *web, const v3 *x, const v3 *v, v3 gravity);
-/* Symplectic Euler for the nodes over h: v' = v + h f/m, x' = x + h v'. Returns the largest
- * speed. In place is allowed (xs == xd). */
-double ws_web_integrate(ws_web *web, const v3 *xs, const v3 *vs, v3 *xd, v3 *vd, double h);
+/* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays
+ * in cache: block k's forces from the springs, node drag and gravity are complete in f once
+ * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
+ * their contact forces and be integrated. A grid web's blocks are its rows; a mesh web is one
+ * block. */
+uint32_t ws_web_block_count(const ws_web *web);
+void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
+                         double since, uint32_t k, uint32_t *n0, uint32_t *n1);
+/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v'. Returns the
+ * largest speed squared (NaN when a speed is NaN). Source and destination are distinct. */
+double ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
+                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1);
 /* Largest stable step for the springs and node drag alone plus a contact of stiffness kc and
  * damping cc on every node (explicit limit with damping, Gershgorin bound on the stiffness). */
 double ws_web_stable_dt(const ws_web *web, double kc, double cc);
 /* Smallest node mass and largest 2 sum(k) + kc over the free nodes (for error messages). */
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k);
-/* Strain and tension of spring s in state (x, v). */
-double ws_web_spring_strain(const ws_web *web, const v3 *x, uint32_t s);
-double ws_web_spring_tension(const ws_web *web, const v3 *x, const v3 *v, uint32_t s);
+/* Strain and tension of spring s in state (x, v), with its committed history. */
+double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s);
+double ws_web_spring_tension(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s);
 /* Elastic energy of all springs in state x, J. */
-double ws_web_elastic_energy(const ws_web *web, const v3 *x);
+double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x);
 
 #endif
 

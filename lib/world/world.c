@@ -337,8 +337,9 @@ ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
         const ws_web *web = w->webs[k];
         if (w->web_slots.dense[k] == UINT32_MAX || !web)
             continue;
-        h = ws_hash_bytes(h, web->x[w->cur], web->n * sizeof *web->x[w->cur]);
-        h = ws_hash_bytes(h, web->v[w->cur], web->n * sizeof *web->v[w->cur]);
+        /* Each state is one block of 3 n doubles: x, y, z components. */
+        h = ws_hash_bytes(h, web->x[w->cur].x, 3 * (size_t)web->n * sizeof(double));
+        h = ws_hash_bytes(h, web->v[w->cur].x, 3 * (size_t)web->n * sizeof(double));
     }
     h = ws_world_hash_elements(w, h); /* their law histories */
     *hash = h;

@@ -153,36 +153,55 @@ static ws_status webs_ready(ws_world *w)
     return WS_OK;
 }
 
-/* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration.
- * Forces on the bodies go into their accumulators, averaged over the sub-steps. */
+/* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
+ * swept block by block (ws_web_forces_block). Forces on the bodies go into their accumulators,
+ * averaged over the sub-steps. */
 static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
 {
     ws_body_store *b = &w->bodies;
-    double body_speed = max_step_travel(w, cur) / w->def.dt; /* bound on any body point's speed */
     if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
     for (size_t k = 0; k < w->web_slots.slot_count; k++) {
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        /* Node candidates are found again when the cache is invalid or when nodes or bodies may
-         * have moved half the margin since: then the cache holds every node-face pair that can
-         * touch, and the result is the same as finding them every step (tests/test_detection.c
-         * shows it for body pairs). The world's detection schedule governs the body pairs. */
+        /* Node candidates: all found again when the cache is invalid or when the bodies near
+         * the web moved apart, turned or came near (ws_node_moved says -1); else those of the
+         * nodes that moved far enough relative to the near bodies, merged into the others.
+         * Either way the list holds every node-feature pair that can touch in this step, and
+         * the result is the same as finding them every step (tests/test_detection.c shows it
+         * for body pairs). The world's detection schedule governs the body pairs. */
         int list = web->list;
-        int again = web->refresh || !w->cand_valid || 2.0 * web->travel >= w->def.contact_margin;
-        web->next_travel = again ? 0.0 : web->travel;
-        if (again) {
+        long moved = 0;
+        int all = web->refresh || !w->cand_valid;
+        if (!all && (moved = ws_node_moved(b, cur, web, web->x[cur], web->v[cur], w->def.dt,
+                                           w->def.contact_margin)) < 0)
+            all = 1;
+        if (all || moved > 0) {
             double t0 = clock_now(w);
+            int old = list;
             list ^= 1;
-            if (ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
-                                   w->def.contact_margin,
-                                   &web->cand[list], &web->ncand[list], &web->capcand[list],
-                                   &w->stats.narrow_checks) != 0)
-                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                               web_label(web));
-            if (ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
-                                 web->ncand[list] + 1, sizeof *web->act) != 0)
+            /* The record of where nodes were found changes now: should the step fail, the
+             * next one finds every node again (refresh stays set until a step commits). */
+            web->refresh = 1;
+            int bad;
+            if (all) {
+                bad = ws_node_track(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin) ||
+                      ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
+                                         w->def.contact_margin, NULL, 0, &web->cand[list],
+                                         &web->ncand[list], &web->capcand[list],
+                                         &w->stats.narrow_checks);
+            } else {
+                bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
+                                         w->def.contact_margin, web->moved, (size_t)moved,
+                                         &web->fresh, &web->nfresh, &web->fresh_cap,
+                                         &w->stats.narrow_checks) ||
+                      ws_node_merge(&w->mem, web, web->cand[old], web->ncand[old], web->fresh,
+                                    web->nfresh, &web->cand[list], &web->ncand[list],
+                                    &web->capcand[list]);
+            }
+            if (bad || ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
+                                        web->ncand[list] + 1, sizeof *web->act) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
             w->stats.seconds_detection += clock_now(w) - t0;
@@ -191,20 +210,51 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
         web->next_list = list;
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
-        for (uint32_t i = 0; i < web->n; i++)
-            web->fc[nxt][i] = v3_make(0, 0, 0);
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
+        const ws_ncand *cand = web->cand[list];
+        const size_t ncand = web->ncand[list];
+        const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
-        double h = w->def.dt / n, share = 1.0 / n;
+        double h = w->def.dt / n, share = 1.0 / n, vmax2 = 0.0;
+        /* Sub-steps alternate between the next state and the web's scratch state so that
+         * none writes what it reads, and the last lands in the next state. */
+        ws_nodes3 xs = web->x[cur], vs = web->v[cur];
         for (int s = 0; s < n; s++) {
-            int src = s == 0 ? cur : nxt;
-            ws_web_internal_forces(web, web->x[src], web->v[src], w->def.gravity);
-            ws_node_contacts(b, cur, &w->node_geom, web, web->x[src], web->v[src], web->cand[list],
-                             web->ncand[list], w->node_par, h, share, web->fc[nxt],
-                             web->bforce[nxt], web->bmoment[nxt], &w->stats.narrow_checks);
-            double vmax = ws_web_integrate(web, web->x[src], web->v[src], web->x[nxt],
-                                           web->v[nxt], h);
+            int last_parity = (n - 1 - s) % 2 == 0;
+            ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
+            ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
+            size_t c0 = 0;
+            double step2 = 0.0;
+            for (uint32_t q = 0; q < blocks; q++) {
+                uint32_t n0, n1;
+                ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
+                                    &n1);
+                if (s == 0)
+                    for (uint32_t i = n0; i < n1; i++)
+                        web->fc[nxt][i] = v3_make(0, 0, 0);
+                size_t c1 = c0;
+                while (c1 < ncand && cand[c1].node < n1)
+                    c1++;
+                ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand ? cand + c0 : NULL,
+                                 c1 - c0,
+                                 w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
+                                 web->bmoment[nxt], &w->stats.narrow_checks);
+                c0 = c1;
+                double v2 = ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1);
+                step2 = v2 <= step2 ? step2 : v2;
+            }
+            xs = xd;
+            vs = vd;
+            if (web->law_failed) {
+                web->law_failed = 0;
+                return ws_fail(w, WS_ERR_CALLBACK,
+                               "step at t = %.6g s: a spring law of web '%s' failed (its user "
+                               "function returned non-zero or gave a non-finite force); the "
+                               "step was undone",
+                               w->time, web_label(web));
+            }
+            double vmax = sqrt(step2);
             if (!(vmax <= w->def.max_speed)) {
                 char what[160];
                 snprintf(what, sizeof what,
@@ -212,10 +262,11 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                          w->time, vmax, w->def.max_speed);
                 return web_unstable(w, web, h, ws_world_web_stable_dt(w, web), what);
             }
-            if (vmax > *vmax_all)
-                *vmax_all = vmax;
-            web->next_travel += (vmax + body_speed) * h;
+            vmax2 = step2 <= vmax2 ? vmax2 : step2;
         }
+        double vmax = sqrt(vmax2);
+        if (vmax > *vmax_all)
+            *vmax_all = vmax;
     }
     return WS_OK;
 }
@@ -361,7 +412,7 @@ ws_status ws_world_step(ws_world *w)
             continue;
         ws_web *web = w->webs[k];
         web->list = web->next_list;
-        web->travel = web->next_travel;
+        ws_web_commit(web, web->x[w->cur], web->v[w->cur], w->time, w->def.dt);
         web->refresh = 0;
     }
     w->steps++;

@@ -102,6 +102,12 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
             return s;
         c->law[2] = w->laws[slot];
     }
+    static const char *const which[3] = {"law", "law_cross", "law_shear"};
+    for (int k = 0; k < 3; k++)
+        if (c->law[k] && c->law[k]->dim != 1)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "web '%s': %s must be a 1D law (a spring has one strain), got a %dD law",
+                           c->label, which[k], c->law[k]->dim);
     return WS_OK;
 }
 
@@ -124,6 +130,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
 {
     for (int k = 0; k < 3; k++)
         web->law[k] = c->law[k];
+    if (ws_web_law_state(&w->mem, web) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     for (uint32_t s = 0; s < web->ns; s++) {
         if (web->kind[s] > WS_SPRING_SHEAR)
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': spring %u has an unknown kind",
@@ -148,7 +156,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
                            "least 2 x 2 nodes; give node_mass instead)",
                            c->label, i);
         web->inv_m[i] = 1.0 / web->m[i];
-        if (!ws_is_finite3(&web->x[0][i]))
+        v3 p = nodes_get(web->x[0], i);
+        if (!ws_is_finite3(&p))
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': node %u is not finite",
                            c->label, i);
     }
@@ -165,8 +174,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->list = 0;
     web->refresh = 1;
     /* Both buffers start equal, so the world's committed index (0 or 1) finds the web. */
-    for (uint32_t i = 0; i < web->n; i++)
-        web->x[1][i] = web->x[0][i];
+    memcpy(web->x[1].x, web->x[0].x, 3 * (size_t)web->n * sizeof(double));
     if (c->d.name && !(web->name = ws_mem_strdup(&w->mem, c->d.name)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     uint32_t slot;
@@ -335,7 +343,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
     if (ws_web_alloc(&w->mem, &web, (uint32_t)g.node_count, (uint32_t)g.spring_count) != WS_OK)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c.label);
     for (uint32_t i = 0; i < web.n; i++) {
-        web.x[0][i] = v3_load(g.positions + 3 * i);
+        nodes_set(web.x[0], i, v3_load(g.positions + 3 * i));
         if (g.node_masses)
             web.m[i] = g.node_masses[i];
     }
@@ -352,7 +360,8 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
         web.sb[k] = b;
         web.kind[k] = g.kinds ? g.kinds[k] : WS_SPRING_AROUND;
         double l0 = g.rest_lengths ? g.rest_lengths[k]
-                                   : v3_norm(v3_sub(web.x[0][b], web.x[0][a]));
+                                   : v3_norm(v3_sub(nodes_get(web.x[0], b),
+                                                    nodes_get(web.x[0], a)));
         web.inv_l0[k] = 1.0 / l0;
     }
     if (c.d.node_mass > 0.0 && g.node_masses)
@@ -513,9 +522,18 @@ static ws_status copy_v3(const ws_world *w, ws_web_id id, double *xyz, size_t ca
     ws_status s = bulk(w, id, xyz, cap, count, 0, fn, &web, &m);
     if (s != WS_OK)
         return s;
-    const v3 *src = which == 0 ? web->x[w->cur] : which == 1 ? web->v[w->cur] : web->fc[w->cur];
-    if (m)
-        memcpy(xyz, src, m * sizeof(v3));
+    if (which == 2) {
+        if (m)
+            memcpy(xyz, web->fc[w->cur], m * sizeof(v3));
+    } else {
+        /* Interleave the structure-of-arrays state into x, y, z triples. */
+        ws_nodes3 src = which == 0 ? web->x[w->cur] : web->v[w->cur];
+        for (size_t i = 0; i < m; i++) {
+            xyz[3 * i] = src.x[i];
+            xyz[3 * i + 1] = src.y[i];
+            xyz[3 * i + 2] = src.z[i];
+        }
+    }
     return bulk_done(w, xyz, cap, *count, fn);
 }
 
@@ -608,14 +626,15 @@ ws_status ws_web_get_containment(const ws_world *w, ws_web_id id, ws_containment
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_web_get_containment: needs a grid web and 1..%d bands, got %zu",
                        web->ny, count);
-    const v3 *x = web->x[w->cur], *v = web->v[w->cur], *fc = web->fc[w->cur];
+    const ws_nodes3 x = web->x[w->cur], v = web->v[w->cur];
+    const v3 *fc = web->fc[w->cur];
     int cols = web->closed ? web->nx : web->nx - 1;
     /* Row pitch from the mean heights of the first and last rows (not one column, which may
      * sag or lean). */
     double zfirst = 0.0, zlast = 0.0;
     for (int i = 0; i < web->nx; i++) {
-        zfirst += x[i].z;
-        zlast += x[(size_t)i + (size_t)web->nx * (size_t)(web->ny - 1)].z;
+        zfirst += x.z[i];
+        zlast += x.z[(size_t)i + (size_t)web->nx * (size_t)(web->ny - 1)];
     }
     double pitch = web->ny > 1 ? (zlast - zfirst) / web->nx / (web->ny - 1) : 0.0;
     for (size_t k = 0; k < count; k++) {
@@ -625,7 +644,7 @@ ws_status ws_web_get_containment(const ws_world *w, ws_web_id id, ws_containment
             double z = 0.0;
             for (int i = 0; i < web->nx; i++) {
                 uint32_t a = (uint32_t)(i + web->nx * j);
-                z += x[a].z;
+                z += x.z[a];
                 nsum += v3_norm(fc[a]); /* normal + friction; friction is small across a band */
             }
             z /= web->nx;
@@ -654,11 +673,11 @@ ws_status ws_web_get_energy(const ws_world *w, ws_web_id id, double *kinetic, do
     ws_status s = get_web(w, id, &web);
     if (s != WS_OK)
         return s;
-    const v3 *x = web->x[w->cur], *v = web->v[w->cur];
+    const ws_nodes3 x = web->x[w->cur], v = web->v[w->cur];
     double ke = 0.0, pe = 0.0;
     for (uint32_t i = 0; i < web->n; i++) {
-        ke += 0.5 * web->m[i] * v3_norm2(v[i]);
-        pe -= web->m[i] * v3_dot(w->def.gravity, x[i]);
+        ke += 0.5 * web->m[i] * v3_norm2(nodes_get(v, i));
+        pe -= web->m[i] * v3_dot(w->def.gravity, nodes_get(x, i));
     }
     if (kinetic)
         *kinetic = ke;
