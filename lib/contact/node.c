@@ -227,18 +227,30 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         size_t e = n - o < chunk ? n : o + chunk;
         const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
         const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
+        if (c > 0.0)
+            for (size_t i = o; i < e; i++) {
+                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
+                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
+                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
+                s[i - o] =
+                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
+            }
+        else /* one sub-step: the contacts see only where the nodes are now */
+            for (size_t i = o; i < e; i++) {
+                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                s[i - o] = ux * ux + uy * uy + uz * uz;
+            }
+        /* Squared when there is one sub-step (no square root needed). */
+        const double bound = c > 0.0 ? lim : lim * lim;
         for (size_t i = o; i < e; i++) {
-            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-            double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-            double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-            double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-            s[i - o] = sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-        }
-        for (size_t i = o; i < e; i++) {
-            redo[i] = !(s[i - o] < lim);
+            redo[i] = !(s[i - o] < bound);
             if (redo[i])
                 web->moved[count++] = (uint32_t)i;
         }
@@ -326,11 +338,14 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
              * the margin together, which changes d_f - D by less than the margin: faces further
              * behind than that cannot come into contact and are not candidates. On a box this
              * drops the side faces next to the one a node lies on. */
-            double D = -INFINITY;
+            double D = -INFINITY, dg[WS_NCAND_FACES];
+            int keep = sh->convex && sh->face_count <= WS_NCAND_FACES;
             if (sh->convex)
                 for (uint32_t f = 0; f < sh->face_count; f++) {
                     double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
                     D = d > D ? d : D;
+                    if (keep)
+                        dg[f] = d;
                 }
             for (uint32_t f = 0; f < sh->face_count; f++) {
                 const ws_face *fc = &sh->faces[f];
@@ -342,7 +357,20 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                     inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
                     if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
                         return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, g->face_base[k] + f, f};
+                    /* Well inside the outline: its projection on the plane lies a margin or
+                     * more behind every other face's plane (those planes bound the face on a
+                     * convex body, and a plane distance never exceeds the distance within the
+                     * face's plane). Nodes and bodies move less than half the margin relative
+                     * to each other until the candidates are found again. */
+                    uint32_t inside = 0;
+                    if (keep) {
+                        inside = WS_NCAND_INSIDE;
+                        for (uint32_t o = 0; o < sh->face_count && inside; o++)
+                            if (o != f &&
+                                !(dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin))
+                                inside = 0;
+                    }
+                    (*out)[(*n)++] = (ws_ncand){i, k, g->face_base[k] + f, f | inside};
                 }
             }
             /* Convex edges within reach of the node: the rounded rim of the contact layer. */
@@ -488,41 +516,68 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *
     return 1;
 }
 
+/* Whether face f is the shallowest of a convex body for a point at distance d under it: no
+ * other face's plane has the point farther out (the prepared faces, global). */
+static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f,
+                             v3 x, double d)
+{
+    for (uint32_t q = 0; q < count; q++)
+        if (q != f && v3_dot(g->face[base + q].n, x) - g->face[base + q].off > d)
+            return 0;
+    return 1;
+}
+
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
                       double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
 {
     const ws_body_state *st = &b->st[cur];
     ws_nact *act = web->act; /* room for n: reserved with the candidates */
-    size_t na = 0;
+    uint32_t *sel = web->sel;
     *checks += n;
-    /* Pass 1: normal forces. A node at a corner touches two faces; doing every normal force
-     * before any friction makes the result independent of the order of the faces (which
-     * differs from corner to corner and would twist a symmetric load). */
+    /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
+     * it now and then: which ones do is a coin toss from step to step. So the plane distance
+     * sorts them first without a branch (the ones within the window are listed), and the rest
+     * of the work runs on that shorter list. Edges go to the list as they are. */
+    const double wl = web->layer;
+    size_t m = 0;
     for (size_t k = 0; k < n; k++) {
         const ws_ncand *c = &cand[k];
+        const ws_wface *F = &g->face[c->local & WS_NCAND_EDGE ? 0 : c->feat];
+        uint32_t i = c->node;
+        double d = F->n.x * x.x[i] + F->n.y * x.y[i] + F->n.z * x.z[i] - F->off;
+        sel[m] = (uint32_t)k;
+        m += (size_t)((d < b->layer[c->body] + wl) | ((c->local & WS_NCAND_EDGE) != 0));
+    }
+    /* Normal forces, in node order. */
+    size_t na = 0;
+    for (size_t q = 0; q < m; q++) {
+        const ws_ncand *c = &cand[sel[q]];
         uint32_t i = c->node, bi = c->body;
-        v3 nrm;
+        v3 xi = nodes_get(x, i), nrm;
         double d;
-        v3 xi = nodes_get(x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
-        double hi = b->layer[bi] + web->layer;
+        double hi = b->layer[bi] + wl;
         if (c->local & WS_NCAND_EDGE) {
             if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
                 continue;
         } else {
-            /* Most candidates lie flat beside a face without pressing it: reject them on the
-             * plane distance alone before anything else is loaded. */
             const ws_wface *F = &g->face[c->feat];
             d = v3_dot(F->n, xi) - F->off;
-            if (!(d < hi))
-                continue;
             const ws_shape *sh = b->shape[bi];
             double lo = -hi - sh->inner;
-            if (!(d > lo) || !in_wface(g, F, xi, lo, hi, &d))
+            if (!(d > lo))
                 continue;
-            if (d < 0.0 && !ws_shallowest_face(sh, c->local,
-                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])), d))
+            /* A node found well inside the face's outline stays over the face while the
+             * candidates are valid: no need to find its triangle. */
+            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi, lo, hi, &d))
+                continue;
+            uint32_t f = c->local & ~WS_NCAND_FLAGS;
+            if (d < 0.0 &&
+                !(sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
+                             : ws_shallowest_face(sh, f,
+                                                  m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
+                                                  d)))
                 continue;
             nrm = F->n; /* from the body to the node */
         }
@@ -533,48 +588,59 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         v3 vrel = v3_sub(nodes_get(v, i), vb);
         double vn = v3_dot(vrel, nrm);
         double fn = p->k * (hi - d) - p->c * vn;
-        if (!(fn > 0.0))
-            continue; /* a contact never pulls */
-        nodes_add(web->f, i, v3_scale(nrm, fn));
-        act[na++] = (ws_nact){i, bi, nrm, xc, v3_madd(vrel, nrm, -vn), v3_make(0, 0, 0), fn,
-                              p->mu, p->vlim};
+        /* A contact never pulls: listed only when it pushes (no branch), and its force is
+         * added times that (0 or 1). */
+        double push = fn > 0.0;
+        nodes_add(web->f, i, v3_scale(nrm, fn * push));
+        act[na] = (ws_nact){i, bi, nrm, xc, v3_madd(vrel, nrm, -vn), v3_make(0, 0, 0), fn,
+                            p->mu, p->vlim};
+        na += (size_t)push;
     }
-    /* Pass 2: friction: eq. 13, limited to the force that stops the node's slip within this
-     * sub-step. Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an
-     * explicit step of a light node (it would reverse the slip and chatter), so the slip is
-     * predicted at the end of the sub-step with the other forces on the node (springs, gravity
-     * and every normal force, none of the frictions: again order-free), and the friction is the
-     * smaller of what stops that slip (m |v_pred| / h) and what eq. 13 gives for it, against it.
-     * Sticking nodes hold their tangential load; sliding ones get mu N; for heavy masses this is
-     * eq. 13 itself. */
-    for (size_t k = 0; k < na; k++) {
-        ws_nact *a = &act[k];
-        uint32_t i = a->node;
-        if (web->inv_m[i] == 0.0)
-            continue;
-        v3 fo = nodes_get(web->f, i);
-        fo = v3_madd(fo, a->n, -v3_dot(fo, a->n)); /* tangential part of the other forces */
-        v3 vp = v3_madd(a->vt, fo, h * web->inv_m[i]);
-        double vps = v3_norm(vp);
-        if (vps > 0.0) {
-            double sr = vps / a->vlim;
-            double law = a->mu * a->fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-            double stop = web->m[i] * vps / h;
-            a->ft = v3_scale(vp, -(law < stop ? law : stop) / vps);
+    /* Node by node, once every normal force of the node is in: its frictions, then all of them
+     * applied. A node at a corner touches two faces; doing every normal force before any
+     * friction makes the result independent of the order of the faces (which differs from
+     * corner to corner and would twist a symmetric load).
+     *
+     * Friction: eq. 13, limited to the force that stops the node's slip within this sub-step.
+     * Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit
+     * step of a light node (it would reverse the slip and chatter), so the slip is predicted at
+     * the end of the sub-step with the other forces on the node (springs, gravity and every
+     * normal force, none of the frictions: again order-free), and the friction is the smaller of
+     * what stops that slip (m |v_pred| / h) and what eq. 13 gives for it, against it. Sticking
+     * nodes hold their tangential load; sliding ones get mu N; for heavy masses this is eq. 13
+     * itself. */
+    size_t k = 0;
+    while (k < na) {
+        const uint32_t i = act[k].node;
+        size_t e = k + 1;
+        while (e < na && act[e].node == i)
+            e++;
+        if (web->inv_m[i] != 0.0) {
+            const v3 f0 = nodes_get(web->f, i);
+            for (size_t q = k; q < e; q++) {
+                ws_nact *a = &act[q];
+                v3 fo = v3_madd(f0, a->n, -v3_dot(f0, a->n)); /* tangential, other forces */
+                v3 vp = v3_madd(a->vt, fo, h * web->inv_m[i]);
+                double vps = v3_norm(vp);
+                double sr = vps / a->vlim;
+                double law = a->mu * a->fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+                double stop = web->m[i] * vps / h;
+                /* vps = 0: no slip, no friction (the division is not taken). */
+                a->ft = vps > 0.0 ? v3_scale(vp, -(law < stop ? law : stop) / vps) : a->ft;
+            }
         }
-    }
-    /* Pass 3: apply; the bodies get the opposite, averaged over the sub-steps. */
-    for (size_t k = 0; k < na; k++) {
-        const ws_nact *a = &act[k];
-        uint32_t i = a->node, bi = a->body;
-        nodes_add(web->f, i, a->ft);
-        v3 Fnode = v3_madd(a->ft, a->n, a->fn);
-        fc[i] = v3_madd(fc[i], Fnode, share);
-        v3 Fb = v3_scale(Fnode, -share);
-        b->f[bi] = v3_add(b->f[bi], Fb);
-        v3 mb = v3_cross(v3_sub(a->xc, st->r[bi]), Fb);
-        b->m[bi] = v3_add(b->m[bi], mb);
-        bforce[bi] = v3_add(bforce[bi], Fb);
-        bmoment[bi] = v3_add(bmoment[bi], mb);
+        /* Apply; the bodies get the opposite, averaged over the sub-steps (into the web's
+         * per-body totals, which the step adds to the bodies once). */
+        for (size_t q = k; q < e; q++) {
+            const ws_nact *a = &act[q];
+            uint32_t bi = a->body;
+            nodes_add(web->f, i, a->ft);
+            v3 Fnode = v3_madd(a->ft, a->n, a->fn);
+            fc[i] = v3_madd(fc[i], Fnode, share);
+            v3 Fb = v3_scale(Fnode, -share);
+            bforce[bi] = v3_add(bforce[bi], Fb);
+            bmoment[bi] = v3_add(bmoment[bi], v3_cross(v3_sub(a->xc, st->r[bi]), Fb));
+        }
+        k = e;
     }
 }

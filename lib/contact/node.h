@@ -69,9 +69,10 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
 int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
                   const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap);
 
-/* Evaluate the candidates at node state (x, v) for a sub-step h: forces into web->f, `share`
- * of them (1 / substeps) into the bodies' accumulators, the node contact forces fc and the
- * per-body totals. pp is indexed by body material. */
+/* Evaluate the candidates (sorted by node) at node state (x, v) for a sub-step h: forces into
+ * web->f, the node contact forces (`share` = 1 / substeps of them) into fc, and the opposite
+ * loads on the bodies (the same share) into the per-body totals bforce and bmoment (global,
+ * moment about the CoG), which the step adds to the bodies. pp is indexed by body material. */
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
                       double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks);

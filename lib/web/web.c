@@ -58,6 +58,8 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
         if (k == 0)
             ws_mem_free(mem, web->act, web->act_cap * sizeof(ws_nact));
+        if (k == 0)
+            ws_mem_free(mem, web->sel, web->sel_cap * sizeof(uint32_t));
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
@@ -350,34 +352,38 @@ static void advance(size_t m, double h, const double *restrict im, const double 
     }
 }
 
-/* The largest of the squared speeds of m nodes; NaN wins (!(s <= most) takes it). */
+/* How many of m nodes are faster than sqrt(lim2) or have a NaN speed (!(s <= lim2) counts
+ * it): a count, so the loop runs on vectors. */
 WS_VECTOR_LOOP
-static double fastest(size_t m, const double *restrict vx, const double *restrict vy,
-                      const double *restrict vz, double *restrict sp)
+static size_t too_fast(size_t m, const double *restrict vx, const double *restrict vy,
+                       const double *restrict vz, double lim2)
 {
+    size_t bad = 0;
     for (size_t i = 0; i < m; i++)
-        sp[i] = vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i];
-    double most = 0.0;
-    for (size_t i = 0; i < m; i++)
-        most = sp[i] <= most ? most : sp[i];
-    return most;
+        bad += !(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i] <= lim2);
+    return bad;
 }
 
-double ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
-                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1)
+size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
+                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
     const double *im = web->inv_m;
     const ws_nodes3 f = web->f;
+    size_t m = n1 - n0;
+    advance(m, h, im + n0, f.x + n0, vs.x + n0, xs.x + n0, vd.x + n0, xd.x + n0);
+    advance(m, h, im + n0, f.y + n0, vs.y + n0, xs.y + n0, vd.y + n0, xd.y + n0);
+    advance(m, h, im + n0, f.z + n0, vs.z + n0, xs.z + n0, vd.z + n0, xd.z + n0);
+    return too_fast(m, vd.x + n0, vd.y + n0, vd.z + n0, vmax * vmax);
+}
+
+double ws_web_fastest(const ws_web *web, ws_nodes3 v)
+{
     double most = 0.0;
-    for (size_t o = n0; o < n1; o += WS_WEB_CHUNK) {
-        size_t m = n1 - o < WS_WEB_CHUNK ? n1 - o : WS_WEB_CHUNK;
-        advance(m, h, im + o, f.x + o, vs.x + o, xs.x + o, vd.x + o, xd.x + o);
-        advance(m, h, im + o, f.y + o, vs.y + o, xs.y + o, vd.y + o, xd.y + o);
-        advance(m, h, im + o, f.z + o, vs.z + o, xs.z + o, vd.z + o, xd.z + o);
-        double s = fastest(m, vd.x + o, vd.y + o, vd.z + o, web->tmp);
-        most = s <= most ? most : s;
+    for (uint32_t i = 0; i < web->n; i++) {
+        double s = v.x[i] * v.x[i] + v.y[i] * v.y[i] + v.z[i] * v.z[i];
+        most = s <= most ? most : s; /* NaN wins */
     }
-    return most;
+    return sqrt(most);
 }
 
 /* Per free node, into the force scratch (not state; no step is running when this is asked):

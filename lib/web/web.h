@@ -12,12 +12,15 @@
 
 /* A node candidate: node `node` of the web against a feature of body `body`: a face, or
  * (local has WS_NCAND_EDGE set) a convex edge. feat indexes the feature prepared in the global
- * frame, local (without the flag) the feature in the body's shape. Candidates are sorted by
+ * frame, local (without the flags) the feature in the body's shape. Candidates are sorted by
  * node, so a sub-step can take them block by block with the nodes. */
 typedef struct ws_ncand {
     uint32_t node, body, feat, local;
 } ws_ncand;
-#define WS_NCAND_EDGE 0x80000000u
+#define WS_NCAND_EDGE 0x80000000u   /* local names an edge */
+#define WS_NCAND_INSIDE 0x40000000u /* the node was found well inside the face's outline */
+#define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE)
+#define WS_NCAND_FACES 64           /* the most faces of a body whose candidates get INSIDE */
 
 /* A node contact of the current sub-step, between the normal and the friction passes. */
 typedef struct ws_nact {
@@ -96,6 +99,8 @@ typedef struct ws_web {
     size_t ncand[2], capcand[2];
     ws_nact *act;  /* active contacts, scratch sized with the candidates */
     size_t act_cap;
+    uint32_t *sel; /* candidates within their window, scratch sized with them */
+    size_t sel_cap;
     int list;      /* the committed list */
     int next_list; /* the list this step used, committed with it */
     /* Force and moment on each body in the last step (global, moment about the CoG). */
@@ -138,10 +143,13 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
-/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v'. Returns the
- * largest speed squared (NaN when a speed is NaN). Source and destination are distinct. */
-double ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
-                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1);
+/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v'. Returns how many
+ * of them end faster than vmax (m/s) or with a NaN speed. Source and destination are
+ * distinct. */
+size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
+                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax);
+/* The largest node speed in v (NaN when one is NaN), m/s. */
+double ws_web_fastest(const ws_web *web, ws_nodes3 v);
 /* Largest stable step for the springs and node drag alone plus a contact of stiffness kc and
  * damping cc on every node (explicit limit with damping, Gershgorin bound on the stiffness). */
 double ws_web_stable_dt(const ws_web *web, double kc, double cc);

@@ -156,7 +156,7 @@ static ws_status webs_ready(ws_world *w)
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
  * swept block by block (ws_web_forces_block). Forces on the bodies go into their accumulators,
  * averaged over the sub-steps. */
-static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
+static ws_status step_webs(ws_world *w, int cur, int nxt)
 {
     ws_body_store *b = &w->bodies;
     if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
@@ -200,8 +200,11 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                                     web->nfresh, &web->cand[list], &web->ncand[list],
                                     &web->capcand[list]);
             }
-            if (bad || ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
-                                        web->ncand[list] + 1, sizeof *web->act) != 0)
+            if (bad ||
+                ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
+                                 web->ncand[list] + 1, sizeof *web->act) != 0 ||
+                ws_array_reserve(&w->mem, (void **)&web->sel, &web->sel_cap,
+                                 web->ncand[list] + 1, sizeof *web->sel) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
             w->stats.seconds_detection += clock_now(w) - t0;
@@ -216,7 +219,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
         const size_t ncand = web->ncand[list];
         const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
-        double h = w->def.dt / n, share = 1.0 / n, vmax2 = 0.0;
+        double h = w->def.dt / n, share = 1.0 / n;
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -224,8 +227,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            size_t c0 = 0;
-            double step2 = 0.0;
+            size_t c0 = 0, fast = 0;
             for (uint32_t q = 0; q < blocks; q++) {
                 uint32_t n0, n1;
                 ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
@@ -237,12 +239,10 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                 while (c1 < ncand && cand[c1].node < n1)
                     c1++;
                 ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand ? cand + c0 : NULL,
-                                 c1 - c0,
-                                 w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
+                                 c1 - c0, w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
                                  web->bmoment[nxt], &w->stats.narrow_checks);
                 c0 = c1;
-                double v2 = ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1);
-                step2 = v2 <= step2 ? step2 : v2;
+                fast += ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1, w->def.max_speed);
             }
             xs = xd;
             vs = vd;
@@ -254,19 +254,20 @@ static ws_status step_webs(ws_world *w, int cur, int nxt, double *vmax_all)
                                "step was undone",
                                w->time, web_label(web));
             }
-            double vmax = sqrt(step2);
-            if (!(vmax <= w->def.max_speed)) {
+            if (fast) {
+                double vmax = ws_web_fastest(web, vd);
                 char what[160];
                 snprintf(what, sizeof what,
                          "a node ran away at t = %.6g s (speed %.3g m/s above max_speed %.3g)",
                          w->time, vmax, w->def.max_speed);
                 return web_unstable(w, web, h, ws_world_web_stable_dt(w, web), what);
             }
-            vmax2 = step2 <= vmax2 ? vmax2 : step2;
         }
-        double vmax = sqrt(vmax2);
-        if (vmax > *vmax_all)
-            *vmax_all = vmax;
+        /* The film's pull on each body, its sub-steps averaged, into the body's accumulators. */
+        for (size_t i = 0; i < web->bcap && i < b->slots; i++) {
+            b->f[i] = v3_add(b->f[i], web->bforce[nxt][i]);
+            b->m[i] = v3_add(b->m[i], web->bmoment[nxt][i]);
+        }
     }
     return WS_OK;
 }
@@ -351,9 +352,8 @@ ws_status ws_world_step(ws_world *w)
 
     double t_web = clock_now(w);
     w->stats.seconds_contacts += t_web - t_eval;
-    double web_speed = 0.0;
     if (w->web_slots.slot_count) {
-        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, cur, nxt, &web_speed)) != WS_OK)
+        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, cur, nxt)) != WS_OK)
             return s;
         w->stats.seconds_web += clock_now(w) - t_web;
     }
