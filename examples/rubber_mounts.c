@@ -208,7 +208,7 @@ int main(int argc, char **argv)
         for (int m = 0; m < MOUNTS; m++) {
             /* On the box (body 2): the opposite of the force on the platform, and moment2. */
             ws_vec3 f = {0.0 - out[m].force.x, 0.0 - out[m].force.y, 0.0 - out[m].force.z};
-            if (k == settled)
+            if (k == settled || (k == steps && steps < settled)) /* at rest, or the end */
                 static_fz[m] = f.z;
             if (k > settled) {
                 peak_f[m] = fmax(peak_f[m], norm(f));
