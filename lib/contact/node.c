@@ -157,12 +157,6 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
     return 0;
 }
 
-/* The angle a rotation q turns by. */
-static double turn_of(qt q)
-{
-    double vec = sqrt(q.e1 * q.e1 + q.e2 * q.e2 + q.e3 * q.e3);
-    return 2.0 * atan2(vec, fabs(q.e0));
-}
 
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin)
@@ -195,7 +189,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         ws_track *t = &web->track[q];
         uint32_t k = t->body;
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
-        double turn = turn_of(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k])));
+        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
         if (t->near) {
             dev = d > dev ? d : dev;
@@ -273,7 +267,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
             least = g < least ? g : least;
         }
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
-        double turn = turn_of(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k])));
+        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
         if (least - d < t->gap)
             t->gap = least - d;

@@ -600,16 +600,6 @@ int ws_law_film_form(const ws_law *L, double *kc, double *dk, double *w, double 
     return 1;
 }
 
-double ws_law1d_energy(const ws_law1d *L, double eps)
-{
-    return ws_law_elastic_energy(L, NULL, &eps);
-}
-
-double ws_law1d_max_stiffness(const ws_law1d *L)
-{
-    return ws_law_max_stiffness(L);
-}
-
 /* ---- creation ---- */
 
 #define FAIL(...)                                                                                  \

@@ -24,9 +24,8 @@
 typedef struct ws_law ws_law;
 
 struct ws_law {
-    /* The 1D film form kept in the old fields, which the web reads directly: for a stateless 1D
-     * law of film form (film != 0), F = kc eps + (k - kc) g_w(eps) + c eps_dot. Other laws
-     * leave k = kc = c = 0, w = 1. */
+    /* The 1D film form (ws_law_film_form): for a stateless 1D law of that form (film != 0),
+     * F = kc eps + (k - kc) g_w(eps) + c eps_dot. Other laws leave k = kc = c = 0, w = 1. */
     ws_law_type type;
     double k, kc, c, w;
     uint32_t users; /* webs, elements and laws that use it */
@@ -64,9 +63,6 @@ struct ws_law {
 
     size_t bytes; /* of the block this law lives in (the struct and its arrays) */
 };
-
-/* Old name, kept while the web moves to ws_law. */
-typedef struct ws_law ws_law1d;
 
 /* Validate a Def and build a law in one block from mem. refs: the laws the Def names, resolved
  * by the caller (SUM: its terms in order; SCALED: the base), nrefs of them. On success they
@@ -117,28 +113,5 @@ static inline double ws_law_film_ramp(double eps, double w, double *slope)
     *slope = a / (2.0 * w);
     return a * a / (4.0 * w);
 }
-
-/* Compatibility with the web's 1D calls. F, dF/deps, dF/deps_dot at (eps, eps_dot) from the
- * initial state at t = 0. Inline: it sits in the web's spring loop. */
-static inline double ws_law1d_eval(const ws_law1d *L, double eps, double epsd, double *dF,
-                                   double *dFd)
-{
-    if (L->film) {
-        double gp, g = ws_law_film_ramp(eps, L->w, &gp);
-        if (dF)
-            *dF = L->kc + (L->k - L->kc) * gp;
-        if (dFd)
-            *dFd = L->c;
-        return L->kc * eps + (L->k - L->kc) * g + L->c * epsd;
-    }
-    double F = 0.0;
-    if (ws_law_eval(L, NULL, &eps, &epsd, 0.0, 0.0, &F, dF, dFd) != 0)
-        return NAN; /* the web's health check reports it */
-    return F;
-}
-/* Integral of the elastic force from 0 to eps (N, i.e. J per metre of rest length). */
-double ws_law1d_energy(const ws_law1d *L, double eps);
-/* Largest tangent stiffness dF/deps over all strains (N). */
-double ws_law1d_max_stiffness(const ws_law1d *L);
 
 #endif

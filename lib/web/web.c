@@ -93,6 +93,16 @@ typedef struct spring_form {
     double t, since;
 } spring_form;
 
+/* The film form's force at (eps, eps_dot): computed, then selected, so it runs on vectors. */
+static inline double film_force(const spring_form *p, double eps, double epsd)
+{
+    double a = eps + p->w;
+    a = a > 0.0 ? a : 0.0;
+    double quad = a * a * p->qw;
+    double ramp = eps >= p->w ? eps : quad;
+    return p->kc * eps + p->dk * ramp + p->c * epsd;
+}
+
 static spring_form form_of(const ws_law *L, double t, double since)
 {
     spring_form p = {0.0, 0.0, 1.0, 0.25, 0.0, NULL, t, since};
@@ -148,25 +158,6 @@ int ws_web_law_state(ws_mem *mem, ws_web *web)
     return 0;
 }
 
-/* A spring of a general law: its history as committed, evaluated at (t, since). A law that
- * fails (a user callback) marks the web; the step reports it. */
-static void spring_general(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, spring_form p)
-{
-    v3 d;
-    double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
-    if (il == 0.0)
-        return;
-    const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-    double F = 0.0;
-    if (ws_law_eval(p.gen, h, &eps, &epsd, p.t, p.since, &F, NULL, NULL) != 0) {
-        web->law_failed = 1;
-        return;
-    }
-    v3 fu = v3_scale(d, F * il);
-    nodes_add(web->f, web->sa[s], fu);
-    nodes_add(web->f, web->sb[s], v3_scale(fu, -1.0));
-}
-
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
 {
     if (!web->nstate)
@@ -203,11 +194,7 @@ static void spring_run(const double *restrict x, const double *restrict y,
         double il = l2 > 0.0 ? inv : 0.0;
         double eps = l * inv_l0[i] - 1.0;
         double epsd = (ux * dx + uy * dy + uz * dz) * il * inv_l0[i];
-        double a = eps + p.w;
-        a = a > 0.0 ? a : 0.0;
-        double quad = a * a * p.qw;
-        double ramp = eps >= p.w ? eps : quad;
-        double s = (p.kc * eps + p.dk * ramp + p.c * epsd) * il; /* tension / length */
+        double s = film_force(&p, eps, epsd) * il; /* tension / length */
         tx[i] = dx * s;
         ty[i] = dy * s;
         tz[i] = dz * s;
@@ -224,27 +211,26 @@ static void spring_apply(double *restrict f, const double *restrict t, size_t st
         f[i + stride] -= t[i];
 }
 
-/* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs). */
+/* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
+ * spring of a general law, which is evaluated with the spring's history as committed, at
+ * (t, since). A law that fails (a user callback) marks the web; the step reports it. */
 static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, spring_form p)
 {
-    if (p.gen) {
-        spring_general(web, x, v, s, p);
+    v3 d;
+    double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+    if (il == 0.0)
+        return; /* coincident ends: no direction to pull along */
+    double F = 0.0;
+    if (!p.gen) {
+        F = film_force(&p, eps, epsd);
+    } else if (ws_law_eval(p.gen, web->nstate ? web->hist + (size_t)s * web->nstate : NULL, &eps,
+                           &epsd, p.t, p.since, &F, NULL, NULL) != 0) {
+        web->law_failed = 1;
         return;
     }
-    uint32_t a = web->sa[s], b = web->sb[s];
-    v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
-    double l2 = v3_dot(d, d);
-    if (!(l2 > 0.0))
-        return;
-    double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
-    double eps = l * il0 - 1.0;
-    double epsd = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), d) * il * il0;
-    double q = eps + p.w;
-    q = q > 0.0 ? q : 0.0;
-    double ramp = eps >= p.w ? eps : q * q * p.qw;
-    v3 fu = v3_scale(d, (p.kc * eps + p.dk * ramp + p.c * epsd) * il);
-    nodes_add(web->f, a, fu);
-    nodes_add(web->f, b, v3_scale(fu, -1.0));
+    v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
+    nodes_add(web->f, web->sa[s], fu);
+    nodes_add(web->f, web->sb[s], v3_scale(fu, -1.0));
 }
 
 /* Gravity and node drag on nodes [n0, n1): the start of their force. */
@@ -270,7 +256,7 @@ static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t
 {
     if (p.gen) {
         for (size_t i = 0; i < m; i++)
-            spring_general(web, x, v, (uint32_t)(s0 + i), p);
+            spring_one(web, x, v, (uint32_t)(s0 + i), p);
         return;
     }
     const double *il0 = web->inv_l0 + s0;
@@ -395,8 +381,8 @@ static void node_bounds(const ws_web *web)
     for (uint32_t i = 0; i < web->n; i++)
         acc.x[i] = acc.y[i] = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_law1d *L = web->law[web->kind[s]];
-        double k = 2.0 * ws_law1d_max_stiffness(L) * web->inv_l0[s];
+        const ws_law *L = web->law[web->kind[s]];
+        double k = 2.0 * ws_law_max_stiffness(L) * web->inv_l0[s];
         double c = 2.0 * ws_law_max_damping(L) * web->inv_l0[s];
         acc.x[web->sa[s]] += k;
         acc.x[web->sb[s]] += k;

@@ -53,7 +53,7 @@ void ws_web_mesh_def_init(ws_web_mesh_def *def)
 typedef struct web_common {
     ws_web_def d;
     uint32_t material;
-    ws_law1d *law[3];
+    ws_law *law[3];
     const char *label;
 } web_common;
 
@@ -115,7 +115,7 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
 static void law_users(ws_web *web, int delta)
 {
     for (int k = 0; k < 3; k++) {
-        ws_law1d *L = web->law[k];
+        ws_law *L = web->law[k];
         int seen = 0;
         for (int j = 0; j < k; j++)
             seen |= web->law[j] == L;
