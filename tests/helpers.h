@@ -140,6 +140,15 @@ static inline void report(const char *fmt, ...)
 }
 
 /* Run the suite; CK_FORK=no is honoured (valgrind). Returns the process exit code. */
+/* A test case of its own, with its own timeout (s), in suite s. */
+static inline void add_case(Suite *s, const char *name, const TTest *t, double timeout)
+{
+    TCase *tc = tcase_create(name);
+    tcase_set_timeout(tc, timeout);
+    tcase_add_test(tc, t);
+    suite_add_tcase(s, tc);
+}
+
 static inline int run_suite(Suite *s)
 {
     SRunner *r = srunner_create(s);

@@ -1482,14 +1482,6 @@ START_TEST(test_attachment_and_stable_dt)
 }
 END_TEST
 
-static void add_case(Suite *s, const char *name, const TTest *t, double timeout)
-{
-    TCase *tc = tcase_create(name);
-    tcase_set_timeout(tc, timeout);
-    tcase_add_test(tc, t);
-    suite_add_tcase(s, tc);
-}
-
 int main(void)
 {
     Suite *s = suite_create("element");

@@ -1720,14 +1720,6 @@ START_TEST(test_spring_user_law_and_failure)
 }
 END_TEST
 
-static void add_case(Suite *s, const char *name, const TTest *t, double timeout)
-{
-    TCase *tc = tcase_create(name);
-    tcase_set_timeout(tc, timeout);
-    tcase_add_test(tc, t);
-    suite_add_tcase(s, tc);
-}
-
 int main(void)
 {
     Suite *s = suite_create("web");
