@@ -18,6 +18,15 @@ static void force_node_detection(ws_world *w)
             w->webs[k]->refresh = 1;
 }
 
+/* The one web of a world. */
+static ws_web *only_web(ws_world *w)
+{
+    for (size_t k = 0; k < w->web_slots.slot_count; k++)
+        if (w->web_slots.dense[k] != UINT32_MAX)
+            return w->webs[k];
+    return NULL;
+}
+
 #define WS_TEST_PI 3.14159265358979323846
 
 static ws_world *drop_world(int interval, int use_ccd, double height)
@@ -399,6 +408,61 @@ static void film_detection_case(int kind)
     ws_world_destroy(b);
 }
 
+/* Film nodes side by side on one face are evaluated on vectors (runs), the others one by one;
+ * the two must be the same arithmetic, operation by operation: the same motion to the bit with
+ * every node one by one. */
+static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep)
+{
+    ws_web_id wa, wb;
+    ws_body_id ba, bb;
+    ws_world *a = kind == 4 ? sag_world(&wa, &ba) : wrapped_world(kind, &wa, &ba);
+    ws_world *b = kind == 4 ? sag_world(&wb, &bb) : wrapped_world(kind, &wb, &bb);
+    ws_web *web_a = only_web(a), *web_b = only_web(b);
+    ck_assert(web_a && web_b);
+    web_a->runs_off = 1;
+    const int steps = 2400;
+    for (int k = 0; k < steps; k++) {
+        ck_ok(a, ws_world_step(a));
+        ck_ok(b, ws_world_step(b));
+    }
+    uint64_t ha, hb;
+    ck_ok(a, ws_world_get_state_hash(a, &ha));
+    ck_ok(b, ws_world_get_state_hash(b, &hb));
+    ws_web_info info;
+    ck_ok(a, ws_web_get_info(a, wa, &info));
+    size_t n;
+    double *xa = malloc(6 * info.node_count * sizeof *xa), *xb = xa + 3 * info.node_count;
+    ck_assert(xa);
+    ck_ok(a, ws_web_copy_positions(a, wa, xa, info.node_count, &n));
+    ck_ok(b, ws_web_copy_positions(b, wb, xb, info.node_count, &n));
+    double max_dev = 0.0;
+    for (size_t i = 0; i < 3 * n; i++)
+        max_dev = fmax(max_dev, fabs(xa[i] - xb[i]));
+    report("film runs (scene %d): %llu node evaluations in runs (%llu in runs gone one by one), "
+           "nodes differ by %.1e m, state hashes %016llx %016llx",
+           kind, (unsigned long long)web_b->run_nodes, (unsigned long long)web_b->run_deep,
+           max_dev, (unsigned long long)ha, (unsigned long long)hb);
+    ck_assert_msg(web_a->run_nodes == 0, "runs were cut with runs off");
+    ck_assert_msg(ha == hb && max_dev == 0.0, "runs differ from one by one: %.3e m", max_dev);
+    *run_nodes += web_b->run_nodes;
+    *run_deep += web_b->run_deep;
+    free(xa);
+    ws_world_destroy(a);
+    ws_world_destroy(b);
+}
+
+START_TEST(film_runs_equal_one_by_one)
+{
+    uint64_t nodes = 0, deep = 0;
+    for (int kind = 0; kind <= 4; kind++)
+        film_runs_case(kind, &nodes, &deep);
+    /* The scenes exercise both: most node evaluations in runs, and runs with a node below the
+     * face, which go one by one. */
+    ck_assert_msg(nodes > 1000000, "few nodes in runs: %llu", (unsigned long long)nodes);
+    ck_assert_msg(deep > 0, "no run had a node below its face");
+}
+END_TEST
+
 START_TEST(film_detection_does_not_change_the_motion)
 {
     film_detection_case(0);
@@ -418,6 +482,7 @@ int main(void)
     tcase_add_test(tc, ccd_gate_does_not_change_the_motion);
     tcase_add_test(tc, impact_stays_within_the_layers);
     tcase_add_test(tc, film_detection_does_not_change_the_motion);
+    tcase_add_test(tc, film_runs_equal_one_by_one);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

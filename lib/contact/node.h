@@ -69,12 +69,19 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
 int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
                   const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap);
 
-/* Evaluate the candidates (sorted by node) at node state (x, v) for a sub-step h: forces into
- * web->f, the node contact forces (`share` = 1 / substeps of them) into fc, and the opposite
- * loads on the bodies (the same share) into the per-body totals bforce and bmoment (global,
- * moment about the CoG), which the step adds to the bodies. pp is indexed by body material. */
+/* Cut the candidates (sorted by node) of list `list` of a web into its stretches (web->seg,
+ * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
+int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list);
+
+/* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),
+ * moving *next past them, at node state (x, v), for a sub-step h: forces into web->f, the node
+ * contact forces (`share` = 1 / substeps of them) into fc, and the opposite loads on the bodies
+ * (the same share) into the per-body totals bforce and bmoment (global, moment about the CoG),
+ * which the step adds to the bodies. cand is the list the stretches were cut from; pp is
+ * indexed by body material. The result does not depend on how the candidates are cut. */
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
-                      double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks);
+                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
+                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
+                      v3 *bmoment, uint64_t *checks);
 
 #endif

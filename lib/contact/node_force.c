@@ -61,14 +61,15 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, size_t n, const ws_node_params *pp,
-                      double h, double share, v3 *fc, v3 *bforce, v3 *bmoment, uint64_t *checks)
+/* Candidates one by one, in node order: any feature, any body. */
+static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
+                             ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, size_t n,
+                             const ws_node_params *pp, double h, double share, v3 *fc,
+                             v3 *bforce, v3 *bmoment)
 {
     const ws_body_state *st = &b->st[cur];
     ws_nact *act = web->act; /* room for n: reserved with the candidates */
     uint32_t *sel = web->sel;
-    *checks += n;
     /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
      * it now and then: which ones do is a coin toss from step to step. So the plane distance
      * sorts them first without a branch (the ones within the window are listed), and the rest
@@ -177,4 +178,209 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         }
         k = e;
     }
+}
+
+/* ---- runs: nodes side by side on one face */
+
+#define RUN_MIN 4     /* shorter stretches go one by one */
+#define RUN_CHUNK 128 /* nodes of a run whose depths are taken at once */
+
+/* A run's face as its depth pass needs it. */
+typedef struct run_face {
+    double nx, ny, nz, off; /* the face's plane, global: d = n . x - off */
+    double hi, lo;          /* the contact window of d */
+} run_face;
+
+/* Depth d of nodes [0, m) under the face's plane and whether it lies in the window (straight-
+ * line code, on vectors). */
+WS_VECTOR_LOOP
+static void run_depth(size_t m, run_face q, const double *restrict x, const double *restrict y,
+                      const double *restrict z, double *restrict d, int64_t *restrict in)
+{
+    for (size_t i = 0; i < m; i++) {
+        double e = q.nx * x[i] + q.ny * y[i] + q.nz * z[i] - q.off;
+        d[i] = e;
+        in[i] = (e < q.hi) & (e > q.lo);
+    }
+}
+
+/* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
+ * The others, in node order, with the arithmetic of contacts_general operation by operation for
+ * a node whose only candidate is a face it lies well inside of, without its look-ups: the face,
+ * body and contact are the run's. A node below the face's plane (d < 0) goes to
+ * contacts_general, which asks whether another face lies shallower. */
+static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
+                         ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
+                         const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
+                         v3 *bmoment)
+{
+    const ws_body_state *st = &b->st[cur];
+    const ws_ncand *c = &cand[sg->c0];
+    const uint32_t bi = c->body;
+    const ws_wface *F = &g->face[c->feat];
+    const ws_node_params *p = &pp[b->material[bi]];
+    const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
+    const v3 n = F->n, r = st->r[bi], vb0 = st->v[bi], wb = b->wg[bi];
+    const double k = p->k, cc = p->c, mu = p->mu, vlim = p->vlim;
+    const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
+    double *D = web->rtmp;
+    int64_t *in = (int64_t *)(web->rtmp + RUN_CHUNK);
+    uint32_t *idx = (uint32_t *)(web->rtmp + 2 * RUN_CHUNK);
+    double *fx = web->f.x, *fy = web->f.y, *fz = web->f.z;
+    v3 bf = bforce[bi], bm = bmoment[bi];
+    for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
+        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
+        run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
+        for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
+            idx[nin] = (uint32_t)e;
+            nin += (size_t)in[e];
+        }
+        web->run_nodes += m;
+        for (size_t t = 0; t < nin; t++) {
+            const uint32_t i = o + idx[t];
+            const double d = D[idx[t]];
+            if (d < 0.0) {
+                web->run_deep++;
+                bforce[bi] = bf;
+                bmoment[bi] = bm;
+                contacts_general(b, cur, g, web, x, v, c + (i - sg->n0), 1, pp, h, share, fc,
+                                 bforce, bmoment);
+                bf = bforce[bi];
+                bm = bmoment[bi];
+                continue;
+            }
+            v3 xi = nodes_get(x, i);
+            v3 xc = v3_madd(xi, n, -0.5 * d);
+            v3 lever = v3_sub(xc, r);
+            v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb0, v3_cross(wb, lever)));
+            double vn = v3_dot(vrel, n);
+            double fn = k * (hi - d) - cc * vn;
+            double push = fn > 0.0;
+            double f1x = fx[i] + n.x * (fn * push), f1y = fy[i] + n.y * (fn * push),
+                   f1z = fz[i] + n.z * (fn * push);
+            if (!(fn > 0.0)) {
+                fx[i] = f1x;
+                fy[i] = f1y;
+                fz[i] = f1z;
+                continue;
+            }
+            v3 ft = v3_make(0, 0, 0);
+            if (web->inv_m[i] != 0.0) {
+                v3 f0 = v3_make(f1x, f1y, f1z);
+                v3 fo = v3_madd(f0, n, -v3_dot(f0, n));
+                v3 vp = v3_madd(v3_madd(vrel, n, -vn), fo, h * web->inv_m[i]);
+                double vps = v3_norm(vp);
+                double sr = vps / vlim;
+                double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+                double stop = web->m[i] * vps / h;
+                ft = vps > 0.0 ? v3_scale(vp, -(law < stop ? law : stop) / vps) : ft;
+            }
+            fx[i] = f1x + ft.x;
+            fy[i] = f1y + ft.y;
+            fz[i] = f1z + ft.z;
+            v3 Fnode = v3_madd(ft, n, fn);
+            fc[i] = v3_madd(fc[i], Fnode, share);
+            v3 Fb = v3_scale(Fnode, -share);
+            bf = v3_add(bf, Fb);
+            bm = v3_add(bm, v3_cross(lever, Fb));
+        }
+    }
+    bforce[bi] = bf;
+    bmoment[bi] = bm;
+}
+
+/* The stretches being cut: a pending run of single inside candidates [r0, r1) and, before it,
+ * pending candidates to go one by one [g0, r0). */
+typedef struct seg_cut {
+    ws_web *web;
+    ws_mem *mem;
+    const ws_ncand *cand;
+    size_t g0, r0, r1;
+} seg_cut;
+
+static int seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
+{
+    ws_web *web = sc->web;
+    if (c0 == c1)
+        return 0;
+    if (ws_array_reserve(sc->mem, (void **)&web->seg, &web->seg_cap, web->nseg + 1,
+                         sizeof *web->seg) != 0)
+        return -1;
+    web->seg[web->nseg++] =
+        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
+    return 0;
+}
+
+/* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
+ * candidates join those. */
+static int seg_close_run(seg_cut *sc)
+{
+    if (sc->r1 - sc->r0 >= RUN_MIN) {
+        if (seg_emit(sc, sc->g0, sc->r0, 0) || seg_emit(sc, sc->r0, sc->r1, 1))
+            return -1;
+        sc->g0 = sc->r1;
+    }
+    sc->r0 = sc->r1;
+    return 0;
+}
+
+int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list)
+{
+    const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
+    web->seg_list = -1;
+    web->nseg = 0;
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, 3 * RUN_CHUNK,
+                         sizeof(double)) != 0)
+        return -1;
+    seg_cut sc = {web, mem, cand, 0, 0, 0};
+    uint32_t end = 0; /* the end of the sweep block of the current node */
+    size_t k = 0;
+    while (k < n) {
+        const uint32_t node = cand[k].node;
+        size_t e = k + 1;
+        while (e < n && cand[e].node == node)
+            e++;
+        if (node >= end) { /* a new block: nothing pending crosses into it */
+            if (seg_close_run(&sc) || seg_emit(&sc, sc.g0, k, 0))
+                return -1;
+            sc.g0 = sc.r0 = sc.r1 = k;
+            end = (node / bl + 1) * bl;
+        }
+        int single = !web->runs_off && e == k + 1 &&
+                     (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
+        if (single && sc.r1 > sc.r0 && sc.r1 == k && cand[k].feat == cand[sc.r0].feat &&
+            node == cand[k - 1].node + 1) {
+            sc.r1 = e; /* the run goes on */
+        } else {
+            if (seg_close_run(&sc))
+                return -1;
+            sc.r0 = k; /* a new run starts here, or an empty one */
+            sc.r1 = single ? e : k;
+            if (!single)
+                sc.r0 = sc.r1 = e; /* one by one: pending from g0 */
+        }
+        k = e;
+    }
+    if (seg_close_run(&sc) || seg_emit(&sc, sc.g0, n, 0))
+        return -1;
+    web->seg_list = list;
+    return 0;
+}
+
+void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
+                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
+                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
+                      v3 *bmoment, uint64_t *checks)
+{
+    size_t k = *next;
+    for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
+        const ws_nseg *sg = &web->seg[k];
+        *checks += sg->c1 - sg->c0;
+        if (sg->run)
+            contacts_run(b, cur, g, web, x, v, cand, sg, pp, h, share, fc, bforce, bmoment);
+        else
+            contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, h, share,
+                             fc, bforce, bmoment);
+    }
+    *next = k;
 }

@@ -22,6 +22,7 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     memset(web, 0, sizeof *web);
     web->n = n;
     web->ns = ns;
+    web->seg_list = -1;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         ok &= nodes_alloc(mem, &web->x[k], n);
@@ -71,6 +72,8 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->redo, (n ? n : 1) * sizeof(uint8_t));
     ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
     ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
+    ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
+    ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
     ws_mem_free(mem, web->tmp, 3 * WS_WEB_CHUNK * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));

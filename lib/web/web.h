@@ -22,6 +22,16 @@ typedef struct ws_ncand {
 #define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE)
 #define WS_NCAND_FACES 64           /* the most faces of a body whose candidates get INSIDE */
 
+/* The candidates of a web cut into stretches of nodes, in node order, within one sweep block
+ * (ws_web_block_count). A run: nodes [n0, n1), each with exactly one candidate, all of the
+ * same face and found well inside it (WS_NCAND_INSIDE); node n0 + k has candidate c0 + k. Runs
+ * are evaluated on vectors (contact/node_force.c). Otherwise: candidates [c0, c1), of nodes in
+ * [n0, n1), evaluated one by one. */
+typedef struct ws_nseg {
+    uint32_t n0, n1, c0, c1;
+    int run;
+} ws_nseg;
+
 /* A node contact of the current sub-step, between the normal and the friction passes. */
 typedef struct ws_nact {
     uint32_t node, body;
@@ -101,6 +111,14 @@ typedef struct ws_web {
     size_t act_cap;
     uint32_t *sel; /* candidates within their window, scratch sized with them */
     size_t sel_cap;
+    ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
+    size_t nseg, seg_cap;
+    int seg_list;
+    int runs_off;  /* cut no runs: every candidate one by one (tests compare the two) */
+    uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
+                                     by one because a node lay below the face (diagnostics) */
+    double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
+    size_t rtmp_cap;
     int list;      /* the committed list */
     int next_list; /* the list this step used, committed with it */
     /* Force and moment on each body in the last step (global, moment about the CoG). */

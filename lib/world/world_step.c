@@ -184,6 +184,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             /* The record of where nodes were found changes now: should the step fail, the
              * next one finds every node again (refresh stays set until a step commits). */
             web->refresh = 1;
+            web->seg_list = -1;
             int bad;
             if (all) {
                 bad = ws_node_track(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin) ||
@@ -211,12 +212,16 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
         web->next_list = list;
+        /* The list cut into stretches for the evaluation: again whenever it changed. */
+        if (web->seg_list != list &&
+            ws_node_segments(&w->mem, web, web->cand[list], web->ncand[list], list) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
         const ws_ncand *cand = web->cand[list];
-        const size_t ncand = web->ncand[list];
         const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
@@ -227,7 +232,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            size_t c0 = 0, fast = 0;
+            size_t next = 0, fast = 0;
             for (uint32_t q = 0; q < blocks; q++) {
                 uint32_t n0, n1;
                 ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
@@ -235,13 +240,9 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                 if (s == 0)
                     for (uint32_t i = n0; i < n1; i++)
                         web->fc[nxt][i] = v3_make(0, 0, 0);
-                size_t c1 = c0;
-                while (c1 < ncand && cand[c1].node < n1)
-                    c1++;
-                ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand ? cand + c0 : NULL,
-                                 c1 - c0, w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
+                ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand, n1, &next,
+                                 w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
                                  web->bmoment[nxt], &w->stats.narrow_checks);
-                c0 = c1;
                 fast += ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1, w->def.max_speed);
             }
             xs = xd;
