@@ -184,7 +184,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             /* The record of where nodes were found changes now: should the step fail, the
              * next one finds every node again (refresh stays set until a step commits). */
             web->refresh = 1;
-            web->seg_list = -1;
+            if (web->seg_list == list) /* cut from what is overwritten now */
+                web->seg_list = -1;
             int bad;
             if (all) {
                 bad = ws_node_track(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin) ||
@@ -212,7 +213,14 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
         web->next_list = list;
-        /* The list cut into stretches for the evaluation: again whenever it changed. */
+        /* The list cut into stretches for the evaluation: again whenever it changed (a list
+         * found again equal to the one cut keeps its stretches). */
+        if (web->seg_list >= 0 && web->seg_list != list &&
+            web->ncand[list] == web->ncand[web->seg_list] &&
+            (web->ncand[list] == 0 ||
+             memcmp(web->cand[list], web->cand[web->seg_list],
+                    web->ncand[list] * sizeof *web->cand[list]) == 0))
+            web->seg_list = list;
         if (web->seg_list != list &&
             ws_node_segments(&w->mem, web, web->cand[list], web->ncand[list], list) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
