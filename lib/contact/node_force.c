@@ -183,7 +183,10 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
 /* ---- runs: nodes side by side on one face */
 
 #define RUN_MIN 4     /* shorter stretches go one by one */
-#define RUN_CHUNK 128 /* nodes of a run whose depths are taken at once */
+#define RUN_CHUNK 128 /* nodes of a run evaluated at once */
+#define RUN_PS 136     /* from one array of pushing nodes to the next (not a divisor of 4096
+                          bytes, whose multiples apart a load may wait on a store) */
+#define RUN_SCRATCH 20 /* doubles of scratch a node (contacts_run) */
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -204,11 +207,51 @@ static void run_depth(size_t m, run_face q, const double *restrict x, const doub
     }
 }
 
+/* A run's pushing nodes, side by side (scratch of contacts_run): node index, normal force,
+ * lever from the CoG, tangential velocity relative to the body, force with the normal force
+ * in, 1 / mass and mass; and the friction found. RUN_PUSH arrays of RUN_CHUNK, RUN_PS apart. */
+enum { P_FN, P_LX, P_LY, P_LZ, P_TX, P_TY, P_TZ, P_KX, P_KY, P_KZ, P_IM, P_M, P_AX, P_AY, P_AZ,
+       RUN_PUSH };
+
+/* Frictions of m pushing nodes on a face of normal n (the scratch's arrays): eq. 13 for the
+ * slip each would have at the end of the sub-step under every force but friction, limited to
+ * what stops it; none for a pinned node or one that does not slip. The arithmetic of
+ * contacts_general, on vectors. */
+WS_VECTOR_LOOP
+static void run_friction(size_t m, double nx, double ny, double nz, double h, double mu,
+                         double vlim, double *restrict P)
+{
+    const double *restrict fn = P + P_FN * RUN_PS, *restrict tx = P + P_TX * RUN_PS,
+                           *restrict ty = P + P_TY * RUN_PS, *restrict tz = P + P_TZ * RUN_PS,
+                           *restrict kx = P + P_KX * RUN_PS, *restrict ky = P + P_KY * RUN_PS,
+                           *restrict kz = P + P_KZ * RUN_PS, *restrict im = P + P_IM * RUN_PS,
+                           *restrict mass = P + P_M * RUN_PS;
+    double *restrict ax = P + P_AX * RUN_PS, *restrict ay = P + P_AY * RUN_PS,
+                     *restrict az = P + P_AZ * RUN_PS;
+    for (size_t t = 0; t < m; t++) {
+        double dot = kx[t] * nx + ky[t] * ny + kz[t] * nz;
+        double ox = kx[t] + nx * (-dot), oy = ky[t] + ny * (-dot), oz = kz[t] + nz * (-dot);
+        double hm = h * im[t];
+        double px = tx[t] + ox * hm, py = ty[t] + oy * hm, pz = tz[t] + oz * hm;
+        double vps = sqrt(px * px + py * py + pz * pz);
+        double sr = vps / vlim;
+        double law = mu * fn[t] * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+        double stop = mass[t] * vps / h;
+        double s = -(law < stop ? law : stop) / vps;
+        int slips = (vps > 0.0) & (im[t] != 0.0);
+        ax[t] = slips ? px * s : 0.0;
+        ay[t] = slips ? py * s : 0.0;
+        az[t] = slips ? pz * s : 0.0;
+    }
+}
+
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
- * The others, in node order, with the arithmetic of contacts_general operation by operation for
- * a node whose only candidate is a face it lies well inside of, without its look-ups: the face,
- * body and contact are the run's. A node below the face's plane (d < 0) goes to
- * contacts_general, which asks whether another face lies shallower. */
+ * The others with the arithmetic of contacts_general operation by operation for a node whose
+ * only candidate is a face it lies well inside of, without its look-ups: the face, body and
+ * contact are the run's. In three passes: the normal forces of the nodes in the window (those
+ * that push are listed), their frictions on vectors, then their forces applied to the nodes and
+ * the body, in node order. A chunk with a node below the face's plane (d < 0), where another
+ * face may lie shallower, goes to contacts_general. */
 static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
                          ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
                          const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
@@ -221,36 +264,40 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
     const ws_node_params *p = &pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb0 = st->v[bi], wb = b->wg[bi];
-    const double k = p->k, cc = p->c, mu = p->mu, vlim = p->vlim;
+    const double k = p->k, cc = p->c;
     const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
-    double *D = web->rtmp;
-    int64_t *in = (int64_t *)(web->rtmp + RUN_CHUNK);
-    uint32_t *idx = (uint32_t *)(web->rtmp + 2 * RUN_CHUNK);
+    /* Scratch (RUN_SCRATCH doubles a node): depth, in-window flag, indices, pushing nodes. */
+    double *D = web->rtmp, *P = D + 3 * RUN_CHUNK;
+    int64_t *in = (int64_t *)(D + RUN_CHUNK);
+    uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK), *pi = idx + RUN_CHUNK;
     double *fx = web->f.x, *fy = web->f.y, *fz = web->f.z;
     v3 bf = bforce[bi], bm = bmoment[bi];
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
-        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
+        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0, np = 0;
         run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
         for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
             idx[nin] = (uint32_t)e;
             nin += (size_t)in[e];
         }
         web->run_nodes += m;
+        int deep = 0;
+        for (size_t t = 0; t < nin; t++)
+            deep |= D[idx[t]] < 0.0;
+        if (deep) { /* one by one, in node order */
+            web->run_deep += m;
+            bforce[bi] = bf;
+            bmoment[bi] = bm;
+            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, h, share, fc,
+                             bforce, bmoment);
+            bf = bforce[bi];
+            bm = bmoment[bi];
+            continue;
+        }
+        /* Normal forces; the pushing nodes are listed (without a branch). */
         for (size_t t = 0; t < nin; t++) {
-            const uint32_t i = o + idx[t];
-            const double d = D[idx[t]];
-            if (d < 0.0) {
-                web->run_deep++;
-                bforce[bi] = bf;
-                bmoment[bi] = bm;
-                contacts_general(b, cur, g, web, x, v, c + (i - sg->n0), 1, pp, h, share, fc,
-                                 bforce, bmoment);
-                bf = bforce[bi];
-                bm = bmoment[bi];
-                continue;
-            }
-            v3 xi = nodes_get(x, i);
-            v3 xc = v3_madd(xi, n, -0.5 * d);
+            const uint32_t e = idx[t], i = o + e;
+            const double d = D[e];
+            v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
             v3 lever = v3_sub(xc, r);
             v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb0, v3_cross(wb, lever)));
             double vn = v3_dot(vrel, n);
@@ -258,26 +305,37 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
             double push = fn > 0.0;
             double f1x = fx[i] + n.x * (fn * push), f1y = fy[i] + n.y * (fn * push),
                    f1z = fz[i] + n.z * (fn * push);
-            if (!(fn > 0.0)) {
-                fx[i] = f1x;
-                fy[i] = f1y;
-                fz[i] = f1z;
-                continue;
-            }
-            v3 ft = v3_make(0, 0, 0);
-            if (web->inv_m[i] != 0.0) {
-                v3 f0 = v3_make(f1x, f1y, f1z);
-                v3 fo = v3_madd(f0, n, -v3_dot(f0, n));
-                v3 vp = v3_madd(v3_madd(vrel, n, -vn), fo, h * web->inv_m[i]);
-                double vps = v3_norm(vp);
-                double sr = vps / vlim;
-                double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-                double stop = web->m[i] * vps / h;
-                ft = vps > 0.0 ? v3_scale(vp, -(law < stop ? law : stop) / vps) : ft;
-            }
-            fx[i] = f1x + ft.x;
-            fy[i] = f1y + ft.y;
-            fz[i] = f1z + ft.z;
+            fx[i] = f1x;
+            fy[i] = f1y;
+            fz[i] = f1z;
+            v3 tv = v3_madd(vrel, n, -vn);
+            pi[np] = i;
+            P[P_FN * RUN_PS + np] = fn;
+            P[P_LX * RUN_PS + np] = lever.x;
+            P[P_LY * RUN_PS + np] = lever.y;
+            P[P_LZ * RUN_PS + np] = lever.z;
+            P[P_TX * RUN_PS + np] = tv.x;
+            P[P_TY * RUN_PS + np] = tv.y;
+            P[P_TZ * RUN_PS + np] = tv.z;
+            P[P_KX * RUN_PS + np] = f1x;
+            P[P_KY * RUN_PS + np] = f1y;
+            P[P_KZ * RUN_PS + np] = f1z;
+            P[P_IM * RUN_PS + np] = web->inv_m[i];
+            P[P_M * RUN_PS + np] = web->m[i];
+            np += (size_t)(fn > 0.0);
+        }
+        run_friction(np, n.x, n.y, n.z, h, p->mu, p->vlim, P);
+        /* Applied: to the nodes, and the opposite to the body, in node order. */
+        for (size_t t = 0; t < np; t++) {
+            const uint32_t i = pi[t];
+            v3 ft = v3_make(P[P_AX * RUN_PS + t], P[P_AY * RUN_PS + t],
+                            P[P_AZ * RUN_PS + t]);
+            v3 lever = v3_make(P[P_LX * RUN_PS + t], P[P_LY * RUN_PS + t],
+                               P[P_LZ * RUN_PS + t]);
+            double fn = P[P_FN * RUN_PS + t];
+            fx[i] += ft.x;
+            fy[i] += ft.y;
+            fz[i] += ft.z;
             v3 Fnode = v3_madd(ft, n, fn);
             fc[i] = v3_madd(fc[i], Fnode, share);
             v3 Fb = v3_scale(Fnode, -share);
@@ -329,7 +387,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
     web->seg_list = -1;
     web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, 3 * RUN_CHUNK,
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, RUN_SCRATCH * RUN_CHUNK,
                          sizeof(double)) != 0)
         return -1;
     seg_cut sc = {web, mem, cand, 0, 0, 0};
