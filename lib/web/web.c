@@ -172,10 +172,25 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
     }
 }
 
+/* Tension / length of a spring of film form whose second end is at d = (dx, dy, dz) from its
+ * first and moves at u = (ux, uy, uz) relative to it, rest length 1 / il0. Computed
+ * unconditionally and then selected, so the loops over springs have no branches. A spring whose
+ * ends coincide has no direction to pull along and gets no force. */
+static inline double film_pull(const spring_form *p, double dx, double dy, double dz, double ux,
+                               double uy, double uz, double il0)
+{
+    double l2 = dx * dx + dy * dy + dz * dz;
+    double l = sqrt(l2);
+    double inv = 1.0 / l;
+    double il = l2 > 0.0 ? inv : 0.0;
+    double eps = l * il0 - 1.0;
+    double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
+    return film_force(p, eps, epsd) * il;
+}
+
 /* Springs from node a + i to node a + i + stride, i in [0, m), all of one law, with rest
  * lengths inv_l0[i]: the force on the first end (the second gets its opposite) into
- * tx, ty, tz. Straight-line code on contiguous arrays, so the compiler runs it on vectors. A
- * spring whose ends coincide has no direction to pull along and gets no force. */
+ * tx, ty, tz. Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
 WS_VECTOR_LOOP
 static void spring_run(const double *restrict x, const double *restrict y,
                        const double *restrict z, const double *restrict vx,
@@ -187,17 +202,36 @@ static void spring_run(const double *restrict x, const double *restrict y,
         double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
         double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
                uz = vz[i + stride] - vz[i];
-        double l2 = dx * dx + dy * dy + dz * dz;
-        double l = sqrt(l2);
-        /* Computed unconditionally and then selected, so the loop has no branches. */
-        double inv = 1.0 / l;
-        double il = l2 > 0.0 ? inv : 0.0;
-        double eps = l * inv_l0[i] - 1.0;
-        double epsd = (ux * dx + uy * dy + uz * dz) * il * inv_l0[i];
-        double s = film_force(&p, eps, epsd) * il; /* tension / length */
+        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
         tx[i] = dx * s;
         ty[i] = dy * s;
         tz[i] = dz * s;
+    }
+}
+
+/* The same springs with stride >= m, so that no node is an end of two of them: their forces
+ * straight onto both ends, fa[i] += t and fb[i] -= t (fa = f + a, fb = f + a + stride), in the
+ * same loop, without the scratch. */
+WS_VECTOR_LOOP
+static void spring_run_apply(const double *restrict x, const double *restrict y,
+                             const double *restrict z, const double *restrict vx,
+                             const double *restrict vy, const double *restrict vz, size_t stride,
+                             size_t m, const double *restrict inv_l0, spring_form p,
+                             double *restrict fax, double *restrict fay, double *restrict faz,
+                             double *restrict fbx, double *restrict fby, double *restrict fbz)
+{
+    for (size_t i = 0; i < m; i++) {
+        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
+        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
+               uz = vz[i + stride] - vz[i];
+        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
+        double tx = dx * s, ty = dy * s, tz = dz * s;
+        fax[i] += tx;
+        fay[i] += ty;
+        faz[i] += tz;
+        fbx[i] -= tx;
+        fby[i] -= ty;
+        fbz[i] -= tz;
     }
 }
 
@@ -271,6 +305,21 @@ static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t
     }
 }
 
+/* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
+static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, spring_form p)
+{
+    const size_t nx = (size_t)web->nx;
+    if (p.gen) {
+        for (size_t i = 0; i < nx; i++)
+            spring_one(web, x, v, (uint32_t)(s0 + i), p);
+        return;
+    }
+    ws_nodes3 f = web->f;
+    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx,
+                     web->inv_l0 + s0, p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx,
+                     f.z + a + nx);
+}
+
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
  * by row, cols a row: node nx r + i to the next, and the wrap of a closed band last). */
 static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const spring_form *P)
@@ -313,7 +362,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     if (j + 1 < ny) {
         grid_row(web, x, v, g, j + 1, P);
         if (web->law[WS_SPRING_UP])
-            spring_block(web, x, v, nx * j, nx, nx, cols * ny + nx * j, P[WS_SPRING_UP]);
+            spring_up(web, x, v, nx * j, cols * ny + nx * j, P[WS_SPRING_UP]);
         size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
         if (shear0 < web->ns)
             for (size_t s = shear0; s < shear0 + 2 * cols; s++)
