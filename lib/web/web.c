@@ -188,20 +188,19 @@ static inline double film_pull(const spring_form *p, double dx, double dy, doubl
     return film_force(p, eps, epsd) * il;
 }
 
-/* Springs from node a + i to node a + i + stride, i in [0, m), all of one law, with rest
- * lengths inv_l0[i]: the force on the first end (the second gets its opposite) into
- * tx, ty, tz. Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
+/* Springs from node a + i to node a + i + 1, i in [0, m), all of one law, with rest lengths
+ * inv_l0[i]: the force on the first end (the second gets its opposite) into tx, ty, tz.
+ * Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
 WS_VECTOR_LOOP
 static void spring_run(const double *restrict x, const double *restrict y,
                        const double *restrict z, const double *restrict vx,
-                       const double *restrict vy, const double *restrict vz, size_t stride,
-                       size_t m, const double *restrict inv_l0, spring_form p,
-                       double *restrict tx, double *restrict ty, double *restrict tz)
+                       const double *restrict vy, const double *restrict vz, size_t m,
+                       const double *restrict inv_l0, spring_form p, double *restrict tx,
+                       double *restrict ty, double *restrict tz)
 {
     for (size_t i = 0; i < m; i++) {
-        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
-        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
-               uz = vz[i + stride] - vz[i];
+        double dx = x[i + 1] - x[i], dy = y[i + 1] - y[i], dz = z[i + 1] - z[i];
+        double ux = vx[i + 1] - vx[i], uy = vy[i + 1] - vy[i], uz = vz[i + 1] - vz[i];
         double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
         tx[i] = dx * s;
         ty[i] = dy * s;
@@ -209,9 +208,10 @@ static void spring_run(const double *restrict x, const double *restrict y,
     }
 }
 
-/* The same springs with stride >= m, so that no node is an end of two of them: their forces
- * straight onto both ends, fa[i] += t and fb[i] -= t (fa = f + a, fb = f + a + stride), in the
- * same loop, without the scratch. */
+/* Springs from node a + i to node a + i + stride, i in [0, m), stride >= m (no node is an end
+ * of two of them), all of one law, with rest lengths inv_l0[i]: their forces straight onto
+ * both ends, fa[i] += t and fb[i] -= t (fa = f + a, fb = f + a + stride), in the loop that
+ * computes them. */
 WS_VECTOR_LOOP
 static void spring_run_apply(const double *restrict x, const double *restrict y,
                              const double *restrict z, const double *restrict vx,
@@ -233,16 +233,6 @@ static void spring_run_apply(const double *restrict x, const double *restrict y,
         fby[i] -= ty;
         fbz[i] -= tz;
     }
-}
-
-/* f[a + i] += t[i] and f[a + i + stride] -= t[i]: split in two loops, each on vectors. */
-WS_VECTOR_LOOP
-static void spring_apply(double *restrict f, const double *restrict t, size_t stride, size_t m)
-{
-    for (size_t i = 0; i < m; i++)
-        f[i] += t[i];
-    for (size_t i = 0; i < m; i++)
-        f[i + stride] -= t[i];
 }
 
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
@@ -283,25 +273,53 @@ static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
     }
 }
 
-/* Springs from node a + i to a + i + stride, i in [0, m), rest lengths il0[i], one law: their
- * forces, in chunks small enough for the scratch to stay in the first-level cache. */
-static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t stride,
-                         size_t m, size_t s0, spring_form p)
+/* Gravity and node drag on node i. */
+static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
 {
-    if (p.gen) {
-        for (size_t i = 0; i < m; i++)
-            spring_one(web, x, v, (uint32_t)(s0 + i), p);
-        return;
+    const double c = web->damping, m = web->m[i];
+    return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
+}
+
+/* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
+ * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
+ * order is that of the results (the state hash): keep it. */
+WS_VECTOR_LOOP
+static void row_forces(size_t k, v3 g, double c, const double *restrict m,
+                       const double *restrict vx, const double *restrict vy,
+                       const double *restrict vz, const double *restrict tx,
+                       const double *restrict ty, const double *restrict tz, double *restrict fx,
+                       double *restrict fy, double *restrict fz)
+{
+    for (size_t i = 1; i < k; i++) {
+        fx[i] = g.x * m[i] - c * vx[i] + tx[i] - tx[i - 1];
+        fy[i] = g.y * m[i] - c * vy[i] + ty[i] - ty[i - 1];
+        fz[i] = g.z * m[i] - c * vz[i] + tz[i] - tz[i - 1];
     }
+}
+
+/* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
+ * form, with the base forces of nodes [a, a + m]: in chunks small enough for the scratch to
+ * stay in the first-level cache, each chunk's forces computed, then put on its nodes in one
+ * pass. A node at the start of a chunk after the first has had the previous chunk's spring
+ * already and gets its right-hand one after it. */
+static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m,
+                       size_t s0, spring_form p)
+{
     const double *il0 = web->inv_l0 + s0;
+    const ws_nodes3 f = web->f;
     double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
     for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
         size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
-        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, stride, k, il0 + o, p,
-                   tx, ty, tz);
-        spring_apply(web->f.x + q, tx, stride, k);
-        spring_apply(web->f.y + q, ty, stride, k);
-        spring_apply(web->f.z + q, tz, stride, k);
+        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, k, il0 + o, p, tx, ty,
+                   tz);
+        v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
+        if (o == 0)
+            nodes_set(f, (uint32_t)q, v3_add(base_force(web, v, g, q), first));
+        else
+            nodes_add(f, (uint32_t)q, first);
+        row_forces(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                   f.x + q, f.y + q, f.z + q);
+        nodes_set(f, (uint32_t)(q + k), v3_sub(base_force(web, v, g, q + k), last));
     }
 }
 
@@ -325,12 +343,20 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
 static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const spring_form *P)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    base_forces(web, v, g, nx * r, nx * (r + 1));
-    if (!web->law[WS_SPRING_AROUND] || nx < 2)
+    const spring_form p = P[WS_SPRING_AROUND];
+    if (!web->law[WS_SPRING_AROUND] || nx < 2) {
+        base_forces(web, v, g, nx * r, nx * (r + 1));
         return;
-    spring_block(web, x, v, nx * r, 1, nx - 1, cols * r, P[WS_SPRING_AROUND]);
+    }
+    if (p.gen) {
+        base_forces(web, v, g, nx * r, nx * (r + 1));
+        for (size_t i = 0; i < nx - 1; i++)
+            spring_one(web, x, v, (uint32_t)(cols * r + i), p);
+    } else {
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p);
+    }
     if (web->closed)
-        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), P[WS_SPRING_AROUND]);
+        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
