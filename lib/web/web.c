@@ -175,43 +175,67 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
     }
 }
 
-/* Springs from node a + i to node a + i + stride, i in [0, m), all of one law, with rest
- * lengths inv_l0[i]: the force on the first end (the second gets its opposite) into
- * tx, ty, tz. Straight-line code on contiguous arrays, so the compiler runs it on vectors. A
- * spring whose ends coincide has no direction to pull along and gets no force. */
+/* Tension / length of a spring of film form whose second end is at d = (dx, dy, dz) from its
+ * first and moves at u = (ux, uy, uz) relative to it, rest length 1 / il0. Computed
+ * unconditionally and then selected, so the loops over springs have no branches. A spring whose
+ * ends coincide has no direction to pull along and gets no force. */
+static inline double film_pull(const spring_form *p, double dx, double dy, double dz, double ux,
+                               double uy, double uz, double il0)
+{
+    double l2 = dx * dx + dy * dy + dz * dz;
+    double l = sqrt(l2);
+    double inv = 1.0 / l;
+    double il = l2 > 0.0 ? inv : 0.0;
+    double eps = l * il0 - 1.0;
+    double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
+    return film_force(p, eps, epsd) * il;
+}
+
+/* Springs from node a + i to node a + i + 1, i in [0, m), all of one law, with rest lengths
+ * inv_l0[i]: the force on the first end (the second gets its opposite) into tx, ty, tz.
+ * Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
 WS_VECTOR_LOOP
 static void spring_run(const double *restrict x, const double *restrict y,
                        const double *restrict z, const double *restrict vx,
-                       const double *restrict vy, const double *restrict vz, size_t stride,
-                       size_t m, const double *restrict inv_l0, spring_form p,
-                       double *restrict tx, double *restrict ty, double *restrict tz)
+                       const double *restrict vy, const double *restrict vz, size_t m,
+                       const double *restrict inv_l0, spring_form p, double *restrict tx,
+                       double *restrict ty, double *restrict tz)
 {
     for (size_t i = 0; i < m; i++) {
-        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
-        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
-               uz = vz[i + stride] - vz[i];
-        double l2 = dx * dx + dy * dy + dz * dz;
-        double l = sqrt(l2);
-        /* Computed unconditionally and then selected, so the loop has no branches. */
-        double inv = 1.0 / l;
-        double il = l2 > 0.0 ? inv : 0.0;
-        double eps = l * inv_l0[i] - 1.0;
-        double epsd = (ux * dx + uy * dy + uz * dz) * il * inv_l0[i];
-        double s = film_force(&p, eps, epsd) * il; /* tension / length */
+        double dx = x[i + 1] - x[i], dy = y[i + 1] - y[i], dz = z[i + 1] - z[i];
+        double ux = vx[i + 1] - vx[i], uy = vy[i + 1] - vy[i], uz = vz[i + 1] - vz[i];
+        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
         tx[i] = dx * s;
         ty[i] = dy * s;
         tz[i] = dz * s;
     }
 }
 
-/* f[a + i] += t[i] and f[a + i + stride] -= t[i]: split in two loops, each on vectors. */
+/* Springs from node a + i to node a + i + stride, i in [0, m), stride >= m (no node is an end
+ * of two of them), all of one law, with rest lengths inv_l0[i]: their forces straight onto
+ * both ends, fa[i] += t and fb[i] -= t (fa = f + a, fb = f + a + stride), in the loop that
+ * computes them. */
 WS_VECTOR_LOOP
-static void spring_apply(double *restrict f, const double *restrict t, size_t stride, size_t m)
+static void spring_run_apply(const double *restrict x, const double *restrict y,
+                             const double *restrict z, const double *restrict vx,
+                             const double *restrict vy, const double *restrict vz, size_t stride,
+                             size_t m, const double *restrict inv_l0, spring_form p,
+                             double *restrict fax, double *restrict fay, double *restrict faz,
+                             double *restrict fbx, double *restrict fby, double *restrict fbz)
 {
-    for (size_t i = 0; i < m; i++)
-        f[i] += t[i];
-    for (size_t i = 0; i < m; i++)
-        f[i + stride] -= t[i];
+    for (size_t i = 0; i < m; i++) {
+        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
+        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
+               uz = vz[i + stride] - vz[i];
+        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
+        double tx = dx * s, ty = dy * s, tz = dz * s;
+        fax[i] += tx;
+        fay[i] += ty;
+        faz[i] += tz;
+        fbx[i] -= tx;
+        fby[i] -= ty;
+        fbz[i] -= tz;
+    }
 }
 
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
@@ -252,26 +276,69 @@ static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
     }
 }
 
-/* Springs from node a + i to a + i + stride, i in [0, m), rest lengths il0[i], one law: their
- * forces, in chunks small enough for the scratch to stay in the first-level cache. */
-static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t stride,
-                         size_t m, size_t s0, spring_form p)
+/* Gravity and node drag on node i. */
+static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
 {
-    if (p.gen) {
-        for (size_t i = 0; i < m; i++)
-            spring_one(web, x, v, (uint32_t)(s0 + i), p);
-        return;
+    const double c = web->damping, m = web->m[i];
+    return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
+}
+
+/* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
+ * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
+ * order is that of the results (the state hash): keep it. */
+WS_VECTOR_LOOP
+static void row_forces(size_t k, v3 g, double c, const double *restrict m,
+                       const double *restrict vx, const double *restrict vy,
+                       const double *restrict vz, const double *restrict tx,
+                       const double *restrict ty, const double *restrict tz, double *restrict fx,
+                       double *restrict fy, double *restrict fz)
+{
+    for (size_t i = 1; i < k; i++) {
+        fx[i] = g.x * m[i] - c * vx[i] + tx[i] - tx[i - 1];
+        fy[i] = g.y * m[i] - c * vy[i] + ty[i] - ty[i - 1];
+        fz[i] = g.z * m[i] - c * vz[i] + tz[i] - tz[i - 1];
     }
+}
+
+/* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
+ * form, with the base forces of nodes [a, a + m]: in chunks small enough for the scratch to
+ * stay in the first-level cache, each chunk's forces computed, then put on its nodes in one
+ * pass. A node at the start of a chunk after the first has had the previous chunk's spring
+ * already and gets its right-hand one after it. */
+static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m,
+                       size_t s0, spring_form p)
+{
     const double *il0 = web->inv_l0 + s0;
+    const ws_nodes3 f = web->f;
     double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
     for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
         size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
-        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, stride, k, il0 + o, p,
-                   tx, ty, tz);
-        spring_apply(web->f.x + q, tx, stride, k);
-        spring_apply(web->f.y + q, ty, stride, k);
-        spring_apply(web->f.z + q, tz, stride, k);
+        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, k, il0 + o, p, tx, ty,
+                   tz);
+        v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
+        if (o == 0)
+            nodes_set(f, (uint32_t)q, v3_add(base_force(web, v, g, q), first));
+        else
+            nodes_add(f, (uint32_t)q, first);
+        row_forces(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                   f.x + q, f.y + q, f.z + q);
+        nodes_set(f, (uint32_t)(q + k), v3_sub(base_force(web, v, g, q + k), last));
     }
+}
+
+/* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
+static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, spring_form p)
+{
+    const size_t nx = (size_t)web->nx;
+    if (p.gen) {
+        for (size_t i = 0; i < nx; i++)
+            spring_one(web, x, v, (uint32_t)(s0 + i), p);
+        return;
+    }
+    ws_nodes3 f = web->f;
+    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx,
+                     web->inv_l0 + s0, p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx,
+                     f.z + a + nx);
 }
 
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
@@ -279,12 +346,20 @@ static void spring_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t
 static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const spring_form *P)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    base_forces(web, v, g, nx * r, nx * (r + 1));
-    if (!web->law[WS_SPRING_AROUND] || nx < 2)
+    const spring_form p = P[WS_SPRING_AROUND];
+    if (!web->law[WS_SPRING_AROUND] || nx < 2) {
+        base_forces(web, v, g, nx * r, nx * (r + 1));
         return;
-    spring_block(web, x, v, nx * r, 1, nx - 1, cols * r, P[WS_SPRING_AROUND]);
+    }
+    if (p.gen) {
+        base_forces(web, v, g, nx * r, nx * (r + 1));
+        for (size_t i = 0; i < nx - 1; i++)
+            spring_one(web, x, v, (uint32_t)(cols * r + i), p);
+    } else {
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p);
+    }
     if (web->closed)
-        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), P[WS_SPRING_AROUND]);
+        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
@@ -316,7 +391,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     if (j + 1 < ny) {
         grid_row(web, x, v, g, j + 1, P);
         if (web->law[WS_SPRING_UP])
-            spring_block(web, x, v, nx * j, nx, nx, cols * ny + nx * j, P[WS_SPRING_UP]);
+            spring_up(web, x, v, nx * j, cols * ny + nx * j, P[WS_SPRING_UP]);
         size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
         if (shear0 < web->ns)
             for (size_t s = shear0; s < shear0 + 2 * cols; s++)
@@ -326,23 +401,34 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     *n1 = (uint32_t)(nx * (j + 1));
 }
 
-/* One component of symplectic Euler for m nodes: v1 = (v0 + h f / m) (0 when pinned), x1 = x0
- * + h v1. Distinct arrays (restrict), so the loop runs on vectors. */
+/* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
+ * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. */
 WS_VECTOR_LOOP
-static void advance(size_t m, double h, const double *restrict im, const double *restrict f,
-                    const double *restrict v0, const double *restrict x0, double *restrict v1,
-                    double *restrict x1)
+static void advance(size_t m, double h, const double *restrict im, const double *restrict fx,
+                    const double *restrict fy, const double *restrict fz,
+                    const double *restrict vx0, const double *restrict vy0,
+                    const double *restrict vz0, const double *restrict x0,
+                    const double *restrict y0, const double *restrict z0, double *restrict vx1,
+                    double *restrict vy1, double *restrict vz1, double *restrict x1,
+                    double *restrict y1, double *restrict z1)
 {
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
-        double u = (v0[i] + h * im[i] * f[i]) * (double)(im[i] != 0.0);
-        v1[i] = u;
-        x1[i] = x0[i] + h * u;
+        double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
+        double ux = (vx0[i] + hi * fx[i]) * unpinned, uy = (vy0[i] + hi * fy[i]) * unpinned,
+               uz = (vz0[i] + hi * fz[i]) * unpinned;
+        vx1[i] = ux;
+        vy1[i] = uy;
+        vz1[i] = uz;
+        x1[i] = x0[i] + h * ux;
+        y1[i] = y0[i] + h * uy;
+        z1[i] = z0[i] + h * uz;
     }
 }
 
 /* How many of m nodes are faster than sqrt(lim2) or have a NaN speed (!(s <= lim2) counts
- * it): a count, so the loop runs on vectors. */
+ * it): a count, so the loop runs on vectors -- in the AVX2 build only; the baseline x86-64 one
+ * lacks the select it takes. Kept out of advance, which would lose its vectors there with it. */
 WS_VECTOR_LOOP
 static size_t too_fast(size_t m, const double *restrict vx, const double *restrict vy,
                        const double *restrict vz, double lim2)
@@ -356,12 +442,11 @@ static size_t too_fast(size_t m, const double *restrict vx, const double *restri
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
-    const double *im = web->inv_m;
     const ws_nodes3 f = web->f;
     size_t m = n1 - n0;
-    advance(m, h, im + n0, f.x + n0, vs.x + n0, xs.x + n0, vd.x + n0, xd.x + n0);
-    advance(m, h, im + n0, f.y + n0, vs.y + n0, xs.y + n0, vd.y + n0, xd.y + n0);
-    advance(m, h, im + n0, f.z + n0, vs.z + n0, xs.z + n0, vd.z + n0, xd.z + n0);
+    advance(m, h, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0, vs.x + n0, vs.y + n0,
+            vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
+            xd.x + n0, xd.y + n0, xd.z + n0);
     return too_fast(m, vd.x + n0, vd.y + n0, vd.z + n0, vmax * vmax);
 }
 
