@@ -61,6 +61,54 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
+/* The friction on a pushing node (eq. 13), limited to the force that stops its slip within
+ * the sub-step h: from the contact's normal n, the node's tangential velocity relative to the
+ * body t, its force with every normal force in k, its 1 / mass and mass, the normal force fn
+ * and the contact's mu and v_lim (contacts_general says why). None for a pinned node or one
+ * that does not slip. Straight-line code, so loops of it run on vectors. */
+static inline void friction_of(double nx, double ny, double nz, double tx, double ty, double tz,
+                               double kx, double ky, double kz, double im, double mass,
+                               double fn, double mu, double vlim, double h, double *ax,
+                               double *ay, double *az)
+{
+    double dot = kx * nx + ky * ny + kz * nz;
+    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
+    double hm = h * im;
+    double px = tx + ox * hm, py = ty + oy * hm, pz = tz + oz * hm;
+    double vps = sqrt(px * px + py * py + pz * pz);
+    double sr = vps / vlim;
+    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+    double stop = mass * vps / h;
+    double s = -(law < stop ? law : stop) / vps;
+    int slips = (vps > 0.0) & (im != 0.0);
+    *ax = slips ? px * s : 0.0;
+    *ay = slips ? py * s : 0.0;
+    *az = slips ? pz * s : 0.0;
+}
+
+#define GEN_CHUNK 64 /* contacts whose frictions are taken at once (contacts_general) */
+enum { G_NX, G_NY, G_NZ, G_TX, G_TY, G_TZ, G_KX, G_KY, G_KZ, G_IM, G_M, G_FN, G_MU, G_VL, G_AX,
+       G_AY, G_AZ, GEN_ARRAYS };
+#define GEN_GS 72 /* from one of those arrays to the next (not a divisor of 4096 bytes) */
+
+/* Frictions of m contacts, each with its own normal and contact law (arrays as above). */
+WS_VECTOR_LOOP
+static void gen_friction(size_t m, double h, double *restrict G)
+{
+    const double *restrict nx = G + G_NX * GEN_GS, *restrict ny = G + G_NY * GEN_GS,
+                           *restrict nz = G + G_NZ * GEN_GS, *restrict tx = G + G_TX * GEN_GS,
+                           *restrict ty = G + G_TY * GEN_GS, *restrict tz = G + G_TZ * GEN_GS,
+                           *restrict kx = G + G_KX * GEN_GS, *restrict ky = G + G_KY * GEN_GS,
+                           *restrict kz = G + G_KZ * GEN_GS, *restrict im = G + G_IM * GEN_GS,
+                           *restrict mass = G + G_M * GEN_GS, *restrict fn = G + G_FN * GEN_GS,
+                           *restrict mu = G + G_MU * GEN_GS, *restrict vl = G + G_VL * GEN_GS;
+    double *restrict ax = G + G_AX * GEN_GS, *restrict ay = G + G_AY * GEN_GS,
+                     *restrict az = G + G_AZ * GEN_GS;
+    for (size_t q = 0; q < m; q++)
+        friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
+                    mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
+}
+
 /* Candidates one by one, in node order: any feature, any body. */
 static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
                              ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, size_t n,
@@ -131,10 +179,11 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
                             p->mu, p->vlim};
         na += (size_t)push;
     }
-    /* Node by node, once every normal force of the node is in: its frictions, then all of them
-     * applied. A node at a corner touches two faces; doing every normal force before any
-     * friction makes the result independent of the order of the faces (which differs from
-     * corner to corner and would twist a symmetric load).
+    /* Once every normal force is in: the frictions (on vectors, from each node's force with all
+     * its normal forces in), then all of them applied in node order. A node at a corner
+     * touches two faces; doing every normal force before any friction makes the result
+     * independent of the order of the faces (which differs from corner to corner and would
+     * twist a symmetric load).
      *
      * Friction: eq. 13, limited to the force that stops the node's slip within this sub-step.
      * Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit
@@ -144,39 +193,43 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
      * what stops that slip (m |v_pred| / h) and what eq. 13 gives for it, against it. Sticking
      * nodes hold their tangential load; sliding ones get mu N; for heavy masses this is eq. 13
      * itself. */
-    size_t k = 0;
-    while (k < na) {
-        const uint32_t i = act[k].node;
-        size_t e = k + 1;
-        while (e < na && act[e].node == i)
-            e++;
-        if (web->inv_m[i] != 0.0) {
-            const v3 f0 = nodes_get(web->f, i);
-            for (size_t q = k; q < e; q++) {
-                ws_nact *a = &act[q];
-                v3 fo = v3_madd(f0, a->n, -v3_dot(f0, a->n)); /* tangential, other forces */
-                v3 vp = v3_madd(a->vt, fo, h * web->inv_m[i]);
-                double vps = v3_norm(vp);
-                double sr = vps / a->vlim;
-                double law = a->mu * a->fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-                double stop = web->m[i] * vps / h;
-                /* vps = 0: no slip, no friction (the division is not taken). */
-                a->ft = vps > 0.0 ? v3_scale(vp, -(law < stop ? law : stop) / vps) : a->ft;
-            }
+    double *G = web->rtmp;
+    for (size_t q0 = 0; q0 < na; q0 += GEN_CHUNK) {
+        size_t cm = na - q0 < GEN_CHUNK ? na - q0 : GEN_CHUNK;
+        for (size_t q = 0; q < cm; q++) {
+            const ws_nact *a = &act[q0 + q];
+            const uint32_t i = a->node;
+            G[G_NX * GEN_GS + q] = a->n.x;
+            G[G_NY * GEN_GS + q] = a->n.y;
+            G[G_NZ * GEN_GS + q] = a->n.z;
+            G[G_TX * GEN_GS + q] = a->vt.x;
+            G[G_TY * GEN_GS + q] = a->vt.y;
+            G[G_TZ * GEN_GS + q] = a->vt.z;
+            G[G_KX * GEN_GS + q] = web->f.x[i];
+            G[G_KY * GEN_GS + q] = web->f.y[i];
+            G[G_KZ * GEN_GS + q] = web->f.z[i];
+            G[G_IM * GEN_GS + q] = web->inv_m[i];
+            G[G_M * GEN_GS + q] = web->m[i];
+            G[G_FN * GEN_GS + q] = a->fn;
+            G[G_MU * GEN_GS + q] = a->mu;
+            G[G_VL * GEN_GS + q] = a->vlim;
         }
-        /* Apply; the bodies get the opposite, averaged over the sub-steps (into the web's
-         * per-body totals, which the step adds to the bodies once). */
-        for (size_t q = k; q < e; q++) {
-            const ws_nact *a = &act[q];
-            uint32_t bi = a->body;
-            nodes_add(web->f, i, a->ft);
-            v3 Fnode = v3_madd(a->ft, a->n, a->fn);
-            fc[i] = v3_madd(fc[i], Fnode, share);
-            v3 Fb = v3_scale(Fnode, -share);
-            bforce[bi] = v3_add(bforce[bi], Fb);
-            bmoment[bi] = v3_add(bmoment[bi], v3_cross(v3_sub(a->xc, st->r[bi]), Fb));
-        }
-        k = e;
+        gen_friction(cm, h, G);
+        for (size_t q = 0; q < cm; q++)
+            act[q0 + q].ft = v3_make(G[G_AX * GEN_GS + q], G[G_AY * GEN_GS + q],
+                                     G[G_AZ * GEN_GS + q]);
+    }
+    /* Apply, in node order; the bodies get the opposite, averaged over the sub-steps (into the
+     * web's per-body totals, which the step adds to the bodies once). */
+    for (size_t q = 0; q < na; q++) {
+        const ws_nact *a = &act[q];
+        const uint32_t i = a->node, bi = a->body;
+        nodes_add(web->f, i, a->ft);
+        v3 Fnode = v3_madd(a->ft, a->n, a->fn);
+        fc[i] = v3_madd(fc[i], Fnode, share);
+        v3 Fb = v3_scale(Fnode, -share);
+        bforce[bi] = v3_add(bforce[bi], Fb);
+        bmoment[bi] = v3_add(bmoment[bi], v3_cross(v3_sub(a->xc, st->r[bi]), Fb));
     }
 }
 
@@ -186,7 +239,8 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
 #define RUN_CHUNK 128 /* nodes of a run evaluated at once */
 #define RUN_PS 136     /* from one array of pushing nodes to the next (not a divisor of 4096
                           bytes, whose multiples apart a load may wait on a store) */
-#define RUN_SCRATCH 20 /* doubles of scratch a node (contacts_run) */
+#define RUN_SCRATCH 20 /* doubles of scratch a node (contacts_run); contacts_general takes
+                          GEN_ARRAYS GEN_GS of it */
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -213,10 +267,7 @@ static void run_depth(size_t m, run_face q, const double *restrict x, const doub
 enum { P_FN, P_LX, P_LY, P_LZ, P_TX, P_TY, P_TZ, P_KX, P_KY, P_KZ, P_IM, P_M, P_AX, P_AY, P_AZ,
        RUN_PUSH };
 
-/* Frictions of m pushing nodes on a face of normal n (the scratch's arrays): eq. 13 for the
- * slip each would have at the end of the sub-step under every force but friction, limited to
- * what stops it; none for a pinned node or one that does not slip. The arithmetic of
- * contacts_general, on vectors. */
+/* Frictions of m pushing nodes on a face of normal n (the scratch's arrays). */
 WS_VECTOR_LOOP
 static void run_friction(size_t m, double nx, double ny, double nz, double h, double mu,
                          double vlim, double *restrict P)
@@ -228,21 +279,9 @@ static void run_friction(size_t m, double nx, double ny, double nz, double h, do
                            *restrict mass = P + P_M * RUN_PS;
     double *restrict ax = P + P_AX * RUN_PS, *restrict ay = P + P_AY * RUN_PS,
                      *restrict az = P + P_AZ * RUN_PS;
-    for (size_t t = 0; t < m; t++) {
-        double dot = kx[t] * nx + ky[t] * ny + kz[t] * nz;
-        double ox = kx[t] + nx * (-dot), oy = ky[t] + ny * (-dot), oz = kz[t] + nz * (-dot);
-        double hm = h * im[t];
-        double px = tx[t] + ox * hm, py = ty[t] + oy * hm, pz = tz[t] + oz * hm;
-        double vps = sqrt(px * px + py * py + pz * pz);
-        double sr = vps / vlim;
-        double law = mu * fn[t] * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-        double stop = mass[t] * vps / h;
-        double s = -(law < stop ? law : stop) / vps;
-        int slips = (vps > 0.0) & (im[t] != 0.0);
-        ax[t] = slips ? px * s : 0.0;
-        ay[t] = slips ? py * s : 0.0;
-        az[t] = slips ? pz * s : 0.0;
-    }
+    for (size_t t = 0; t < m; t++)
+        friction_of(nx, ny, nz, tx[t], ty[t], tz[t], kx[t], ky[t], kz[t], im[t], mass[t], fn[t],
+                    mu, vlim, h, &ax[t], &ay[t], &az[t]);
 }
 
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
