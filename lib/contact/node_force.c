@@ -227,6 +227,7 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
         nodes_add(web->f, i, a->ft);
         v3 Fnode = v3_madd(a->ft, a->n, a->fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
+        web->fct[web->fck][web->nfct[web->fck]++] = i;
         v3 Fb = v3_scale(Fnode, -share);
         bforce[bi] = v3_add(bforce[bi], Fb);
         bmoment[bi] = v3_add(bmoment[bi], v3_cross(v3_sub(a->xc, st->r[bi]), Fb));
@@ -377,6 +378,7 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
             fz[i] += ft.z;
             v3 Fnode = v3_madd(ft, n, fn);
             fc[i] = v3_madd(fc[i], Fnode, share);
+            web->fct[web->fck][web->nfct[web->fck]++] = i;
             v3 Fb = v3_scale(Fnode, -share);
             bf = v3_add(bf, Fb);
             bm = v3_add(bm, v3_cross(lever, Fb));

@@ -56,6 +56,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         nodes_free(mem, &web->x[k], web->n);
         nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
+        ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
         ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
         if (k == 0)
             ws_mem_free(mem, web->act, web->act_cap * sizeof(ws_nact));

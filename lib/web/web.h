@@ -90,6 +90,10 @@ typedef struct ws_web {
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
+    uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
+                                zeroed at the start of a step that writes fc[k] */
+    size_t nfct[2], fct_cap[2];
+    int fck;                 /* the fc the contacts of the running step add to (scratch) */
     double *m, *inv_m;       /* inv_m = 0: pinned */
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */

@@ -229,6 +229,17 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
+        /* The node contact forces this step writes: zero where they were not (the nodes that
+         * had contacts when fc[nxt] was last written), room to list every contact of every
+         * sub-step. */
+        for (size_t q = 0; q < web->nfct[nxt]; q++)
+            web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
+        web->nfct[nxt] = 0;
+        web->fck = nxt;
+        if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
+                             (size_t)web->substeps * web->ncand[list] + 1, sizeof(uint32_t)) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
         const ws_ncand *cand = web->cand[list];
         const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
@@ -245,9 +256,6 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                 uint32_t n0, n1;
                 ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
                                     &n1);
-                if (s == 0)
-                    for (uint32_t i = n0; i < n1; i++)
-                        web->fc[nxt][i] = v3_make(0, 0, 0);
                 ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand, n1, &next,
                                  w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
                                  web->bmoment[nxt], &w->stats.narrow_checks);
