@@ -421,10 +421,43 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep)
     ck_assert(web_a && web_b);
     web_a->runs_off = 1;
     const int steps = 2400;
+    ws_web_info wi;
+    ck_ok(b, ws_web_get_info(b, wb, &wi));
+    double *fa = malloc(6 * wi.node_count * sizeof *fa), *fb = fa + 3 * wi.node_count;
+    ck_assert(fa);
+    double worst = 0.0;
     for (int k = 0; k < steps; k++) {
         ck_ok(a, ws_world_step(a));
         ck_ok(b, ws_world_step(b));
+        if (k % 50 != 49)
+            continue;
+        /* The nodes' contact forces: the same both ways, and they add up to minus the film's
+         * load on the bodies (a node that stopped touching reads zero, not what it had). */
+        size_t nc;
+        ck_ok(a, ws_web_copy_contact_forces(a, wa, fa, wi.node_count, &nc));
+        ck_ok(b, ws_web_copy_contact_forces(b, wb, fb, wi.node_count, &nc));
+        double sum[3] = {0, 0, 0}, size = 0.0;
+        for (size_t i = 0; i < 3 * nc; i++) {
+            ck_assert_msg(fa[i] == fb[i], "contact forces differ at node %zu", i / 3);
+            sum[i % 3] += fb[i];
+            size += fabs(fb[i]);
+        }
+        const ws_body_store *bs = &b->bodies;
+        for (size_t q = 0; q < bs->slots; q++)
+            if (bs->alive[q]) {
+                sum[0] += web_b->bforce[b->cur][q].x;
+                sum[1] += web_b->bforce[b->cur][q].y;
+                sum[2] += web_b->bforce[b->cur][q].z;
+            }
+        /* Round-off of two sums of the same terms in different orders. */
+        double off = fabs(sum[0]) + fabs(sum[1]) + fabs(sum[2]);
+        ck_assert_msg(off <= 1e-12 * size + 1e-300, "contact forces sum to %.3e N off the loads "
+                      "on the bodies (of %.3e N)", off, size);
+        worst = fmax(worst, size > 0.0 ? off / size : 0.0);
     }
+    free(fa);
+    report("film runs (scene %d): node contact forces add up to the loads on the bodies to "
+           "%.1e of their size", kind, worst);
     uint64_t ha, hb;
     ck_ok(a, ws_world_get_state_hash(a, &ha));
     ck_ok(b, ws_world_get_state_hash(b, &hb));
