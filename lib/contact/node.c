@@ -300,6 +300,100 @@ int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t no
     return 0;
 }
 
+/* Append c to the list. 0, or -1 when out of memory. */
+static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_ncand c)
+{
+    if (*n == *cap && ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
+        return -1;
+    (*out)[(*n)++] = c;
+    return 0;
+}
+
+/* Index of the lowest set bit of m (m != 0). */
+static inline uint32_t lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(m);
+#else
+    uint32_t f = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
+/* The tests of inside_box without its branches. */
+static inline int in_box(v3 p, v3 lo, v3 hi, double e)
+{
+    return (p.x > lo.x - e) & (p.x < hi.x + e) & (p.y > lo.y - e) & (p.y < hi.y + e) &
+           (p.z > lo.z - e) & (p.z < hi.z + e);
+}
+
+/* Node i at s (body frame) against a convex body k of at most WS_NCAND_FACES faces: the faces
+ * and edges the general search below would list, in the same order, with the faces' tests as
+ * bit masks so that a node pays only for the few features near it and takes few branches.
+ * Only here may a face candidate be marked INSIDE. */
+static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g, uint32_t i,
+                             uint32_t k, v3 s, double reach, double margin, ws_ncand **out,
+                             size_t *n, size_t *cap, uint64_t *checks)
+{
+    const uint32_t nf = sh->face_count;
+    const double deep = -reach - sh->inner;
+    double D = -INFINITY, dg[WS_NCAND_FACES];
+    /* boxes: the faces whose box, grown by the reach, holds the node. An edge's box lies in
+     * the boxes of both its faces, so an edge within reach of the node needs two of them:
+     * most nodes, over the middle of a face, have at most one and skip the edges. */
+    uint64_t boxes = 0, pass = 0;
+    for (uint32_t f = 0; f < nf; f++) {
+        const ws_face *F = &sh->faces[f];
+        double d = v3_dot(F->normal, s) - F->offset;
+        dg[f] = d;
+        D = d > D ? d : D;
+        boxes |= (uint64_t)in_box(s, F->lo, F->hi, reach) << f;
+    }
+    for (uint32_t f = 0; f < nf; f++) {
+        double d = dg[f];
+        pass |= (uint64_t)((d > deep) & (d < reach) & (d >= D - margin)) << f;
+    }
+    *checks += nf;
+    for (; pass; pass &= pass - 1) {
+        uint32_t f = lowest_bit(pass);
+        const ws_face *fc = &sh->faces[f];
+        double d = dg[f];
+        if (!inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
+            continue;
+        /* Well inside the outline: its projection on the plane lies a margin or more behind
+         * every other face's plane (those planes bound the face on a convex body, and a plane
+         * distance never exceeds the distance within the face's plane). Nodes and bodies move
+         * less than half the margin relative to each other until the candidates are found
+         * again. */
+        int inside = 1;
+        for (uint32_t o = 0; o < nf; o++)
+            inside &= (o == f) | (dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin);
+        ws_ncand c = {i, k, g->face_base[k] + f, f | (inside ? WS_NCAND_INSIDE : 0u)};
+        if (push_cand(mem, out, n, cap, c) != 0)
+            return -1;
+    }
+    if (!(boxes & (boxes - 1)))
+        return 0;
+    for (uint32_t e = 0; e < sh->edge_count; e++) {
+        const ws_edge *E = &sh->edges[e];
+        if (!((boxes >> E->f1) & (boxes >> E->f2) & 1u) || !inside_box(s, E->lo, E->hi, reach))
+            continue;
+        (*checks)++;
+        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
+        if (t < 0.0 || t > 1.0)
+            continue;
+        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
+            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+            return -1;
+    }
+    return 0;
+}
+
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
                        ws_web *web, ws_nodes3 x, double margin, const uint32_t *nodes,
                        size_t count, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
@@ -315,10 +409,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
         uint32_t i = nodes ? nodes[q] : (uint32_t)q;
         v3 p = nodes_get(x, i);
         for (uint32_t k = 0; k < b->slots; k++) {
-            if (!b->alive[k])
-                continue;
-            if (p.x < b->lo[k].x - pad || p.x > b->hi[k].x + pad || p.y < b->lo[k].y - pad ||
-                p.y > b->hi[k].y + pad || p.z < b->lo[k].z - pad || p.z > b->hi[k].z + pad)
+            if (!b->alive[k] || !in_box(p, b->lo[k], b->hi[k], pad))
                 continue;
             const ws_shape *sh = b->shape[k];
             double reach = b->layer[k] + web->layer + margin;
@@ -332,14 +423,16 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
              * the margin together, which changes d_f - D by less than the margin: faces further
              * behind than that cannot come into contact and are not candidates. On a box this
              * drops the side faces next to the one a node lies on. */
-            double D = -INFINITY, dg[WS_NCAND_FACES];
-            int keep = sh->convex && sh->face_count <= WS_NCAND_FACES;
+            if (sh->convex && sh->face_count <= WS_NCAND_FACES) {
+                if (convex_candidates(mem, sh, g, i, k, s, reach, margin, out, n, cap, checks))
+                    return -1;
+                continue;
+            }
+            double D = -INFINITY;
             if (sh->convex)
                 for (uint32_t f = 0; f < sh->face_count; f++) {
                     double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
                     D = d > D ? d : D;
-                    if (keep)
-                        dg[f] = d;
                 }
             for (uint32_t f = 0; f < sh->face_count; f++) {
                 const ws_face *fc = &sh->faces[f];
@@ -348,24 +441,9 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 /* Depth counts along the normal only: the point's projection on the face's
                  * plane must lie within reach of the face. */
                 if (d > -reach - sh->inner && d < reach && d >= D - margin &&
-                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
-                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
-                        return -1;
-                    /* Well inside the outline: its projection on the plane lies a margin or
-                     * more behind every other face's plane (those planes bound the face on a
-                     * convex body, and a plane distance never exceeds the distance within the
-                     * face's plane). Nodes and bodies move less than half the margin relative
-                     * to each other until the candidates are found again. */
-                    uint32_t inside = 0;
-                    if (keep) {
-                        inside = WS_NCAND_INSIDE;
-                        for (uint32_t o = 0; o < sh->face_count && inside; o++)
-                            if (o != f &&
-                                !(dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin))
-                                inside = 0;
-                    }
-                    (*out)[(*n)++] = (ws_ncand){i, k, g->face_base[k] + f, f | inside};
-                }
+                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach) &&
+                    push_cand(mem, out, n, cap, (ws_ncand){i, k, g->face_base[k] + f, f}))
+                    return -1;
             }
             /* Convex edges within reach of the node: the rounded rim of the contact layer. */
             for (uint32_t e = 0; e < sh->edge_count; e++) {
@@ -377,11 +455,10 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
                 if (t < 0.0 || t > 1.0)
                     continue;
-                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach) {
-                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
-                        return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
-                }
+                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
+                    push_cand(mem, out, n, cap,
+                              (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+                    return -1;
             }
         }
     }
