@@ -158,6 +158,68 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 }
 
 
+/* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
+ * bound (or is NaN), else 0. Straight-line code, on vectors; the measure is squared when
+ * there is one sub-step (c = 0: no square root needed). */
+WS_VECTOR_LOOP
+static void flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
+                       double c, double lim)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
+                           *restrict oz = web->xdet.z;
+    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
+    const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
+    uint8_t *restrict redo = web->redo;
+    const size_t n = web->n;
+    if (c > 0.0) {
+        for (size_t i = 0; i < n; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+            double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
+            double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
+            double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
+            double m = sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
+            redo[i] = !(m < lim);
+        }
+    } else { /* one sub-step: the contacts see only where the nodes are now */
+        const double lim2 = lim * lim;
+        for (size_t i = 0; i < n; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+            redo[i] = !(ux * ux + uy * uy + uz * uz < lim2);
+        }
+    }
+}
+
+/* The flagged nodes (flags 0 or 1) into `moved`, in order; how many. Eight flags at a time:
+ * most steps flag few nodes, and those in runs. */
+static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
+{
+    size_t count = 0, i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t word;
+        memcpy(&word, flag + i, sizeof word);
+        if (!word)
+            continue;
+        for (size_t j = i; j < i + 8; j++) {
+            moved[count] = (uint32_t)j;
+            count += flag[j];
+        }
+    }
+    for (; i < n; i++) {
+        moved[count] = (uint32_t)i;
+        count += flag[i];
+    }
+    return count;
+}
+
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin)
 {
@@ -206,49 +268,8 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * the sub-steps' forces add) keep a node's move relative to any near body under half the
      * margin: what the candidates were found to cover. */
     const double lim = 0.1875 * margin, c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    const double *a = A.m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
-                           *restrict oz = web->xdet.z;
-    uint8_t *restrict redo = web->redo;
-    double *restrict s = web->tmp; /* 3 WS_WEB_CHUNK doubles */
-    const size_t n = web->n, chunk = 3 * WS_WEB_CHUNK;
-    long count = 0;
-    /* In chunks: the measure of each node into the scratch (straight-line code, on vectors),
-     * then the test (NaN flags too). */
-    for (size_t o = 0; o < n; o += chunk) {
-        size_t e = n - o < chunk ? n : o + chunk;
-        const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
-        const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
-        if (c > 0.0)
-            for (size_t i = o; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-                s[i - o] =
-                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-            }
-        else /* one sub-step: the contacts see only where the nodes are now */
-            for (size_t i = o; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                s[i - o] = ux * ux + uy * uy + uz * uz;
-            }
-        /* Squared when there is one sub-step (no square root needed). */
-        const double bound = c > 0.0 ? lim : lim * lim;
-        for (size_t i = o; i < e; i++) {
-            redo[i] = !(s[i - o] < bound);
-            if (redo[i])
-                web->moved[count++] = (uint32_t)i;
-        }
-    }
+    flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    long count = (long)collect_flagged(web->redo, web->n, web->moved);
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
     for (size_t q = 0; count && q < web->ntrack; q++) {
