@@ -300,23 +300,62 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     return count;
 }
 
-int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
-                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap)
+/* The first index in [a, n) whose candidate's node is not below m, n when none: a galloping
+ * search from a, in steps of the logarithm of the distance whether the next node found again
+ * is near or far. */
+static size_t first_not_below(const ws_ncand *c, size_t a, size_t n, uint32_t m)
+{
+    if (a >= n || c[a].node >= m)
+        return a;
+    size_t lo = a, hi = a + 1, step = 1; /* c[lo].node < m */
+    while (hi < n && c[hi].node < m) {
+        lo = hi;
+        step *= 2;
+        hi = lo + step;
+    }
+    if (hi > n)
+        hi = n;
+    while (hi - lo > 1) { /* c[lo].node < m, and hi is n or c[hi].node >= m */
+        size_t mid = lo + (hi - lo) / 2;
+        if (c[mid].node < m)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return hi;
+}
+
+/* Append src[from, from + len) to o at *k (src may be NULL when len is 0). */
+static void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from, size_t len)
+{
+    if (len) {
+        memcpy(o + *k, src + from, len * sizeof *o);
+        *k += len;
+    }
+}
+
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
+                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
+                  size_t *cap)
 {
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
     size_t k = 0, a = 0, f = 0;
-    while (a < nold || f < nfresh) {
-        if (a < nold && web->redo[old[a].node]) {
-            a++; /* replaced by the fresh ones */
-            continue;
-        }
-        if (f < nfresh && (a == nold || fresh[f].node <= old[a].node))
-            o[k++] = fresh[f++];
-        else
-            o[k++] = old[a++];
+    /* Node by node found again: the old candidates of the nodes before it as they are, its
+     * old ones dropped, its fresh ones in their place. */
+    for (size_t q = 0; q < count; q++) {
+        const uint32_t m = nodes[q];
+        size_t e = first_not_below(old, a, nold, m);
+        append_run(o, &k, old, a, e - a);
+        for (a = e; a < nold && old[a].node == m; a++)
+            ;
+        for (e = f; e < nfresh && fresh[e].node == m; e++)
+            ;
+        append_run(o, &k, fresh, f, e - f);
+        f = e;
     }
+    append_run(o, &k, old, a, nold - a);
     *n = k;
     return 0;
 }

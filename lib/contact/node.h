@@ -64,10 +64,12 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
-/* Candidates of the committed list `old` for the nodes not marked in web->redo and the found
- * ones `fresh` (of the marked nodes), merged by node into out. 0, or -1 when out of memory. */
-int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
-                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap);
+/* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
+ * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
+ * into out. 0, or -1 when out of memory. */
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
+                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
+                  size_t *cap);
 
 /* Evaluate the candidates (sorted by node) at node state (x, v) for a sub-step h: forces into
  * web->f, the node contact forces (`share` = 1 / substeps of them) into fc, and the opposite

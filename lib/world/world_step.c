@@ -196,9 +196,9 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          w->def.contact_margin, web->moved, (size_t)moved,
                                          &web->fresh, &web->nfresh, &web->fresh_cap,
                                          &w->stats.narrow_checks) ||
-                      ws_node_merge(&w->mem, web, web->cand[old], web->ncand[old], web->fresh,
-                                    web->nfresh, &web->cand[list], &web->ncand[list],
-                                    &web->capcand[list]);
+                      ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
+                                    web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
+                                    &web->ncand[list], &web->capcand[list]);
             }
             if (bad ||
                 ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
