@@ -33,6 +33,13 @@ static double far_corner(v3 p, v3 lo, v3 hi)
     return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+/* How far from its CoG a point of body k can touch a node, whatever the web's shape: its
+ * bounding sphere grown by the layers and the margin. */
+static double sphere_lever(const ws_body_store *b, uint32_t k, const ws_web *web, double margin)
+{
+    return b->shape[k]->radius + b->layer[k] + web->layer + margin;
+}
+
 /* Body k's box along its own axis j (global, a), grown by its layer and the web's. */
 static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int j, v3 *a,
                       double *lo, double *hi)
@@ -132,7 +139,7 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
         t->near = t->gap <= 0.25 * margin;
         /* A point of the body touches a node only within its bounding sphere grown by the
          * layers and the margin, and only in the web's box. */
-        t->lever = fmin(b->shape[k]->radius + b->layer[k] + web->layer + margin,
+        t->lever = fmin(sphere_lever(b, k, web, margin),
                         far_corner(b->st[cur].r[k], web->box_lo, web->box_hi));
         /* The reference: the heaviest dynamic body near the web (the load the film rides
          * on), else a kinematic one. */
@@ -220,6 +227,47 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
     return count;
 }
 
+/* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
+ * open box (lo, hi). Straight-line code, on vectors. */
+WS_VECTOR_LOOP
+static void flag_in_box(uint8_t *restrict flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo,
+                        v3 hi)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
+    for (size_t i = 0; i < n; i++) {
+        double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+        double sx = a0 * px + a3 * py + a6 * pz;
+        double sy = a1 * px + a4 * py + a7 * pz;
+        double sz = a2 * px + a5 * py + a8 * pz;
+        flag[i] |= (uint8_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) &
+                             (sz > lo.z) & (sz < hi.z));
+    }
+}
+
+/* Re-base near body k (see ws_node_moved) at state cur: its record (rho, q) in the reference
+ * frame (A, r, conjugate orientation pc) and its lever from now, and the nodes it may meet
+ * flagged in web->redo: those in its box grown by the reach (layers + margin), in its frame
+ * now, and those that hold a candidate of it in the committed list. */
+static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
+                        double margin, const m3 *A, v3 r, qt pc)
+{
+    const uint32_t k = t->body;
+    const ws_shape *sh = b->shape[k];
+    const double e = b->layer[k] + web->layer + margin;
+    flag_in_box(web->redo, x, web->n, &b->A[k], b->st[cur].r[k],
+                v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
+                v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
+    const ws_ncand *c = web->cand[web->list];
+    for (size_t q = 0; q < web->ncand[web->list]; q++)
+        web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
+    t->q = qt_mul(pc, b->st[cur].p[k]);
+    t->lever = sphere_lever(b, k, web, margin);
+}
+
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin)
 {
@@ -242,25 +290,36 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     /* The contacts of this step are evaluated with the bodies as they are now (state cur),
      * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
      * move relative to the reference counts as it stands: its CoG's move and its turn times
-     * its lever since the full detection. Near ones must stay within margin / 8 of it. A far
-     * one closes on a node by at most its own move (twice: since the node was last found, the
+     * its lever since its record. Near ones must stay within margin / 8 of it. A far one
+     * closes on a node by at most its own move (twice: since the node was last found, the
      * body moved at most its move then plus its move now, which `gap` and `close` count) and
-     * the node's (under a quarter margin): it must not reach the node. */
-    double dev = 0.0;
+     * the node's (under a quarter margin): it must not reach the node.
+     *
+     * A near body past its bound is re-based (rebase_body) rather than every node found
+     * again: its record becomes its pose now, and the nodes in its box grown by the reach
+     * (layers + margin), in its frame now, are found again now and count their moves from
+     * here, against the new record, like any node found. Any other node is farther than the
+     * reach from every point of the body now. Until it is found again, it stays within 3/16
+     * of the margin (at the start of a step) and 1/4 (in the sub-steps, see below) of where
+     * it was found, so within 7/16 of where it is now; and the body's points stay within
+     * margin / 8 of where they are now (their deviation from the new record, past which the
+     * body is re-based again), with the lever of its bounding sphere, which holds wherever
+     * the nodes go. Together under 9/16 of the margin: the node stays farther than the layers
+     * from the body, cannot touch it and needs no candidate of it. The holders of its
+     * candidates are found again too: the body may have jumped, so that they are out of its
+     * grown box with a candidate that no longer holds (a flag INSIDE). */
+    int rebase = 0;
     for (size_t q = 0; q < web->ntrack; q++) {
         ws_track *t = &web->track[q];
         uint32_t k = t->body;
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
         double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
-        if (t->near) {
-            dev = d > dev ? d : dev;
-        } else if (d + 0.25 * margin >= t->gap) {
+        t->rebase = t->near && d >= margin / 8.0;
+        rebase |= t->rebase;
+        if (!t->near && d + 0.25 * margin >= t->gap)
             return -1;
-        }
     }
-    if (dev >= margin / 8.0)
-        return -1;
     /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
      * the reference frame since it was found, w its velocity relative to the reference body's
      * point where it is, h_more the time its sub-steps go beyond this state (0 with one
@@ -269,6 +328,9 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * margin: what the candidates were found to cover. */
     const double lim = 0.1875 * margin, c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    for (size_t q = 0; rebase && q < web->ntrack; q++)
+        if (web->track[q].rebase)
+            rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);
     long count = (long)collect_flagged(web->redo, web->n, web->moved);
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */

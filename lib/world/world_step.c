@@ -165,9 +165,10 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        /* Node candidates: all found again when the cache is invalid or when the bodies near
-         * the web moved apart, turned or came near (ws_node_moved says -1); else those of the
-         * nodes that moved far enough relative to the near bodies, merged into the others.
+        /* Node candidates: all found again when the cache is invalid or when a body may have
+         * come near (ws_node_moved says -1); else those of the nodes that moved far enough
+         * relative to the near bodies, or that a near body past its bound may meet, merged
+         * into the others.
          * Either way the list holds every node-feature pair that can touch in this step, and
          * the result is the same as finding them every step (tests/test_detection.c shows it
          * for body pairs). The world's detection schedule governs the body pairs. */
