@@ -396,6 +396,24 @@ static void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from,
     }
 }
 
+int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+                 const ws_ncand *fresh, size_t nfresh)
+{
+    size_t a = 0, f = 0;
+    for (size_t q = 0; q < count; q++) {
+        const uint32_t m = nodes[q];
+        size_t a1 = first_not_below(old, a, nold, m), f1 = f;
+        for (a = a1; a < nold && old[a].node == m; a++)
+            ;
+        for (; f1 < nfresh && fresh[f1].node == m; f1++)
+            ;
+        if (a - a1 != f1 - f || (f1 > f && memcmp(old + a1, fresh + f, (f1 - f) * sizeof *old)))
+            return 0;
+        f = f1;
+    }
+    return 1;
+}
+
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
                   size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
                   size_t *cap)

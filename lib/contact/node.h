@@ -67,6 +67,11 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
+/* Whether the found candidates `fresh` of `nodes` (count of them, in increasing order) are
+ * those the committed list `old` holds for them: then it stays as it is. */
+int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+                 const ws_ncand *fresh, size_t nfresh);
+
 /* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
  * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
  * into out. 0, or -1 when out of memory. */

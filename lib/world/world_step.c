@@ -196,10 +196,17 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                 bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
                                          w->def.contact_margin, web->moved, (size_t)moved,
                                          &web->fresh, &web->nfresh, &web->fresh_cap,
-                                         &w->stats.narrow_checks) ||
-                      ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
-                                    web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
-                                    &web->ncand[list], &web->capcand[list]);
+                                         &w->stats.narrow_checks);
+                /* Mostly the nodes found again have the candidates they had: then the
+                 * committed list serves again, uncopied. */
+                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cand[old],
+                                         web->ncand[old], web->fresh, web->nfresh))
+                    list = old;
+                else
+                    bad = bad || ws_node_merge(&w->mem, web->moved, (size_t)moved,
+                                               web->cand[old], web->ncand[old], web->fresh,
+                                               web->nfresh, &web->cand[list], &web->ncand[list],
+                                               &web->capcand[list]);
             }
             if (bad ||
                 ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
