@@ -299,13 +299,13 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * again: its record becomes its pose now, and the nodes in its box grown by the reach
      * (layers + margin), in its frame now, are found again now and count their moves from
      * here, against the new record, like any node found. Any other node is farther than the
-     * reach from every point of the body now. Until it is found again, it stays within 3/16
-     * of the margin (at the start of a step) and 1/4 (in the sub-steps, see below) of where
-     * it was found, so within 7/16 of where it is now; and the body's points stay within
-     * margin / 8 of where they are now (their deviation from the new record, past which the
-     * body is re-based again), with the lever of its bounding sphere, which holds wherever
-     * the nodes go. Together under 9/16 of the margin: the node stays farther than the layers
-     * from the body, cannot touch it and needs no candidate of it. The holders of its
+     * reach from every point of the body now. Until it is found again, the contacts see it
+     * within a quarter margin of where it was found (see below), so within half the margin of
+     * where it is now; and the body's points stay within margin / 8 of where they are now
+     * (their deviation from the new record, past which the body is re-based again), with the
+     * lever of its bounding sphere, which holds wherever the nodes go. Together under 5/8 of
+     * the margin: the node stays farther than the layers from the body, cannot touch it and
+     * needs no candidate of it. The holders of its
      * candidates are found again too: the body may have jumped, so that they are out of its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
     int rebase = 0;
@@ -322,11 +322,15 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     }
     /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
      * the reference frame since it was found, w its velocity relative to the reference body's
-     * point where it is, h_more the time its sub-steps go beyond this state (0 with one
-     * sub-step). Two near bodies' deviations (margin / 4) and the rest (margin / 16, for what
-     * the sub-steps' forces add) keep a node's move relative to any near body under half the
-     * margin: what the candidates were found to cover. */
-    const double lim = 0.1875 * margin, c = 1.5 * dt * (web->substeps - 1) / web->substeps;
+     * point where it is, h_more the time its sub-steps go beyond this state. Two near bodies'
+     * deviations (margin / 4) and the rest (margin / 16, for what the sub-steps' forces add)
+     * keep a node's move relative to any near body under half the margin: what the
+     * candidates were found to cover. With one sub-step the contacts see the nodes only where
+     * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
+     * the margin. Either way a node stays within a quarter margin of where it was found
+     * wherever the contacts see it. */
+    const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
+                 c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     flag_moved(web, x, v, &A, r, vr, wr, c, lim);
     for (size_t q = 0; rebase && q < web->ntrack; q++)
         if (web->track[q].rebase)
