@@ -153,6 +153,19 @@ START_TEST(impact_stays_within_the_layers)
 }
 END_TEST
 
+/* Case 5's paddle: pressed on the band, it spins at 3 rad/s about its axis across the band
+ * and jumps 4 cm along the band every 50 ms (a drive may jump). */
+static int spin_and_jump(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec3 *w)
+{
+    (void)user;
+    const double rate = 3.0, phi = rate * t;
+    pose->position = (ws_vec3){0.1535, (long)floor(t / 0.05) % 2 ? 0.02 : -0.02, 0.12};
+    pose->orientation = (ws_quat){cos(0.5 * phi), sin(0.5 * phi), 0, 0};
+    *v = (ws_vec3){0, 0, 0};
+    *w = (ws_vec3){rate, 0, 0};
+    return 0;
+}
+
 /* A 0.25 m cube wrapped in a band of film (24 x 6 nodes) on a platform that tilts at 1 rad/s
  * from the start: the film snaps on, the platform turns the stack, and from about 0.29 s
  * (tan 16.7 deg = 0.3) box and film slide down it together. */
@@ -205,7 +218,10 @@ static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
     else {
         /* A paddle (2 Hz). Case 2: far from the film at first, it swings in, pokes 7 mm into
          * the film and the box and swings out: a body that comes near. Case 3: it touches the
-         * film from the start and slides along it, over nodes that need not move to be met. */
+         * film from the start and slides along it, over nodes that need not move to be met.
+         * Case 5: it touches the film, spins and jumps (spin_and_jump): the film is found again
+         * only near it and where it held the film, and only its turn tells that its corners
+         * sweep over new nodes. */
         ws_shape_id pad;
         ck_ok(w, ws_shape_create_box(w, 0.05, kind == 2 ? 0.3 : 0.1, 0.1, &pad));
         bd.shape = pad;
@@ -215,7 +231,8 @@ static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
         ck_ok(w, ws_body_create(w, &bd, &paddle));
         ws_drive_def sine;
         ws_drive_def_init(&sine);
-        sine.type = WS_DRIVE_SINE;
+        sine.type = kind == 5 ? WS_DRIVE_CALLBACK : WS_DRIVE_SINE;
+        sine.callback = spin_and_jump;
         sine.direction = kind == 2 ? (ws_vec3){-1, 0, 0} : (ws_vec3){0, 1, 0};
         sine.amplitude = kind == 2 ? 0.065 : 0.06;
         sine.frequency = 2.0;
@@ -382,6 +399,7 @@ static void film_detection_case(int kind)
            : kind == 2 ? "a paddle pokes the band"
            : kind == 3 ? "a paddle slides along the band"
            : kind == 4 ? "a block rises into a sagging sheet"
+           : kind == 5 ? "a paddle spins and jumps on the band"
                        : "a band around the box",
            max_dev, fabs(pa.x - pb.x) + fabs(pa.y - pb.y) + fabs(pa.z - pb.z),
            kind == 4 ? "rose" : "slid", slid);
@@ -394,7 +412,7 @@ static void film_detection_case(int kind)
         report("the block carries %.3f N of the sheet (weight of its free nodes 0.98 N)", -fw.z);
         ck_assert_msg(-fw.z > 0.1, "the sheet does not rest on the block: %g N", -fw.z);
     }
-    if (kind != 3) /* the sliding paddle leaves the box in place */
+    if (kind != 3 && kind != 5) /* the paddle on the band leaves the box in place */
         ck_assert_msg(slid > 0.005, "the box did not move (%.4f m): the case tests too little",
                       slid);
     ws_world_stats sa, sb;
@@ -503,6 +521,7 @@ START_TEST(film_detection_does_not_change_the_motion)
     film_detection_case(2);
     film_detection_case(3);
     film_detection_case(4);
+    film_detection_case(5);
 }
 END_TEST
 

@@ -33,6 +33,13 @@ static double far_corner(v3 p, v3 lo, v3 hi)
     return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+/* How far from its CoG a point of body k can touch a node, whatever the web's shape: its
+ * bounding sphere grown by the layers and the margin. */
+static double sphere_lever(const ws_body_store *b, uint32_t k, const ws_web *web, double margin)
+{
+    return b->shape[k]->radius + b->layer[k] + web->layer + margin;
+}
+
 /* Body k's box along its own axis j (global, a), grown by its layer and the web's. */
 static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int j, v3 *a,
                       double *lo, double *hi)
@@ -132,7 +139,7 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
         t->near = t->gap <= 0.25 * margin;
         /* A point of the body touches a node only within its bounding sphere grown by the
          * layers and the margin, and only in the web's box. */
-        t->lever = fmin(b->shape[k]->radius + b->layer[k] + web->layer + margin,
+        t->lever = fmin(sphere_lever(b, k, web, margin),
                         far_corner(b->st[cur].r[k], web->box_lo, web->box_hi));
         /* The reference: the heaviest dynamic body near the web (the load the film rides
          * on), else a kinematic one. */
@@ -158,6 +165,109 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 }
 
 
+/* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
+ * bound (or is NaN), else 0. Straight-line code, on vectors; the measure is squared when
+ * there is one sub-step (c = 0: no square root needed). */
+WS_VECTOR_LOOP
+static void flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
+                       double c, double lim)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
+                           *restrict oz = web->xdet.z;
+    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
+    const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
+    uint8_t *restrict redo = web->redo;
+    const size_t n = web->n;
+    if (c > 0.0) {
+        for (size_t i = 0; i < n; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+            double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
+            double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
+            double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
+            double m = sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
+            redo[i] = !(m < lim);
+        }
+    } else { /* one sub-step: the contacts see only where the nodes are now */
+        const double lim2 = lim * lim;
+        for (size_t i = 0; i < n; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+            redo[i] = !(ux * ux + uy * uy + uz * uz < lim2);
+        }
+    }
+}
+
+/* The flagged nodes (flags 0 or 1) into `moved`, in order; how many. Eight flags at a time:
+ * most steps flag few nodes, and those in runs. */
+static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
+{
+    size_t count = 0, i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t word;
+        memcpy(&word, flag + i, sizeof word);
+        if (!word)
+            continue;
+        for (size_t j = i; j < i + 8; j++) {
+            moved[count] = (uint32_t)j;
+            count += flag[j];
+        }
+    }
+    for (; i < n; i++) {
+        moved[count] = (uint32_t)i;
+        count += flag[i];
+    }
+    return count;
+}
+
+/* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
+ * open box (lo, hi). Straight-line code, on vectors. */
+WS_VECTOR_LOOP
+static void flag_in_box(uint8_t *restrict flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo,
+                        v3 hi)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
+    for (size_t i = 0; i < n; i++) {
+        double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+        double sx = a0 * px + a3 * py + a6 * pz;
+        double sy = a1 * px + a4 * py + a7 * pz;
+        double sz = a2 * px + a5 * py + a8 * pz;
+        flag[i] |= (uint8_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) &
+                             (sz > lo.z) & (sz < hi.z));
+    }
+}
+
+/* Re-base near body k (see ws_node_moved) at state cur: its record (rho, q) in the reference
+ * frame (A, r, conjugate orientation pc) and its lever from now, and the nodes it may meet
+ * flagged in web->redo: those in its box grown by the reach (layers + margin), in its frame
+ * now, and those that hold a candidate of it in the committed list. */
+static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
+                        double margin, const m3 *A, v3 r, qt pc)
+{
+    const uint32_t k = t->body;
+    const ws_shape *sh = b->shape[k];
+    const double e = b->layer[k] + web->layer + margin;
+    flag_in_box(web->redo, x, web->n, &b->A[k], b->st[cur].r[k],
+                v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
+                v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
+    const ws_ncand *c = web->cand[web->list];
+    for (size_t q = 0; q < web->ncand[web->list]; q++)
+        web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
+    t->q = qt_mul(pc, b->st[cur].p[k]);
+    t->lever = sphere_lever(b, k, web, margin);
+}
+
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin)
 {
@@ -180,75 +290,52 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     /* The contacts of this step are evaluated with the bodies as they are now (state cur),
      * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
      * move relative to the reference counts as it stands: its CoG's move and its turn times
-     * its lever since the full detection. Near ones must stay within margin / 8 of it. A far
-     * one closes on a node by at most its own move (twice: since the node was last found, the
+     * its lever since its record. Near ones must stay within margin / 8 of it. A far one
+     * closes on a node by at most its own move (twice: since the node was last found, the
      * body moved at most its move then plus its move now, which `gap` and `close` count) and
-     * the node's (under a quarter margin): it must not reach the node. */
-    double dev = 0.0;
+     * the node's (under a quarter margin): it must not reach the node.
+     *
+     * A near body past its bound is re-based (rebase_body) rather than every node found
+     * again: its record becomes its pose now, and the nodes in its box grown by the reach
+     * (layers + margin), in its frame now, are found again now and count their moves from
+     * here, against the new record, like any node found. Any other node is farther than the
+     * reach from every point of the body now. Until it is found again, the contacts see it
+     * within a quarter margin of where it was found (see below), so within half the margin of
+     * where it is now; and the body's points stay within margin / 8 of where they are now
+     * (their deviation from the new record, past which the body is re-based again), with the
+     * lever of its bounding sphere, which holds wherever the nodes go. Together under 5/8 of
+     * the margin: the node stays farther than the layers from the body, cannot touch it and
+     * needs no candidate of it. The holders of its
+     * candidates are found again too: the body may have jumped, so that they are out of its
+     * grown box with a candidate that no longer holds (a flag INSIDE). */
+    int rebase = 0;
     for (size_t q = 0; q < web->ntrack; q++) {
         ws_track *t = &web->track[q];
         uint32_t k = t->body;
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
         double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
-        if (t->near) {
-            dev = d > dev ? d : dev;
-        } else if (d + 0.25 * margin >= t->gap) {
+        t->rebase = t->near && d >= margin / 8.0;
+        rebase |= t->rebase;
+        if (!t->near && d + 0.25 * margin >= t->gap)
             return -1;
-        }
     }
-    if (dev >= margin / 8.0)
-        return -1;
     /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
      * the reference frame since it was found, w its velocity relative to the reference body's
-     * point where it is, h_more the time its sub-steps go beyond this state (0 with one
-     * sub-step). Two near bodies' deviations (margin / 4) and the rest (margin / 16, for what
-     * the sub-steps' forces add) keep a node's move relative to any near body under half the
-     * margin: what the candidates were found to cover. */
-    const double lim = 0.1875 * margin, c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    const double *a = A.m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
-                           *restrict oz = web->xdet.z;
-    uint8_t *restrict redo = web->redo;
-    double *restrict s = web->tmp; /* 3 WS_WEB_CHUNK doubles */
-    const size_t n = web->n, chunk = 3 * WS_WEB_CHUNK;
-    long count = 0;
-    /* In chunks: the measure of each node into the scratch (straight-line code, on vectors),
-     * then the test (NaN flags too). */
-    for (size_t o = 0; o < n; o += chunk) {
-        size_t e = n - o < chunk ? n : o + chunk;
-        const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
-        const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
-        if (c > 0.0)
-            for (size_t i = o; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-                s[i - o] =
-                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-            }
-        else /* one sub-step: the contacts see only where the nodes are now */
-            for (size_t i = o; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                s[i - o] = ux * ux + uy * uy + uz * uz;
-            }
-        /* Squared when there is one sub-step (no square root needed). */
-        const double bound = c > 0.0 ? lim : lim * lim;
-        for (size_t i = o; i < e; i++) {
-            redo[i] = !(s[i - o] < bound);
-            if (redo[i])
-                web->moved[count++] = (uint32_t)i;
-        }
-    }
+     * point where it is, h_more the time its sub-steps go beyond this state. Two near bodies'
+     * deviations (margin / 4) and the rest (margin / 16, for what the sub-steps' forces add)
+     * keep a node's move relative to any near body under half the margin: what the
+     * candidates were found to cover. With one sub-step the contacts see the nodes only where
+     * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
+     * the margin. Either way a node stays within a quarter margin of where it was found
+     * wherever the contacts see it. */
+    const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
+                 c = 1.5 * dt * (web->substeps - 1) / web->substeps;
+    flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    for (size_t q = 0; rebase && q < web->ntrack; q++)
+        if (web->track[q].rebase)
+            rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);
+    long count = (long)collect_flagged(web->redo, web->n, web->moved);
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
     for (size_t q = 0; count && q < web->ntrack; q++) {
@@ -279,24 +366,175 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     return count;
 }
 
-int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
-                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap)
+/* The first index in [a, n) whose candidate's node is not below m, n when none: a galloping
+ * search from a, in steps of the logarithm of the distance whether the next node found again
+ * is near or far. */
+static size_t first_not_below(const ws_ncand *c, size_t a, size_t n, uint32_t m)
+{
+    if (a >= n || c[a].node >= m)
+        return a;
+    size_t lo = a, hi = a + 1, step = 1; /* c[lo].node < m */
+    while (hi < n && c[hi].node < m) {
+        lo = hi;
+        step *= 2;
+        hi = lo + step;
+    }
+    if (hi > n)
+        hi = n;
+    while (hi - lo > 1) { /* c[lo].node < m, and hi is n or c[hi].node >= m */
+        size_t mid = lo + (hi - lo) / 2;
+        if (c[mid].node < m)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return hi;
+}
+
+/* Append src[from, from + len) to o at *k (src may be NULL when len is 0). */
+static void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from, size_t len)
+{
+    if (len) {
+        memcpy(o + *k, src + from, len * sizeof *o);
+        *k += len;
+    }
+}
+
+int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+                 const ws_ncand *fresh, size_t nfresh)
+{
+    size_t a = 0, f = 0;
+    for (size_t q = 0; q < count; q++) {
+        const uint32_t m = nodes[q];
+        size_t a1 = first_not_below(old, a, nold, m), f1 = f;
+        for (a = a1; a < nold && old[a].node == m; a++)
+            ;
+        for (; f1 < nfresh && fresh[f1].node == m; f1++)
+            ;
+        if (a - a1 != f1 - f || (f1 > f && memcmp(old + a1, fresh + f, (f1 - f) * sizeof *old)))
+            return 0;
+        f = f1;
+    }
+    return 1;
+}
+
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
+                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
+                  size_t *cap)
 {
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
     size_t k = 0, a = 0, f = 0;
-    while (a < nold || f < nfresh) {
-        if (a < nold && web->redo[old[a].node]) {
-            a++; /* replaced by the fresh ones */
-            continue;
-        }
-        if (f < nfresh && (a == nold || fresh[f].node <= old[a].node))
-            o[k++] = fresh[f++];
-        else
-            o[k++] = old[a++];
+    /* Node by node found again: the old candidates of the nodes before it as they are, its
+     * old ones dropped, its fresh ones in their place. */
+    for (size_t q = 0; q < count; q++) {
+        const uint32_t m = nodes[q];
+        size_t e = first_not_below(old, a, nold, m);
+        append_run(o, &k, old, a, e - a);
+        for (a = e; a < nold && old[a].node == m; a++)
+            ;
+        for (e = f; e < nfresh && fresh[e].node == m; e++)
+            ;
+        append_run(o, &k, fresh, f, e - f);
+        f = e;
     }
+    append_run(o, &k, old, a, nold - a);
     *n = k;
+    return 0;
+}
+
+/* Append c to the list. 0, or -1 when out of memory. */
+static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_ncand c)
+{
+    if (*n == *cap && ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
+        return -1;
+    (*out)[(*n)++] = c;
+    return 0;
+}
+
+/* Index of the lowest set bit of m (m != 0). */
+static inline uint32_t lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(m);
+#else
+    uint32_t f = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
+/* The tests of inside_box without its branches. */
+static inline int in_box(v3 p, v3 lo, v3 hi, double e)
+{
+    return (p.x > lo.x - e) & (p.x < hi.x + e) & (p.y > lo.y - e) & (p.y < hi.y + e) &
+           (p.z > lo.z - e) & (p.z < hi.z + e);
+}
+
+/* Node i at s (body frame) against a convex body k of at most WS_NCAND_FACES faces: the faces
+ * and edges the general search below would list, in the same order, with the faces' tests as
+ * bit masks so that a node pays only for the few features near it and takes few branches.
+ * Only here may a face candidate be marked INSIDE. */
+static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g, uint32_t i,
+                             uint32_t k, v3 s, double reach, double margin, ws_ncand **out,
+                             size_t *n, size_t *cap, uint64_t *checks)
+{
+    const uint32_t nf = sh->face_count;
+    const double deep = -reach - sh->inner;
+    double D = -INFINITY, dg[WS_NCAND_FACES];
+    /* boxes: the faces whose box, grown by the reach, holds the node. An edge's box lies in
+     * the boxes of both its faces, so an edge within reach of the node needs two of them:
+     * most nodes, over the middle of a face, have at most one and skip the edges. */
+    uint64_t boxes = 0, pass = 0;
+    for (uint32_t f = 0; f < nf; f++) {
+        const ws_face *F = &sh->faces[f];
+        double d = v3_dot(F->normal, s) - F->offset;
+        dg[f] = d;
+        D = d > D ? d : D;
+        boxes |= (uint64_t)in_box(s, F->lo, F->hi, reach) << f;
+    }
+    for (uint32_t f = 0; f < nf; f++) {
+        double d = dg[f];
+        pass |= (uint64_t)((d > deep) & (d < reach) & (d >= D - margin)) << f;
+    }
+    *checks += nf;
+    for (; pass; pass &= pass - 1) {
+        uint32_t f = lowest_bit(pass);
+        const ws_face *fc = &sh->faces[f];
+        double d = dg[f];
+        if (!inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
+            continue;
+        /* Well inside the outline: its projection on the plane lies a margin or more behind
+         * every other face's plane (those planes bound the face on a convex body, and a plane
+         * distance never exceeds the distance within the face's plane). Nodes and bodies move
+         * less than half the margin relative to each other until the candidates are found
+         * again. */
+        int inside = 1;
+        for (uint32_t o = 0; o < nf; o++)
+            inside &= (o == f) | (dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin);
+        ws_ncand c = {i, k, g->face_base[k] + f, f | (inside ? WS_NCAND_INSIDE : 0u)};
+        if (push_cand(mem, out, n, cap, c) != 0)
+            return -1;
+    }
+    if (!(boxes & (boxes - 1)))
+        return 0;
+    for (uint32_t e = 0; e < sh->edge_count; e++) {
+        const ws_edge *E = &sh->edges[e];
+        if (!((boxes >> E->f1) & (boxes >> E->f2) & 1u) || !inside_box(s, E->lo, E->hi, reach))
+            continue;
+        (*checks)++;
+        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
+        if (t < 0.0 || t > 1.0)
+            continue;
+        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
+            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+            return -1;
+    }
     return 0;
 }
 
@@ -315,10 +553,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
         uint32_t i = nodes ? nodes[q] : (uint32_t)q;
         v3 p = nodes_get(x, i);
         for (uint32_t k = 0; k < b->slots; k++) {
-            if (!b->alive[k])
-                continue;
-            if (p.x < b->lo[k].x - pad || p.x > b->hi[k].x + pad || p.y < b->lo[k].y - pad ||
-                p.y > b->hi[k].y + pad || p.z < b->lo[k].z - pad || p.z > b->hi[k].z + pad)
+            if (!b->alive[k] || !in_box(p, b->lo[k], b->hi[k], pad))
                 continue;
             const ws_shape *sh = b->shape[k];
             double reach = b->layer[k] + web->layer + margin;
@@ -332,14 +567,16 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
              * the margin together, which changes d_f - D by less than the margin: faces further
              * behind than that cannot come into contact and are not candidates. On a box this
              * drops the side faces next to the one a node lies on. */
-            double D = -INFINITY, dg[WS_NCAND_FACES];
-            int keep = sh->convex && sh->face_count <= WS_NCAND_FACES;
+            if (sh->convex && sh->face_count <= WS_NCAND_FACES) {
+                if (convex_candidates(mem, sh, g, i, k, s, reach, margin, out, n, cap, checks))
+                    return -1;
+                continue;
+            }
+            double D = -INFINITY;
             if (sh->convex)
                 for (uint32_t f = 0; f < sh->face_count; f++) {
                     double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
                     D = d > D ? d : D;
-                    if (keep)
-                        dg[f] = d;
                 }
             for (uint32_t f = 0; f < sh->face_count; f++) {
                 const ws_face *fc = &sh->faces[f];
@@ -348,24 +585,9 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 /* Depth counts along the normal only: the point's projection on the face's
                  * plane must lie within reach of the face. */
                 if (d > -reach - sh->inner && d < reach && d >= D - margin &&
-                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach)) {
-                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
-                        return -1;
-                    /* Well inside the outline: its projection on the plane lies a margin or
-                     * more behind every other face's plane (those planes bound the face on a
-                     * convex body, and a plane distance never exceeds the distance within the
-                     * face's plane). Nodes and bodies move less than half the margin relative
-                     * to each other until the candidates are found again. */
-                    uint32_t inside = 0;
-                    if (keep) {
-                        inside = WS_NCAND_INSIDE;
-                        for (uint32_t o = 0; o < sh->face_count && inside; o++)
-                            if (o != f &&
-                                !(dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin))
-                                inside = 0;
-                    }
-                    (*out)[(*n)++] = (ws_ncand){i, k, g->face_base[k] + f, f | inside};
-                }
+                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach) &&
+                    push_cand(mem, out, n, cap, (ws_ncand){i, k, g->face_base[k] + f, f}))
+                    return -1;
             }
             /* Convex edges within reach of the node: the rounded rim of the contact layer. */
             for (uint32_t e = 0; e < sh->edge_count; e++) {
@@ -377,11 +599,10 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
                 if (t < 0.0 || t > 1.0)
                     continue;
-                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach) {
-                    if (ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
-                        return -1;
-                    (*out)[(*n)++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
-                }
+                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
+                    push_cand(mem, out, n, cap,
+                              (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+                    return -1;
             }
         }
     }

@@ -56,18 +56,28 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
- * reach 3/16 of the margin. They go to web->moved (count returned) with web->redo set, and
- * their xdet is moved to where they are now. -1: every node must be found again (a body came
- * near the web, or the near bodies moved apart or turned by more than margin / 8 at their
- * lever). Until a node is found again its move relative to a near body stays under half the
- * margin, the distance a candidate list is built to cover: see node.c. */
+ * reach 3/16 of the margin (1/4 with one sub-step); and when a near body moved or turned by
+ * margin / 8 at its lever relative to the reference, the nodes it may meet (in its box grown
+ * by the layers and the margin, or holding a candidate of it), its record starting again from
+ * now. They go to web->moved (count returned) with web->redo set, and their xdet is moved to
+ * where they are now. -1: every node must be found again (a body was made since the full
+ * detection, or a far body may have come near the web). Until a node is found again its move
+ * relative to a near body stays under half the margin, the distance a candidate list is built
+ * to cover, and a body it holds no candidate of cannot touch it: see node.c. */
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
-/* Candidates of the committed list `old` for the nodes not marked in web->redo and the found
- * ones `fresh` (of the marked nodes), merged by node into out. 0, or -1 when out of memory. */
-int ws_node_merge(ws_mem *mem, const ws_web *web, const ws_ncand *old, size_t nold,
-                  const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n, size_t *cap);
+/* Whether the found candidates `fresh` of `nodes` (count of them, in increasing order) are
+ * those the committed list `old` holds for them: then it stays as it is. */
+int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+                 const ws_ncand *fresh, size_t nfresh);
+
+/* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
+ * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
+ * into out. 0, or -1 when out of memory. */
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
+                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
+                  size_t *cap);
 
 /* Cut the candidates (sorted by node) of list `list` of a web into its stretches (web->seg,
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */

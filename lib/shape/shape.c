@@ -303,6 +303,8 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         ws_edge *e = &out->edges[out->edge_count++];
         e->a = he[i].lo;
         e->b = he[i].hi;
+        e->f1 = face_of[t0];
+        e->f2 = face_of[t1];
         e->n1 = tn[t0];
         e->n2 = tn[t1];
         e->lo = v3_min(out->vertices[e->a], out->vertices[e->b]);

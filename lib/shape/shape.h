@@ -26,9 +26,11 @@ typedef struct ws_face {
 } ws_face;
 
 /* A convex feature edge between two faces that are not coplanar. n1, n2: the outward normals of
- * the two faces, for the normal-cone test. */
+ * the two faces, for the normal-cone test; f1, f2: the two faces (an edge lies in the box of
+ * each). */
 typedef struct ws_edge {
     uint32_t a, b;
+    uint32_t f1, f2;
     v3 n1, n2;
     v3 lo, hi; /* bounding box of the edge */
 } ws_edge;

@@ -68,13 +68,15 @@ static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
 
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
  * reference body (see ws_web): its CoG (rho) and orientation (q) in the reference body's
- * frame; its lever: how far from its CoG a point of it can touch a node. Near the web, or far
- * from it: then every node lies beyond its box (grown by the layers) along its own axis
- * `axis` (0, 1, 2), whose interval is (lo, hi), and `gap` is the least distance beyond it that
- * a node had when last found, less how far the body had moved by then (ws_node_moved). */
+ * frame (for a near body, as it was when it last moved past its bound, ws_node_moved); its
+ * lever: how far from its CoG a point of it can touch a node. Near the web, or far from it:
+ * then every node lies beyond its box (grown by the layers) along its own axis `axis` (0, 1,
+ * 2), whose interval is (lo, hi), and `gap` is the least distance beyond it that a node had
+ * when last found, less how far the body had moved by then (ws_node_moved). rebase: scratch
+ * of ws_node_moved. */
 typedef struct ws_track {
     uint32_t body;
-    int near, axis;
+    int near, axis, rebase;
     v3 rho;
     qt q;
     double lo, hi, gap, lever;

@@ -165,9 +165,10 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        /* Node candidates: all found again when the cache is invalid or when the bodies near
-         * the web moved apart, turned or came near (ws_node_moved says -1); else those of the
-         * nodes that moved far enough relative to the near bodies, merged into the others.
+        /* Node candidates: all found again when the cache is invalid or when a body may have
+         * come near (ws_node_moved says -1); else those of the nodes that moved far enough
+         * relative to the near bodies, or that a near body past its bound may meet, merged
+         * into the others.
          * Either way the list holds every node-feature pair that can touch in this step, and
          * the result is the same as finding them every step (tests/test_detection.c shows it
          * for body pairs). The world's detection schedule governs the body pairs. */
@@ -197,10 +198,17 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                 bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
                                          w->def.contact_margin, web->moved, (size_t)moved,
                                          &web->fresh, &web->nfresh, &web->fresh_cap,
-                                         &w->stats.narrow_checks) ||
-                      ws_node_merge(&w->mem, web, web->cand[old], web->ncand[old], web->fresh,
-                                    web->nfresh, &web->cand[list], &web->ncand[list],
-                                    &web->capcand[list]);
+                                         &w->stats.narrow_checks);
+                /* Mostly the nodes found again have the candidates they had: then the
+                 * committed list serves again, uncopied. */
+                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cand[old],
+                                         web->ncand[old], web->fresh, web->nfresh))
+                    list = old;
+                else
+                    bad = bad || ws_node_merge(&w->mem, web->moved, (size_t)moved,
+                                               web->cand[old], web->ncand[old], web->fresh,
+                                               web->nfresh, &web->cand[list], &web->ncand[list],
+                                               &web->capcand[list]);
             }
             if (bad ||
                 ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
