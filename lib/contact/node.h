@@ -79,6 +79,10 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_nca
                   size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
                   size_t *cap);
 
+/* Room for evaluating ncand candidates (web->act, web->sel). 0, or -1 when out of memory. */
+int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand);
+void ws_node_scratch_free(ws_mem *mem, ws_web *web);
+
 /* Cut the candidates (sorted by node) of list `list` of a web into its stretches (web->seg,
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list);

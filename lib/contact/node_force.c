@@ -61,11 +61,21 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
-/* The friction on a pushing node (eq. 13), limited to the force that stops its slip within
- * the sub-step h: from the contact's normal n, the node's tangential velocity relative to the
- * body t, its force with every normal force in k, its 1 / mass and mass, the normal force fn
- * and the contact's mu and v_lim (contacts_general says why). None for a pinned node or one
- * that does not slip. Straight-line code, so loops of it run on vectors. */
+/* The friction on a pushing node: from the contact's normal n, the node's tangential velocity
+ * relative to the body t, its force with every normal force in k, its 1 / mass and mass, the
+ * normal force fn and the contact's mu and v_lim. None for a pinned node or one that does not
+ * slip. Straight-line code, so loops of it run on vectors.
+ *
+ * Eq. 13, limited to the force that stops the node's slip within this sub-step h. Below v_lim
+ * eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit step of a light node
+ * (it would reverse the slip and chatter), so the slip is predicted at the end of the sub-step
+ * with the other forces on the node (springs, gravity and every normal force, none of the
+ * frictions: order-free), and the friction is the smaller of what stops that slip
+ * (m |v_pred| / h) and what eq. 13 gives for it, against it. Sticking nodes hold their
+ * tangential load; sliding ones get mu N; for heavy masses this is eq. 13 itself. Every normal
+ * force comes before any friction: a node at a corner touches two faces, and this makes the
+ * result independent of the order of the faces (which differs from corner to corner and would
+ * twist a symmetric load). */
 static inline void friction_of(double nx, double ny, double nz, double tx, double ty, double tz,
                                double kx, double ky, double kz, double im, double mass,
                                double fn, double mu, double vlim, double h, double *ax,
@@ -86,37 +96,134 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
     *az = slips ? pz * s : 0.0;
 }
 
-#define GEN_CHUNK 64 /* contacts whose frictions are taken at once (contacts_general) */
-enum { G_NX, G_NY, G_NZ, G_TX, G_TY, G_TZ, G_KX, G_KY, G_KZ, G_IM, G_M, G_FN, G_MU, G_VL, G_AX,
-       G_AY, G_AZ, GEN_ARRAYS };
-#define GEN_GS 72 /* from one of those arrays to the next (not a divisor of 4096 bytes) */
+/* ---- the pushing contacts of a sweep block
+ *
+ * The normal passes (one by one, and runs) put each node's normal forces into f and list the
+ * contacts that push, in node order, as arrays of web->act_cap (web->act). Once every normal
+ * force of the block is in, their frictions go on vectors, and then all of them are applied to
+ * the nodes and the bodies in node order. */
 
-/* Frictions of m contacts, each with its own normal and contact law (arrays as above). */
-WS_VECTOR_LOOP
-static void gen_friction(size_t m, double h, double *restrict G)
+enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
+       A_IM, A_M, A_AX, A_AY, A_AZ, ACT_ARRAYS };
+
+/* The list: per contact its normal (from the body to the node), lever from the body's CoG to
+ * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
+ * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
+ * found. node and body name the node and the body's slot. */
+typedef struct act_list {
+    double *a[ACT_ARRAYS];
+    uint32_t *node, *body;
+    size_t n;
+} act_list;
+
+static act_list act_open(ws_web *web)
 {
-    const double *restrict nx = G + G_NX * GEN_GS, *restrict ny = G + G_NY * GEN_GS,
-                           *restrict nz = G + G_NZ * GEN_GS, *restrict tx = G + G_TX * GEN_GS,
-                           *restrict ty = G + G_TY * GEN_GS, *restrict tz = G + G_TZ * GEN_GS,
-                           *restrict kx = G + G_KX * GEN_GS, *restrict ky = G + G_KY * GEN_GS,
-                           *restrict kz = G + G_KZ * GEN_GS, *restrict im = G + G_IM * GEN_GS,
-                           *restrict mass = G + G_M * GEN_GS, *restrict fn = G + G_FN * GEN_GS,
-                           *restrict mu = G + G_MU * GEN_GS, *restrict vl = G + G_VL * GEN_GS;
-    double *restrict ax = G + G_AX * GEN_GS, *restrict ay = G + G_AY * GEN_GS,
-                     *restrict az = G + G_AZ * GEN_GS;
+    act_list L;
+    for (int k = 0; k < ACT_ARRAYS; k++)
+        L.a[k] = web->act + (size_t)k * web->act_cap;
+    L.node = web->act_id;
+    L.body = web->act_id + web->act_cap;
+    L.n = 0;
+    return L;
+}
+
+/* Contact `node` against body `body`: written at the end of the list, and kept when `keep`
+ * (no branch: the list has room for every candidate of the block and one more). */
+static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 lever, v3 vt,
+                            double fn, double mu, double vlim, int keep)
+{
+    const size_t q = L->n;
+    L->node[q] = node;
+    L->body[q] = body;
+    L->a[A_NX][q] = n.x;
+    L->a[A_NY][q] = n.y;
+    L->a[A_NZ][q] = n.z;
+    L->a[A_LX][q] = lever.x;
+    L->a[A_LY][q] = lever.y;
+    L->a[A_LZ][q] = lever.z;
+    L->a[A_TX][q] = vt.x;
+    L->a[A_TY][q] = vt.y;
+    L->a[A_TZ][q] = vt.z;
+    L->a[A_FN][q] = fn;
+    L->a[A_MU][q] = mu;
+    L->a[A_VL][q] = vlim;
+    L->n += (size_t)(keep != 0);
+}
+
+/* Frictions of the m contacts of the list. */
+WS_VECTOR_LOOP
+static void act_friction(size_t m, double h, double *const *A)
+{
+    const double *restrict nx = A[A_NX], *restrict ny = A[A_NY], *restrict nz = A[A_NZ];
+    const double *restrict tx = A[A_TX], *restrict ty = A[A_TY], *restrict tz = A[A_TZ];
+    const double *restrict kx = A[A_KX], *restrict ky = A[A_KY], *restrict kz = A[A_KZ];
+    const double *restrict im = A[A_IM], *restrict mass = A[A_M], *restrict fn = A[A_FN];
+    const double *restrict mu = A[A_MU], *restrict vl = A[A_VL];
+    double *restrict ax = A[A_AX], *restrict ay = A[A_AY], *restrict az = A[A_AZ];
     for (size_t q = 0; q < m; q++)
         friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
                     mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
 }
 
-/* Candidates one by one, in node order: any feature, any body. */
-static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
-                             ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, size_t n,
-                             const ws_node_params *pp, double h, double share, v3 *fc,
-                             v3 *bforce, v3 *bmoment)
+/* The list's frictions, then every contact applied in node order: friction to the node, the
+ * contact force's share to the node's record, the opposite to the body's totals. */
+static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc, v3 *bforce,
+                      v3 *bmoment)
+{
+    const size_t m = L->n;
+    double *const *A = L->a;
+    ws_nodes3 f = web->f;
+    for (size_t q = 0; q < m; q++) { /* each node's force with all its normal forces in */
+        const uint32_t i = L->node[q];
+        A[A_KX][q] = f.x[i];
+        A[A_KY][q] = f.y[i];
+        A[A_KZ][q] = f.z[i];
+        A[A_IM][q] = web->inv_m[i];
+        A[A_M][q] = web->m[i];
+    }
+    act_friction(m, h, A);
+    uint32_t *touched = web->fct[web->fck];
+    size_t nt = web->nfct[web->fck];
+    uint32_t body = UINT32_MAX;
+    v3 bf = v3_make(0, 0, 0), bm = bf;
+    for (size_t q = 0; q < m; q++) {
+        const uint32_t i = L->node[q], bi = L->body[q];
+        if (bi != body) { /* the running sums of the body at hand, kept in registers */
+            if (body != UINT32_MAX) {
+                bforce[body] = bf;
+                bmoment[body] = bm;
+            }
+            body = bi;
+            bf = bforce[bi];
+            bm = bmoment[bi];
+        }
+        v3 ft = v3_make(A[A_AX][q], A[A_AY][q], A[A_AZ][q]);
+        v3 n = v3_make(A[A_NX][q], A[A_NY][q], A[A_NZ][q]);
+        v3 lever = v3_make(A[A_LX][q], A[A_LY][q], A[A_LZ][q]);
+        double fn = A[A_FN][q];
+        nodes_add(f, i, ft);
+        v3 Fnode = v3_madd(ft, n, fn);
+        fc[i] = v3_madd(fc[i], Fnode, share);
+        touched[nt++] = i;
+        v3 Fb = v3_scale(Fnode, -share);
+        bf = v3_add(bf, Fb);
+        bm = v3_add(bm, v3_cross(lever, Fb));
+    }
+    if (body != UINT32_MAX) {
+        bforce[body] = bf;
+        bmoment[body] = bm;
+    }
+    web->nfct[web->fck] = nt;
+    L->n = 0;
+}
+
+/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
+ * contacts that push into the list. */
+static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom *g,
+                             ws_web *web, ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand,
+                             size_t n, const ws_node_params *pp, act_list *L)
 {
     const ws_body_state *st = &b->st[cur];
-    ws_nact *act = web->act; /* room for n: reserved with the candidates */
     uint32_t *sel = web->sel;
     /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
      * it now and then: which ones do is a coin toss from step to step. So the plane distance
@@ -133,7 +240,6 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
         m += (size_t)((d < b->layer[c->body] + wl) | ((c->local & WS_NCAND_EDGE) != 0));
     }
     /* Normal forces, in node order. */
-    size_t na = 0;
     for (size_t q = 0; q < m; q++) {
         const ws_ncand *c = &cand[sel[q]];
         uint32_t i = c->node, bi = c->body;
@@ -167,7 +273,8 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
         const ws_node_params *p = &pp[b->material[bi]];
         v3 r = st->r[bi];
         v3 xc = v3_madd(xi, nrm, -0.5 * d);
-        v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], v3_sub(xc, r)));
+        v3 lever = v3_sub(xc, r);
+        v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], lever));
         v3 vrel = v3_sub(nodes_get(v, i), vb);
         double vn = v3_dot(vrel, nrm);
         double fn = p->k * (hi - d) - p->c * vn;
@@ -175,73 +282,15 @@ static void contacts_general(ws_body_store *b, int cur, const ws_node_geom *g, w
          * added times that (0 or 1). */
         double push = fn > 0.0;
         nodes_add(web->f, i, v3_scale(nrm, fn * push));
-        act[na] = (ws_nact){i, bi, nrm, xc, v3_madd(vrel, nrm, -vn), v3_make(0, 0, 0), fn,
-                            p->mu, p->vlim};
-        na += (size_t)push;
-    }
-    /* Once every normal force is in: the frictions (on vectors, from each node's force with all
-     * its normal forces in), then all of them applied in node order. A node at a corner
-     * touches two faces; doing every normal force before any friction makes the result
-     * independent of the order of the faces (which differs from corner to corner and would
-     * twist a symmetric load).
-     *
-     * Friction: eq. 13, limited to the force that stops the node's slip within this sub-step.
-     * Below v_lim eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit
-     * step of a light node (it would reverse the slip and chatter), so the slip is predicted at
-     * the end of the sub-step with the other forces on the node (springs, gravity and every
-     * normal force, none of the frictions: again order-free), and the friction is the smaller of
-     * what stops that slip (m |v_pred| / h) and what eq. 13 gives for it, against it. Sticking
-     * nodes hold their tangential load; sliding ones get mu N; for heavy masses this is eq. 13
-     * itself. */
-    double *G = web->rtmp;
-    for (size_t q0 = 0; q0 < na; q0 += GEN_CHUNK) {
-        size_t cm = na - q0 < GEN_CHUNK ? na - q0 : GEN_CHUNK;
-        for (size_t q = 0; q < cm; q++) {
-            const ws_nact *a = &act[q0 + q];
-            const uint32_t i = a->node;
-            G[G_NX * GEN_GS + q] = a->n.x;
-            G[G_NY * GEN_GS + q] = a->n.y;
-            G[G_NZ * GEN_GS + q] = a->n.z;
-            G[G_TX * GEN_GS + q] = a->vt.x;
-            G[G_TY * GEN_GS + q] = a->vt.y;
-            G[G_TZ * GEN_GS + q] = a->vt.z;
-            G[G_KX * GEN_GS + q] = web->f.x[i];
-            G[G_KY * GEN_GS + q] = web->f.y[i];
-            G[G_KZ * GEN_GS + q] = web->f.z[i];
-            G[G_IM * GEN_GS + q] = web->inv_m[i];
-            G[G_M * GEN_GS + q] = web->m[i];
-            G[G_FN * GEN_GS + q] = a->fn;
-            G[G_MU * GEN_GS + q] = a->mu;
-            G[G_VL * GEN_GS + q] = a->vlim;
-        }
-        gen_friction(cm, h, G);
-        for (size_t q = 0; q < cm; q++)
-            act[q0 + q].ft = v3_make(G[G_AX * GEN_GS + q], G[G_AY * GEN_GS + q],
-                                     G[G_AZ * GEN_GS + q]);
-    }
-    /* Apply, in node order; the bodies get the opposite, averaged over the sub-steps (into the
-     * web's per-body totals, which the step adds to the bodies once). */
-    for (size_t q = 0; q < na; q++) {
-        const ws_nact *a = &act[q];
-        const uint32_t i = a->node, bi = a->body;
-        nodes_add(web->f, i, a->ft);
-        v3 Fnode = v3_madd(a->ft, a->n, a->fn);
-        fc[i] = v3_madd(fc[i], Fnode, share);
-        web->fct[web->fck][web->nfct[web->fck]++] = i;
-        v3 Fb = v3_scale(Fnode, -share);
-        bforce[bi] = v3_add(bforce[bi], Fb);
-        bmoment[bi] = v3_add(bmoment[bi], v3_cross(v3_sub(a->xc, st->r[bi]), Fb));
+        act_push(L, i, bi, nrm, lever, v3_madd(vrel, nrm, -vn), fn, p->mu, p->vlim,
+                 fn > 0.0);
     }
 }
 
 /* ---- runs: nodes side by side on one face */
 
 #define RUN_MIN 4     /* shorter stretches go one by one */
-#define RUN_CHUNK 128 /* nodes of a run evaluated at once */
-#define RUN_PS 136     /* from one array of pushing nodes to the next (not a divisor of 4096
-                          bytes, whose multiples apart a load may wait on a store) */
-#define RUN_SCRATCH 20 /* doubles of scratch a node (contacts_run); contacts_general takes
-                          GEN_ARRAYS GEN_GS of it */
+#define RUN_CHUNK 128 /* nodes of a run whose depths are taken at once */
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -262,40 +311,14 @@ static void run_depth(size_t m, run_face q, const double *restrict x, const doub
     }
 }
 
-/* A run's pushing nodes, side by side (scratch of contacts_run): node index, normal force,
- * lever from the CoG, tangential velocity relative to the body, force with the normal force
- * in, 1 / mass and mass; and the friction found. RUN_PUSH arrays of RUN_CHUNK, RUN_PS apart. */
-enum { P_FN, P_LX, P_LY, P_LZ, P_TX, P_TY, P_TZ, P_KX, P_KY, P_KZ, P_IM, P_M, P_AX, P_AY, P_AZ,
-       RUN_PUSH };
-
-/* Frictions of m pushing nodes on a face of normal n (the scratch's arrays). */
-WS_VECTOR_LOOP
-static void run_friction(size_t m, double nx, double ny, double nz, double h, double mu,
-                         double vlim, double *restrict P)
-{
-    const double *restrict fn = P + P_FN * RUN_PS, *restrict tx = P + P_TX * RUN_PS,
-                           *restrict ty = P + P_TY * RUN_PS, *restrict tz = P + P_TZ * RUN_PS,
-                           *restrict kx = P + P_KX * RUN_PS, *restrict ky = P + P_KY * RUN_PS,
-                           *restrict kz = P + P_KZ * RUN_PS, *restrict im = P + P_IM * RUN_PS,
-                           *restrict mass = P + P_M * RUN_PS;
-    double *restrict ax = P + P_AX * RUN_PS, *restrict ay = P + P_AY * RUN_PS,
-                     *restrict az = P + P_AZ * RUN_PS;
-    for (size_t t = 0; t < m; t++)
-        friction_of(nx, ny, nz, tx[t], ty[t], tz[t], kx[t], ky[t], kz[t], im[t], mass[t], fn[t],
-                    mu, vlim, h, &ax[t], &ay[t], &az[t]);
-}
-
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
  * The others with the arithmetic of contacts_general operation by operation for a node whose
  * only candidate is a face it lies well inside of, without its look-ups: the face, body and
- * contact are the run's. In three passes: the normal forces of the nodes in the window (those
- * that push are listed), their frictions on vectors, then their forces applied to the nodes and
- * the body, in node order. A chunk with a node below the face's plane (d < 0), where another
- * face may lie shallower, goes to contacts_general. */
-static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
+ * contact are the run's. A chunk with a node below the face's plane (d < 0), where another face
+ * may lie shallower, goes to contacts_general. */
+static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
                          ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
-                         const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
-                         v3 *bmoment)
+                         const ws_node_params *pp, act_list *L)
 {
     const ws_body_state *st = &b->st[cur];
     const ws_ncand *c = &cand[sg->c0];
@@ -304,16 +327,14 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
     const ws_node_params *p = &pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb0 = st->v[bi], wb = b->wg[bi];
-    const double k = p->k, cc = p->c;
+    const double k = p->k, cc = p->c, mu = p->mu, vlim = p->vlim;
     const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
-    /* Scratch (RUN_SCRATCH doubles a node): depth, in-window flag, indices, pushing nodes. */
-    double *D = web->rtmp, *P = D + 3 * RUN_CHUNK;
+    double *D = web->rtmp; /* depth, in-window flag and node indices of a chunk */
     int64_t *in = (int64_t *)(D + RUN_CHUNK);
-    uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK), *pi = idx + RUN_CHUNK;
+    uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK);
     double *fx = web->f.x, *fy = web->f.y, *fz = web->f.z;
-    v3 bf = bforce[bi], bm = bmoment[bi];
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
-        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0, np = 0;
+        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
         run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
         for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
             idx[nin] = (uint32_t)e;
@@ -323,17 +344,11 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
         int deep = 0;
         for (size_t t = 0; t < nin; t++)
             deep |= D[idx[t]] < 0.0;
-        if (deep) { /* one by one, in node order */
+        if (deep) { /* one by one */
             web->run_deep += m;
-            bforce[bi] = bf;
-            bmoment[bi] = bm;
-            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, h, share, fc,
-                             bforce, bmoment);
-            bf = bforce[bi];
-            bm = bmoment[bi];
+            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
             continue;
         }
-        /* Normal forces; the pushing nodes are listed (without a branch). */
         for (size_t t = 0; t < nin; t++) {
             const uint32_t e = idx[t], i = o + e;
             const double d = D[e];
@@ -343,49 +358,12 @@ static void contacts_run(ws_body_store *b, int cur, const ws_node_geom *g, ws_we
             double vn = v3_dot(vrel, n);
             double fn = k * (hi - d) - cc * vn;
             double push = fn > 0.0;
-            double f1x = fx[i] + n.x * (fn * push), f1y = fy[i] + n.y * (fn * push),
-                   f1z = fz[i] + n.z * (fn * push);
-            fx[i] = f1x;
-            fy[i] = f1y;
-            fz[i] = f1z;
-            v3 tv = v3_madd(vrel, n, -vn);
-            pi[np] = i;
-            P[P_FN * RUN_PS + np] = fn;
-            P[P_LX * RUN_PS + np] = lever.x;
-            P[P_LY * RUN_PS + np] = lever.y;
-            P[P_LZ * RUN_PS + np] = lever.z;
-            P[P_TX * RUN_PS + np] = tv.x;
-            P[P_TY * RUN_PS + np] = tv.y;
-            P[P_TZ * RUN_PS + np] = tv.z;
-            P[P_KX * RUN_PS + np] = f1x;
-            P[P_KY * RUN_PS + np] = f1y;
-            P[P_KZ * RUN_PS + np] = f1z;
-            P[P_IM * RUN_PS + np] = web->inv_m[i];
-            P[P_M * RUN_PS + np] = web->m[i];
-            np += (size_t)(fn > 0.0);
-        }
-        run_friction(np, n.x, n.y, n.z, h, p->mu, p->vlim, P);
-        /* Applied: to the nodes, and the opposite to the body, in node order. */
-        for (size_t t = 0; t < np; t++) {
-            const uint32_t i = pi[t];
-            v3 ft = v3_make(P[P_AX * RUN_PS + t], P[P_AY * RUN_PS + t],
-                            P[P_AZ * RUN_PS + t]);
-            v3 lever = v3_make(P[P_LX * RUN_PS + t], P[P_LY * RUN_PS + t],
-                               P[P_LZ * RUN_PS + t]);
-            double fn = P[P_FN * RUN_PS + t];
-            fx[i] += ft.x;
-            fy[i] += ft.y;
-            fz[i] += ft.z;
-            v3 Fnode = v3_madd(ft, n, fn);
-            fc[i] = v3_madd(fc[i], Fnode, share);
-            web->fct[web->fck][web->nfct[web->fck]++] = i;
-            v3 Fb = v3_scale(Fnode, -share);
-            bf = v3_add(bf, Fb);
-            bm = v3_add(bm, v3_cross(lever, Fb));
+            fx[i] = fx[i] + n.x * (fn * push);
+            fy[i] = fy[i] + n.y * (fn * push);
+            fz[i] = fz[i] + n.z * (fn * push);
+            act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, mu, vlim, fn > 0.0);
         }
     }
-    bforce[bi] = bf;
-    bmoment[bi] = bm;
 }
 
 /* The stretches being cut: a pending run of single inside candidates [r0, r1) and, before it,
@@ -428,7 +406,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
     web->seg_list = -1;
     web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, RUN_SCRATCH * RUN_CHUNK,
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, 3 * RUN_CHUNK,
                          sizeof(double)) != 0)
         return -1;
     seg_cut sc = {web, mem, cand, 0, 0, 0};
@@ -471,15 +449,45 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
                       const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
                       v3 *bmoment, uint64_t *checks)
 {
+    act_list L = act_open(web);
     size_t k = *next;
     for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &web->seg[k];
         *checks += sg->c1 - sg->c0;
         if (sg->run)
-            contacts_run(b, cur, g, web, x, v, cand, sg, pp, h, share, fc, bforce, bmoment);
+            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L);
         else
-            contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, h, share,
-                             fc, bforce, bmoment);
+            contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
     }
     *next = k;
+    act_apply(web, &L, h, share, fc, bforce, bmoment);
+}
+
+int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
+{
+    size_t need = ncand + 1;
+    if (need > web->act_cap) {
+        ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
+        ws_mem_free(mem, web->act_id, web->act_cap * 2 * sizeof(uint32_t));
+        web->act_cap = 0;
+        web->act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
+        web->act_id = ws_mem_calloc(mem, need * 2, sizeof(uint32_t));
+        if (!web->act || !web->act_id)
+            return -1;
+        web->act_cap = need;
+    }
+    return ws_array_reserve(mem, (void **)&web->sel, &web->sel_cap, need, sizeof *web->sel);
+}
+
+void ws_node_scratch_free(ws_mem *mem, ws_web *web)
+{
+    ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
+    ws_mem_free(mem, web->act_id, web->act_cap * 2 * sizeof(uint32_t));
+    ws_mem_free(mem, web->sel, web->sel_cap * sizeof *web->sel);
+    ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
+    web->act = NULL;
+    web->act_id = NULL;
+    web->sel = NULL;
+    web->rtmp = NULL;
+    web->act_cap = web->sel_cap = web->rtmp_cap = 0;
 }

@@ -58,10 +58,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
         ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
-        if (k == 0)
-            ws_mem_free(mem, web->act, web->act_cap * sizeof(ws_nact));
-        if (k == 0)
-            ws_mem_free(mem, web->sel, web->sel_cap * sizeof(uint32_t));
+
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
@@ -74,7 +71,6 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
     ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
     ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
-    ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
     ws_mem_free(mem, web->tmp, 3 * WS_WEB_CHUNK * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));

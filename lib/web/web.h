@@ -32,13 +32,6 @@ typedef struct ws_nseg {
     int run;
 } ws_nseg;
 
-/* A node contact of the current sub-step, between the normal and the friction passes. */
-typedef struct ws_nact {
-    uint32_t node, body;
-    v3 n, xc, vt, ft;
-    double fn, mu, vlim;
-} ws_nact;
-
 /* Node vectors as structure of arrays: the x, y and z components apart (one allocation of 3 n
  * doubles), so loops over nodes and over grid springs run on whole vectors. */
 typedef struct ws_nodes3 {
@@ -113,7 +106,8 @@ typedef struct ws_web {
     /* Node-face candidates: changed only by full detection, into the other list. */
     ws_ncand *cand[2];
     size_t ncand[2], capcand[2];
-    ws_nact *act;  /* active contacts, scratch sized with the candidates */
+    double *act;        /* the pushing contacts of a sweep block (scratch, sized with the */
+    uint32_t *act_id;   /* candidates; contact/node_force.c) */
     size_t act_cap;
     uint32_t *sel; /* candidates within their window, scratch sized with them */
     size_t sel_cap;

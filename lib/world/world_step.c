@@ -211,10 +211,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                                &web->capcand[list]);
             }
             if (bad ||
-                ws_array_reserve(&w->mem, (void **)&web->act, &web->act_cap,
-                                 web->ncand[list] + 1, sizeof *web->act) != 0 ||
-                ws_array_reserve(&w->mem, (void **)&web->sel, &web->sel_cap,
-                                 web->ncand[list] + 1, sizeof *web->sel) != 0)
+                ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
             w->stats.seconds_detection += clock_now(w) - t0;
