@@ -528,9 +528,10 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
             continue;
         (*checks)++;
         v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        /* Within reach of the segment (t clamped to it): a node past an end may slide along
+         * the edge into its span before it is found again. */
         double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
-        if (t < 0.0 || t > 1.0)
-            continue;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
         if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
             push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
             return -1;
@@ -597,8 +598,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_no
                 (*checks)++;
                 v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
                 double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
-                if (t < 0.0 || t > 1.0)
-                    continue;
+                t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t; /* within reach of the segment */
                 if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
                     push_cand(mem, out, n, cap,
                               (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
