@@ -150,16 +150,19 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     L->n += (size_t)(keep != 0);
 }
 
-/* Frictions of the m contacts of the list. */
+/* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
+ * out, out + cap and out + 2 cap (A_AX...: apart from the inputs, so the loop needs no checks of
+ * overlap to run on vectors). */
 WS_VECTOR_LOOP
-static void act_friction(size_t m, double h, double *const *A)
+static void act_friction(size_t m, double h, const double *restrict P, double *restrict out,
+                         size_t cap)
 {
-    const double *restrict nx = A[A_NX], *restrict ny = A[A_NY], *restrict nz = A[A_NZ];
-    const double *restrict tx = A[A_TX], *restrict ty = A[A_TY], *restrict tz = A[A_TZ];
-    const double *restrict kx = A[A_KX], *restrict ky = A[A_KY], *restrict kz = A[A_KZ];
-    const double *restrict im = A[A_IM], *restrict mass = A[A_M], *restrict fn = A[A_FN];
-    const double *restrict mu = A[A_MU], *restrict vl = A[A_VL];
-    double *restrict ax = A[A_AX], *restrict ay = A[A_AY], *restrict az = A[A_AZ];
+    const double *nx = P + A_NX * cap, *ny = P + A_NY * cap, *nz = P + A_NZ * cap,
+                 *tx = P + A_TX * cap, *ty = P + A_TY * cap, *tz = P + A_TZ * cap,
+                 *kx = P + A_KX * cap, *ky = P + A_KY * cap, *kz = P + A_KZ * cap,
+                 *im = P + A_IM * cap, *mass = P + A_M * cap, *fn = P + A_FN * cap,
+                 *mu = P + A_MU * cap, *vl = P + A_VL * cap;
+    double *ax = out, *ay = out + cap, *az = out + 2 * cap;
     for (size_t q = 0; q < m; q++)
         friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
                     mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
@@ -181,7 +184,7 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc, 
         A[A_IM][q] = web->inv_m[i];
         A[A_M][q] = web->m[i];
     }
-    act_friction(m, h, A);
+    act_friction(m, h, web->act, web->act + A_AX * web->act_cap, web->act_cap);
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
     uint32_t body = UINT32_MAX;
