@@ -210,8 +210,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                                web->nfresh, &web->cand[list], &web->ncand[list],
                                                &web->capcand[list]);
             }
-            if (bad ||
-                ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
+            if (bad || ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                                web_label(web));
             w->stats.seconds_detection += clock_now(w) - t0;
@@ -219,13 +218,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         }
         web->next_list = list;
         /* The list cut into stretches for the evaluation: again whenever it changed (a list
-         * found again equal to the one cut keeps its stretches). */
-        if (web->seg_list >= 0 && web->seg_list != list &&
-            web->ncand[list] == web->ncand[web->seg_list] &&
-            (web->ncand[list] == 0 ||
-             memcmp(web->cand[list], web->cand[web->seg_list],
-                    web->ncand[list] * sizeof *web->cand[list]) == 0))
-            web->seg_list = list;
+         * that serves again keeps its stretches). */
         if (web->seg_list != list &&
             ws_node_segments(&w->mem, web, web->cand[list], web->ncand[list], list) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
