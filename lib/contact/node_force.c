@@ -150,6 +150,25 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     L->n += (size_t)(keep != 0);
 }
 
+/* The normal force of node i on body bi at depth d along the normal n (from the body to the
+ * node), within the window (hi the layers): into f; the contact is listed when it pushes.
+ * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
+ * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
+ * force is added times whether it pushes (0 or 1), without a branch. Both passes use it. */
+static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
+                             uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
+                             const ws_node_params *p)
+{
+    v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
+    v3 lever = v3_sub(xc, r);
+    v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
+    double vn = v3_dot(vrel, n);
+    double fn = p->k * (hi - d) - p->c * vn;
+    double push = fn > 0.0;
+    nodes_add(web->f, i, v3_scale(n, fn * push));
+    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
+}
+
 /* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
  * out, out + cap and out + 2 cap (A_AX...: apart from the inputs, so the loop needs no checks of
  * overlap to run on vectors). */
@@ -273,20 +292,8 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
                 continue;
             nrm = F->n; /* from the body to the node */
         }
-        const ws_node_params *p = &pp[b->material[bi]];
-        v3 r = st->r[bi];
-        v3 xc = v3_madd(xi, nrm, -0.5 * d);
-        v3 lever = v3_sub(xc, r);
-        v3 vb = v3_add(st->v[bi], v3_cross(b->wg[bi], lever));
-        v3 vrel = v3_sub(nodes_get(v, i), vb);
-        double vn = v3_dot(vrel, nrm);
-        double fn = p->k * (hi - d) - p->c * vn;
-        /* A contact never pulls: listed only when it pushes (no branch), and its force is
-         * added times that (0 or 1). */
-        double push = fn > 0.0;
-        nodes_add(web->f, i, v3_scale(nrm, fn * push));
-        act_push(L, i, bi, nrm, lever, v3_madd(vrel, nrm, -vn), fn, p->mu, p->vlim,
-                 fn > 0.0);
+        normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
+                  &pp[b->material[bi]]);
     }
 }
 
@@ -330,12 +337,10 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
     const ws_node_params *p = &pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb0 = st->v[bi], wb = b->wg[bi];
-    const double k = p->k, cc = p->c, mu = p->mu, vlim = p->vlim;
     const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
     double *D = web->rtmp; /* depth, in-window flag and node indices of a chunk */
     int64_t *in = (int64_t *)(D + RUN_CHUNK);
     uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK);
-    double *fx = web->f.x, *fy = web->f.y, *fz = web->f.z;
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
         run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
@@ -352,20 +357,8 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
             contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
             continue;
         }
-        for (size_t t = 0; t < nin; t++) {
-            const uint32_t e = idx[t], i = o + e;
-            const double d = D[e];
-            v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
-            v3 lever = v3_sub(xc, r);
-            v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb0, v3_cross(wb, lever)));
-            double vn = v3_dot(vrel, n);
-            double fn = k * (hi - d) - cc * vn;
-            double push = fn > 0.0;
-            fx[i] = fx[i] + n.x * (fn * push);
-            fy[i] = fy[i] + n.y * (fn * push);
-            fz[i] = fz[i] + n.z * (fn * push);
-            act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, mu, vlim, fn > 0.0);
-        }
+        for (size_t t = 0; t < nin; t++)
+            normal_of(web, L, x, v, o + idx[t], bi, n, D[idx[t]], hi, r, vb0, wb, p);
     }
 }
 
