@@ -288,6 +288,58 @@ static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
     return w;
 }
 
+/* A light film against the world's default material (4000 N/m, 1 kg/s, mu 0.5), nodes of 1 g
+ * joined by springs of 5 N: into wd. */
+static void soft_film(ws_world *w, ws_web_def *wd)
+{
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film_mat, dflt;
+    md.name = "film";
+    ck_ok(w, ws_material_create(w, &md, &film_mat));
+    ck_ok(w, ws_world_get_default_material(w, &dflt));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    ck_ok(w, ws_world_set_contact(w, film_mat, dflt, &cd));
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.stiffness = 5.0;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def_init(wd);
+    wd->node_mass = 1e-3;
+    wd->law = law;
+    wd->material = film_mat;
+}
+
+/* A kinematic box of sizes h (m) at `at` that rises by `amplitude` (a sine of 1 Hz from
+ * `start`, at once). */
+static void rising_box(ws_world *w, ws_vec3 h, ws_vec3 at, double amplitude, double start,
+                       const char *name, ws_body_id *box)
+{
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, h.x, h.y, h.z, &cube));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = cube;
+    bd.position = at;
+    bd.name = name;
+    ck_ok(w, ws_body_create(w, &bd, box));
+    ws_drive_def up;
+    ws_drive_def_init(&up);
+    up.type = WS_DRIVE_SINE;
+    up.direction = (ws_vec3){0, 0, 1};
+    up.amplitude = amplitude;
+    up.frequency = 1.0;
+    up.start_time = start;
+    up.ramp_time = 0.0;
+    ck_ok(w, ws_body_set_drive(w, *box, &up));
+}
+
 /* Case 4: a square sheet pinned at its border sags under its weight (its nodes move and are
  * found again on the way down) to some mm above a kinematic block that was 16 mm below it at
  * the first search; then the block rises 15 mm and lifts the sheet. The sagged nodes stand
@@ -300,48 +352,11 @@ static ws_world *sag_world(ws_web_id *web, ws_body_id *block)
     d.detection_interval = 5;
     ws_world *w;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
-    ws_material_def md;
-    ws_material_def_init(&md);
-    ws_material_id film_mat;
-    md.name = "film";
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ws_material_id dflt;
-    ck_ok(w, ws_world_get_default_material(w, &dflt));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    ck_ok(w, ws_world_set_contact(w, film_mat, dflt, &cd));
-    ws_shape_id cube;
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.05, &cube));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.type = WS_BODY_KINEMATIC;
-    bd.shape = cube;
-    bd.position = (ws_vec3){0, 0, 0.159}; /* top at 0.184 m */
-    bd.name = "block";
-    ck_ok(w, ws_body_create(w, &bd, block));
-    ws_drive_def up;
-    ws_drive_def_init(&up);
-    up.type = WS_DRIVE_SINE;
-    up.direction = (ws_vec3){0, 0, 1};
-    up.amplitude = 0.015;
-    up.frequency = 1.0; /* a quarter period, 0.25 s, to rise 15 mm */
-    up.start_time = 0.3;
-    up.ramp_time = 0.0;
-    ck_ok(w, ws_body_set_drive(w, *block, &up));
-    ws_law_def ld;
-    ws_law_def_init(&ld);
-    ld.stiffness = 5.0;
-    ws_law_id law;
-    ck_ok(w, ws_law_create(w, &ld, &law));
+    /* Top at 0.184 m; a quarter period, 0.25 s, to rise 15 mm. */
+    rising_box(w, (ws_vec3){0.1, 0.1, 0.05}, (ws_vec3){0, 0, 0.159}, 0.015, 0.3, "block", block);
     ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
+    soft_film(w, &wd);
     wd.node_damping = 0.2;
-    wd.law = law;
-    wd.material = film_mat;
     wd.name = "sheet";
     enum { N = 12 };
     uint32_t pin[4 * N];
@@ -438,46 +453,10 @@ static ws_world *edge_end_world(ws_web_id *web, ws_body_id *box)
     d.dt = 2.5e-4;
     ws_world *w;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
-    ws_material_def md;
-    ws_material_def_init(&md);
-    ws_material_id film_mat, dflt;
-    md.name = "film";
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_world_get_default_material(w, &dflt));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    ck_ok(w, ws_world_set_contact(w, film_mat, dflt, &cd));
-    ws_shape_id cube;
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &cube));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.type = WS_BODY_KINEMATIC;
-    bd.shape = cube;
-    bd.contact_layer = 1e-3;
-    bd.name = "box";
-    ck_ok(w, ws_body_create(w, &bd, box));
-    ws_drive_def up;
-    ws_drive_def_init(&up);
-    up.type = WS_DRIVE_SINE;
-    up.direction = (ws_vec3){0, 0, 1};
-    up.amplitude = 0.01;
-    up.frequency = 1.0; /* rises at 63 mm/s: 16 um a step */
-    up.ramp_time = 0.0;
-    ck_ok(w, ws_body_set_drive(w, *box, &up));
-    ws_law_def ld;
-    ws_law_def_init(&ld);
-    ld.stiffness = 5.0;
-    ws_law_id law;
-    ck_ok(w, ws_law_create(w, &ld, &law));
+    /* Rises at 63 mm/s: 16 um a step. */
+    rising_box(w, (ws_vec3){0.1, 0.1, 0.1}, (ws_vec3){0, 0, 0}, 0.01, 0.0, "box", box);
     ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
-    wd.contact_layer = 1e-3;
-    wd.material = film_mat;
-    wd.law = law;
+    soft_film(w, &wd);
     /* 1.5 mm from the edge's line (x = y = 0.05 m) on its diagonal, 50 um above its top end;
      * the other node is pinned far off. */
     const double o = 0.05 + 1.5e-3 / sqrt(2.0);
