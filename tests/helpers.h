@@ -116,6 +116,15 @@ static inline ws_body_id add_box(ws_world *w, double lx, double ly, double lz, d
     return id;
 }
 
+/* Hamilton product of Euler parameters: rotation b, then a. */
+static inline ws_quat qmul(ws_quat a, ws_quat b)
+{
+    return (ws_quat){a.e0 * b.e0 - a.e1 * b.e1 - a.e2 * b.e2 - a.e3 * b.e3,
+                     a.e0 * b.e1 + a.e1 * b.e0 + a.e2 * b.e3 - a.e3 * b.e2,
+                     a.e0 * b.e2 - a.e1 * b.e3 + a.e2 * b.e0 + a.e3 * b.e1,
+                     a.e0 * b.e3 + a.e1 * b.e2 - a.e2 * b.e1 + a.e3 * b.e0};
+}
+
 static inline ws_material_id no_material(void)
 {
     ws_material_id m = {0};

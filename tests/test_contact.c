@@ -42,14 +42,6 @@ static ws_quat quat_axis(ws_vec3 axis, double angle)
     double s = sin(0.5 * angle);
     return (ws_quat){cos(0.5 * angle), axis.x * s, axis.y * s, axis.z * s};
 }
-/* Hamilton product: rotation b, then a. */
-static ws_quat qmul(ws_quat a, ws_quat b)
-{
-    return (ws_quat){a.e0 * b.e0 - a.e1 * b.e1 - a.e2 * b.e2 - a.e3 * b.e3,
-                     a.e0 * b.e1 + a.e1 * b.e0 + a.e2 * b.e3 - a.e3 * b.e2,
-                     a.e0 * b.e2 - a.e1 * b.e3 + a.e2 * b.e0 + a.e3 * b.e1,
-                     a.e0 * b.e3 + a.e1 * b.e2 - a.e2 * b.e1 + a.e3 * b.e0};
-}
 static ws_quat qconj(ws_quat q) { return (ws_quat){q.e0, -q.e1, -q.e2, -q.e3}; }
 /* Rotation angle of a unit quaternion, accurate for small angles: 2 atan2(|e|, |e0|). */
 static double qangle(ws_quat q)

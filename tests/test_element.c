@@ -80,13 +80,6 @@ static ws_quat qrot(ws_vec3 phi)
     double s = sin(0.5 * a) / a;
     return (ws_quat){cos(0.5 * a), phi.x * s, phi.y * s, phi.z * s};
 }
-static ws_quat qmul(ws_quat a, ws_quat b)
-{
-    return (ws_quat){a.e0 * b.e0 - a.e1 * b.e1 - a.e2 * b.e2 - a.e3 * b.e3,
-                     a.e0 * b.e1 + a.e1 * b.e0 + a.e2 * b.e3 - a.e3 * b.e2,
-                     a.e0 * b.e2 - a.e1 * b.e3 + a.e2 * b.e0 + a.e3 * b.e1,
-                     a.e0 * b.e3 + a.e1 * b.e2 - a.e2 * b.e1 + a.e3 * b.e0};
-}
 
 /* Deterministic pseudo-random numbers (xorshift64*), so a failure is reproducible. */
 static uint64_t rng = 0x2545F4914F6CDD1Dull;
