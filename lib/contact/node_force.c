@@ -308,27 +308,98 @@ typedef struct run_face {
     double hi, lo;          /* the contact window of d */
 } run_face;
 
-/* Depth d of nodes [0, m) under the face's plane and whether it lies in the window (straight-
- * line code, on vectors). */
+/* Depth d of nodes [0, m) under the face's plane and whether it lies in the window; whether
+ * one in the window lies below the plane (straight-line code, on vectors). */
 WS_VECTOR_LOOP
-static void run_depth(size_t m, run_face q, const double *restrict x, const double *restrict y,
-                      const double *restrict z, double *restrict d, int64_t *restrict in)
+static int64_t run_depth(size_t m, run_face q, const double *restrict x, const double *restrict y,
+                         const double *restrict z, double *restrict d, int64_t *restrict in)
 {
+    int64_t deep = 0;
     for (size_t i = 0; i < m; i++) {
         double e = q.nx * x[i] + q.ny * y[i] + q.nz * z[i] - q.off;
+        int64_t w = (e < q.hi) & (e > q.lo);
         d[i] = e;
-        in[i] = (e < q.hi) & (e > q.lo);
+        in[i] = w;
+        deep |= w & (e < 0.0);
+    }
+    return deep;
+}
+
+/* A run's contacts in the window, from its nodes' gathered values (I_*): the contact of
+ * normal_of, and for one that pushes the friction of act_apply, with the same arithmetic
+ * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other contact, so its force with
+ * every normal force in is its force with this one. Gives per contact the node's new force,
+ * whether it pushes, and the body's share of the load (force and moment about the CoG), which
+ * the caller adds in node order. Straight-line code, so it runs on vectors. */
+enum { O_FX, O_FY, O_FZ, O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_PUSH, O_ARRAYS };
+
+typedef struct run_const {
+    double nx, ny, nz, rx, ry, rz, vx, vy, vz, wx, wy, wz; /* normal; body CoG, velocity, spin */
+    double hi, k, c, mu, vlim, h, share;
+} run_const;
+
+/* The kernel's inputs, gathered: arrays of RUN_CHUNK from `in` on, in this order. */
+enum { I_X, I_Y, I_Z, I_VX, I_VY, I_VZ, I_FX, I_FY, I_FZ, I_D, I_IM, I_M, I_ARRAYS };
+
+WS_VECTOR_LOOP
+static void run_kernel(size_t m, run_const q, const double *restrict in, double *restrict out)
+{
+    const double *px = in + I_X * RUN_CHUNK, *py = in + I_Y * RUN_CHUNK,
+                 *pz = in + I_Z * RUN_CHUNK, *ux = in + I_VX * RUN_CHUNK,
+                 *uy = in + I_VY * RUN_CHUNK, *uz = in + I_VZ * RUN_CHUNK,
+                 *gx = in + I_FX * RUN_CHUNK, *gy = in + I_FY * RUN_CHUNK,
+                 *gz = in + I_FZ * RUN_CHUNK, *dd = in + I_D * RUN_CHUNK,
+                 *im = in + I_IM * RUN_CHUNK, *mass = in + I_M * RUN_CHUNK;
+    double *ofx = out + O_FX * RUN_CHUNK, *ofy = out + O_FY * RUN_CHUNK,
+           *ofz = out + O_FZ * RUN_CHUNK, *obx = out + O_BX * RUN_CHUNK,
+           *oby = out + O_BY * RUN_CHUNK, *obz = out + O_BZ * RUN_CHUNK,
+           *omx = out + O_MX * RUN_CHUNK, *omy = out + O_MY * RUN_CHUNK,
+           *omz = out + O_MZ * RUN_CHUNK, *opush = out + O_PUSH * RUN_CHUNK;
+    const double nx = q.nx, ny = q.ny, nz = q.nz;
+    for (size_t t = 0; t < m; t++) {
+        const double d = dd[t], s = -0.5 * d;
+        /* normal_of */
+        double lx = (px[t] + nx * s) - q.rx, ly = (py[t] + ny * s) - q.ry,
+               lz = (pz[t] + nz * s) - q.rz;
+        double bx = q.vx + (q.wy * lz - q.wz * ly), by = q.vy + (q.wz * lx - q.wx * lz),
+               bz = q.vz + (q.wx * ly - q.wy * lx);
+        double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
+        double vn = vrx * nx + vry * ny + vrz * nz;
+        double fn = q.k * (q.hi - d) - q.c * vn;
+        double push = fn > 0.0, fp = fn * push;
+        double kx = gx[t] + nx * fp, ky = gy[t] + ny * fp, kz = gz[t] + nz * fp;
+        /* act_apply */
+        double ax, ay, az;
+        friction_of(nx, ny, nz, vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn), kx, ky, kz,
+                    im[t], mass[t], fn, q.mu, q.vlim, q.h, &ax, &ay, &az);
+        ofx[t] = fn > 0.0 ? kx + ax : kx;
+        ofy[t] = fn > 0.0 ? ky + ay : ky;
+        ofz[t] = fn > 0.0 ? kz + az : kz;
+        /* The body's share, zero for a contact that does not push: adding +0 leaves every
+         * sum as it was (sums that start at +0 never reach -0). */
+        double Bx = fn > 0.0 ? (ax + nx * fn) * -q.share : 0.0,
+               By = fn > 0.0 ? (ay + ny * fn) * -q.share : 0.0,
+               Bz = fn > 0.0 ? (az + nz * fn) * -q.share : 0.0;
+        obx[t] = Bx;
+        oby[t] = By;
+        obz[t] = Bz;
+        omx[t] = ly * Bz - lz * By;
+        omy[t] = lz * Bx - lx * Bz;
+        omz[t] = lx * By - ly * Bx;
+        opush[t] = push;
     }
 }
 
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
- * The others with the arithmetic of contacts_general operation by operation for a node whose
- * only candidate is a face it lies well inside of, without its look-ups: the face, body and
- * contact are the run's. A chunk with a node below the face's plane (d < 0), where another face
- * may lie shallower, goes to contacts_general. */
+ * The others are gathered and go through run_kernel: the arithmetic of contacts_general for a
+ * node whose only candidate is a face it lies well inside of, without its look-ups (the face,
+ * body and contact are the run's). Their loads go to the body in node order. A chunk with a
+ * node below the face's plane (d < 0), where another face may lie shallower, goes to
+ * contacts_general. */
 static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
                          ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
-                         const ws_node_params *pp, act_list *L)
+                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc,
+                         v3 *bforce, v3 *bmoment)
 {
     const ws_body_state *st = &b->st[cur];
     const ws_ncand *c = &cand[sg->c0];
@@ -336,29 +407,76 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
     const ws_wface *F = &g->face[c->feat];
     const ws_node_params *p = &pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
-    const v3 n = F->n, r = st->r[bi], vb0 = st->v[bi], wb = b->wg[bi];
+    const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
-    double *D = web->rtmp; /* depth, in-window flag and node indices of a chunk */
+    const run_const rc = {n.x,  n.y,  n.z,  r.x,  r.y, r.z,     vb.x, vb.y, vb.z, wb.x, wb.y,
+                          wb.z, hi,   p->k, p->c, p->mu, p->vlim, h,    share};
+    /* Scratch: the chunk's depths, in-window flags and node indices, then run_kernel's
+     * inputs I_* and outputs O_*. */
+    double *D = web->rtmp, *I = D + 3 * RUN_CHUNK, *O = I + I_ARRAYS * RUN_CHUNK;
     int64_t *in = (int64_t *)(D + RUN_CHUNK);
     uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
-        run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
+        int64_t deep = run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
+        web->run_nodes += m;
+        if (deep) { /* one by one */
+            web->run_deep += m;
+            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
+            act_apply(web, L, h, share, fc, bforce, bmoment);
+            continue;
+        }
         for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
             idx[nin] = (uint32_t)e;
             nin += (size_t)in[e];
         }
-        web->run_nodes += m;
-        int deep = 0;
-        for (size_t t = 0; t < nin; t++)
-            deep |= D[idx[t]] < 0.0;
-        if (deep) { /* one by one */
-            web->run_deep += m;
-            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
+        if (nin == 0)
             continue;
+        /* Gathered, and padded to whole vectors with copies of the last (dropped after). */
+        size_t mv = (nin + 3) & ~(size_t)3;
+        for (size_t t = nin; t < mv; t++)
+            idx[t] = idx[nin - 1];
+        for (size_t t = 0; t < mv; t++) {
+            const size_t e = idx[t], i = o + e;
+            I[I_X * RUN_CHUNK + t] = x.x[i];
+            I[I_Y * RUN_CHUNK + t] = x.y[i];
+            I[I_Z * RUN_CHUNK + t] = x.z[i];
+            I[I_VX * RUN_CHUNK + t] = v.x[i];
+            I[I_VY * RUN_CHUNK + t] = v.y[i];
+            I[I_VZ * RUN_CHUNK + t] = v.z[i];
+            I[I_FX * RUN_CHUNK + t] = web->f.x[i];
+            I[I_FY * RUN_CHUNK + t] = web->f.y[i];
+            I[I_FZ * RUN_CHUNK + t] = web->f.z[i];
+            I[I_D * RUN_CHUNK + t] = D[e];
+            I[I_IM * RUN_CHUNK + t] = web->inv_m[i];
+            I[I_M * RUN_CHUNK + t] = web->m[i];
         }
-        for (size_t t = 0; t < nin; t++)
-            normal_of(web, L, x, v, o + idx[t], bi, n, D[idx[t]], hi, r, vb0, wb, p);
+        run_kernel(mv, rc, I, O);
+        /* In node order: the new forces, and for the contacts that push (the others add
+         * zeros) the node's share and the body's loads. */
+        const double *ofx = O + O_FX * RUN_CHUNK, *ofy = O + O_FY * RUN_CHUNK,
+                     *ofz = O + O_FZ * RUN_CHUNK, *obx = O + O_BX * RUN_CHUNK,
+                     *oby = O + O_BY * RUN_CHUNK, *obz = O + O_BZ * RUN_CHUNK,
+                     *omx = O + O_MX * RUN_CHUNK, *omy = O + O_MY * RUN_CHUNK,
+                     *omz = O + O_MZ * RUN_CHUNK, *opush = O + O_PUSH * RUN_CHUNK;
+        uint32_t *touched = web->fct[web->fck];
+        size_t nt = web->nfct[web->fck];
+        v3 bf = bforce[bi], bm = bmoment[bi];
+        for (size_t t = 0; t < nin; t++) {
+            const uint32_t i = o + idx[t];
+            web->f.x[i] = ofx[t];
+            web->f.y[i] = ofy[t];
+            web->f.z[i] = ofz[t];
+            v3 Fb = v3_make(obx[t], oby[t], obz[t]);
+            fc[i] = v3_sub(fc[i], Fb); /* the node's share: -Fb, to the bit */
+            touched[nt] = i;
+            nt += (size_t)(opush[t] != 0.0);
+            bf = v3_add(bf, Fb);
+            bm = v3_add(bm, v3_make(omx[t], omy[t], omz[t]));
+        }
+        bforce[bi] = bf;
+        bmoment[bi] = bm;
+        web->nfct[web->fck] = nt;
     }
 }
 
@@ -402,7 +520,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
     web->seg_list = -1;
     web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, 3 * RUN_CHUNK,
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, (3 + I_ARRAYS + O_ARRAYS) * RUN_CHUNK,
                          sizeof(double)) != 0)
         return -1;
     seg_cut sc = {web, mem, cand, 0, 0, 0};
@@ -450,13 +568,14 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &web->seg[k];
         *checks += sg->c1 - sg->c0;
-        if (sg->run)
-            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L);
-        else
+        if (sg->run) {
+            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc, bforce, bmoment);
+        } else {
             contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
+            act_apply(web, &L, h, share, fc, bforce, bmoment);
+        }
     }
     *next = k;
-    act_apply(web, &L, h, share, fc, bforce, bmoment);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
