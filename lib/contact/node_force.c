@@ -98,22 +98,25 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
 
 /* ---- the pushing contacts of a sweep block
  *
- * The normal passes (one by one, and runs) put each node's normal forces into f and list the
- * contacts that push, in node order, as arrays of web->act_cap (web->act). Once every normal
- * force of the block is in, their frictions go on vectors, and then all of them are applied to
- * the nodes and the bodies in node order. */
+ * The one-by-one pass puts each node's normal forces into f and lists the contacts that push,
+ * in node order, as arrays of web->act_cap (web->act). Once every normal force of the block is
+ * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs at
+ * once. The loads on the bodies of both go to one list of loads in node order, which is summed
+ * last: the bodies' totals are added in the same order however the candidates are cut. */
 
 enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
-       A_IM, A_M, A_AX, A_AY, A_AZ, ACT_ARRAYS };
+       A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
 
 /* The list: per contact its normal (from the body to the node), lever from the body's CoG to
  * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
  * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
- * found. node and body name the node and the body's slot. */
+ * found. node and body name the node and the body's slot, slot its place in the loads.
+ * The loads: per load on a body (A_BX... A_MZ: force, moment about the CoG) and the body's
+ * slot (lbody), nl of them. */
 typedef struct act_list {
     double *a[ACT_ARRAYS];
-    uint32_t *node, *body;
-    size_t n;
+    uint32_t *node, *body, *slot, *lbody;
+    size_t n, nl;
 } act_list;
 
 static act_list act_open(ws_web *web)
@@ -123,7 +126,9 @@ static act_list act_open(ws_web *web)
         L.a[k] = web->act + (size_t)k * web->act_cap;
     L.node = web->act_id;
     L.body = web->act_id + web->act_cap;
-    L.n = 0;
+    L.slot = web->act_id + 2 * web->act_cap;
+    L.lbody = web->act_id + 3 * web->act_cap;
+    L.n = L.nl = 0;
     return L;
 }
 
@@ -147,7 +152,9 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     L->a[A_FN][q] = fn;
     L->a[A_MU][q] = mu;
     L->a[A_VL][q] = vlim;
+    L->slot[q] = (uint32_t)L->nl;
     L->n += (size_t)(keep != 0);
+    L->nl += (size_t)(keep != 0);
 }
 
 /* The normal force of node i on body bi at depth d along the normal n (from the body to the
@@ -187,10 +194,9 @@ static void act_friction(size_t m, double h, const double *restrict P, double *r
                     mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
 }
 
-/* The list's frictions, then every contact applied in node order: friction to the node, the
- * contact force's share to the node's record, the opposite to the body's totals. */
-static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc, v3 *bforce,
-                      v3 *bmoment)
+/* The list's frictions, then each contact applied: friction to the node, the contact force's
+ * share to the node's record, the opposite to its place in the loads. */
+static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
 {
     const size_t m = L->n;
     double *const *A = L->a;
@@ -206,19 +212,8 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc, 
     act_friction(m, h, web->act, web->act + A_AX * web->act_cap, web->act_cap);
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
-    uint32_t body = UINT32_MAX;
-    v3 bf = v3_make(0, 0, 0), bm = bf;
     for (size_t q = 0; q < m; q++) {
-        const uint32_t i = L->node[q], bi = L->body[q];
-        if (bi != body) { /* the running sums of the body at hand, kept in registers */
-            if (body != UINT32_MAX) {
-                bforce[body] = bf;
-                bmoment[body] = bm;
-            }
-            body = bi;
-            bf = bforce[bi];
-            bm = bmoment[bi];
-        }
+        const uint32_t i = L->node[q], at = L->slot[q];
         v3 ft = v3_make(A[A_AX][q], A[A_AY][q], A[A_AZ][q]);
         v3 n = v3_make(A[A_NX][q], A[A_NY][q], A[A_NZ][q]);
         v3 lever = v3_make(A[A_LX][q], A[A_LY][q], A[A_LZ][q]);
@@ -227,16 +222,45 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc, 
         v3 Fnode = v3_madd(ft, n, fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
         touched[nt++] = i;
-        v3 Fb = v3_scale(Fnode, -share);
-        bf = v3_add(bf, Fb);
-        bm = v3_add(bm, v3_cross(lever, Fb));
+        v3 Fb = v3_scale(Fnode, -share), Mb = v3_cross(lever, Fb);
+        A[A_BX][at] = Fb.x;
+        A[A_BY][at] = Fb.y;
+        A[A_BZ][at] = Fb.z;
+        A[A_MX][at] = Mb.x;
+        A[A_MY][at] = Mb.y;
+        A[A_MZ][at] = Mb.z;
+        L->lbody[at] = L->body[q];
+    }
+    web->nfct[web->fck] = nt;
+    L->n = 0;
+}
+
+/* The loads on the bodies, added to their totals in order (the running sums of the body at
+ * hand kept in registers). */
+static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
+{
+    double *const *A = L->a;
+    uint32_t body = UINT32_MAX;
+    v3 bf = v3_make(0, 0, 0), bm = bf;
+    for (size_t q = 0; q < L->nl; q++) {
+        const uint32_t bi = L->lbody[q];
+        if (bi != body) {
+            if (body != UINT32_MAX) {
+                bforce[body] = bf;
+                bmoment[body] = bm;
+            }
+            body = bi;
+            bf = bforce[bi];
+            bm = bmoment[bi];
+        }
+        bf = v3_add(bf, v3_make(A[A_BX][q], A[A_BY][q], A[A_BZ][q]));
+        bm = v3_add(bm, v3_make(A[A_MX][q], A[A_MY][q], A[A_MZ][q]));
     }
     if (body != UINT32_MAX) {
         bforce[body] = bf;
         bmoment[body] = bm;
     }
-    web->nfct[web->fck] = nt;
-    L->n = 0;
+    L->nl = 0;
 }
 
 /* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
@@ -398,8 +422,7 @@ static void run_kernel(size_t m, run_const q, const double *restrict in, double 
  * contacts_general. */
 static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
                          ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
-                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc,
-                         v3 *bforce, v3 *bmoment)
+                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc)
 {
     const ws_body_state *st = &b->st[cur];
     const ws_ncand *c = &cand[sg->c0];
@@ -423,7 +446,6 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
         if (deep) { /* one by one */
             web->run_deep += m;
             contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
-            act_apply(web, L, h, share, fc, bforce, bmoment);
             continue;
         }
         for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
@@ -460,22 +482,28 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
                      *omx = O + O_MX * RUN_CHUNK, *omy = O + O_MY * RUN_CHUNK,
                      *omz = O + O_MZ * RUN_CHUNK, *opush = O + O_PUSH * RUN_CHUNK;
         uint32_t *touched = web->fct[web->fck];
-        size_t nt = web->nfct[web->fck];
-        v3 bf = bforce[bi], bm = bmoment[bi];
+        size_t nt = web->nfct[web->fck], nl = L->nl;
+        double *const *A = L->a;
         for (size_t t = 0; t < nin; t++) {
             const uint32_t i = o + idx[t];
+            const size_t pushes = (size_t)(opush[t] != 0.0);
             web->f.x[i] = ofx[t];
             web->f.y[i] = ofy[t];
             web->f.z[i] = ofz[t];
             v3 Fb = v3_make(obx[t], oby[t], obz[t]);
             fc[i] = v3_sub(fc[i], Fb); /* the node's share: -Fb, to the bit */
             touched[nt] = i;
-            nt += (size_t)(opush[t] != 0.0);
-            bf = v3_add(bf, Fb);
-            bm = v3_add(bm, v3_make(omx[t], omy[t], omz[t]));
+            nt += pushes;
+            A[A_BX][nl] = Fb.x;
+            A[A_BY][nl] = Fb.y;
+            A[A_BZ][nl] = Fb.z;
+            A[A_MX][nl] = omx[t];
+            A[A_MY][nl] = omy[t];
+            A[A_MZ][nl] = omz[t];
+            L->lbody[nl] = bi;
+            nl += pushes;
         }
-        bforce[bi] = bf;
-        bmoment[bi] = bm;
+        L->nl = nl;
         web->nfct[web->fck] = nt;
     }
 }
@@ -568,14 +596,14 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &web->seg[k];
         *checks += sg->c1 - sg->c0;
-        if (sg->run) {
-            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc, bforce, bmoment);
-        } else {
+        if (sg->run)
+            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc);
+        else
             contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
-            act_apply(web, &L, h, share, fc, bforce, bmoment);
-        }
     }
     *next = k;
+    act_apply(web, &L, h, share, fc);
+    loads_apply(&L, bforce, bmoment);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
@@ -583,10 +611,10 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
     size_t need = ncand + 1;
     if (need > web->act_cap) {
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
-        ws_mem_free(mem, web->act_id, web->act_cap * 2 * sizeof(uint32_t));
+        ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
         web->act_cap = 0;
         web->act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
-        web->act_id = ws_mem_calloc(mem, need * 2, sizeof(uint32_t));
+        web->act_id = ws_mem_calloc(mem, need * 4, sizeof(uint32_t));
         if (!web->act || !web->act_id)
             return -1;
         web->act_cap = need;
@@ -597,7 +625,7 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 void ws_node_scratch_free(ws_mem *mem, ws_web *web)
 {
     ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
-    ws_mem_free(mem, web->act_id, web->act_cap * 2 * sizeof(uint32_t));
+    ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
     ws_mem_free(mem, web->sel, web->sel_cap * sizeof *web->sel);
     ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
     web->act = NULL;
