@@ -21,7 +21,7 @@
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
 {
     double k1 = g00 * b1 + g01 * b2, k2 = g01 * b1 + g11 * b2;
-    return k1 >= -WS_FEATURE_TOL && k2 >= -WS_FEATURE_TOL && k1 + k2 <= 1.0 + WS_FEATURE_TOL;
+    return (k1 >= -WS_FEATURE_TOL) & (k2 >= -WS_FEATURE_TOL) & (k1 + k2 <= 1.0 + WS_FEATURE_TOL);
 }
 
 /* A candidate feature pair, kept between full detections. Point-face: a owns face fa, b owns

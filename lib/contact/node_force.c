@@ -11,15 +11,16 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, doubl
     double d = v3_dot(F->n, x) - F->off;
     if (!(d > lo && d < hi))
         return 0;
+    /* Every triangle tested (a face has few), without an early way out: whether a node near
+     * the outline projects in is a coin toss. */
+    int in = 0;
     for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
         const ws_wtri *q = &g->tri[t];
         v3 r = v3_sub(x, q->p);
-        if (ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11)) {
-            *dist = d;
-            return 1;
-        }
+        in |= ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11);
     }
-    return 0;
+    *dist = d;
+    return in;
 }
 
 /* A node against the rounded rim of a convex edge: only in the edge's own region, where the
@@ -456,8 +457,7 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
             continue;
         /* Gathered, and padded to whole vectors with copies of the last (dropped after). */
         size_t mv = (nin + 3) & ~(size_t)3;
-        for (size_t t = nin; t < mv; t++)
-            idx[t] = idx[nin - 1];
+        idx[nin] = idx[nin + 1] = idx[nin + 2] = idx[nin - 1]; /* room: 2 RUN_CHUNK */
         for (size_t t = 0; t < mv; t++) {
             const size_t e = idx[t], i = o + e;
             I[I_X * RUN_CHUNK + t] = x.x[i];
