@@ -3,52 +3,41 @@
 #include "contact/contact.h"
 #include "contact/node.h"
 
-/* Eq. 14 in the global frame for a prepared face: 1 and the signed distance when the point
- * projects into the face and lies within (lo, hi) of its plane. */
-static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, double lo, double hi,
-                           double *dist)
+/* Eq. 14 in the global frame for a prepared face: whether the point projects into it. Every
+ * triangle is tested (a face has few), without an early way out: whether a node near the
+ * outline projects in is a coin toss. */
+static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
 {
-    double d = v3_dot(F->n, x) - F->off;
-    if (!(d > lo && d < hi))
-        return 0;
-    /* Every triangle tested (a face has few), without an early way out: whether a node near
-     * the outline projects in is a coin toss. */
     int in = 0;
     for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
         const ws_wtri *q = &g->tri[t];
         v3 r = v3_sub(x, q->p);
         in |= ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11);
     }
-    *dist = d;
     return in;
 }
 
 /* A node against the rounded rim of a convex edge: only in the edge's own region, where the
  * direction from the edge to the node lies strictly between the normals of its two faces
- * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
- * to the node and the distance. */
+ * (elsewhere a face holds the node), and closer than `hi`. Whether it is; the unit normal from
+ * the edge to the node and the distance when it is, else a zero normal and the distance hi
+ * (a contact of no force). Without branches: near a corner which region holds a node is a coin
+ * toss. */
 static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
     double t = v3_dot(rp, E->e) * E->inv_e2;
-    if (!(t > 0.0 && t < 1.0))
-        return 0;
     v3 r = v3_madd(rp, E->e, -t);
     double l2 = v3_dot(r, r);
-    if (!(l2 < hi * hi) || !(l2 > 0.0))
-        return 0;
-    /* Outside both faces' planes: in the wedge between them. */
-    if (!(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
-        return 0;
-    /* And not over either face: r = a n1 + b n2 with a, b > 0. */
+    /* Outside both faces' planes, and not over either face: r = a n1 + b n2 with a, b > 0. */
     double c = v3_dot(E->n1, E->n2), r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
     double den = 1.0 - c * c;
-    if (den < 1e-12 || !(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
-        return 0;
+    int in = (t > 0.0) & (t < 1.0) & (l2 < hi * hi) & (l2 > 0.0) & (r1 > 0.0) & (r2 > 0.0) &
+             (den >= 1e-12) & (r1 - c * r2 > 0.0) & (r2 - c * r1 > 0.0);
     double l = sqrt(l2);
-    *nrm = v3_scale(r, 1.0 / l);
-    *dist = l;
-    return 1;
+    *nrm = v3_scale(r, in ? 1.0 / l : 0.0);
+    *dist = in ? l : hi;
+    return in;
 }
 
 /* Whether face f is the shallowest of a convex body for a point at distance d under it: no
@@ -115,23 +104,20 @@ enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A
  * The loads: per load on a body (A_BX... A_MZ: force, moment about the CoG) and the body's
  * slot (lbody), nl of them. */
 typedef struct act_list {
-    double *a[ACT_ARRAYS];
+    double *base; /* array k at base + k cap */
+    size_t cap;
     uint32_t *node, *body, *slot, *lbody;
     size_t n, nl;
 } act_list;
 
 static act_list act_open(ws_web *web)
 {
-    act_list L;
-    for (int k = 0; k < ACT_ARRAYS; k++)
-        L.a[k] = web->act + (size_t)k * web->act_cap;
-    L.node = web->act_id;
-    L.body = web->act_id + web->act_cap;
-    L.slot = web->act_id + 2 * web->act_cap;
-    L.lbody = web->act_id + 3 * web->act_cap;
-    L.n = L.nl = 0;
-    return L;
+    const size_t cap = web->act_cap;
+    uint32_t *id = web->act_id;
+    return (act_list){web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, 0, 0};
 }
+
+static inline double *act_a(const act_list *L, int k) { return L->base + (size_t)k * L->cap; }
 
 /* Contact `node` against body `body`: written at the end of the list, and kept when `keep`
  * (no branch: the list has room for every candidate of the block and one more). */
@@ -141,18 +127,18 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     const size_t q = L->n;
     L->node[q] = node;
     L->body[q] = body;
-    L->a[A_NX][q] = n.x;
-    L->a[A_NY][q] = n.y;
-    L->a[A_NZ][q] = n.z;
-    L->a[A_LX][q] = lever.x;
-    L->a[A_LY][q] = lever.y;
-    L->a[A_LZ][q] = lever.z;
-    L->a[A_TX][q] = vt.x;
-    L->a[A_TY][q] = vt.y;
-    L->a[A_TZ][q] = vt.z;
-    L->a[A_FN][q] = fn;
-    L->a[A_MU][q] = mu;
-    L->a[A_VL][q] = vlim;
+    act_a(L, A_NX)[q] = n.x;
+    act_a(L, A_NY)[q] = n.y;
+    act_a(L, A_NZ)[q] = n.z;
+    act_a(L, A_LX)[q] = lever.x;
+    act_a(L, A_LY)[q] = lever.y;
+    act_a(L, A_LZ)[q] = lever.z;
+    act_a(L, A_TX)[q] = vt.x;
+    act_a(L, A_TY)[q] = vt.y;
+    act_a(L, A_TZ)[q] = vt.z;
+    act_a(L, A_FN)[q] = fn;
+    act_a(L, A_MU)[q] = mu;
+    act_a(L, A_VL)[q] = vlim;
     L->slot[q] = (uint32_t)L->nl;
     L->n += (size_t)(keep != 0);
     L->nl += (size_t)(keep != 0);
@@ -161,20 +147,21 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
 /* The normal force of node i on body bi at depth d along the normal n (from the body to the
  * node), within the window (hi the layers): into f; the contact is listed when it pushes.
  * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
- * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
- * force is added times whether it pushes (0 or 1), without a branch. Both passes use it. */
+ * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls, nor
+ * one the geometry turned down (in = 0): its force is added times whether it pushes (0 or 1),
+ * without a branch. run_kernel has the same arithmetic for a run's nodes. */
 static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
                              uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
-                             const ws_node_params *p)
+                             const ws_node_params *p, int in)
 {
     v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
     v3 lever = v3_sub(xc, r);
     v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
     double vn = v3_dot(vrel, n);
     double fn = p->k * (hi - d) - p->c * vn;
-    double push = fn > 0.0;
-    nodes_add(web->f, i, v3_scale(n, fn * push));
-    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
+    int pushes = in & (fn > 0.0);
+    nodes_add(web->f, i, v3_scale(n, fn * (double)pushes));
+    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, pushes);
 }
 
 /* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
@@ -200,36 +187,35 @@ static void act_friction(size_t m, double h, const double *restrict P, double *r
 static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
 {
     const size_t m = L->n;
-    double *const *A = L->a;
     ws_nodes3 f = web->f;
     for (size_t q = 0; q < m; q++) { /* each node's force with all its normal forces in */
         const uint32_t i = L->node[q];
-        A[A_KX][q] = f.x[i];
-        A[A_KY][q] = f.y[i];
-        A[A_KZ][q] = f.z[i];
-        A[A_IM][q] = web->inv_m[i];
-        A[A_M][q] = web->m[i];
+        act_a(L, A_KX)[q] = f.x[i];
+        act_a(L, A_KY)[q] = f.y[i];
+        act_a(L, A_KZ)[q] = f.z[i];
+        act_a(L, A_IM)[q] = web->inv_m[i];
+        act_a(L, A_M)[q] = web->m[i];
     }
     act_friction(m, h, web->act, web->act + A_AX * web->act_cap, web->act_cap);
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
         const uint32_t i = L->node[q], at = L->slot[q];
-        v3 ft = v3_make(A[A_AX][q], A[A_AY][q], A[A_AZ][q]);
-        v3 n = v3_make(A[A_NX][q], A[A_NY][q], A[A_NZ][q]);
-        v3 lever = v3_make(A[A_LX][q], A[A_LY][q], A[A_LZ][q]);
-        double fn = A[A_FN][q];
+        v3 ft = v3_make(act_a(L, A_AX)[q], act_a(L, A_AY)[q], act_a(L, A_AZ)[q]);
+        v3 n = v3_make(act_a(L, A_NX)[q], act_a(L, A_NY)[q], act_a(L, A_NZ)[q]);
+        v3 lever = v3_make(act_a(L, A_LX)[q], act_a(L, A_LY)[q], act_a(L, A_LZ)[q]);
+        double fn = act_a(L, A_FN)[q];
         nodes_add(f, i, ft);
         v3 Fnode = v3_madd(ft, n, fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
         touched[nt++] = i;
         v3 Fb = v3_scale(Fnode, -share), Mb = v3_cross(lever, Fb);
-        A[A_BX][at] = Fb.x;
-        A[A_BY][at] = Fb.y;
-        A[A_BZ][at] = Fb.z;
-        A[A_MX][at] = Mb.x;
-        A[A_MY][at] = Mb.y;
-        A[A_MZ][at] = Mb.z;
+        act_a(L, A_BX)[at] = Fb.x;
+        act_a(L, A_BY)[at] = Fb.y;
+        act_a(L, A_BZ)[at] = Fb.z;
+        act_a(L, A_MX)[at] = Mb.x;
+        act_a(L, A_MY)[at] = Mb.y;
+        act_a(L, A_MZ)[at] = Mb.z;
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
@@ -240,7 +226,6 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
  * hand kept in registers). */
 static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
 {
-    double *const *A = L->a;
     uint32_t body = UINT32_MAX;
     v3 bf = v3_make(0, 0, 0), bm = bf;
     for (size_t q = 0; q < L->nl; q++) {
@@ -254,8 +239,8 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
             bf = bforce[bi];
             bm = bmoment[bi];
         }
-        bf = v3_add(bf, v3_make(A[A_BX][q], A[A_BY][q], A[A_BZ][q]));
-        bm = v3_add(bm, v3_make(A[A_MX][q], A[A_MY][q], A[A_MZ][q]));
+        bf = v3_add(bf, v3_make(act_a(L, A_BX)[q], act_a(L, A_BY)[q], act_a(L, A_BZ)[q]));
+        bm = v3_add(bm, v3_make(act_a(L, A_MX)[q], act_a(L, A_MY)[q], act_a(L, A_MZ)[q]));
     }
     if (body != UINT32_MAX) {
         bforce[body] = bf;
@@ -286,39 +271,36 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
         sel[m] = (uint32_t)k;
         m += (size_t)((d < b->layer[c->body] + wl) | ((c->local & WS_NCAND_EDGE) != 0));
     }
-    /* Normal forces, in node order. */
+    /* Normal forces, in node order. A candidate the geometry turns down goes on as a contact
+     * that does not push (no branch: which ones are turned down is a coin toss). */
     for (size_t q = 0; q < m; q++) {
         const ws_ncand *c = &cand[sel[q]];
         uint32_t i = c->node, bi = c->body;
         v3 xi = nodes_get(x, i), nrm;
         double d;
+        int in;
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         double hi = b->layer[bi] + wl;
         if (c->local & WS_NCAND_EDGE) {
-            if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
-                continue;
+            in = in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d);
         } else {
             const ws_wface *F = &g->face[c->feat];
-            d = v3_dot(F->n, xi) - F->off;
+            d = v3_dot(F->n, xi) - F->off; /* below hi: listed above */
             const ws_shape *sh = b->shape[bi];
             double lo = -hi - sh->inner;
-            if (!(d > lo))
-                continue;
             /* A node found well inside the face's outline stays over the face while the
              * candidates are valid: no need to find its triangle. */
-            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi, lo, hi, &d))
-                continue;
+            in = (d > lo) & (((c->local & WS_NCAND_INSIDE) != 0) | in_wface(g, F, xi));
             uint32_t f = c->local & ~WS_NCAND_FLAGS;
-            if (d < 0.0 &&
-                !(sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                             : ws_shallowest_face(sh, f,
-                                                  m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                                  d)))
-                continue;
+            if (in && d < 0.0) /* rare: a node below the face's plane */
+                in = sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
+                                : ws_shallowest_face(sh, f,
+                                                     m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
+                                                     d);
             nrm = F->n; /* from the body to the node */
         }
         normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
-                  &pp[b->material[bi]]);
+                  &pp[b->material[bi]], in);
     }
 }
 
@@ -483,7 +465,8 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
                      *omz = O + O_MZ * RUN_CHUNK, *opush = O + O_PUSH * RUN_CHUNK;
         uint32_t *touched = web->fct[web->fck];
         size_t nt = web->nfct[web->fck], nl = L->nl;
-        double *const *A = L->a;
+        double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
+               *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
         for (size_t t = 0; t < nin; t++) {
             const uint32_t i = o + idx[t];
             const size_t pushes = (size_t)(opush[t] != 0.0);
@@ -494,12 +477,12 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
             fc[i] = v3_sub(fc[i], Fb); /* the node's share: -Fb, to the bit */
             touched[nt] = i;
             nt += pushes;
-            A[A_BX][nl] = Fb.x;
-            A[A_BY][nl] = Fb.y;
-            A[A_BZ][nl] = Fb.z;
-            A[A_MX][nl] = omx[t];
-            A[A_MY][nl] = omy[t];
-            A[A_MZ][nl] = omz[t];
+            lbx[nl] = Fb.x;
+            lby[nl] = Fb.y;
+            lbz[nl] = Fb.z;
+            lmx[nl] = omx[t];
+            lmy[nl] = omy[t];
+            lmz[nl] = omz[t];
             L->lbody[nl] = bi;
             nl += pushes;
         }
