@@ -3,41 +3,54 @@
 #include "contact/contact.h"
 #include "contact/node.h"
 
-/* Eq. 14 in the global frame for a prepared face: whether the point projects into it. Every
- * triangle is tested (a face has few), without an early way out: whether a node near the
- * outline projects in is a coin toss. */
-static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
+_Static_assert(WS_NCAND_EDGE == 0x80000000u, "contacts_general reads the edge flag as the top bit");
+
+/* Eq. 14 in the global frame for a prepared face: 1 and the signed distance when the point
+ * projects into the face and lies within (lo, hi) of its plane. */
+static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, double lo, double hi,
+                           double *dist)
 {
+    double d = v3_dot(F->n, x) - F->off;
+    if (!(d > lo && d < hi))
+        return 0;
+    /* Every triangle tested (a face has few), without an early way out: whether a node near
+     * the outline projects in is a coin toss. */
     int in = 0;
     for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
         const ws_wtri *q = &g->tri[t];
         v3 r = v3_sub(x, q->p);
         in |= ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11);
     }
+    *dist = d;
     return in;
 }
 
 /* A node against the rounded rim of a convex edge: only in the edge's own region, where the
  * direction from the edge to the node lies strictly between the normals of its two faces
- * (elsewhere a face holds the node), and closer than `hi`. Whether it is; the unit normal from
- * the edge to the node and the distance when it is, else a zero normal and the distance hi
- * (a contact of no force). Without branches: near a corner which region holds a node is a coin
- * toss. */
+ * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
+ * to the node and the distance. */
 static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
     double t = v3_dot(rp, E->e) * E->inv_e2;
+    if (!(t > 0.0 && t < 1.0))
+        return 0;
     v3 r = v3_madd(rp, E->e, -t);
     double l2 = v3_dot(r, r);
-    /* Outside both faces' planes, and not over either face: r = a n1 + b n2 with a, b > 0. */
+    if (!(l2 < hi * hi) || !(l2 > 0.0))
+        return 0;
+    /* Outside both faces' planes: in the wedge between them. */
+    if (!(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
+        return 0;
+    /* And not over either face: r = a n1 + b n2 with a, b > 0. */
     double c = v3_dot(E->n1, E->n2), r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
     double den = 1.0 - c * c;
-    int in = (t > 0.0) & (t < 1.0) & (l2 < hi * hi) & (l2 > 0.0) & (r1 > 0.0) & (r2 > 0.0) &
-             (den >= 1e-12) & (r1 - c * r2 > 0.0) & (r2 - c * r1 > 0.0);
+    if (den < 1e-12 || !(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+        return 0;
     double l = sqrt(l2);
-    *nrm = v3_scale(r, in ? 1.0 / l : 0.0);
-    *dist = in ? l : hi;
-    return in;
+    *nrm = v3_scale(r, 1.0 / l);
+    *dist = l;
+    return 1;
 }
 
 /* Whether face f is the shallowest of a convex body for a point at distance d under it: no
@@ -147,21 +160,20 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
 /* The normal force of node i on body bi at depth d along the normal n (from the body to the
  * node), within the window (hi the layers): into f; the contact is listed when it pushes.
  * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
- * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls, nor
- * one the geometry turned down (in = 0): its force is added times whether it pushes (0 or 1),
- * without a branch. run_kernel has the same arithmetic for a run's nodes. */
+ * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
+ * force is added times whether it pushes (0 or 1), without a branch. Both passes use it. */
 static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
                              uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
-                             const ws_node_params *p, int in)
+                             const ws_node_params *p)
 {
     v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
     v3 lever = v3_sub(xc, r);
     v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
     double vn = v3_dot(vrel, n);
     double fn = p->k * (hi - d) - p->c * vn;
-    int pushes = in & (fn > 0.0);
-    nodes_add(web->f, i, v3_scale(n, fn * (double)pushes));
-    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, pushes);
+    double push = fn > 0.0;
+    nodes_add(web->f, i, v3_scale(n, fn * push));
+    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
 }
 
 /* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
@@ -265,42 +277,46 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
     size_t m = 0;
     for (size_t k = 0; k < n; k++) {
         const ws_ncand *c = &cand[k];
-        const ws_wface *F = &g->face[c->local & WS_NCAND_EDGE ? 0 : c->feat];
+        const uint32_t edge = c->local >> 31; /* WS_NCAND_EDGE, as 0 or 1 */
+        const ws_wface *F = &g->face[c->feat & (edge - 1u)]; /* any face for an edge */
         uint32_t i = c->node;
         double d = F->n.x * x.x[i] + F->n.y * x.y[i] + F->n.z * x.z[i] - F->off;
         sel[m] = (uint32_t)k;
-        m += (size_t)((d < b->layer[c->body] + wl) | ((c->local & WS_NCAND_EDGE) != 0));
+        m += (size_t)((d < b->layer[c->body] + wl) | edge);
     }
-    /* Normal forces, in node order. A candidate the geometry turns down goes on as a contact
-     * that does not push (no branch: which ones are turned down is a coin toss). */
+    /* Normal forces, in node order. */
     for (size_t q = 0; q < m; q++) {
         const ws_ncand *c = &cand[sel[q]];
         uint32_t i = c->node, bi = c->body;
         v3 xi = nodes_get(x, i), nrm;
         double d;
-        int in;
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         double hi = b->layer[bi] + wl;
         if (c->local & WS_NCAND_EDGE) {
-            in = in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d);
+            if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
+                continue;
         } else {
             const ws_wface *F = &g->face[c->feat];
-            d = v3_dot(F->n, xi) - F->off; /* below hi: listed above */
+            d = v3_dot(F->n, xi) - F->off;
             const ws_shape *sh = b->shape[bi];
             double lo = -hi - sh->inner;
+            if (!(d > lo))
+                continue;
             /* A node found well inside the face's outline stays over the face while the
              * candidates are valid: no need to find its triangle. */
-            in = (d > lo) & (((c->local & WS_NCAND_INSIDE) != 0) | in_wface(g, F, xi));
+            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi, lo, hi, &d))
+                continue;
             uint32_t f = c->local & ~WS_NCAND_FLAGS;
-            if (in && d < 0.0) /* rare: a node below the face's plane */
-                in = sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                                : ws_shallowest_face(sh, f,
-                                                     m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                                     d);
+            if (d < 0.0 &&
+                !(sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
+                             : ws_shallowest_face(sh, f,
+                                                  m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
+                                                  d)))
+                continue;
             nrm = F->n; /* from the body to the node */
         }
         normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
-                  &pp[b->material[bi]], in);
+                  &pp[b->material[bi]]);
     }
 }
 
@@ -569,6 +585,28 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     return 0;
 }
 
+/* What the next sweep block's contacts will read first and is seldom in cache by then (a
+ * step streams about a megabyte of node state): the contact forces of its nodes and its
+ * candidates. Asked for now, so that the loads of this block's integration and the next one's
+ * springs hide their wait. */
+static void ahead(const ws_web *web, const ws_ncand *cand, size_t k, const v3 *fc)
+{
+    if (k >= web->nseg)
+        return;
+    const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
+    const uint32_t end = (web->seg[k].n0 / bl + 1) * bl; /* the end of the next block */
+    size_t e = k;
+    while (e + 1 < web->nseg && web->seg[e + 1].n0 < end)
+        e++;
+    const char *p0 = (const char *)(fc + web->seg[k].n0), *p1 = (const char *)(fc + web->seg[e].n1);
+    for (const char *p = p0; p < p1; p += 64)
+        __builtin_prefetch(p, 1);
+    p0 = (const char *)(cand + web->seg[k].c0);
+    p1 = (const char *)(cand + web->seg[e].c1);
+    for (const char *p = p0; p < p1; p += 64)
+        __builtin_prefetch(p, 0);
+}
+
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
                       const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
@@ -587,6 +625,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
+    ahead(web, cand, k, fc);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
