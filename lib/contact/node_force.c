@@ -600,11 +600,11 @@ static void ahead(const ws_web *web, const ws_ncand *cand, size_t k, const v3 *f
         e++;
     const char *p0 = (const char *)(fc + web->seg[k].n0), *p1 = (const char *)(fc + web->seg[e].n1);
     for (const char *p = p0; p < p1; p += 64)
-        __builtin_prefetch(p, 1);
+        WS_PREFETCH(p, 1);
     p0 = (const char *)(cand + web->seg[k].c0);
     p1 = (const char *)(cand + web->seg[e].c1);
     for (const char *p = p0; p < p1; p += 64)
-        __builtin_prefetch(p, 0);
+        WS_PREFETCH(p, 0);
 }
 
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
