@@ -41,9 +41,9 @@ static int in_cone(v3 n, v3 n1, v3 n2)
  * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
  * the parameters, the oriented normal and the signed distance; 0 for parallel edges (the system
  * is singular: point-face contacts carry that case) or when the closest points are not interior
- * to both edges (within `slack` of the ends, in parameter units) or the cones disagree. */
-static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double slack,
-                     int check_cones, double *s_out, double *t_out, v3 *n_out, double *d_out)
+ * to both edges or the cones disagree. */
+static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double *s_out,
+                     double *t_out, v3 *n_out, double *d_out)
 {
     v3 u = v3_sub(qi, pi), w = v3_sub(qj, pj);
     v3 n = v3_cross(u, w);
@@ -53,21 +53,17 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     v3 r = v3_sub(pj, pi);
     double ru = v3_dot(r, u), rw = v3_dot(r, w);
     double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
-    double lo = WS_FEATURE_TOL - slack, hi = 1.0 - WS_FEATURE_TOL + slack;
+    double lo = WS_FEATURE_TOL, hi = 1.0 - WS_FEATURE_TOL;
     if (!(s > lo && s < hi && t > lo && t < hi))
         return 0;
     n = v3_scale(n, 1.0 / sqrt(nn));
-    if (check_cones) {
-        if (!in_cone(n, n1i, n2i)) {
-            n = v3_neg(n);
-            if (!in_cone(n, n1i, n2i))
-                return 0;
-        }
-        if (!in_cone(v3_neg(n), n1j, n2j))
-            return 0;
-    } else if (v3_dot(n, v3_add(n1i, n2i)) < 0.0) {
+    if (!in_cone(n, n1i, n2i)) {
         n = v3_neg(n);
+        if (!in_cone(n, n1i, n2i))
+            return 0;
     }
+    if (!in_cone(v3_neg(n), n1j, n2j))
+        return 0;
     *s_out = s;
     *t_out = t;
     *n_out = n;
@@ -148,6 +144,37 @@ static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb
     return 0;
 }
 
+/* Distance from x to the segment a + t d, t in [0, 1]. */
+static double point_segment(v3 x, v3 a, v3 d)
+{
+    double t = v3_dot(v3_sub(x, a), d) / v3_dot(d, d);
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    return v3_norm(v3_sub(x, v3_madd(a, d, t)));
+}
+
+/* The distance between the segments p + s u and q + t w (s, t in [0, 1]); for nearly parallel
+ * ones a lower bound of it. It changes by no more than the segments' points move, unlike where
+ * the lines' closest points lie: those run along the edges at the points' speed over the sine
+ * of the edges' angle. */
+static double segment_gap(v3 p, v3 u, v3 q, v3 w)
+{
+    v3 n = v3_cross(u, w), r = v3_sub(q, p);
+    double uu = v3_dot(u, u), ww = v3_dot(w, w), uw = v3_dot(u, w), nn = v3_dot(n, n);
+    double ends = fmin(fmin(point_segment(p, q, w), point_segment(v3_add(p, u), q, w)),
+                       fmin(point_segment(q, p, u), point_segment(v3_add(q, w), p, u)));
+    if (nn < 1e-8 * uu * ww) {
+        /* The closest points are ill-conditioned: from the interior ones, along the two lines'
+         * valley to the border of the parameter square, the distance grows by at most
+         * min(|u|, |w|) sin(angle) = |n| / max(|u|, |w|). */
+        return ends - sqrt(nn / fmax(uu, ww));
+    }
+    double ru = v3_dot(r, u), rw = v3_dot(r, w);
+    double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
+    if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0)
+        return fabs(v3_dot(r, n)) / sqrt(nn);
+    return ends; /* the least over the border of the parameter square */
+}
+
 static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib, ws_cand **cand,
                        size_t *n, size_t *cap)
 {
@@ -165,7 +192,6 @@ static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib,
         if (hi.x < sa->lo.x - reach || lo.x > sa->hi.x + reach || hi.y < sa->lo.y - reach ||
             lo.y > sa->hi.y + reach || hi.z < sa->lo.z - reach || lo.z > sa->hi.z + reach)
             continue;
-        double lj = v3_norm(v3_sub(qj, pj));
         for (uint32_t ea = 0; ea < sa->edge_count; ea++) {
             const ws_edge *F = &sa->edges[ea];
             /* Edge boxes first: most pairs are far apart. */
@@ -174,13 +200,13 @@ static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib,
                 continue;
             v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
             x->narrow_checks++;
-            double li = v3_norm(v3_sub(qi, pi));
-            double slack = reach / fmin(li, lj);
-            double s, u, d;
-            v3 nrm;
-            if (edge_edge(pi, qi, F->n1, F->n2, pj, qj, v3_make(0, 0, 0), v3_make(0, 0, 0),
-                          slack, 0, &s, &u, &nrm, &d) &&
-                fabs(d) < reach + fmin(sa->inner, sb->inner))
+            /* A contact of the two (eq. 16-17: closest points within both edges, |d| below the
+             * layers + the inner depth) is one of the segments' distance. Until the next full
+             * detection the bodies' points move less than the margin together, and so does
+             * the segments' distance: within the layers + margin + inner depth now, or no
+             * contact before then. Parallel edges too: they may turn until then. */
+            if (segment_gap(pi, v3_sub(qi, pi), pj, v3_sub(qj, pj)) <
+                reach + fmin(sa->inner, sb->inner))
                 if (push(mem, cand, n, cap, ia, ib, ea, eb, WS_CONTACT_EDGE_EDGE) != 0)
                     return -1;
         }
@@ -231,8 +257,8 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
     double s, u, d;
     v3 n;
-    if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), 0.0,
-                   1, &s, &u, &n, &d))
+    if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), &s, &u,
+                   &n, &d))
         return 0;
     if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
         return 0;
