@@ -222,6 +222,77 @@ START_TEST(schedule_keeps_nearly_parallel_edges)
 }
 END_TEST
 
+/* A cube turned 45 deg about x (its bottom edge, the keel, along x) resting across a fixed block
+ * turned 45 deg about y (its top edge, the ridge, along y) on a soft contact: the crossed edges
+ * carry the cube alone. interval: the detection interval. */
+static ws_world *ridge_world(int interval, double k, ws_body_id *cube, double *ridge_top)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.detection_interval = interval;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id mat;
+    ck_ok(w, ws_material_create(w, &md, &mat));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = k;
+    cd.damping = 40.0; /* 0.63 of critical for 1 kg on 1000 N/m */
+    ck_ok(w, ws_world_set_contact(w, mat, mat, &cd));
+    ws_shape_id big, small;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &big));
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &small));
+    const double s2 = sqrt(0.5), c8 = cos(0.125 * 3.14159265358979323846), s8 = sin(0.125 * 3.14159265358979323846);
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = big;
+    bd.material = mat;
+    bd.orientation = (ws_quat){c8, 0.0, s8, 0.0}; /* 45 deg about y: an edge on top, along y */
+    bd.name = "ridge";
+    ws_body_id ridge;
+    ck_ok(w, ws_body_create(w, &bd, &ridge));
+    *ridge_top = 0.1 / s2;
+    ws_body_def_init(&bd);
+    bd.shape = small;
+    bd.material = mat;
+    bd.mass = 1.0;
+    bd.orientation = (ws_quat){c8, s8, 0.0, 0.0}; /* 45 deg about x: an edge below, along x */
+    /* The keel just touching: at the layers (1 mm each) above the ridge. */
+    bd.position = (ws_vec3){0.0, 0.0, *ridge_top + 2e-3 + 0.05 / s2};
+    bd.name = "cube";
+    ck_ok(w, ws_body_create(w, &bd, cube));
+    return w;
+}
+
+START_TEST(crossed_edges_hold_below_the_margin)
+{
+    /* Penalty on the overlap of the layers: at rest k (2 delta - d) = m g, so the keel lies
+     * d = 2 delta - m g / k = 2 - 9.81 = -7.81 mm from the ridge, deeper than the layers +
+     * margin (4 mm) but well within the cube's inner depth (25 mm), where a contact is still
+     * seen. Detected every step or every fifth, the edges must hold the cube there. Tolerance
+     * 1e-5 m: the damped bounce (0.63 of critical, 31.6 rad/s) has decayed by e^-10 of its
+     * 9.8 mm in 0.5 s. */
+    const double k = 1000.0, g = 9.81, want = 2e-3 - g / k;
+    for (int interval = 1; interval <= 5; interval += 4) {
+        ws_body_id cube;
+        double top;
+        ws_world *w = ridge_world(interval, k, &cube, &top);
+        ck_ok(w, ws_world_step_n(w, 2000));
+        ws_vec3 p;
+        ws_body_get_position(w, cube, &p);
+        double d = p.z - 0.05 / sqrt(0.5) - top;
+        report("crossed edges, detection every %d step(s): the keel rests %.4f mm from the ridge "
+               "(theory %.4f mm)", interval, 1e3 * d, 1e3 * want);
+        ck_assert_msg(fabs(d - want) < 1e-5, "keel at %.6f m from the ridge, theory %.6f m", d,
+                      want);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 /* Case 5's paddle: pressed on the band, it spins at 3 rad/s about its axis across the band
  * and jumps 4 cm along the band every 50 ms (a drive may jump). */
 static int spin_and_jump(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec3 *w)
@@ -677,6 +748,7 @@ int main(void)
     tcase_add_test(tc, schedule_does_not_change_the_motion);
     tcase_add_test(tc, ccd_gate_does_not_change_the_motion);
     tcase_add_test(tc, schedule_keeps_nearly_parallel_edges);
+    tcase_add_test(tc, crossed_edges_hold_below_the_margin);
     tcase_add_test(tc, impact_stays_within_the_layers);
     tcase_add_test(tc, film_detection_does_not_change_the_motion);
     tcase_add_test(tc, film_runs_equal_one_by_one);
