@@ -324,6 +324,10 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
 
 #define RUN_MIN 4     /* shorter stretches go one by one */
 #define RUN_CHUNK 128 /* nodes of a run whose depths are taken at once */
+/* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
+ * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
+ * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
+#define RUN_STRIDE (RUN_CHUNK + 8)
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -361,23 +365,23 @@ typedef struct run_const {
     double hi, k, c, mu, vlim, h, share;
 } run_const;
 
-/* The kernel's inputs, gathered: arrays of RUN_CHUNK from `in` on, in this order. */
+/* The kernel's inputs, gathered: arrays RUN_STRIDE apart from `in` on, in this order. */
 enum { I_X, I_Y, I_Z, I_VX, I_VY, I_VZ, I_FX, I_FY, I_FZ, I_D, I_IM, I_M, I_ARRAYS };
 
 WS_VECTOR_LOOP
 static void run_kernel(size_t m, run_const q, const double *restrict in, double *restrict out)
 {
-    const double *px = in + I_X * RUN_CHUNK, *py = in + I_Y * RUN_CHUNK,
-                 *pz = in + I_Z * RUN_CHUNK, *ux = in + I_VX * RUN_CHUNK,
-                 *uy = in + I_VY * RUN_CHUNK, *uz = in + I_VZ * RUN_CHUNK,
-                 *gx = in + I_FX * RUN_CHUNK, *gy = in + I_FY * RUN_CHUNK,
-                 *gz = in + I_FZ * RUN_CHUNK, *dd = in + I_D * RUN_CHUNK,
-                 *im = in + I_IM * RUN_CHUNK, *mass = in + I_M * RUN_CHUNK;
-    double *ofx = out + O_FX * RUN_CHUNK, *ofy = out + O_FY * RUN_CHUNK,
-           *ofz = out + O_FZ * RUN_CHUNK, *obx = out + O_BX * RUN_CHUNK,
-           *oby = out + O_BY * RUN_CHUNK, *obz = out + O_BZ * RUN_CHUNK,
-           *omx = out + O_MX * RUN_CHUNK, *omy = out + O_MY * RUN_CHUNK,
-           *omz = out + O_MZ * RUN_CHUNK, *opush = out + O_PUSH * RUN_CHUNK;
+    const double *px = in + I_X * RUN_STRIDE, *py = in + I_Y * RUN_STRIDE,
+                 *pz = in + I_Z * RUN_STRIDE, *ux = in + I_VX * RUN_STRIDE,
+                 *uy = in + I_VY * RUN_STRIDE, *uz = in + I_VZ * RUN_STRIDE,
+                 *gx = in + I_FX * RUN_STRIDE, *gy = in + I_FY * RUN_STRIDE,
+                 *gz = in + I_FZ * RUN_STRIDE, *dd = in + I_D * RUN_STRIDE,
+                 *im = in + I_IM * RUN_STRIDE, *mass = in + I_M * RUN_STRIDE;
+    double *ofx = out + O_FX * RUN_STRIDE, *ofy = out + O_FY * RUN_STRIDE,
+           *ofz = out + O_FZ * RUN_STRIDE, *obx = out + O_BX * RUN_STRIDE,
+           *oby = out + O_BY * RUN_STRIDE, *obz = out + O_BZ * RUN_STRIDE,
+           *omx = out + O_MX * RUN_STRIDE, *omy = out + O_MY * RUN_STRIDE,
+           *omz = out + O_MZ * RUN_STRIDE, *opush = out + O_PUSH * RUN_STRIDE;
     const double nx = q.nx, ny = q.ny, nz = q.nz;
     for (size_t t = 0; t < m; t++) {
         const double d = dd[t], s = -0.5 * d;
@@ -435,9 +439,9 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
                           wb.z, hi,   p->k, p->c, p->mu, p->vlim, h,    share};
     /* Scratch: the chunk's depths, in-window flags and node indices, then run_kernel's
      * inputs I_* and outputs O_*. */
-    double *D = web->rtmp, *I = D + 3 * RUN_CHUNK, *O = I + I_ARRAYS * RUN_CHUNK;
-    int64_t *in = (int64_t *)(D + RUN_CHUNK);
-    uint32_t *idx = (uint32_t *)(D + 2 * RUN_CHUNK);
+    double *D = web->rtmp, *I = D + 3 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
+    int64_t *in = (int64_t *)(D + RUN_STRIDE);
+    uint32_t *idx = (uint32_t *)(D + 2 * RUN_STRIDE);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
         int64_t deep = run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
@@ -455,30 +459,30 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
             continue;
         /* Gathered, and padded to whole vectors with copies of the last (dropped after). */
         size_t mv = (nin + 3) & ~(size_t)3;
-        idx[nin] = idx[nin + 1] = idx[nin + 2] = idx[nin - 1]; /* room: 2 RUN_CHUNK */
+        idx[nin] = idx[nin + 1] = idx[nin + 2] = idx[nin - 1]; /* room: 2 RUN_STRIDE */
         for (size_t t = 0; t < mv; t++) {
             const size_t e = idx[t], i = o + e;
-            I[I_X * RUN_CHUNK + t] = x.x[i];
-            I[I_Y * RUN_CHUNK + t] = x.y[i];
-            I[I_Z * RUN_CHUNK + t] = x.z[i];
-            I[I_VX * RUN_CHUNK + t] = v.x[i];
-            I[I_VY * RUN_CHUNK + t] = v.y[i];
-            I[I_VZ * RUN_CHUNK + t] = v.z[i];
-            I[I_FX * RUN_CHUNK + t] = web->f.x[i];
-            I[I_FY * RUN_CHUNK + t] = web->f.y[i];
-            I[I_FZ * RUN_CHUNK + t] = web->f.z[i];
-            I[I_D * RUN_CHUNK + t] = D[e];
-            I[I_IM * RUN_CHUNK + t] = web->inv_m[i];
-            I[I_M * RUN_CHUNK + t] = web->m[i];
+            I[I_X * RUN_STRIDE + t] = x.x[i];
+            I[I_Y * RUN_STRIDE + t] = x.y[i];
+            I[I_Z * RUN_STRIDE + t] = x.z[i];
+            I[I_VX * RUN_STRIDE + t] = v.x[i];
+            I[I_VY * RUN_STRIDE + t] = v.y[i];
+            I[I_VZ * RUN_STRIDE + t] = v.z[i];
+            I[I_FX * RUN_STRIDE + t] = web->f.x[i];
+            I[I_FY * RUN_STRIDE + t] = web->f.y[i];
+            I[I_FZ * RUN_STRIDE + t] = web->f.z[i];
+            I[I_D * RUN_STRIDE + t] = D[e];
+            I[I_IM * RUN_STRIDE + t] = web->inv_m[i];
+            I[I_M * RUN_STRIDE + t] = web->m[i];
         }
         run_kernel(mv, rc, I, O);
         /* In node order: the new forces, and for the contacts that push (the others add
          * zeros) the node's share and the body's loads. */
-        const double *ofx = O + O_FX * RUN_CHUNK, *ofy = O + O_FY * RUN_CHUNK,
-                     *ofz = O + O_FZ * RUN_CHUNK, *obx = O + O_BX * RUN_CHUNK,
-                     *oby = O + O_BY * RUN_CHUNK, *obz = O + O_BZ * RUN_CHUNK,
-                     *omx = O + O_MX * RUN_CHUNK, *omy = O + O_MY * RUN_CHUNK,
-                     *omz = O + O_MZ * RUN_CHUNK, *opush = O + O_PUSH * RUN_CHUNK;
+        const double *ofx = O + O_FX * RUN_STRIDE, *ofy = O + O_FY * RUN_STRIDE,
+                     *ofz = O + O_FZ * RUN_STRIDE, *obx = O + O_BX * RUN_STRIDE,
+                     *oby = O + O_BY * RUN_STRIDE, *obz = O + O_BZ * RUN_STRIDE,
+                     *omx = O + O_MX * RUN_STRIDE, *omy = O + O_MY * RUN_STRIDE,
+                     *omz = O + O_MZ * RUN_STRIDE, *opush = O + O_PUSH * RUN_STRIDE;
         uint32_t *touched = web->fct[web->fck];
         size_t nt = web->nfct[web->fck], nl = L->nl;
         double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
@@ -547,8 +551,8 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
     web->seg_list = -1;
     web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, (3 + I_ARRAYS + O_ARRAYS) * RUN_CHUNK,
-                         sizeof(double)) != 0)
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap,
+                         (3 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE, sizeof(double)) != 0)
         return -1;
     seg_cut sc = {web, mem, cand, 0, 0, 0};
     uint32_t end = 0; /* the end of the sweep block of the current node */
@@ -630,7 +634,9 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
-    size_t need = ncand + 1;
+    /* One more than every candidate; an odd number of cache lines, so that the arrays' starts
+     * fall in different sets of the first-level cache. */
+    size_t need = (((ncand + 1 + 7) / 8) | 1) * 8;
     if (need > web->act_cap) {
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
