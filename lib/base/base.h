@@ -21,14 +21,6 @@
 #define WS_VECTOR_LOOP
 #endif
 
-/* Asks for the cache line at p ahead of its use (w: 1 to be written); a hint, nothing where the
- * compiler has none. */
-#if defined(__GNUC__)
-#define WS_PREFETCH(p, w) __builtin_prefetch((p), (w))
-#else
-#define WS_PREFETCH(p, w) ((void)(p))
-#endif
-
 /* Written by every ws_*_def_init(); an uninitialised Def almost never carries it. */
 #define WS_DEF_MAGIC 0x57534446u /* "WSDF" */
 

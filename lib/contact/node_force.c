@@ -589,28 +589,6 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     return 0;
 }
 
-/* What the next sweep block's contacts will read first and is seldom in cache by then (a
- * step streams about a megabyte of node state): the contact forces of its nodes and its
- * candidates. Asked for now, so that the loads of this block's integration and the next one's
- * springs hide their wait. */
-static void ahead(const ws_web *web, const ws_ncand *cand, size_t k, const v3 *fc)
-{
-    if (k >= web->nseg)
-        return;
-    const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
-    const uint32_t end = (web->seg[k].n0 / bl + 1) * bl; /* the end of the next block */
-    size_t e = k;
-    while (e + 1 < web->nseg && web->seg[e + 1].n0 < end)
-        e++;
-    const char *p0 = (const char *)(fc + web->seg[k].n0), *p1 = (const char *)(fc + web->seg[e].n1);
-    for (const char *p = p0; p < p1; p += 64)
-        WS_PREFETCH(p, 1);
-    p0 = (const char *)(cand + web->seg[k].c0);
-    p1 = (const char *)(cand + web->seg[e].c1);
-    for (const char *p = p0; p < p1; p += 64)
-        WS_PREFETCH(p, 0);
-}
-
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
                       const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
@@ -629,7 +607,6 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
-    ahead(web, cand, k, fc);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
