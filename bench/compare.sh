@@ -17,7 +17,7 @@ fi
 a=$1
 b=$2
 rounds=${3:-8}
-[ $# -ge 3 ] && shift 3 || shift 2
+if [ $# -ge 3 ]; then shift 3; else shift 2; fi
 for prog in "$a" "$b"; do
     [ -x "$prog" ] || { echo "compare.sh: $prog is not an executable program" >&2; exit 2; }
 done
