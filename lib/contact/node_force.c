@@ -354,10 +354,11 @@ static int64_t run_depth(size_t m, run_face q, const double *restrict x, const d
 
 /* A run's contacts in the window, from its nodes' gathered values (I_*): the contact of
  * normal_of, and for one that pushes the friction of act_apply, with the same arithmetic
- * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other contact, so its force with
- * every normal force in is its force with this one. Gives per contact the node's new force,
- * whether it pushes, and the body's share of the load (force and moment about the CoG), which
- * the caller adds in node order. Straight-line code, so it runs on vectors. */
+ * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's
+ * node has no other contact, so its force with every normal force in is its force with this
+ * one. Gives per contact the node's new force, whether it pushes, and the body's share of the
+ * load (force and moment about the CoG), which the caller lists in node order. Straight-line
+ * code, so it runs on vectors. */
 enum { O_FX, O_FY, O_FZ, O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_PUSH, O_ARRAYS };
 
 typedef struct run_const {
