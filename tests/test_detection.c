@@ -244,7 +244,8 @@ static ws_world *ridge_world(int interval, double k, ws_body_id *cube, double *r
     ws_shape_id big, small;
     ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &big));
     ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &small));
-    const double s2 = sqrt(0.5), c8 = cos(0.125 * 3.14159265358979323846), s8 = sin(0.125 * 3.14159265358979323846);
+    const double pi = 3.14159265358979323846;
+    const double s2 = sqrt(0.5), c8 = cos(0.125 * pi), s8 = sin(0.125 * pi);
     ws_body_def bd;
     ws_body_def_init(&bd);
     bd.type = WS_BODY_KINEMATIC;
