@@ -5,23 +5,17 @@
 
 _Static_assert(WS_NCAND_EDGE == 0x80000000u, "contacts_general reads the edge flag as the top bit");
 
-/* Eq. 14 in the global frame for a prepared face: 1 and the signed distance when the point
- * projects into the face and lies within (lo, hi) of its plane. */
-static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x, double lo, double hi,
-                           double *dist)
+/* Eq. 14 in the global frame for a prepared face: whether the point projects into it (its
+ * distance to the plane is the caller's). Every triangle is tested (a face has few), without an
+ * early way out: whether a node near the outline projects in is a coin toss. */
+static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
 {
-    double d = v3_dot(F->n, x) - F->off;
-    if (!(d > lo && d < hi))
-        return 0;
-    /* Every triangle tested (a face has few), without an early way out: whether a node near
-     * the outline projects in is a coin toss. */
     int in = 0;
     for (uint32_t t = F->first_tri; t < F->first_tri + F->tri_count; t++) {
         const ws_wtri *q = &g->tri[t];
         v3 r = v3_sub(x, q->p);
         in |= ws_bary_inside(v3_dot(r, q->w), v3_dot(r, q->v), q->g00, q->g01, q->g11);
     }
-    *dist = d;
     return in;
 }
 
@@ -132,6 +126,19 @@ static act_list act_open(ws_web *web)
 
 static inline double *act_a(const act_list *L, int k) { return L->base + (size_t)k * L->cap; }
 
+/* A vector in arrays k, k + 1, k + 2 (A_NX, A_NY, A_NZ say) at place q, and back. */
+static inline void act_set3(const act_list *L, int k, size_t q, v3 a)
+{
+    act_a(L, k)[q] = a.x;
+    act_a(L, k + 1)[q] = a.y;
+    act_a(L, k + 2)[q] = a.z;
+}
+
+static inline v3 act_get3(const act_list *L, int k, size_t q)
+{
+    return v3_make(act_a(L, k)[q], act_a(L, k + 1)[q], act_a(L, k + 2)[q]);
+}
+
 /* Contact `node` against body `body`: written at the end of the list, and kept when `keep`
  * (no branch: the list has room for every candidate of the block and one more). */
 static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 lever, v3 vt,
@@ -140,15 +147,9 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     const size_t q = L->n;
     L->node[q] = node;
     L->body[q] = body;
-    act_a(L, A_NX)[q] = n.x;
-    act_a(L, A_NY)[q] = n.y;
-    act_a(L, A_NZ)[q] = n.z;
-    act_a(L, A_LX)[q] = lever.x;
-    act_a(L, A_LY)[q] = lever.y;
-    act_a(L, A_LZ)[q] = lever.z;
-    act_a(L, A_TX)[q] = vt.x;
-    act_a(L, A_TY)[q] = vt.y;
-    act_a(L, A_TZ)[q] = vt.z;
+    act_set3(L, A_NX, q, n);
+    act_set3(L, A_LX, q, lever);
+    act_set3(L, A_TX, q, vt);
     act_a(L, A_FN)[q] = fn;
     act_a(L, A_MU)[q] = mu;
     act_a(L, A_VL)[q] = vlim;
@@ -161,7 +162,8 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
  * node), within the window (hi the layers): into f; the contact is listed when it pushes.
  * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
  * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
- * force is added times whether it pushes (0 or 1), without a branch. Both passes use it. */
+ * force is added times whether it pushes (0 or 1), without a branch. The one-by-one pass uses
+ * it; run_kernel has the same arithmetic for a run's nodes. */
 static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
                              uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
                              const ws_node_params *p)
@@ -213,21 +215,15 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
     size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
         const uint32_t i = L->node[q], at = L->slot[q];
-        v3 ft = v3_make(act_a(L, A_AX)[q], act_a(L, A_AY)[q], act_a(L, A_AZ)[q]);
-        v3 n = v3_make(act_a(L, A_NX)[q], act_a(L, A_NY)[q], act_a(L, A_NZ)[q]);
-        v3 lever = v3_make(act_a(L, A_LX)[q], act_a(L, A_LY)[q], act_a(L, A_LZ)[q]);
+        v3 ft = act_get3(L, A_AX, q), n = act_get3(L, A_NX, q), lever = act_get3(L, A_LX, q);
         double fn = act_a(L, A_FN)[q];
         nodes_add(f, i, ft);
         v3 Fnode = v3_madd(ft, n, fn);
         fc[i] = v3_madd(fc[i], Fnode, share);
         touched[nt++] = i;
-        v3 Fb = v3_scale(Fnode, -share), Mb = v3_cross(lever, Fb);
-        act_a(L, A_BX)[at] = Fb.x;
-        act_a(L, A_BY)[at] = Fb.y;
-        act_a(L, A_BZ)[at] = Fb.z;
-        act_a(L, A_MX)[at] = Mb.x;
-        act_a(L, A_MY)[at] = Mb.y;
-        act_a(L, A_MZ)[at] = Mb.z;
+        v3 Fb = v3_scale(Fnode, -share);
+        act_set3(L, A_BX, at, Fb);
+        act_set3(L, A_MX, at, v3_cross(lever, Fb));
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
@@ -251,8 +247,8 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
             bf = bforce[bi];
             bm = bmoment[bi];
         }
-        bf = v3_add(bf, v3_make(act_a(L, A_BX)[q], act_a(L, A_BY)[q], act_a(L, A_BZ)[q]));
-        bm = v3_add(bm, v3_make(act_a(L, A_MX)[q], act_a(L, A_MY)[q], act_a(L, A_MZ)[q]));
+        bf = v3_add(bf, act_get3(L, A_BX, q));
+        bm = v3_add(bm, act_get3(L, A_MX, q));
     }
     if (body != UINT32_MAX) {
         bforce[body] = bf;
@@ -269,6 +265,7 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
 {
     const ws_body_state *st = &b->st[cur];
     uint32_t *sel = web->sel;
+    double *seld = web->seld; /* their distances to the face's plane */
     /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
      * it now and then: which ones do is a coin toss from step to step. So the plane distance
      * sorts them first without a branch (the ones within the window are listed), and the rest
@@ -282,6 +279,7 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
         uint32_t i = c->node;
         double d = F->n.x * x.x[i] + F->n.y * x.y[i] + F->n.z * x.z[i] - F->off;
         sel[m] = (uint32_t)k;
+        seld[m] = d;
         m += (size_t)((d < b->layer[c->body] + wl) | edge);
     }
     /* Normal forces, in node order. */
@@ -297,14 +295,14 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
                 continue;
         } else {
             const ws_wface *F = &g->face[c->feat];
-            d = v3_dot(F->n, xi) - F->off;
+            d = seld[q]; /* below hi: listed */
             const ws_shape *sh = b->shape[bi];
             double lo = -hi - sh->inner;
             if (!(d > lo))
                 continue;
             /* A node found well inside the face's outline stays over the face while the
              * candidates are valid: no need to find its triangle. */
-            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi, lo, hi, &d))
+            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
                 continue;
             uint32_t f = c->local & ~WS_NCAND_FLAGS;
             if (d < 0.0 &&
@@ -625,7 +623,10 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
             return -1;
         web->act_cap = need;
     }
-    return ws_array_reserve(mem, (void **)&web->sel, &web->sel_cap, need, sizeof *web->sel);
+    if (ws_array_reserve(mem, (void **)&web->sel, &web->sel_cap, need, sizeof *web->sel) != 0 ||
+        ws_array_reserve(mem, (void **)&web->seld, &web->seld_cap, need, sizeof *web->seld) != 0)
+        return -1;
+    return 0;
 }
 
 void ws_node_scratch_free(ws_mem *mem, ws_web *web)
@@ -633,10 +634,12 @@ void ws_node_scratch_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
     ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
     ws_mem_free(mem, web->sel, web->sel_cap * sizeof *web->sel);
+    ws_mem_free(mem, web->seld, web->seld_cap * sizeof *web->seld);
     ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
     web->act = NULL;
     web->act_id = NULL;
     web->sel = NULL;
+    web->seld = NULL;
     web->rtmp = NULL;
-    web->act_cap = web->sel_cap = web->rtmp_cap = 0;
+    web->act_cap = web->sel_cap = web->seld_cap = web->rtmp_cap = 0;
 }
