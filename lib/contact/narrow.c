@@ -156,23 +156,29 @@ static double point_segment(v3 x, v3 a, v3 d)
  * ones a lower bound of it. It changes by no more than the segments' points move, unlike where
  * the lines' closest points lie: those run along the edges at the points' speed over the sine
  * of the edges' angle. */
+/* The least distance over the border of the parameter square: from each segment's ends to the
+ * other segment. */
+static double ends_gap(v3 p, v3 u, v3 q, v3 w)
+{
+    return fmin(fmin(point_segment(p, q, w), point_segment(v3_add(p, u), q, w)),
+                fmin(point_segment(q, p, u), point_segment(v3_add(q, w), p, u)));
+}
+
 static double segment_gap(v3 p, v3 u, v3 q, v3 w)
 {
     v3 n = v3_cross(u, w), r = v3_sub(q, p);
     double uu = v3_dot(u, u), ww = v3_dot(w, w), uw = v3_dot(u, w), nn = v3_dot(n, n);
-    double ends = fmin(fmin(point_segment(p, q, w), point_segment(v3_add(p, u), q, w)),
-                       fmin(point_segment(q, p, u), point_segment(v3_add(q, w), p, u)));
     if (nn < 1e-8 * uu * ww) {
         /* The closest points are ill-conditioned: from the interior ones, along the two lines'
          * valley to the border of the parameter square, the distance grows by at most
          * min(|u|, |w|) sin(angle) = |n| / max(|u|, |w|). */
-        return ends - sqrt(nn / fmax(uu, ww));
+        return ends_gap(p, u, q, w) - sqrt(nn / fmax(uu, ww));
     }
     double ru = v3_dot(r, u), rw = v3_dot(r, w);
     double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
     if (s >= 0.0 && s <= 1.0 && t >= 0.0 && t <= 1.0)
         return fabs(v3_dot(r, n)) / sqrt(nn);
-    return ends; /* the least over the border of the parameter square */
+    return ends_gap(p, u, q, w);
 }
 
 static int edges_edges(ws_mem *mem, ws_contact_ctx *x, uint32_t ia, uint32_t ib, ws_cand **cand,
