@@ -153,6 +153,34 @@ START_TEST(impact_stays_within_the_layers)
 }
 END_TEST
 
+/* A fixed 0.2 m block turned by qb and a free 1 kg cube of 0.1 m at pc turned by qc, moving at
+ * vc; both of material mat (a null id: the world's default). */
+static void block_and_cube(ws_world *w, ws_material_id mat, ws_quat qb, ws_vec3 pc, ws_quat qc,
+                           ws_vec3 vc, ws_body_id *cube)
+{
+    ws_shape_id big, small;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &big));
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &small));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = big;
+    bd.material = mat;
+    bd.orientation = qb;
+    bd.name = "block";
+    ws_body_id block;
+    ck_ok(w, ws_body_create(w, &bd, &block));
+    ws_body_def_init(&bd);
+    bd.shape = small;
+    bd.material = mat;
+    bd.mass = 1.0;
+    bd.position = pc;
+    bd.orientation = qc;
+    bd.velocity = vc;
+    bd.name = "cube";
+    ck_ok(w, ws_body_create(w, &bd, cube));
+}
+
 /* Two edges nearly parallel: a cube's edge (the keel) passes 1.5 mm from the top front edge of
  * a fixed block, turned 0.01 rad from it about their common normal n. Moving across n at
  * 5 cm/s, the cube moves the lines' crossing along its keel a hundred times as fast, 1.25 mm a
@@ -166,30 +194,16 @@ static ws_world *keel_world(int interval, ws_body_id *cube)
     d.detection_interval = interval;
     ws_world *w;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
-    ws_shape_id big, small;
-    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &big));
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &small));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.type = WS_BODY_KINEMATIC;
-    bd.shape = big;
-    bd.name = "block";
-    ws_body_id block;
-    ck_ok(w, ws_body_create(w, &bd, &block));
     /* n = (1, 0, 1) / sqrt 2 out of the block's edge (0.1, y, 0.1); m = n x y = (-1, 0, 1) /
      * sqrt 2. The keel, the cube's edge at (-h, y, -h) in its frame, lies along y turned by a
      * about n, so along cos a y + sin a m, at gap along n from the block's edge and mu along m
      * at its middle: the lines cross at -mu / sin a along the keel from its middle. */
     const double s2 = sqrt(0.5), h = 0.05, gap = 1.5e-3, a = 0.01, mu = (h + 0.02) * sin(a);
     const double c = gap + h * sqrt(2.0);
-    ws_body_def_init(&bd);
-    bd.shape = small;
-    bd.mass = 1.0;
-    bd.position = (ws_vec3){0.1 + s2 * (c - mu), 0.0, 0.1 + s2 * (c + mu)};
-    bd.orientation = (ws_quat){cos(0.5 * a), s2 * sin(0.5 * a), 0.0, s2 * sin(0.5 * a)};
-    bd.velocity = (ws_vec3){0.05 * s2, 0.0, -0.05 * s2}; /* -m at 5 cm/s */
-    bd.name = "cube";
-    ck_ok(w, ws_body_create(w, &bd, cube));
+    block_and_cube(w, (ws_material_id){0}, (ws_quat){1, 0, 0, 0},
+                   (ws_vec3){0.1 + s2 * (c - mu), 0.0, 0.1 + s2 * (c + mu)},
+                   (ws_quat){cos(0.5 * a), s2 * sin(0.5 * a), 0.0, s2 * sin(0.5 * a)},
+                   (ws_vec3){0.05 * s2, 0.0, -0.05 * s2} /* -m at 5 cm/s */, cube);
     return w;
 }
 
@@ -241,30 +255,14 @@ static ws_world *ridge_world(int interval, double k, ws_body_id *cube, double *r
     cd.stiffness = k;
     cd.damping = 40.0; /* 0.63 of critical for 1 kg on 1000 N/m */
     ck_ok(w, ws_world_set_contact(w, mat, mat, &cd));
-    ws_shape_id big, small;
-    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &big));
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &small));
     const double pi = 3.14159265358979323846;
     const double s2 = sqrt(0.5), c8 = cos(0.125 * pi), s8 = sin(0.125 * pi);
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.type = WS_BODY_KINEMATIC;
-    bd.shape = big;
-    bd.material = mat;
-    bd.orientation = (ws_quat){c8, 0.0, s8, 0.0}; /* 45 deg about y: an edge on top, along y */
-    bd.name = "ridge";
-    ws_body_id ridge;
-    ck_ok(w, ws_body_create(w, &bd, &ridge));
     *ridge_top = 0.1 / s2;
-    ws_body_def_init(&bd);
-    bd.shape = small;
-    bd.material = mat;
-    bd.mass = 1.0;
-    bd.orientation = (ws_quat){c8, s8, 0.0, 0.0}; /* 45 deg about x: an edge below, along x */
-    /* The keel just touching: at the layers (1 mm each) above the ridge. */
-    bd.position = (ws_vec3){0.0, 0.0, *ridge_top + 2e-3 + 0.05 / s2};
-    bd.name = "cube";
-    ck_ok(w, ws_body_create(w, &bd, cube));
+    /* The block turned 45 deg about y: an edge on top, along y; the cube 45 deg about x: an
+     * edge below, along x, just touching: at the layers (1 mm each) above the ridge. */
+    block_and_cube(w, mat, (ws_quat){c8, 0.0, s8, 0.0},
+                   (ws_vec3){0.0, 0.0, *ridge_top + 2e-3 + 0.05 / s2}, (ws_quat){c8, s8, 0.0, 0.0},
+                   (ws_vec3){0, 0, 0}, cube);
     return w;
 }
 
