@@ -468,58 +468,163 @@ static inline uint32_t lowest_bit(uint64_t m)
 #endif
 }
 
-/* The tests of inside_box without its branches. */
-static inline int in_box(v3 p, v3 lo, v3 hi, double e)
+/* ---- the search
+ *
+ * Nodes are taken FIND_CHUNK at a time. For each body, in slot order, the nodes of the group in
+ * its box (grown by the web's layer and half the margin) are listed (find_near). On a convex
+ * body of at most WS_NCAND_FACES faces their body-frame positions, their distances to the
+ * faces' planes and the faces' tests as bit masks are found for all of them on vectors
+ * (find_faces); a node then pays only for the few features near it (convex_candidates) and
+ * takes few branches. Any other body is searched node by node (general_candidates). The
+ * candidates are listed node by node, and for a node body by body. */
+enum { FIND_CHUNK = 64 };
+
+/* A body near a group of nodes: its slot, how many of the group's nodes lie in its grown box and
+ * where their values are in the scratch: their places in the group at find_node + node; at
+ * find_val + val, FIND_CHUNK apart, their body-frame x, y, z, the largest plane distance D, then
+ * their distance to each face's plane; at find_mask + mask, FIND_CHUNK apart, the masks M_*.
+ * general: searched node by node, without values. next: the next of its nodes to list. */
+typedef struct ws_find_body {
+    uint32_t body, count, next;
+    int general;
+    size_t node, val, mask;
+} ws_find_body;
+
+enum { V_X, V_Y, V_Z, V_D, V_FACES }; /* the values of a node, V_FACES + f: face f */
+enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_ARRAYS };
+/* M_LOCAL: 1 when the node lies in the body's own box grown by the reach (else it has no
+ * candidate of the body); M_PASS: the faces it is a candidate of (within reach of it along their
+ * normals, within the margin of the outermost one, its projection on the plane within reach of
+ * the face's box); M_BOXES: the faces whose box, grown by the reach, holds it; M_OUT: of the
+ * faces in M_PASS, those it is not well inside of (see convex_candidates). */
+
+/* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0. */
+WS_VECTOR_LOOP
+static void find_near(uint64_t *restrict hit, const double *restrict px, const double *restrict py,
+                      const double *restrict pz, size_t m, v3 lo, v3 hi)
 {
-    return (p.x > lo.x - e) & (p.x < hi.x + e) & (p.y > lo.y - e) & (p.y < hi.y + e) &
-           (p.z > lo.z - e) & (p.z < hi.z + e);
+    for (size_t j = 0; j < m; j++)
+        hit[j] = (uint64_t)((px[j] > lo.x) & (px[j] < hi.x) & (py[j] > lo.y) & (py[j] < hi.y) &
+                            (pz[j] > lo.z) & (pz[j] < hi.z));
 }
 
-/* Node i at s (body frame) against a convex body k of at most WS_NCAND_FACES faces: the faces
- * and edges the general search below would list, in the same order, with the faces' tests as
- * bit masks so that a node pays only for the few features near it and takes few branches.
- * Only here may a face candidate be marked INSIDE. */
-static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g, uint32_t i,
-                             uint32_t k, v3 s, double reach, double margin, ws_ncand **out,
-                             size_t *n, size_t *cap, uint64_t *checks)
+/* The values and masks of m nodes against a convex body of shape sh at pose (A, r) (see
+ * ws_find_body); val holds their global positions in its first three arrays, which become their
+ * body-frame ones. The arithmetic of the one-node search, operation by operation. */
+WS_VECTOR_LOOP
+static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, double margin, size_t m,
+                       double *val, uint64_t *mask)
 {
-    const uint32_t nf = sh->face_count;
-    const double deep = -reach - sh->inner;
-    double D = -INFINITY, dg[WS_NCAND_FACES];
-    /* boxes: the faces whose box, grown by the reach, holds the node. An edge's box lies in
-     * the boxes of both its faces, so an edge within reach of the node needs two of them:
-     * most nodes, over the middle of a face, have at most one and skip the edges. */
-    uint64_t boxes = 0, pass = 0;
-    for (uint32_t f = 0; f < nf; f++) {
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double lx = sh->lo.x - reach, ly = sh->lo.y - reach, lz = sh->lo.z - reach,
+                 hx = sh->hi.x + reach, hy = sh->hi.y + reach, hz = sh->hi.z + reach;
+    double *restrict sx = val + V_X * FIND_CHUNK, *restrict sy = val + V_Y * FIND_CHUNK,
+                     *restrict sz = val + V_Z * FIND_CHUNK, *restrict D = val + V_D * FIND_CHUNK;
+    uint64_t *restrict local = mask + M_LOCAL * FIND_CHUNK,
+                       *restrict pass = mask + M_PASS * FIND_CHUNK,
+                       *restrict boxes = mask + M_BOXES * FIND_CHUNK;
+    for (size_t j = 0; j < m; j++) {
+        double px = sx[j] - r.x, py = sy[j] - r.y, pz = sz[j] - r.z;
+        double x = a0 * px + a3 * py + a6 * pz;
+        double y = a1 * px + a4 * py + a7 * pz;
+        double z = a2 * px + a5 * py + a8 * pz;
+        sx[j] = x;
+        sy[j] = y;
+        sz[j] = z;
+        local[j] = (uint64_t)((x > lx) & (x < hx) & (y > ly) & (y < hy) & (z > lz) & (z < hz));
+        D[j] = -INFINITY;
+        pass[j] = boxes[j] = 0;
+    }
+    for (uint32_t f = 0; f < sh->face_count; f++) {
         const ws_face *F = &sh->faces[f];
-        double d = v3_dot(F->normal, s) - F->offset;
-        dg[f] = d;
-        D = d > D ? d : D;
-        boxes |= (uint64_t)in_box(s, F->lo, F->hi, reach) << f;
+        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z, off = F->offset;
+        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
+                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        double *restrict dg = val + (V_FACES + f) * FIND_CHUNK;
+        for (size_t j = 0; j < m; j++) {
+            double x = sx[j], y = sy[j], z = sz[j];
+            double d = nx * x + ny * y + nz * z - off;
+            dg[j] = d;
+            D[j] = d > D[j] ? d : D[j];
+            boxes[j] |=
+                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
+                << f;
+        }
     }
-    for (uint32_t f = 0; f < nf; f++) {
-        double d = dg[f];
-        pass |= (uint64_t)((d > deep) & (d < reach) & (d >= D - margin)) << f;
+    const double deep = -reach - sh->inner;
+    for (uint32_t f = 0; f < sh->face_count; f++) {
+        const double *restrict dg = val + (V_FACES + f) * FIND_CHUNK;
+        for (size_t j = 0; j < m; j++) {
+            double d = dg[j];
+            pass[j] |= (uint64_t)((d > deep) & (d < reach) & (d >= D[j] - margin)) << f;
+        }
     }
+    /* The faces that pass for some node: for every node, the projection's test and whether it
+     * lies well inside the outline (convex_candidates); what they say of a node a face does not
+     * pass for is not read. */
+    uint64_t any = 0, *restrict out = mask + M_OUT * FIND_CHUNK;
+    for (size_t j = 0; j < m; j++) {
+        any |= pass[j];
+        out[j] = 0;
+    }
+    for (; any; any &= any - 1) {
+        const uint32_t f = lowest_bit(any);
+        const ws_face *F = &sh->faces[f];
+        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z;
+        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
+                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        const double *restrict df = val + (V_FACES + f) * FIND_CHUNK;
+        const uint64_t drop = ~((uint64_t)1 << f);
+        for (size_t j = 0; j < m; j++) {
+            double d = -df[j];
+            double x = sx[j] + nx * d, y = sy[j] + ny * d, z = sz[j] + nz * d;
+            pass[j] &=
+                drop |
+                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
+                    << f;
+        }
+        for (uint32_t o = 0; o < sh->face_count; o++) {
+            if (o == f)
+                continue;
+            const double c = v3_dot(sh->faces[o].normal, F->normal);
+            const double *restrict dg = val + (V_FACES + o) * FIND_CHUNK;
+            for (size_t j = 0; j < m; j++)
+                out[j] |= (uint64_t)(!(dg[j] - df[j] * c <= -margin)) << f;
+        }
+    }
+}
+
+/* Node i, the c-th of body fb's nodes, against that convex body of shape sh, from its values
+ * and masks (find_faces): the faces and edges the general search below would list, in the same
+ * order. Only here may a face candidate be marked INSIDE. */
+static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g,
+                             const ws_find_body *fb, uint32_t c, uint32_t i, double reach,
+                             double margin, ws_ncand **out, size_t *n, size_t *cap,
+                             uint64_t *checks)
+{
+    const uint32_t nf = sh->face_count, k = fb->body;
+    const double *v = g->find_val + fb->val + c;
+    const uint64_t *mk = g->find_mask + fb->mask + c;
+    const v3 s = v3_make(v[V_X * FIND_CHUNK], v[V_Y * FIND_CHUNK], v[V_Z * FIND_CHUNK]);
+    const uint64_t boxes = mk[M_BOXES * FIND_CHUNK];
+    const uint64_t outside = mk[M_OUT * FIND_CHUNK];
     *checks += nf;
-    for (; pass; pass &= pass - 1) {
+    /* Well inside a face's outline: its projection on the plane lies a margin or more behind
+     * every other face's plane (those planes bound the face on a convex body, and a plane
+     * distance never exceeds the distance within the face's plane). Nodes and bodies move less
+     * than half the margin relative to each other until the candidates are found again. */
+    for (uint64_t pass = mk[M_PASS * FIND_CHUNK]; pass; pass &= pass - 1) {
         uint32_t f = lowest_bit(pass);
-        const ws_face *fc = &sh->faces[f];
-        double d = dg[f];
-        if (!inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
-            continue;
-        /* Well inside the outline: its projection on the plane lies a margin or more behind
-         * every other face's plane (those planes bound the face on a convex body, and a plane
-         * distance never exceeds the distance within the face's plane). Nodes and bodies move
-         * less than half the margin relative to each other until the candidates are found
-         * again. */
-        int inside = 1;
-        for (uint32_t o = 0; o < nf; o++)
-            inside &= (o == f) | (dg[o] - d * v3_dot(sh->faces[o].normal, fc->normal) <= -margin);
-        ws_ncand c = {i, k, g->face_base[k] + f, f | (inside ? WS_NCAND_INSIDE : 0u)};
-        if (push_cand(mem, out, n, cap, c) != 0)
+        ws_ncand nc = {i, k, g->face_base[k] + f,
+                       f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
+        if (push_cand(mem, out, n, cap, nc) != 0)
             return -1;
     }
+    /* An edge's box lies in the boxes of both its faces, so an edge within reach of the node
+     * needs two of them: most nodes, over the middle of a face, have at most one and skip the
+     * edges. */
     if (!(boxes & (boxes - 1)))
         return 0;
     for (uint32_t e = 0; e < sh->edge_count; e++) {
@@ -539,69 +644,146 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
     return 0;
 }
 
-int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
-                       ws_web *web, ws_nodes3 x, double margin, const uint32_t *nodes,
-                       size_t count, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+/* Node i at p (global) against body k of any shape, one by one. */
+static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
+                              uint32_t i, uint32_t k, v3 p, double reach, double margin,
+                              ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+{
+    const ws_shape *sh = b->shape[k];
+    v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
+    if (!inside_box(s, sh->lo, sh->hi, reach))
+        return 0;
+    /* On a convex body a node touches face f only while f is the face whose plane it is
+     * farthest out of (the largest signed distance D): over a face it projects into, d_g <= d_f
+     * for every other face g, and inside the body the shallowest face is the one of largest d.
+     * Until the next detection nodes and bodies move less than half the margin together, which
+     * changes d_f - D by less than the margin: faces further behind than that cannot come into
+     * contact and are not candidates. On a box this drops the side faces next to the one a node
+     * lies on. */
+    double D = -INFINITY;
+    if (sh->convex)
+        for (uint32_t f = 0; f < sh->face_count; f++) {
+            double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
+            D = d > D ? d : D;
+        }
+    for (uint32_t f = 0; f < sh->face_count; f++) {
+        const ws_face *fc = &sh->faces[f];
+        (*checks)++;
+        double d = v3_dot(fc->normal, s) - fc->offset;
+        /* Depth counts along the normal only: the point's projection on the face's plane must
+         * lie within reach of the face. */
+        if (d > -reach - sh->inner && d < reach && d >= D - margin &&
+            inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach) &&
+            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->face_base[k] + f, f}))
+            return -1;
+    }
+    /* Convex edges within reach of the node: the rounded rim of the contact layer. */
+    for (uint32_t e = 0; e < sh->edge_count; e++) {
+        const ws_edge *E = &sh->edges[e];
+        if (!inside_box(s, E->lo, E->hi, reach))
+            continue;
+        (*checks)++;
+        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t; /* within reach of the segment */
+        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
+            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+            return -1;
+    }
+    return 0;
+}
+
+int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
+                       ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
+                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
 {
     *n = 0;
     if (web->n == 0)
         return 0;
-    double pad = web->layer + 0.5 * margin;
+    const double pad = web->layer + 0.5 * margin;
     if (!nodes)
         count = web->n;
-    /* Node by node (the order the sub-steps take them in), against each body near it. */
-    for (size_t q = 0; q < count; q++) {
-        uint32_t i = nodes ? nodes[q] : (uint32_t)q;
-        v3 p = nodes_get(x, i);
+    if (ws_array_reserve(mem, (void **)&g->find, &g->find_cap, b->slots + 1, sizeof *g->find) != 0)
+        return -1;
+    double px[FIND_CHUNK], py[FIND_CHUNK], pz[FIND_CHUNK];
+    uint64_t hit[FIND_CHUNK];
+    for (size_t q0 = 0; q0 < count; q0 += FIND_CHUNK) {
+        const size_t m = count - q0 < FIND_CHUNK ? count - q0 : (size_t)FIND_CHUNK;
+        for (size_t j = 0; j < m; j++) {
+            uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
+            px[j] = x.x[i];
+            py[j] = x.y[i];
+            pz[j] = x.z[i];
+        }
+        /* The bodies near the group, in slot order, with the group's nodes in their boxes. */
+        size_t nb = 0, nnode = 0, nval = 0, nmask = 0;
         for (uint32_t k = 0; k < b->slots; k++) {
-            if (!b->alive[k] || !in_box(p, b->lo[k], b->hi[k], pad))
+            if (!b->alive[k])
+                continue;
+            find_near(hit, px, py, pz, m,
+                      v3_make(b->lo[k].x - pad, b->lo[k].y - pad, b->lo[k].z - pad),
+                      v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
+            if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
+                                 sizeof *g->find_node) != 0)
+                return -1;
+            uint32_t *nd = g->find_node + nnode, c = 0;
+            for (size_t j = 0; j < m; j++) {
+                nd[c] = (uint32_t)j;
+                c += (uint32_t)hit[j];
+            }
+            if (!c)
                 continue;
             const ws_shape *sh = b->shape[k];
-            double reach = b->layer[k] + web->layer + margin;
-            v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
-            if (!inside_box(s, sh->lo, sh->hi, reach))
-                continue;
-            /* On a convex body a node touches face f only while f is the face whose plane it
-             * is farthest out of (the largest signed distance D): over a face it projects into,
-             * d_g <= d_f for every other face g, and inside the body the shallowest face is the
-             * one of largest d. Until the next detection nodes and bodies move less than half
-             * the margin together, which changes d_f - D by less than the margin: faces further
-             * behind than that cannot come into contact and are not candidates. On a box this
-             * drops the side faces next to the one a node lies on. */
-            if (sh->convex && sh->face_count <= WS_NCAND_FACES) {
-                if (convex_candidates(mem, sh, g, i, k, s, reach, margin, out, n, cap, checks))
-                    return -1;
-                continue;
+            ws_find_body *fb = &g->find[nb++];
+            *fb = (ws_find_body){.body = k, .count = c, .node = nnode, .val = nval, .mask = nmask};
+            fb->general = !sh->convex || sh->face_count > WS_NCAND_FACES;
+            nnode += c;
+            if (!fb->general) {
+                nval += (V_FACES + sh->face_count) * (size_t)FIND_CHUNK;
+                nmask += M_ARRAYS * (size_t)FIND_CHUNK;
             }
-            double D = -INFINITY;
-            if (sh->convex)
-                for (uint32_t f = 0; f < sh->face_count; f++) {
-                    double d = v3_dot(sh->faces[f].normal, s) - sh->faces[f].offset;
-                    D = d > D ? d : D;
-                }
-            for (uint32_t f = 0; f < sh->face_count; f++) {
-                const ws_face *fc = &sh->faces[f];
-                (*checks)++;
-                double d = v3_dot(fc->normal, s) - fc->offset;
-                /* Depth counts along the normal only: the point's projection on the face's
-                 * plane must lie within reach of the face. */
-                if (d > -reach - sh->inner && d < reach && d >= D - margin &&
-                    inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach) &&
-                    push_cand(mem, out, n, cap, (ws_ncand){i, k, g->face_base[k] + f, f}))
-                    return -1;
+        }
+        if (ws_array_reserve(mem, (void **)&g->find_val, &g->find_val_cap, nval + 1,
+                             sizeof *g->find_val) != 0 ||
+            ws_array_reserve(mem, (void **)&g->find_mask, &g->find_mask_cap, nmask + 1,
+                             sizeof *g->find_mask) != 0)
+            return -1;
+        /* Per convex body, on vectors: the nodes in its frame, their plane distances and
+         * their faces' masks. */
+        for (size_t q = 0; q < nb; q++) {
+            const ws_find_body *fb = &g->find[q];
+            if (fb->general)
+                continue;
+            const uint32_t k = fb->body, *nd = g->find_node + fb->node;
+            double *v = g->find_val + fb->val;
+            for (uint32_t c = 0; c < fb->count; c++) {
+                v[V_X * FIND_CHUNK + c] = px[nd[c]];
+                v[V_Y * FIND_CHUNK + c] = py[nd[c]];
+                v[V_Z * FIND_CHUNK + c] = pz[nd[c]];
             }
-            /* Convex edges within reach of the node: the rounded rim of the contact layer. */
-            for (uint32_t e = 0; e < sh->edge_count; e++) {
-                const ws_edge *E = &sh->edges[e];
-                if (!inside_box(s, E->lo, E->hi, reach))
+            find_faces(b->shape[k], &b->A[k], b->st[cur].r[k], b->layer[k] + web->layer + margin,
+                       margin, fb->count, v, g->find_mask + fb->mask);
+        }
+        /* Node by node (the order the sub-steps take them in), against each body near it. */
+        for (size_t j = 0; j < m; j++) {
+            const uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
+            for (size_t q = 0; q < nb; q++) {
+                ws_find_body *fb = &g->find[q];
+                if (fb->next == fb->count || g->find_node[fb->node + fb->next] != j)
                     continue;
-                (*checks)++;
-                v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
-                double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
-                t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t; /* within reach of the segment */
-                if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
-                    push_cand(mem, out, n, cap,
-                              (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
+                const uint32_t c = fb->next++, k = fb->body;
+                const double reach = b->layer[k] + web->layer + margin;
+                int bad;
+                if (fb->general) {
+                    bad = general_candidates(mem, b, cur, g, i, k, v3_make(px[j], py[j], pz[j]),
+                                             reach, margin, out, n, cap, checks);
+                } else {
+                    if (!g->find_mask[fb->mask + M_LOCAL * FIND_CHUNK + c])
+                        continue;
+                    bad = convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, out, n,
+                                            cap, checks);
+                }
+                if (bad)
                     return -1;
             }
         }
@@ -682,4 +864,8 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->tri_base, g->tri_base_cap * sizeof *g->tri_base);
     ws_mem_free(mem, g->edge, g->edge_cap * sizeof *g->edge);
     ws_mem_free(mem, g->edge_base, g->edge_base_cap * sizeof *g->edge_base);
+    ws_mem_free(mem, g->find, g->find_cap * sizeof *g->find);
+    ws_mem_free(mem, g->find_val, g->find_val_cap * sizeof *g->find_val);
+    ws_mem_free(mem, g->find_mask, g->find_mask_cap * sizeof *g->find_mask);
+    ws_mem_free(mem, g->find_node, g->find_node_cap * sizeof *g->find_node);
 }

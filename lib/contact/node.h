@@ -30,12 +30,21 @@ typedef struct ws_wedge {
     double inv_e2;
 } ws_wedge;
 
+struct ws_find_body;
+
 typedef struct ws_node_geom {
     ws_wface *face;
     ws_wtri *tri;
     ws_wedge *edge;
     uint32_t *face_base, *tri_base, *edge_base;
     size_t face_cap, tri_cap, edge_cap, face_base_cap, tri_base_cap, edge_base_cap;
+    /* Scratch of ws_node_candidates (node.c): the bodies near a group of nodes, with the nodes'
+     * values against each. */
+    struct ws_find_body *find;
+    double *find_val;
+    uint64_t *find_mask;
+    uint32_t *find_node;
+    size_t find_cap, find_val_cap, find_mask_cap, find_node_cap;
 } ws_node_geom;
 
 /* Fill g for the bodies at state cur. 0, or -1 when out of memory (only when bodies were
@@ -44,10 +53,11 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Node candidates of a web: every node-face and node-edge pair within the layers + margin, for
- * the nodes listed (all when `nodes` is NULL), sorted by node. 0, or -1 when out of memory. */
-int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
-                       ws_web *web, ws_nodes3 x, double margin, const uint32_t *nodes,
-                       size_t count, ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks);
+ * the nodes listed (all when `nodes` is NULL), sorted by node; g's scratch is used. 0, or -1
+ * when out of memory. */
+int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
+                       ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
+                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks);
 
 /* A full detection's record (see ws_web): the web's box from x and the bodies whose boxes come
  * within reach of it, with their pose at state cur; xdet = x. 0, or -1 when out of memory. */
