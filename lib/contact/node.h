@@ -98,6 +98,12 @@ void ws_node_scratch_free(ws_mem *mem, ws_web *web);
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list);
 
+/* The same for list `list` merged (ws_node_merge) from list `from` and the candidates found
+ * again of `nodes` (count of them, in increasing order): when the stretches are those of `from`,
+ * only the sweep blocks that hold one of the nodes are cut again. 0, or -1 when out of memory. */
+int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
+                            int from, const uint32_t *nodes, size_t count);
+
 /* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),
  * moving *next past them, at node state (x, v), for a sub-step h: forces into web->f, the node
  * contact forces (`share` = 1 / substeps of them) into fc, and the opposite loads on the bodies

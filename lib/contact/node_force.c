@@ -3,6 +3,8 @@
 #include "contact/contact.h"
 #include "contact/node.h"
 
+#include <string.h>
+
 _Static_assert(WS_NCAND_EDGE == 0x80000000u, "contacts_general reads the edge flag as the top bit");
 
 /* Eq. 14 in the global frame for a prepared face: whether the point projects into it (its
@@ -510,80 +512,145 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
     }
 }
 
-/* The stretches being cut: a pending run of single inside candidates [r0, r1) and, before it,
- * pending candidates to go one by one [g0, r0). */
+/* The stretches being cut into seg, which has room for one per candidate (none is empty): a
+ * pending run of single inside candidates [r0, r1) and, before it, pending candidates to go one by
+ * one [g0, r0). */
 typedef struct seg_cut {
-    ws_web *web;
-    ws_mem *mem;
     const ws_ncand *cand;
-    size_t g0, r0, r1;
+    ws_nseg *seg;
+    size_t nseg, g0, r0, r1;
 } seg_cut;
 
-static int seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
+static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    ws_web *web = sc->web;
-    if (c0 == c1)
-        return 0;
-    if (ws_array_reserve(sc->mem, (void **)&web->seg, &web->seg_cap, web->nseg + 1,
-                         sizeof *web->seg) != 0)
-        return -1;
-    web->seg[web->nseg++] =
-        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
-    return 0;
+    if (c0 < c1)
+        sc->seg[sc->nseg++] = (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1,
+                                        (uint32_t)c0, (uint32_t)c1, run};
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
  * candidates join those. */
-static int seg_close_run(seg_cut *sc)
+static void seg_close_run(seg_cut *sc)
 {
     if (sc->r1 - sc->r0 >= RUN_MIN) {
-        if (seg_emit(sc, sc->g0, sc->r0, 0) || seg_emit(sc, sc->r0, sc->r1, 1))
-            return -1;
+        seg_emit(sc, sc->g0, sc->r0, 0);
+        seg_emit(sc, sc->r0, sc->r1, 1);
         sc->g0 = sc->r1;
     }
     sc->r0 = sc->r1;
-    return 0;
 }
 
-int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list)
+/* Cut the candidates from k on (of n) whose nodes lie below stop, the start of a sweep block of
+ * bl nodes; the index past them. A block's stretches depend on its own candidates alone. */
+static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t k, size_t n,
+                            uint64_t stop)
 {
-    const uint32_t bl = web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
-    web->seg_list = -1;
-    web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap,
-                         (3 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE, sizeof(double)) != 0)
-        return -1;
-    seg_cut sc = {web, mem, cand, 0, 0, 0};
-    uint32_t end = 0; /* the end of the sweep block of the current node */
-    size_t k = 0;
-    while (k < n) {
+    const ws_ncand *cand = sc->cand;
+    uint64_t end = 0; /* the end of the sweep block of the current node, at most stop */
+    sc->g0 = sc->r0 = sc->r1 = k;
+    while (k < n && cand[k].node < stop) {
         const uint32_t node = cand[k].node;
         size_t e = k + 1;
         while (e < n && cand[e].node == node)
             e++;
         if (node >= end) { /* a new block: nothing pending crosses into it */
-            if (seg_close_run(&sc) || seg_emit(&sc, sc.g0, k, 0))
-                return -1;
-            sc.g0 = sc.r0 = sc.r1 = k;
-            end = (node / bl + 1) * bl;
+            seg_close_run(sc);
+            seg_emit(sc, sc->g0, k, 0);
+            sc->g0 = sc->r0 = sc->r1 = k;
+            end = (uint64_t)(node / bl + 1) * bl;
+            end = end < stop ? end : stop;
         }
         int single = !web->runs_off && e == k + 1 &&
                      (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
-        if (single && sc.r1 > sc.r0 && sc.r1 == k && cand[k].feat == cand[sc.r0].feat &&
+        if (single && sc->r1 > sc->r0 && sc->r1 == k && cand[k].feat == cand[sc->r0].feat &&
             node == cand[k - 1].node + 1) {
-            sc.r1 = e; /* the run goes on */
+            sc->r1 = e; /* the run goes on */
         } else {
-            if (seg_close_run(&sc))
-                return -1;
-            sc.r0 = k; /* a new run starts here, or an empty one */
-            sc.r1 = single ? e : k;
+            seg_close_run(sc);
+            sc->r0 = k; /* a new run starts here, or an empty one */
+            sc->r1 = single ? e : k;
             if (!single)
-                sc.r0 = sc.r1 = e; /* one by one: pending from g0 */
+                sc->r0 = sc->r1 = e; /* one by one: pending from g0 */
+        }
+        if (single) {
+            /* The run goes on over the next nodes of the block, each with one inside candidate
+             * of its face, as the steps above would find one by one. */
+            const uint32_t feat = cand[sc->r0].feat;
+            uint32_t prev = node;
+            while (e < n && cand[e].node == prev + 1 && cand[e].node < end &&
+                   cand[e].feat == feat && (cand[e].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE &&
+                   (e + 1 == n || cand[e + 1].node != cand[e].node)) {
+                prev = cand[e].node;
+                e++;
+            }
+            sc->r1 = e;
         }
         k = e;
     }
-    if (seg_close_run(&sc) || seg_emit(&sc, sc.g0, n, 0))
+    seg_close_run(sc);
+    seg_emit(sc, sc->g0, k, 0);
+    return k;
+}
+
+/* The sweep blocks' length: a grid web's rows, else the whole web. */
+static uint32_t seg_block(const ws_web *web)
+{
+    return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
+}
+
+int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list)
+{
+    web->seg_list = -1;
+    web->nseg = 0;
+    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap,
+                         (3 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE, sizeof(double)) != 0 ||
+        ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
         return -1;
+    seg_cut sc = {cand, web->seg, 0, 0, 0, 0};
+    seg_cut_range(&sc, web, seg_block(web), 0, n, UINT64_MAX);
+    web->nseg = sc.nseg;
+    web->seg_list = list;
+    return 0;
+}
+
+int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
+                            int from, const uint32_t *nodes, size_t count)
+{
+    if (web->seg_list != from)
+        return ws_node_segments(mem, web, cand, n, list);
+    const uint32_t bl = seg_block(web);
+    const size_t nold = web->nseg;
+    web->seg_list = -1;
+    /* The new stretches go after the old ones, then down in their place. */
+    if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, nold + n + 1, sizeof *web->seg) !=
+        0)
+        return -1;
+    const ws_nseg *old = web->seg;
+    seg_cut sc = {cand, web->seg + nold, 0, 0, 0, 0};
+    size_t p = 0, k = 0; /* the next old stretch; where the next candidates lie in cand */
+    for (size_t q = 0; q <= count;) {
+        const uint64_t b0 = q < count ? (uint64_t)(nodes[q] / bl) * bl : UINT64_MAX,
+                       b1 = q < count ? b0 + bl : UINT64_MAX;
+        /* The blocks before the next one that changed keep their stretches, which now start
+         * at k: the candidates before them are those of the blocks before. */
+        for (; p < nold && old[p].n0 < b0; p++) {
+            ws_nseg sg = old[p];
+            sg.c1 = (uint32_t)k + (sg.c1 - sg.c0);
+            sg.c0 = (uint32_t)k;
+            k = sg.c1;
+            sc.seg[sc.nseg++] = sg;
+        }
+        if (q == count)
+            break;
+        /* That block is cut again from the candidates it holds now. */
+        for (; p < nold && old[p].n0 < b1; p++)
+            ;
+        k = seg_cut_range(&sc, web, bl, k, n, b1);
+        while (q < count && nodes[q] < b1)
+            q++;
+    }
+    memmove(web->seg, sc.seg, sc.nseg * sizeof *web->seg);
+    web->nseg = sc.nseg;
     web->seg_list = list;
     return 0;
 }

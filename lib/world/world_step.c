@@ -205,10 +205,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          web->ncand[old], web->fresh, web->nfresh))
                     list = old;
                 else
-                    bad = bad || ws_node_merge(&w->mem, web->moved, (size_t)moved,
-                                               web->cand[old], web->ncand[old], web->fresh,
-                                               web->nfresh, &web->cand[list], &web->ncand[list],
-                                               &web->capcand[list]);
+                    bad = bad ||
+                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
+                                        web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
+                                        &web->ncand[list], &web->capcand[list]) ||
+                          ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
+                                                  list, old, web->moved, (size_t)moved);
             }
             if (bad || ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
