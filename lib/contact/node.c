@@ -165,59 +165,81 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 }
 
 
+/* Flags are found FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come
+ * from, then narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector
+ * iteration and runs out of registers. */
+enum { FLAG_CHUNK = 256 };
+
 /* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
- * bound (or is NaN), else 0. Straight-line code, on vectors; the measure is squared when
- * there is one sub-step (c = 0: no square root needed). */
+ * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
+ * is squared when there is one sub-step (c = 0: no square root needed). */
 WS_VECTOR_LOOP
-static void flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
-                       double c, double lim)
+static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
+                         double c, double lim)
 {
     const double *a = A->m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
-    const double *restrict ox = web->xdet.x, *restrict oy = web->xdet.y,
-                           *restrict oz = web->xdet.z;
-    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
-    const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
-    uint8_t *restrict redo = web->redo;
+    const double lim2 = lim * lim;
     const size_t n = web->n;
-    if (c > 0.0) {
-        for (size_t i = 0; i < n; i++) {
-            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-            double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-            double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-            double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-            double m = sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-            redo[i] = !(m < lim);
+    uint64_t flag[FLAG_CHUNK];
+    size_t count = 0;
+    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
+        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        const double *restrict ox = web->xdet.x + i0, *restrict oy = web->xdet.y + i0,
+                               *restrict oz = web->xdet.z + i0;
+        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
+        if (c > 0.0) {
+            for (size_t i = 0; i < e; i++) {
+                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
+                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
+                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
+                double m =
+                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
+                uint64_t f = !(m < lim);
+                flag[i] = f;
+                count += f;
+            }
+        } else { /* one sub-step: the contacts see only where the nodes are now */
+            for (size_t i = 0; i < e; i++) {
+                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
+                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
+                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
+                flag[i] = f;
+                count += f;
+            }
         }
-    } else { /* one sub-step: the contacts see only where the nodes are now */
-        const double lim2 = lim * lim;
-        for (size_t i = 0; i < n; i++) {
-            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-            double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-            double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-            double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-            redo[i] = !(ux * ux + uy * uy + uz * uz < lim2);
-        }
+        uint8_t *restrict redo = web->redo + i0;
+        for (size_t i = 0; i < e; i++)
+            redo[i] = (uint8_t)flag[i];
     }
+    return count;
 }
 
-/* The flagged nodes (flags 0 or 1) into `moved`, in order; how many. Eight flags at a time:
- * most steps flag few nodes, and those in runs. */
+/* The flagged nodes (flags 0 or 1) into `moved`, in order; how many. Thirty-two flags at a
+ * time, then eight: most steps flag few nodes, and those in runs. */
 static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
 {
     size_t count = 0, i = 0;
-    for (; i + 8 <= n; i += 8) {
-        uint64_t word;
-        memcpy(&word, flag + i, sizeof word);
-        if (!word)
+    for (; i + 32 <= n; i += 32) {
+        uint64_t word[4];
+        memcpy(word, flag + i, sizeof word);
+        if (!(word[0] | word[1] | word[2] | word[3]))
             continue;
-        for (size_t j = i; j < i + 8; j++) {
-            moved[count] = (uint32_t)j;
-            count += flag[j];
+        for (size_t w = 0; w < 4; w++) {
+            if (!word[w])
+                continue;
+            for (size_t j = i + 8 * w; j < i + 8 * w + 8; j++) {
+                moved[count] = (uint32_t)j;
+                count += flag[j];
+            }
         }
     }
     for (; i < n; i++) {
@@ -228,22 +250,28 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
 }
 
 /* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
- * open box (lo, hi). Straight-line code, on vectors. */
+ * open box (lo, hi). Straight-line code, on vectors, FLAG_CHUNK nodes at a time. */
 WS_VECTOR_LOOP
-static void flag_in_box(uint8_t *restrict flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo,
-                        v3 hi)
+static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo, v3 hi)
 {
     const double *a = A->m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
-    const double *restrict qx = x.x, *restrict qy = x.y, *restrict qz = x.z;
-    for (size_t i = 0; i < n; i++) {
-        double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-        double sx = a0 * px + a3 * py + a6 * pz;
-        double sy = a1 * px + a4 * py + a7 * pz;
-        double sz = a2 * px + a5 * py + a8 * pz;
-        flag[i] |= (uint8_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) &
-                             (sz > lo.z) & (sz < hi.z));
+    uint64_t in[FLAG_CHUNK];
+    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
+        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        for (size_t i = 0; i < e; i++) {
+            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
+            double sx = a0 * px + a3 * py + a6 * pz;
+            double sy = a1 * px + a4 * py + a7 * pz;
+            double sz = a2 * px + a5 * py + a8 * pz;
+            in[i] = (uint64_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) & (sz > lo.z) &
+                               (sz < hi.z));
+        }
+        uint8_t *restrict f = flag + i0;
+        for (size_t i = 0; i < e; i++)
+            f[i] |= (uint8_t)in[i];
     }
 }
 
@@ -261,8 +289,20 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
                 v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
                 v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
     const ws_ncand *c = web->cand[web->list];
-    for (size_t q = 0; q < web->ncand[web->list]; q++)
-        web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    if (web->seg_list == web->list) {
+        /* The list's stretches: a run's candidates are of one face, so of one body. */
+        for (size_t s = 0; s < web->nseg; s++) {
+            const ws_nseg *sg = &web->seg[s];
+            if (sg->run && c[sg->c0].body == k)
+                memset(web->redo + sg->n0, 1, sg->n1 - sg->n0);
+            else if (!sg->run)
+                for (size_t q = sg->c0; q < sg->c1; q++)
+                    web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+        }
+    } else {
+        for (size_t q = 0; q < web->ncand[web->list]; q++)
+            web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    }
     t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
     t->q = qt_mul(pc, b->st[cur].p[k]);
     t->lever = sphere_lever(b, k, web, margin);
@@ -331,11 +371,12 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * wherever the contacts see it. */
     const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    size_t flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
     for (size_t q = 0; rebase && q < web->ntrack; q++)
         if (web->track[q].rebase)
             rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);
-    long count = (long)collect_flagged(web->redo, web->n, web->moved);
+    /* Most steps flag no node. */
+    long count = flagged || rebase ? (long)collect_flagged(web->redo, web->n, web->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
     for (size_t q = 0; count && q < web->ntrack; q++) {
