@@ -539,14 +539,21 @@ enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_ARRAYS };
  * the face's box); M_BOXES: the faces whose box, grown by the reach, holds it; M_OUT: of the
  * faces in M_PASS, those it is not well inside of (see convex_candidates). */
 
-/* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0. */
+/* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0; how
+ * many do. */
 WS_VECTOR_LOOP
-static void find_near(uint64_t *restrict hit, const double *restrict px, const double *restrict py,
-                      const double *restrict pz, size_t m, v3 lo, v3 hi)
+static size_t find_near(uint64_t *restrict hit, const double *restrict px,
+                        const double *restrict py, const double *restrict pz, size_t m, v3 lo,
+                        v3 hi)
 {
-    for (size_t j = 0; j < m; j++)
-        hit[j] = (uint64_t)((px[j] > lo.x) & (px[j] < hi.x) & (py[j] > lo.y) & (py[j] < hi.y) &
-                            (pz[j] > lo.z) & (pz[j] < hi.z));
+    size_t count = 0;
+    for (size_t j = 0; j < m; j++) {
+        uint64_t h = (uint64_t)((px[j] > lo.x) & (px[j] < hi.x) & (py[j] > lo.y) &
+                                (py[j] < hi.y) & (pz[j] > lo.z) & (pz[j] < hi.z));
+        hit[j] = h;
+        count += h;
+    }
+    return count;
 }
 
 /* The values and masks of m nodes against a convex body of shape sh at pose (A, r) (see
@@ -761,19 +768,19 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
         for (uint32_t k = 0; k < b->slots; k++) {
             if (!b->alive[k])
                 continue;
-            find_near(hit, px, py, pz, m,
-                      v3_make(b->lo[k].x - pad, b->lo[k].y - pad, b->lo[k].z - pad),
-                      v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
+            const uint32_t c = (uint32_t)find_near(
+                hit, px, py, pz, m, v3_make(b->lo[k].x - pad, b->lo[k].y - pad, b->lo[k].z - pad),
+                v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
+            if (!c)
+                continue;
             if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
                                  sizeof *g->find_node) != 0)
                 return -1;
-            uint32_t *nd = g->find_node + nnode, c = 0;
-            for (size_t j = 0; j < m; j++) {
-                nd[c] = (uint32_t)j;
-                c += (uint32_t)hit[j];
+            uint32_t *nd = g->find_node + nnode;
+            for (size_t j = 0, e = 0; j < m; j++) {
+                nd[e] = (uint32_t)j;
+                e += hit[j];
             }
-            if (!c)
-                continue;
             const ws_shape *sh = b->shape[k];
             ws_find_body *fb = &g->find[nb++];
             *fb = (ws_find_body){.body = k, .count = c, .node = nnode, .val = nval, .mask = nmask};
