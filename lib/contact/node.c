@@ -172,7 +172,8 @@ enum { FLAG_CHUNK = 256 };
 
 /* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
  * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
- * is squared when there is one sub-step (c = 0: no square root needed). */
+ * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
+ * have none flagged: their bytes are cleared, not narrowed. */
 WS_VECTOR_LOOP
 static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
                          double c, double lim)
@@ -190,6 +191,7 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
                                *restrict oz = web->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
+        const size_t before = count;
         if (c > 0.0) {
             for (size_t i = 0; i < e; i++) {
                 double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
@@ -217,6 +219,10 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
             }
         }
         uint8_t *restrict redo = web->redo + i0;
+        if (count == before) {
+            memset(redo, 0, e);
+            continue;
+        }
         for (size_t i = 0; i < e; i++)
             redo[i] = (uint8_t)flag[i];
     }
@@ -250,7 +256,8 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
 }
 
 /* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
- * open box (lo, hi). Straight-line code, on vectors, FLAG_CHUNK nodes at a time. */
+ * open box (lo, hi). Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those of a
+ * group with none in the box are left as they are). */
 WS_VECTOR_LOOP
 static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo, v3 hi)
 {
@@ -261,6 +268,7 @@ static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r,
     for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
         const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        uint64_t any = 0;
         for (size_t i = 0; i < e; i++) {
             double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
             double sx = a0 * px + a3 * py + a6 * pz;
@@ -268,7 +276,10 @@ static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r,
             double sz = a2 * px + a5 * py + a8 * pz;
             in[i] = (uint64_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) & (sz > lo.z) &
                                (sz < hi.z));
+            any |= in[i];
         }
+        if (!any)
+            continue;
         uint8_t *restrict f = flag + i0;
         for (size_t i = 0; i < e; i++)
             f[i] |= (uint8_t)in[i];
