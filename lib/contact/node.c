@@ -472,12 +472,12 @@ int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_
 
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
                   size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap)
+                  size_t *cap, uint32_t *changed, size_t *nchanged)
 {
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
-    size_t k = 0, a = 0, f = 0;
+    size_t k = 0, a = 0, f = 0, c = 0;
     /* Node by node found again: the old candidates of the nodes before it as they are, its
      * old ones dropped, its fresh ones in their place. */
     for (size_t q = 0; q < count; q++) {
@@ -486,13 +486,16 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_nca
         append_run(o, &k, old, a, e - a);
         for (a = e; a < nold && old[a].node == m; a++)
             ;
-        for (e = f; e < nfresh && fresh[e].node == m; e++)
+        const size_t f0 = f;
+        for (; f < nfresh && fresh[f].node == m; f++)
             ;
-        append_run(o, &k, fresh, f, e - f);
-        f = e;
+        if (a - e != f - f0 || (f > f0 && memcmp(old + e, fresh + f0, (f - f0) * sizeof *old)))
+            changed[c++] = m;
+        append_run(o, &k, fresh, f0, f - f0);
     }
     append_run(o, &k, old, a, nold - a);
     *n = k;
+    *nchanged = c;
     return 0;
 }
 

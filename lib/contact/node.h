@@ -84,10 +84,11 @@ int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_
 
 /* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
  * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
- * into out. 0, or -1 when out of memory. */
+ * into out; the nodes whose fresh candidates are not those they had into `changed` (room for
+ * count; it may be `nodes` itself), in order, *nchanged of them. 0, or -1 when out of memory. */
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
                   size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap);
+                  size_t *cap, uint32_t *changed, size_t *nchanged);
 
 /* Room for evaluating ncand candidates (web->act, web->sel, web->seld). 0, or -1 when out of
  * memory. */
@@ -98,9 +99,10 @@ void ws_node_scratch_free(ws_mem *mem, ws_web *web);
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list);
 
-/* The same for list `list` merged (ws_node_merge) from list `from` and the candidates found
- * again of `nodes` (count of them, in increasing order): when the stretches are those of `from`,
- * only the sweep blocks that hold one of the nodes are cut again. 0, or -1 when out of memory. */
+/* The same for list `list` merged (ws_node_merge) from list `from`, where only the nodes
+ * `nodes` (count of them, in increasing order) have other candidates: when the stretches are
+ * those of `from`, only the sweep blocks that hold one of the nodes are cut again. 0, or -1 when
+ * out of memory. */
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
                             int from, const uint32_t *nodes, size_t count);
 

@@ -174,6 +174,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
          * for body pairs). The world's detection schedule governs the body pairs. */
         int list = web->list;
         long moved = 0;
+        size_t changed = 0;
         int all = web->refresh || !w->cand_valid;
         if (!all && (moved = ws_node_moved(b, cur, web, web->x[cur], web->v[cur], w->def.dt,
                                            w->def.contact_margin)) < 0)
@@ -204,13 +205,15 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                 if (!bad && ws_node_same(web->moved, (size_t)moved, web->cand[old],
                                          web->ncand[old], web->fresh, web->nfresh))
                     list = old;
-                else
+                else /* web->moved keeps the nodes whose candidates changed: their sweep
+                        blocks alone are cut into stretches again */
                     bad = bad ||
                           ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
                                         web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
-                                        &web->ncand[list], &web->capcand[list]) ||
+                                        &web->ncand[list], &web->capcand[list], web->moved,
+                                        &changed) ||
                           ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
-                                                  list, old, web->moved, (size_t)moved);
+                                                  list, old, web->moved, changed);
             }
             if (bad || ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
                 return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
