@@ -443,13 +443,18 @@ static size_t first_not_below(const ws_ncand *c, size_t a, size_t n, uint32_t m)
     return hi;
 }
 
-/* Append src[from, from + len) to o at *k (src may be NULL when len is 0). */
-static void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from, size_t len)
+/* Append src[from, from + len) to o at *k (src may be NULL when len is 0). A node has a
+ * candidate or two: those are copied in place. */
+static inline void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from, size_t len)
 {
-    if (len) {
+    if (len == 1)
+        o[*k] = src[from];
+    else if (len == 2) {
+        o[*k] = src[from];
+        o[*k + 1] = src[from + 1];
+    } else if (len)
         memcpy(o + *k, src + from, len * sizeof *o);
-        *k += len;
-    }
+    *k += len;
 }
 
 int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
@@ -489,7 +494,13 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_nca
         const size_t f0 = f;
         for (; f < nfresh && fresh[f].node == m; f++)
             ;
-        if (a - e != f - f0 || (f > f0 && memcmp(old + e, fresh + f0, (f - f0) * sizeof *old)))
+        int same = a - e == f - f0;
+        if (same && f - f0 == 1) /* the common case, without a call */
+            same = old[e].body == fresh[f0].body && old[e].feat == fresh[f0].feat &&
+                   old[e].local == fresh[f0].local;
+        else if (same && f > f0)
+            same = !memcmp(old + e, fresh + f0, (f - f0) * sizeof *old);
+        if (!same)
             changed[c++] = m;
         append_run(o, &k, fresh, f0, f - f0);
     }
