@@ -11,6 +11,21 @@ static int inside_box(v3 p, v3 lo, v3 hi, double e)
            p.z > lo.z - e && p.z < hi.z + e;
 }
 
+/* Index of the lowest set bit of m (m != 0). */
+static inline uint32_t lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(m);
+#else
+    uint32_t f = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
 /* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
@@ -240,12 +255,18 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
         if (!(word[0] | word[1] | word[2] | word[3]))
             continue;
         for (size_t w = 0; w < 4; w++) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+            /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
+            for (uint64_t b = word[w]; b; b &= b - 1)
+                moved[count++] = (uint32_t)(i + 8 * w + lowest_bit(b) / 8);
+#else
             if (!word[w])
                 continue;
             for (size_t j = i + 8 * w; j < i + 8 * w + 8; j++) {
                 moved[count] = (uint32_t)j;
                 count += flag[j];
             }
+#endif
         }
     }
     for (; i < n; i++) {
@@ -517,21 +538,6 @@ static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_nca
         return -1;
     (*out)[(*n)++] = c;
     return 0;
-}
-
-/* Index of the lowest set bit of m (m != 0). */
-static inline uint32_t lowest_bit(uint64_t m)
-{
-#if defined(__GNUC__)
-    return (uint32_t)__builtin_ctzll(m);
-#else
-    uint32_t f = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        f++;
-    }
-    return f;
-#endif
 }
 
 /* ---- the search
