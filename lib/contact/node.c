@@ -551,7 +551,8 @@ static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_nca
  * candidates are listed node by node, and for a node body by body. */
 enum { FIND_CHUNK = 64 };
 
-/* A body near a group of nodes: its slot, how many of the group's nodes lie in its grown box and
+/* A body near a group of nodes: its slot, its reach (the layers and the margin), how many of the
+ * group's nodes lie in its grown box and
  * where their values are in the scratch: their places in the group at find_node + node; at
  * find_val + val, FIND_CHUNK apart, their body-frame x, y, z, the largest plane distance D, then
  * their distance to each face's plane; at find_mask + mask, FIND_CHUNK apart, the masks M_*.
@@ -559,6 +560,7 @@ enum { FIND_CHUNK = 64 };
 typedef struct ws_find_body {
     uint32_t body, count, next;
     int general;
+    double reach;
     size_t node, val, mask;
 } ws_find_body;
 
@@ -815,6 +817,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
             const ws_shape *sh = b->shape[k];
             ws_find_body *fb = &g->find[nb++];
             *fb = (ws_find_body){.body = k, .count = c, .node = nnode, .val = nval, .mask = nmask};
+            fb->reach = b->layer[k] + web->layer + margin;
             fb->general = !sh->convex || sh->face_count > WS_NCAND_FACES;
             nnode += c;
             if (!fb->general) {
@@ -840,8 +843,8 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 v[V_Y * FIND_CHUNK + c] = py[nd[c]];
                 v[V_Z * FIND_CHUNK + c] = pz[nd[c]];
             }
-            find_faces(b->shape[k], &b->A[k], b->st[cur].r[k], b->layer[k] + web->layer + margin,
-                       margin, fb->count, v, g->find_mask + fb->mask);
+            find_faces(b->shape[k], &b->A[k], b->st[cur].r[k], fb->reach, margin, fb->count, v,
+                       g->find_mask + fb->mask);
         }
         /* Node by node (the order the sub-steps take them in), against each body near it. */
         for (size_t j = 0; j < m; j++) {
@@ -851,7 +854,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 if (fb->next == fb->count || g->find_node[fb->node + fb->next] != j)
                     continue;
                 const uint32_t c = fb->next++, k = fb->body;
-                const double reach = b->layer[k] + web->layer + margin;
+                const double reach = fb->reach;
                 int bad;
                 if (fb->general) {
                     bad = general_candidates(mem, b, cur, g, i, k, v3_make(px[j], py[j], pz[j]),
