@@ -120,6 +120,9 @@ typedef struct ws_web {
                                      by one because a node lay below the face (diagnostics) */
     double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
     size_t rtmp_cap;
+    struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
+    size_t rface_cap;          /* body, filled in sub-step rface_gen (scratch, node_force.c) */
+    uint64_t rface_gen;
     int list;      /* the committed list */
     int next_list; /* the list this step used, committed with it */
     /* Force and moment on each body in the last step (global, moment about the CoG). */
