@@ -399,16 +399,20 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. */
+ * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. Returns how
+ * many nodes end faster than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count,
+ * so the loop keeps its vectors, and taken from the new velocity while it is at hand. */
 WS_VECTOR_LOOP
-static void advance(size_t m, double h, const double *restrict im, const double *restrict fx,
-                    const double *restrict fy, const double *restrict fz,
-                    const double *restrict vx0, const double *restrict vy0,
-                    const double *restrict vz0, const double *restrict x0,
-                    const double *restrict y0, const double *restrict z0, double *restrict vx1,
-                    double *restrict vy1, double *restrict vz1, double *restrict x1,
-                    double *restrict y1, double *restrict z1)
+static size_t advance(size_t m, double h, double lim2, const double *restrict im,
+                      const double *restrict fx, const double *restrict fy,
+                      const double *restrict fz, const double *restrict vx0,
+                      const double *restrict vy0, const double *restrict vz0,
+                      const double *restrict x0, const double *restrict y0,
+                      const double *restrict z0, double *restrict vx1, double *restrict vy1,
+                      double *restrict vz1, double *restrict x1, double *restrict y1,
+                      double *restrict z1)
 {
+    size_t bad = 0;
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
         double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
@@ -420,19 +424,8 @@ static void advance(size_t m, double h, const double *restrict im, const double 
         x1[i] = x0[i] + h * ux;
         y1[i] = y0[i] + h * uy;
         z1[i] = z0[i] + h * uz;
+        bad += !(ux * ux + uy * uy + uz * uz <= lim2);
     }
-}
-
-/* How many of m nodes are faster than sqrt(lim2) or have a NaN speed (!(s <= lim2) counts
- * it): a count, so the loop runs on vectors -- in the AVX2 build only; the baseline x86-64 one
- * lacks the select it takes. Kept out of advance, which would lose its vectors there with it. */
-WS_VECTOR_LOOP
-static size_t too_fast(size_t m, const double *restrict vx, const double *restrict vy,
-                       const double *restrict vz, double lim2)
-{
-    size_t bad = 0;
-    for (size_t i = 0; i < m; i++)
-        bad += !(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i] <= lim2);
     return bad;
 }
 
@@ -440,11 +433,9 @@ size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
     const ws_nodes3 f = web->f;
-    size_t m = n1 - n0;
-    advance(m, h, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0, vs.x + n0, vs.y + n0,
-            vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
-            xd.x + n0, xd.y + n0, xd.z + n0);
-    return too_fast(m, vd.x + n0, vd.y + n0, vd.z + n0, vmax * vmax);
+    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0,
+                   vs.x + n0, vs.y + n0, vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0,
+                   vd.y + n0, vd.z + n0, xd.x + n0, xd.y + n0, xd.z + n0);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)
