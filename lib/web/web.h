@@ -75,6 +75,16 @@ typedef struct ws_track {
     double lo, hi, gap, lever;
 } ws_track;
 
+/* A spring law in the form every stateless 1D law of the film's kind takes (lib/law/law.h):
+ * F = kc eps + dk g(eps) + c eps_dot, g the C1 ramp of half-width w (qw = 1 / (4 w)). Linear
+ * laws have dk = 0. Any other law (a table, relaxation, a user's) is `gen`, evaluated spring
+ * by spring with the spring's own history, at time t, `since` after it was committed. */
+typedef struct ws_spring_form {
+    double kc, dk, w, qw, c;
+    const ws_law *gen;
+    double t, since;
+} ws_spring_form;
+
 typedef struct ws_web {
     char *name;
     uint32_t n, ns;          /* nodes, springs */
@@ -84,6 +94,7 @@ typedef struct ws_web {
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
+    ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
                                 zeroed at the start of a step that writes fc[k] */
@@ -161,7 +172,7 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * in cache: block k's forces from the springs, node drag and gravity are complete in f once
  * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
  * their contact forces and be integrated. A grid web's blocks are its rows; a mesh web is one
- * block. */
+ * block. Every sweep starts at block 0, which takes the laws at (t, since) for all of it. */
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
