@@ -180,20 +180,20 @@ static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v,
     act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
 }
 
-/* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
- * out, out + cap and out + 2 cap (A_AX...: apart from the inputs, so the loop needs no checks of
- * overlap to run on vectors). */
+/* Frictions of the contacts [0, 4 nv) of the list, whole vectors (none left over; the list
+ * has room, ws_node_scratch): its input arrays at P + k cap, the frictions into ax, ay, az
+ * (A_AX...: apart from the inputs, so the loop needs no checks of overlap to run on
+ * vectors). */
 WS_VECTOR_LOOP
-static void act_friction(size_t m, double h, const double *restrict P, double *restrict out,
-                         size_t cap)
+static void act_friction(size_t nv, double h, const double *restrict P, size_t cap,
+                         double *restrict ax, double *restrict ay, double *restrict az)
 {
     const double *nx = P + A_NX * cap, *ny = P + A_NY * cap, *nz = P + A_NZ * cap,
                  *tx = P + A_TX * cap, *ty = P + A_TY * cap, *tz = P + A_TZ * cap,
                  *kx = P + A_KX * cap, *ky = P + A_KY * cap, *kz = P + A_KZ * cap,
                  *im = P + A_IM * cap, *mass = P + A_M * cap, *fn = P + A_FN * cap,
                  *mu = P + A_MU * cap, *vl = P + A_VL * cap;
-    double *ax = out, *ay = out + cap, *az = out + 2 * cap;
-    for (size_t q = 0; q < m; q++)
+    for (size_t q = 0; q < 4 * nv; q++)
         friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
                     mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
 }
@@ -212,7 +212,10 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
         act_a(L, A_IM)[q] = web->inv_m[i];
         act_a(L, A_M)[q] = web->m[i];
     }
-    act_friction(m, h, web->act, web->act + A_AX * web->act_cap, web->act_cap);
+    /* The lanes past m read what the list held (its first values were zeros), and their
+     * frictions are not read. */
+    act_friction((m + 3) / 4, h, web->act, web->act_cap, act_a(L, A_AX), act_a(L, A_AY),
+                 act_a(L, A_AZ));
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
@@ -662,14 +665,19 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
         web->rface_gen++;
-    for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
-        const ws_nseg *sg = &web->seg[k];
-        *checks += sg->c1 - sg->c0;
+    /* In locals: the stores of the passes would make the compiler load them again. */
+    const ws_nseg *seg = web->seg;
+    const size_t nseg = web->nseg;
+    uint64_t tried = 0;
+    for (; k < nseg && seg[k].n0 < n1; k++) {
+        const ws_nseg *sg = &seg[k];
+        tried += sg->c1 - sg->c0;
         if (sg->run)
             contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc);
         else
             contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
     }
+    *checks += tried;
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
