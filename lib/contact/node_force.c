@@ -262,76 +262,63 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
     L->nl = 0;
 }
 
-/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
- * contacts that push into the list. */
-static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom *g,
-                             ws_web *web, ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand,
-                             size_t n, const ws_node_params *pp, act_list *L)
+/* ---- a node at a convex body's edge
+ *
+ * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
+ * them, and at most one of the three holds the node. On a convex body every face lies behind
+ * every other face's plane, so the two planes' distances dA, dB tell them apart at once: face A
+ * is turned down when the node's projection on its plane stands out of B's plane, and the
+ * reverse; the edge when the node lies behind either plane or beyond the window of one, or is
+ * not a positive sum of the two normals (in_wedge's distances along the normals are dA, dB to
+ * round-off). Only by a margin eps that the full tests (eq. 14's for a face, in_wedge) cannot
+ * disagree with: the feature left, if any, takes its full test, and the contacts are the same
+ * as one by one. A face found well inside its outline takes no test and is not turned down. */
+
+/* The margin of the planes' tests for a node at xi and a flat convex shape at r: its faces'
+ * outlines stand out of the other faces' planes by its convexity tolerance (1e-9 of its size)
+ * and eq. 14's (1e-9 of a triangle) at most, a few 1e-9 of its radius; round-off and the
+ * flatness of its faces (1e-12) come at the size of the coordinates and distances. Both with
+ * room to spare: a node that close to a boundary takes the full test. */
+static inline double corner_eps(const ws_shape *sh, v3 xi, v3 r, double hi)
 {
-    const ws_body_state *st = &b->st[cur];
-    uint32_t *sel = web->sel;
-    double *seld = web->seld; /* their distances to the face's plane */
-    /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
-     * it now and then: which ones do is a coin toss from step to step. So the plane distance
-     * sorts them first without a branch (the ones within the window are listed), and the rest
-     * of the work runs on that shorter list. Edges go to the list as they are. */
-    const double wl = web->layer;
-    size_t m = 0;
-    for (size_t k = 0; k < n; k++) {
-        const ws_ncand *c = &cand[k];
-        const uint32_t edge = c->local >> 31; /* WS_NCAND_EDGE, as 0 or 1 */
-        const ws_wface *F = &g->face[c->feat & (edge - 1u)]; /* any face for an edge */
-        uint32_t i = c->node;
-        double d = F->n.x * x.x[i] + F->n.y * x.y[i] + F->n.z * x.z[i] - F->off;
-        sel[m] = (uint32_t)k;
-        seld[m] = d;
-        m += (size_t)((d < b->layer[c->body] + wl) | edge);
-    }
-    /* Normal forces, in node order. */
-    for (size_t q = 0; q < m; q++) {
-        const ws_ncand *c = &cand[sel[q]];
-        uint32_t i = c->node, bi = c->body;
-        v3 xi = nodes_get(x, i), nrm;
-        double d;
-        /* The contact window of the pair: the two layers outside, the body's inner depth in. */
-        double hi = b->layer[bi] + wl;
-        if (c->local & WS_NCAND_EDGE) {
-            if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
-                continue;
-        } else {
-            const ws_wface *F = &g->face[c->feat];
-            d = seld[q]; /* below hi: listed */
-            const ws_shape *sh = b->shape[bi];
-            double lo = -hi - sh->inner;
-            if (!(d > lo))
-                continue;
-            /* A node found well inside the face's outline stays over the face while the
-             * candidates are valid: no need to find its triangle. */
-            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
-                continue;
-            uint32_t f = c->local & ~WS_NCAND_FLAGS;
-            if (d < 0.0 &&
-                !(sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                             : ws_shallowest_face(sh, f,
-                                                  m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                                  d)))
-                continue;
-            nrm = F->n; /* from the body to the node */
-        }
-        normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
-                  &pp[b->material[bi]]);
-    }
+    double size = fabs(xi.x) + fabs(xi.y) + fabs(xi.z) + fabs(r.x) + fabs(r.y) + fabs(r.z) +
+                  sh->radius + sh->inner + hi;
+    return 1e-7 * sh->radius + 1e-10 * size;
 }
 
-/* ---- runs: nodes side by side on one face */
+/* Whether c[0, 3) (all there) are a corner: two faces of a node on a flat convex shape, then
+ * the edge between them. */
+static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
+{
+    const uint32_t a = c[0].local, z = c[1].local;
+    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(c[2].local & WS_NCAND_EDGE) ||
+        c[1].node != c[0].node || c[2].node != c[0].node || c[1].body != c[0].body ||
+        c[2].body != c[0].body || !sh->convex || !sh->flat)
+        return 0;
+    const ws_edge *E = &sh->edges[c[2].local & ~WS_NCAND_FLAGS];
+    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
+    return (E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa);
+}
 
-#define RUN_MIN 4    /* shorter stretches go one by one */
-#define RUN_CHUNK 64 /* nodes of a run whose depths are taken at once: a bit each in a word */
-_Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit has 64");
-/* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
- * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
- * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
-#define RUN_STRIDE (RUN_CHUNK + 8)
+/* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
+ * to their full tests, one bit each: a face within the window's top and not turned down, the
+ * edge unless turned down. */
+static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
+                                   v3 xi, v3 r, double hi)
+{
+    const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
+    /* The planes' distances as the one-by-one pass takes them. */
+    const double dA = A->n.x * xi.x + A->n.y * xi.y + A->n.z * xi.z - A->off,
+                 dB = B->n.x * xi.x + B->n.y * xi.y + B->n.z * xi.z - B->off;
+    const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
+    const double eps = corner_eps(sh, xi, r, hi);
+    /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
+    const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
+    const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
+    const uint32_t e = (dA > -eps) & (dB > -eps) & (dA < hi + eps) & (dB < hi + eps) &
+                       (qA > -eps) & (qB > -eps);
+    return a | z << 1 | e << 2;
+}
 
 /* Index of the lowest set bit of m (m != 0). */
 static inline uint32_t lowest_bit(uint64_t m)
@@ -347,6 +334,72 @@ static inline uint32_t lowest_bit(uint64_t m)
     return f;
 #endif
 }
+
+/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
+ * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
+ * first, and only what they leave takes the tests. */
+static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom *g,
+                             ws_web *web, ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand,
+                             size_t n, const ws_node_params *pp, act_list *L)
+{
+    const ws_body_state *st = &b->st[cur];
+    const double wl = web->layer;
+    for (size_t k = 0; k < n;) {
+        const ws_ncand *c0 = &cand[k];
+        const uint32_t i = c0->node, bi = c0->body;
+        const ws_shape *sh = b->shape[bi];
+        const v3 xi = nodes_get(x, i);
+        /* The contact window of the pair: the two layers outside, the body's inner depth in. */
+        const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
+        /* The candidates from k on decided here, and those of them left to their tests. */
+        uint32_t left = 1;
+        size_t e = k + 1;
+        if (n - k >= 3 && is_corner(sh, c0)) {
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi);
+            e = k + 3;
+        }
+        k = e;
+        for (; left; left &= left - 1) {
+            const ws_ncand *c = c0 + lowest_bit(left);
+            v3 nrm;
+            double d;
+            if (c->local & WS_NCAND_EDGE) {
+                if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
+                    continue;
+            } else {
+                const ws_wface *F = &g->face[c->feat];
+                d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
+                if (!(d < hi) || !(d > lo))
+                    continue;
+                /* A node found well inside the face's outline stays over the face while the
+                 * candidates are valid: no need to find its triangle. */
+                if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
+                    continue;
+                uint32_t f = c->local & ~WS_NCAND_FLAGS;
+                if (d < 0.0 &&
+                    !(sh->convex
+                          ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
+                          : ws_shallowest_face(sh, f,
+                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
+                                               d)))
+                    continue;
+                nrm = F->n; /* from the body to the node */
+            }
+            normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
+                      &pp[b->material[bi]]);
+        }
+    }
+}
+
+/* ---- runs: nodes side by side on one face */
+
+#define RUN_MIN 4    /* shorter stretches go one by one */
+#define RUN_CHUNK 64 /* nodes of a run whose depths are taken at once: a bit each in a word */
+_Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit has 64");
+/* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
+ * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
+ * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
+#define RUN_STRIDE (RUN_CHUNK + 8)
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
