@@ -160,17 +160,17 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     L->nl += (size_t)(keep != 0);
 }
 
-/* The normal force of node i on body bi at depth d along the normal n (from the body to the
- * node), within the window (hi the layers): into f; the contact is listed when it pushes.
+/* The normal force of node i (at xi) on body bi at depth d along the normal n (from the body to
+ * the node), within the window (hi the layers): into f; the contact is listed when it pushes.
  * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
  * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
  * force is added times whether it pushes (0 or 1), without a branch. The one-by-one pass uses
  * it; run_kernel has the same arithmetic for a run's nodes. */
-static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
+static inline void normal_of(ws_web *web, act_list *L, v3 xi, ws_nodes3 v, uint32_t i,
                              uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
                              const ws_node_params *p)
 {
-    v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
+    v3 xc = v3_madd(xi, n, -0.5 * d);
     v3 lever = v3_sub(xc, r);
     v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
     double vn = v3_dot(vrel, n);
@@ -262,17 +262,51 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
     L->nl = 0;
 }
 
+/* What the node contacts of a sweep block read: the bodies and their state, their faces in the
+ * global frame, the web and its node state (x, v), the contact parameters by body material and
+ * the list of pushing contacts. */
+typedef struct node_env {
+    const ws_body_store *b;
+    const ws_body_state *st;
+    const ws_node_geom *g;
+    ws_web *web;
+    ws_nodes3 x, v;
+    const ws_node_params *pp;
+    act_list *L;
+} node_env;
+
+/* Kept out of line where GCC would inline it: see node_push. */
+#if defined(__GNUC__)
+#define NODE_OUT_OF_LINE __attribute__((noinline))
+#else
+#define NODE_OUT_OF_LINE
+#endif
+
+/* normal_of for node i at (xx, xy, xz) against body bi, along (nx, ny, nz) at depth d, window
+ * top hi. Out of line: inlined, its many values crowd the registers of contacts_general's
+ * loop, which then keeps its own on the stack (7 k instructions a step more on the reference
+ * case). */
+NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t bi, double nx,
+                                       double ny, double nz, double d, double hi, double xx,
+                                       double xy, double xz)
+{
+    const ws_body_store *b = E->b;
+    normal_of(E->web, E->L, v3_make(xx, xy, xz), E->v, i, bi, v3_make(nx, ny, nz), d, hi,
+              E->st->r[bi], E->st->v[bi], b->wg[bi], &E->pp[b->material[bi]]);
+}
+
 /* ---- a node at a convex body's edge
  *
  * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
  * them, and at most one of the three holds the node. On a convex body every face lies behind
  * every other face's plane, so the two planes' distances dA, dB tell them apart at once: face A
  * is turned down when the node's projection on its plane stands out of B's plane, and the
- * reverse; the edge when the node lies behind either plane or beyond the window of one, or is
- * not a positive sum of the two normals (in_wedge's distances along the normals are dA, dB to
- * round-off). Only by a margin eps that the full tests (eq. 14's for a face, in_wedge) cannot
- * disagree with: the feature left, if any, takes its full test, and the contacts are the same
- * as one by one. A face found well inside its outline takes no test and is not turned down. */
+ * reverse; the edge when the node is not a positive sum of the two normals (it lies over a
+ * face, or behind it) or lies beyond the window of either plane (in_wedge's distances along
+ * the normals are dA, dB to round-off). Only by a margin eps that the full tests (eq. 14's for
+ * a face, in_wedge) cannot disagree with: the feature left, if any, takes its full test, and
+ * the contacts are the same as one by one. A face found well inside its outline takes no test
+ * and is not turned down. */
 
 /* The margin of the planes' tests for a node at xi and a flat convex shape at r: its faces'
  * outlines stand out of the other faces' planes by its convexity tolerance (1e-9 of its size)
@@ -292,8 +326,7 @@ static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
 {
     const uint32_t a = c[0].local, z = c[1].local;
     if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(c[2].local & WS_NCAND_EDGE) ||
-        c[1].node != c[0].node || c[2].node != c[0].node || c[1].body != c[0].body ||
-        c[2].body != c[0].body || !sh->convex || !sh->flat)
+        !sh->convex || !sh->flat)
         return 0;
     const ws_edge *E = &sh->edges[c[2].local & ~WS_NCAND_FLAGS];
     const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
@@ -315,8 +348,8 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
     const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
     const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
-    const uint32_t e = (dA > -eps) & (dB > -eps) & (dA < hi + eps) & (dB < hi + eps) &
-                       (qA > -eps) & (qB > -eps);
+    const double dmax = dA > dB ? dA : dB;
+    const uint32_t e = (qA > -eps) & (qB > -eps) & (dmax < hi + eps);
     return a | z << 1 | e << 2;
 }
 
@@ -338,26 +371,28 @@ static inline uint32_t lowest_bit(uint64_t m)
 /* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
  * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
  * first, and only what they leave takes the tests. */
-static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom *g,
-                             ws_web *web, ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand,
-                             size_t n, const ws_node_params *pp, act_list *L)
+static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
-    const ws_body_state *st = &b->st[cur];
-    const double wl = web->layer;
+    const ws_body_store *b = E->b;
+    const ws_body_state *st = E->st;
+    const ws_node_geom *g = E->g;
+    const ws_nodes3 x = E->x;
+    const double wl = E->web->layer;
     for (size_t k = 0; k < n;) {
         const ws_ncand *c0 = &cand[k];
         const uint32_t i = c0->node, bi = c0->body;
+        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
+         * their tests. */
+        size_t e = k + 1;
+        while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
+            e++;
         const ws_shape *sh = b->shape[bi];
         const v3 xi = nodes_get(x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
-        /* The candidates from k on decided here, and those of them left to their tests. */
-        uint32_t left = 1;
-        size_t e = k + 1;
-        if (n - k >= 3 && is_corner(sh, c0)) {
+        uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
+        if (e - k == 3 && is_corner(sh, c0))
             left = corner_left(g, sh, c0, xi, st->r[bi], hi);
-            e = k + 3;
-        }
         k = e;
         for (; left; left &= left - 1) {
             const ws_ncand *c = c0 + lowest_bit(left);
@@ -385,8 +420,7 @@ static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom
                     continue;
                 nrm = F->n; /* from the body to the node */
             }
-            normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
-                      &pp[b->material[bi]]);
+            node_push(E, i, bi, nrm.x, nrm.y, nrm.z, d, hi, xi.x, xi.y, xi.z);
         }
     }
 }
@@ -566,7 +600,8 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
         web->run_nodes += m;
         if (!whole || (in & below)) { /* one by one */
             web->run_deep += whole ? m : 0;
-            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
+            const node_env E = {b, &b->st[cur], g, web, x, v, pp, L};
+            contacts_general(&E, c + (o - sg->n0), m);
             continue;
         }
         /* The ones in the window, gathered: a pass of the loop per node in it, found by its
@@ -715,6 +750,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
                       v3 *bmoment, uint64_t *checks)
 {
     act_list L = act_open(web);
+    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
         web->rface_gen++;
@@ -728,7 +764,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         if (sg->run)
             contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc);
         else
-            contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
+            contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }
     *checks += tried;
     *next = k;
