@@ -262,6 +262,12 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
     L->nl = 0;
 }
 
+/* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
+typedef struct corner_memo {
+    uint32_t body;
+    double eps;
+} corner_memo;
+
 /* What the node contacts of a sweep block read: the bodies and their state, their faces in the
  * global frame, the web and its node state (x, v), the contact parameters by body material and
  * the list of pushing contacts. */
@@ -273,6 +279,7 @@ typedef struct node_env {
     ws_nodes3 x, v;
     const ws_node_params *pp;
     act_list *L;
+    struct corner_memo *memo;
 } node_env;
 
 /* Kept out of line where GCC would inline it: see node_push. */
@@ -308,16 +315,23 @@ NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t b
  * the contacts are the same as one by one. A face found well inside its outline takes no test
  * and is not turned down. */
 
-/* The margin of the planes' tests for a node at xi and a flat convex shape at r: its faces'
- * outlines stand out of the other faces' planes by its convexity tolerance (1e-9 of its size)
- * and eq. 14's (1e-9 of a triangle) at most, a few 1e-9 of its radius; round-off and the
- * flatness of its faces (1e-12) come at the size of the coordinates and distances. Both with
- * room to spare: a node that close to a boundary takes the full test. */
-static inline double corner_eps(const ws_shape *sh, v3 xi, v3 r, double hi)
+/* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
+ * the window's top hi: its faces' outlines stand out of the other faces' planes by its
+ * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few 1e-9
+ * of its radius; round-off and the flatness of its faces (1e-12) come at the size of the
+ * coordinates and distances. Both with room to spare: a node that close to a boundary takes
+ * the full test. (On the reference case the closest calls stand 2.4e-10 m out of the other
+ * plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) The body's part is
+ * kept in memo for the next node. */
+static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *sh, v3 xi, v3 r,
+                                double hi)
 {
-    double size = fabs(xi.x) + fabs(xi.y) + fabs(xi.z) + fabs(r.x) + fabs(r.y) + fabs(r.z) +
-                  sh->radius + sh->inner + hi;
-    return 1e-7 * sh->radius + 1e-10 * size;
+    if (memo->body != bi) {
+        memo->body = bi;
+        memo->eps = 1e-7 * sh->radius + 1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius +
+                                                  sh->inner + hi);
+    }
+    return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
 }
 
 /* Whether c[0, 3) (all there) are a corner: two faces of a node on a flat convex shape, then
@@ -337,14 +351,14 @@ static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
  * to their full tests, one bit each: a face within the window's top and not turned down, the
  * edge unless turned down. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
-                                   v3 xi, v3 r, double hi)
+                                   v3 xi, v3 r, double hi, corner_memo *memo)
 {
     const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
     /* The planes' distances as the one-by-one pass takes them. */
     const double dA = A->n.x * xi.x + A->n.y * xi.y + A->n.z * xi.z - A->off,
                  dB = B->n.x * xi.x + B->n.y * xi.y + B->n.z * xi.z - B->off;
     const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
-    const double eps = corner_eps(sh, xi, r, hi);
+    const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
     const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
     const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
@@ -392,7 +406,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
         uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
         if (e - k == 3 && is_corner(sh, c0))
-            left = corner_left(g, sh, c0, xi, st->r[bi], hi);
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
         k = e;
         for (; left; left &= left - 1) {
             const ws_ncand *c = c0 + lowest_bit(left);
@@ -600,7 +614,8 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
         web->run_nodes += m;
         if (!whole || (in & below)) { /* one by one */
             web->run_deep += whole ? m : 0;
-            const node_env E = {b, &b->st[cur], g, web, x, v, pp, L};
+            corner_memo memo = {UINT32_MAX, 0.0};
+            const node_env E = {b, &b->st[cur], g, web, x, v, pp, L, &memo};
             contacts_general(&E, c + (o - sg->n0), m);
             continue;
         }
@@ -750,7 +765,8 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
                       v3 *bmoment, uint64_t *checks)
 {
     act_list L = act_open(web);
-    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L};
+    corner_memo memo = {UINT32_MAX, 0.0};
+    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
         web->rface_gen++;
