@@ -804,9 +804,6 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
             return -1;
         web->act_cap = need;
     }
-    if (ws_array_reserve(mem, (void **)&web->sel, &web->sel_cap, need, sizeof *web->sel) != 0 ||
-        ws_array_reserve(mem, (void **)&web->seld, &web->seld_cap, need, sizeof *web->seld) != 0)
-        return -1;
     return 0;
 }
 
@@ -814,15 +811,11 @@ void ws_node_scratch_free(ws_mem *mem, ws_web *web)
 {
     ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
     ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
-    ws_mem_free(mem, web->sel, web->sel_cap * sizeof *web->sel);
-    ws_mem_free(mem, web->seld, web->seld_cap * sizeof *web->seld);
     ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
     ws_mem_free(mem, web->rface, web->rface_cap * sizeof *web->rface);
     web->rface = NULL;
     web->act = NULL;
     web->act_id = NULL;
-    web->sel = NULL;
-    web->seld = NULL;
     web->rtmp = NULL;
-    web->act_cap = web->sel_cap = web->seld_cap = web->rtmp_cap = web->rface_cap = 0;
+    web->act_cap = web->rtmp_cap = web->rface_cap = 0;
 }

@@ -120,9 +120,6 @@ typedef struct ws_web {
     double *act;        /* the pushing contacts of a sweep block (scratch, sized with the */
     uint32_t *act_id;   /* candidates; contact/node_force.c) */
     size_t act_cap;
-    uint32_t *sel; /* candidates within their window, scratch sized with them */
-    double *seld;  /* and their distances to the face's plane */
-    size_t sel_cap, seld_cap;
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
