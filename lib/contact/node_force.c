@@ -5,8 +5,6 @@
 
 #include <string.h>
 
-_Static_assert(WS_NCAND_EDGE == 0x80000000u, "contacts_general reads the edge flag as the top bit");
-
 /* Eq. 14 in the global frame for a prepared face: whether the point projects into it (its
  * distance to the plane is the caller's). Every triangle is tested (a face has few), without an
  * early way out: whether a node near the outline projects in is a coin toss. */
