@@ -403,8 +403,10 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
         uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
-        if (e - k == 3 && is_corner(sh, c0))
+        if (e - k == 3 && !E->web->runs_off && is_corner(sh, c0)) {
             left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
+            E->web->corners++;
+        }
         k = e;
         for (; left; left &= left - 1) {
             const ws_ncand *c = c0 + lowest_bit(left);

@@ -123,9 +123,11 @@ typedef struct ws_web {
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
-    int runs_off;  /* cut no runs: every candidate one by one (tests compare the two) */
+    int runs_off;  /* no short cuts: no runs and no corners, every candidate one by one
+                      through its full tests (tests compare the two) */
     uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
                                      by one because a node lay below the face (diagnostics) */
+    uint64_t corners;             /* corners told apart by their planes (diagnostics) */
     double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
     size_t rtmp_cap;
     struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
