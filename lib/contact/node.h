@@ -90,8 +90,7 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_nca
                   size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
                   size_t *cap, uint32_t *changed, size_t *nchanged);
 
-/* Room for evaluating ncand candidates (web->act, web->sel, web->seld). 0, or -1 when out of
- * memory. */
+/* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand);
 void ws_node_scratch_free(ws_mem *mem, ws_web *web);
 

@@ -5,8 +5,6 @@
 
 #include <string.h>
 
-_Static_assert(WS_NCAND_EDGE == 0x80000000u, "contacts_general reads the edge flag as the top bit");
-
 /* Eq. 14 in the global frame for a prepared face: whether the point projects into it (its
  * distance to the plane is the caller's). Every triangle is tested (a face has few), without an
  * early way out: whether a node near the outline projects in is a coin toss. */
@@ -160,17 +158,17 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 
     L->nl += (size_t)(keep != 0);
 }
 
-/* The normal force of node i on body bi at depth d along the normal n (from the body to the
- * node), within the window (hi the layers): into f; the contact is listed when it pushes.
+/* The normal force of node i (at xi) on body bi at depth d along the normal n (from the body to
+ * the node), within the window (hi the layers): into f; the contact is listed when it pushes.
  * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
  * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
  * force is added times whether it pushes (0 or 1), without a branch. The one-by-one pass uses
  * it; run_kernel has the same arithmetic for a run's nodes. */
-static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v, uint32_t i,
+static inline void normal_of(ws_web *web, act_list *L, v3 xi, ws_nodes3 v, uint32_t i,
                              uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
                              const ws_node_params *p)
 {
-    v3 xc = v3_madd(nodes_get(x, i), n, -0.5 * d);
+    v3 xc = v3_madd(xi, n, -0.5 * d);
     v3 lever = v3_sub(xc, r);
     v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
     double vn = v3_dot(vrel, n);
@@ -180,20 +178,20 @@ static inline void normal_of(ws_web *web, act_list *L, ws_nodes3 x, ws_nodes3 v,
     act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
 }
 
-/* Frictions of the m contacts of the list: its input arrays at P + k cap, the frictions into
- * out, out + cap and out + 2 cap (A_AX...: apart from the inputs, so the loop needs no checks of
- * overlap to run on vectors). */
+/* Frictions of the contacts [0, 4 nv) of the list, whole vectors (none left over; the list
+ * has room, ws_node_scratch): its input arrays at P + k cap, the frictions into ax, ay, az
+ * (A_AX...: apart from the inputs, so the loop needs no checks of overlap to run on
+ * vectors). */
 WS_VECTOR_LOOP
-static void act_friction(size_t m, double h, const double *restrict P, double *restrict out,
-                         size_t cap)
+static void act_friction(size_t nv, double h, const double *restrict P, size_t cap,
+                         double *restrict ax, double *restrict ay, double *restrict az)
 {
     const double *nx = P + A_NX * cap, *ny = P + A_NY * cap, *nz = P + A_NZ * cap,
                  *tx = P + A_TX * cap, *ty = P + A_TY * cap, *tz = P + A_TZ * cap,
                  *kx = P + A_KX * cap, *ky = P + A_KY * cap, *kz = P + A_KZ * cap,
                  *im = P + A_IM * cap, *mass = P + A_M * cap, *fn = P + A_FN * cap,
                  *mu = P + A_MU * cap, *vl = P + A_VL * cap;
-    double *ax = out, *ay = out + cap, *az = out + 2 * cap;
-    for (size_t q = 0; q < m; q++)
+    for (size_t q = 0; q < 4 * nv; q++)
         friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
                     mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
 }
@@ -212,7 +210,10 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
         act_a(L, A_IM)[q] = web->inv_m[i];
         act_a(L, A_M)[q] = web->m[i];
     }
-    act_friction(m, h, web->act, web->act + A_AX * web->act_cap, web->act_cap);
+    /* The lanes past m read what the list held (its first values were zeros), and their
+     * frictions are not read. */
+    act_friction((m + 3) / 4, h, web->act, web->act_cap, act_a(L, A_AX), act_a(L, A_AY),
+                 act_a(L, A_AZ));
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
@@ -259,71 +260,190 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
     L->nl = 0;
 }
 
-/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
- * contacts that push into the list. */
-static void contacts_general(const ws_body_store *b, int cur, const ws_node_geom *g,
-                             ws_web *web, ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand,
-                             size_t n, const ws_node_params *pp, act_list *L)
+/* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
+typedef struct corner_memo {
+    uint32_t body;
+    double eps;
+} corner_memo;
+
+/* What the node contacts of a sweep block read: the bodies and their state, their faces in the
+ * global frame, the web and its node state (x, v), the contact parameters by body material and
+ * the list of pushing contacts. */
+typedef struct node_env {
+    const ws_body_store *b;
+    const ws_body_state *st;
+    const ws_node_geom *g;
+    ws_web *web;
+    ws_nodes3 x, v;
+    const ws_node_params *pp;
+    act_list *L;
+    struct corner_memo *memo;
+} node_env;
+
+/* Kept out of line where GCC would inline it: see node_push. */
+#if defined(__GNUC__)
+#define NODE_OUT_OF_LINE __attribute__((noinline))
+#else
+#define NODE_OUT_OF_LINE
+#endif
+
+/* normal_of for node i at (xx, xy, xz) against body bi, along (nx, ny, nz) at depth d, window
+ * top hi. Out of line: inlined, its many values crowd the registers of contacts_general's
+ * loop, which then keeps its own on the stack (7 k instructions a step more on the reference
+ * case). */
+NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t bi, double nx,
+                                       double ny, double nz, double d, double hi, double xx,
+                                       double xy, double xz)
 {
-    const ws_body_state *st = &b->st[cur];
-    uint32_t *sel = web->sel;
-    double *seld = web->seld; /* their distances to the face's plane */
-    /* Most face candidates lie flat beside their face, at about the layers' distance, pressing
-     * it now and then: which ones do is a coin toss from step to step. So the plane distance
-     * sorts them first without a branch (the ones within the window are listed), and the rest
-     * of the work runs on that shorter list. Edges go to the list as they are. */
-    const double wl = web->layer;
-    size_t m = 0;
-    for (size_t k = 0; k < n; k++) {
-        const ws_ncand *c = &cand[k];
-        const uint32_t edge = c->local >> 31; /* WS_NCAND_EDGE, as 0 or 1 */
-        const ws_wface *F = &g->face[c->feat & (edge - 1u)]; /* any face for an edge */
-        uint32_t i = c->node;
-        double d = F->n.x * x.x[i] + F->n.y * x.y[i] + F->n.z * x.z[i] - F->off;
-        sel[m] = (uint32_t)k;
-        seld[m] = d;
-        m += (size_t)((d < b->layer[c->body] + wl) | edge);
+    const ws_body_store *b = E->b;
+    normal_of(E->web, E->L, v3_make(xx, xy, xz), E->v, i, bi, v3_make(nx, ny, nz), d, hi,
+              E->st->r[bi], E->st->v[bi], b->wg[bi], &E->pp[b->material[bi]]);
+}
+
+/* ---- a node at a convex body's edge
+ *
+ * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
+ * them, and at most one of the three holds the node. On a convex body every face lies behind
+ * every other face's plane, so the two planes' distances dA, dB tell them apart at once: face A
+ * is turned down when the node's projection on its plane stands out of B's plane, and the
+ * reverse; the edge when the node is not a positive sum of the two normals (it lies over a
+ * face, or behind it) or lies beyond the window of either plane (in_wedge's distances along
+ * the normals are dA, dB to round-off). Only by a margin eps that the full tests (eq. 14's for
+ * a face, in_wedge) cannot disagree with: the feature left, if any, takes its full test, and
+ * the contacts are the same as one by one. A face found well inside its outline takes no test
+ * and is not turned down. */
+
+/* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
+ * the window's top hi: its faces' outlines stand out of the other faces' planes by its
+ * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few 1e-9
+ * of its radius; round-off and the flatness of its faces (1e-12) come at the size of the
+ * coordinates and distances. Both with room to spare: a node that close to a boundary takes
+ * the full test. (On the reference case the closest calls stand 2.4e-10 m out of the other
+ * plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) The body's part is
+ * kept in memo for the next node. */
+static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *sh, v3 xi, v3 r,
+                                double hi)
+{
+    if (memo->body != bi) {
+        memo->body = bi;
+        memo->eps = 1e-7 * sh->radius + 1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius +
+                                                  sh->inner + hi);
     }
-    /* Normal forces, in node order. */
-    for (size_t q = 0; q < m; q++) {
-        const ws_ncand *c = &cand[sel[q]];
-        uint32_t i = c->node, bi = c->body;
-        v3 xi = nodes_get(x, i), nrm;
-        double d;
+    return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
+}
+
+/* Whether c[0, 3) (all there) are a corner: two faces of a node on a flat convex shape, then
+ * the edge between them. */
+static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
+{
+    const uint32_t a = c[0].local, z = c[1].local;
+    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(c[2].local & WS_NCAND_EDGE) ||
+        !sh->convex || !sh->flat)
+        return 0;
+    const ws_edge *E = &sh->edges[c[2].local & ~WS_NCAND_FLAGS];
+    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
+    return (E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa);
+}
+
+/* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
+ * to their full tests, one bit each: a face within the window's top and not turned down, the
+ * edge unless turned down. */
+static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
+                                   v3 xi, v3 r, double hi, corner_memo *memo)
+{
+    const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
+    /* The planes' distances as the one-by-one pass takes them. */
+    const double dA = A->n.x * xi.x + A->n.y * xi.y + A->n.z * xi.z - A->off,
+                 dB = B->n.x * xi.x + B->n.y * xi.y + B->n.z * xi.z - B->off;
+    const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
+    const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
+    /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
+    const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
+    const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
+    const double dmax = dA > dB ? dA : dB;
+    const uint32_t e = (qA > -eps) & (qB > -eps) & (dmax < hi + eps);
+    return a | z << 1 | e << 2;
+}
+
+/* Index of the lowest set bit of m (m != 0). */
+static inline uint32_t lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(m);
+#else
+    uint32_t f = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
+/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
+ * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
+ * first, and only what they leave takes the tests. */
+static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
+{
+    const ws_body_store *b = E->b;
+    const ws_body_state *st = E->st;
+    const ws_node_geom *g = E->g;
+    const ws_nodes3 x = E->x;
+    const double wl = E->web->layer;
+    for (size_t k = 0; k < n;) {
+        const ws_ncand *c0 = &cand[k];
+        const uint32_t i = c0->node, bi = c0->body;
+        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
+         * their tests. */
+        size_t e = k + 1;
+        while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
+            e++;
+        const ws_shape *sh = b->shape[bi];
+        const v3 xi = nodes_get(x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
-        double hi = b->layer[bi] + wl;
-        if (c->local & WS_NCAND_EDGE) {
-            if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
-                continue;
-        } else {
-            const ws_wface *F = &g->face[c->feat];
-            d = seld[q]; /* below hi: listed */
-            const ws_shape *sh = b->shape[bi];
-            double lo = -hi - sh->inner;
-            if (!(d > lo))
-                continue;
-            /* A node found well inside the face's outline stays over the face while the
-             * candidates are valid: no need to find its triangle. */
-            if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
-                continue;
-            uint32_t f = c->local & ~WS_NCAND_FLAGS;
-            if (d < 0.0 &&
-                !(sh->convex ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                             : ws_shallowest_face(sh, f,
-                                                  m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                                  d)))
-                continue;
-            nrm = F->n; /* from the body to the node */
+        const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
+        uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
+        if (e - k == 3 && !E->web->runs_off && is_corner(sh, c0)) {
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
+            E->web->corners++;
         }
-        normal_of(web, L, x, v, i, bi, nrm, d, hi, st->r[bi], st->v[bi], b->wg[bi],
-                  &pp[b->material[bi]]);
+        k = e;
+        for (; left; left &= left - 1) {
+            const ws_ncand *c = c0 + lowest_bit(left);
+            v3 nrm;
+            double d;
+            if (c->local & WS_NCAND_EDGE) {
+                if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
+                    continue;
+            } else {
+                const ws_wface *F = &g->face[c->feat];
+                d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
+                if (!(d < hi) || !(d > lo))
+                    continue;
+                /* A node found well inside the face's outline stays over the face while the
+                 * candidates are valid: no need to find its triangle. */
+                if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
+                    continue;
+                uint32_t f = c->local & ~WS_NCAND_FLAGS;
+                if (d < 0.0 &&
+                    !(sh->convex
+                          ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
+                          : ws_shallowest_face(sh, f,
+                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
+                                               d)))
+                    continue;
+                nrm = F->n; /* from the body to the node */
+            }
+            node_push(E, i, bi, nrm.x, nrm.y, nrm.z, d, hi, xi.x, xi.y, xi.z);
+        }
     }
 }
 
 /* ---- runs: nodes side by side on one face */
 
-#define RUN_MIN 4     /* shorter stretches go one by one */
-#define RUN_CHUNK 128 /* nodes of a run whose depths are taken at once */
+#define RUN_MIN 4    /* shorter stretches go one by one */
+#define RUN_CHUNK 64 /* nodes of a run whose depths are taken at once: a bit each in a word */
+_Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit has 64");
 /* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
  * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
  * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
@@ -335,42 +455,65 @@ typedef struct run_face {
     double hi, lo;          /* the contact window of d */
 } run_face;
 
-/* Depth d of nodes [0, m) under the face's plane and whether it lies in the window; whether
- * one in the window lies below the plane (straight-line code, on vectors). */
+/* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
+ * rather than a shift by its own index, which takes more work on vectors. */
+#define RUN_BIT4(k) (uint64_t)1 << (k), (uint64_t)1 << ((k) + 1), (uint64_t)1 << ((k) + 2), \
+                    (uint64_t)1 << ((k) + 3)
+#define RUN_BIT16(k) RUN_BIT4(k), RUN_BIT4((k) + 4), RUN_BIT4((k) + 8), RUN_BIT4((k) + 12)
+static const uint64_t run_bit[RUN_CHUNK] = {RUN_BIT16(0), RUN_BIT16(16), RUN_BIT16(32),
+                                            RUN_BIT16(48)};
+
+/* Depth d of nodes [0, 4 nv) (4 nv <= RUN_CHUNK) under the face's plane: bit i of the answer
+ * says whether node i lies in the window, bit i of *below whether it lies below the plane.
+ * Whole vectors of four, so that no loop is left over; straight-line code. */
 WS_VECTOR_LOOP
-static int64_t run_depth(size_t m, run_face q, const double *restrict x, const double *restrict y,
-                         const double *restrict z, double *restrict d, int64_t *restrict in)
+static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *restrict x,
+                          const double *restrict y, const double *restrict z, double *restrict d,
+                          uint64_t *restrict below)
 {
-    int64_t deep = 0;
-    for (size_t i = 0; i < m; i++) {
-        double e = q.nx * x[i] + q.ny * y[i] + q.nz * z[i] - q.off;
-        int64_t w = (e < q.hi) & (e > q.lo);
+    const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
+    uint64_t in = 0, neg = 0;
+    for (size_t i = 0; i < 4 * nv; i++) {
+        double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
+        const uint64_t bit = run_bit[i];
         d[i] = e;
-        in[i] = w;
-        deep |= w & (e < 0.0);
+        in |= bit & (0 - (uint64_t)((e < hi) & (e > lo)));
+        neg |= bit & (0 - (uint64_t)(e < 0.0));
     }
-    return deep;
+    *below = neg;
+    return in;
 }
 
 /* A run's contacts in the window, from its nodes' gathered values (I_*): the contact of
  * normal_of, and for one that pushes the friction of act_apply, with the same arithmetic
  * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's
  * node has no other contact, so its force with every normal force in is its force with this
- * one. Gives per contact the node's new force, whether it pushes, and the body's share of the
- * load (force and moment about the CoG), which the caller lists in node order. Straight-line
- * code, so it runs on vectors. */
-enum { O_FX, O_FY, O_FZ, O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_PUSH, O_ARRAYS };
+ * one. Gives per contact the node's new force (O_*) and the body's share of the load (force
+ * and moment about the CoG), zero for a contact that does not push, straight into the list of
+ * loads. For nodes [0, 4 nv). Straight-line code, so it runs on vectors. */
+enum { O_FX, O_FY, O_FZ, O_ARRAYS };
 
 typedef struct run_const {
     double nx, ny, nz, rx, ry, rz, vx, vy, vz, wx, wy, wz; /* normal; body CoG, velocity, spin */
     double hi, k, c, mu, vlim, h, share;
 } run_const;
 
+/* What a run needs of its face and body, the same for every run on the face in a sub-step:
+ * filled by the first of them (gen: the sub-step, web->rface_gen). */
+typedef struct ws_run_face {
+    run_face q;
+    run_const rc;
+    uint64_t gen;
+} ws_run_face;
+
 /* The kernel's inputs, gathered: arrays RUN_STRIDE apart from `in` on, in this order. */
 enum { I_X, I_Y, I_Z, I_VX, I_VY, I_VZ, I_FX, I_FY, I_FZ, I_D, I_IM, I_M, I_ARRAYS };
 
 WS_VECTOR_LOOP
-static void run_kernel(size_t m, run_const q, const double *restrict in, double *restrict out)
+static void run_kernel(size_t nv, const run_const *restrict q, const double *restrict in,
+                       double *restrict out, double *restrict obx, double *restrict oby,
+                       double *restrict obz, double *restrict omx, double *restrict omy,
+                       double *restrict omz)
 {
     const double *px = in + I_X * RUN_STRIDE, *py = in + I_Y * RUN_STRIDE,
                  *pz = in + I_Z * RUN_STRIDE, *ux = in + I_VX * RUN_STRIDE,
@@ -379,136 +522,149 @@ static void run_kernel(size_t m, run_const q, const double *restrict in, double 
                  *gz = in + I_FZ * RUN_STRIDE, *dd = in + I_D * RUN_STRIDE,
                  *im = in + I_IM * RUN_STRIDE, *mass = in + I_M * RUN_STRIDE;
     double *ofx = out + O_FX * RUN_STRIDE, *ofy = out + O_FY * RUN_STRIDE,
-           *ofz = out + O_FZ * RUN_STRIDE, *obx = out + O_BX * RUN_STRIDE,
-           *oby = out + O_BY * RUN_STRIDE, *obz = out + O_BZ * RUN_STRIDE,
-           *omx = out + O_MX * RUN_STRIDE, *omy = out + O_MY * RUN_STRIDE,
-           *omz = out + O_MZ * RUN_STRIDE, *opush = out + O_PUSH * RUN_STRIDE;
-    const double nx = q.nx, ny = q.ny, nz = q.nz;
-    for (size_t t = 0; t < m; t++) {
+           *ofz = out + O_FZ * RUN_STRIDE;
+    /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
+    const double nx = q->nx, ny = q->ny, nz = q->nz, rx = q->rx, ry = q->ry, rz = q->rz,
+                 vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy, wz = q->wz,
+                 hi = q->hi, k = q->k, c = q->c, mu = q->mu, vlim = q->vlim, h = q->h,
+                 share = q->share;
+    for (size_t t = 0; t < 4 * nv; t++) { /* whole vectors: none left over */
         const double d = dd[t], s = -0.5 * d;
         /* normal_of */
-        double lx = (px[t] + nx * s) - q.rx, ly = (py[t] + ny * s) - q.ry,
-               lz = (pz[t] + nz * s) - q.rz;
-        double bx = q.vx + (q.wy * lz - q.wz * ly), by = q.vy + (q.wz * lx - q.wx * lz),
-               bz = q.vz + (q.wx * ly - q.wy * lx);
+        double lx = (px[t] + nx * s) - rx, ly = (py[t] + ny * s) - ry, lz = (pz[t] + nz * s) - rz;
+        double bx = vx + (wy * lz - wz * ly), by = vy + (wz * lx - wx * lz),
+               bz = vz + (wx * ly - wy * lx);
         double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
         double vn = vrx * nx + vry * ny + vrz * nz;
-        double fn = q.k * (q.hi - d) - q.c * vn;
+        double fn = k * (hi - d) - c * vn;
         double push = fn > 0.0, fp = fn * push;
         double kx = gx[t] + nx * fp, ky = gy[t] + ny * fp, kz = gz[t] + nz * fp;
         /* act_apply */
         double ax, ay, az;
         friction_of(nx, ny, nz, vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn), kx, ky, kz,
-                    im[t], mass[t], fn, q.mu, q.vlim, q.h, &ax, &ay, &az);
+                    im[t], mass[t], fn, mu, vlim, h, &ax, &ay, &az);
         ofx[t] = fn > 0.0 ? kx + ax : kx;
         ofy[t] = fn > 0.0 ? ky + ay : ky;
         ofz[t] = fn > 0.0 ? kz + az : kz;
         /* The body's share, zero for a contact that does not push: adding +0 leaves every
-         * sum as it was (sums that start at +0 never reach -0). */
-        double Bx = fn > 0.0 ? (ax + nx * fn) * -q.share : 0.0,
-               By = fn > 0.0 ? (ay + ny * fn) * -q.share : 0.0,
-               Bz = fn > 0.0 ? (az + nz * fn) * -q.share : 0.0;
+         * sum as it was (sums that start at +0 never reach -0), and so does the moment's
+         * zero, of either sign. */
+        double Bx = fn > 0.0 ? (ax + nx * fn) * -share : 0.0,
+               By = fn > 0.0 ? (ay + ny * fn) * -share : 0.0,
+               Bz = fn > 0.0 ? (az + nz * fn) * -share : 0.0;
         obx[t] = Bx;
         oby[t] = By;
         obz[t] = Bz;
         omx[t] = ly * Bz - lz * By;
         omy[t] = lz * Bx - lx * Bz;
         omz[t] = lx * By - ly * Bx;
-        opush[t] = push;
     }
 }
 
-/* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
- * The others are gathered and go through run_kernel: the arithmetic of contacts_general for a
- * node whose only candidate is a face it lies well inside of, without its look-ups (the face,
- * body and contact are the run's). Their loads go to the body in node order. A chunk with a
- * node below the face's plane (d < 0), where another face may lie shallower, goes to
- * contacts_general. */
-static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
-                         ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
-                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc)
+/* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
+ * from the face, its body and their materials by the first run on it. */
+static const ws_run_face *run_face_of(const ws_body_store *b, int cur, const ws_node_geom *g,
+                                      ws_web *web, const ws_ncand *c, const ws_node_params *pp,
+                                      double h, double share)
 {
+    ws_run_face *e = &web->rface[c->feat];
+    if (e->gen == web->rface_gen)
+        return e;
     const ws_body_state *st = &b->st[cur];
-    const ws_ncand *c = &cand[sg->c0];
     const uint32_t bi = c->body;
     const ws_wface *F = &g->face[c->feat];
     const ws_node_params *p = &pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
-    const run_face q = {n.x, n.y, n.z, F->off, hi, lo};
-    const run_const rc = {n.x,  n.y,  n.z,  r.x,  r.y, r.z,     vb.x, vb.y, vb.z, wb.x, wb.y,
-                          wb.z, hi,   p->k, p->c, p->mu, p->vlim, h,    share};
-    /* Scratch: the chunk's depths, in-window flags and node indices, then run_kernel's
-     * inputs I_* and outputs O_*. */
-    double *D = web->rtmp, *I = D + 3 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
-    int64_t *in = (int64_t *)(D + RUN_STRIDE);
-    uint32_t *idx = (uint32_t *)(D + 2 * RUN_STRIDE);
+    e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
+    e->rc = (run_const){n.x,  n.y,  n.z,  r.x,  r.y,   r.z,     vb.x, vb.y, vb.z, wb.x,
+                        wb.y, wb.z, hi,   p->k, p->c,  p->mu,   p->vlim, h,   share};
+    e->gen = web->rface_gen;
+    return e;
+}
+
+/* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
+ * The others are gathered and go through run_kernel: the arithmetic of contacts_general for a
+ * node whose only candidate is a face it lies well inside of, without its look-ups (the face,
+ * body and contact are the run's). Their loads go to the list in node order, those that do
+ * not push as zeros. A chunk with a node below the face's plane (d < 0), where another face
+ * may lie shallower, goes to contacts_general. */
+static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
+                         ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
+                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc)
+{
+    const ws_ncand *c = &cand[sg->c0];
+    const uint32_t bi = c->body;
+    const ws_run_face *rf = run_face_of(b, cur, g, web, c, pp, h, share);
+    /* Scratch: the chunk's depths and the gathered nodes' indices, then run_kernel's inputs
+     * I_* and outputs O_*. */
+    double *D = web->rtmp, *I = D + 2 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
+    uint32_t *idx = (uint32_t *)(D + RUN_STRIDE);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
-        int64_t deep = run_depth(m, q, x.x + o, x.y + o, x.z + o, D, in);
+        /* Depths on whole vectors, past the run (its row goes on), the bits of the nodes past
+         * it dropped; a chunk whose vectors would end past the last node goes one by one. */
+        const size_t nv = (m + 3) / 4;
+        uint64_t below = 0, in = 0;
+        int whole = o + 4 * nv <= web->n;
+        if (whole) {
+            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, D, &below);
+            in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
+        }
         web->run_nodes += m;
-        if (deep) { /* one by one */
-            web->run_deep += m;
-            contacts_general(b, cur, g, web, x, v, c + (o - sg->n0), m, pp, L);
+        if (!whole || (in & below)) { /* one by one */
+            web->run_deep += whole ? m : 0;
+            corner_memo memo = {UINT32_MAX, 0.0};
+            const node_env E = {b, &b->st[cur], g, web, x, v, pp, L, &memo};
+            contacts_general(&E, c + (o - sg->n0), m);
             continue;
         }
-        for (size_t e = 0; e < m; e++) { /* the ones in the window, without a branch */
-            idx[nin] = (uint32_t)e;
-            nin += (size_t)in[e];
+        /* The ones in the window, gathered: a pass of the loop per node in it, found by its
+         * bit. */
+        for (; in; in &= in - 1, nin++) {
+            const uint32_t e = lowest_bit(in), i = o + e;
+            idx[nin] = i;
+            I[I_X * RUN_STRIDE + nin] = x.x[i];
+            I[I_Y * RUN_STRIDE + nin] = x.y[i];
+            I[I_Z * RUN_STRIDE + nin] = x.z[i];
+            I[I_VX * RUN_STRIDE + nin] = v.x[i];
+            I[I_VY * RUN_STRIDE + nin] = v.y[i];
+            I[I_VZ * RUN_STRIDE + nin] = v.z[i];
+            I[I_FX * RUN_STRIDE + nin] = web->f.x[i];
+            I[I_FY * RUN_STRIDE + nin] = web->f.y[i];
+            I[I_FZ * RUN_STRIDE + nin] = web->f.z[i];
+            I[I_D * RUN_STRIDE + nin] = D[e];
+            I[I_IM * RUN_STRIDE + nin] = web->inv_m[i];
+            I[I_M * RUN_STRIDE + nin] = web->m[i];
         }
         if (nin == 0)
             continue;
-        /* Gathered, and padded to whole vectors with copies of the last (dropped after). */
-        size_t mv = (nin + 3) & ~(size_t)3;
-        idx[nin] = idx[nin + 1] = idx[nin + 2] = idx[nin - 1]; /* room: 2 RUN_STRIDE */
-        for (size_t t = 0; t < mv; t++) {
-            const size_t e = idx[t], i = o + e;
-            I[I_X * RUN_STRIDE + t] = x.x[i];
-            I[I_Y * RUN_STRIDE + t] = x.y[i];
-            I[I_Z * RUN_STRIDE + t] = x.z[i];
-            I[I_VX * RUN_STRIDE + t] = v.x[i];
-            I[I_VY * RUN_STRIDE + t] = v.y[i];
-            I[I_VZ * RUN_STRIDE + t] = v.z[i];
-            I[I_FX * RUN_STRIDE + t] = web->f.x[i];
-            I[I_FY * RUN_STRIDE + t] = web->f.y[i];
-            I[I_FZ * RUN_STRIDE + t] = web->f.z[i];
-            I[I_D * RUN_STRIDE + t] = D[e];
-            I[I_IM * RUN_STRIDE + t] = web->inv_m[i];
-            I[I_M * RUN_STRIDE + t] = web->m[i];
-        }
-        run_kernel(mv, rc, I, O);
-        /* In node order: the new forces, and for the contacts that push (the others add
-         * zeros) the node's share and the body's loads. */
+        /* On whole vectors: the lanes past nin hold what the scratch held (earlier nodes'
+         * values, or the zeros it started with), and their results are not read. The loads
+         * land at the end of the list, the padding's past it (room: ws_node_scratch). */
+        const size_t nl = L->nl;
+        const double *lbx = act_a(L, A_BX) + nl, *lby = act_a(L, A_BY) + nl,
+                     *lbz = act_a(L, A_BZ) + nl;
+        run_kernel((nin + 3) / 4, &rf->rc, I, O, act_a(L, A_BX) + nl, act_a(L, A_BY) + nl,
+                   act_a(L, A_BZ) + nl, act_a(L, A_MX) + nl, act_a(L, A_MY) + nl,
+                   act_a(L, A_MZ) + nl);
+        /* In node order: the new forces, and the node's share; the body's loads are listed.
+         * A contact that does not push has a share of zero, and is listed as touched and
+         * loaded all the same (a branch would be a coin toss). */
         const double *ofx = O + O_FX * RUN_STRIDE, *ofy = O + O_FY * RUN_STRIDE,
-                     *ofz = O + O_FZ * RUN_STRIDE, *obx = O + O_BX * RUN_STRIDE,
-                     *oby = O + O_BY * RUN_STRIDE, *obz = O + O_BZ * RUN_STRIDE,
-                     *omx = O + O_MX * RUN_STRIDE, *omy = O + O_MY * RUN_STRIDE,
-                     *omz = O + O_MZ * RUN_STRIDE, *opush = O + O_PUSH * RUN_STRIDE;
-        uint32_t *touched = web->fct[web->fck];
-        size_t nt = web->nfct[web->fck], nl = L->nl;
-        double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
-               *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
+                     *ofz = O + O_FZ * RUN_STRIDE;
+        uint32_t *touched = web->fct[web->fck] + web->nfct[web->fck], *lbody = L->lbody + nl;
         for (size_t t = 0; t < nin; t++) {
-            const uint32_t i = o + idx[t];
-            const size_t pushes = (size_t)(opush[t] != 0.0);
+            const uint32_t i = idx[t];
             web->f.x[i] = ofx[t];
             web->f.y[i] = ofy[t];
             web->f.z[i] = ofz[t];
-            v3 Fb = v3_make(obx[t], oby[t], obz[t]);
-            fc[i] = v3_sub(fc[i], Fb); /* the node's share: -Fb, to the bit */
-            touched[nt] = i;
-            nt += pushes;
-            lbx[nl] = Fb.x;
-            lby[nl] = Fb.y;
-            lbz[nl] = Fb.z;
-            lmx[nl] = omx[t];
-            lmy[nl] = omy[t];
-            lmz[nl] = omz[t];
-            L->lbody[nl] = bi;
-            nl += pushes;
+            fc[i] = v3_sub(fc[i], v3_make(lbx[t], lby[t], lbz[t])); /* the share: -Fb, to the bit */
+            touched[t] = i;
+            lbody[t] = bi;
         }
-        L->nl = nl;
-        web->nfct[web->fck] = nt;
+        L->nl = nl + nin;
+        web->nfct[web->fck] += nin;
     }
 }
 
@@ -519,13 +675,17 @@ typedef struct seg_cut {
     const ws_ncand *cand;
     ws_nseg *seg;
     size_t nseg, g0, r0, r1;
+    uint32_t faces; /* one past the highest face a run lies on */
 } seg_cut;
 
 static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    if (c0 < c1)
-        sc->seg[sc->nseg++] = (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1,
-                                        (uint32_t)c0, (uint32_t)c1, run};
+    if (c0 == c1)
+        return;
+    sc->seg[sc->nseg++] =
+        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
+    if (run && sc->cand[c0].feat >= sc->faces)
+        sc->faces = sc->cand[c0].feat + 1;
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -598,19 +758,36 @@ static uint32_t seg_block(const ws_web *web)
     return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
 }
 
+/* The stretches cut (sc) are list `list`'s: room for the faces their runs lie on. */
+static int seg_done(ws_mem *mem, ws_web *web, const seg_cut *sc, int list)
+{
+    web->nseg = sc->nseg;
+    const size_t had = web->rface_cap;
+    if (ws_array_reserve(mem, (void **)&web->rface, &web->rface_cap, sc->faces,
+                         sizeof *web->rface) != 0)
+        return -1;
+    for (size_t f = had; f < web->rface_cap; f++)
+        web->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
+    web->seg_list = list;
+    return 0;
+}
+
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list)
 {
     web->seg_list = -1;
     web->nseg = 0;
-    if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap,
-                         (3 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE, sizeof(double)) != 0 ||
-        ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
+    if (web->rtmp_cap == 0) {
+        /* Zeroed once: a run's kernel reads its padding lanes, whose results it drops. */
+        const size_t need = (2 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE;
+        if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
+            return -1;
+        memset(web->rtmp, 0, web->rtmp_cap * sizeof(double));
+    }
+    if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
         return -1;
-    seg_cut sc = {cand, web->seg, 0, 0, 0, 0};
+    seg_cut sc = {cand, web->seg, 0, 0, 0, 0, 0};
     seg_cut_range(&sc, web, seg_block(web), 0, n, UINT64_MAX);
-    web->nseg = sc.nseg;
-    web->seg_list = list;
-    return 0;
+    return seg_done(mem, web, &sc, list);
 }
 
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
@@ -626,7 +803,7 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
         0)
         return -1;
     const ws_nseg *old = web->seg;
-    seg_cut sc = {cand, web->seg + nold, 0, 0, 0, 0};
+    seg_cut sc = {cand, web->seg + nold, 0, 0, 0, 0, 0};
     size_t p = 0, k = 0; /* the next old stretch; where the next candidates lie in cand */
     for (size_t q = 0; q <= count;) {
         const uint64_t b0 = q < count ? (uint64_t)(nodes[q] / bl) * bl : UINT64_MAX,
@@ -639,6 +816,8 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
             sg.c0 = (uint32_t)k;
             k = sg.c1;
             sc.seg[sc.nseg++] = sg;
+            if (sg.run && cand[sg.c0].feat >= sc.faces)
+                sc.faces = cand[sg.c0].feat + 1;
         }
         if (q == count)
             break;
@@ -650,9 +829,7 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
             q++;
     }
     memmove(web->seg, sc.seg, sc.nseg * sizeof *web->seg);
-    web->nseg = sc.nseg;
-    web->seg_list = list;
-    return 0;
+    return seg_done(mem, web, &sc, list);
 }
 
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
@@ -661,15 +838,24 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
                       v3 *bmoment, uint64_t *checks)
 {
     act_list L = act_open(web);
+    corner_memo memo = {UINT32_MAX, 0.0};
+    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
     size_t k = *next;
-    for (; k < web->nseg && web->seg[k].n0 < n1; k++) {
-        const ws_nseg *sg = &web->seg[k];
-        *checks += sg->c1 - sg->c0;
+    if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
+        web->rface_gen++;
+    /* In locals: the stores of the passes would make the compiler load them again. */
+    const ws_nseg *seg = web->seg;
+    const size_t nseg = web->nseg;
+    uint64_t tried = 0;
+    for (; k < nseg && seg[k].n0 < n1; k++) {
+        const ws_nseg *sg = &seg[k];
+        tried += sg->c1 - sg->c0;
         if (sg->run)
             contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc);
         else
-            contacts_general(b, cur, g, web, x, v, cand + sg->c0, sg->c1 - sg->c0, pp, &L);
+            contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }
+    *checks += tried;
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
@@ -677,9 +863,10 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
-    /* One more than every candidate; an odd number of cache lines, so that the arrays' starts
-     * fall in different sets of the first-level cache. */
-    size_t need = (((ncand + 1 + 7) / 8) | 1) * 8;
+    /* Four more than every candidate (a run's loads are written in whole vectors of four); an
+     * odd number of cache lines, so that the arrays' starts fall in different sets of the
+     * first-level cache. */
+    size_t need = (((ncand + 4 + 7) / 8) | 1) * 8;
     if (need > web->act_cap) {
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
@@ -690,9 +877,6 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
             return -1;
         web->act_cap = need;
     }
-    if (ws_array_reserve(mem, (void **)&web->sel, &web->sel_cap, need, sizeof *web->sel) != 0 ||
-        ws_array_reserve(mem, (void **)&web->seld, &web->seld_cap, need, sizeof *web->seld) != 0)
-        return -1;
     return 0;
 }
 
@@ -700,13 +884,11 @@ void ws_node_scratch_free(ws_mem *mem, ws_web *web)
 {
     ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
     ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
-    ws_mem_free(mem, web->sel, web->sel_cap * sizeof *web->sel);
-    ws_mem_free(mem, web->seld, web->seld_cap * sizeof *web->seld);
     ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
+    ws_mem_free(mem, web->rface, web->rface_cap * sizeof *web->rface);
+    web->rface = NULL;
     web->act = NULL;
     web->act_id = NULL;
-    web->sel = NULL;
-    web->seld = NULL;
     web->rtmp = NULL;
-    web->act_cap = web->sel_cap = web->seld_cap = web->rtmp_cap = 0;
+    web->act_cap = web->rtmp_cap = web->rface_cap = 0;
 }

@@ -365,6 +365,19 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
                 out->convex = 0;
                 break;
             }
+    /* Faces merged within COPLANAR_TOL may bend a little; flat ones are planar to round-off.
+     * On a flat convex shape a face's outline lies behind every other face's plane as closely
+     * as eq. 14's test sees it, so node contacts may turn a face down by those planes. */
+    out->flat = 1;
+    for (uint32_t k = 0; k < nt; k++) {
+        uint32_t t = order[k];
+        const ws_face *fc = &out->faces[face_of[t]];
+        int on = v3_norm(v3_sub(tn[t], fc->normal)) <= 1e-12;
+        for (int c = 0; c < 3; c++)
+            on &= fabs(v3_dot(fc->normal, out->vertices[tri[3 * t + c]]) - fc->offset) <=
+                  1e-12 * diag;
+        out->flat &= on;
+    }
     ws_mem_free(mem, tn, nt * sizeof *tn);
     ws_mem_free(mem, nbr, 3 * nt * sizeof *nbr);
     st = WS_OK;

@@ -51,6 +51,7 @@ typedef struct ws_shape {
     m3 inertia_unit; /* about the centroid, density 1 */
     v3 centroid;     /* where the given vertices had their centroid */
     int convex;
+    int flat; /* every face's triangles lie in its plane to round-off (1e-12) */
     uint32_t users;  /* bodies using it */
 } ws_shape;
 

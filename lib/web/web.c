@@ -83,18 +83,8 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     memset(web, 0, sizeof *web);
 }
 
-/* A spring law in the form every stateless 1D law of the film's kind takes (lib/law/law.h):
- * F = kc eps + dk g(eps) + c eps_dot, g the C1 ramp of half-width w (qw = 1 / (4 w)). Linear
- * laws have dk = 0. Any other law (a table, relaxation, a user's) is `gen`, evaluated spring
- * by spring with the spring's own history, at time t, `since` after it was committed. */
-typedef struct spring_form {
-    double kc, dk, w, qw, c;
-    const ws_law *gen;
-    double t, since;
-} spring_form;
-
 /* The film form's force at (eps, eps_dot): computed, then selected, so it runs on vectors. */
-static inline double film_force(const spring_form *p, double eps, double epsd)
+static inline double film_force(const ws_spring_form *p, double eps, double epsd)
 {
     double a = eps + p->w;
     a = a > 0.0 ? a : 0.0;
@@ -103,9 +93,9 @@ static inline double film_force(const spring_form *p, double eps, double epsd)
     return p->kc * eps + p->dk * ramp + p->c * epsd;
 }
 
-static spring_form form_of(const ws_law *L, double t, double since)
+static ws_spring_form form_of(const ws_law *L, double t, double since)
 {
-    spring_form p = {0.0, 0.0, 1.0, 0.25, 0.0, NULL, t, since};
+    ws_spring_form p = {0.0, 0.0, 1.0, 0.25, 0.0, NULL, t, since};
     if (L && !ws_law_film_form(L, &p.kc, &p.dk, &p.w, &p.c))
         p.gen = L;
     else if (L)
@@ -176,7 +166,7 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
  * first and moves at u = (ux, uy, uz) relative to it, rest length 1 / il0. Computed
  * unconditionally and then selected, so the loops over springs have no branches. A spring whose
  * ends coincide has no direction to pull along and gets no force. */
-static inline double film_pull(const spring_form *p, double dx, double dy, double dz, double ux,
+static inline double film_pull(const ws_spring_form *p, double dx, double dy, double dz, double ux,
                                double uy, double uz, double il0)
 {
     double l2 = dx * dx + dy * dy + dz * dz;
@@ -195,7 +185,7 @@ WS_VECTOR_LOOP
 static void spring_run(const double *restrict x, const double *restrict y,
                        const double *restrict z, const double *restrict vx,
                        const double *restrict vy, const double *restrict vz, size_t m,
-                       const double *restrict inv_l0, spring_form p, double *restrict tx,
+                       const double *restrict inv_l0, ws_spring_form p, double *restrict tx,
                        double *restrict ty, double *restrict tz)
 {
     for (size_t i = 0; i < m; i++) {
@@ -216,7 +206,7 @@ WS_VECTOR_LOOP
 static void spring_run_apply(const double *restrict x, const double *restrict y,
                              const double *restrict z, const double *restrict vx,
                              const double *restrict vy, const double *restrict vz, size_t stride,
-                             size_t m, const double *restrict inv_l0, spring_form p,
+                             size_t m, const double *restrict inv_l0, ws_spring_form p,
                              double *restrict fax, double *restrict fay, double *restrict faz,
                              double *restrict fbx, double *restrict fby, double *restrict fbz)
 {
@@ -238,7 +228,7 @@ static void spring_run_apply(const double *restrict x, const double *restrict y,
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
  * spring of a general law, which is evaluated with the spring's history as committed, at
  * (t, since). A law that fails (a user callback) marks the web; the step reports it. */
-static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, spring_form p)
+static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p)
 {
     v3 d;
     double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
@@ -303,7 +293,7 @@ static void row_forces(size_t k, v3 g, double c, const double *restrict m,
  * pass. A node at the start of a chunk after the first has had the previous chunk's spring
  * already and gets its right-hand one after it. */
 static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m,
-                       size_t s0, spring_form p)
+                       size_t s0, ws_spring_form p)
 {
     const double *il0 = web->inv_l0 + s0;
     const ws_nodes3 f = web->f;
@@ -324,7 +314,7 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
 }
 
 /* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
-static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, spring_form p)
+static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, ws_spring_form p)
 {
     const size_t nx = (size_t)web->nx;
     if (p.gen) {
@@ -340,10 +330,10 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
 
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
  * by row, cols a row: node nx r + i to the next, and the wrap of a closed band last). */
-static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const spring_form *P)
+static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const ws_spring_form *P)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    const spring_form p = P[WS_SPRING_AROUND];
+    const ws_spring_form p = P[WS_SPRING_AROUND];
     if (!web->law[WS_SPRING_AROUND] || nx < 2) {
         base_forces(web, v, g, nx * r, nx * (r + 1));
         return;
@@ -367,10 +357,11 @@ uint32_t ws_web_block_count(const ws_web *web)
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, double since,
                          uint32_t k, uint32_t *n0, uint32_t *n1)
 {
-    /* The laws' parameters by spring kind, hoisted out of the loops. */
-    spring_form P[3];
-    for (int q = 0; q < 3; q++)
-        P[q] = form_of(web->law[q], t, since);
+    /* The laws' parameters by spring kind, taken once a sweep and hoisted out of the loops. */
+    const ws_spring_form *P = web->form;
+    if (k == 0)
+        for (int q = 0; q < 3; q++)
+            web->form[q] = form_of(web->law[q], t, since);
     if (web->nx == 0) {
         base_forces(web, v, g, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
@@ -399,16 +390,20 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. */
+ * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. Returns how
+ * many nodes end faster than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count,
+ * so the loop keeps its vectors, and taken from the new velocity while it is at hand. */
 WS_VECTOR_LOOP
-static void advance(size_t m, double h, const double *restrict im, const double *restrict fx,
-                    const double *restrict fy, const double *restrict fz,
-                    const double *restrict vx0, const double *restrict vy0,
-                    const double *restrict vz0, const double *restrict x0,
-                    const double *restrict y0, const double *restrict z0, double *restrict vx1,
-                    double *restrict vy1, double *restrict vz1, double *restrict x1,
-                    double *restrict y1, double *restrict z1)
+static size_t advance(size_t m, double h, double lim2, const double *restrict im,
+                      const double *restrict fx, const double *restrict fy,
+                      const double *restrict fz, const double *restrict vx0,
+                      const double *restrict vy0, const double *restrict vz0,
+                      const double *restrict x0, const double *restrict y0,
+                      const double *restrict z0, double *restrict vx1, double *restrict vy1,
+                      double *restrict vz1, double *restrict x1, double *restrict y1,
+                      double *restrict z1)
 {
+    size_t bad = 0;
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
         double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
@@ -420,19 +415,8 @@ static void advance(size_t m, double h, const double *restrict im, const double 
         x1[i] = x0[i] + h * ux;
         y1[i] = y0[i] + h * uy;
         z1[i] = z0[i] + h * uz;
+        bad += !(ux * ux + uy * uy + uz * uz <= lim2);
     }
-}
-
-/* How many of m nodes are faster than sqrt(lim2) or have a NaN speed (!(s <= lim2) counts
- * it): a count, so the loop runs on vectors -- in the AVX2 build only; the baseline x86-64 one
- * lacks the select it takes. Kept out of advance, which would lose its vectors there with it. */
-WS_VECTOR_LOOP
-static size_t too_fast(size_t m, const double *restrict vx, const double *restrict vy,
-                       const double *restrict vz, double lim2)
-{
-    size_t bad = 0;
-    for (size_t i = 0; i < m; i++)
-        bad += !(vx[i] * vx[i] + vy[i] * vy[i] + vz[i] * vz[i] <= lim2);
     return bad;
 }
 
@@ -440,11 +424,9 @@ size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
     const ws_nodes3 f = web->f;
-    size_t m = n1 - n0;
-    advance(m, h, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0, vs.x + n0, vs.y + n0,
-            vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
-            xd.x + n0, xd.y + n0, xd.z + n0);
-    return too_fast(m, vd.x + n0, vd.y + n0, vd.z + n0, vmax * vmax);
+    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0,
+                   vs.x + n0, vs.y + n0, vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0,
+                   vd.y + n0, vd.z + n0, xd.x + n0, xd.y + n0, xd.z + n0);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)

@@ -75,6 +75,16 @@ typedef struct ws_track {
     double lo, hi, gap, lever;
 } ws_track;
 
+/* A spring law in the form every stateless 1D law of the film's kind takes (lib/law/law.h):
+ * F = kc eps + dk g(eps) + c eps_dot, g the C1 ramp of half-width w (qw = 1 / (4 w)). Linear
+ * laws have dk = 0. Any other law (a table, relaxation, a user's) is `gen`, evaluated spring
+ * by spring with the spring's own history, at time t, `since` after it was committed. */
+typedef struct ws_spring_form {
+    double kc, dk, w, qw, c;
+    const ws_law *gen;
+    double t, since;
+} ws_spring_form;
+
 typedef struct ws_web {
     char *name;
     uint32_t n, ns;          /* nodes, springs */
@@ -84,6 +94,7 @@ typedef struct ws_web {
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
+    ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
                                 zeroed at the start of a step that writes fc[k] */
@@ -109,17 +120,19 @@ typedef struct ws_web {
     double *act;        /* the pushing contacts of a sweep block (scratch, sized with the */
     uint32_t *act_id;   /* candidates; contact/node_force.c) */
     size_t act_cap;
-    uint32_t *sel; /* candidates within their window, scratch sized with them */
-    double *seld;  /* and their distances to the face's plane */
-    size_t sel_cap, seld_cap;
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
-    int runs_off;  /* cut no runs: every candidate one by one (tests compare the two) */
+    int runs_off;  /* no short cuts: no runs and no corners, every candidate one by one
+                      through its full tests (tests compare the two) */
     uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
                                      by one because a node lay below the face (diagnostics) */
+    uint64_t corners;             /* corners told apart by their planes (diagnostics) */
     double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
     size_t rtmp_cap;
+    struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
+    size_t rface_cap;          /* body, filled in sub-step rface_gen (scratch, node_force.c) */
+    uint64_t rface_gen;
     int list;      /* the committed list */
     int next_list; /* the list this step used, committed with it */
     /* Force and moment on each body in the last step (global, moment about the CoG). */
@@ -158,7 +171,7 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * in cache: block k's forces from the springs, node drag and gravity are complete in f once
  * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
  * their contact forces and be integrated. A grid web's blocks are its rows; a mesh web is one
- * block. */
+ * block. Every sweep starts at block 0, which takes the laws at (t, since) for all of it. */
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
