@@ -65,6 +65,21 @@ enum {
 #define WS_ID_GEN_BITS 20
 #define WS_ID_MAX_SLOTS ((1u << WS_ID_SLOT_BITS) - 2u)
 
+/* Index of the lowest set bit of m (m != 0). */
+static inline uint32_t ws_lowest_bit(uint64_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctzll(m);
+#else
+    uint32_t f = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        f++;
+    }
+    return f;
+#endif
+}
+
 static inline uint64_t ws_id_pack(uint16_t tag, unsigned kind, uint32_t gen, uint32_t slot)
 {
     return ((uint64_t)tag << 48) | ((uint64_t)(kind & 0xFu) << 44) |

@@ -11,21 +11,6 @@ static int inside_box(v3 p, v3 lo, v3 hi, double e)
            p.z > lo.z - e && p.z < hi.z + e;
 }
 
-/* Index of the lowest set bit of m (m != 0). */
-static inline uint32_t lowest_bit(uint64_t m)
-{
-#if defined(__GNUC__)
-    return (uint32_t)__builtin_ctzll(m);
-#else
-    uint32_t f = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        f++;
-    }
-    return f;
-#endif
-}
-
 /* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
@@ -258,7 +243,7 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
             /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
             for (uint64_t b = word[w]; b; b &= b - 1)
-                moved[count++] = (uint32_t)(i + 8 * w + lowest_bit(b) / 8);
+                moved[count++] = (uint32_t)(i + 8 * w + ws_lowest_bit(b) / 8);
 #else
             if (!word[w])
                 continue;
@@ -651,7 +636,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
         out[j] = 0;
     }
     for (; any; any &= any - 1) {
-        const uint32_t f = lowest_bit(any);
+        const uint32_t f = ws_lowest_bit(any);
         const ws_face *F = &sh->faces[f];
         const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z;
         const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
@@ -697,7 +682,7 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
      * distance never exceeds the distance within the face's plane). Nodes and bodies move less
      * than half the margin relative to each other until the candidates are found again. */
     for (uint64_t pass = mk[M_PASS * FIND_CHUNK]; pass; pass &= pass - 1) {
-        uint32_t f = lowest_bit(pass);
+        uint32_t f = ws_lowest_bit(pass);
         ws_ncand nc = {i, k, g->face_base[k] + f,
                        f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
         if (push_cand(mem, out, n, cap, nc) != 0)

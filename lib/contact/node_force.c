@@ -365,21 +365,6 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     return a | z << 1 | e << 2;
 }
 
-/* Index of the lowest set bit of m (m != 0). */
-static inline uint32_t lowest_bit(uint64_t m)
-{
-#if defined(__GNUC__)
-    return (uint32_t)__builtin_ctzll(m);
-#else
-    uint32_t f = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        f++;
-    }
-    return f;
-#endif
-}
-
 /* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
  * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
  * first, and only what they leave takes the tests. */
@@ -409,7 +394,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         }
         k = e;
         for (; left; left &= left - 1) {
-            const ws_ncand *c = c0 + lowest_bit(left);
+            const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
             if (c->local & WS_NCAND_EDGE) {
@@ -622,7 +607,7 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
         /* The ones in the window, gathered: a pass of the loop per node in it, found by its
          * bit. */
         for (; in; in &= in - 1, nin++) {
-            const uint32_t e = lowest_bit(in), i = o + e;
+            const uint32_t e = ws_lowest_bit(in), i = o + e;
             idx[nin] = i;
             I[I_X * RUN_STRIDE + nin] = x.x[i];
             I[I_Y * RUN_STRIDE + nin] = x.y[i];
