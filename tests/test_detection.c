@@ -733,6 +733,49 @@ START_TEST(film_runs_equal_one_by_one)
 }
 END_TEST
 
+/* The corner short cut of the node contacts (a node at a box's edge told apart by the two
+ * faces' planes) holds on convex shapes whose faces are flat; a face merged from triangles that
+ * bend within the merging tolerance is not, and its corners take the full tests. */
+START_TEST(corners_need_flat_faces)
+{
+    ws_world *w = NULL;
+    ws_world_def wd;
+    ws_world_def_init(&wd);
+    ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+    static const uint32_t tri[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                     2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+    double v[24] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+    ws_shape_id box, mesh, bent;
+    ck_ok(w, ws_shape_create_box(w, 0.5, 0.5, 0.5, &box));
+    ws_mesh_def md;
+    ws_mesh_def_init(&md);
+    md.vertices = v;
+    md.vertex_count = 8;
+    md.triangles = tri;
+    md.triangle_count = 12;
+    ck_ok(w, ws_shape_create_mesh(w, &md, &mesh));
+    /* Vertex 5 lies on the +z, -y and +x faces; lowered along z it leaves only +z's plane, by
+     * 1e-8 m (lowered, the top folds outward along its diagonal 4-7 and stays convex): its two
+     * triangles' normals then differ by 1e-8 rad, well within the merging tolerance (1 - cos =
+     * 5e-17 against 1e-9), and the vertex lies 1e-8 off the plane, far past round-off (1e-12
+     * of the size). */
+    v[3 * 5 + 2] -= 1e-8;
+    ck_ok(w, ws_shape_create_mesh(w, &md, &bent));
+    const ws_shape_id ids[3] = {box, mesh, bent};
+    const int flat[3] = {1, 1, 0};
+    for (int k = 0; k < 3; k++) {
+        uint32_t slot;
+        ck_assert_int_eq(ws_lookup_shape(w, ids[k], &slot), WS_OK);
+        const ws_shape *sh = w->shapes[slot];
+        ck_assert_uint_eq(sh->face_count, 6); /* the bent top is still one face */
+        ck_assert_int_eq(sh->convex, 1);
+        ck_assert_msg(sh->flat == flat[k], "shape %d: flat %d, expected %d", k, sh->flat,
+                      flat[k]);
+    }
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(film_detection_does_not_change_the_motion)
 {
     film_detection_case(0);
@@ -757,6 +800,7 @@ int main(void)
     tcase_add_test(tc, film_detection_does_not_change_the_motion);
     tcase_add_test(tc, film_runs_equal_one_by_one);
     tcase_add_test(tc, film_node_past_an_edge_end);
+    tcase_add_test(tc, corners_need_flat_faces);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }
