@@ -548,17 +548,18 @@ static void run_kernel(size_t nv, const run_const *restrict q, const double *res
 
 /* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
  * from the face, its body and their materials by the first run on it. */
-static const ws_run_face *run_face_of(const ws_body_store *b, int cur, const ws_node_geom *g,
-                                      ws_web *web, const ws_ncand *c, const ws_node_params *pp,
-                                      double h, double share)
+static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c, double h,
+                                      double share)
 {
+    ws_web *web = E->web;
     ws_run_face *e = &web->rface[c->feat];
     if (e->gen == web->rface_gen)
         return e;
-    const ws_body_state *st = &b->st[cur];
+    const ws_body_store *b = E->b;
+    const ws_body_state *st = E->st;
     const uint32_t bi = c->body;
-    const ws_wface *F = &g->face[c->feat];
-    const ws_node_params *p = &pp[b->material[bi]];
+    const ws_wface *F = &E->g->face[c->feat];
+    const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
@@ -574,13 +575,15 @@ static const ws_run_face *run_face_of(const ws_body_store *b, int cur, const ws_
  * body and contact are the run's). Their loads go to the list in node order, those that do
  * not push as zeros. A chunk with a node below the face's plane (d < 0), where another face
  * may lie shallower, goes to contacts_general. */
-static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web,
-                         ws_nodes3 x, ws_nodes3 v, const ws_ncand *cand, const ws_nseg *sg,
-                         const ws_node_params *pp, act_list *L, double h, double share, v3 *fc)
+static void contacts_run(const node_env *E, const ws_ncand *cand, const ws_nseg *sg, double h,
+                         double share, v3 *fc)
 {
+    ws_web *web = E->web;
+    const ws_nodes3 x = E->x, v = E->v;
+    act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
     const uint32_t bi = c->body;
-    const ws_run_face *rf = run_face_of(b, cur, g, web, c, pp, h, share);
+    const ws_run_face *rf = run_face_of(E, c, h, share);
     /* Scratch: the chunk's depths and the gathered nodes' indices, then run_kernel's inputs
      * I_* and outputs O_*. */
     double *D = web->rtmp, *I = D + 2 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
@@ -599,9 +602,7 @@ static void contacts_run(const ws_body_store *b, int cur, const ws_node_geom *g,
         web->run_nodes += m;
         if (!whole || (in & below)) { /* one by one */
             web->run_deep += whole ? m : 0;
-            corner_memo memo = {UINT32_MAX, 0.0};
-            const node_env E = {b, &b->st[cur], g, web, x, v, pp, L, &memo};
-            contacts_general(&E, c + (o - sg->n0), m);
+            contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
         /* The ones in the window, gathered: a pass of the loop per node in it, found by its
@@ -836,7 +837,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         const ws_nseg *sg = &seg[k];
         tried += sg->c1 - sg->c0;
         if (sg->run)
-            contacts_run(b, cur, g, web, x, v, cand, sg, pp, &L, h, share, fc);
+            contacts_run(&E, cand, sg, h, share, fc);
         else
             contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }
