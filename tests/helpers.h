@@ -81,6 +81,29 @@ static inline ws_world *new_world(double dt)
     return w;
 }
 
+/* A shape from a triangle mesh (v: nv points, t: nt triangles). */
+static inline ws_status create_mesh(ws_world *w, const double *v, size_t nv, const uint32_t *t,
+                                    size_t nt, ws_shape_id *out)
+{
+    ws_mesh_def d;
+    ws_mesh_def_init(&d);
+    d.vertices = v;
+    d.vertex_count = nv;
+    d.triangles = t;
+    d.triangle_count = nt;
+    return ws_shape_create_mesh(w, &d, out);
+}
+
+/* The unit cube [0,1]^3, wound counter-clockwise seen from outside. */
+static const double cube_v[24] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,
+                                  0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+static const uint32_t cube_t[36] = {0, 2, 3, 0, 3, 1, /* -z */
+                                    4, 5, 7, 4, 7, 6, /* +z */
+                                    0, 1, 5, 0, 5, 4, /* -y */
+                                    2, 6, 7, 2, 7, 3, /* +y */
+                                    0, 4, 6, 0, 6, 2, /* -x */
+                                    1, 3, 7, 1, 7, 5 /* +x */};
+
 /* A static (kinematic) box whose top face is the plane z = 0, large in x and y. */
 static inline ws_body_id add_ground(ws_world *w, double half, ws_material_id mat)
 {

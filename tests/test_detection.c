@@ -738,29 +738,19 @@ END_TEST
  * bend within the merging tolerance is not, and its corners take the full tests. */
 START_TEST(corners_need_flat_faces)
 {
-    ws_world *w = NULL;
-    ws_world_def wd;
-    ws_world_def_init(&wd);
-    ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
-    static const uint32_t tri[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
-                                     2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
-    double v[24] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+    ws_world *w = new_world(2.5e-4);
+    double v[24];
+    memcpy(v, cube_v, sizeof v);
     ws_shape_id box, mesh, bent;
     ck_ok(w, ws_shape_create_box(w, 0.5, 0.5, 0.5, &box));
-    ws_mesh_def md;
-    ws_mesh_def_init(&md);
-    md.vertices = v;
-    md.vertex_count = 8;
-    md.triangles = tri;
-    md.triangle_count = 12;
-    ck_ok(w, ws_shape_create_mesh(w, &md, &mesh));
+    ck_ok(w, create_mesh(w, v, 8, cube_t, 12, &mesh));
     /* Vertex 5 lies on the +z, -y and +x faces; lowered along z it leaves only +z's plane, by
      * 1e-8 m (lowered, the top folds outward along its diagonal 4-7 and stays convex): its two
      * triangles' normals then differ by 1e-8 rad, well within the merging tolerance (1 - cos =
      * 5e-17 against 1e-9), and the vertex lies 1e-8 off the plane, far past round-off (1e-12
      * of the size). */
     v[3 * 5 + 2] -= 1e-8;
-    ck_ok(w, ws_shape_create_mesh(w, &md, &bent));
+    ck_ok(w, create_mesh(w, v, 8, cube_t, 12, &bent));
     const ws_shape_id ids[3] = {box, mesh, bent};
     const int flat[3] = {1, 1, 0};
     for (int k = 0; k < 3; k++) {

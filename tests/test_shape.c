@@ -26,28 +26,6 @@ static ws_shape_info info_of(ws_world *w, ws_shape_id s)
     return i;
 }
 
-static ws_status mesh(ws_world *w, const double *v, size_t nv, const uint32_t *t, size_t nt,
-                      ws_shape_id *out)
-{
-    ws_mesh_def d;
-    ws_mesh_def_init(&d);
-    d.vertices = v;
-    d.vertex_count = nv;
-    d.triangles = t;
-    d.triangle_count = nt;
-    return ws_shape_create_mesh(w, &d, out);
-}
-
-/* The unit cube [0,1]^3, wound counter-clockwise seen from outside. */
-static const double cube_v[24] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,
-                                  0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
-static const uint32_t cube_t[36] = {0, 2, 3, 0, 3, 1, /* -z */
-                                    4, 5, 7, 4, 7, 6, /* +z */
-                                    0, 1, 5, 0, 5, 4, /* -y */
-                                    2, 6, 7, 2, 7, 3, /* +y */
-                                    0, 4, 6, 0, 6, 2, /* -x */
-                                    1, 3, 7, 1, 7, 5 /* +x */};
-
 /* Inertia of a solid box (density 1) about its centre, diagonal. */
 static void box_inertia(double lx, double ly, double lz, double out[3])
 {
@@ -118,7 +96,7 @@ START_TEST(test_mesh_recentred)
         v[3 * k + 2] = c[2] + (cube_v[3 * k + 2] - 0.5) * lz;
     }
     ws_shape_id s;
-    ck_ok(w, mesh(w, v, 8, cube_t, 12, &s));
+    ck_ok(w, create_mesh(w, v, 8, cube_t, 12, &s));
     ws_shape_info i = info_of(w, s);
     /* Coordinates of size ~3: the centroid to a few ulp of 3, 1e-12 generous. */
     ck_assert_double_eq_tol(i.centroid.x, c[0], 1e-12);
@@ -173,7 +151,7 @@ START_TEST(test_tetrahedron)
     const double v[12] = {0, 0, 0, a, 0, 0, 0, a, 0, 0, 0, a};
     static const uint32_t t[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
     ws_shape_id s;
-    ck_ok(w, mesh(w, v, 4, t, 4, &s));
+    ck_ok(w, create_mesh(w, v, 4, t, 4, &s));
     ws_shape_info i = info_of(w, s);
     ck_rel(i.volume, a * a * a / 6.0, RT);
     ck_rel(i.centroid.x, a / 4, RT);
@@ -242,7 +220,7 @@ static void expect_rejected(ws_world *w, const double *v, size_t nv, const uint3
     ws_world_stats before, after;
     ck_ok(w, ws_world_get_stats(w, &before));
     ws_shape_id s = {12345};
-    ws_status st = mesh(w, v, nv, t, nt, &s);
+    ws_status st = create_mesh(w, v, nv, t, nt, &s);
     ck_assert_msg(st == want, "expected %s ('%s'), got %s (%s)", ws_status_string(want), word,
                   ws_status_string(st), ws_world_last_error(w));
     ck_err_has(w, word);
@@ -258,7 +236,7 @@ START_TEST(test_rejected_meshes)
     uint32_t t[48];
     double v[30];
     ws_shape_id ok;
-    ck_ok(w, mesh(w, cube_v, 8, cube_t, 12, &ok)); /* the base mesh itself is fine */
+    ck_ok(w, create_mesh(w, cube_v, 8, cube_t, 12, &ok)); /* the base mesh itself is fine */
 
     /* Open: the last triangle removed. */
     expect_rejected(w, cube_v, 8, cube_t, 11, WS_ERR_BAD_MESH, "closed");
@@ -295,7 +273,7 @@ START_TEST(test_rejected_meshes)
     /* ... and without the sliver (0,1,5 split instead) the same vertices make a good mesh. */
     t[36 + 3] = 0, t[36 + 4] = 8, t[36 + 5] = 5; /* (0,8,5) */
     t[12] = 8, t[13] = 1, t[14] = 5;             /* (0,1,5) -> (8,1,5) */
-    ck_ok(w, mesh(w, v, 9, t, 14, &ok));
+    ck_ok(w, create_mesh(w, v, 9, t, 14, &ok));
 
     /* Index out of range. */
     memcpy(t, cube_t, sizeof cube_t);
@@ -348,7 +326,7 @@ START_TEST(test_l_prism_nonconvex)
     }
     ck_assert_int_eq(p - t, 60);
     ws_shape_id s;
-    ck_ok(w, mesh(w, v, 12, t, 20, &s));
+    ck_ok(w, create_mesh(w, v, 12, t, 20, &s));
     ws_shape_info i = info_of(w, s);
     ck_assert_int_eq(i.convex, 0);
     ck_assert_uint_eq(i.face_count, 8); /* two caps, six sides */
