@@ -228,7 +228,8 @@ START_TEST(schedule_keeps_nearly_parallel_edges)
     ws_body_get_velocity(a, ia, &v);
     double out = sqrt(0.5) * (v.x + v.z); /* along n: what the edges' contact gave */
     report("nearly parallel edges: the cube leaves the block at %.3f m/s along their normal; "
-           "every 50th step and every step agree to %.1e m", out, max_dev);
+           "every 50th step and every step agree to %.1e m",
+           out, max_dev);
     ck_assert_msg(out > 0.05, "the edges never touched (%.4f m/s): the case tests nothing", out);
     ck_assert_msg(max_dev < 1e-9, "trajectories differ by %.3e m", max_dev);
     ws_world_destroy(a);
@@ -284,7 +285,8 @@ START_TEST(crossed_edges_hold_below_the_margin)
         ws_body_get_position(w, cube, &p);
         double d = p.z - 0.05 / sqrt(0.5) - top;
         report("crossed edges, detection every %d step(s): the keel rests %.4f mm from the ridge "
-               "(theory %.4f mm)", interval, 1e3 * d, 1e3 * want);
+               "(theory %.4f mm)",
+               interval, 1e3 * d, 1e3 * want);
         ck_assert_msg(fabs(d - want) < 1e-5, "keel at %.6f m from the ridge, theory %.6f m", d,
                       want);
         ws_world_destroy(w);
@@ -632,11 +634,71 @@ START_TEST(film_node_past_an_edge_end)
         pushed = fmax(pushed, xa[0] - x0);
     }
     report("film node past an edge's end: pushed out %.1f um by the edge; found every step and "
-           "as scheduled agree to %.1e m", 1e6 * pushed, max_dev);
+           "as scheduled agree to %.1e m",
+           1e6 * pushed, max_dev);
     ck_assert_msg(pushed > 1e-6, "the edge never pushed the node: the case tests nothing");
     ck_assert_msg(max_dev < 1e-12, "the scheduled node differs by %.3e m", max_dev);
     ws_world_destroy(a);
     ws_world_destroy(b);
+}
+END_TEST
+
+/* A node over a box's top face, near its edge with a side face, but with its projection on
+ * the top a margin or more behind the side's plane (well inside the top), can be held by the top
+ * alone until it is found again: the edge is no candidate of it, and it may join a run. A node
+ * whose projection lies nearer the side's plane than the margin keeps the edge. Both are
+ * within reach (layers + margin, 4 mm) of the edge. */
+START_TEST(edges_of_faces_a_node_is_well_inside_of_are_dropped)
+{
+    ws_web_id web;
+    ws_body_id box;
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.gravity = (ws_vec3){0, 0, 0};
+    d.dt = 2.5e-4;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    rising_box(w, (ws_vec3){0.1, 0.1, 0.1}, (ws_vec3){0, 0, 0}, 0.0, 0.0, "box", &box);
+    ws_web_def wd;
+    soft_film(w, &wd);
+    /* 1 mm over the top (z = 0.05 m), 3 mm and 1.5 mm in from the +x side (x = 0.05 m), whose
+     * plane the margin (2 mm) separates: 3.2 mm and 1.8 mm from the edge. The third node is
+     * pinned far off. */
+    const double top = 0.05 + 1e-3;
+    const double pos[9] = {0.05 - 3e-3, 0.0, top, 0.05 - 1.5e-3, 0.0, top, 0.3, 0.3, top};
+    const uint32_t spring[4] = {0, 2, 1, 2}, pin[1] = {2};
+    ws_web_mesh_def mesh;
+    ws_web_mesh_def_init(&mesh);
+    mesh.positions = pos;
+    mesh.node_count = 3;
+    mesh.springs = spring;
+    mesh.spring_count = 2;
+    mesh.pinned = pin;
+    mesh.pinned_count = 1;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, &web));
+    ck_ok(w, ws_world_step(w));
+    const ws_web *wb = only_web(w);
+    const ws_ncand *c = wb->cand[wb->next_list];
+    int faces[2] = {0, 0}, edges[2] = {0, 0}, inside[2] = {0, 0};
+    for (size_t k = 0; k < wb->ncand[wb->next_list]; k++) {
+        ck_assert_uint_lt(c[k].node, 2);
+        if (c[k].local & WS_NCAND_EDGE) {
+            edges[c[k].node]++;
+        } else {
+            faces[c[k].node]++;
+            inside[c[k].node] += (c[k].local & WS_NCAND_INSIDE) != 0;
+        }
+    }
+    report("node well inside the top: %d face(s), %d inside, %d edge(s); node near the side's "
+           "plane: %d face(s), %d inside, %d edge(s)",
+           faces[0], inside[0], edges[0], faces[1], inside[1], edges[1]);
+    ck_assert_msg(faces[0] == 1 && inside[0] == 1 && edges[0] == 0,
+                  "the node well inside the top has %d faces (%d inside) and %d edges", faces[0],
+                  inside[0], edges[0]);
+    ck_assert_msg(faces[1] == 1 && inside[1] == 0 && edges[1] == 1,
+                  "the node near the side's plane has %d faces (%d inside) and %d edges", faces[1],
+                  inside[1], edges[1]);
+    ws_world_destroy(w);
 }
 END_TEST
 
@@ -685,13 +747,16 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep, ui
             }
         /* Round-off of two sums of the same terms in different orders. */
         double off = fabs(sum[0]) + fabs(sum[1]) + fabs(sum[2]);
-        ck_assert_msg(off <= 1e-12 * size + 1e-300, "contact forces sum to %.3e N off the loads "
-                      "on the bodies (of %.3e N)", off, size);
+        ck_assert_msg(off <= 1e-12 * size + 1e-300,
+                      "contact forces sum to %.3e N off the loads "
+                      "on the bodies (of %.3e N)",
+                      off, size);
         worst = fmax(worst, size > 0.0 ? off / size : 0.0);
     }
     free(fa);
     report("film runs (scene %d): node contact forces add up to the loads on the bodies to "
-           "%.1e of their size", kind, worst);
+           "%.1e of their size",
+           kind, worst);
     uint64_t ha, hb;
     ck_ok(a, ws_world_get_state_hash(a, &ha));
     ck_ok(b, ws_world_get_state_hash(b, &hb));
@@ -707,8 +772,8 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep, ui
         max_dev = fmax(max_dev, fabs(xa[i] - xb[i]));
     report("film runs (scene %d): %llu node evaluations in runs (%llu in runs gone one by one), "
            "nodes differ by %.1e m, state hashes %016llx %016llx",
-           kind, (unsigned long long)web_b->run_nodes, (unsigned long long)web_b->run_deep,
-           max_dev, (unsigned long long)ha, (unsigned long long)hb);
+           kind, (unsigned long long)web_b->run_nodes, (unsigned long long)web_b->run_deep, max_dev,
+           (unsigned long long)ha, (unsigned long long)hb);
     ck_assert_msg(web_a->run_nodes == 0 && web_a->corners == 0, "short cuts taken with runs off");
     ck_assert_msg(ha == hb && max_dev == 0.0, "runs differ from one by one: %.3e m", max_dev);
     *run_nodes += web_b->run_nodes;
@@ -759,8 +824,7 @@ START_TEST(corners_need_flat_faces)
         const ws_shape *sh = w->shapes[slot];
         ck_assert_uint_eq(sh->face_count, 6); /* the bent top is still one face */
         ck_assert_int_eq(sh->convex, 1);
-        ck_assert_msg(sh->flat == flat[k], "shape %d: flat %d, expected %d", k, sh->flat,
-                      flat[k]);
+        ck_assert_msg(sh->flat == flat[k], "shape %d: flat %d, expected %d", k, sh->flat, flat[k]);
     }
     ws_world_destroy(w);
 }
@@ -790,6 +854,7 @@ int main(void)
     tcase_add_test(tc, film_detection_does_not_change_the_motion);
     tcase_add_test(tc, film_runs_equal_one_by_one);
     tcase_add_test(tc, film_node_past_an_edge_end);
+    tcase_add_test(tc, edges_of_faces_a_node_is_well_inside_of_are_dropped);
     tcase_add_test(tc, corners_need_flat_faces);
     suite_add_tcase(s, tc);
     return run_suite(s);

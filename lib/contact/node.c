@@ -693,9 +693,15 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
      * edges. */
     if (!(boxes & (boxes - 1)))
         return 0;
+    /* Nor can an edge of a face the node is well inside of hold it: the edge holds only a node
+     * that is a positive sum of its two faces' normals (in_wedge), whose projection on either
+     * face's plane lies past the other's plane, and this node's projection on that face lies
+     * a margin or more behind every other plane, with less than half a margin to move until it
+     * is found again. Dropped, the node is a face's alone and may join a run. */
+    const uint64_t near = boxes & ~(mk[M_PASS * FIND_CHUNK] & ~outside);
     for (uint32_t e = 0; e < sh->edge_count; e++) {
         const ws_edge *E = &sh->edges[e];
-        if (!((boxes >> E->f1) & (boxes >> E->f2) & 1u) || !inside_box(s, E->lo, E->hi, reach))
+        if (!((near >> E->f1) & (near >> E->f2) & 1u) || !inside_box(s, E->lo, E->hi, reach))
             continue;
         (*checks)++;
         v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
