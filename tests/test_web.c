@@ -1299,6 +1299,42 @@ START_TEST(test_stable_dt_refusal_counted)
 }
 END_TEST
 
+START_TEST(test_step_leaves_no_scratch_in_state)
+{
+    /* A sweep keeps the nodes' forces where it writes their new velocities (web.h,
+     * ws_web_sweep_begin); after the step the force scratch must be an array of its own again,
+     * for what uses it between steps (the stable-step bound, the VTK writer) writes over it.
+     * Asking the stable step after a step must leave the state as it was, with one sub-step
+     * and with two (the scratch state between them). */
+    for (int sub = 1; sub <= 2; sub++) {
+        ws_world *w = world_g(1e-4, DOWN_G);
+        ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 100.0, 0.0, 0.0, 0.0);
+        ws_web_id web = pinned_row(w, 11, 0.01, 1e-3, law, "row");
+        ck_ok(w, ws_web_set_substeps(w, web, sub));
+        ck_ok(w, ws_world_step_n(w, 20));
+        size_t n;
+        ck_ok(w, ws_web_copy_velocities(w, web, NULL, 0, &n));
+        double *v0 = calloc(3 * n, sizeof *v0), *v1 = calloc(3 * n, sizeof *v1);
+        ck_assert(v0 && v1);
+        uint64_t h0, h1;
+        ck_ok(w, ws_web_copy_velocities(w, web, v0, n, &n));
+        ck_ok(w, ws_world_get_state_hash(w, &h0));
+        double S;
+        ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+        ck_ok(w, ws_web_copy_velocities(w, web, v1, n, &n));
+        ck_ok(w, ws_world_get_state_hash(w, &h1));
+        ws_world_destroy(w); /* before the verdict, so a failure leaks nothing (CK_FORK=no) */
+        int same = memcmp(v0, v1, 3 * n * sizeof *v0) == 0;
+        double vy = v0[3 * 5 + 2];
+        free(v0);
+        free(v1);
+        ck_assert_msg(vy != 0.0, "the row does not move: the check would see nothing");
+        ck_assert_msg(same && h0 == h1,
+                      "%d sub-step(s): the stable-step bound changed the node velocities", sub);
+    }
+}
+END_TEST
+
 START_TEST(test_state_hash_sees_web)
 {
     /* ws_world_get_state_hash: "a hash of the whole dynamic state ... the determinism check".
@@ -1735,6 +1771,7 @@ int main(void)
     add_case(s, "energy_no_gain", test_energy_no_gain, 30);
     add_case(s, "stable_dt", test_stable_dt, 30);
     add_case(s, "stable_dt_refusal_counted", test_stable_dt_refusal_counted, 10);
+    add_case(s, "step_leaves_no_scratch_in_state", test_step_leaves_no_scratch_in_state, 10);
     add_case(s, "state_hash_sees_web", test_state_hash_sees_web, 10);
     add_case(s, "sheet_generator", test_sheet_generator, 20);
     add_case(s, "mesh_node_masses", test_mesh_node_masses, 10);

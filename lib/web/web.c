@@ -29,7 +29,8 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
         ok &= nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
-    ok &= nodes_alloc(mem, &web->f, n);
+    ok &= nodes_alloc(mem, &web->fmem, n);
+    web->f = web->fmem;
     ok &= nodes_alloc(mem, &web->xdet, n);
     ok &= nodes_alloc(mem, &web->xsub, n);
     ok &= nodes_alloc(mem, &web->vsub, n);
@@ -62,7 +63,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
-    nodes_free(mem, &web->f, web->n);
+    nodes_free(mem, &web->fmem, web->n);
     nodes_free(mem, &web->xdet, web->n);
     nodes_free(mem, &web->xsub, web->n);
     nodes_free(mem, &web->vsub, web->n);
@@ -390,28 +391,27 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. Returns how
- * many nodes end faster than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count,
- * so the loop keeps its vectors, and taken from the new velocity while it is at hand. */
+ * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out). Distinct
+ * arrays otherwise (restrict), so the loop runs on vectors. Returns how many nodes end faster
+ * than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its
+ * vectors, and taken from the new velocity while it is at hand. */
 WS_VECTOR_LOOP
 static size_t advance(size_t m, double h, double lim2, const double *restrict im,
-                      const double *restrict fx, const double *restrict fy,
-                      const double *restrict fz, const double *restrict vx0,
-                      const double *restrict vy0, const double *restrict vz0,
-                      const double *restrict x0, const double *restrict y0,
-                      const double *restrict z0, double *restrict vx1, double *restrict vy1,
-                      double *restrict vz1, double *restrict x1, double *restrict y1,
-                      double *restrict z1)
+                      const double *restrict vx0, const double *restrict vy0,
+                      const double *restrict vz0, const double *restrict x0,
+                      const double *restrict y0, const double *restrict z0, double *restrict fvx,
+                      double *restrict fvy, double *restrict fvz, double *restrict x1,
+                      double *restrict y1, double *restrict z1)
 {
     size_t bad = 0;
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
         double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
-        double ux = (vx0[i] + hi * fx[i]) * unpinned, uy = (vy0[i] + hi * fy[i]) * unpinned,
-               uz = (vz0[i] + hi * fz[i]) * unpinned;
-        vx1[i] = ux;
-        vy1[i] = uy;
-        vz1[i] = uz;
+        double ux = (vx0[i] + hi * fvx[i]) * unpinned, uy = (vy0[i] + hi * fvy[i]) * unpinned,
+               uz = (vz0[i] + hi * fvz[i]) * unpinned;
+        fvx[i] = ux;
+        fvy[i] = uy;
+        fvz[i] = uz;
         x1[i] = x0[i] + h * ux;
         y1[i] = y0[i] + h * uy;
         z1[i] = z0[i] + h * uz;
@@ -420,13 +420,22 @@ static size_t advance(size_t m, double h, double lim2, const double *restrict im
     return bad;
 }
 
+void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd)
+{
+    web->f = vd;
+}
+
+void ws_web_sweep_end(ws_web *web)
+{
+    web->f = web->fmem;
+}
+
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
-    const ws_nodes3 f = web->f;
-    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0,
-                   vs.x + n0, vs.y + n0, vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0,
-                   vd.y + n0, vd.z + n0, xd.x + n0, xd.y + n0, xd.z + n0);
+    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
+                   xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
+                   xd.y + n0, xd.z + n0);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)

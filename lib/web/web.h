@@ -90,7 +90,9 @@ typedef struct ws_web {
     uint32_t n, ns;          /* nodes, springs */
     int nx, ny, closed;      /* grid: node i + nx j; 0 for a mesh web */
     ws_nodes3 x[2], v[2];    /* state, double-buffered like the bodies' */
-    ws_nodes3 f;             /* force accumulator (scratch) */
+    ws_nodes3 f;             /* force accumulator (scratch): in a sweep, the velocities it
+                                writes (ws_web_sweep_begin), else fmem */
+    ws_nodes3 fmem;          /* scratch of n nodes' vectors (node_bounds, writers) */
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
@@ -175,9 +177,15 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
-/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v'. Returns how many
- * of them end faster than vmax (m/s) or with a NaN speed. Source and destination are
- * distinct. */
+/* A sweep that writes the velocities vd keeps the nodes' forces in vd until it integrates
+ * them, in place of an array of its own: each node's force is complete before its new
+ * velocity is written over it, and the state the sweep streams is smaller by an n-node array
+ * (f is then vd; ws_web_sweep_end makes it the scratch again). */
+void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd);
+void ws_web_sweep_end(ws_web *web);
+/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v', f read from vd
+ * (ws_web_sweep_begin). Returns how many of them end faster than vmax (m/s) or with a NaN
+ * speed. Source and destination are distinct. */
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax);
 /* The largest node speed in v (NaN when one is NaN), m/s. */
