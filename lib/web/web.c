@@ -36,7 +36,7 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     ok &= nodes_alloc(mem, &web->vsub, n);
     ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
-    ok &= (web->tmp = ws_mem_calloc(mem, 3 * WS_WEB_CHUNK, sizeof(double))) != NULL;
+    ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->sa = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
@@ -72,7 +72,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
     ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
     ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
-    ws_mem_free(mem, web->tmp, 3 * WS_WEB_CHUNK * sizeof(double));
+    ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
     ws_mem_free(mem, web->sa, ns * sizeof(uint32_t));
@@ -288,29 +288,87 @@ static void row_forces(size_t k, v3 g, double c, const double *restrict m,
     }
 }
 
+/* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
+ * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
+ * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
+ * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 / length il[i], 0
+ * when the ends coincide (out: these four). The arithmetic of spring_run; taken apart from the
+ * rows, the division and square root of one row's wrap no longer hold up the rest of its
+ * forces. */
+WS_VECTOR_LOOP
+static void wrap_lanes(const double *restrict in, ws_spring_form p, double *restrict out)
+{
+    enum { L = WS_WEB_WRAPS };
+    for (size_t i = 0; i < L; i++) {
+        double dx = in[i], dy = in[L + i], dz = in[2 * L + i];
+        double ux = in[3 * L + i], uy = in[4 * L + i], uz = in[5 * L + i], il0 = in[6 * L + i];
+        double l2 = dx * dx + dy * dy + dz * dz;
+        double l = sqrt(l2);
+        double inv = 1.0 / l;
+        double il = l2 > 0.0 ? inv : 0.0;
+        double eps = l * il0 - 1.0;
+        double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
+        double q = film_force(&p, eps, epsd) * il;
+        out[i] = dx * q;
+        out[L + i] = dy * q;
+        out[2 * L + i] = dz * q;
+        out[3 * L + i] = il;
+    }
+}
+
+/* The wrap springs of rows [r, r + WS_WEB_WRAPS) (those below ny) into the web's scratch
+ * (wrap_lanes' out); lanes past the last row have ends that coincide. */
+static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, ws_spring_form p)
+{
+    enum { L = WS_WEB_WRAPS };
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    double in[7 * L];
+    for (size_t i = 0; i < L; i++) {
+        const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
+        const int row = r + i < ny;
+        in[i] = row ? x.x[b] - x.x[a] : 0.0;
+        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
+        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
+        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
+        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
+        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
+        in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
+    }
+    wrap_lanes(in, p, web->tmp + 3 * WS_WEB_CHUNK);
+}
+
 /* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
  * form, with the base forces of nodes [a, a + m]: in chunks small enough for the scratch to
  * stay in the first-level cache, each chunk's forces computed, then put on its nodes in one
  * pass. A node at the start of a chunk after the first has had the previous chunk's spring
- * already and gets its right-hand one after it. */
-static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m,
-                       size_t s0, ws_spring_form p)
+ * already and gets its right-hand one after it. wrap, unless NULL, is the row's lane of
+ * wrap_rows' out: the wrap spring from node a + m to node a, which these two nodes get last. */
+static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m, size_t s0,
+                       ws_spring_form p, const double *wrap)
 {
     const double *il0 = web->inv_l0 + s0;
     const ws_nodes3 f = web->f;
     double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
+    v3 fw = v3_make(0.0, 0.0, 0.0);
+    if (wrap && wrap[3 * WS_WEB_WRAPS] != 0.0) /* else coincident ends: no direction to pull */
+        fw = v3_make(wrap[0], wrap[WS_WEB_WRAPS], wrap[2 * WS_WEB_WRAPS]);
+    else
+        wrap = NULL;
     for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
         size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
         spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, k, il0 + o, p, tx, ty,
                    tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
-        if (o == 0)
-            nodes_set(f, (uint32_t)q, v3_add(base_force(web, v, g, q), first));
-        else
+        if (o == 0) {
+            v3 fa = v3_add(base_force(web, v, g, q), first);
+            nodes_set(f, (uint32_t)q, wrap ? v3_add(fa, v3_scale(fw, -1.0)) : fa);
+        } else {
             nodes_add(f, (uint32_t)q, first);
+        }
         row_forces(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
                    f.x + q, f.y + q, f.z + q);
-        nodes_set(f, (uint32_t)(q + k), v3_sub(base_force(web, v, g, q + k), last));
+        v3 fb = v3_sub(base_force(web, v, g, q + k), last);
+        nodes_set(f, (uint32_t)(q + k), wrap && o + k == m ? v3_add(fb, fw) : fb);
     }
 }
 
@@ -343,11 +401,18 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, cons
         base_forces(web, v, g, nx * r, nx * (r + 1));
         for (size_t i = 0; i < nx - 1; i++)
             spring_one(web, x, v, (uint32_t)(cols * r + i), p);
+        if (web->closed)
+            spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
+    } else if (web->closed) {
+        /* A sweep starts rows in order from row 0, so the first of each WS_WEB_WRAPS rows
+         * finds the wraps of them all. */
+        if (r % WS_WEB_WRAPS == 0)
+            wrap_rows(web, x, v, r, p);
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p,
+                   web->tmp + 3 * WS_WEB_CHUNK + r % WS_WEB_WRAPS);
     } else {
-        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p);
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p, NULL);
     }
-    if (web->closed)
-        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)

@@ -58,6 +58,8 @@ static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
 }
 
 #define WS_WEB_CHUNK 256 /* springs evaluated at once */
+#define WS_WEB_WRAPS 4   /* wrap springs of a closed band evaluated at once */
+#define WS_WEB_TMP (3 * WS_WEB_CHUNK + 4 * WS_WEB_WRAPS) /* doubles of ws_web.tmp */
 
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
  * reference body (see ws_web): its CoG (rho) and orientation (q) in the reference body's
@@ -95,7 +97,8 @@ typedef struct ws_web {
     ws_nodes3 fmem;          /* scratch of n nodes' vectors (node_bounds, writers) */
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
-    double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
+    double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
+                                WS_WEB_WRAPS wrap springs (scratch, WS_WEB_TMP) */
     ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
