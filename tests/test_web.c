@@ -1335,6 +1335,86 @@ START_TEST(test_step_leaves_no_scratch_in_state)
 }
 END_TEST
 
+/* A free sheet nx x ny with spacing 0.01 m and no pre-stretch (springs slack as placed), its
+ * masses from node_mass (all alike) or from areal_density (edges and corners lighter), one
+ * node pinned if pin >= 0. */
+static ws_web_id free_sheet(ws_world *w, ws_law_id law, int nx, int ny, double node_mass,
+                            double density, int pin)
+{
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = node_mass;
+    wd.areal_density = density;
+    wd.law = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = nx;
+    sd.ny = ny;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    uint32_t p = (uint32_t)(pin >= 0 ? pin : 0);
+    sd.pinned = pin >= 0 ? &p : NULL;
+    sd.pinned_count = pin >= 0 ? 1 : 0;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    return web;
+}
+
+START_TEST(test_node_masses_each_their_own)
+{
+    /* A web whose nodes all weigh the same is swept with that one mass rather than the array
+     * (web.h, same_m / same_inv_m); any other with each node's own. Under gravity alone a
+     * slack web falls as one: every node's force m_i g over its own m_i, so after k steps of
+     * dt every free node moves at g k dt (symplectic Euler is exact for a constant force up
+     * to round-off, 1e-12 of it here) and the springs stay slack. A node swept with another
+     * node's mass or inverse mass falls at g times their ratio (1/4 to 4 here), and a pinned
+     * node must not move at all (the others of its sheet, held by it, must). */
+    const int steps = 100;
+    const double dt = 1e-4, vz = -G0 * steps * dt;
+    ws_world *w = world_g(dt, DOWN_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1.0, 0.0, 0.0, 0.0);
+    ws_web_id webs[4];
+    webs[0] = free_sheet(w, law, 4, 3, 1e-3, 0.0, -1); /* all alike */
+    webs[1] = free_sheet(w, law, 4, 3, 0.0, 2.0, -1);  /* corners 1/4, edges 1/2 */
+    webs[2] = free_sheet(w, law, 4, 3, 1e-3, 0.0, 5);  /* same masses, one pinned */
+    double p[9] = {0, 0, 0, 0.01, 0, 0, 0.02, 0, 0}, ms[3] = {1e-3, 2e-3, 4e-3};
+    uint32_t sp[4] = {0, 1, 1, 2};
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law;
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = p;
+    md.node_count = 3;
+    md.node_masses = ms;
+    md.springs = sp;
+    md.spring_count = 2;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &webs[3]));
+    ck_ok(w, ws_world_step_n(w, steps));
+    double worst = 0.0, pinned_speed = -1.0, moving = INFINITY;
+    for (int k = 0; k < 4; k++) {
+        double v[3 * 12];
+        size_t n;
+        ck_ok(w, ws_web_copy_velocities(w, webs[k], v, 12, &n));
+        for (size_t i = 0; i < n; i++) {
+            if (k == 2) { /* held by its pinned node: not free fall */
+                if (i == 5)
+                    pinned_speed = fabs(v[3 * i]) + fabs(v[3 * i + 1]) + fabs(v[3 * i + 2]);
+                else
+                    moving = fmin(moving, fabs(v[3 * i + 2]));
+                continue;
+            }
+            double e = fabs(v[3 * i]) + fabs(v[3 * i + 1]) + fabs(v[3 * i + 2] - vz);
+            worst = fmax(worst, e / fabs(vz));
+        }
+    }
+    ws_world_destroy(w); /* before the verdict, so a failure leaks nothing (CK_FORK=no) */
+    report("free fall of slack webs: worst relative velocity error %.3g", worst);
+    ck_assert_msg(worst < 1e-12, "a node did not fall at g: relative error %g", worst);
+    ck_assert_msg(pinned_speed == 0.0, "the pinned node moves: |v| sum %g", pinned_speed);
+    ck_assert_msg(moving > 0.0, "a free node of the pinned sheet does not move");
+}
+END_TEST
+
 START_TEST(test_state_hash_sees_web)
 {
     /* ws_world_get_state_hash: "a hash of the whole dynamic state ... the determinism check".
@@ -1772,6 +1852,7 @@ int main(void)
     add_case(s, "stable_dt", test_stable_dt, 30);
     add_case(s, "stable_dt_refusal_counted", test_stable_dt_refusal_counted, 10);
     add_case(s, "step_leaves_no_scratch_in_state", test_step_leaves_no_scratch_in_state, 10);
+    add_case(s, "node_masses_each_their_own", test_node_masses_each_their_own, 10);
     add_case(s, "state_hash_sees_web", test_state_hash_sees_web, 10);
     add_case(s, "sheet_generator", test_sheet_generator, 20);
     add_case(s, "mesh_node_masses", test_mesh_node_masses, 10);

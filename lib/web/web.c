@@ -84,6 +84,17 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     memset(web, 0, sizeof *web);
 }
 
+void ws_web_note_masses(ws_web *web)
+{
+    web->same_m = web->same_inv_m = web->n > 0;
+    for (uint32_t i = 1; i < web->n; i++) {
+        web->same_m &= web->m[i] == web->m[0];
+        web->same_inv_m &= web->inv_m[i] == web->inv_m[0];
+    }
+    web->m1 = web->n ? web->m[0] : 0.0;
+    web->inv_m1 = web->n ? web->inv_m[0] : 0.0;
+}
+
 /* The film form's force at (eps, eps_dot): computed, then selected, so it runs on vectors. */
 static inline double film_force(const ws_spring_form *p, double eps, double epsd)
 {
@@ -249,43 +260,84 @@ static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spr
 }
 
 /* Gravity and node drag on nodes [n0, n1): the start of their force. */
-WS_VECTOR_LOOP
-static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+static inline void base_forces_of(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1, int same)
 {
-    const double c = web->damping;
+    const double c = web->damping, m1 = web->m1;
     const double *restrict m = web->m;
     double *restrict fx = web->f.x, *restrict fy = web->f.y, *restrict fz = web->f.z;
     /* The arrays into locals: loads through the struct would stay in the loop. */
     const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
     for (size_t i = n0; i < n1; i++) {
-        fx[i] = g.x * m[i] - c * vx[i];
-        fy[i] = g.y * m[i] - c * vy[i];
-        fz[i] = g.z * m[i] - c * vz[i];
+        const double mi = same ? m1 : m[i];
+        fx[i] = g.x * mi - c * vx[i];
+        fy[i] = g.y * mi - c * vy[i];
+        fz[i] = g.z * mi - c * vz[i];
     }
+}
+
+WS_VECTOR_LOOP
+static void base_forces_each(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    base_forces_of(web, v, g, n0, n1, 0);
+}
+
+WS_VECTOR_LOOP
+static void base_forces_same(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    base_forces_of(web, v, g, n0, n1, 1);
+}
+
+static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    if (web->same_m)
+        base_forces_same(web, v, g, n0, n1);
+    else
+        base_forces_each(web, v, g, n0, n1);
 }
 
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
 {
-    const double c = web->damping, m = web->m[i];
+    const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
     return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
  * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. */
-WS_VECTOR_LOOP
-static void row_forces(size_t k, v3 g, double c, const double *restrict m,
-                       const double *restrict vx, const double *restrict vy,
-                       const double *restrict vz, const double *restrict tx,
-                       const double *restrict ty, const double *restrict tz, double *restrict fx,
-                       double *restrict fy, double *restrict fz)
+ * order is that of the results (the state hash): keep it. Node i's mass is m[i], or m1 for
+ * every node when same (then m is not read). */
+static inline void row_forces_of(size_t k, v3 g, double c, const double *restrict m, double m1,
+                                 int same, const double *restrict vx, const double *restrict vy,
+                                 const double *restrict vz, const double *restrict tx,
+                                 const double *restrict ty, const double *restrict tz,
+                                 double *restrict fx, double *restrict fy, double *restrict fz)
 {
     for (size_t i = 1; i < k; i++) {
-        fx[i] = g.x * m[i] - c * vx[i] + tx[i] - tx[i - 1];
-        fy[i] = g.y * m[i] - c * vy[i] + ty[i] - ty[i - 1];
-        fz[i] = g.z * m[i] - c * vz[i] + tz[i] - tz[i - 1];
+        const double mi = same ? m1 : m[i];
+        fx[i] = g.x * mi - c * vx[i] + tx[i] - tx[i - 1];
+        fy[i] = g.y * mi - c * vy[i] + ty[i] - ty[i - 1];
+        fz[i] = g.z * mi - c * vz[i] + tz[i] - tz[i - 1];
     }
+}
+
+WS_VECTOR_LOOP
+static void row_forces_each(size_t k, v3 g, double c, const double *restrict m,
+                            const double *restrict vx, const double *restrict vy,
+                            const double *restrict vz, const double *restrict tx,
+                            const double *restrict ty, const double *restrict tz,
+                            double *restrict fx, double *restrict fy, double *restrict fz)
+{
+    row_forces_of(k, g, c, m, 0.0, 0, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+}
+
+WS_VECTOR_LOOP
+static void row_forces_same(size_t k, v3 g, double c, double m1, const double *restrict vx,
+                            const double *restrict vy, const double *restrict vz,
+                            const double *restrict tx, const double *restrict ty,
+                            const double *restrict tz, double *restrict fx, double *restrict fy,
+                            double *restrict fz)
+{
+    row_forces_of(k, g, c, NULL, m1, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
 }
 
 /* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
@@ -365,8 +417,12 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
         } else {
             nodes_add(f, (uint32_t)q, first);
         }
-        row_forces(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
-                   f.x + q, f.y + q, f.z + q);
+        if (web->same_m)
+            row_forces_same(k, g, web->damping, web->m1, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                            f.x + q, f.y + q, f.z + q);
+        else
+            row_forces_each(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                            f.x + q, f.y + q, f.z + q);
         v3 fb = v3_sub(base_force(web, v, g, q + k), last);
         nodes_set(f, (uint32_t)(q + k), wrap && o + k == m ? v3_add(fb, fw) : fb);
     }
@@ -456,22 +512,24 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out). Distinct
- * arrays otherwise (restrict), so the loop runs on vectors. Returns how many nodes end faster
- * than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its
- * vectors, and taken from the new velocity while it is at hand. */
-WS_VECTOR_LOOP
-static size_t advance(size_t m, double h, double lim2, const double *restrict im,
-                      const double *restrict vx0, const double *restrict vy0,
-                      const double *restrict vz0, const double *restrict x0,
-                      const double *restrict y0, const double *restrict z0, double *restrict fvx,
-                      double *restrict fvy, double *restrict fvz, double *restrict x1,
-                      double *restrict y1, double *restrict z1)
+ * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out); 1 / m is
+ * im[i], or im1 for every node when same (then im is not read). Distinct arrays otherwise
+ * (restrict), so the loop runs on vectors. Returns how many nodes end faster than sqrt(lim2)
+ * or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its vectors, and
+ * taken from the new velocity while it is at hand. */
+static inline size_t advance_of(size_t m, double h, double lim2, const double *restrict im,
+                                double im1, int same, const double *restrict vx0,
+                                const double *restrict vy0, const double *restrict vz0,
+                                const double *restrict x0, const double *restrict y0,
+                                const double *restrict z0, double *restrict fvx,
+                                double *restrict fvy, double *restrict fvz, double *restrict x1,
+                                double *restrict y1, double *restrict z1)
 {
     size_t bad = 0;
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
-        double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
+        const double imi = same ? im1 : im[i];
+        double unpinned = (double)(imi != 0.0), hi = h * imi;
         double ux = (vx0[i] + hi * fvx[i]) * unpinned, uy = (vy0[i] + hi * fvy[i]) * unpinned,
                uz = (vz0[i] + hi * fvz[i]) * unpinned;
         fvx[i] = ux;
@@ -483,6 +541,29 @@ static size_t advance(size_t m, double h, double lim2, const double *restrict im
         bad += !(ux * ux + uy * uy + uz * uz <= lim2);
     }
     return bad;
+}
+
+WS_VECTOR_LOOP
+static size_t advance_each(size_t m, double h, double lim2, const double *restrict im,
+                           const double *restrict vx0, const double *restrict vy0,
+                           const double *restrict vz0, const double *restrict x0,
+                           const double *restrict y0, const double *restrict z0,
+                           double *restrict fvx, double *restrict fvy, double *restrict fvz,
+                           double *restrict x1, double *restrict y1, double *restrict z1)
+{
+    return advance_of(m, h, lim2, im, 0.0, 0, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1, z1);
+}
+
+WS_VECTOR_LOOP
+static size_t advance_same(size_t m, double h, double lim2, double im1, const double *restrict vx0,
+                           const double *restrict vy0, const double *restrict vz0,
+                           const double *restrict x0, const double *restrict y0,
+                           const double *restrict z0, double *restrict fvx, double *restrict fvy,
+                           double *restrict fvz, double *restrict x1, double *restrict y1,
+                           double *restrict z1)
+{
+    return advance_of(m, h, lim2, NULL, im1, 1, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1,
+                      z1);
 }
 
 void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd)
@@ -498,9 +579,13 @@ void ws_web_sweep_end(ws_web *web)
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
-    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
-                   xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
-                   xd.y + n0, xd.z + n0);
+    if (web->same_inv_m)
+        return advance_same(n1 - n0, h, vmax * vmax, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
+                            xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
+                            xd.x + n0, xd.y + n0, xd.z + n0);
+    return advance_each(n1 - n0, h, vmax * vmax, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
+                        xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
+                        xd.y + n0, xd.z + n0);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)

@@ -106,6 +106,11 @@ typedef struct ws_web {
     size_t nfct[2], fct_cap[2];
     int fck;                 /* the fc the contacts of the running step add to (scratch) */
     double *m, *inv_m;       /* inv_m = 0: pinned */
+    /* When every node has the same mass (same_m) or the same inverse mass (same_inv_m: the
+     * same mass and none pinned), it is m1 or inv_m1, and the sweep reads it in place of the
+     * array (ws_web_note_masses). */
+    int same_m, same_inv_m;
+    double m1, inv_m1;
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
@@ -163,6 +168,8 @@ typedef struct ws_web {
     int refresh;
 } ws_web;
 
+/* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */
+void ws_web_note_masses(ws_web *web);
 /* Allocate a web of n nodes and ns springs (zeroed). */
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns);
 void ws_web_free(ws_mem *mem, ws_web *web);
