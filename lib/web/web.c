@@ -2,9 +2,11 @@
 
 #include <string.h>
 
+/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
+ * read past a grid's last node). */
 static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
-    double *p = ws_mem_calloc(mem, 3 * (size_t)n, sizeof(double));
+    double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
     a->x = p;
     a->y = p ? p + n : NULL;
     a->z = p ? p + 2 * (size_t)n : NULL;
@@ -13,7 +15,7 @@ static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 
 static void nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
-    ws_mem_free(mem, a->x, 3 * (size_t)n * sizeof(double));
+    ws_mem_free(mem, a->x, (3 * (size_t)n + WS_WEB_PAD) * sizeof(double));
     a->x = a->y = a->z = NULL;
 }
 
@@ -41,7 +43,7 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->sa = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->sb = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
-    ok &= (web->inv_l0 = ws_mem_calloc(mem, ns ? ns : 1, sizeof(double))) != NULL;
+    ok &= (web->inv_l0 = ws_mem_calloc(mem, (size_t)ns + WS_WEB_PAD, sizeof(double))) != NULL;
     ok &= (web->kind = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint8_t))) != NULL;
     if (!ok) {
         ws_web_free(mem, web);
@@ -77,7 +79,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
     ws_mem_free(mem, web->sa, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->sb, ns * sizeof(uint32_t));
-    ws_mem_free(mem, web->inv_l0, ns * sizeof(double));
+    ws_mem_free(mem, web->inv_l0, ((size_t)web->ns + WS_WEB_PAD) * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free_str(mem, web->name);
@@ -408,8 +410,11 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
         wrap = NULL;
     for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
         size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
-        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, k, il0 + o, p, tx, ty,
-                   tz);
+        /* Whole vectors: up to three springs more, whose forces are not used, from the nodes
+         * after the row (the next row's, or the padding after the last) and the rest lengths
+         * after its springs. Cheaper than the left-over springs one at a time. */
+        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
+                   il0 + o, p, tx, ty, tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
         if (o == 0) {
             v3 fa = v3_add(base_force(web, v, g, q), first);

@@ -58,6 +58,7 @@ static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
 }
 
 #define WS_WEB_CHUNK 256 /* springs evaluated at once */
+#define WS_WEB_PAD 4     /* doubles of padding after node vectors and rest lengths (web.c) */
 #define WS_WEB_WRAPS 4   /* wrap springs of a closed band evaluated at once */
 #define WS_WEB_TMP (3 * WS_WEB_CHUNK + 4 * WS_WEB_WRAPS) /* doubles of ws_web.tmp */
 
