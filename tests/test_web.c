@@ -1367,7 +1367,8 @@ START_TEST(test_node_masses_each_their_own)
      * dt every free node moves at g k dt (symplectic Euler is exact for a constant force up
      * to round-off, 1e-12 of it here) and the springs stay slack. A node swept with another
      * node's mass or inverse mass falls at g times their ratio (1/4 to 4 here), and a pinned
-     * node must not move at all (the others of its sheet, held by it, must). */
+     * node must not move at all (the others of its sheet, held by it, must), nor a web pinned at
+     * every node (its nodes are all alike, but with no inverse mass to sweep with). */
     const int steps = 100;
     const double dt = 1e-4, vz = -G0 * steps * dt;
     ws_world *w = world_g(dt, DOWN_G);
@@ -1389,7 +1390,21 @@ START_TEST(test_node_masses_each_their_own)
     md.springs = sp;
     md.spring_count = 2;
     ck_ok(w, ws_web_create_mesh(w, &wd, &md, &webs[3]));
+    /* Every node pinned: all alike, with an inverse mass of 0. */
+    uint32_t all[3] = {0, 1, 2};
+    md.node_masses = NULL;
+    md.pinned = all;
+    md.pinned_count = 3;
+    wd.node_mass = 1e-3;
+    ws_web_id held;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &held));
     ck_ok(w, ws_world_step_n(w, steps));
+    double vh[9];
+    size_t nh;
+    ck_ok(w, ws_web_copy_velocities(w, held, vh, 3, &nh));
+    double held_speed = 0.0;
+    for (size_t i = 0; i < 3 * nh; i++)
+        held_speed += fabs(vh[i]);
     double worst = 0.0, pinned_speed = -1.0, moving = INFINITY;
     for (int k = 0; k < 4; k++) {
         double v[3 * 12];
@@ -1412,6 +1427,7 @@ START_TEST(test_node_masses_each_their_own)
     ck_assert_msg(worst < 1e-12, "a node did not fall at g: relative error %g", worst);
     ck_assert_msg(pinned_speed == 0.0, "the pinned node moves: |v| sum %g", pinned_speed);
     ck_assert_msg(moving > 0.0, "a free node of the pinned sheet does not move");
+    ck_assert_msg(held_speed == 0.0, "a web pinned at every node moves: |v| sum %g", held_speed);
 }
 END_TEST
 

@@ -518,10 +518,10 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
  * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out); 1 / m is
- * im[i], or im1 for every node when same (then im is not read). Distinct arrays otherwise
- * (restrict), so the loop runs on vectors. Returns how many nodes end faster than sqrt(lim2)
- * or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its vectors, and
- * taken from the new velocity while it is at hand. */
+ * im[i], or im1 > 0 for every node when same (none pinned; im is not read). Distinct arrays
+ * otherwise (restrict), so the loop runs on vectors. Returns how many nodes end faster than
+ * sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its vectors,
+ * and taken from the new velocity while it is at hand. */
 static inline size_t advance_of(size_t m, double h, double lim2, const double *restrict im,
                                 double im1, int same, const double *restrict vx0,
                                 const double *restrict vy0, const double *restrict vz0,
@@ -535,8 +535,12 @@ static inline size_t advance_of(size_t m, double h, double lim2, const double *r
         /* Computed, then selected: no branch. */
         const double imi = same ? im1 : im[i];
         double unpinned = (double)(imi != 0.0), hi = h * imi;
-        double ux = (vx0[i] + hi * fvx[i]) * unpinned, uy = (vy0[i] + hi * fvy[i]) * unpinned,
-               uz = (vz0[i] + hi * fvz[i]) * unpinned;
+        double ux = vx0[i] + hi * fvx[i], uy = vy0[i] + hi * fvy[i], uz = vz0[i] + hi * fvz[i];
+        if (!same) { /* else none is pinned: the product by 1 would change nothing */
+            ux *= unpinned;
+            uy *= unpinned;
+            uz *= unpinned;
+        }
         fvx[i] = ux;
         fvy[i] = uy;
         fvz[i] = uz;
@@ -584,7 +588,7 @@ void ws_web_sweep_end(ws_web *web)
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
-    if (web->same_inv_m)
+    if (web->same_inv_m && web->inv_m1 != 0.0)
         return advance_same(n1 - n0, h, vmax * vmax, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
                             xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
                             xd.x + n0, xd.y + n0, xd.z + n0);
