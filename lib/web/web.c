@@ -372,7 +372,7 @@ static void wrap_lanes(const double *restrict in, ws_spring_form p, double *rest
 
 /* The wrap springs of rows [r, r + WS_WEB_WRAPS) (those below ny) into the web's scratch
  * (wrap_lanes' out); lanes past the last row have ends that coincide. */
-static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, ws_spring_form p)
+static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, const ws_spring_form *p)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
@@ -388,7 +388,7 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, ws_spring
         in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
-    wrap_lanes(in, p, web->tmp + 3 * WS_WEB_CHUNK);
+    wrap_lanes(in, *p, web->tmp + 3 * WS_WEB_CHUNK);
 }
 
 /* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
@@ -398,7 +398,7 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, ws_spring
  * already and gets its right-hand one after it. wrap, unless NULL, is the row's lane of
  * wrap_rows' out: the wrap spring from node a + m to node a, which these two nodes get last. */
 static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m, size_t s0,
-                       ws_spring_form p, const double *wrap)
+                       const ws_spring_form *p, const double *wrap)
 {
     const double *il0 = web->inv_l0 + s0;
     const ws_nodes3 f = web->f;
@@ -414,7 +414,7 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
          * after the row (the next row's, or the padding after the last) and the rest lengths
          * after its springs. Cheaper than the left-over springs one at a time. */
         spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
-                   il0 + o, p, tx, ty, tz);
+                   il0 + o, *p, tx, ty, tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
         if (o == 0) {
             v3 fa = v3_add(base_force(web, v, g, q), first);
@@ -434,18 +434,18 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
 }
 
 /* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
-static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, ws_spring_form p)
+static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0,
+                      const ws_spring_form *p)
 {
     const size_t nx = (size_t)web->nx;
-    if (p.gen) {
+    if (p->gen) {
         for (size_t i = 0; i < nx; i++)
-            spring_one(web, x, v, (uint32_t)(s0 + i), p);
+            spring_one(web, x, v, (uint32_t)(s0 + i), *p);
         return;
     }
     ws_nodes3 f = web->f;
-    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx,
-                     web->inv_l0 + s0, p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx,
-                     f.z + a + nx);
+    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx, web->inv_l0 + s0,
+                     *p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx, f.z + a + nx);
 }
 
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
@@ -453,17 +453,17 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
 static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const ws_spring_form *P)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    const ws_spring_form p = P[WS_SPRING_AROUND];
+    const ws_spring_form *p = &P[WS_SPRING_AROUND];
     if (!web->law[WS_SPRING_AROUND] || nx < 2) {
         base_forces(web, v, g, nx * r, nx * (r + 1));
         return;
     }
-    if (p.gen) {
+    if (p->gen) {
         base_forces(web, v, g, nx * r, nx * (r + 1));
         for (size_t i = 0; i < nx - 1; i++)
-            spring_one(web, x, v, (uint32_t)(cols * r + i), p);
+            spring_one(web, x, v, (uint32_t)(cols * r + i), *p);
         if (web->closed)
-            spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
+            spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), *p);
     } else if (web->closed) {
         /* A sweep starts rows in order from row 0, so the first of each WS_WEB_WRAPS rows
          * finds the wraps of them all. */
@@ -506,7 +506,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     if (j + 1 < ny) {
         grid_row(web, x, v, g, j + 1, P);
         if (web->law[WS_SPRING_UP])
-            spring_up(web, x, v, nx * j, cols * ny + nx * j, P[WS_SPRING_UP]);
+            spring_up(web, x, v, nx * j, cols * ny + nx * j, &P[WS_SPRING_UP]);
         size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
         if (shear0 < web->ns)
             for (size_t s = shear0; s < shear0 + 2 * cols; s++)
