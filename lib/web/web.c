@@ -309,16 +309,23 @@ static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
  * order is that of the results (the state hash): keep it. Node i's mass is m[i], or m1 for
  * every node when same (then m is not read). */
 static inline void row_forces_of(size_t k, v3 g, double c, const double *restrict m, double m1,
-                                 int same, const double *restrict vx, const double *restrict vy,
-                                 const double *restrict vz, const double *restrict tx,
-                                 const double *restrict ty, const double *restrict tz,
-                                 double *restrict fx, double *restrict fy, double *restrict fz)
+                                 int same, int drag, const double *restrict vx,
+                                 const double *restrict vy, const double *restrict vz,
+                                 const double *restrict tx, const double *restrict ty,
+                                 const double *restrict tz, double *restrict fx,
+                                 double *restrict fy, double *restrict fz)
 {
     for (size_t i = 1; i < k; i++) {
         const double mi = same ? m1 : m[i];
-        fx[i] = g.x * mi - c * vx[i] + tx[i] - tx[i - 1];
-        fy[i] = g.y * mi - c * vy[i] + ty[i] - ty[i - 1];
-        fz[i] = g.z * mi - c * vz[i] + tz[i] - tz[i - 1];
+        if (drag) {
+            fx[i] = g.x * mi - c * vx[i] + tx[i] - tx[i - 1];
+            fy[i] = g.y * mi - c * vy[i] + ty[i] - ty[i - 1];
+            fz[i] = g.z * mi - c * vz[i] + tz[i] - tz[i - 1];
+        } else {
+            fx[i] = g.x * mi + tx[i] - tx[i - 1];
+            fy[i] = g.y * mi + ty[i] - ty[i - 1];
+            fz[i] = g.z * mi + tz[i] - tz[i - 1];
+        }
     }
 }
 
@@ -329,7 +336,7 @@ static void row_forces_each(size_t k, v3 g, double c, const double *restrict m,
                             const double *restrict ty, const double *restrict tz,
                             double *restrict fx, double *restrict fy, double *restrict fz)
 {
-    row_forces_of(k, g, c, m, 0.0, 0, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+    row_forces_of(k, g, c, m, 0.0, 0, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
 }
 
 WS_VECTOR_LOOP
@@ -339,7 +346,16 @@ static void row_forces_same(size_t k, v3 g, double c, double m1, const double *r
                             const double *restrict tz, double *restrict fx, double *restrict fy,
                             double *restrict fz)
 {
-    row_forces_of(k, g, c, NULL, m1, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+    row_forces_of(k, g, c, NULL, m1, 1, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+}
+
+/* Nodes of one mass and no drag (web->no_drag): the velocities are not read. */
+WS_VECTOR_LOOP
+static void row_forces_same_free(size_t k, v3 g, double m1, const double *restrict tx,
+                                 const double *restrict ty, const double *restrict tz,
+                                 double *restrict fx, double *restrict fy, double *restrict fz)
+{
+    row_forces_of(k, g, 0.0, NULL, m1, 1, 0, NULL, NULL, NULL, tx, ty, tz, fx, fy, fz);
 }
 
 /* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
@@ -422,7 +438,9 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
         } else {
             nodes_add(f, (uint32_t)q, first);
         }
-        if (web->same_m)
+        if (web->same_m && web->no_drag)
+            row_forces_same_free(k, g, web->m1, tx, ty, tz, f.x + q, f.y + q, f.z + q);
+        else if (web->same_m)
             row_forces_same(k, g, web->damping, web->m1, v.x + q, v.y + q, v.z + q, tx, ty, tz,
                             f.x + q, f.y + q, f.z + q);
         else
@@ -486,9 +504,16 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 {
     /* The laws' parameters by spring kind, taken once a sweep and hoisted out of the loops. */
     const ws_spring_form *P = web->form;
-    if (k == 0)
+    if (k == 0) {
         for (int q = 0; q < 3; q++)
             web->form[q] = form_of(web->law[q], t, since);
+        /* Without drag, gravity and drag m g - c v is m g to the bit: c v is a zero (the
+         * velocities are finite, or the step fails on them), which leaves any m g but -0 as
+         * it is. */
+        web->no_drag = web->damping == 0.0 && !signbit(web->damping) &&
+                       !(g.x == 0.0 && signbit(g.x)) && !(g.y == 0.0 && signbit(g.y)) &&
+                       !(g.z == 0.0 && signbit(g.z));
+    }
     if (web->nx == 0) {
         base_forces(web, v, g, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)

@@ -101,6 +101,7 @@ typedef struct ws_web {
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
                                 WS_WEB_WRAPS wrap springs (scratch, WS_WEB_TMP) */
     ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
+    int no_drag;             /* the running sweep's nodes have no drag (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
                                 zeroed at the start of a step that writes fc[k] */
