@@ -194,14 +194,17 @@ static inline double film_pull(const ws_spring_form *p, double dx, double dy, do
 
 /* Springs from node a + i to node a + i + 1, i in [0, m), all of one law, with rest lengths
  * inv_l0[i]: the force on the first end (the second gets its opposite) into tx, ty, tz.
- * Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
+ * Straight-line code on contiguous arrays, so the compiler runs it on vectors. The law's film
+ * form comes as its five numbers, which a call passes in registers (a ws_spring_form goes
+ * through the stack). */
 WS_VECTOR_LOOP
-static void spring_run(const double *restrict x, const double *restrict y,
-                       const double *restrict z, const double *restrict vx,
-                       const double *restrict vy, const double *restrict vz, size_t m,
-                       const double *restrict inv_l0, ws_spring_form p, double *restrict tx,
+static void spring_run(const double *restrict x, const double *restrict y, const double *restrict z,
+                       const double *restrict vx, const double *restrict vy,
+                       const double *restrict vz, size_t m, const double *restrict inv_l0,
+                       double kc, double dk, double w, double qw, double c, double *restrict tx,
                        double *restrict ty, double *restrict tz)
 {
+    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
     for (size_t i = 0; i < m; i++) {
         double dx = x[i + 1] - x[i], dy = y[i + 1] - y[i], dz = z[i + 1] - z[i];
         double ux = vx[i + 1] - vx[i], uy = vy[i + 1] - vy[i], uz = vz[i + 1] - vz[i];
@@ -220,10 +223,12 @@ WS_VECTOR_LOOP
 static void spring_run_apply(const double *restrict x, const double *restrict y,
                              const double *restrict z, const double *restrict vx,
                              const double *restrict vy, const double *restrict vz, size_t stride,
-                             size_t m, const double *restrict inv_l0, ws_spring_form p,
-                             double *restrict fax, double *restrict fay, double *restrict faz,
-                             double *restrict fbx, double *restrict fby, double *restrict fbz)
+                             size_t m, const double *restrict inv_l0, double kc, double dk,
+                             double w, double qw, double c, double *restrict fax,
+                             double *restrict fay, double *restrict faz, double *restrict fbx,
+                             double *restrict fby, double *restrict fbz)
 {
+    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
     for (size_t i = 0; i < m; i++) {
         double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
         double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
@@ -430,7 +435,7 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
          * after the row (the next row's, or the padding after the last) and the rest lengths
          * after its springs. Cheaper than the left-over springs one at a time. */
         spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
-                   il0 + o, *p, tx, ty, tz);
+                   il0 + o, p->kc, p->dk, p->w, p->qw, p->c, tx, ty, tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
         if (o == 0) {
             v3 fa = v3_add(base_force(web, v, g, q), first);
@@ -463,7 +468,8 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
     }
     ws_nodes3 f = web->f;
     spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx, web->inv_l0 + s0,
-                     *p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx, f.z + a + nx);
+                     p->kc, p->dk, p->w, p->qw, p->c, f.x + a, f.y + a, f.z + a, f.x + a + nx,
+                     f.y + a + nx, f.z + a + nx);
 }
 
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
