@@ -1299,6 +1299,138 @@ START_TEST(test_stable_dt_refusal_counted)
 }
 END_TEST
 
+START_TEST(test_step_leaves_no_scratch_in_state)
+{
+    /* A sweep keeps the nodes' forces where it writes their new velocities (web.h,
+     * ws_web_sweep_begin); after the step the force scratch must be an array of its own again,
+     * for what uses it between steps (the stable-step bound, the VTK writer) writes over it.
+     * Asking the stable step after a step must leave the state as it was, with one sub-step
+     * and with two (the scratch state between them). */
+    for (int sub = 1; sub <= 2; sub++) {
+        ws_world *w = world_g(1e-4, DOWN_G);
+        ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 100.0, 0.0, 0.0, 0.0);
+        ws_web_id web = pinned_row(w, 11, 0.01, 1e-3, law, "row");
+        ck_ok(w, ws_web_set_substeps(w, web, sub));
+        ck_ok(w, ws_world_step_n(w, 20));
+        size_t n;
+        ck_ok(w, ws_web_copy_velocities(w, web, NULL, 0, &n));
+        double *v0 = calloc(3 * n, sizeof *v0), *v1 = calloc(3 * n, sizeof *v1);
+        ck_assert(v0 && v1);
+        uint64_t h0, h1;
+        ck_ok(w, ws_web_copy_velocities(w, web, v0, n, &n));
+        ck_ok(w, ws_world_get_state_hash(w, &h0));
+        double S;
+        ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+        ck_ok(w, ws_web_copy_velocities(w, web, v1, n, &n));
+        ck_ok(w, ws_world_get_state_hash(w, &h1));
+        ws_world_destroy(w); /* before the verdict, so a failure leaks nothing (CK_FORK=no) */
+        int same = memcmp(v0, v1, 3 * n * sizeof *v0) == 0;
+        double vy = v0[3 * 5 + 2];
+        free(v0);
+        free(v1);
+        ck_assert_msg(vy != 0.0, "the row does not move: the check would see nothing");
+        ck_assert_msg(same && h0 == h1,
+                      "%d sub-step(s): the stable-step bound changed the node velocities", sub);
+    }
+}
+END_TEST
+
+/* A free sheet nx x ny with spacing 0.01 m and no pre-stretch (springs slack as placed), its
+ * masses from node_mass (all alike) or from areal_density (edges and corners lighter), one
+ * node pinned if pin >= 0. */
+static ws_web_id free_sheet(ws_world *w, ws_law_id law, int nx, int ny, double node_mass,
+                            double density, int pin)
+{
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = node_mass;
+    wd.areal_density = density;
+    wd.law = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = nx;
+    sd.ny = ny;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    uint32_t p = (uint32_t)(pin >= 0 ? pin : 0);
+    sd.pinned = pin >= 0 ? &p : NULL;
+    sd.pinned_count = pin >= 0 ? 1 : 0;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    return web;
+}
+
+START_TEST(test_node_masses_each_their_own)
+{
+    /* A web whose nodes all weigh the same is swept with that one mass rather than the array
+     * (web.h, same_m / same_inv_m); any other with each node's own. Under gravity alone a
+     * slack web falls as one: every node's force m_i g over its own m_i, so after k steps of
+     * dt every free node moves at g k dt (symplectic Euler is exact for a constant force up
+     * to round-off, 1e-12 of it here) and the springs stay slack. A node swept with another
+     * node's mass or inverse mass falls at g times their ratio (1/4 to 4 here), and a pinned
+     * node must not move at all (the others of its sheet, held by it, must), nor a web pinned at
+     * every node (its nodes are all alike, but with no inverse mass to sweep with). */
+    const int steps = 100;
+    const double dt = 1e-4, vz = -G0 * steps * dt;
+    ws_world *w = world_g(dt, DOWN_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1.0, 0.0, 0.0, 0.0);
+    ws_web_id webs[4];
+    webs[0] = free_sheet(w, law, 4, 3, 1e-3, 0.0, -1); /* all alike */
+    webs[1] = free_sheet(w, law, 4, 3, 0.0, 2.0, -1);  /* corners 1/4, edges 1/2 */
+    webs[2] = free_sheet(w, law, 4, 3, 1e-3, 0.0, 5);  /* same masses, one pinned */
+    double p[9] = {0, 0, 0, 0.01, 0, 0, 0.02, 0, 0}, ms[3] = {1e-3, 2e-3, 4e-3};
+    uint32_t sp[4] = {0, 1, 1, 2};
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law;
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = p;
+    md.node_count = 3;
+    md.node_masses = ms;
+    md.springs = sp;
+    md.spring_count = 2;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &webs[3]));
+    /* Every node pinned: all alike, with an inverse mass of 0. */
+    uint32_t all[3] = {0, 1, 2};
+    md.node_masses = NULL;
+    md.pinned = all;
+    md.pinned_count = 3;
+    wd.node_mass = 1e-3;
+    ws_web_id held;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &held));
+    ck_ok(w, ws_world_step_n(w, steps));
+    double vh[9];
+    size_t nh;
+    ck_ok(w, ws_web_copy_velocities(w, held, vh, 3, &nh));
+    double held_speed = 0.0;
+    for (size_t i = 0; i < 3 * nh; i++)
+        held_speed += fabs(vh[i]);
+    double worst = 0.0, pinned_speed = -1.0, moving = INFINITY;
+    for (int k = 0; k < 4; k++) {
+        double v[3 * 12];
+        size_t n;
+        ck_ok(w, ws_web_copy_velocities(w, webs[k], v, 12, &n));
+        for (size_t i = 0; i < n; i++) {
+            if (k == 2) { /* held by its pinned node: not free fall */
+                if (i == 5)
+                    pinned_speed = fabs(v[3 * i]) + fabs(v[3 * i + 1]) + fabs(v[3 * i + 2]);
+                else
+                    moving = fmin(moving, fabs(v[3 * i + 2]));
+                continue;
+            }
+            double e = fabs(v[3 * i]) + fabs(v[3 * i + 1]) + fabs(v[3 * i + 2] - vz);
+            worst = fmax(worst, e / fabs(vz));
+        }
+    }
+    ws_world_destroy(w); /* before the verdict, so a failure leaks nothing (CK_FORK=no) */
+    report("free fall of slack webs: worst relative velocity error %.3g", worst);
+    ck_assert_msg(worst < 1e-12, "a node did not fall at g: relative error %g", worst);
+    ck_assert_msg(pinned_speed == 0.0, "the pinned node moves: |v| sum %g", pinned_speed);
+    ck_assert_msg(moving > 0.0, "a free node of the pinned sheet does not move");
+    ck_assert_msg(held_speed == 0.0, "a web pinned at every node moves: |v| sum %g", held_speed);
+}
+END_TEST
+
 START_TEST(test_state_hash_sees_web)
 {
     /* ws_world_get_state_hash: "a hash of the whole dynamic state ... the determinism check".
@@ -1735,6 +1867,8 @@ int main(void)
     add_case(s, "energy_no_gain", test_energy_no_gain, 30);
     add_case(s, "stable_dt", test_stable_dt, 30);
     add_case(s, "stable_dt_refusal_counted", test_stable_dt_refusal_counted, 10);
+    add_case(s, "step_leaves_no_scratch_in_state", test_step_leaves_no_scratch_in_state, 10);
+    add_case(s, "node_masses_each_their_own", test_node_masses_each_their_own, 10);
     add_case(s, "state_hash_sees_web", test_state_hash_sees_web, 10);
     add_case(s, "sheet_generator", test_sheet_generator, 20);
     add_case(s, "mesh_node_masses", test_mesh_node_masses, 10);

@@ -2,9 +2,11 @@
 
 #include <string.h>
 
+/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
+ * read past a grid's last node). */
 static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
-    double *p = ws_mem_calloc(mem, 3 * (size_t)n, sizeof(double));
+    double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
     a->x = p;
     a->y = p ? p + n : NULL;
     a->z = p ? p + 2 * (size_t)n : NULL;
@@ -13,7 +15,7 @@ static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 
 static void nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
-    ws_mem_free(mem, a->x, 3 * (size_t)n * sizeof(double));
+    ws_mem_free(mem, a->x, (3 * (size_t)n + WS_WEB_PAD) * sizeof(double));
     a->x = a->y = a->z = NULL;
 }
 
@@ -29,18 +31,19 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
         ok &= nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
-    ok &= nodes_alloc(mem, &web->f, n);
+    ok &= nodes_alloc(mem, &web->fmem, n);
+    web->f = web->fmem;
     ok &= nodes_alloc(mem, &web->xdet, n);
     ok &= nodes_alloc(mem, &web->xsub, n);
     ok &= nodes_alloc(mem, &web->vsub, n);
     ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
-    ok &= (web->tmp = ws_mem_calloc(mem, 3 * WS_WEB_CHUNK, sizeof(double))) != NULL;
+    ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->sa = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->sb = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
-    ok &= (web->inv_l0 = ws_mem_calloc(mem, ns ? ns : 1, sizeof(double))) != NULL;
+    ok &= (web->inv_l0 = ws_mem_calloc(mem, (size_t)ns + WS_WEB_PAD, sizeof(double))) != NULL;
     ok &= (web->kind = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint8_t))) != NULL;
     if (!ok) {
         ws_web_free(mem, web);
@@ -62,7 +65,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
-    nodes_free(mem, &web->f, web->n);
+    nodes_free(mem, &web->fmem, web->n);
     nodes_free(mem, &web->xdet, web->n);
     nodes_free(mem, &web->xsub, web->n);
     nodes_free(mem, &web->vsub, web->n);
@@ -71,16 +74,27 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
     ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
     ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
-    ws_mem_free(mem, web->tmp, 3 * WS_WEB_CHUNK * sizeof(double));
+    ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
     ws_mem_free(mem, web->sa, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->sb, ns * sizeof(uint32_t));
-    ws_mem_free(mem, web->inv_l0, ns * sizeof(double));
+    ws_mem_free(mem, web->inv_l0, ((size_t)web->ns + WS_WEB_PAD) * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free_str(mem, web->name);
     memset(web, 0, sizeof *web);
+}
+
+void ws_web_note_masses(ws_web *web)
+{
+    web->same_m = web->same_inv_m = web->n > 0;
+    for (uint32_t i = 1; i < web->n; i++) {
+        web->same_m &= web->m[i] == web->m[0];
+        web->same_inv_m &= web->inv_m[i] == web->inv_m[0];
+    }
+    web->m1 = web->n ? web->m[0] : 0.0;
+    web->inv_m1 = web->n ? web->inv_m[0] : 0.0;
 }
 
 /* The film form's force at (eps, eps_dot): computed, then selected, so it runs on vectors. */
@@ -180,14 +194,17 @@ static inline double film_pull(const ws_spring_form *p, double dx, double dy, do
 
 /* Springs from node a + i to node a + i + 1, i in [0, m), all of one law, with rest lengths
  * inv_l0[i]: the force on the first end (the second gets its opposite) into tx, ty, tz.
- * Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
+ * Straight-line code on contiguous arrays, so the compiler runs it on vectors. The law's film
+ * form comes as its five numbers, which a call passes in registers (a ws_spring_form goes
+ * through the stack). */
 WS_VECTOR_LOOP
-static void spring_run(const double *restrict x, const double *restrict y,
-                       const double *restrict z, const double *restrict vx,
-                       const double *restrict vy, const double *restrict vz, size_t m,
-                       const double *restrict inv_l0, ws_spring_form p, double *restrict tx,
+static void spring_run(const double *restrict x, const double *restrict y, const double *restrict z,
+                       const double *restrict vx, const double *restrict vy,
+                       const double *restrict vz, size_t m, const double *restrict inv_l0,
+                       double kc, double dk, double w, double qw, double c, double *restrict tx,
                        double *restrict ty, double *restrict tz)
 {
+    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
     for (size_t i = 0; i < m; i++) {
         double dx = x[i + 1] - x[i], dy = y[i + 1] - y[i], dz = z[i + 1] - z[i];
         double ux = vx[i + 1] - vx[i], uy = vy[i + 1] - vy[i], uz = vz[i + 1] - vz[i];
@@ -206,10 +223,12 @@ WS_VECTOR_LOOP
 static void spring_run_apply(const double *restrict x, const double *restrict y,
                              const double *restrict z, const double *restrict vx,
                              const double *restrict vy, const double *restrict vz, size_t stride,
-                             size_t m, const double *restrict inv_l0, ws_spring_form p,
-                             double *restrict fax, double *restrict fay, double *restrict faz,
-                             double *restrict fbx, double *restrict fby, double *restrict fbz)
+                             size_t m, const double *restrict inv_l0, double kc, double dk,
+                             double w, double qw, double c, double *restrict fax,
+                             double *restrict fay, double *restrict faz, double *restrict fbx,
+                             double *restrict fby, double *restrict fbz)
 {
+    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
     for (size_t i = 0; i < m; i++) {
         double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
         double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
@@ -248,84 +267,209 @@ static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spr
 }
 
 /* Gravity and node drag on nodes [n0, n1): the start of their force. */
-WS_VECTOR_LOOP
-static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+static inline void base_forces_of(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1, int same)
 {
-    const double c = web->damping;
+    const double c = web->damping, m1 = web->m1;
     const double *restrict m = web->m;
     double *restrict fx = web->f.x, *restrict fy = web->f.y, *restrict fz = web->f.z;
     /* The arrays into locals: loads through the struct would stay in the loop. */
     const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
     for (size_t i = n0; i < n1; i++) {
-        fx[i] = g.x * m[i] - c * vx[i];
-        fy[i] = g.y * m[i] - c * vy[i];
-        fz[i] = g.z * m[i] - c * vz[i];
+        const double mi = same ? m1 : m[i];
+        fx[i] = g.x * mi - c * vx[i];
+        fy[i] = g.y * mi - c * vy[i];
+        fz[i] = g.z * mi - c * vz[i];
     }
+}
+
+WS_VECTOR_LOOP
+static void base_forces_each(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    base_forces_of(web, v, g, n0, n1, 0);
+}
+
+WS_VECTOR_LOOP
+static void base_forces_same(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    base_forces_of(web, v, g, n0, n1, 1);
+}
+
+static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+{
+    if (web->same_m)
+        base_forces_same(web, v, g, n0, n1);
+    else
+        base_forces_each(web, v, g, n0, n1);
 }
 
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
 {
-    const double c = web->damping, m = web->m[i];
+    const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
     return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
  * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. */
-WS_VECTOR_LOOP
-static void row_forces(size_t k, v3 g, double c, const double *restrict m,
-                       const double *restrict vx, const double *restrict vy,
-                       const double *restrict vz, const double *restrict tx,
-                       const double *restrict ty, const double *restrict tz, double *restrict fx,
-                       double *restrict fy, double *restrict fz)
+ * order is that of the results (the state hash): keep it. Node i's mass is m[i], or m1 for
+ * every node when same (then m is not read). */
+static inline void row_forces_of(size_t k, v3 g, double c, const double *restrict m, double m1,
+                                 int same, int drag, const double *restrict vx,
+                                 const double *restrict vy, const double *restrict vz,
+                                 const double *restrict tx, const double *restrict ty,
+                                 const double *restrict tz, double *restrict fx,
+                                 double *restrict fy, double *restrict fz)
 {
     for (size_t i = 1; i < k; i++) {
-        fx[i] = g.x * m[i] - c * vx[i] + tx[i] - tx[i - 1];
-        fy[i] = g.y * m[i] - c * vy[i] + ty[i] - ty[i - 1];
-        fz[i] = g.z * m[i] - c * vz[i] + tz[i] - tz[i - 1];
+        const double mi = same ? m1 : m[i];
+        if (drag) {
+            fx[i] = g.x * mi - c * vx[i] + tx[i] - tx[i - 1];
+            fy[i] = g.y * mi - c * vy[i] + ty[i] - ty[i - 1];
+            fz[i] = g.z * mi - c * vz[i] + tz[i] - tz[i - 1];
+        } else {
+            fx[i] = g.x * mi + tx[i] - tx[i - 1];
+            fy[i] = g.y * mi + ty[i] - ty[i - 1];
+            fz[i] = g.z * mi + tz[i] - tz[i - 1];
+        }
     }
+}
+
+WS_VECTOR_LOOP
+static void row_forces_each(size_t k, v3 g, double c, const double *restrict m,
+                            const double *restrict vx, const double *restrict vy,
+                            const double *restrict vz, const double *restrict tx,
+                            const double *restrict ty, const double *restrict tz,
+                            double *restrict fx, double *restrict fy, double *restrict fz)
+{
+    row_forces_of(k, g, c, m, 0.0, 0, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+}
+
+WS_VECTOR_LOOP
+static void row_forces_same(size_t k, v3 g, double c, double m1, const double *restrict vx,
+                            const double *restrict vy, const double *restrict vz,
+                            const double *restrict tx, const double *restrict ty,
+                            const double *restrict tz, double *restrict fx, double *restrict fy,
+                            double *restrict fz)
+{
+    row_forces_of(k, g, c, NULL, m1, 1, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
+}
+
+/* Nodes of one mass and no drag (web->no_drag): the velocities are not read. */
+WS_VECTOR_LOOP
+static void row_forces_same_free(size_t k, v3 g, double m1, const double *restrict tx,
+                                 const double *restrict ty, const double *restrict tz,
+                                 double *restrict fx, double *restrict fy, double *restrict fz)
+{
+    row_forces_of(k, g, 0.0, NULL, m1, 1, 0, NULL, NULL, NULL, tx, ty, tz, fx, fy, fz);
+}
+
+/* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
+ * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
+ * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
+ * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 / length il[i], 0
+ * when the ends coincide (out: these four). The arithmetic of spring_run; taken apart from the
+ * rows, the division and square root of one row's wrap no longer hold up the rest of its
+ * forces. */
+WS_VECTOR_LOOP
+static void wrap_lanes(const double *restrict in, ws_spring_form p, double *restrict out)
+{
+    enum { L = WS_WEB_WRAPS };
+    for (size_t i = 0; i < L; i++) {
+        double dx = in[i], dy = in[L + i], dz = in[2 * L + i];
+        double ux = in[3 * L + i], uy = in[4 * L + i], uz = in[5 * L + i], il0 = in[6 * L + i];
+        double l2 = dx * dx + dy * dy + dz * dz;
+        double l = sqrt(l2);
+        double inv = 1.0 / l;
+        double il = l2 > 0.0 ? inv : 0.0;
+        double eps = l * il0 - 1.0;
+        double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
+        double q = film_force(&p, eps, epsd) * il;
+        out[i] = dx * q;
+        out[L + i] = dy * q;
+        out[2 * L + i] = dz * q;
+        out[3 * L + i] = il;
+    }
+}
+
+/* The wrap springs of rows [r, r + WS_WEB_WRAPS) (those below ny) into the web's scratch
+ * (wrap_lanes' out); lanes past the last row have ends that coincide. */
+static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, const ws_spring_form *p)
+{
+    enum { L = WS_WEB_WRAPS };
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    double in[7 * L];
+    for (size_t i = 0; i < L; i++) {
+        const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
+        const int row = r + i < ny;
+        in[i] = row ? x.x[b] - x.x[a] : 0.0;
+        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
+        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
+        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
+        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
+        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
+        in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
+    }
+    wrap_lanes(in, *p, web->tmp + 3 * WS_WEB_CHUNK);
 }
 
 /* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
  * form, with the base forces of nodes [a, a + m]: in chunks small enough for the scratch to
  * stay in the first-level cache, each chunk's forces computed, then put on its nodes in one
  * pass. A node at the start of a chunk after the first has had the previous chunk's spring
- * already and gets its right-hand one after it. */
-static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m,
-                       size_t s0, ws_spring_form p)
+ * already and gets its right-hand one after it. wrap, unless NULL, is the row's lane of
+ * wrap_rows' out: the wrap spring from node a + m to node a, which these two nodes get last. */
+static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m, size_t s0,
+                       const ws_spring_form *p, const double *wrap)
 {
     const double *il0 = web->inv_l0 + s0;
     const ws_nodes3 f = web->f;
     double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
+    v3 fw = v3_make(0.0, 0.0, 0.0);
+    if (wrap && wrap[3 * WS_WEB_WRAPS] != 0.0) /* else coincident ends: no direction to pull */
+        fw = v3_make(wrap[0], wrap[WS_WEB_WRAPS], wrap[2 * WS_WEB_WRAPS]);
+    else
+        wrap = NULL;
     for (size_t o = 0; o < m; o += WS_WEB_CHUNK) {
         size_t q = a + o, k = m - o < WS_WEB_CHUNK ? m - o : WS_WEB_CHUNK;
-        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, k, il0 + o, p, tx, ty,
-                   tz);
+        /* Whole vectors: up to three springs more, whose forces are not used, from the nodes
+         * after the row (the next row's, or the padding after the last) and the rest lengths
+         * after its springs. Cheaper than the left-over springs one at a time. */
+        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
+                   il0 + o, p->kc, p->dk, p->w, p->qw, p->c, tx, ty, tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
-        if (o == 0)
-            nodes_set(f, (uint32_t)q, v3_add(base_force(web, v, g, q), first));
-        else
+        if (o == 0) {
+            v3 fa = v3_add(base_force(web, v, g, q), first);
+            nodes_set(f, (uint32_t)q, wrap ? v3_add(fa, v3_scale(fw, -1.0)) : fa);
+        } else {
             nodes_add(f, (uint32_t)q, first);
-        row_forces(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
-                   f.x + q, f.y + q, f.z + q);
-        nodes_set(f, (uint32_t)(q + k), v3_sub(base_force(web, v, g, q + k), last));
+        }
+        if (web->same_m && web->no_drag)
+            row_forces_same_free(k, g, web->m1, tx, ty, tz, f.x + q, f.y + q, f.z + q);
+        else if (web->same_m)
+            row_forces_same(k, g, web->damping, web->m1, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                            f.x + q, f.y + q, f.z + q);
+        else
+            row_forces_each(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
+                            f.x + q, f.y + q, f.z + q);
+        v3 fb = v3_sub(base_force(web, v, g, q + k), last);
+        nodes_set(f, (uint32_t)(q + k), wrap && o + k == m ? v3_add(fb, fw) : fb);
     }
 }
 
 /* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
-static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0, ws_spring_form p)
+static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0,
+                      const ws_spring_form *p)
 {
     const size_t nx = (size_t)web->nx;
-    if (p.gen) {
+    if (p->gen) {
         for (size_t i = 0; i < nx; i++)
-            spring_one(web, x, v, (uint32_t)(s0 + i), p);
+            spring_one(web, x, v, (uint32_t)(s0 + i), *p);
         return;
     }
     ws_nodes3 f = web->f;
-    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx,
-                     web->inv_l0 + s0, p, f.x + a, f.y + a, f.z + a, f.x + a + nx, f.y + a + nx,
-                     f.z + a + nx);
+    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx, web->inv_l0 + s0,
+                     p->kc, p->dk, p->w, p->qw, p->c, f.x + a, f.y + a, f.z + a, f.x + a + nx,
+                     f.y + a + nx, f.z + a + nx);
 }
 
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
@@ -333,20 +477,27 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
 static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const ws_spring_form *P)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    const ws_spring_form p = P[WS_SPRING_AROUND];
+    const ws_spring_form *p = &P[WS_SPRING_AROUND];
     if (!web->law[WS_SPRING_AROUND] || nx < 2) {
         base_forces(web, v, g, nx * r, nx * (r + 1));
         return;
     }
-    if (p.gen) {
+    if (p->gen) {
         base_forces(web, v, g, nx * r, nx * (r + 1));
         for (size_t i = 0; i < nx - 1; i++)
-            spring_one(web, x, v, (uint32_t)(cols * r + i), p);
+            spring_one(web, x, v, (uint32_t)(cols * r + i), *p);
+        if (web->closed)
+            spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), *p);
+    } else if (web->closed) {
+        /* A sweep starts rows in order from row 0, so the first of each WS_WEB_WRAPS rows
+         * finds the wraps of them all. */
+        if (r % WS_WEB_WRAPS == 0)
+            wrap_rows(web, x, v, r, p);
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p,
+                   web->tmp + 3 * WS_WEB_CHUNK + r % WS_WEB_WRAPS);
     } else {
-        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p);
+        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p, NULL);
     }
-    if (web->closed)
-        spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), p);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
@@ -359,9 +510,16 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 {
     /* The laws' parameters by spring kind, taken once a sweep and hoisted out of the loops. */
     const ws_spring_form *P = web->form;
-    if (k == 0)
+    if (k == 0) {
         for (int q = 0; q < 3; q++)
             web->form[q] = form_of(web->law[q], t, since);
+        /* Without drag, gravity and drag m g - c v is m g to the bit: c v is a zero (the
+         * velocities are finite, or the step fails on them), which leaves any m g but -0 as
+         * it is. */
+        web->no_drag = web->damping == 0.0 && !signbit(web->damping) &&
+                       !(g.x == 0.0 && signbit(g.x)) && !(g.y == 0.0 && signbit(g.y)) &&
+                       !(g.z == 0.0 && signbit(g.z));
+    }
     if (web->nx == 0) {
         base_forces(web, v, g, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
@@ -379,7 +537,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     if (j + 1 < ny) {
         grid_row(web, x, v, g, j + 1, P);
         if (web->law[WS_SPRING_UP])
-            spring_up(web, x, v, nx * j, cols * ny + nx * j, P[WS_SPRING_UP]);
+            spring_up(web, x, v, nx * j, cols * ny + nx * j, &P[WS_SPRING_UP]);
         size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
         if (shear0 < web->ns)
             for (size_t s = shear0; s < shear0 + 2 * cols; s++)
@@ -390,28 +548,33 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1. Distinct arrays (restrict), so the loop runs on vectors. Returns how
- * many nodes end faster than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count,
- * so the loop keeps its vectors, and taken from the new velocity while it is at hand. */
-WS_VECTOR_LOOP
-static size_t advance(size_t m, double h, double lim2, const double *restrict im,
-                      const double *restrict fx, const double *restrict fy,
-                      const double *restrict fz, const double *restrict vx0,
-                      const double *restrict vy0, const double *restrict vz0,
-                      const double *restrict x0, const double *restrict y0,
-                      const double *restrict z0, double *restrict vx1, double *restrict vy1,
-                      double *restrict vz1, double *restrict x1, double *restrict y1,
-                      double *restrict z1)
+ * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out); 1 / m is
+ * im[i], or im1 > 0 for every node when same (none pinned; im is not read). Distinct arrays
+ * otherwise (restrict), so the loop runs on vectors. Returns how many nodes end faster than
+ * sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its vectors,
+ * and taken from the new velocity while it is at hand. */
+static inline size_t advance_of(size_t m, double h, double lim2, const double *restrict im,
+                                double im1, int same, const double *restrict vx0,
+                                const double *restrict vy0, const double *restrict vz0,
+                                const double *restrict x0, const double *restrict y0,
+                                const double *restrict z0, double *restrict fvx,
+                                double *restrict fvy, double *restrict fvz, double *restrict x1,
+                                double *restrict y1, double *restrict z1)
 {
     size_t bad = 0;
     for (size_t i = 0; i < m; i++) {
         /* Computed, then selected: no branch. */
-        double unpinned = (double)(im[i] != 0.0), hi = h * im[i];
-        double ux = (vx0[i] + hi * fx[i]) * unpinned, uy = (vy0[i] + hi * fy[i]) * unpinned,
-               uz = (vz0[i] + hi * fz[i]) * unpinned;
-        vx1[i] = ux;
-        vy1[i] = uy;
-        vz1[i] = uz;
+        const double imi = same ? im1 : im[i];
+        double unpinned = (double)(imi != 0.0), hi = h * imi;
+        double ux = vx0[i] + hi * fvx[i], uy = vy0[i] + hi * fvy[i], uz = vz0[i] + hi * fvz[i];
+        if (!same) { /* else none is pinned: the product by 1 would change nothing */
+            ux *= unpinned;
+            uy *= unpinned;
+            uz *= unpinned;
+        }
+        fvx[i] = ux;
+        fvy[i] = uy;
+        fvz[i] = uz;
         x1[i] = x0[i] + h * ux;
         y1[i] = y0[i] + h * uy;
         z1[i] = z0[i] + h * uz;
@@ -420,13 +583,49 @@ static size_t advance(size_t m, double h, double lim2, const double *restrict im
     return bad;
 }
 
+WS_VECTOR_LOOP
+static size_t advance_each(size_t m, double h, double lim2, const double *restrict im,
+                           const double *restrict vx0, const double *restrict vy0,
+                           const double *restrict vz0, const double *restrict x0,
+                           const double *restrict y0, const double *restrict z0,
+                           double *restrict fvx, double *restrict fvy, double *restrict fvz,
+                           double *restrict x1, double *restrict y1, double *restrict z1)
+{
+    return advance_of(m, h, lim2, im, 0.0, 0, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1, z1);
+}
+
+WS_VECTOR_LOOP
+static size_t advance_same(size_t m, double h, double lim2, double im1, const double *restrict vx0,
+                           const double *restrict vy0, const double *restrict vz0,
+                           const double *restrict x0, const double *restrict y0,
+                           const double *restrict z0, double *restrict fvx, double *restrict fvy,
+                           double *restrict fvz, double *restrict x1, double *restrict y1,
+                           double *restrict z1)
+{
+    return advance_of(m, h, lim2, NULL, im1, 1, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1,
+                      z1);
+}
+
+void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd)
+{
+    web->f = vd;
+}
+
+void ws_web_sweep_end(ws_web *web)
+{
+    web->f = web->fmem;
+}
+
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
-    const ws_nodes3 f = web->f;
-    return advance(n1 - n0, h, vmax * vmax, web->inv_m + n0, f.x + n0, f.y + n0, f.z + n0,
-                   vs.x + n0, vs.y + n0, vs.z + n0, xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0,
-                   vd.y + n0, vd.z + n0, xd.x + n0, xd.y + n0, xd.z + n0);
+    if (web->same_inv_m && web->inv_m1 != 0.0)
+        return advance_same(n1 - n0, h, vmax * vmax, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
+                            xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
+                            xd.x + n0, xd.y + n0, xd.z + n0);
+    return advance_each(n1 - n0, h, vmax * vmax, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
+                        xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
+                        xd.y + n0, xd.z + n0);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)

@@ -58,6 +58,9 @@ static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
 }
 
 #define WS_WEB_CHUNK 256 /* springs evaluated at once */
+#define WS_WEB_PAD 4     /* doubles of padding after node vectors and rest lengths (web.c) */
+#define WS_WEB_WRAPS 4   /* wrap springs of a closed band evaluated at once */
+#define WS_WEB_TMP (3 * WS_WEB_CHUNK + 4 * WS_WEB_WRAPS) /* doubles of ws_web.tmp */
 
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
  * reference body (see ws_web): its CoG (rho) and orientation (q) in the reference body's
@@ -90,17 +93,26 @@ typedef struct ws_web {
     uint32_t n, ns;          /* nodes, springs */
     int nx, ny, closed;      /* grid: node i + nx j; 0 for a mesh web */
     ws_nodes3 x[2], v[2];    /* state, double-buffered like the bodies' */
-    ws_nodes3 f;             /* force accumulator (scratch) */
+    ws_nodes3 f;             /* force accumulator (scratch): in a sweep, the velocities it
+                                writes (ws_web_sweep_begin), else fmem */
+    ws_nodes3 fmem;          /* scratch of n nodes' vectors (node_bounds, writers) */
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
-    double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK (scratch) */
+    double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
+                                WS_WEB_WRAPS wrap springs (scratch, WS_WEB_TMP) */
     ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
+    int no_drag;             /* the running sweep's nodes have no drag (scratch) */
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
                                 zeroed at the start of a step that writes fc[k] */
     size_t nfct[2], fct_cap[2];
     int fck;                 /* the fc the contacts of the running step add to (scratch) */
     double *m, *inv_m;       /* inv_m = 0: pinned */
+    /* When every node has the same mass (same_m) or the same inverse mass (same_inv_m: the
+     * same mass and none pinned), it is m1 or inv_m1, and the sweep reads it in place of the
+     * array (ws_web_note_masses). */
+    int same_m, same_inv_m;
+    double m1, inv_m1;
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
@@ -158,6 +170,8 @@ typedef struct ws_web {
     int refresh;
 } ws_web;
 
+/* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */
+void ws_web_note_masses(ws_web *web);
 /* Allocate a web of n nodes and ns springs (zeroed). */
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns);
 void ws_web_free(ws_mem *mem, ws_web *web);
@@ -175,9 +189,15 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
-/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v'. Returns how many
- * of them end faster than vmax (m/s) or with a NaN speed. Source and destination are
- * distinct. */
+/* A sweep that writes the velocities vd keeps the nodes' forces in vd until it integrates
+ * them, in place of an array of its own: each node's force is complete before its new
+ * velocity is written over it, and the state the sweep streams is smaller by an n-node array
+ * (f is then vd; ws_web_sweep_end makes it the scratch again). */
+void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd);
+void ws_web_sweep_end(ws_web *web);
+/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v', f read from vd
+ * (ws_web_sweep_begin). Returns how many of them end faster than vmax (m/s) or with a NaN
+ * speed. Source and destination are distinct. */
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax);
 /* The largest node speed in v (NaN when one is NaN), m/s. */

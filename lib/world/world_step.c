@@ -255,6 +255,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
             size_t next = 0, fast = 0;
+            ws_web_sweep_begin(web, vd);
             for (uint32_t q = 0; q < blocks; q++) {
                 uint32_t n0, n1;
                 ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
@@ -264,6 +265,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                  web->bmoment[nxt], &w->stats.narrow_checks);
                 fast += ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1, w->def.max_speed);
             }
+            ws_web_sweep_end(web);
             xs = xd;
             vs = vd;
             if (web->law_failed) {

@@ -167,6 +167,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
                            c->label, pinned[k]);
         web->inv_m[pinned[k]] = 0.0;
     }
+    ws_web_note_masses(web);
     web->layer = c->d.contact_layer;
     web->material = c->material;
     web->damping = c->d.node_damping;
