@@ -830,6 +830,85 @@ START_TEST(corners_need_flat_faces)
 }
 END_TEST
 
+/* The detection marks a node's candidates of a body as a corner (WS_NCAND_CORNER on the first)
+ * when they are two faces and then the edge between them on a flat convex shape, and only then:
+ * the node contacts take the planes' short cut for those alone. A node 0.5 mm out of the +x
+ * and +z planes of a unit cube, midway along their edge, is a corner of the box and of the cube
+ * mesh, not of the cube whose top bends 1e-8 m (corners_need_flat_faces); a node 0.5 mm out of
+ * three planes at a vertex (three faces, three edges), or out of two and 3 mm behind the third
+ * (two faces, three edges), is no corner of any. */
+START_TEST(corners_are_marked_by_the_detection)
+{
+    double v[24];
+    memcpy(v, cube_v, sizeof v);
+    v[3 * 5 + 2] -= 1e-8;
+    for (int k = 0; k < 3; k++) {
+        ws_world_def d;
+        ws_world_def_init(&d);
+        d.gravity = (ws_vec3){0, 0, 0};
+        d.dt = 2.5e-4;
+        ws_world *w;
+        ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+        ws_shape_id shape;
+        if (k == 0)
+            ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
+        else
+            ck_ok(w, create_mesh(w, k == 1 ? cube_v : v, 8, cube_t, 12, &shape));
+        ws_body_def bd;
+        ws_body_def_init(&bd);
+        bd.type = WS_BODY_KINEMATIC;
+        bd.shape = shape;
+        ws_body_id body;
+        ck_ok(w, ws_body_create(w, &bd, &body));
+        ws_web_def wd;
+        soft_film(w, &wd);
+        const double o = 0.5 + 0.5e-3;
+        const double pos[12] = {o, 0.0, o, o, o, o, o, 0.497, o, 3.0, 3.0, 3.0};
+        const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
+        ws_web_mesh_def mesh;
+        ws_web_mesh_def_init(&mesh);
+        mesh.positions = pos;
+        mesh.node_count = 4;
+        mesh.springs = spring;
+        mesh.spring_count = 3;
+        mesh.pinned = pin;
+        mesh.pinned_count = 1;
+        ws_web_id web;
+        ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, &web));
+        ck_ok(w, ws_world_step(w));
+        const ws_web *wb = only_web(w);
+        const ws_ncand *c = wb->cand[wb->next_list];
+        int count[3] = {0, 0, 0}, marked[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
+        for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+            ck_assert_uint_lt(c[q].node, 3);
+            count[c[q].node]++;
+            marked[c[q].node] += (c[q].local & WS_NCAND_CORNER) != 0;
+            edges[c[q].node] += (c[q].local & WS_NCAND_EDGE) != 0;
+        }
+        report("shape %d: node at an edge: %d candidates (%d edges), %d marked; node at a vertex: "
+               "%d candidates (%d edges), %d marked; node near a vertex: %d candidates (%d edges), "
+               "%d marked",
+               k, count[0], edges[0], marked[0], count[1], edges[1], marked[1], count[2], edges[2],
+               marked[2]);
+        ck_assert_msg(count[0] == 3 && edges[0] == 1,
+                      "shape %d: the node at the edge has %d candidates (%d edges)", k, count[0],
+                      edges[0]);
+        ck_assert_msg(count[1] == 6 && edges[1] == 3,
+                      "shape %d: the node at the vertex has %d candidates (%d edges)", k, count[1],
+                      edges[1]);
+        ck_assert_msg(count[2] == 5 && edges[2] == 3,
+                      "shape %d: the node near the vertex has %d candidates (%d edges)", k,
+                      count[2], edges[2]);
+        ck_assert_msg(marked[0] == (k < 2) && marked[1] == 0 && marked[2] == 0,
+                      "shape %d: %d marked at the edge, %d and %d at the vertex", k, marked[0],
+                      marked[1], marked[2]);
+        if (k < 2)
+            ck_assert(c[0].local & WS_NCAND_CORNER); /* on the first of the three */
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 START_TEST(film_detection_does_not_change_the_motion)
 {
     film_detection_case(0);
@@ -856,6 +935,7 @@ int main(void)
     tcase_add_test(tc, film_node_past_an_edge_end);
     tcase_add_test(tc, edges_of_faces_a_node_is_well_inside_of_are_dropped);
     tcase_add_test(tc, corners_need_flat_faces);
+    tcase_add_test(tc, corners_are_marked_by_the_detection);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -525,6 +525,22 @@ static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_nca
     return 0;
 }
 
+/* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
+ * (WS_NCAND_CORNER on the first) when they are two faces and then the edge between them, on a
+ * flat convex shape, where the contacts tell them apart by the two faces' planes. */
+static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
+{
+    if (n - n0 != 3 || !sh->convex || !sh->flat)
+        return;
+    const uint32_t a = out[n0].local, z = out[n0 + 1].local, e = out[n0 + 2].local;
+    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(e & WS_NCAND_EDGE))
+        return;
+    const ws_edge *E = &sh->edges[e & ~WS_NCAND_FLAGS];
+    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
+    if ((E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa))
+        out[n0].local |= WS_NCAND_CORNER;
+}
+
 /* ---- the search
  *
  * Nodes are taken FIND_CHUNK at a time. For each body, in slot order, the nodes of the group in
@@ -676,6 +692,7 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
     const v3 s = v3_make(v[V_X * FIND_CHUNK], v[V_Y * FIND_CHUNK], v[V_Z * FIND_CHUNK]);
     const uint64_t boxes = mk[M_BOXES * FIND_CHUNK];
     const uint64_t outside = mk[M_OUT * FIND_CHUNK];
+    const size_t n0 = *n;
     *checks += nf;
     /* Well inside a face's outline: its projection on the plane lies a margin or more behind
      * every other face's plane (those planes bound the face on a convex body, and a plane
@@ -713,6 +730,7 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
             push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
             return -1;
     }
+    mark_corner(sh, *out, n0, *n);
     return 0;
 }
 
@@ -725,6 +743,7 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
     v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
     if (!inside_box(s, sh->lo, sh->hi, reach))
         return 0;
+    const size_t n0 = *n;
     /* On a convex body a node touches face f only while f is the face whose plane it is
      * farthest out of (the largest signed distance D): over a face it projects into, d_g <= d_f
      * for every other face g, and inside the body the shallowest face is the one of largest d.
@@ -762,6 +781,7 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
             push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
             return -1;
     }
+    mark_corner(sh, *out, n0, *n);
     return 0;
 }
 

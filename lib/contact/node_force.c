@@ -332,19 +332,6 @@ static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *
     return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
 }
 
-/* Whether c[0, 3) (all there) are a corner: two faces of a node on a flat convex shape, then
- * the edge between them. */
-static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
-{
-    const uint32_t a = c[0].local, z = c[1].local;
-    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(c[2].local & WS_NCAND_EDGE) ||
-        !sh->convex || !sh->flat)
-        return 0;
-    const ws_edge *E = &sh->edges[c[2].local & ~WS_NCAND_FLAGS];
-    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
-    return (E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa);
-}
-
 /* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
  * to their full tests, one bit each: a face within the window's top and not turned down, the
  * edge unless turned down. */
@@ -366,8 +353,9 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
 }
 
 /* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
- * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
- * first, and only what they leave takes the tests. */
+ * contacts that push into the list. A corner (marked WS_NCAND_CORNER by the detection, which
+ * looks at a node's candidates once where this pass would every sub-step) is told apart by its
+ * faces' planes first, and only what they leave takes the tests. */
 static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
     const ws_body_store *b = E->b;
@@ -378,21 +366,24 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
     for (size_t k = 0; k < n;) {
         const ws_ncand *c0 = &cand[k];
         const uint32_t i = c0->node, bi = c0->body;
-        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
-         * their tests. */
-        size_t e = k + 1;
-        while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
-            e++;
         const ws_shape *sh = b->shape[bi];
         const v3 xi = nodes_get(x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
-        uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
-        if (e - k == 3 && !E->web->runs_off && is_corner(sh, c0)) {
+        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
+         * their tests: a corner's three (marked by the detection) as its planes leave them. */
+        uint32_t left;
+        if ((c0->local & WS_NCAND_CORNER) && !E->web->runs_off) {
             left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
             E->web->corners++;
+            k += 3;
+        } else {
+            size_t e = k + 1;
+            while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
+                e++;
+            left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
+            k = e;
         }
-        k = e;
         for (; left; left &= left - 1) {
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
