@@ -300,6 +300,20 @@ NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t b
               E->st->r[bi], E->st->v[bi], b->wg[bi], &E->pp[b->material[bi]]);
 }
 
+/* Whether the face of candidate c (of body bi, shape sh) is the shallowest for a node at
+ * (xx, xy, xz) under it at depth d. Out of line: the few nodes below a face need it, and
+ * inlined its values would crowd contacts_general's registers. */
+NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
+                                       const ws_ncand *c, double xx, double xy, double xz,
+                                       double d)
+{
+    const uint32_t f = c->local & ~WS_NCAND_FLAGS;
+    const v3 xi = v3_make(xx, xy, xz);
+    if (sh->convex)
+        return convex_shallowest(E->g, c->feat - f, sh->face_count, f, xi, d);
+    return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+}
+
 /* ---- a node at a convex body's edge
  *
  * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
@@ -400,13 +414,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
                  * candidates are valid: no need to find its triangle. */
                 if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
                     continue;
-                uint32_t f = c->local & ~WS_NCAND_FLAGS;
-                if (d < 0.0 &&
-                    !(sh->convex
-                          ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                          : ws_shallowest_face(sh, f,
-                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                               d)))
+                if (d < 0.0 && !shallowest(E, sh, bi, c, xi.x, xi.y, xi.z, d))
                     continue;
                 nrm = F->n; /* from the body to the node */
             }
