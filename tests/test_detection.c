@@ -909,6 +909,118 @@ START_TEST(corners_are_marked_by_the_detection)
 }
 END_TEST
 
+/* A film of three free nodes, tied to a fourth pinned far off, near an edge of a kinematic
+ * body at the origin, with the short cuts off when runs_off. Prism 0: a unit box, the nodes
+ * near its +x/+z edge, 0.5 mm out of one plane and 1e-9 m under the other, or 0.3 mm out of
+ * both. Prism 1: a prism on an equilateral triangle (its edges' faces 60 degrees apart, their
+ * normals' dot product -0.5), the nodes by its top edge, 0.5 mm out of one plane and 1e-9 m
+ * under the other, which lies a quarter millimetre out of the first face's plane. */
+static ws_world *edge_film_world(int prism, int runs_off, ws_web_id *web)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.gravity = (ws_vec3){0, 0, 0};
+    d.dt = 2.5e-4;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    const double h = 0.5 * sqrt(3.0);
+    const double pv[18] = {0, -0.5, 0, 1, -0.5, 0, 0.5, -0.5, h, 0, 0.5, 0, 1, 0.5, 0, 0.5, 0.5, h};
+    const uint32_t pt[24] = {0, 4, 1, 0, 3, 4, /* bottom */ 0, 1, 2, 3, 5, 4, /* ends */
+                             1, 4, 5, 1, 5, 2, /* right */ 0,  2, 5, 0, 5, 3 /* left */};
+    ws_shape_id shape;
+    if (prism)
+        ck_ok(w, create_mesh(w, pv, 6, pt, 8, &shape));
+    else
+        ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = shape;
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    ws_web_def wd;
+    soft_film(w, &wd);
+    double pos[12];
+    if (prism) {
+        /* From the top edge (recentred) by a along the left face's normal (-h, 0, 1/2) and b
+         * along the right one's (h, 0, 1/2): out of the left plane by a - b / 2 = -1e-9 m and
+         * of the right one by b - a / 2 = 0.5 mm; the second node mirrored, the third 0.3 mm
+         * out of both (a = b = 0.6 mm). */
+        ws_shape_info si;
+        ck_ok(w, ws_shape_get_info(w, shape, &si));
+        const double b = (0.5e-3 - 0.5e-9) / 0.75, a = 0.5 * b - 1e-9;
+        const double rx[3] = {h * (b - a), h * (a - b), 0.0},
+                     rz[3] = {0.5 * (a + b), 0.5 * (a + b), 0.6e-3};
+        for (int i = 0; i < 3; i++) {
+            pos[3 * i] = 0.5 - si.centroid.x + rx[i];
+            pos[3 * i + 1] = 0.1 * (i - 1);
+            pos[3 * i + 2] = h - si.centroid.z + rz[i];
+        }
+    } else {
+        const double o = 0.5 + 0.5e-3, u = 0.5 - 1e-9, e = 0.5 + 0.3e-3;
+        const double q[9] = {o, 0.0, u, u, 0.1, o, e, -0.1, e};
+        memcpy(pos, q, sizeof q);
+    }
+    pos[9] = pos[10] = pos[11] = 3.0;
+    const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
+    ws_web_mesh_def mesh;
+    ws_web_mesh_def_init(&mesh);
+    mesh.positions = pos;
+    mesh.node_count = 4;
+    mesh.springs = spring;
+    mesh.spring_count = 3;
+    mesh.pinned = pin;
+    mesh.pinned_count = 1;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, web));
+    only_web(w)->runs_off = runs_off;
+    return w;
+}
+
+/* At a corner the planes may spare the edge its tests of direction (in_wedge), but only where
+ * they show the node in the edge's region by their margin: a node 1e-9 m under one face's
+ * plane is not (on the box the other face holds it, not the edge; on the prism's sharp edge
+ * neither), one 0.3 mm out of both planes of the box is. The first step's contact forces are
+ * those of every candidate through its full tests, to the bit. */
+START_TEST(corner_edge_tests_spared_only_in_its_region)
+{
+    for (int prism = 0; prism < 2; prism++) {
+        ws_web_id wa, wb;
+        ws_world *a = edge_film_world(prism, 1, &wa), *b = edge_film_world(prism, 0, &wb);
+        ck_ok(a, ws_world_step(a));
+        ck_ok(b, ws_world_step(b));
+        ck_assert_uint_eq(only_web(a)->corners, 0);
+        ck_assert_uint_eq(only_web(b)->corners, 3);
+        double fa[12], fb[12];
+        size_t n;
+        ck_ok(a, ws_web_copy_contact_forces(a, wa, fa, 4, &n));
+        ck_ok(b, ws_web_copy_contact_forces(b, wb, fb, 4, &n));
+        report("node contact forces at the edge of %s: (%.3g %.3g %.3g), (%.3g %.3g %.3g), "
+               "(%.3g %.3g %.3g) N",
+               prism ? "the prism" : "the box", fb[0], fb[1], fb[2], fb[3], fb[4], fb[5], fb[6],
+               fb[7], fb[8]);
+        for (int i = 0; i < 12; i++)
+            ck_assert_msg(fa[i] == fb[i],
+                          "node %d: contact force %.17g with the short cuts, "
+                          "%.17g without",
+                          i / 3, fb[i], fa[i]);
+        if (prism) {
+            /* The first two are over no face and behind a plane: no contact; the third is the
+             * edge's. */
+            for (int i = 0; i < 6; i++)
+                ck_assert(fb[i] == 0.0);
+            ck_assert(fb[6] == 0.0 && fb[8] > 0.0);
+        } else {
+            /* The first two are held by one face, along its normal; the third by the edge. */
+            ck_assert(fb[0] > 0.0 && fb[1] == 0.0 && fb[2] == 0.0);
+            ck_assert(fb[3] == 0.0 && fb[4] == 0.0 && fb[5] > 0.0);
+            ck_assert(fb[6] > 0.0 && fb[8] > 0.0);
+        }
+        ws_world_destroy(a);
+        ws_world_destroy(b);
+    }
+}
+END_TEST
+
 START_TEST(film_detection_does_not_change_the_motion)
 {
     film_detection_case(0);
@@ -936,6 +1048,7 @@ int main(void)
     tcase_add_test(tc, edges_of_faces_a_node_is_well_inside_of_are_dropped);
     tcase_add_test(tc, corners_need_flat_faces);
     tcase_add_test(tc, corners_are_marked_by_the_detection);
+    tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

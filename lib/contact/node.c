@@ -941,6 +941,7 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
             o->n1 = m3_mul_v(A, E->n1);
             o->n2 = m3_mul_v(A, E->n2);
             o->inv_e2 = 1.0 / v3_dot(d, d);
+            o->c = v3_dot(o->n1, o->n2);
         }
         fo += sh->face_count;
         to += sh->triangle_count;

@@ -22,8 +22,9 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
 /* A node against the rounded rim of a convex edge: only in the edge's own region, where the
  * direction from the edge to the node lies strictly between the normals of its two faces
  * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
- * to the node and the distance. */
-static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *dist)
+ * to the node and the distance. `sure`: the faces' planes have shown the direction to lie
+ * between the normals (corner_left), which is then not tested again. */
+static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
     double t = v3_dot(rp, E->e) * E->inv_e2;
@@ -34,13 +35,17 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *
     if (!(l2 < hi * hi) || !(l2 > 0.0))
         return 0;
     /* Outside both faces' planes: in the wedge between them. */
-    if (!(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
+    if (!sure && !(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
         return 0;
     /* And not over either face: r = a n1 + b n2 with a, b > 0. */
-    double c = v3_dot(E->n1, E->n2), r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
-    double den = 1.0 - c * c;
-    if (den < 1e-12 || !(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+    const double c = E->c, den = 1.0 - c * c;
+    if (den < 1e-12)
         return 0;
+    if (!sure) {
+        const double r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
+        if (!(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+            return 0;
+    }
     double l = sqrt(l2);
     *nrm = v3_scale(r, 1.0 / l);
     *dist = l;
@@ -348,9 +353,12 @@ static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *
 
 /* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
  * to their full tests, one bit each: a face within the window's top and not turned down, the
- * edge unless turned down. */
+ * edge unless turned down. *sure: the node lies out of both planes and each face's projection
+ * of it out of the other's plane, by eps, so that in_wedge's tests of the direction (r . n1,
+ * r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off, as for
+ * turning the edge down) hold and need not be taken. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
-                                   v3 xi, v3 r, double hi, corner_memo *memo)
+                                   v3 xi, v3 r, double hi, corner_memo *memo, int *sure)
 {
     const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
     /* The planes' distances as the one-by-one pass takes them. */
@@ -363,6 +371,7 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
     const double dmax = dA > dB ? dA : dB;
     const uint32_t e = (qA > -eps) & (qB > -eps) & (dmax < hi + eps);
+    *sure = (qA > eps) & (qB > eps) & (dA > eps) & (dB > eps);
     return a | z << 1 | e << 2;
 }
 
@@ -387,8 +396,9 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
          * their tests: a corner's three (marked by the detection) as its planes leave them. */
         uint32_t left;
+        int sure = 0;
         if ((c0->local & WS_NCAND_CORNER) && !E->web->runs_off) {
-            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo, &sure);
             E->web->corners++;
             k += 3;
         } else {
@@ -403,7 +413,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             v3 nrm;
             double d;
             if (c->local & WS_NCAND_EDGE) {
-                if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
+                if (!in_wedge(&g->edge[c->feat], xi, hi, sure, &nrm, &d))
                     continue;
             } else {
                 const ws_wface *F = &g->face[c->feat];
