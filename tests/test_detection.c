@@ -909,13 +909,29 @@ START_TEST(corners_are_marked_by_the_detection)
 }
 END_TEST
 
-/* A film of three free nodes, tied to a fourth pinned far off, near an edge of a kinematic
- * body at the origin, with the short cuts off when runs_off. Prism 0: a unit box, the nodes
- * near its +x/+z edge, 0.5 mm out of one plane and 1e-9 m under the other, or 0.3 mm out of
- * both. Prism 1: a prism on an equilateral triangle (its edges' faces 60 degrees apart, their
- * normals' dot product -0.5), the nodes by its top edge, 0.5 mm out of one plane and 1e-9 m
- * under the other, which lies a quarter millimetre out of the first face's plane. */
-static ws_world *edge_film_world(int prism, int runs_off, ws_web_id *web)
+/* The prism on an equilateral triangle of side 1 m in the xz plane, 1 m long along y: its
+ * edges' faces stand 60 degrees apart, their normals' dot product is -0.5. */
+static const double prism_h = 0.86602540378443864676; /* sqrt(3) / 2 */
+static const double prism_v[18] = {0, -0.5, 0, 1, -0.5, 0, 0.5, -0.5, 0.86602540378443864676,
+                                   0, 0.5,  0, 1, 0.5,  0, 0.5, 0.5,  0.86602540378443864676};
+static const uint32_t prism_t[24] = {0, 4, 1, 0, 3, 4, /* bottom */ 0, 1, 2, 3, 5, 4, /* ends */
+                                     1, 4, 5, 1, 5, 2, /* right */ 0,  2, 5, 0, 5, 3 /* left */};
+
+/* From the prism's top edge, at y: out of its left face's plane (normal (-h, 0, 1/2)) by dl
+ * and of its right one's ((h, 0, 1/2)) by dr, into o: a dl-plane distance a - b / 2 and a
+ * dr one b - a / 2 for a and b along the two normals. */
+static void prism_offset(double dl, double dr, double y, double *o)
+{
+    const double a = (dl + 0.5 * dr) / 0.75, b = (dr + 0.5 * dl) / 0.75;
+    o[0] = prism_h * (b - a);
+    o[1] = y;
+    o[2] = 0.5 * (a + b);
+}
+
+/* A film of three free nodes, tied to a fourth pinned far off, at offsets off (9 values) from
+ * an edge of a kinematic body at the origin, with the short cuts off when runs_off: the unit
+ * box's +x/+z edge, or the prism's top edge. */
+static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_web_id *web)
 {
     ws_world_def d;
     ws_world_def_init(&d);
@@ -923,15 +939,13 @@ static ws_world *edge_film_world(int prism, int runs_off, ws_web_id *web)
     d.dt = 2.5e-4;
     ws_world *w;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
-    const double h = 0.5 * sqrt(3.0);
-    const double pv[18] = {0, -0.5, 0, 1, -0.5, 0, 0.5, -0.5, h, 0, 0.5, 0, 1, 0.5, 0, 0.5, 0.5, h};
-    const uint32_t pt[24] = {0, 4, 1, 0, 3, 4, /* bottom */ 0, 1, 2, 3, 5, 4, /* ends */
-                             1, 4, 5, 1, 5, 2, /* right */ 0,  2, 5, 0, 5, 3 /* left */};
     ws_shape_id shape;
     if (prism)
-        ck_ok(w, create_mesh(w, pv, 6, pt, 8, &shape));
+        ck_ok(w, create_mesh(w, prism_v, 6, prism_t, 8, &shape));
     else
         ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
+    ws_shape_info si;
+    ck_ok(w, ws_shape_get_info(w, shape, &si));
     ws_body_def bd;
     ws_body_def_init(&bd);
     bd.type = WS_BODY_KINEMATIC;
@@ -940,26 +954,13 @@ static ws_world *edge_film_world(int prism, int runs_off, ws_web_id *web)
     ck_ok(w, ws_body_create(w, &bd, &body));
     ws_web_def wd;
     soft_film(w, &wd);
+    /* The edge in the body's frame, which the shape's centroid is the origin of. */
+    const double ex = prism ? 0.5 - si.centroid.x : 0.5, ez = prism ? prism_h - si.centroid.z : 0.5;
     double pos[12];
-    if (prism) {
-        /* From the top edge (recentred) by a along the left face's normal (-h, 0, 1/2) and b
-         * along the right one's (h, 0, 1/2): out of the left plane by a - b / 2 = -1e-9 m and
-         * of the right one by b - a / 2 = 0.5 mm; the second node mirrored, the third 0.3 mm
-         * out of both (a = b = 0.6 mm). */
-        ws_shape_info si;
-        ck_ok(w, ws_shape_get_info(w, shape, &si));
-        const double b = (0.5e-3 - 0.5e-9) / 0.75, a = 0.5 * b - 1e-9;
-        const double rx[3] = {h * (b - a), h * (a - b), 0.0},
-                     rz[3] = {0.5 * (a + b), 0.5 * (a + b), 0.6e-3};
-        for (int i = 0; i < 3; i++) {
-            pos[3 * i] = 0.5 - si.centroid.x + rx[i];
-            pos[3 * i + 1] = 0.1 * (i - 1);
-            pos[3 * i + 2] = h - si.centroid.z + rz[i];
-        }
-    } else {
-        const double o = 0.5 + 0.5e-3, u = 0.5 - 1e-9, e = 0.5 + 0.3e-3;
-        const double q[9] = {o, 0.0, u, u, 0.1, o, e, -0.1, e};
-        memcpy(pos, q, sizeof q);
+    for (int i = 0; i < 3; i++) {
+        pos[3 * i] = ex + off[3 * i];
+        pos[3 * i + 1] = off[3 * i + 1];
+        pos[3 * i + 2] = ez + off[3 * i + 2];
     }
     pos[9] = pos[10] = pos[11] = 3.0;
     const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
@@ -977,15 +978,24 @@ static ws_world *edge_film_world(int prism, int runs_off, ws_web_id *web)
 }
 
 /* At a corner the planes may spare the edge its tests of direction (in_wedge), but only where
- * they show the node in the edge's region by their margin: a node 1e-9 m under one face's
- * plane is not (on the box the other face holds it, not the edge; on the prism's sharp edge
- * neither), one 0.3 mm out of both planes of the box is. The first step's contact forces are
- * those of every candidate through its full tests, to the bit. */
+ * they show the node in the edge's region by their margin. By the box's edge: nodes 0.5 mm out
+ * of one plane and 1e-9 m under the other are not (the other face holds them, not the edge),
+ * one 0.3 mm out of both is. By the prism's sharp edge: nodes 0.5 mm out of one plane and 1e-9
+ * m under the other, where the planes' test alone would take them (each face's projection of
+ * them stands a quarter millimetre out of the other's plane), are held by nothing; one 0.3 mm
+ * out of both is the edge's. The first step's contact forces are those of every candidate
+ * through its full tests, to the bit. */
 START_TEST(corner_edge_tests_spared_only_in_its_region)
 {
     for (int prism = 0; prism < 2; prism++) {
+        double off[9] = {0.5e-3, 0.0, -1e-9, -1e-9, 0.1, 0.5e-3, 0.3e-3, -0.1, 0.3e-3};
+        if (prism) {
+            prism_offset(-1e-9, 0.5e-3, -0.1, off);
+            prism_offset(0.5e-3, -1e-9, 0.0, off + 3);
+            prism_offset(0.3e-3, 0.3e-3, 0.1, off + 6);
+        }
         ws_web_id wa, wb;
-        ws_world *a = edge_film_world(prism, 1, &wa), *b = edge_film_world(prism, 0, &wb);
+        ws_world *a = edge_film_world(prism, off, 1, &wa), *b = edge_film_world(prism, off, 0, &wb);
         ck_ok(a, ws_world_step(a));
         ck_ok(b, ws_world_step(b));
         ck_assert_uint_eq(only_web(a)->corners, 0);
@@ -1008,7 +1018,7 @@ START_TEST(corner_edge_tests_spared_only_in_its_region)
              * edge's. */
             for (int i = 0; i < 6; i++)
                 ck_assert(fb[i] == 0.0);
-            ck_assert(fb[6] == 0.0 && fb[8] > 0.0);
+            ck_assert(fabs(fb[6]) < 1e-9 && fb[8] > 0.0);
         } else {
             /* The first two are held by one face, along its normal; the third by the edge. */
             ck_assert(fb[0] > 0.0 && fb[1] == 0.0 && fb[2] == 0.0);
@@ -1018,6 +1028,45 @@ START_TEST(corner_edge_tests_spared_only_in_its_region)
         ws_world_destroy(a);
         ws_world_destroy(b);
     }
+}
+END_TEST
+
+/* Whether a node lies well inside a face (a margin or more behind every other face's plane
+ * where it projects on the face's plane) takes the projection: out of the face's plane by df,
+ * it lies dg - df c out of face g's plane, c the dot product of their normals. By the prism's
+ * top edge (c = -0.5), 1.5 mm out of one face's plane: 2.25 mm behind the other's plane the
+ * projection lies 1.5 mm behind it, within the margin (2 mm): not well inside, and the edge is
+ * a candidate; 3.25 mm behind the plane, 2.5 mm: well inside, the face alone. */
+START_TEST(well_inside_takes_the_projection)
+{
+    double off[9];
+    prism_offset(-2.25e-3, 1.5e-3, -0.1, off);
+    prism_offset(1.5e-3, -2.25e-3, 0.0, off + 3);
+    prism_offset(-3.25e-3, 1.5e-3, 0.1, off + 6);
+    ws_web_id id;
+    ws_world *w = edge_film_world(1, off, 0, &id);
+    ck_ok(w, ws_world_step(w));
+    const ws_web *wb = only_web(w);
+    const ws_ncand *c = wb->cand[wb->next_list];
+    int faces[3] = {0, 0, 0}, inside[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
+    for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+        ck_assert_uint_lt(c[q].node, 3);
+        if (c[q].local & WS_NCAND_EDGE) {
+            edges[c[q].node]++;
+        } else {
+            faces[c[q].node]++;
+            inside[c[q].node] += (c[q].local & WS_NCAND_INSIDE) != 0;
+        }
+    }
+    for (int i = 0; i < 3; i++)
+        report("prism, node %d: %d face(s), %d inside, %d edge(s)", i, faces[i], inside[i],
+               edges[i]);
+    for (int i = 0; i < 2; i++)
+        ck_assert_msg(faces[i] == 1 && inside[i] == 0 && edges[i] == 1,
+                      "node %d: %d faces (%d inside), %d edges", i, faces[i], inside[i], edges[i]);
+    ck_assert_msg(faces[2] == 1 && inside[2] == 1 && edges[2] == 0,
+                  "node 2: %d faces (%d inside), %d edges", faces[2], inside[2], edges[2]);
+    ws_world_destroy(w);
 }
 END_TEST
 
@@ -1049,6 +1098,7 @@ int main(void)
     tcase_add_test(tc, corners_need_flat_faces);
     tcase_add_test(tc, corners_are_marked_by_the_detection);
     tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
+    tcase_add_test(tc, well_inside_takes_the_projection);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -566,12 +566,13 @@ typedef struct ws_find_body {
 } ws_find_body;
 
 enum { V_X, V_Y, V_Z, V_D, V_FACES }; /* the values of a node, V_FACES + f: face f */
-enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_ARRAYS };
+enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_NEAR, M_ARRAYS };
 /* M_LOCAL: 1 when the node lies in the body's own box grown by the reach (else it has no
  * candidate of the body); M_PASS: the faces it is a candidate of (within reach of it along their
  * normals, within the margin of the outermost one, its projection on the plane within reach of
  * the face's box); M_BOXES: the faces whose box, grown by the reach, holds it; M_OUT: of the
- * faces in M_PASS, those it is not well inside of (see convex_candidates). */
+ * faces in M_PASS, those it is not well inside of (see convex_candidates); M_NEAR: the faces
+ * whose plane it is not a margin or more behind. */
 
 /* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0; how
  * many do. */
@@ -606,7 +607,8 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                      *restrict sz = val + V_Z * FIND_CHUNK, *restrict D = val + V_D * FIND_CHUNK;
     uint64_t *restrict local = mask + M_LOCAL * FIND_CHUNK,
                        *restrict pass = mask + M_PASS * FIND_CHUNK,
-                       *restrict boxes = mask + M_BOXES * FIND_CHUNK;
+                       *restrict boxes = mask + M_BOXES * FIND_CHUNK,
+                       *restrict near = mask + M_NEAR * FIND_CHUNK;
     for (size_t j = 0; j < m; j++) {
         double px = sx[j] - r.x, py = sy[j] - r.y, pz = sz[j] - r.z;
         double x = a0 * px + a3 * py + a6 * pz;
@@ -617,7 +619,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
         sz[j] = z;
         local[j] = (uint64_t)((x > lx) & (x < hx) & (y > ly) & (y < hy) & (z > lz) & (z < hz));
         D[j] = -INFINITY;
-        pass[j] = boxes[j] = 0;
+        pass[j] = boxes[j] = near[j] = 0;
     }
     for (uint32_t f = 0; f < sh->face_count; f++) {
         const ws_face *F = &sh->faces[f];
@@ -630,6 +632,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
             double d = nx * x + ny * y + nz * z - off;
             dg[j] = d;
             D[j] = d > D[j] ? d : D[j];
+            near[j] |= (uint64_t)(!(d <= -margin)) << f;
             boxes[j] |=
                 (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
                 << f;
@@ -667,14 +670,25 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                 (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
                     << f;
         }
+        /* The projection on f's plane lies dg - df c out of face o's plane: dg itself for a
+         * face square to f (c = 0, and df is finite), whose test is then the node's own
+         * (M_NEAR), taken for all those faces at once. */
+        uint64_t square = 0;
         for (uint32_t o = 0; o < sh->face_count; o++) {
             if (o == f)
                 continue;
             const double c = v3_dot(sh->faces[o].normal, F->normal);
+            if (c == 0.0) {
+                square |= (uint64_t)1 << o;
+                continue;
+            }
             const double *restrict dg = val + (V_FACES + o) * FIND_CHUNK;
             for (size_t j = 0; j < m; j++)
                 out[j] |= (uint64_t)(!(dg[j] - df[j] * c <= -margin)) << f;
         }
+        if (square)
+            for (size_t j = 0; j < m; j++)
+                out[j] |= (uint64_t)((near[j] & square) != 0) << f;
     }
 }
 
