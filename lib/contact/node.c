@@ -527,13 +527,14 @@ static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_nca
 
 /* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
  * (WS_NCAND_CORNER on the first) when they are two faces and then the edge between them, on a
- * flat convex shape, where the contacts tell them apart by the two faces' planes. */
+ * flat convex shape, where the contacts tell them apart by the two faces' planes. Neither face
+ * is one the node is well inside of (convex_candidates lists no edge of such a face). */
 static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
 {
     if (n - n0 != 3 || !sh->convex || !sh->flat)
         return;
     const uint32_t a = out[n0].local, z = out[n0 + 1].local, e = out[n0 + 2].local;
-    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(e & WS_NCAND_EDGE))
+    if (((a | z) & (WS_NCAND_EDGE | WS_NCAND_INSIDE)) || !(e & WS_NCAND_EDGE))
         return;
     const ws_edge *E = &sh->edges[e & ~WS_NCAND_FLAGS];
     const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;

@@ -329,8 +329,8 @@ NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, ui
  * face, or behind it) or lies beyond the window of either plane (in_wedge's distances along
  * the normals are dA, dB to round-off). Only by a margin eps that the full tests (eq. 14's for
  * a face, in_wedge) cannot disagree with: the feature left, if any, takes its full test, and
- * the contacts are the same as one by one. A face found well inside its outline takes no test
- * and is not turned down. */
+ * the contacts are the same as one by one. No face of a corner is one the node was found well
+ * inside of (mark_corner): that face alone would hold it, and its edge is no candidate. */
 
 /* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
  * the window's top hi: its faces' outlines stand out of the other faces' planes by its
@@ -367,8 +367,8 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
     const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
-    const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
-    const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
+    const uint32_t a = (dA < hi) & !(qB > eps);
+    const uint32_t z = (dB < hi) & !(qA > eps);
     const double dmax = dA > dB ? dA : dB;
     const uint32_t e = (qA > -eps) & (qB > -eps) & (dmax < hi + eps);
     *sure = (qA > eps) & (qB > eps) & (dA > eps) & (dB > eps);
