@@ -827,6 +827,29 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
     return seg_done(mem, web, &sc, list);
 }
 
+/* The stretches of the next sweep block, from seg[k] on (the block after the one ending at n1),
+ * and the first and last of their candidates, asked of the memory now so that they arrive
+ * while the block's springs are evaluated: from one step to the next they leave the caches,
+ * and a block reads them in a few places (the first candidate of a run, a one-by-one stretch),
+ * each a wait for the memory otherwise. */
+static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uint32_t n1)
+{
+#if defined(__GNUC__)
+    const uint64_t end = (uint64_t)n1 + seg_block(web);
+    size_t s = k;
+    for (; s < web->nseg && web->seg[s].n0 < end; s++) {
+        const ws_nseg *sg = &web->seg[s];
+        __builtin_prefetch(cand + sg->c0);
+        __builtin_prefetch(cand + sg->c1 - 1);
+    }
+    /* And the stretches of the block after, whose places the next call reads. */
+    for (size_t q = 0; q < 16 && s + q < web->nseg; q += 3)
+        __builtin_prefetch(web->seg + s + q);
+#else
+    (void)web, (void)cand, (void)k, (void)n1;
+#endif
+}
+
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
                       const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
@@ -854,6 +877,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
+    node_prefetch(web, cand, k, n1);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
