@@ -832,23 +832,33 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
  * while the block's springs are evaluated: from one step to the next they leave the caches,
  * and a block reads them in a few places (the first candidate of a run, a one-by-one stretch),
  * each a wait for the memory otherwise. */
+#if defined(__GNUC__)
+/* Inlined: as a call of its own, GCC takes a function that only prefetches for one without
+ * effects, and drops the call. */
+__attribute__((always_inline)) static inline void node_prefetch(const ws_web *web,
+                                                                const ws_ncand *cand, size_t k,
+                                                                uint32_t n1)
+{
+    const uint64_t end = (uint64_t)n1 + seg_block(web);
+    const ws_nseg *seg = web->seg;
+    const size_t nseg = web->nseg;
+    size_t s = k;
+    for (; s < nseg && seg[s].n0 < end; s++) {
+        __builtin_prefetch(cand + seg[s].c0);
+        if (!seg[s].run) /* a run reads its first candidate only */
+            __builtin_prefetch(cand + seg[s].c1 - 1);
+    }
+    /* And the first stretches of the block after, whose places the next call reads (a dozen
+     * stretches, 20 bytes each). */
+    for (size_t q = s; q < s + 12 && q < nseg; q += 3)
+        __builtin_prefetch(seg + q);
+}
+#else
 static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uint32_t n1)
 {
-#if defined(__GNUC__)
-    const uint64_t end = (uint64_t)n1 + seg_block(web);
-    size_t s = k;
-    for (; s < web->nseg && web->seg[s].n0 < end; s++) {
-        const ws_nseg *sg = &web->seg[s];
-        __builtin_prefetch(cand + sg->c0);
-        __builtin_prefetch(cand + sg->c1 - 1);
-    }
-    /* And the stretches of the block after, whose places the next call reads. */
-    for (size_t q = 0; q < 16 && s + q < web->nseg; q += 3)
-        __builtin_prefetch(web->seg + s + q);
-#else
     (void)web, (void)cand, (void)k, (void)n1;
-#endif
 }
+#endif
 
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
