@@ -709,17 +709,22 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
     const uint64_t outside = mk[M_OUT * FIND_CHUNK];
     const size_t n0 = *n;
     *checks += nf;
+    /* Room for every face and edge of the shape: one check, not one per candidate. */
+    const size_t room = n0 + nf + sh->edge_count;
+    if (room > *cap && ws_array_reserve(mem, (void **)out, cap, room, sizeof **out) != 0)
+        return -1;
+    ws_ncand *o = *out;
+    size_t q = n0;
     /* Well inside a face's outline: its projection on the plane lies a margin or more behind
      * every other face's plane (those planes bound the face on a convex body, and a plane
      * distance never exceeds the distance within the face's plane). Nodes and bodies move less
      * than half the margin relative to each other until the candidates are found again. */
+    const uint32_t fbase = g->face_base[k];
     for (uint64_t pass = mk[M_PASS * FIND_CHUNK]; pass; pass &= pass - 1) {
-        uint32_t f = ws_lowest_bit(pass);
-        ws_ncand nc = {i, k, g->face_base[k] + f,
-                       f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
-        if (push_cand(mem, out, n, cap, nc) != 0)
-            return -1;
+        const uint32_t f = ws_lowest_bit(pass);
+        o[q++] = (ws_ncand){i, k, fbase + f, f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
     }
+    *n = q;
     /* An edge's box lies in the boxes of both its faces, so an edge within reach of the node
      * needs two of them: most nodes, over the middle of a face, have at most one and skip the
      * edges. */
@@ -741,11 +746,11 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
          * the edge into its span before it is found again. */
         double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
         t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
-            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
-            return -1;
+        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach)
+            o[q++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
     }
-    mark_corner(sh, *out, n0, *n);
+    *n = q;
+    mark_corner(sh, o, n0, q);
     return 0;
 }
 
