@@ -381,18 +381,19 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
  * faces' planes first, and only what they leave takes the tests. */
 static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
-    const ws_body_store *b = E->b;
-    const ws_body_state *st = E->st;
-    const ws_node_geom *g = E->g;
-    const ws_nodes3 x = E->x;
-    const double wl = E->web->layer;
+    /* E's members are read where used, not copied first: node_push may change what E points
+     * to as far as the compiler knows, so they are loaded again after it either way, and
+     * copies would be kept on the stack at every call. */
     for (size_t k = 0; k < n;) {
+        const ws_body_store *b = E->b;
+        const ws_body_state *st = E->st;
+        const ws_node_geom *g = E->g;
         const ws_ncand *c0 = &cand[k];
         const uint32_t i = c0->node, bi = c0->body;
         const ws_shape *sh = b->shape[bi];
-        const v3 xi = nodes_get(x, i);
+        const v3 xi = nodes_get(E->x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
-        const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
+        const double hi = b->layer[bi] + E->web->layer, lo = -hi - sh->inner;
         /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
          * their tests: a corner's three (marked by the detection) as its planes leave them. */
         uint32_t left;
