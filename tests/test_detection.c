@@ -830,6 +830,246 @@ START_TEST(corners_need_flat_faces)
 }
 END_TEST
 
+/* The detection marks a node's candidates of a body as a corner (WS_NCAND_CORNER on the first)
+ * when they are two faces and then the edge between them on a flat convex shape, and only then:
+ * the node contacts take the planes' short cut for those alone. A node 0.5 mm out of the +x
+ * and +z planes of a unit cube, midway along their edge, is a corner of the box and of the cube
+ * mesh, not of the cube whose top bends 1e-8 m (corners_need_flat_faces); a node 0.5 mm out of
+ * three planes at a vertex (three faces, three edges), or out of two and 3 mm behind the third
+ * (two faces, three edges), is no corner of any. */
+START_TEST(corners_are_marked_by_the_detection)
+{
+    double v[24];
+    memcpy(v, cube_v, sizeof v);
+    v[3 * 5 + 2] -= 1e-8;
+    for (int k = 0; k < 3; k++) {
+        ws_world_def d;
+        ws_world_def_init(&d);
+        d.gravity = (ws_vec3){0, 0, 0};
+        d.dt = 2.5e-4;
+        ws_world *w;
+        ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+        ws_shape_id shape;
+        if (k == 0)
+            ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
+        else
+            ck_ok(w, create_mesh(w, k == 1 ? cube_v : v, 8, cube_t, 12, &shape));
+        ws_body_def bd;
+        ws_body_def_init(&bd);
+        bd.type = WS_BODY_KINEMATIC;
+        bd.shape = shape;
+        ws_body_id body;
+        ck_ok(w, ws_body_create(w, &bd, &body));
+        ws_web_def wd;
+        soft_film(w, &wd);
+        const double o = 0.5 + 0.5e-3;
+        const double pos[12] = {o, 0.0, o, o, o, o, o, 0.497, o, 3.0, 3.0, 3.0};
+        const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
+        ws_web_mesh_def mesh;
+        ws_web_mesh_def_init(&mesh);
+        mesh.positions = pos;
+        mesh.node_count = 4;
+        mesh.springs = spring;
+        mesh.spring_count = 3;
+        mesh.pinned = pin;
+        mesh.pinned_count = 1;
+        ws_web_id web;
+        ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, &web));
+        ck_ok(w, ws_world_step(w));
+        const ws_web *wb = only_web(w);
+        const ws_ncand *c = wb->cand[wb->next_list];
+        int count[3] = {0, 0, 0}, marked[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
+        for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+            ck_assert_uint_lt(c[q].node, 3);
+            count[c[q].node]++;
+            marked[c[q].node] += (c[q].local & WS_NCAND_CORNER) != 0;
+            edges[c[q].node] += (c[q].local & WS_NCAND_EDGE) != 0;
+        }
+        report("shape %d: node at an edge: %d candidates (%d edges), %d marked; node at a vertex: "
+               "%d candidates (%d edges), %d marked; node near a vertex: %d candidates (%d edges), "
+               "%d marked",
+               k, count[0], edges[0], marked[0], count[1], edges[1], marked[1], count[2], edges[2],
+               marked[2]);
+        ck_assert_msg(count[0] == 3 && edges[0] == 1,
+                      "shape %d: the node at the edge has %d candidates (%d edges)", k, count[0],
+                      edges[0]);
+        ck_assert_msg(count[1] == 6 && edges[1] == 3,
+                      "shape %d: the node at the vertex has %d candidates (%d edges)", k, count[1],
+                      edges[1]);
+        ck_assert_msg(count[2] == 5 && edges[2] == 3,
+                      "shape %d: the node near the vertex has %d candidates (%d edges)", k,
+                      count[2], edges[2]);
+        ck_assert_msg(marked[0] == (k < 2) && marked[1] == 0 && marked[2] == 0,
+                      "shape %d: %d marked at the edge, %d and %d at the vertex", k, marked[0],
+                      marked[1], marked[2]);
+        if (k < 2)
+            ck_assert(c[0].local & WS_NCAND_CORNER); /* on the first of the three */
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
+/* The prism on an equilateral triangle of side 1 m in the xz plane, 1 m long along y: its
+ * edges' faces stand 60 degrees apart, their normals' dot product is -0.5. */
+static const double prism_h = 0.86602540378443864676; /* sqrt(3) / 2 */
+static const double prism_v[18] = {0, -0.5, 0, 1, -0.5, 0, 0.5, -0.5, 0.86602540378443864676,
+                                   0, 0.5,  0, 1, 0.5,  0, 0.5, 0.5,  0.86602540378443864676};
+static const uint32_t prism_t[24] = {0, 4, 1, 0, 3, 4, /* bottom */ 0, 1, 2, 3, 5, 4, /* ends */
+                                     1, 4, 5, 1, 5, 2, /* right */ 0,  2, 5, 0, 5, 3 /* left */};
+
+/* From the prism's top edge, at y: out of its left face's plane (normal (-h, 0, 1/2)) by dl
+ * and of its right one's ((h, 0, 1/2)) by dr, into o: a dl-plane distance a - b / 2 and a
+ * dr one b - a / 2 for a and b along the two normals. */
+static void prism_offset(double dl, double dr, double y, double *o)
+{
+    const double a = (dl + 0.5 * dr) / 0.75, b = (dr + 0.5 * dl) / 0.75;
+    o[0] = prism_h * (b - a);
+    o[1] = y;
+    o[2] = 0.5 * (a + b);
+}
+
+/* A film of three free nodes, tied to a fourth pinned far off, at offsets off (9 values) from
+ * an edge of a kinematic body at the origin, with the short cuts off when runs_off: the unit
+ * box's +x/+z edge, or the prism's top edge. */
+static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_web_id *web)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.gravity = (ws_vec3){0, 0, 0};
+    d.dt = 2.5e-4;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_shape_id shape;
+    if (prism)
+        ck_ok(w, create_mesh(w, prism_v, 6, prism_t, 8, &shape));
+    else
+        ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
+    ws_shape_info si;
+    ck_ok(w, ws_shape_get_info(w, shape, &si));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = shape;
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    ws_web_def wd;
+    soft_film(w, &wd);
+    /* The edge in the body's frame, which the shape's centroid is the origin of. */
+    const double ex = prism ? 0.5 - si.centroid.x : 0.5, ez = prism ? prism_h - si.centroid.z : 0.5;
+    double pos[12];
+    for (int i = 0; i < 3; i++) {
+        pos[3 * i] = ex + off[3 * i];
+        pos[3 * i + 1] = off[3 * i + 1];
+        pos[3 * i + 2] = ez + off[3 * i + 2];
+    }
+    pos[9] = pos[10] = pos[11] = 3.0;
+    const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
+    ws_web_mesh_def mesh;
+    ws_web_mesh_def_init(&mesh);
+    mesh.positions = pos;
+    mesh.node_count = 4;
+    mesh.springs = spring;
+    mesh.spring_count = 3;
+    mesh.pinned = pin;
+    mesh.pinned_count = 1;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, web));
+    only_web(w)->runs_off = runs_off;
+    return w;
+}
+
+/* At a corner the planes may spare the edge its tests of direction (in_wedge), but only where
+ * they show the node in the edge's region by their margin. By the box's edge: nodes 0.5 mm out
+ * of one plane and 1e-9 m under the other are not (the other face holds them, not the edge),
+ * one 0.3 mm out of both is. By the prism's sharp edge: nodes 0.5 mm out of one plane and 1e-9
+ * m under the other, where the planes' test alone would take them (each face's projection of
+ * them stands a quarter millimetre out of the other's plane), are held by nothing; one 0.3 mm
+ * out of both is the edge's. The first step's contact forces are those of every candidate
+ * through its full tests, to the bit. */
+START_TEST(corner_edge_tests_spared_only_in_its_region)
+{
+    for (int prism = 0; prism < 2; prism++) {
+        double off[9] = {0.5e-3, 0.0, -1e-9, -1e-9, 0.1, 0.5e-3, 0.3e-3, -0.1, 0.3e-3};
+        if (prism) {
+            prism_offset(-1e-9, 0.5e-3, -0.1, off);
+            prism_offset(0.5e-3, -1e-9, 0.0, off + 3);
+            prism_offset(0.3e-3, 0.3e-3, 0.1, off + 6);
+        }
+        ws_web_id wa, wb;
+        ws_world *a = edge_film_world(prism, off, 1, &wa), *b = edge_film_world(prism, off, 0, &wb);
+        ck_ok(a, ws_world_step(a));
+        ck_ok(b, ws_world_step(b));
+        ck_assert_uint_eq(only_web(a)->corners, 0);
+        ck_assert_uint_eq(only_web(b)->corners, 3);
+        double fa[12], fb[12];
+        size_t n;
+        ck_ok(a, ws_web_copy_contact_forces(a, wa, fa, 4, &n));
+        ck_ok(b, ws_web_copy_contact_forces(b, wb, fb, 4, &n));
+        report("node contact forces at the edge of %s: (%.3g %.3g %.3g), (%.3g %.3g %.3g), "
+               "(%.3g %.3g %.3g) N",
+               prism ? "the prism" : "the box", fb[0], fb[1], fb[2], fb[3], fb[4], fb[5], fb[6],
+               fb[7], fb[8]);
+        for (int i = 0; i < 12; i++)
+            ck_assert_msg(fa[i] == fb[i],
+                          "node %d: contact force %.17g with the short cuts, "
+                          "%.17g without",
+                          i / 3, fb[i], fa[i]);
+        if (prism) {
+            /* The first two are over no face and behind a plane: no contact; the third is the
+             * edge's. */
+            for (int i = 0; i < 6; i++)
+                ck_assert(fb[i] == 0.0);
+            ck_assert(fabs(fb[6]) < 1e-9 && fb[8] > 0.0);
+        } else {
+            /* The first two are held by one face, along its normal; the third by the edge. */
+            ck_assert(fb[0] > 0.0 && fb[1] == 0.0 && fb[2] == 0.0);
+            ck_assert(fb[3] == 0.0 && fb[4] == 0.0 && fb[5] > 0.0);
+            ck_assert(fb[6] > 0.0 && fb[8] > 0.0);
+        }
+        ws_world_destroy(a);
+        ws_world_destroy(b);
+    }
+}
+END_TEST
+
+/* Whether a node lies well inside a face (a margin or more behind every other face's plane
+ * where it projects on the face's plane) takes the projection: out of the face's plane by df,
+ * it lies dg - df c out of face g's plane, c the dot product of their normals. By the prism's
+ * top edge (c = -0.5), 1.5 mm out of one face's plane: 2.25 mm behind the other's plane the
+ * projection lies 1.5 mm behind it, within the margin (2 mm): not well inside, and the edge is
+ * a candidate; 3.25 mm behind the plane, 2.5 mm: well inside, the face alone. */
+START_TEST(well_inside_takes_the_projection)
+{
+    double off[9];
+    prism_offset(-2.25e-3, 1.5e-3, -0.1, off);
+    prism_offset(1.5e-3, -2.25e-3, 0.0, off + 3);
+    prism_offset(-3.25e-3, 1.5e-3, 0.1, off + 6);
+    ws_web_id id;
+    ws_world *w = edge_film_world(1, off, 0, &id);
+    ck_ok(w, ws_world_step(w));
+    const ws_web *wb = only_web(w);
+    const ws_ncand *c = wb->cand[wb->next_list];
+    int faces[3] = {0, 0, 0}, inside[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
+    for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+        ck_assert_uint_lt(c[q].node, 3);
+        if (c[q].local & WS_NCAND_EDGE) {
+            edges[c[q].node]++;
+        } else {
+            faces[c[q].node]++;
+            inside[c[q].node] += (c[q].local & WS_NCAND_INSIDE) != 0;
+        }
+    }
+    for (int i = 0; i < 3; i++)
+        report("prism, node %d: %d face(s), %d inside, %d edge(s)", i, faces[i], inside[i],
+               edges[i]);
+    for (int i = 0; i < 2; i++)
+        ck_assert_msg(faces[i] == 1 && inside[i] == 0 && edges[i] == 1,
+                      "node %d: %d faces (%d inside), %d edges", i, faces[i], inside[i], edges[i]);
+    ck_assert_msg(faces[2] == 1 && inside[2] == 1 && edges[2] == 0,
+                  "node 2: %d faces (%d inside), %d edges", faces[2], inside[2], edges[2]);
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(film_detection_does_not_change_the_motion)
 {
     film_detection_case(0);
@@ -856,6 +1096,9 @@ int main(void)
     tcase_add_test(tc, film_node_past_an_edge_end);
     tcase_add_test(tc, edges_of_faces_a_node_is_well_inside_of_are_dropped);
     tcase_add_test(tc, corners_need_flat_faces);
+    tcase_add_test(tc, corners_are_marked_by_the_detection);
+    tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
+    tcase_add_test(tc, well_inside_takes_the_projection);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -525,6 +525,23 @@ static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_nca
     return 0;
 }
 
+/* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
+ * (WS_NCAND_CORNER on the first) when they are two faces and then the edge between them, on a
+ * flat convex shape, where the contacts tell them apart by the two faces' planes. Neither face
+ * is one the node is well inside of (convex_candidates lists no edge of such a face). */
+static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
+{
+    if (n - n0 != 3 || !sh->convex || !sh->flat)
+        return;
+    const uint32_t a = out[n0].local, z = out[n0 + 1].local, e = out[n0 + 2].local;
+    if (((a | z) & (WS_NCAND_EDGE | WS_NCAND_INSIDE)) || !(e & WS_NCAND_EDGE))
+        return;
+    const ws_edge *E = &sh->edges[e & ~WS_NCAND_FLAGS];
+    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
+    if ((E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa))
+        out[n0].local |= WS_NCAND_CORNER;
+}
+
 /* ---- the search
  *
  * Nodes are taken FIND_CHUNK at a time. For each body, in slot order, the nodes of the group in
@@ -550,12 +567,13 @@ typedef struct ws_find_body {
 } ws_find_body;
 
 enum { V_X, V_Y, V_Z, V_D, V_FACES }; /* the values of a node, V_FACES + f: face f */
-enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_ARRAYS };
+enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_NEAR, M_ARRAYS };
 /* M_LOCAL: 1 when the node lies in the body's own box grown by the reach (else it has no
  * candidate of the body); M_PASS: the faces it is a candidate of (within reach of it along their
  * normals, within the margin of the outermost one, its projection on the plane within reach of
  * the face's box); M_BOXES: the faces whose box, grown by the reach, holds it; M_OUT: of the
- * faces in M_PASS, those it is not well inside of (see convex_candidates). */
+ * faces in M_PASS, those it is not well inside of (see convex_candidates); M_NEAR: the faces
+ * whose plane it is not a margin or more behind. */
 
 /* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0; how
  * many do. */
@@ -590,7 +608,8 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                      *restrict sz = val + V_Z * FIND_CHUNK, *restrict D = val + V_D * FIND_CHUNK;
     uint64_t *restrict local = mask + M_LOCAL * FIND_CHUNK,
                        *restrict pass = mask + M_PASS * FIND_CHUNK,
-                       *restrict boxes = mask + M_BOXES * FIND_CHUNK;
+                       *restrict boxes = mask + M_BOXES * FIND_CHUNK,
+                       *restrict near = mask + M_NEAR * FIND_CHUNK;
     for (size_t j = 0; j < m; j++) {
         double px = sx[j] - r.x, py = sy[j] - r.y, pz = sz[j] - r.z;
         double x = a0 * px + a3 * py + a6 * pz;
@@ -601,7 +620,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
         sz[j] = z;
         local[j] = (uint64_t)((x > lx) & (x < hx) & (y > ly) & (y < hy) & (z > lz) & (z < hz));
         D[j] = -INFINITY;
-        pass[j] = boxes[j] = 0;
+        pass[j] = boxes[j] = near[j] = 0;
     }
     for (uint32_t f = 0; f < sh->face_count; f++) {
         const ws_face *F = &sh->faces[f];
@@ -614,6 +633,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
             double d = nx * x + ny * y + nz * z - off;
             dg[j] = d;
             D[j] = d > D[j] ? d : D[j];
+            near[j] |= (uint64_t)(!(d <= -margin)) << f;
             boxes[j] |=
                 (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
                 << f;
@@ -651,14 +671,25 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                 (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
                     << f;
         }
+        /* The projection on f's plane lies dg - df c out of face o's plane: dg itself for a
+         * face square to f (c = 0, and df is finite), whose test is then the node's own
+         * (M_NEAR), taken for all those faces at once. */
+        uint64_t square = 0;
         for (uint32_t o = 0; o < sh->face_count; o++) {
             if (o == f)
                 continue;
             const double c = v3_dot(sh->faces[o].normal, F->normal);
+            if (c == 0.0) {
+                square |= (uint64_t)1 << o;
+                continue;
+            }
             const double *restrict dg = val + (V_FACES + o) * FIND_CHUNK;
             for (size_t j = 0; j < m; j++)
                 out[j] |= (uint64_t)(!(dg[j] - df[j] * c <= -margin)) << f;
         }
+        if (square)
+            for (size_t j = 0; j < m; j++)
+                out[j] |= (uint64_t)((near[j] & square) != 0) << f;
     }
 }
 
@@ -676,18 +707,24 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
     const v3 s = v3_make(v[V_X * FIND_CHUNK], v[V_Y * FIND_CHUNK], v[V_Z * FIND_CHUNK]);
     const uint64_t boxes = mk[M_BOXES * FIND_CHUNK];
     const uint64_t outside = mk[M_OUT * FIND_CHUNK];
+    const size_t n0 = *n;
     *checks += nf;
+    /* Room for every face and edge of the shape: one check, not one per candidate. */
+    const size_t room = n0 + nf + sh->edge_count;
+    if (room > *cap && ws_array_reserve(mem, (void **)out, cap, room, sizeof **out) != 0)
+        return -1;
+    ws_ncand *o = *out;
+    size_t q = n0;
     /* Well inside a face's outline: its projection on the plane lies a margin or more behind
      * every other face's plane (those planes bound the face on a convex body, and a plane
      * distance never exceeds the distance within the face's plane). Nodes and bodies move less
      * than half the margin relative to each other until the candidates are found again. */
+    const uint32_t fbase = g->face_base[k];
     for (uint64_t pass = mk[M_PASS * FIND_CHUNK]; pass; pass &= pass - 1) {
-        uint32_t f = ws_lowest_bit(pass);
-        ws_ncand nc = {i, k, g->face_base[k] + f,
-                       f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
-        if (push_cand(mem, out, n, cap, nc) != 0)
-            return -1;
+        const uint32_t f = ws_lowest_bit(pass);
+        o[q++] = (ws_ncand){i, k, fbase + f, f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
     }
+    *n = q;
     /* An edge's box lies in the boxes of both its faces, so an edge within reach of the node
      * needs two of them: most nodes, over the middle of a face, have at most one and skip the
      * edges. */
@@ -709,10 +746,11 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
          * the edge into its span before it is found again. */
         double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
         t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
-            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
-            return -1;
+        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach)
+            o[q++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
     }
+    *n = q;
+    mark_corner(sh, o, n0, q);
     return 0;
 }
 
@@ -725,6 +763,7 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
     v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
     if (!inside_box(s, sh->lo, sh->hi, reach))
         return 0;
+    const size_t n0 = *n;
     /* On a convex body a node touches face f only while f is the face whose plane it is
      * farthest out of (the largest signed distance D): over a face it projects into, d_g <= d_f
      * for every other face g, and inside the body the shallowest face is the one of largest d.
@@ -762,6 +801,7 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
             push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
             return -1;
     }
+    mark_corner(sh, *out, n0, *n);
     return 0;
 }
 
@@ -921,6 +961,7 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
             o->n1 = m3_mul_v(A, E->n1);
             o->n2 = m3_mul_v(A, E->n2);
             o->inv_e2 = 1.0 / v3_dot(d, d);
+            o->c = v3_dot(o->n1, o->n2);
         }
         fo += sh->face_count;
         to += sh->triangle_count;

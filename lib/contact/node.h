@@ -24,10 +24,10 @@ typedef struct ws_wtri {
 } ws_wtri;
 
 /* A convex edge in the global frame: from p along e (|e| = length), with the outward normals of
- * its two faces; inv_e2 = 1 / |e|^2. */
+ * its two faces; inv_e2 = 1 / |e|^2, c = n1 . n2. */
 typedef struct ws_wedge {
     v3 p, e, n1, n2;
-    double inv_e2;
+    double inv_e2, c;
 } ws_wedge;
 
 struct ws_find_body;

@@ -22,8 +22,9 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
 /* A node against the rounded rim of a convex edge: only in the edge's own region, where the
  * direction from the edge to the node lies strictly between the normals of its two faces
  * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
- * to the node and the distance. */
-static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *dist)
+ * to the node and the distance. `sure`: the faces' planes have shown the direction to lie
+ * between the normals (corner_left), which is then not tested again. */
+static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
     double t = v3_dot(rp, E->e) * E->inv_e2;
@@ -34,13 +35,17 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, v3 *nrm, double *
     if (!(l2 < hi * hi) || !(l2 > 0.0))
         return 0;
     /* Outside both faces' planes: in the wedge between them. */
-    if (!(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
+    if (!sure && !(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
         return 0;
     /* And not over either face: r = a n1 + b n2 with a, b > 0. */
-    double c = v3_dot(E->n1, E->n2), r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
-    double den = 1.0 - c * c;
-    if (den < 1e-12 || !(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+    const double c = E->c, den = 1.0 - c * c;
+    if (den < 1e-12)
         return 0;
+    if (!sure) {
+        const double r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
+        if (!(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+            return 0;
+    }
     double l = sqrt(l2);
     *nrm = v3_scale(r, 1.0 / l);
     *dist = l;
@@ -300,6 +305,20 @@ NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t b
               E->st->r[bi], E->st->v[bi], b->wg[bi], &E->pp[b->material[bi]]);
 }
 
+/* Whether the face of candidate c (of body bi, shape sh) is the shallowest for a node at
+ * (xx, xy, xz) under it at depth d. Out of line: the few nodes below a face need it, and
+ * inlined its values would crowd contacts_general's registers. */
+NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
+                                       const ws_ncand *c, double xx, double xy, double xz,
+                                       double d)
+{
+    const uint32_t f = c->local & ~WS_NCAND_FLAGS;
+    const v3 xi = v3_make(xx, xy, xz);
+    if (sh->convex)
+        return convex_shallowest(E->g, c->feat - f, sh->face_count, f, xi, d);
+    return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+}
+
 /* ---- a node at a convex body's edge
  *
  * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
@@ -310,8 +329,8 @@ NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t b
  * face, or behind it) or lies beyond the window of either plane (in_wedge's distances along
  * the normals are dA, dB to round-off). Only by a margin eps that the full tests (eq. 14's for
  * a face, in_wedge) cannot disagree with: the feature left, if any, takes its full test, and
- * the contacts are the same as one by one. A face found well inside its outline takes no test
- * and is not turned down. */
+ * the contacts are the same as one by one. No face of a corner is one the node was found well
+ * inside of (mark_corner): that face alone would hold it, and its edge is no candidate. */
 
 /* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
  * the window's top hi: its faces' outlines stand out of the other faces' planes by its
@@ -332,24 +351,14 @@ static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *
     return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
 }
 
-/* Whether c[0, 3) (all there) are a corner: two faces of a node on a flat convex shape, then
- * the edge between them. */
-static inline int is_corner(const ws_shape *sh, const ws_ncand *c)
-{
-    const uint32_t a = c[0].local, z = c[1].local;
-    if ((a & WS_NCAND_EDGE) || (z & WS_NCAND_EDGE) || !(c[2].local & WS_NCAND_EDGE) ||
-        !sh->convex || !sh->flat)
-        return 0;
-    const ws_edge *E = &sh->edges[c[2].local & ~WS_NCAND_FLAGS];
-    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
-    return (E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa);
-}
-
 /* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
  * to their full tests, one bit each: a face within the window's top and not turned down, the
- * edge unless turned down. */
+ * edge unless turned down. *sure: the node lies out of both planes and each face's projection
+ * of it out of the other's plane, by eps, so that in_wedge's tests of the direction (r . n1,
+ * r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off, as for
+ * turning the edge down) hold and need not be taken. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
-                                   v3 xi, v3 r, double hi, corner_memo *memo)
+                                   v3 xi, v3 r, double hi, corner_memo *memo, int *sure)
 {
     const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
     /* The planes' distances as the one-by-one pass takes them. */
@@ -358,47 +367,54 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
     const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
-    const uint32_t a = (dA < hi) & ((c[0].local & WS_NCAND_INSIDE) != 0 || !(qB > eps));
-    const uint32_t z = (dB < hi) & ((c[1].local & WS_NCAND_INSIDE) != 0 || !(qA > eps));
+    const uint32_t a = (dA < hi) & !(qB > eps);
+    const uint32_t z = (dB < hi) & !(qA > eps);
     const double dmax = dA > dB ? dA : dB;
     const uint32_t e = (qA > -eps) & (qB > -eps) & (dmax < hi + eps);
+    *sure = (qA > eps) & (qB > eps) & (dA > eps) & (dB > eps);
     return a | z << 1 | e << 2;
 }
 
 /* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
- * contacts that push into the list. A corner (is_corner) is told apart by its faces' planes
- * first, and only what they leave takes the tests. */
+ * contacts that push into the list. A corner (marked WS_NCAND_CORNER by the detection, which
+ * looks at a node's candidates once where this pass would every sub-step) is told apart by its
+ * faces' planes first, and only what they leave takes the tests. */
 static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
-    const ws_body_store *b = E->b;
-    const ws_body_state *st = E->st;
-    const ws_node_geom *g = E->g;
-    const ws_nodes3 x = E->x;
-    const double wl = E->web->layer;
+    /* E's members are read where used, not copied first: node_push may change what E points
+     * to as far as the compiler knows, so they are loaded again after it either way, and
+     * copies would be kept on the stack at every call. */
     for (size_t k = 0; k < n;) {
+        const ws_body_store *b = E->b;
+        const ws_body_state *st = E->st;
+        const ws_node_geom *g = E->g;
         const ws_ncand *c0 = &cand[k];
         const uint32_t i = c0->node, bi = c0->body;
-        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
-         * their tests. */
-        size_t e = k + 1;
-        while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
-            e++;
         const ws_shape *sh = b->shape[bi];
-        const v3 xi = nodes_get(x, i);
+        const v3 xi = nodes_get(E->x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
-        const double hi = b->layer[bi] + wl, lo = -hi - sh->inner;
-        uint32_t left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
-        if (e - k == 3 && !E->web->runs_off && is_corner(sh, c0)) {
-            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo);
+        const double hi = b->layer[bi] + E->web->layer, lo = -hi - sh->inner;
+        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
+         * their tests: a corner's three (marked by the detection) as its planes leave them. */
+        uint32_t left;
+        int sure = 0;
+        if ((c0->local & WS_NCAND_CORNER) && !E->web->runs_off) {
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo, &sure);
             E->web->corners++;
+            k += 3;
+        } else {
+            size_t e = k + 1;
+            while (e < n && e < k + 32 && cand[e].node == i && cand[e].body == bi)
+                e++;
+            left = (uint32_t)(((uint64_t)1 << (e - k)) - 1u);
+            k = e;
         }
-        k = e;
         for (; left; left &= left - 1) {
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
             if (c->local & WS_NCAND_EDGE) {
-                if (!in_wedge(&g->edge[c->feat], xi, hi, &nrm, &d))
+                if (!in_wedge(&g->edge[c->feat], xi, hi, sure, &nrm, &d))
                     continue;
             } else {
                 const ws_wface *F = &g->face[c->feat];
@@ -409,13 +425,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
                  * candidates are valid: no need to find its triangle. */
                 if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
                     continue;
-                uint32_t f = c->local & ~WS_NCAND_FLAGS;
-                if (d < 0.0 &&
-                    !(sh->convex
-                          ? convex_shallowest(g, c->feat - f, sh->face_count, f, xi, d)
-                          : ws_shallowest_face(sh, f,
-                                               m3_tmul_v(&b->A[bi], v3_sub(xi, st->r[bi])),
-                                               d)))
+                if (d < 0.0 && !shallowest(E, sh, bi, c, xi.x, xi.y, xi.z, d))
                     continue;
                 nrm = F->n; /* from the body to the node */
             }
@@ -818,6 +828,39 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
     return seg_done(mem, web, &sc, list);
 }
 
+/* The stretches of the next sweep block, from seg[k] on (the block after the one ending at n1),
+ * and the first and last of their candidates, asked of the memory now so that they arrive
+ * while the block's springs are evaluated: from one step to the next they leave the caches,
+ * and a block reads them in a few places (the first candidate of a run, a one-by-one stretch),
+ * each a wait for the memory otherwise. */
+#if defined(__GNUC__)
+/* Inlined: as a call of its own, GCC takes a function that only prefetches for one without
+ * effects, and drops the call. */
+__attribute__((always_inline)) static inline void node_prefetch(const ws_web *web,
+                                                                const ws_ncand *cand, size_t k,
+                                                                uint32_t n1)
+{
+    const uint64_t end = (uint64_t)n1 + seg_block(web);
+    const ws_nseg *seg = web->seg;
+    const size_t nseg = web->nseg;
+    size_t s = k;
+    for (; s < nseg && seg[s].n0 < end; s++) {
+        __builtin_prefetch(cand + seg[s].c0);
+        if (!seg[s].run) /* a run reads its first candidate only */
+            __builtin_prefetch(cand + seg[s].c1 - 1);
+    }
+    /* And the first stretches of the block after, whose places the next call reads (a dozen
+     * stretches, 20 bytes each). */
+    for (size_t q = s; q < s + 12 && q < nseg; q += 3)
+        __builtin_prefetch(seg + q);
+}
+#else
+static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uint32_t n1)
+{
+    (void)web, (void)cand, (void)k, (void)n1;
+}
+#endif
+
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
                       const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
@@ -845,6 +888,7 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
+    node_prefetch(web, cand, k, n1);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)

@@ -19,7 +19,10 @@ typedef struct ws_ncand {
 } ws_ncand;
 #define WS_NCAND_EDGE 0x80000000u   /* local names an edge */
 #define WS_NCAND_INSIDE 0x40000000u /* the node was found well inside the face's outline */
-#define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE)
+/* On the first of a node's candidates of a body: they are a corner, two faces of a flat convex
+ * shape and then the edge between them (the contacts tell the three apart by the planes). */
+#define WS_NCAND_CORNER 0x20000000u
+#define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE | WS_NCAND_CORNER)
 #define WS_NCAND_FACES 64           /* the most faces of a body whose candidates get INSIDE */
 
 /* The candidates of a web cut into stretches of nodes, in node order, within one sweep block
