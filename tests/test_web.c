@@ -1796,6 +1796,74 @@ static int failing_law(void *user, int dim, const double *u, const double *ud, d
     return 0;
 }
 
+/* A user law that kicks: 1e306 N whatever the strain (its stated stiffness, 1 N, is what the
+ * stable step believes). */
+static int kicking_law(void *user, int dim, const double *u, const double *ud, double t,
+                       double *F, double *dFdu, double *dFdud)
+{
+    (void)user;
+    (void)dim;
+    (void)u;
+    (void)ud;
+    (void)t;
+    (void)dFdud;
+    F[0] = 1e306;
+    dFdu[0] = 1.0;
+    return 0;
+}
+
+START_TEST(test_runaway_without_a_speed_limit)
+{
+    /* max_speed infinite turns the runaway guard's limit off, but a node's state must still
+     * never go infinite unnoticed. A spring that pulls with 1e306 N on a free node of 1 g at
+     * dt = 1 ms gives it 1e306 m/s in one step (finite, but its square overflows) and an
+     * infinite speed in the next: the first step must fail as a runaway, name the speed, and
+     * leave the node where it was, finite. */
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 1e-3;
+    d.gravity = NO_G;
+    d.max_speed = INFINITY;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_USER;
+    ld.stiffness = 1.0;
+    ld.user_fn = kicking_law;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law;
+    wd.node_mass = 1e-3;
+    double p[6] = {0, 0, 0, 0.1, 0, 0};
+    uint32_t sp[2] = {0, 1}, pin[1] = {0};
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = p;
+    md.node_count = 2;
+    md.springs = sp;
+    md.spring_count = 1;
+    md.pinned = pin;
+    md.pinned_count = 1;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &web));
+    ws_status s = ws_world_step(w);
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", ws_world_last_error(w));
+    double x[6];
+    size_t n;
+    ck_ok(w, ws_web_copy_positions(w, web, x, 2, &n));
+    ws_world_destroy(w);
+    report("kicked node without a speed limit: status %d, '%s'", (int)s, msg);
+    ck_assert_int_eq(s, WS_ERR_NUMERICAL);
+    ck_assert_msg(strstr(msg, "ran away") && strstr(msg, "1e+306"), "message: %s", msg);
+    ck_assert_msg(x[3] == 0.1 && x[4] == 0.0 && x[5] == 0.0, "the node moved to (%g, %g, %g)",
+                  x[3], x[4], x[5]);
+}
+END_TEST
+
 START_TEST(test_spring_user_law_and_failure)
 {
     /* A spring of a user law gives the user's force; when the callback fails the step fails
@@ -1869,6 +1937,7 @@ int main(void)
     add_case(s, "stable_dt_refusal_counted", test_stable_dt_refusal_counted, 10);
     add_case(s, "step_leaves_no_scratch_in_state", test_step_leaves_no_scratch_in_state, 10);
     add_case(s, "node_masses_each_their_own", test_node_masses_each_their_own, 10);
+    add_case(s, "runaway_without_a_speed_limit", test_runaway_without_a_speed_limit, 10);
     add_case(s, "state_hash_sees_web", test_state_hash_sees_web, 10);
     add_case(s, "sheet_generator", test_sheet_generator, 20);
     add_case(s, "mesh_node_masses", test_mesh_node_masses, 10);

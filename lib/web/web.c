@@ -1,5 +1,6 @@
 #include "web/web.h"
 
+#include <float.h>
 #include <string.h>
 
 /* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
@@ -619,11 +620,15 @@ void ws_web_sweep_end(ws_web *web)
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
 {
+    /* A speed whose square overflows counts as too fast even without a limit (max_speed
+     * infinite): a node's state never goes infinite unnoticed. */
+    double lim2 = vmax * vmax;
+    lim2 = lim2 <= DBL_MAX ? lim2 : DBL_MAX;
     if (web->same_inv_m && web->inv_m1 != 0.0)
-        return advance_same(n1 - n0, h, vmax * vmax, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
+        return advance_same(n1 - n0, h, lim2, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
                             xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
                             xd.x + n0, xd.y + n0, xd.z + n0);
-    return advance_each(n1 - n0, h, vmax * vmax, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
+    return advance_each(n1 - n0, h, lim2, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
                         xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
                         xd.y + n0, xd.z + n0);
 }
@@ -632,10 +637,10 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v)
 {
     double most = 0.0;
     for (uint32_t i = 0; i < web->n; i++) {
-        double s = v.x[i] * v.x[i] + v.y[i] * v.y[i] + v.z[i] * v.z[i];
-        most = s <= most ? most : s; /* NaN wins */
+        double s = hypot(hypot(v.x[i], v.y[i]), v.z[i]); /* no overflow below DBL_MAX */
+        most = s <= most ? most : s;                      /* NaN wins */
     }
-    return sqrt(most);
+    return most;
 }
 
 /* Per free node, into the force scratch (not state; no step is running when this is asked):

@@ -199,8 +199,9 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, doub
 void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd);
 void ws_web_sweep_end(ws_web *web);
 /* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v', f read from vd
- * (ws_web_sweep_begin). Returns how many of them end faster than vmax (m/s) or with a NaN
- * speed. Source and destination are distinct. */
+ * (ws_web_sweep_begin). Returns how many of them end faster than vmax (m/s), with a NaN
+ * speed or with one whose square overflows (whatever vmax). Source and destination are
+ * distinct. */
 size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
                               ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax);
 /* The largest node speed in v (NaN when one is NaN), m/s. */

@@ -279,9 +279,15 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             if (fast) {
                 double vmax = ws_web_fastest(web, vd);
                 char what[160];
-                snprintf(what, sizeof what,
-                         "a node ran away at t = %.6g s (speed %.3g m/s above max_speed %.3g)",
-                         w->time, vmax, w->def.max_speed);
+                if (vmax <= w->def.max_speed) /* past it only as the square overflowed */
+                    snprintf(what, sizeof what,
+                             "a node ran away at t = %.6g s (speed %.3g m/s, beyond what a "
+                             "double can square)",
+                             w->time, vmax);
+                else
+                    snprintf(what, sizeof what,
+                             "a node ran away at t = %.6g s (speed %.3g m/s above max_speed %.3g)",
+                             w->time, vmax, w->def.max_speed);
                 return web_unstable(w, web, h, ws_world_web_stable_dt(w, web), what);
             }
         }
