@@ -58,6 +58,49 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
+/* a where the bits of mask are set (all or none), else b: by their bits, so that a store of
+ * the choice stays a store (as a select, the compiler turns a store of b, the value read from
+ * the same place, into a masked store of a, which is slow, or a branch). */
+static inline double pick(uint64_t mask, double a, double b)
+{
+    uint64_t ua, ub;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & mask) | (ub & ~mask);
+    memcpy(&a, &ua, sizeof a);
+    return a;
+}
+
+/* friction_of in parts, which run_kernel takes in different passes. The slip velocity
+ * predicted at the end of the sub-step, from t, the other forces k and 1 / mass im. */
+static inline void friction_pred(double nx, double ny, double nz, double tx, double ty, double tz,
+                                 double kx, double ky, double kz, double im, double h, double *px,
+                                 double *py, double *pz)
+{
+    double dot = kx * nx + ky * ny + kz * nz;
+    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
+    double hm = h * im;
+    *px = tx + ox * hm;
+    *py = ty + oy * hm;
+    *pz = tz + oz * hm;
+}
+
+/* The friction over the predicted slip velocity, of speed vps (for a node that slips). */
+static inline double friction_scale(double vps, double mass, double fn, double mu, double vlim,
+                                    double h)
+{
+    double sr = vps / vlim;
+    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+    double stop = mass * vps / h;
+    return -(law < stop ? law : stop) / vps;
+}
+
+/* Whether a node slips (at the predicted speed vps): all bits or none, for pick. */
+static inline uint64_t friction_slips(double vps, double im)
+{
+    return 0 - (uint64_t)((vps > 0.0) & (im != 0.0));
+}
+
 /* The friction on a pushing node: from the contact's normal n, the node's tangential velocity
  * relative to the body t, its force with every normal force in k, its 1 / mass and mass, the
  * normal force fn and the contact's mu and v_lim. None for a pinned node or one that does not
@@ -74,32 +117,27 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
  * result independent of the order of the faces (which differs from corner to corner and would
  * twist a symmetric load). */
 static inline void friction_of(double nx, double ny, double nz, double tx, double ty, double tz,
-                               double kx, double ky, double kz, double im, double mass,
-                               double fn, double mu, double vlim, double h, double *ax,
-                               double *ay, double *az)
+                               double kx, double ky, double kz, double im, double mass, double fn,
+                               double mu, double vlim, double h, double *ax, double *ay, double *az)
 {
-    double dot = kx * nx + ky * ny + kz * nz;
-    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
-    double hm = h * im;
-    double px = tx + ox * hm, py = ty + oy * hm, pz = tz + oz * hm;
-    double vps = sqrt(px * px + py * py + pz * pz);
-    double sr = vps / vlim;
-    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-    double stop = mass * vps / h;
-    double s = -(law < stop ? law : stop) / vps;
-    int slips = (vps > 0.0) & (im != 0.0);
-    *ax = slips ? px * s : 0.0;
-    *ay = slips ? py * s : 0.0;
-    *az = slips ? pz * s : 0.0;
+    double px, py, pz;
+    friction_pred(nx, ny, nz, tx, ty, tz, kx, ky, kz, im, h, &px, &py, &pz);
+    const double vps = sqrt(px * px + py * py + pz * pz);
+    const double s = friction_scale(vps, mass, fn, mu, vlim, h);
+    const uint64_t slips = friction_slips(vps, im);
+    *ax = pick(slips, px * s, 0.0);
+    *ay = pick(slips, py * s, 0.0);
+    *az = pick(slips, pz * s, 0.0);
 }
 
 /* ---- the pushing contacts of a sweep block
  *
  * The one-by-one pass puts each node's normal forces into f and lists the contacts that push,
  * in node order, as arrays of web->act_cap (web->act). Once every normal force of the block is
- * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs at
- * once. The loads on the bodies of both go to one list of loads in node order, which is summed
- * last: the bodies' totals are added in the same order however the candidates are cut. */
+ * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs in
+ * batches (run_flush), into the places in the list of loads they took. The loads on the bodies of
+ * both go to one list of loads in node order, which is summed last: the bodies' totals are added in
+ * the same order however the candidates are cut. */
 
 enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
        A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
@@ -429,10 +467,13 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 #define RUN_MIN 4    /* shorter stretches go one by one */
 #define RUN_CHUNK 64 /* nodes of a run whose depths are taken at once: a bit each in a word */
 _Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit has 64");
-/* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
- * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
- * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
-#define RUN_STRIDE (RUN_CHUNK + 8)
+/* Groups of four nodes a sweep block's batch holds (run_batch): at least a chunk's. */
+#define RUN_GROUPS 32
+_Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty batch");
+/* The batch's output arrays lie this many doubles apart: not a power of two, so that their
+ * first lines, the ones a short batch uses, fall in different sets of the first-level cache
+ * (at a power of two apart they crowd into a few sets and evict each other). */
+#define RUN_OSTRIDE (4 * RUN_GROUPS + 8)
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -448,12 +489,12 @@ typedef struct run_face {
 static const uint64_t run_bit[RUN_CHUNK] = {RUN_BIT16(0), RUN_BIT16(16), RUN_BIT16(32),
                                             RUN_BIT16(48)};
 
-/* Depth d of nodes [0, 4 nv) (4 nv <= RUN_CHUNK) under the face's plane: bit i of the answer
- * says whether node i lies in the window, bit i of *below whether it lies below the plane.
- * Whole vectors of four, so that no loop is left over; straight-line code. */
+/* Nodes [0, 4 nv) (4 nv <= RUN_CHUNK) against the face's plane: bit i of the answer says
+ * whether node i lies in the window, bit i of *below whether it lies below the plane. Whole
+ * vectors of four, so that no loop is left over; straight-line code. */
 WS_VECTOR_LOOP
 static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *restrict x,
-                          const double *restrict y, const double *restrict z, double *restrict d,
+                          const double *restrict y, const double *restrict z,
                           uint64_t *restrict below)
 {
     const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
@@ -461,7 +502,6 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     for (size_t i = 0; i < 4 * nv; i++) {
         double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
         const uint64_t bit = run_bit[i];
-        d[i] = e;
         in |= bit & (0 - (uint64_t)((e < hi) & (e > lo)));
         neg |= bit & (0 - (uint64_t)(e < 0.0));
     }
@@ -469,18 +509,12 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* A run's contacts in the window, from its nodes' gathered values (I_*): the contact of
- * normal_of, and for one that pushes the friction of act_apply, with the same arithmetic
- * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's
- * node has no other contact, so its force with every normal force in is its force with this
- * one. Gives per contact the node's new force (O_*) and the body's share of the load (force
- * and moment about the CoG), zero for a contact that does not push, straight into the list of
- * loads. For nodes [0, 4 nv). Straight-line code, so it runs on vectors. */
-enum { O_FX, O_FY, O_FZ, O_ARRAYS };
-
+/* What a run needs of its face and body in run_kernel: the face's plane and window as in
+ * run_face, the body's CoG, velocity and spin, the contact's parameters. */
 typedef struct run_const {
-    double nx, ny, nz, rx, ry, rz, vx, vy, vz, wx, wy, wz; /* normal; body CoG, velocity, spin */
-    double hi, k, c, mu, vlim, h, share;
+    double nx, ny, nz, off, hi, lo;
+    double rx, ry, rz, vx, vy, vz, wx, wy, wz;
+    double k, c, mu, vlim;
 } run_const;
 
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
@@ -491,65 +525,235 @@ typedef struct ws_run_face {
     uint64_t gen;
 } ws_run_face;
 
-/* The kernel's inputs, gathered: arrays RUN_STRIDE apart from `in` on, in this order. */
-enum { I_X, I_Y, I_Z, I_VX, I_VY, I_VZ, I_FX, I_FY, I_FZ, I_D, I_IM, I_M, I_ARRAYS };
+/* Four consecutive nodes of a run, from a multiple of four past its chunk's start, at least
+ * one of them in the window: the unit of run_kernel. */
+typedef struct run_group {
+    const run_const *rc; /* the run's face and body */
+    uint32_t node;       /* the first of the four */
+    uint32_t lanes;      /* how many of the four are the run's (the last group may go past it) */
+    uint32_t bits;       /* those in the window: bit l for node + l */
+    uint32_t slot;       /* the place of the first of them in the list of loads */
+    uint32_t body;
+    uint32_t pad;
+} run_group;
+
+/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and its
+ * outputs: per group four lanes of each O_* array, RUN_OSTRIDE apart. The lists of the block
+ * (the loads) keep their places for them, so they may wait until the block's end. */
+typedef struct run_batch {
+    run_group *grp;
+    double *out;
+    size_t n, max; /* max: how many groups it holds, at most RUN_GROUPS: it runs before a
+                      chunk that could take it past them (a chunk's groups go in whole) */
+} run_batch;
+
+enum { O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_ARRAYS };
+
+/* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
+ * the nodes' arrays: the contact of normal_of, and for one that pushes the friction of
+ * act_apply, with the same arithmetic operation by operation (film_runs_equal_one_by_one holds
+ * them to it, to the bit). A run's node has no other contact, so its force with every normal
+ * force in is its force with this one. The nodes' new forces go into f (the lanes of the group
+ * that are not in the window, or not the run's, keep theirs); the body's share of each load
+ * (force and moment about the CoG, zero for a contact that does not push) into out, for every
+ * lane. Whole groups, so that the four lanes of a group run on vectors.
+ *
+ * In passes over all the groups, their values in between in tmp (T_*): a contact's arithmetic
+ * is one long chain (some 180 cycles from the node's position to its force, with a square root
+ * and two divisions in a row), about as long as the window of instructions a processor runs
+ * ahead in holds; in one pass a group's chain held back the next group's. Cut in four, the
+ * chains of several groups run side by side. The values a later pass takes only under a
+ * condition are read there as masks (as a select, the compiler would read them under the
+ * condition: slow masked loads). */
+enum {
+    T_KX,
+    T_KY,
+    T_KZ,
+    T_TX,
+    T_TY,
+    T_TZ,
+    T_FN,
+    T_LX,
+    T_LY,
+    T_LZ,
+    T_KEEP,
+    T_PX,
+    T_PY,
+    T_PZ,
+    T_VPS,
+    T_S,
+    T_SLIPS,
+    T_ARRAYS
+};
+
+#define RUN_T(k) (tmp + (k)*RUN_OSTRIDE + 4 * g)
+
+static inline uint64_t bits_of(double a)
+{
+    uint64_t u;
+    memcpy(&u, &a, sizeof u);
+    return u;
+}
+
+static inline double double_of(uint64_t u)
+{
+    double a;
+    memcpy(&a, &u, sizeof a);
+    return a;
+}
 
 WS_VECTOR_LOOP
-static void run_kernel(size_t nv, const run_const *restrict q, const double *restrict in,
-                       double *restrict out, double *restrict obx, double *restrict oby,
-                       double *restrict obz, double *restrict omx, double *restrict omy,
-                       double *restrict omz)
+static void run_kernel(size_t ng, const run_group *restrict grp, const double *restrict px,
+                       const double *restrict py, const double *restrict pz,
+                       const double *restrict ux, const double *restrict uy,
+                       const double *restrict uz, double *restrict gx, double *restrict gy,
+                       double *restrict gz, const double *restrict im, const double *restrict mass,
+                       double h, double share, double *restrict tmp, double *restrict out)
 {
-    const double *px = in + I_X * RUN_STRIDE, *py = in + I_Y * RUN_STRIDE,
-                 *pz = in + I_Z * RUN_STRIDE, *ux = in + I_VX * RUN_STRIDE,
-                 *uy = in + I_VY * RUN_STRIDE, *uz = in + I_VZ * RUN_STRIDE,
-                 *gx = in + I_FX * RUN_STRIDE, *gy = in + I_FY * RUN_STRIDE,
-                 *gz = in + I_FZ * RUN_STRIDE, *dd = in + I_D * RUN_STRIDE,
-                 *im = in + I_IM * RUN_STRIDE, *mass = in + I_M * RUN_STRIDE;
-    double *ofx = out + O_FX * RUN_STRIDE, *ofy = out + O_FY * RUN_STRIDE,
-           *ofz = out + O_FZ * RUN_STRIDE;
-    /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-    const double nx = q->nx, ny = q->ny, nz = q->nz, rx = q->rx, ry = q->ry, rz = q->rz,
-                 vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy, wz = q->wz,
-                 hi = q->hi, k = q->k, c = q->c, mu = q->mu, vlim = q->vlim, h = q->h,
-                 share = q->share;
-    for (size_t t = 0; t < 4 * nv; t++) { /* whole vectors: none left over */
-        const double d = dd[t], s = -0.5 * d;
-        /* normal_of */
-        double lx = (px[t] + nx * s) - rx, ly = (py[t] + ny * s) - ry, lz = (pz[t] + nz * s) - rz;
-        double bx = vx + (wy * lz - wz * ly), by = vy + (wz * lx - wx * lz),
-               bz = vz + (wx * ly - wy * lx);
-        double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
-        double vn = vrx * nx + vry * ny + vrz * nz;
-        double fn = k * (hi - d) - c * vn;
-        double push = fn > 0.0, fp = fn * push;
-        double kx = gx[t] + nx * fp, ky = gy[t] + ny * fp, kz = gz[t] + nz * fp;
-        /* act_apply */
-        double ax, ay, az;
-        friction_of(nx, ny, nz, vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn), kx, ky, kz,
-                    im[t], mass[t], fn, mu, vlim, h, &ax, &ay, &az);
-        ofx[t] = fn > 0.0 ? kx + ax : kx;
-        ofy[t] = fn > 0.0 ? ky + ay : ky;
-        ofz[t] = fn > 0.0 ? kz + az : kz;
-        /* The body's share, zero for a contact that does not push: adding +0 leaves every
-         * sum as it was (sums that start at +0 never reach -0), and so does the moment's
-         * zero, of either sign. */
-        double Bx = fn > 0.0 ? (ax + nx * fn) * -share : 0.0,
-               By = fn > 0.0 ? (ay + ny * fn) * -share : 0.0,
-               Bz = fn > 0.0 ? (az + nz * fn) * -share : 0.0;
-        obx[t] = Bx;
-        oby[t] = By;
-        obz[t] = Bz;
-        omx[t] = ly * Bz - lz * By;
-        omy[t] = lz * Bx - lx * Bz;
-        omz[t] = lx * By - ly * Bx;
+    /* normal_of, to the node's force with its normal force in and its tangential velocity */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node, lanes = grp[g].lanes;
+        /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
+        const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo,
+                     rx = q->rx, ry = q->ry, rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz,
+                     wx = q->wx, wy = q->wy, wz = q->wz, k = q->k, c = q->c;
+        double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *tx = RUN_T(T_TX),
+               *ty = RUN_T(T_TY), *tz = RUN_T(T_TZ), *fnt = RUN_T(T_FN), *lx = RUN_T(T_LX),
+               *ly = RUN_T(T_LY), *lz = RUN_T(T_LZ), *keep = RUN_T(T_KEEP);
+        for (size_t l = 0; l < 4; l++) {
+            const size_t t = o + l;
+            /* The depth as run_depth took it, and so whether the node is in the window. */
+            const double d = nx * px[t] + ny * py[t] + nz * pz[t] - off, s = -0.5 * d;
+            keep[l] = double_of(0 - (uint64_t)((d < hi) & (d > lo) & (l < lanes)));
+            const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
+                         az = (pz[t] + nz * s) - rz;
+            const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
+                         bz = vz + (wx * ay - wy * ax);
+            const double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
+            const double vn = vrx * nx + vry * ny + vrz * nz;
+            const double fn = k * (hi - d) - c * vn;
+            const double push = fn > 0.0, fp = fn * push;
+            kx[l] = gx[t] + nx * fp;
+            ky[l] = gy[t] + ny * fp;
+            kz[l] = gz[t] + nz * fp;
+            tx[l] = vrx + nx * (-vn);
+            ty[l] = vry + ny * (-vn);
+            tz[l] = vrz + nz * (-vn);
+            fnt[l] = fn;
+            lx[l] = ax;
+            ly[l] = ay;
+            lz[l] = az;
+        }
     }
+    /* act_apply's friction: the slip predicted */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double nx = q->nx, ny = q->ny, nz = q->nz;
+        const double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *tx = RUN_T(T_TX),
+                     *ty = RUN_T(T_TY), *tz = RUN_T(T_TZ);
+        double *sx = RUN_T(T_PX), *sy = RUN_T(T_PY), *sz = RUN_T(T_PZ), *vps = RUN_T(T_VPS);
+        for (size_t l = 0; l < 4; l++) {
+            double ax, ay, az;
+            friction_pred(nx, ny, nz, tx[l], ty[l], tz[l], kx[l], ky[l], kz[l], im[o + l], h, &ax,
+                          &ay, &az);
+            sx[l] = ax;
+            sy[l] = ay;
+            sz[l] = az;
+            vps[l] = sqrt(ax * ax + ay * ay + az * az);
+        }
+    }
+    /* its size */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double mu = q->mu, vlim = q->vlim;
+        const double *vps = RUN_T(T_VPS), *fn = RUN_T(T_FN);
+        double *s = RUN_T(T_S), *slips = RUN_T(T_SLIPS);
+        for (size_t l = 0; l < 4; l++) {
+            s[l] = friction_scale(vps[l], mass[o + l], fn[l], mu, vlim, h);
+            slips[l] = double_of(friction_slips(vps[l], im[o + l]));
+        }
+    }
+    /* the node's new force and the body's share */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double nx = q->nx, ny = q->ny, nz = q->nz;
+        const double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *fnt = RUN_T(T_FN),
+                     *lx = RUN_T(T_LX), *ly = RUN_T(T_LY), *lz = RUN_T(T_LZ), *keep = RUN_T(T_KEEP),
+                     *sx = RUN_T(T_PX), *sy = RUN_T(T_PY), *sz = RUN_T(T_PZ), *s = RUN_T(T_S),
+                     *slips = RUN_T(T_SLIPS);
+        double *ob = out + 4 * g;
+        for (size_t l = 0; l < 4; l++) {
+            const size_t t = o + l;
+            const double fn = fnt[l];
+            const uint64_t sl = bits_of(slips[l]), kp = bits_of(keep[l]);
+            const double ax = pick(sl, sx[l] * s[l], 0.0), ay = pick(sl, sy[l] * s[l], 0.0),
+                         az = pick(sl, sz[l] * s[l], 0.0);
+            gx[t] = pick(kp, fn > 0.0 ? kx[l] + ax : kx[l], gx[t]);
+            gy[t] = pick(kp, fn > 0.0 ? ky[l] + ay : ky[l], gy[t]);
+            gz[t] = pick(kp, fn > 0.0 ? kz[l] + az : kz[l], gz[t]);
+            /* The body's share, zero for a contact that does not push: adding +0 leaves every
+             * sum as it was (sums that start at +0 never reach -0), and so does the moment's
+             * zero, of either sign. */
+            double Bx = fn > 0.0 ? (ax + nx * fn) * -share : 0.0,
+                   By = fn > 0.0 ? (ay + ny * fn) * -share : 0.0,
+                   Bz = fn > 0.0 ? (az + nz * fn) * -share : 0.0;
+            ob[O_BX * RUN_OSTRIDE + l] = Bx;
+            ob[O_BY * RUN_OSTRIDE + l] = By;
+            ob[O_BZ * RUN_OSTRIDE + l] = Bz;
+            ob[O_MX * RUN_OSTRIDE + l] = ly[l] * Bz - lz[l] * By;
+            ob[O_MY * RUN_OSTRIDE + l] = lz[l] * Bx - lx[l] * Bz;
+            ob[O_MZ * RUN_OSTRIDE + l] = lx[l] * By - ly[l] * Bx;
+        }
+    }
+}
+
+/* The batch's contacts: run_kernel, then, in node order, each node's share of its contact
+ * force and its body's load into their places in the list of loads. A contact that does not
+ * push has a share of zero, and is listed as touched and loaded all the same (a branch would
+ * be a coin toss). */
+static void run_flush(const node_env *E, run_batch *B, double h, double share, v3 *fc)
+{
+    if (B->n == 0)
+        return;
+    ws_web *web = E->web;
+    const ws_nodes3 x = E->x, v = E->v, f = web->f;
+    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m, h,
+               share, B->out + O_ARRAYS * RUN_OSTRIDE, B->out);
+    act_list *L = E->L;
+    double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
+           *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
+    uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
+    size_t nt = web->nfct[web->fck];
+    for (size_t g = 0; g < B->n; g++) {
+        const run_group *G = &B->grp[g];
+        const double *ob = B->out + 4 * g;
+        size_t s = G->slot;
+        for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
+            const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
+            const double bx = ob[O_BX * RUN_OSTRIDE + l], by = ob[O_BY * RUN_OSTRIDE + l],
+                         bz = ob[O_BZ * RUN_OSTRIDE + l];
+            fc[i] = v3_sub(fc[i], v3_make(bx, by, bz)); /* the share: -Fb, to the bit */
+            touched[nt++] = i;
+            lbx[s] = bx;
+            lby[s] = by;
+            lbz[s] = bz;
+            lmx[s] = ob[O_MX * RUN_OSTRIDE + l];
+            lmy[s] = ob[O_MY * RUN_OSTRIDE + l];
+            lmz[s] = ob[O_MZ * RUN_OSTRIDE + l];
+            lbody[s] = G->body;
+        }
+    }
+    web->nfct[web->fck] = nt;
+    B->n = 0;
 }
 
 /* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
  * from the face, its body and their materials by the first run on it. */
-static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c, double h,
-                                      double share)
+static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
 {
     ws_web *web = E->web;
     ws_run_face *e = &web->rface[c->feat];
@@ -563,40 +767,39 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c, doub
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  r.x,  r.y,   r.z,     vb.x, vb.y, vb.z, wb.x,
-                        wb.y, wb.z, hi,   p->k, p->c,  p->mu,   p->vlim, h,   share};
+    e->rc = (run_const){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,  r.y,   r.z,    vb.x,
+                        vb.y, vb.z, wb.x, wb.y,   wb.z, p->k, p->c, p->mu, p->vlim};
     e->gen = web->rface_gen;
     return e;
 }
 
+/* Nodes in the window of each group of four: their count. */
+static const uint8_t run_count4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
- * The others are gathered and go through run_kernel: the arithmetic of contacts_general for a
- * node whose only candidate is a face it lies well inside of, without its look-ups (the face,
- * body and contact are the run's). Their loads go to the list in node order, those that do
- * not push as zeros. A chunk with a node below the face's plane (d < 0), where another face
- * may lie shallower, goes to contacts_general. */
-static void contacts_run(const node_env *E, const ws_ncand *cand, const ws_nseg *sg, double h,
-                         double share, v3 *fc)
+ * The groups of four nodes with one in the window join the block's batch (B), with their
+ * places in the list of loads, in node order: run_kernel takes them with the arithmetic of
+ * contacts_general for a node whose only candidate is a face it lies well inside of, without
+ * its look-ups (the face, body and contact are the run's). A chunk with a node below the face's
+ * plane (d < 0), where another face may lie shallower, goes to contacts_general. */
+static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, const ws_nseg *sg,
+                         double h, double share, v3 *fc)
 {
     ws_web *web = E->web;
-    const ws_nodes3 x = E->x, v = E->v;
+    const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
     const uint32_t bi = c->body;
-    const ws_run_face *rf = run_face_of(E, c, h, share);
-    /* Scratch: the chunk's depths and the gathered nodes' indices, then run_kernel's inputs
-     * I_* and outputs O_*. */
-    double *D = web->rtmp, *I = D + 2 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
-    uint32_t *idx = (uint32_t *)(D + RUN_STRIDE);
+    const ws_run_face *rf = run_face_of(E, c);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
-        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
+        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK;
         /* Depths on whole vectors, past the run (its row goes on), the bits of the nodes past
          * it dropped; a chunk whose vectors would end past the last node goes one by one. */
         const size_t nv = (m + 3) / 4;
         uint64_t below = 0, in = 0;
         int whole = o + 4 * nv <= web->n;
         if (whole) {
-            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, D, &below);
+            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
         web->run_nodes += m;
@@ -605,52 +808,21 @@ static void contacts_run(const node_env *E, const ws_ncand *cand, const ws_nseg 
             contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
-        /* The ones in the window, gathered: a pass of the loop per node in it, found by its
-         * bit. */
-        for (; in; in &= in - 1, nin++) {
-            const uint32_t e = ws_lowest_bit(in), i = o + e;
-            idx[nin] = i;
-            I[I_X * RUN_STRIDE + nin] = x.x[i];
-            I[I_Y * RUN_STRIDE + nin] = x.y[i];
-            I[I_Z * RUN_STRIDE + nin] = x.z[i];
-            I[I_VX * RUN_STRIDE + nin] = v.x[i];
-            I[I_VY * RUN_STRIDE + nin] = v.y[i];
-            I[I_VZ * RUN_STRIDE + nin] = v.z[i];
-            I[I_FX * RUN_STRIDE + nin] = web->f.x[i];
-            I[I_FY * RUN_STRIDE + nin] = web->f.y[i];
-            I[I_FZ * RUN_STRIDE + nin] = web->f.z[i];
-            I[I_D * RUN_STRIDE + nin] = D[e];
-            I[I_IM * RUN_STRIDE + nin] = web->inv_m[i];
-            I[I_M * RUN_STRIDE + nin] = web->m[i];
+        /* The batch runs first if the chunk's groups (nv at most) could take it past its
+         * size. */
+        if (B->n + nv > B->max)
+            run_flush(E, B, h, share, fc);
+        /* The groups with a node in the window: bit 4 g set for group g. */
+        uint64_t any = in | in >> 1 | in >> 2 | in >> 3;
+        any &= 0x1111111111111111u;
+        uint32_t slot = (uint32_t)L->nl;
+        for (; any; any &= any - 1) {
+            const uint32_t e = ws_lowest_bit(any), bits = (uint32_t)(in >> e) & 15u;
+            B->grp[B->n++] =
+                (run_group){&rf->rc, o + e, m - e < 4 ? (uint32_t)(m - e) : 4u, bits, slot, bi, 0};
+            slot += run_count4[bits];
         }
-        if (nin == 0)
-            continue;
-        /* On whole vectors: the lanes past nin hold what the scratch held (earlier nodes'
-         * values, or the zeros it started with), and their results are not read. The loads
-         * land at the end of the list, the padding's past it (room: ws_node_scratch). */
-        const size_t nl = L->nl;
-        const double *lbx = act_a(L, A_BX) + nl, *lby = act_a(L, A_BY) + nl,
-                     *lbz = act_a(L, A_BZ) + nl;
-        run_kernel((nin + 3) / 4, &rf->rc, I, O, act_a(L, A_BX) + nl, act_a(L, A_BY) + nl,
-                   act_a(L, A_BZ) + nl, act_a(L, A_MX) + nl, act_a(L, A_MY) + nl,
-                   act_a(L, A_MZ) + nl);
-        /* In node order: the new forces, and the node's share; the body's loads are listed.
-         * A contact that does not push has a share of zero, and is listed as touched and
-         * loaded all the same (a branch would be a coin toss). */
-        const double *ofx = O + O_FX * RUN_STRIDE, *ofy = O + O_FY * RUN_STRIDE,
-                     *ofz = O + O_FZ * RUN_STRIDE;
-        uint32_t *touched = web->fct[web->fck] + web->nfct[web->fck], *lbody = L->lbody + nl;
-        for (size_t t = 0; t < nin; t++) {
-            const uint32_t i = idx[t];
-            web->f.x[i] = ofx[t];
-            web->f.y[i] = ofy[t];
-            web->f.z[i] = ofz[t];
-            fc[i] = v3_sub(fc[i], v3_make(lbx[t], lby[t], lbz[t])); /* the share: -Fb, to the bit */
-            touched[t] = i;
-            lbody[t] = bi;
-        }
-        L->nl = nl + nin;
-        web->nfct[web->fck] += nin;
+        L->nl = slot;
     }
 }
 
@@ -763,11 +935,11 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     web->seg_list = -1;
     web->nseg = 0;
     if (web->rtmp_cap == 0) {
-        /* Zeroed once: a run's kernel reads its padding lanes, whose results it drops. */
-        const size_t need = (2 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE;
+        /* A run batch: its groups, then run_kernel's outputs. */
+        const size_t need =
+            RUN_GROUPS * sizeof(run_group) / sizeof(double) + (O_ARRAYS + T_ARRAYS) * RUN_OSTRIDE;
         if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
             return -1;
-        memset(web->rtmp, 0, web->rtmp_cap * sizeof(double));
     }
     if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
         return -1;
@@ -826,6 +998,9 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     act_list L = act_open(web);
     corner_memo memo = {UINT32_MAX, 0.0};
     const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
+    run_batch B = {(run_group *)web->rtmp,
+                   web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double), 0,
+                   web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
         web->rface_gen++;
@@ -837,12 +1012,13 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         const ws_nseg *sg = &seg[k];
         tried += sg->c1 - sg->c0;
         if (sg->run)
-            contacts_run(&E, cand, sg, h, share, fc);
+            contacts_run(&E, &B, cand, sg, h, share, fc);
         else
             contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }
     *checks += tried;
     *next = k;
+    run_flush(&E, &B, h, share, fc);
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
 }

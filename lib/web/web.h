@@ -125,6 +125,8 @@ typedef struct ws_web {
     int seg_list;
     int runs_off;  /* no short cuts: no runs and no corners, every candidate one by one
                       through its full tests (tests compare the two) */
+    uint32_t run_batch;           /* groups of run nodes taken at once; 0: as many as fit
+                                     (tests make it small to run the batches often) */
     uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
                                      by one because a node lay below the face (diagnostics) */
     uint64_t corners;             /* corners told apart by their planes (diagnostics) */
