@@ -470,9 +470,9 @@ _Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit ha
 /* Groups of four nodes a sweep block's batch holds (run_batch): at least a chunk's. */
 #define RUN_GROUPS 32
 _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty batch");
-/* The batch's output arrays lie this many doubles apart: not a power of two, so that their
- * first lines, the ones a short batch uses, fall in different sets of the first-level cache
- * (at a power of two apart they crowd into a few sets and evict each other). */
+/* The length of the batch's scratch arrays (run_tmp): not a power of two, so that their first
+ * lines, the ones a short batch uses, fall in different sets of the first-level cache (at a
+ * power of two apart they crowd into a few sets and evict each other). */
 #define RUN_OSTRIDE (4 * RUN_GROUPS + 8)
 
 /* A run's face as its depth pass needs it. */
@@ -537,17 +537,15 @@ typedef struct run_group {
     uint32_t pad;
 } run_group;
 
-/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and its
- * outputs: per group four lanes of each O_* array, RUN_OSTRIDE apart. The lists of the block
- * (the loads) keep their places for them, so they may wait until the block's end. */
+/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and the
+ * kernel's scratch (run_tmp). The list of loads keeps their places, so they may wait until the
+ * block's end. */
 typedef struct run_batch {
     run_group *grp;
-    double *out;
+    struct run_tmp *tmp;
     size_t n, max; /* max: how many groups it holds, at most RUN_GROUPS: it runs before a
                       chunk that could take it past them (a chunk's groups go in whole) */
 } run_batch;
-
-enum { O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_ARRAYS };
 
 /* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
  * the nodes' arrays: the contact of normal_of, and for one that pushes the friction of
@@ -565,28 +563,18 @@ enum { O_BX, O_BY, O_BZ, O_MX, O_MY, O_MZ, O_ARRAYS };
  * chains of several groups run side by side. The values a later pass takes only under a
  * condition are read there as masks (as a select, the compiler would read them under the
  * condition: slow masked loads). */
-enum {
-    T_KX,
-    T_KY,
-    T_KZ,
-    T_TX,
-    T_TY,
-    T_TZ,
-    T_FN,
-    T_LX,
-    T_LY,
-    T_LZ,
-    T_KEEP,
-    T_PX,
-    T_PY,
-    T_PZ,
-    T_VPS,
-    T_S,
-    T_SLIPS,
-    T_ARRAYS
-};
-
-#define RUN_T(k) (tmp + (k)*RUN_OSTRIDE + 4 * g)
+/* The batch's values between the passes and its outputs, each array a value's of every lane
+ * (4 g + l for lane l of group g). */
+typedef struct run_tmp {
+    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* force with the normal force */
+    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
+    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
+    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
+    double px[RUN_OSTRIDE], py[RUN_OSTRIDE], pz[RUN_OSTRIDE];    /* predicted slip velocity */
+    double vps[RUN_OSTRIDE], s[RUN_OSTRIDE], slips[RUN_OSTRIDE]; /* its speed, scale, slips */
+    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
+    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
+} run_tmp;
 
 static inline uint64_t bits_of(double a)
 {
@@ -608,7 +596,7 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
                        const double *restrict ux, const double *restrict uy,
                        const double *restrict uz, double *restrict gx, double *restrict gy,
                        double *restrict gz, const double *restrict im, const double *restrict mass,
-                       double h, double share, double *restrict tmp, double *restrict out)
+                       double h, double share, run_tmp *restrict T)
 {
     /* normal_of, to the node's force with its normal force in and its tangential velocity */
     for (size_t g = 0; g < ng; g++) {
@@ -618,14 +606,11 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo,
                      rx = q->rx, ry = q->ry, rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz,
                      wx = q->wx, wy = q->wy, wz = q->wz, k = q->k, c = q->c;
-        double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *tx = RUN_T(T_TX),
-               *ty = RUN_T(T_TY), *tz = RUN_T(T_TZ), *fnt = RUN_T(T_FN), *lx = RUN_T(T_LX),
-               *ly = RUN_T(T_LY), *lz = RUN_T(T_LZ), *keep = RUN_T(T_KEEP);
         for (size_t l = 0; l < 4; l++) {
-            const size_t t = o + l;
+            const size_t t = o + l, e = 4 * g + l;
             /* The depth as run_depth took it, and so whether the node is in the window. */
             const double d = nx * px[t] + ny * py[t] + nz * pz[t] - off, s = -0.5 * d;
-            keep[l] = double_of(0 - (uint64_t)((d < hi) & (d > lo) & (l < lanes)));
+            T->keep[e] = double_of(0 - (uint64_t)((d < hi) & (d > lo) & (l < lanes)));
             const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
                          az = (pz[t] + nz * s) - rz;
             const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
@@ -634,16 +619,16 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             const double vn = vrx * nx + vry * ny + vrz * nz;
             const double fn = k * (hi - d) - c * vn;
             const double push = fn > 0.0, fp = fn * push;
-            kx[l] = gx[t] + nx * fp;
-            ky[l] = gy[t] + ny * fp;
-            kz[l] = gz[t] + nz * fp;
-            tx[l] = vrx + nx * (-vn);
-            ty[l] = vry + ny * (-vn);
-            tz[l] = vrz + nz * (-vn);
-            fnt[l] = fn;
-            lx[l] = ax;
-            ly[l] = ay;
-            lz[l] = az;
+            T->kx[e] = gx[t] + nx * fp;
+            T->ky[e] = gy[t] + ny * fp;
+            T->kz[e] = gz[t] + nz * fp;
+            T->tx[e] = vrx + nx * (-vn);
+            T->ty[e] = vry + ny * (-vn);
+            T->tz[e] = vrz + nz * (-vn);
+            T->fn[e] = fn;
+            T->lx[e] = ax;
+            T->ly[e] = ay;
+            T->lz[e] = az;
         }
     }
     /* act_apply's friction: the slip predicted */
@@ -651,17 +636,15 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
         const double nx = q->nx, ny = q->ny, nz = q->nz;
-        const double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *tx = RUN_T(T_TX),
-                     *ty = RUN_T(T_TY), *tz = RUN_T(T_TZ);
-        double *sx = RUN_T(T_PX), *sy = RUN_T(T_PY), *sz = RUN_T(T_PZ), *vps = RUN_T(T_VPS);
         for (size_t l = 0; l < 4; l++) {
+            const size_t e = 4 * g + l;
             double ax, ay, az;
-            friction_pred(nx, ny, nz, tx[l], ty[l], tz[l], kx[l], ky[l], kz[l], im[o + l], h, &ax,
-                          &ay, &az);
-            sx[l] = ax;
-            sy[l] = ay;
-            sz[l] = az;
-            vps[l] = sqrt(ax * ax + ay * ay + az * az);
+            friction_pred(nx, ny, nz, T->tx[e], T->ty[e], T->tz[e], T->kx[e], T->ky[e], T->kz[e],
+                          im[o + l], h, &ax, &ay, &az);
+            T->px[e] = ax;
+            T->py[e] = ay;
+            T->pz[e] = az;
+            T->vps[e] = sqrt(ax * ax + ay * ay + az * az);
         }
     }
     /* its size */
@@ -669,11 +652,10 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
         const double mu = q->mu, vlim = q->vlim;
-        const double *vps = RUN_T(T_VPS), *fn = RUN_T(T_FN);
-        double *s = RUN_T(T_S), *slips = RUN_T(T_SLIPS);
         for (size_t l = 0; l < 4; l++) {
-            s[l] = friction_scale(vps[l], mass[o + l], fn[l], mu, vlim, h);
-            slips[l] = double_of(friction_slips(vps[l], im[o + l]));
+            const size_t e = 4 * g + l;
+            T->s[e] = friction_scale(T->vps[e], mass[o + l], T->fn[e], mu, vlim, h);
+            T->slips[e] = double_of(friction_slips(T->vps[e], im[o + l]));
         }
     }
     /* the node's new force and the body's share */
@@ -681,32 +663,30 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
         const double nx = q->nx, ny = q->ny, nz = q->nz;
-        const double *kx = RUN_T(T_KX), *ky = RUN_T(T_KY), *kz = RUN_T(T_KZ), *fnt = RUN_T(T_FN),
-                     *lx = RUN_T(T_LX), *ly = RUN_T(T_LY), *lz = RUN_T(T_LZ), *keep = RUN_T(T_KEEP),
-                     *sx = RUN_T(T_PX), *sy = RUN_T(T_PY), *sz = RUN_T(T_PZ), *s = RUN_T(T_S),
-                     *slips = RUN_T(T_SLIPS);
-        double *ob = out + 4 * g;
         for (size_t l = 0; l < 4; l++) {
-            const size_t t = o + l;
-            const double fn = fnt[l];
-            const uint64_t sl = bits_of(slips[l]), kp = bits_of(keep[l]);
-            const double ax = pick(sl, sx[l] * s[l], 0.0), ay = pick(sl, sy[l] * s[l], 0.0),
-                         az = pick(sl, sz[l] * s[l], 0.0);
-            gx[t] = pick(kp, fn > 0.0 ? kx[l] + ax : kx[l], gx[t]);
-            gy[t] = pick(kp, fn > 0.0 ? ky[l] + ay : ky[l], gy[t]);
-            gz[t] = pick(kp, fn > 0.0 ? kz[l] + az : kz[l], gz[t]);
+            const size_t t = o + l, e = 4 * g + l;
+            const double fn = T->fn[e], s = T->s[e];
+            const uint64_t slips = bits_of(T->slips[e]), keep = bits_of(T->keep[e]),
+                           push = 0 - (uint64_t)(fn > 0.0);
+            const double ax = pick(slips, T->px[e] * s, 0.0), ay = pick(slips, T->py[e] * s, 0.0),
+                         az = pick(slips, T->pz[e] * s, 0.0);
+            const double kx = T->kx[e], ky = T->ky[e], kz = T->kz[e];
+            gx[t] = pick(keep, pick(push, kx + ax, kx), gx[t]);
+            gy[t] = pick(keep, pick(push, ky + ay, ky), gy[t]);
+            gz[t] = pick(keep, pick(push, kz + az, kz), gz[t]);
             /* The body's share, zero for a contact that does not push: adding +0 leaves every
              * sum as it was (sums that start at +0 never reach -0), and so does the moment's
              * zero, of either sign. */
-            double Bx = fn > 0.0 ? (ax + nx * fn) * -share : 0.0,
-                   By = fn > 0.0 ? (ay + ny * fn) * -share : 0.0,
-                   Bz = fn > 0.0 ? (az + nz * fn) * -share : 0.0;
-            ob[O_BX * RUN_OSTRIDE + l] = Bx;
-            ob[O_BY * RUN_OSTRIDE + l] = By;
-            ob[O_BZ * RUN_OSTRIDE + l] = Bz;
-            ob[O_MX * RUN_OSTRIDE + l] = ly[l] * Bz - lz[l] * By;
-            ob[O_MY * RUN_OSTRIDE + l] = lz[l] * Bx - lx[l] * Bz;
-            ob[O_MZ * RUN_OSTRIDE + l] = lx[l] * By - ly[l] * Bx;
+            const double Bx = pick(push, (ax + nx * fn) * -share, 0.0),
+                         By = pick(push, (ay + ny * fn) * -share, 0.0),
+                         Bz = pick(push, (az + nz * fn) * -share, 0.0);
+            const double lx = T->lx[e], ly = T->ly[e], lz = T->lz[e];
+            T->bx[e] = Bx;
+            T->by[e] = By;
+            T->bz[e] = Bz;
+            T->mx[e] = ly * Bz - lz * By;
+            T->my[e] = lz * Bx - lx * Bz;
+            T->mz[e] = lx * By - ly * Bx;
         }
     }
 }
@@ -721,8 +701,9 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
         return;
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
+    run_tmp *T = B->tmp;
     run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m, h,
-               share, B->out + O_ARRAYS * RUN_OSTRIDE, B->out);
+               share, T);
     act_list *L = E->L;
     double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
            *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
@@ -730,20 +711,19 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     size_t nt = web->nfct[web->fck];
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
-        const double *ob = B->out + 4 * g;
         size_t s = G->slot;
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
             const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
-            const double bx = ob[O_BX * RUN_OSTRIDE + l], by = ob[O_BY * RUN_OSTRIDE + l],
-                         bz = ob[O_BZ * RUN_OSTRIDE + l];
+            const size_t e = 4 * g + l;
+            const double bx = T->bx[e], by = T->by[e], bz = T->bz[e];
             fc[i] = v3_sub(fc[i], v3_make(bx, by, bz)); /* the share: -Fb, to the bit */
             touched[nt++] = i;
             lbx[s] = bx;
             lby[s] = by;
             lbz[s] = bz;
-            lmx[s] = ob[O_MX * RUN_OSTRIDE + l];
-            lmy[s] = ob[O_MY * RUN_OSTRIDE + l];
-            lmz[s] = ob[O_MZ * RUN_OSTRIDE + l];
+            lmx[s] = T->mx[e];
+            lmy[s] = T->my[e];
+            lmz[s] = T->mz[e];
             lbody[s] = G->body;
         }
     }
@@ -936,8 +916,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     web->nseg = 0;
     if (web->rtmp_cap == 0) {
         /* A run batch: its groups, then run_kernel's outputs. */
-        const size_t need =
-            RUN_GROUPS * sizeof(run_group) / sizeof(double) + (O_ARRAYS + T_ARRAYS) * RUN_OSTRIDE;
+        const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double);
         if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
             return -1;
     }
@@ -999,7 +978,8 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     corner_memo memo = {UINT32_MAX, 0.0};
     const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
     run_batch B = {(run_group *)web->rtmp,
-                   web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double), 0,
+                   (struct run_tmp *)(web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double)),
+                   0,
                    web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
