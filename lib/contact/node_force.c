@@ -489,12 +489,12 @@ typedef struct run_face {
 static const uint64_t run_bit[RUN_CHUNK] = {RUN_BIT16(0), RUN_BIT16(16), RUN_BIT16(32),
                                             RUN_BIT16(48)};
 
-/* Nodes [0, 4 nv) (4 nv <= RUN_CHUNK) against the face's plane: bit i of the answer says
- * whether node i lies in the window, bit i of *below whether it lies below the plane. Whole
- * vectors of four, so that no loop is left over; straight-line code. */
+/* Depth d of nodes [0, 4 nv) (4 nv <= RUN_CHUNK) under the face's plane: bit i of the answer
+ * says whether node i lies in the window, bit i of *below whether it lies below the plane.
+ * Whole vectors of four, so that no loop is left over; straight-line code. */
 WS_VECTOR_LOOP
 static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *restrict x,
-                          const double *restrict y, const double *restrict z,
+                          const double *restrict y, const double *restrict z, double *restrict d,
                           uint64_t *restrict below)
 {
     const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
@@ -502,6 +502,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     for (size_t i = 0; i < 4 * nv; i++) {
         double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
         const uint64_t bit = run_bit[i];
+        d[i] = e;
         in |= bit & (0 - (uint64_t)((e < hi) & (e > lo)));
         neg |= bit & (0 - (uint64_t)(e < 0.0));
     }
@@ -509,10 +510,10 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in run_kernel: the face's plane and window as in
+/* What a run needs of its face and body in run_kernel: the face's normal and window as in
  * run_face, the body's CoG, velocity and spin, the contact's parameters. */
 typedef struct run_const {
-    double nx, ny, nz, off, hi, lo;
+    double nx, ny, nz, hi, lo;
     double rx, ry, rz, vx, vy, vz, wx, wy, wz;
     double k, c, mu, vlim;
 } run_const;
@@ -543,6 +544,8 @@ typedef struct run_group {
 typedef struct run_batch {
     run_group *grp;
     struct run_tmp *tmp;
+    double *depth; /* by node: the depths run_depth took, under the face of the run it took
+                      them for (past a run's end, the next run's take the place of its) */
     size_t n, max; /* max: how many groups it holds, at most RUN_GROUPS: it runs before a
                       chunk that could take it past them (a chunk's groups go in whole) */
 } run_batch;
@@ -596,20 +599,20 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
                        const double *restrict ux, const double *restrict uy,
                        const double *restrict uz, double *restrict gx, double *restrict gy,
                        double *restrict gz, const double *restrict im, const double *restrict mass,
-                       double h, double share, run_tmp *restrict T)
+                       const double *restrict depth, double h, double share, run_tmp *restrict T)
 {
     /* normal_of, to the node's force with its normal force in and its tangential velocity */
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node, lanes = grp[g].lanes;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo,
-                     rx = q->rx, ry = q->ry, rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz,
-                     wx = q->wx, wy = q->wy, wz = q->wz, k = q->k, c = q->c;
+        const double nx = q->nx, ny = q->ny, nz = q->nz, hi = q->hi, lo = q->lo, rx = q->rx,
+                     ry = q->ry, rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx,
+                     wy = q->wy, wz = q->wz, k = q->k, c = q->c;
         for (size_t l = 0; l < 4; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            /* The depth as run_depth took it, and so whether the node is in the window. */
-            const double d = nx * px[t] + ny * py[t] + nz * pz[t] - off, s = -0.5 * d;
+            /* The depth run_depth took, and so whether the node is in the window. */
+            const double d = depth[t], s = -0.5 * d;
             T->keep[e] = double_of(0 - (uint64_t)((d < hi) & (d > lo) & (l < lanes)));
             const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
                          az = (pz[t] + nz * s) - rz;
@@ -702,8 +705,8 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
     run_tmp *T = B->tmp;
-    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m, h,
-               share, T);
+    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m,
+               B->depth, h, share, T);
     act_list *L = E->L;
     double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
            *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
@@ -747,8 +750,8 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,  r.y,   r.z,    vb.x,
-                        vb.y, vb.z, wb.x, wb.y,   wb.z, p->k, p->c, p->mu, p->vlim};
+    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   lo,   r.x,  r.y,  r.z,   vb.x,
+                        vb.y, vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim};
     e->gen = web->rface_gen;
     return e;
 }
@@ -779,7 +782,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
         uint64_t below = 0, in = 0;
         int whole = o + 4 * nv <= web->n;
         if (whole) {
-            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, &below);
+            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
         web->run_nodes += m;
@@ -915,8 +918,9 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     web->seg_list = -1;
     web->nseg = 0;
     if (web->rtmp_cap == 0) {
-        /* A run batch: its groups, then run_kernel's outputs. */
-        const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double);
+        /* A run batch: its groups, run_kernel's scratch, the nodes' depths. */
+        const size_t need =
+            (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
         if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
             return -1;
     }
@@ -977,9 +981,9 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     act_list L = act_open(web);
     corner_memo memo = {UINT32_MAX, 0.0};
     const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
-    run_batch B = {(run_group *)web->rtmp,
-                   (struct run_tmp *)(web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double)),
-                   0,
+    double *tmp = web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
+    run_batch B = {(run_group *)web->rtmp, (struct run_tmp *)tmp,
+                   tmp + sizeof(run_tmp) / sizeof(double), 0,
                    web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
