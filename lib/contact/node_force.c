@@ -510,12 +510,14 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in run_kernel: the face's normal and window as in
- * run_face, the body's CoG, velocity and spin, the contact's parameters. */
+/* What a run needs of its face and body in run_kernel and run_flush: the face's normal and
+ * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
+ * parameters, the body's slot. */
 typedef struct run_const {
-    double nx, ny, nz, hi, lo;
+    double nx, ny, nz, hi;
     double rx, ry, rz, vx, vy, vz, wx, wy, wz;
     double k, c, mu, vlim;
+    uint32_t body;
 } run_const;
 
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
@@ -531,11 +533,8 @@ typedef struct ws_run_face {
 typedef struct run_group {
     const run_const *rc; /* the run's face and body */
     uint32_t node;       /* the first of the four */
-    uint32_t lanes;      /* how many of the four are the run's (the last group may go past it) */
-    uint32_t bits;       /* those in the window: bit l for node + l */
     uint32_t slot;       /* the place of the first of them in the list of loads */
-    uint32_t body;
-    uint32_t pad;
+    uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
 /* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and the
@@ -604,16 +603,16 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
     /* normal_of, to the node's force with its normal force in and its tangential velocity */
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
-        const size_t o = grp[g].node, lanes = grp[g].lanes;
+        const size_t o = grp[g].node;
+        const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const double nx = q->nx, ny = q->ny, nz = q->nz, hi = q->hi, lo = q->lo, rx = q->rx,
-                     ry = q->ry, rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx,
-                     wy = q->wy, wz = q->wz, k = q->k, c = q->c;
+        const double nx = q->nx, ny = q->ny, nz = q->nz, hi = q->hi, rx = q->rx, ry = q->ry,
+                     rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy,
+                     wz = q->wz, k = q->k, c = q->c;
         for (size_t l = 0; l < 4; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            /* The depth run_depth took, and so whether the node is in the window. */
-            const double d = depth[t], s = -0.5 * d;
-            T->keep[e] = double_of(0 - (uint64_t)((d < hi) & (d > lo) & (l < lanes)));
+            const double d = depth[t], s = -0.5 * d; /* the depth run_depth took */
+            T->keep[e] = double_of(0 - ((bits >> l) & 1u));
             const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
                          az = (pz[t] + nz * s) - rz;
             const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
@@ -727,7 +726,7 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
             lmx[s] = T->mx[e];
             lmy[s] = T->my[e];
             lmz[s] = T->mz[e];
-            lbody[s] = G->body;
+            lbody[s] = G->rc->body;
         }
     }
     web->nfct[web->fck] = nt;
@@ -750,8 +749,8 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   lo,   r.x,  r.y,  r.z,   vb.x,
-                        vb.y, vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim};
+    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   r.x,  r.y,  r.z,   vb.x,    vb.y,
+                        vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim, bi};
     e->gen = web->rface_gen;
     return e;
 }
@@ -772,7 +771,6 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
     const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
-    const uint32_t bi = c->body;
     const ws_run_face *rf = run_face_of(E, c);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK;
@@ -801,8 +799,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
         uint32_t slot = (uint32_t)L->nl;
         for (; any; any &= any - 1) {
             const uint32_t e = ws_lowest_bit(any), bits = (uint32_t)(in >> e) & 15u;
-            B->grp[B->n++] =
-                (run_group){&rf->rc, o + e, m - e < 4 ? (uint32_t)(m - e) : 4u, bits, slot, bi, 0};
+            B->grp[B->n++] = (run_group){&rf->rc, o + e, slot, bits};
             slot += run_count4[bits];
         }
         L->nl = slot;
