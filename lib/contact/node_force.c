@@ -142,16 +142,25 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
 enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
        A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
 
+/* A load on a body: force and moment about the CoG; the list's loads take the room of arrays
+ * A_BX to A_MZ (cap of them). */
+typedef struct act_load {
+    v3 f, m;
+} act_load;
+_Static_assert(sizeof(act_load) == 6 * sizeof(double) && A_MZ == A_BX + 5,
+               "a list's loads fill arrays A_BX to A_MZ");
+
 /* The list: per contact its normal (from the body to the node), lever from the body's CoG to
  * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
  * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
  * found. node and body name the node and the body's slot, slot its place in the loads.
- * The loads: per load on a body (A_BX... A_MZ: force, moment about the CoG) and the body's
- * slot (lbody), nl of them. */
+ * The loads: per load on a body its force and moment (load) and the body's slot (lbody), nl
+ * of them. */
 typedef struct act_list {
     double *base; /* array k at base + k cap */
     size_t cap;
     uint32_t *node, *body, *slot, *lbody;
+    act_load *load;
     size_t n, nl;
 } act_list;
 
@@ -159,7 +168,9 @@ static act_list act_open(ws_web *web)
 {
     const size_t cap = web->act_cap;
     uint32_t *id = web->act_id;
-    return (act_list){web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, 0, 0};
+    act_list L = {web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
+    L.load = (act_load *)(web->act + A_BX * cap);
+    return L;
 }
 
 static inline double *act_a(const act_list *L, int k) { return L->base + (size_t)k * L->cap; }
@@ -263,8 +274,7 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
         fc[i] = v3_madd(fc[i], Fnode, share);
         touched[nt++] = i;
         v3 Fb = v3_scale(Fnode, -share);
-        act_set3(L, A_BX, at, Fb);
-        act_set3(L, A_MX, at, v3_cross(lever, Fb));
+        L->load[at] = (act_load){Fb, v3_cross(lever, Fb)};
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
@@ -288,8 +298,8 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
             bf = bforce[bi];
             bm = bmoment[bi];
         }
-        bf = v3_add(bf, act_get3(L, A_BX, q));
-        bm = v3_add(bm, act_get3(L, A_MX, q));
+        bf = v3_add(bf, L->load[q].f);
+        bm = v3_add(bm, L->load[q].m);
     }
     if (body != UINT32_MAX) {
         bforce[body] = bf;
@@ -707,8 +717,7 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m,
                B->depth, h, share, T);
     act_list *L = E->L;
-    double *lbx = act_a(L, A_BX), *lby = act_a(L, A_BY), *lbz = act_a(L, A_BZ),
-           *lmx = act_a(L, A_MX), *lmy = act_a(L, A_MY), *lmz = act_a(L, A_MZ);
+    act_load *load = L->load;
     uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
     size_t nt = web->nfct[web->fck];
     for (size_t g = 0; g < B->n; g++) {
@@ -717,15 +726,10 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
             const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
             const size_t e = 4 * g + l;
-            const double bx = T->bx[e], by = T->by[e], bz = T->bz[e];
-            fc[i] = v3_sub(fc[i], v3_make(bx, by, bz)); /* the share: -Fb, to the bit */
+            const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
+            fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
             touched[nt++] = i;
-            lbx[s] = bx;
-            lby[s] = by;
-            lbz[s] = bz;
-            lmx[s] = T->mx[e];
-            lmy[s] = T->my[e];
-            lmz[s] = T->mz[e];
+            load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
             lbody[s] = G->rc->body;
         }
     }
