@@ -130,7 +130,8 @@ typedef struct ws_web {
     uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
                                      by one because a node lay below the face (diagnostics) */
     uint64_t corners;             /* corners told apart by their planes (diagnostics) */
-    double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
+    double *rtmp; /* the runs' batch, its kernel's values, the nodes' depths (scratch, */
+                  /* contact/node_force.c) */
     size_t rtmp_cap;
     struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
     size_t rface_cap;          /* body, filled in sub-step rface_gen (scratch, node_force.c) */
