@@ -538,8 +538,8 @@ typedef struct ws_run_face {
     uint64_t gen;
 } ws_run_face;
 
-/* Four consecutive nodes of a run, from a multiple of four past its chunk's start, at least
- * one of them in the window: the unit of run_kernel. */
+/* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
+ * depths were taken of: the unit of run_kernel. */
 typedef struct run_group {
     const run_const *rc; /* the run's face and body */
     uint32_t node;       /* the first of the four */
@@ -797,12 +797,16 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
          * size. */
         if (B->n + nv > B->max)
             run_flush(E, B, h, share, fc);
-        /* The groups with a node in the window: bit 4 g set for group g. */
-        uint64_t any = in | in >> 1 | in >> 2 | in >> 3;
-        any &= 0x1111111111111111u;
+        /* The groups: each from the first node in the window not yet in one, so that nodes in
+         * the window side by side share few groups; the last no further than the depths
+         * reach (it may then hold nodes of the one before, not as its own). */
         uint32_t slot = (uint32_t)L->nl;
-        for (; any; any &= any - 1) {
-            const uint32_t e = ws_lowest_bit(any), bits = (uint32_t)(in >> e) & 15u;
+        const uint32_t last = (uint32_t)(4 * nv - 4);
+        while (in) {
+            uint32_t e = ws_lowest_bit(in);
+            e = e < last ? e : last;
+            const uint32_t bits = (uint32_t)(in >> e) & 15u;
+            in &= ~((uint64_t)15u << e);
             B->grp[B->n++] = (run_group){&rf->rc, o + e, slot, bits};
             slot += run_count4[bits];
         }
