@@ -716,6 +716,10 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep, ui
     ws_web *web_a = only_web(a), *web_b = only_web(b);
     ck_assert(web_a && web_b);
     web_a->runs_off = 1;
+    /* Runs take their groups of nodes in batches, each sweep block's at its end; in two of the
+     * scenes a batch runs before every chunk of a run instead, as a block with more than a
+     * batch holds does. */
+    web_b->run_batch = kind % 2 ? 1u : 0u;
     const int steps = 2400;
     ws_web_info wi;
     ck_ok(b, ws_web_get_info(b, wb, &wi));

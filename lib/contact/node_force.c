@@ -63,6 +63,49 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
+/* a where the bits of mask are set (all or none), else b: by their bits, so that a store of
+ * the choice stays a store (as a select, the compiler turns a store of b, the value read from
+ * the same place, into a masked store of a, which is slow, or a branch). */
+static inline double pick(uint64_t mask, double a, double b)
+{
+    uint64_t ua, ub;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & mask) | (ub & ~mask);
+    memcpy(&a, &ua, sizeof a);
+    return a;
+}
+
+/* friction_of in parts, which run_kernel takes in different passes. The slip velocity
+ * predicted at the end of the sub-step, from t, the other forces k and 1 / mass im. */
+static inline void friction_pred(double nx, double ny, double nz, double tx, double ty, double tz,
+                                 double kx, double ky, double kz, double im, double h, double *px,
+                                 double *py, double *pz)
+{
+    double dot = kx * nx + ky * ny + kz * nz;
+    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
+    double hm = h * im;
+    *px = tx + ox * hm;
+    *py = ty + oy * hm;
+    *pz = tz + oz * hm;
+}
+
+/* The friction over the predicted slip velocity, of speed vps (for a node that slips). */
+static inline double friction_scale(double vps, double mass, double fn, double mu, double vlim,
+                                    double h)
+{
+    double sr = vps / vlim;
+    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
+    double stop = mass * vps / h;
+    return -(law < stop ? law : stop) / vps;
+}
+
+/* Whether a node slips (at the predicted speed vps): all bits or none, for pick. */
+static inline uint64_t friction_slips(double vps, double im)
+{
+    return 0 - (uint64_t)((vps > 0.0) & (im != 0.0));
+}
+
 /* The friction on a pushing node: from the contact's normal n, the node's tangential velocity
  * relative to the body t, its force with every normal force in k, its 1 / mass and mass, the
  * normal force fn and the contact's mu and v_lim. None for a pinned node or one that does not
@@ -79,46 +122,50 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
  * result independent of the order of the faces (which differs from corner to corner and would
  * twist a symmetric load). */
 static inline void friction_of(double nx, double ny, double nz, double tx, double ty, double tz,
-                               double kx, double ky, double kz, double im, double mass,
-                               double fn, double mu, double vlim, double h, double *ax,
-                               double *ay, double *az)
+                               double kx, double ky, double kz, double im, double mass, double fn,
+                               double mu, double vlim, double h, double *ax, double *ay, double *az)
 {
-    double dot = kx * nx + ky * ny + kz * nz;
-    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
-    double hm = h * im;
-    double px = tx + ox * hm, py = ty + oy * hm, pz = tz + oz * hm;
-    double vps = sqrt(px * px + py * py + pz * pz);
-    double sr = vps / vlim;
-    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-    double stop = mass * vps / h;
-    double s = -(law < stop ? law : stop) / vps;
-    int slips = (vps > 0.0) & (im != 0.0);
-    *ax = slips ? px * s : 0.0;
-    *ay = slips ? py * s : 0.0;
-    *az = slips ? pz * s : 0.0;
+    double px, py, pz;
+    friction_pred(nx, ny, nz, tx, ty, tz, kx, ky, kz, im, h, &px, &py, &pz);
+    const double vps = sqrt(px * px + py * py + pz * pz);
+    const double s = friction_scale(vps, mass, fn, mu, vlim, h);
+    const uint64_t slips = friction_slips(vps, im);
+    *ax = pick(slips, px * s, 0.0);
+    *ay = pick(slips, py * s, 0.0);
+    *az = pick(slips, pz * s, 0.0);
 }
 
 /* ---- the pushing contacts of a sweep block
  *
  * The one-by-one pass puts each node's normal forces into f and lists the contacts that push,
  * in node order, as arrays of web->act_cap (web->act). Once every normal force of the block is
- * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs at
- * once. The loads on the bodies of both go to one list of loads in node order, which is summed
- * last: the bodies' totals are added in the same order however the candidates are cut. */
+ * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs in
+ * batches (run_flush), into the places in the list of loads they took. The loads on the bodies of
+ * both go to one list of loads in node order, which is summed last: the bodies' totals are added in
+ * the same order however the candidates are cut. */
 
 enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
        A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
+
+/* A load on a body: force and moment about the CoG; the list's loads take the room of arrays
+ * A_BX to A_MZ (cap of them). */
+typedef struct act_load {
+    v3 f, m;
+} act_load;
+_Static_assert(sizeof(act_load) == 6 * sizeof(double) && A_MZ == A_BX + 5,
+               "a list's loads fill arrays A_BX to A_MZ");
 
 /* The list: per contact its normal (from the body to the node), lever from the body's CoG to
  * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
  * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
  * found. node and body name the node and the body's slot, slot its place in the loads.
- * The loads: per load on a body (A_BX... A_MZ: force, moment about the CoG) and the body's
- * slot (lbody), nl of them. */
+ * The loads: per load on a body its force and moment (load) and the body's slot (lbody), nl
+ * of them. */
 typedef struct act_list {
     double *base; /* array k at base + k cap */
     size_t cap;
     uint32_t *node, *body, *slot, *lbody;
+    act_load *load;
     size_t n, nl;
 } act_list;
 
@@ -126,7 +173,9 @@ static act_list act_open(ws_web *web)
 {
     const size_t cap = web->act_cap;
     uint32_t *id = web->act_id;
-    return (act_list){web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, 0, 0};
+    act_list L = {web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
+    L.load = (act_load *)(web->act + A_BX * cap);
+    return L;
 }
 
 static inline double *act_a(const act_list *L, int k) { return L->base + (size_t)k * L->cap; }
@@ -230,8 +279,7 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
         fc[i] = v3_madd(fc[i], Fnode, share);
         touched[nt++] = i;
         v3 Fb = v3_scale(Fnode, -share);
-        act_set3(L, A_BX, at, Fb);
-        act_set3(L, A_MX, at, v3_cross(lever, Fb));
+        L->load[at] = (act_load){Fb, v3_cross(lever, Fb)};
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
@@ -255,8 +303,8 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
             bf = bforce[bi];
             bm = bmoment[bi];
         }
-        bf = v3_add(bf, act_get3(L, A_BX, q));
-        bm = v3_add(bm, act_get3(L, A_MX, q));
+        bf = v3_add(bf, L->load[q].f);
+        bm = v3_add(bm, L->load[q].m);
     }
     if (body != UINT32_MAX) {
         bforce[body] = bf;
@@ -439,10 +487,13 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 #define RUN_MIN 4    /* shorter stretches go one by one */
 #define RUN_CHUNK 64 /* nodes of a run whose depths are taken at once: a bit each in a word */
 _Static_assert(RUN_CHUNK == 64, "run_depth answers with a bit a node, run_bit has 64");
-/* The run's scratch arrays lie this many doubles apart: not a power of two, so that their first
- * lines, the ones a run of a few dozen nodes uses, fall in different sets of the first-level
- * cache (at 1024 bytes apart the two dozen of them shared four sets, and evicted each other). */
-#define RUN_STRIDE (RUN_CHUNK + 8)
+/* Groups of four nodes a sweep block's batch holds (run_batch): at least a chunk's. */
+#define RUN_GROUPS 32
+_Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty batch");
+/* The length of the batch's scratch arrays (run_tmp): not a power of two, so that their first
+ * lines, the ones a short batch uses, fall in different sets of the first-level cache (at a
+ * power of two apart they crowd into a few sets and evict each other). */
+#define RUN_OSTRIDE (4 * RUN_GROUPS + 8)
 
 /* A run's face as its depth pass needs it. */
 typedef struct run_face {
@@ -479,18 +530,14 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* A run's contacts in the window, from its nodes' gathered values (I_*): the contact of
- * normal_of, and for one that pushes the friction of act_apply, with the same arithmetic
- * operation by operation (film_runs_equal_one_by_one holds them to it, to the bit). A run's
- * node has no other contact, so its force with every normal force in is its force with this
- * one. Gives per contact the node's new force (O_*) and the body's share of the load (force
- * and moment about the CoG), zero for a contact that does not push, straight into the list of
- * loads. For nodes [0, 4 nv). Straight-line code, so it runs on vectors. */
-enum { O_FX, O_FY, O_FZ, O_ARRAYS };
-
+/* What a run needs of its face and body in run_kernel and run_flush: the face's normal and
+ * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
+ * parameters, the body's slot. */
 typedef struct run_const {
-    double nx, ny, nz, rx, ry, rz, vx, vy, vz, wx, wy, wz; /* normal; body CoG, velocity, spin */
-    double hi, k, c, mu, vlim, h, share;
+    double nx, ny, nz, hi;
+    double rx, ry, rz, vx, vy, vz, wx, wy, wz;
+    double k, c, mu, vlim;
+    uint32_t body;
 } run_const;
 
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
@@ -501,65 +548,208 @@ typedef struct ws_run_face {
     uint64_t gen;
 } ws_run_face;
 
-/* The kernel's inputs, gathered: arrays RUN_STRIDE apart from `in` on, in this order. */
-enum { I_X, I_Y, I_Z, I_VX, I_VY, I_VZ, I_FX, I_FY, I_FZ, I_D, I_IM, I_M, I_ARRAYS };
+/* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
+ * depths were taken of: the unit of run_kernel. */
+typedef struct run_group {
+    const run_const *rc; /* the run's face and body */
+    uint32_t node;       /* the first of the four */
+    uint32_t slot;       /* the place of the first of them in the list of loads */
+    uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
+} run_group;
+
+/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and the
+ * kernel's scratch (run_tmp). The list of loads keeps their places, so they may wait until the
+ * block's end. */
+typedef struct run_batch {
+    run_group *grp;
+    struct run_tmp *tmp;
+    double *depth; /* by node: the depths run_depth took, under the face of the run it took
+                      them for (past a run's end, the next run's take the place of its) */
+    size_t n, max; /* max: how many groups it holds, at most RUN_GROUPS: it runs before a
+                      chunk that could take it past them (a chunk's groups go in whole) */
+} run_batch;
+
+/* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
+ * the nodes' arrays: the contact of normal_of, and for one that pushes the friction of
+ * act_apply, with the same arithmetic operation by operation (film_runs_equal_one_by_one holds
+ * them to it, to the bit). A run's node has no other contact, so its force with every normal
+ * force in is its force with this one. The nodes' new forces go into f (the lanes of the group
+ * that are not in the window, or not the run's, keep theirs); the body's share of each load
+ * (force and moment about the CoG, zero for a contact that does not push) into out, for every
+ * lane. Whole groups, so that the four lanes of a group run on vectors.
+ *
+ * In passes over all the groups, their values in between in tmp (T_*): a contact's arithmetic
+ * is one long chain (some 180 cycles from the node's position to its force, with a square root
+ * and two divisions in a row), about as long as the window of instructions a processor runs
+ * ahead in holds; in one pass a group's chain held back the next group's. Cut in four, the
+ * chains of several groups run side by side. The values a later pass takes only under a
+ * condition are read there as masks (as a select, the compiler would read them under the
+ * condition: slow masked loads). */
+/* The batch's values between the passes and its outputs, each array a value's of every lane
+ * (4 g + l for lane l of group g). */
+typedef struct run_tmp {
+    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* force with the normal force */
+    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
+    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
+    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
+    double px[RUN_OSTRIDE], py[RUN_OSTRIDE], pz[RUN_OSTRIDE];    /* predicted slip velocity */
+    double vps[RUN_OSTRIDE], s[RUN_OSTRIDE], slips[RUN_OSTRIDE]; /* its speed, scale, slips */
+    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
+    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
+} run_tmp;
+
+static inline uint64_t bits_of(double a)
+{
+    uint64_t u;
+    memcpy(&u, &a, sizeof u);
+    return u;
+}
+
+static inline double double_of(uint64_t u)
+{
+    double a;
+    memcpy(&a, &u, sizeof a);
+    return a;
+}
 
 WS_VECTOR_LOOP
-static void run_kernel(size_t nv, const run_const *restrict q, const double *restrict in,
-                       double *restrict out, double *restrict obx, double *restrict oby,
-                       double *restrict obz, double *restrict omx, double *restrict omy,
-                       double *restrict omz)
+static void run_kernel(size_t ng, const run_group *restrict grp, const double *restrict px,
+                       const double *restrict py, const double *restrict pz,
+                       const double *restrict ux, const double *restrict uy,
+                       const double *restrict uz, double *restrict gx, double *restrict gy,
+                       double *restrict gz, const double *restrict im, const double *restrict mass,
+                       const double *restrict depth, double h, double share, run_tmp *restrict T)
 {
-    const double *px = in + I_X * RUN_STRIDE, *py = in + I_Y * RUN_STRIDE,
-                 *pz = in + I_Z * RUN_STRIDE, *ux = in + I_VX * RUN_STRIDE,
-                 *uy = in + I_VY * RUN_STRIDE, *uz = in + I_VZ * RUN_STRIDE,
-                 *gx = in + I_FX * RUN_STRIDE, *gy = in + I_FY * RUN_STRIDE,
-                 *gz = in + I_FZ * RUN_STRIDE, *dd = in + I_D * RUN_STRIDE,
-                 *im = in + I_IM * RUN_STRIDE, *mass = in + I_M * RUN_STRIDE;
-    double *ofx = out + O_FX * RUN_STRIDE, *ofy = out + O_FY * RUN_STRIDE,
-           *ofz = out + O_FZ * RUN_STRIDE;
-    /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-    const double nx = q->nx, ny = q->ny, nz = q->nz, rx = q->rx, ry = q->ry, rz = q->rz,
-                 vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy, wz = q->wz,
-                 hi = q->hi, k = q->k, c = q->c, mu = q->mu, vlim = q->vlim, h = q->h,
-                 share = q->share;
-    for (size_t t = 0; t < 4 * nv; t++) { /* whole vectors: none left over */
-        const double d = dd[t], s = -0.5 * d;
-        /* normal_of */
-        double lx = (px[t] + nx * s) - rx, ly = (py[t] + ny * s) - ry, lz = (pz[t] + nz * s) - rz;
-        double bx = vx + (wy * lz - wz * ly), by = vy + (wz * lx - wx * lz),
-               bz = vz + (wx * ly - wy * lx);
-        double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
-        double vn = vrx * nx + vry * ny + vrz * nz;
-        double fn = k * (hi - d) - c * vn;
-        double push = fn > 0.0, fp = fn * push;
-        double kx = gx[t] + nx * fp, ky = gy[t] + ny * fp, kz = gz[t] + nz * fp;
-        /* act_apply */
-        double ax, ay, az;
-        friction_of(nx, ny, nz, vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn), kx, ky, kz,
-                    im[t], mass[t], fn, mu, vlim, h, &ax, &ay, &az);
-        ofx[t] = fn > 0.0 ? kx + ax : kx;
-        ofy[t] = fn > 0.0 ? ky + ay : ky;
-        ofz[t] = fn > 0.0 ? kz + az : kz;
-        /* The body's share, zero for a contact that does not push: adding +0 leaves every
-         * sum as it was (sums that start at +0 never reach -0), and so does the moment's
-         * zero, of either sign. */
-        double Bx = fn > 0.0 ? (ax + nx * fn) * -share : 0.0,
-               By = fn > 0.0 ? (ay + ny * fn) * -share : 0.0,
-               Bz = fn > 0.0 ? (az + nz * fn) * -share : 0.0;
-        obx[t] = Bx;
-        oby[t] = By;
-        obz[t] = Bz;
-        omx[t] = ly * Bz - lz * By;
-        omy[t] = lz * Bx - lx * Bz;
-        omz[t] = lx * By - ly * Bx;
+    /* normal_of, to the node's force with its normal force in and its tangential velocity */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const uint64_t bits = grp[g].bits;
+        /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
+        const double nx = q->nx, ny = q->ny, nz = q->nz, hi = q->hi, rx = q->rx, ry = q->ry,
+                     rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy,
+                     wz = q->wz, k = q->k, c = q->c;
+        for (size_t l = 0; l < 4; l++) {
+            const size_t t = o + l, e = 4 * g + l;
+            const double d = depth[t], s = -0.5 * d; /* the depth run_depth took */
+            T->keep[e] = double_of(0 - ((bits >> l) & 1u));
+            const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
+                         az = (pz[t] + nz * s) - rz;
+            const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
+                         bz = vz + (wx * ay - wy * ax);
+            const double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
+            const double vn = vrx * nx + vry * ny + vrz * nz;
+            const double fn = k * (hi - d) - c * vn;
+            const double push = fn > 0.0, fp = fn * push;
+            T->kx[e] = gx[t] + nx * fp;
+            T->ky[e] = gy[t] + ny * fp;
+            T->kz[e] = gz[t] + nz * fp;
+            T->tx[e] = vrx + nx * (-vn);
+            T->ty[e] = vry + ny * (-vn);
+            T->tz[e] = vrz + nz * (-vn);
+            T->fn[e] = fn;
+            T->lx[e] = ax;
+            T->ly[e] = ay;
+            T->lz[e] = az;
+        }
     }
+    /* act_apply's friction: the slip predicted */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double nx = q->nx, ny = q->ny, nz = q->nz;
+        for (size_t l = 0; l < 4; l++) {
+            const size_t e = 4 * g + l;
+            double ax, ay, az;
+            friction_pred(nx, ny, nz, T->tx[e], T->ty[e], T->tz[e], T->kx[e], T->ky[e], T->kz[e],
+                          im[o + l], h, &ax, &ay, &az);
+            T->px[e] = ax;
+            T->py[e] = ay;
+            T->pz[e] = az;
+            T->vps[e] = sqrt(ax * ax + ay * ay + az * az);
+        }
+    }
+    /* its size */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double mu = q->mu, vlim = q->vlim;
+        for (size_t l = 0; l < 4; l++) {
+            const size_t e = 4 * g + l;
+            T->s[e] = friction_scale(T->vps[e], mass[o + l], T->fn[e], mu, vlim, h);
+            T->slips[e] = double_of(friction_slips(T->vps[e], im[o + l]));
+        }
+    }
+    /* the node's new force and the body's share */
+    for (size_t g = 0; g < ng; g++) {
+        const run_const *q = grp[g].rc;
+        const size_t o = grp[g].node;
+        const double nx = q->nx, ny = q->ny, nz = q->nz;
+        for (size_t l = 0; l < 4; l++) {
+            const size_t t = o + l, e = 4 * g + l;
+            const double fn = T->fn[e], s = T->s[e];
+            const uint64_t slips = bits_of(T->slips[e]), keep = bits_of(T->keep[e]),
+                           push = 0 - (uint64_t)(fn > 0.0);
+            const double ax = pick(slips, T->px[e] * s, 0.0), ay = pick(slips, T->py[e] * s, 0.0),
+                         az = pick(slips, T->pz[e] * s, 0.0);
+            const double kx = T->kx[e], ky = T->ky[e], kz = T->kz[e];
+            gx[t] = pick(keep, pick(push, kx + ax, kx), gx[t]);
+            gy[t] = pick(keep, pick(push, ky + ay, ky), gy[t]);
+            gz[t] = pick(keep, pick(push, kz + az, kz), gz[t]);
+            /* The body's share, zero for a contact that does not push: adding +0 leaves every
+             * sum as it was (sums that start at +0 never reach -0), and so does the moment's
+             * zero, of either sign. */
+            const double Bx = pick(push, (ax + nx * fn) * -share, 0.0),
+                         By = pick(push, (ay + ny * fn) * -share, 0.0),
+                         Bz = pick(push, (az + nz * fn) * -share, 0.0);
+            const double lx = T->lx[e], ly = T->ly[e], lz = T->lz[e];
+            T->bx[e] = Bx;
+            T->by[e] = By;
+            T->bz[e] = Bz;
+            T->mx[e] = ly * Bz - lz * By;
+            T->my[e] = lz * Bx - lx * Bz;
+            T->mz[e] = lx * By - ly * Bx;
+        }
+    }
+}
+
+/* The batch's contacts: run_kernel, then, in node order, each node's share of its contact
+ * force and its body's load into their places in the list of loads. A contact that does not
+ * push has a share of zero, and is listed as touched and loaded all the same (a branch would
+ * be a coin toss). */
+static void run_flush(const node_env *E, run_batch *B, double h, double share, v3 *fc)
+{
+    if (B->n == 0)
+        return;
+    ws_web *web = E->web;
+    const ws_nodes3 x = E->x, v = E->v, f = web->f;
+    run_tmp *T = B->tmp;
+    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m,
+               B->depth, h, share, T);
+    act_list *L = E->L;
+    act_load *load = L->load;
+    uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
+    size_t nt = web->nfct[web->fck];
+    for (size_t g = 0; g < B->n; g++) {
+        const run_group *G = &B->grp[g];
+        size_t s = G->slot;
+        for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
+            const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
+            const size_t e = 4 * g + l;
+            const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
+            fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
+            touched[nt++] = i;
+            load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
+            lbody[s] = G->rc->body;
+        }
+    }
+    web->nfct[web->fck] = nt;
+    B->n = 0;
 }
 
 /* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
  * from the face, its body and their materials by the first run on it. */
-static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c, double h,
-                                      double share)
+static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
 {
     ws_web *web = E->web;
     ws_run_face *e = &web->rface[c->feat];
@@ -573,40 +763,38 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c, doub
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  r.x,  r.y,   r.z,     vb.x, vb.y, vb.z, wb.x,
-                        wb.y, wb.z, hi,   p->k, p->c,  p->mu,   p->vlim, h,   share};
+    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   r.x,  r.y,  r.z,   vb.x,    vb.y,
+                        vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim, bi};
     e->gen = web->rface_gen;
     return e;
 }
 
+/* Nodes in the window of each group of four: their count. */
+static const uint8_t run_count4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
- * The others are gathered and go through run_kernel: the arithmetic of contacts_general for a
- * node whose only candidate is a face it lies well inside of, without its look-ups (the face,
- * body and contact are the run's). Their loads go to the list in node order, those that do
- * not push as zeros. A chunk with a node below the face's plane (d < 0), where another face
- * may lie shallower, goes to contacts_general. */
-static void contacts_run(const node_env *E, const ws_ncand *cand, const ws_nseg *sg, double h,
-                         double share, v3 *fc)
+ * The groups of four nodes with one in the window join the block's batch (B), with their
+ * places in the list of loads, in node order: run_kernel takes them with the arithmetic of
+ * contacts_general for a node whose only candidate is a face it lies well inside of, without
+ * its look-ups (the face, body and contact are the run's). A chunk with a node below the face's
+ * plane (d < 0), where another face may lie shallower, goes to contacts_general. */
+static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, const ws_nseg *sg,
+                         double h, double share, v3 *fc)
 {
     ws_web *web = E->web;
-    const ws_nodes3 x = E->x, v = E->v;
+    const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
-    const uint32_t bi = c->body;
-    const ws_run_face *rf = run_face_of(E, c, h, share);
-    /* Scratch: the chunk's depths and the gathered nodes' indices, then run_kernel's inputs
-     * I_* and outputs O_*. */
-    double *D = web->rtmp, *I = D + 2 * RUN_STRIDE, *O = I + I_ARRAYS * RUN_STRIDE;
-    uint32_t *idx = (uint32_t *)(D + RUN_STRIDE);
+    const ws_run_face *rf = run_face_of(E, c);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
-        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK, nin = 0;
+        size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK;
         /* Depths on whole vectors, past the run (its row goes on), the bits of the nodes past
          * it dropped; a chunk whose vectors would end past the last node goes one by one. */
         const size_t nv = (m + 3) / 4;
         uint64_t below = 0, in = 0;
         int whole = o + 4 * nv <= web->n;
         if (whole) {
-            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, D, &below);
+            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
         web->run_nodes += m;
@@ -615,52 +803,24 @@ static void contacts_run(const node_env *E, const ws_ncand *cand, const ws_nseg 
             contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
-        /* The ones in the window, gathered: a pass of the loop per node in it, found by its
-         * bit. */
-        for (; in; in &= in - 1, nin++) {
-            const uint32_t e = ws_lowest_bit(in), i = o + e;
-            idx[nin] = i;
-            I[I_X * RUN_STRIDE + nin] = x.x[i];
-            I[I_Y * RUN_STRIDE + nin] = x.y[i];
-            I[I_Z * RUN_STRIDE + nin] = x.z[i];
-            I[I_VX * RUN_STRIDE + nin] = v.x[i];
-            I[I_VY * RUN_STRIDE + nin] = v.y[i];
-            I[I_VZ * RUN_STRIDE + nin] = v.z[i];
-            I[I_FX * RUN_STRIDE + nin] = web->f.x[i];
-            I[I_FY * RUN_STRIDE + nin] = web->f.y[i];
-            I[I_FZ * RUN_STRIDE + nin] = web->f.z[i];
-            I[I_D * RUN_STRIDE + nin] = D[e];
-            I[I_IM * RUN_STRIDE + nin] = web->inv_m[i];
-            I[I_M * RUN_STRIDE + nin] = web->m[i];
+        /* The batch runs first if the chunk's groups (nv at most) could take it past its
+         * size. */
+        if (B->n + nv > B->max)
+            run_flush(E, B, h, share, fc);
+        /* The groups: each from the first node in the window not yet in one, so that nodes in
+         * the window side by side share few groups; the last no further than the depths
+         * reach (it may then hold nodes of the one before, not as its own). */
+        uint32_t slot = (uint32_t)L->nl;
+        const uint32_t last = (uint32_t)(4 * nv - 4);
+        while (in) {
+            uint32_t e = ws_lowest_bit(in);
+            e = e < last ? e : last;
+            const uint32_t bits = (uint32_t)(in >> e) & 15u;
+            in &= ~((uint64_t)15u << e);
+            B->grp[B->n++] = (run_group){&rf->rc, o + e, slot, bits};
+            slot += run_count4[bits];
         }
-        if (nin == 0)
-            continue;
-        /* On whole vectors: the lanes past nin hold what the scratch held (earlier nodes'
-         * values, or the zeros it started with), and their results are not read. The loads
-         * land at the end of the list, the padding's past it (room: ws_node_scratch). */
-        const size_t nl = L->nl;
-        const double *lbx = act_a(L, A_BX) + nl, *lby = act_a(L, A_BY) + nl,
-                     *lbz = act_a(L, A_BZ) + nl;
-        run_kernel((nin + 3) / 4, &rf->rc, I, O, act_a(L, A_BX) + nl, act_a(L, A_BY) + nl,
-                   act_a(L, A_BZ) + nl, act_a(L, A_MX) + nl, act_a(L, A_MY) + nl,
-                   act_a(L, A_MZ) + nl);
-        /* In node order: the new forces, and the node's share; the body's loads are listed.
-         * A contact that does not push has a share of zero, and is listed as touched and
-         * loaded all the same (a branch would be a coin toss). */
-        const double *ofx = O + O_FX * RUN_STRIDE, *ofy = O + O_FY * RUN_STRIDE,
-                     *ofz = O + O_FZ * RUN_STRIDE;
-        uint32_t *touched = web->fct[web->fck] + web->nfct[web->fck], *lbody = L->lbody + nl;
-        for (size_t t = 0; t < nin; t++) {
-            const uint32_t i = idx[t];
-            web->f.x[i] = ofx[t];
-            web->f.y[i] = ofy[t];
-            web->f.z[i] = ofz[t];
-            fc[i] = v3_sub(fc[i], v3_make(lbx[t], lby[t], lbz[t])); /* the share: -Fb, to the bit */
-            touched[t] = i;
-            lbody[t] = bi;
-        }
-        L->nl = nl + nin;
-        web->nfct[web->fck] += nin;
+        L->nl = slot;
     }
 }
 
@@ -773,11 +933,11 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     web->seg_list = -1;
     web->nseg = 0;
     if (web->rtmp_cap == 0) {
-        /* Zeroed once: a run's kernel reads its padding lanes, whose results it drops. */
-        const size_t need = (2 + I_ARRAYS + O_ARRAYS) * RUN_STRIDE;
+        /* A run batch: its groups, run_kernel's scratch, the nodes' depths. */
+        const size_t need =
+            (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
         if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
             return -1;
-        memset(web->rtmp, 0, web->rtmp_cap * sizeof(double));
     }
     if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
         return -1;
@@ -869,6 +1029,10 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     act_list L = act_open(web);
     corner_memo memo = {UINT32_MAX, 0.0};
     const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
+    double *tmp = web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
+    run_batch B = {(run_group *)web->rtmp, (struct run_tmp *)tmp,
+                   tmp + sizeof(run_tmp) / sizeof(double), 0,
+                   web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
     size_t k = *next;
     if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
         web->rface_gen++;
@@ -880,12 +1044,13 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
         const ws_nseg *sg = &seg[k];
         tried += sg->c1 - sg->c0;
         if (sg->run)
-            contacts_run(&E, cand, sg, h, share, fc);
+            contacts_run(&E, &B, cand, sg, h, share, fc);
         else
             contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }
     *checks += tried;
     *next = k;
+    run_flush(&E, &B, h, share, fc);
     act_apply(web, &L, h, share, fc);
     loads_apply(&L, bforce, bmoment);
     node_prefetch(web, cand, k, n1);
@@ -893,8 +1058,8 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
-    /* Four more than every candidate (a run's loads are written in whole vectors of four); an
-     * odd number of cache lines, so that the arrays' starts fall in different sets of the
+    /* Four more than every candidate (act_friction runs on whole vectors of four); an odd
+     * number of cache lines, so that the arrays' starts fall in different sets of the
      * first-level cache. */
     size_t need = (((ncand + 4 + 7) / 8) | 1) * 8;
     if (need > web->act_cap) {

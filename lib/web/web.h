@@ -140,10 +140,13 @@ typedef struct ws_web {
     int seg_list;
     int runs_off;  /* no short cuts: no runs and no corners, every candidate one by one
                       through its full tests (tests compare the two) */
+    uint32_t run_batch;           /* groups of run nodes taken at once; 0: as many as fit
+                                     (tests make it small to run the batches often) */
     uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
                                      by one because a node lay below the face (diagnostics) */
     uint64_t corners;             /* corners told apart by their planes (diagnostics) */
-    double *rtmp; /* a run's per-node values (scratch, contact/node_force.c) */
+    double *rtmp; /* the runs' batch, its kernel's values, the nodes' depths (scratch, */
+                  /* contact/node_force.c) */
     size_t rtmp_cap;
     struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
     size_t rface_cap;          /* body, filled in sub-step rface_gen (scratch, node_force.c) */
