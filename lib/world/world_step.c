@@ -10,6 +10,7 @@
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
 #include "world/world_internal.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -106,6 +107,12 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
     double r = h / stable;
     int need = (int)ceil(w->def.dt / stable);
+    if (r <= 1.0) /* ran away though stable as its laws state them: sub-steps would not help */
+        return ws_fail(w, WS_ERR_NUMERICAL,
+                       "web '%s': %s, though dt/substeps = %.3g s is within its stable step "
+                       "%.3g s: a spring law stiffer or stronger than it states (a user or "
+                       "table law), or a body that hits the film too fast. Try a smaller dt.",
+                       web_label(web), what, h, stable);
     return ws_fail(w, WS_ERR_NUMERICAL,
                    "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
                    "(smallest node mass %.3g kg). Use substeps >= %d (ws_web_set_substeps), or "
@@ -279,7 +286,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             if (fast) {
                 double vmax = ws_web_fastest(web, vd);
                 char what[160];
-                if (vmax <= w->def.max_speed) /* past it only as the square overflowed */
+                if (vmax * vmax > DBL_MAX) /* too fast only as its square overflowed */
                     snprintf(what, sizeof what,
                              "a node ran away at t = %.6g s (speed %.3g m/s, beyond what a "
                              "double can square)",
