@@ -1798,8 +1798,8 @@ static int failing_law(void *user, int dim, const double *u, const double *ud, d
 
 /* A user law that kicks: 1e306 N whatever the strain (its stated stiffness, 1 N, is what the
  * stable step believes). */
-static int kicking_law(void *user, int dim, const double *u, const double *ud, double t,
-                       double *F, double *dFdu, double *dFdud)
+static int kicking_law(void *user, int dim, const double *u, const double *ud, double t, double *F,
+                       double *dFdu, double *dFdud)
 {
     (void)user;
     (void)dim;
@@ -1862,8 +1862,8 @@ START_TEST(test_runaway_without_a_speed_limit)
     ck_assert_msg(strstr(msg, "ran away") && strstr(msg, "1e+306") &&
                       strstr(msg, "within its stable step") && !strstr(msg, "substeps >="),
                   "message: %s", msg);
-    ck_assert_msg(x[3] == 0.1 && x[4] == 0.0 && x[5] == 0.0, "the node moved to (%g, %g, %g)",
-                  x[3], x[4], x[5]);
+    ck_assert_msg(x[3] == 0.1 && x[4] == 0.0 && x[5] == 0.0, "the node moved to (%g, %g, %g)", x[3],
+                  x[4], x[5]);
 }
 END_TEST
 
