@@ -367,10 +367,10 @@ static void row_forces_same_free(size_t k, v3 g, double m1, const double *restri
 /* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
  * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
  * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
- * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 / length il[i], 0
- * when the ends coincide (out: these four). The arithmetic of spring_run; taken apart from the
- * rows, the division and square root of one row's wrap no longer hold up the rest of its
- * forces. */
+ * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 where the ends lie
+ * apart, 0 where they coincide (out: these four). film_pull, as spring_run takes it; taken
+ * apart from the rows, the division and square root of one row's wrap no longer hold up the
+ * rest of its forces. */
 WS_VECTOR_LOOP
 static void wrap_lanes(const double *restrict in, ws_spring_form p, double *restrict out)
 {
@@ -378,17 +378,11 @@ static void wrap_lanes(const double *restrict in, ws_spring_form p, double *rest
     for (size_t i = 0; i < L; i++) {
         double dx = in[i], dy = in[L + i], dz = in[2 * L + i];
         double ux = in[3 * L + i], uy = in[4 * L + i], uz = in[5 * L + i], il0 = in[6 * L + i];
-        double l2 = dx * dx + dy * dy + dz * dz;
-        double l = sqrt(l2);
-        double inv = 1.0 / l;
-        double il = l2 > 0.0 ? inv : 0.0;
-        double eps = l * il0 - 1.0;
-        double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
-        double q = film_force(&p, eps, epsd) * il;
+        double q = film_pull(&p, dx, dy, dz, ux, uy, uz, il0);
         out[i] = dx * q;
         out[L + i] = dy * q;
         out[2 * L + i] = dz * q;
-        out[3 * L + i] = il;
+        out[3 * L + i] = dx * dx + dy * dy + dz * dz > 0.0 ? 1.0 : 0.0;
     }
 }
 
