@@ -582,11 +582,8 @@ static void film_detection_case(int kind)
     ws_world_destroy(b);
 }
 
-/* A film node just past the top end of a box's vertical edge, within the layers of the edge's
- * line, while the box rises: the edge's span comes to the node within a few steps, before the
- * node or the box has moved far enough to be found again. It must be an edge candidate from the
- * start (within reach of the segment, not only of its span). */
-static ws_world *edge_end_world(ws_web_id *web, ws_body_id *box)
+/* A world without gravity at dt = 0.25 ms, for film nodes placed by hand. */
+static ws_world *weightless_world(void)
 {
     ws_world_def d;
     ws_world_def_init(&d);
@@ -594,6 +591,38 @@ static ws_world *edge_end_world(ws_web_id *web, ws_body_id *box)
     d.dt = 2.5e-4;
     ws_world *w;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    return w;
+}
+
+/* A web of `probes` nodes placed by hand (pos, 3 each), each held by a spring to one more node
+ * after them, pinned (pos holds probes + 1 points). */
+static void probe_web(ws_world *w, const ws_web_def *wd, const double *pos, uint32_t probes,
+                      ws_web_id *web)
+{
+    uint32_t spring[8], pin[1] = {probes};
+    ck_assert_uint_le(probes, 4);
+    for (uint32_t i = 0; i < probes; i++) {
+        spring[2 * i] = i;
+        spring[2 * i + 1] = probes;
+    }
+    ws_web_mesh_def mesh;
+    ws_web_mesh_def_init(&mesh);
+    mesh.positions = pos;
+    mesh.node_count = probes + 1;
+    mesh.springs = spring;
+    mesh.spring_count = probes;
+    mesh.pinned = pin;
+    mesh.pinned_count = 1;
+    ck_ok(w, ws_web_create_mesh(w, wd, &mesh, web));
+}
+
+/* A film node just past the top end of a box's vertical edge, within the layers of the edge's
+ * line, while the box rises: the edge's span comes to the node within a few steps, before the
+ * node or the box has moved far enough to be found again. It must be an edge candidate from the
+ * start (within reach of the segment, not only of its span). */
+static ws_world *edge_end_world(ws_web_id *web, ws_body_id *box)
+{
+    ws_world *w = weightless_world();
     /* Rises at 63 mm/s: 16 um a step. */
     rising_box(w, (ws_vec3){0.1, 0.1, 0.1}, (ws_vec3){0, 0, 0}, 0.01, 0.0, "box", box);
     ws_web_def wd;
@@ -602,16 +631,7 @@ static ws_world *edge_end_world(ws_web_id *web, ws_body_id *box)
      * the other node is pinned far off. */
     const double o = 0.05 + 1.5e-3 / sqrt(2.0);
     const double pos[6] = {o, o, 0.05 + 5e-5, 0.3, 0.3, 0.05 + 5e-5};
-    const uint32_t spring[2] = {0, 1}, pin[1] = {1};
-    ws_web_mesh_def mesh;
-    ws_web_mesh_def_init(&mesh);
-    mesh.positions = pos;
-    mesh.node_count = 2;
-    mesh.springs = spring;
-    mesh.spring_count = 1;
-    mesh.pinned = pin;
-    mesh.pinned_count = 1;
-    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, web));
+    probe_web(w, &wd, pos, 1, web);
     return w;
 }
 
@@ -652,12 +672,7 @@ START_TEST(edges_of_faces_a_node_is_well_inside_of_are_dropped)
 {
     ws_web_id web;
     ws_body_id box;
-    ws_world_def d;
-    ws_world_def_init(&d);
-    d.gravity = (ws_vec3){0, 0, 0};
-    d.dt = 2.5e-4;
-    ws_world *w;
-    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_world *w = weightless_world();
     rising_box(w, (ws_vec3){0.1, 0.1, 0.1}, (ws_vec3){0, 0, 0}, 0.0, 0.0, "box", &box);
     ws_web_def wd;
     soft_film(w, &wd);
@@ -666,16 +681,7 @@ START_TEST(edges_of_faces_a_node_is_well_inside_of_are_dropped)
      * pinned far off. */
     const double top = 0.05 + 1e-3;
     const double pos[9] = {0.05 - 3e-3, 0.0, top, 0.05 - 1.5e-3, 0.0, top, 0.3, 0.3, top};
-    const uint32_t spring[4] = {0, 2, 1, 2}, pin[1] = {2};
-    ws_web_mesh_def mesh;
-    ws_web_mesh_def_init(&mesh);
-    mesh.positions = pos;
-    mesh.node_count = 3;
-    mesh.springs = spring;
-    mesh.spring_count = 2;
-    mesh.pinned = pin;
-    mesh.pinned_count = 1;
-    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, &web));
+    probe_web(w, &wd, pos, 2, &web);
     ck_ok(w, ws_world_step(w));
     const ws_web *wb = only_web(w);
     const ws_ncand *c = wb->cand[wb->next_list];
@@ -847,12 +853,7 @@ START_TEST(corners_are_marked_by_the_detection)
     memcpy(v, cube_v, sizeof v);
     v[3 * 5 + 2] -= 1e-8;
     for (int k = 0; k < 3; k++) {
-        ws_world_def d;
-        ws_world_def_init(&d);
-        d.gravity = (ws_vec3){0, 0, 0};
-        d.dt = 2.5e-4;
-        ws_world *w;
-        ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+        ws_world *w = weightless_world();
         ws_shape_id shape;
         if (k == 0)
             ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
@@ -868,17 +869,8 @@ START_TEST(corners_are_marked_by_the_detection)
         soft_film(w, &wd);
         const double o = 0.5 + 0.5e-3;
         const double pos[12] = {o, 0.0, o, o, o, o, o, 0.497, o, 3.0, 3.0, 3.0};
-        const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
-        ws_web_mesh_def mesh;
-        ws_web_mesh_def_init(&mesh);
-        mesh.positions = pos;
-        mesh.node_count = 4;
-        mesh.springs = spring;
-        mesh.spring_count = 3;
-        mesh.pinned = pin;
-        mesh.pinned_count = 1;
         ws_web_id web;
-        ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, &web));
+        probe_web(w, &wd, pos, 3, &web);
         ck_ok(w, ws_world_step(w));
         const ws_web *wb = only_web(w);
         const ws_ncand *c = wb->cand[wb->next_list];
@@ -937,12 +929,7 @@ static void prism_offset(double dl, double dr, double y, double *o)
  * box's +x/+z edge, or the prism's top edge. */
 static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_web_id *web)
 {
-    ws_world_def d;
-    ws_world_def_init(&d);
-    d.gravity = (ws_vec3){0, 0, 0};
-    d.dt = 2.5e-4;
-    ws_world *w;
-    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_world *w = weightless_world();
     ws_shape_id shape;
     if (prism)
         ck_ok(w, create_mesh(w, prism_v, 6, prism_t, 8, &shape));
@@ -967,16 +954,7 @@ static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_
         pos[3 * i + 2] = ez + off[3 * i + 2];
     }
     pos[9] = pos[10] = pos[11] = 3.0;
-    const uint32_t spring[6] = {0, 3, 1, 3, 2, 3}, pin[1] = {3};
-    ws_web_mesh_def mesh;
-    ws_web_mesh_def_init(&mesh);
-    mesh.positions = pos;
-    mesh.node_count = 4;
-    mesh.springs = spring;
-    mesh.spring_count = 3;
-    mesh.pinned = pin;
-    mesh.pinned_count = 1;
-    ck_ok(w, ws_web_create_mesh(w, &wd, &mesh, web));
+    probe_web(w, &wd, pos, 3, web);
     only_web(w)->runs_off = runs_off;
     return w;
 }
