@@ -727,15 +727,17 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     size_t nt = web->nfct[web->fck];
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
+        /* Read here: as far as the compiler knows, the stores below could change them. */
+        const uint32_t body = G->rc->body, node = G->node;
         size_t s = G->slot;
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
-            const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
+            const uint32_t l = ws_lowest_bit(bits), i = node + l;
             const size_t e = 4 * g + l;
             const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
             fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
             touched[nt++] = i;
             load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
-            lbody[s] = G->rc->body;
+            lbody[s] = body;
         }
     }
     web->nfct[web->fck] = nt;
