@@ -581,8 +581,9 @@ typedef struct run_batch {
  * In passes over all the groups, their values in between in tmp (T_*): a contact's arithmetic
  * is one long chain (some 180 cycles from the node's position to its force, with a square root
  * and two divisions in a row), about as long as the window of instructions a processor runs
- * ahead in holds; in one pass a group's chain held back the next group's. Cut in four, the
- * chains of several groups run side by side. The values a later pass takes only under a
+ * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
+ * friction's square root and divisions in one, a pass of their own each cost more instructions
+ * and saved no time), the chains of several groups run side by side. The values a later pass takes only under a
  * condition are read there as masks (as a select, the compiler would read them under the
  * condition: slow masked loads). */
 /* The batch's values between the passes and its outputs, each array a value's of every lane
@@ -593,7 +594,7 @@ typedef struct run_tmp {
     double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
     double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
     double px[RUN_OSTRIDE], py[RUN_OSTRIDE], pz[RUN_OSTRIDE];    /* predicted slip velocity */
-    double vps[RUN_OSTRIDE], s[RUN_OSTRIDE], slips[RUN_OSTRIDE]; /* its speed, scale, slips */
+    double s[RUN_OSTRIDE], slips[RUN_OSTRIDE];                   /* its scale; it slips */
     double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
     double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
 } run_tmp;
@@ -653,11 +654,11 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             T->lz[e] = az;
         }
     }
-    /* act_apply's friction: the slip predicted */
+    /* act_apply's friction: the slip predicted, and its size */
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
-        const double nx = q->nx, ny = q->ny, nz = q->nz;
+        const double nx = q->nx, ny = q->ny, nz = q->nz, mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < 4; l++) {
             const size_t e = 4 * g + l;
             double ax, ay, az;
@@ -666,18 +667,9 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             T->px[e] = ax;
             T->py[e] = ay;
             T->pz[e] = az;
-            T->vps[e] = sqrt(ax * ax + ay * ay + az * az);
-        }
-    }
-    /* its size */
-    for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
-        const size_t o = grp[g].node;
-        const double mu = q->mu, vlim = q->vlim;
-        for (size_t l = 0; l < 4; l++) {
-            const size_t e = 4 * g + l;
-            T->s[e] = friction_scale(T->vps[e], mass[o + l], T->fn[e], mu, vlim, h);
-            T->slips[e] = double_of(friction_slips(T->vps[e], im[o + l]));
+            const double vps = sqrt(ax * ax + ay * ay + az * az);
+            T->s[e] = friction_scale(vps, mass[o + l], T->fn[e], mu, vlim, h);
+            T->slips[e] = double_of(friction_slips(vps, im[o + l]));
         }
     }
     /* the node's new force and the body's share */
@@ -688,14 +680,17 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         for (size_t l = 0; l < 4; l++) {
             const size_t t = o + l, e = 4 * g + l;
             const double fn = T->fn[e], s = T->s[e];
-            const uint64_t slips = bits_of(T->slips[e]), keep = bits_of(T->keep[e]),
-                           push = 0 - (uint64_t)(fn > 0.0);
-            const double ax = pick(slips, T->px[e] * s, 0.0), ay = pick(slips, T->py[e] * s, 0.0),
-                         az = pick(slips, T->pz[e] * s, 0.0);
-            const double kx = T->kx[e], ky = T->ky[e], kz = T->kz[e];
-            gx[t] = pick(keep, pick(push, kx + ax, kx), gx[t]);
-            gy[t] = pick(keep, pick(push, ky + ay, ky), gy[t]);
-            gz[t] = pick(keep, pick(push, kz + az, kz), gz[t]);
+            const uint64_t keep = bits_of(T->keep[e]), push = 0 - (uint64_t)(fn > 0.0),
+                           slips = bits_of(T->slips[e]) & push, none = ~push & bits_of(-0.0);
+            /* The friction of a node that pushes (zero unless it slips); -0 for one that does
+             * not push, which leaves its force as it was to the bit when added, as the one by
+             * one pass leaves the force of a contact it does not list. */
+            const double ax = double_of((bits_of(T->px[e] * s) & slips) | none),
+                         ay = double_of((bits_of(T->py[e] * s) & slips) | none),
+                         az = double_of((bits_of(T->pz[e] * s) & slips) | none);
+            gx[t] = pick(keep, T->kx[e] + ax, gx[t]);
+            gy[t] = pick(keep, T->ky[e] + ay, gy[t]);
+            gz[t] = pick(keep, T->kz[e] + az, gz[t]);
             /* The body's share, zero for a contact that does not push: adding +0 leaves every
              * sum as it was (sums that start at +0 never reach -0), and so does the moment's
              * zero, of either sign. */
@@ -732,15 +727,17 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     size_t nt = web->nfct[web->fck];
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
+        /* Read here: as far as the compiler knows, the stores below could change them. */
+        const uint32_t body = G->rc->body, node = G->node;
         size_t s = G->slot;
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
-            const uint32_t l = ws_lowest_bit(bits), i = G->node + l;
+            const uint32_t l = ws_lowest_bit(bits), i = node + l;
             const size_t e = 4 * g + l;
             const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
             fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
             touched[nt++] = i;
             load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
-            lbody[s] = G->rc->body;
+            lbody[s] = body;
         }
     }
     web->nfct[web->fck] = nt;
