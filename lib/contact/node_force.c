@@ -582,10 +582,10 @@ typedef struct run_batch {
  * is one long chain (some 180 cycles from the node's position to its force, with a square root
  * and two divisions in a row), about as long as the window of instructions a processor runs
  * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
- * friction's square root and divisions in one, a pass of their own each cost more instructions
- * and saved no time), the chains of several groups run side by side. The values a later pass takes only under a
- * condition are read there as masks (as a select, the compiler would read them under the
- * condition: slow masked loads). */
+ * friction's square root and divisions in one: a pass of their own each cost more instructions
+ * and saved no time), the chains of several groups run side by side. The values a later pass
+ * takes only under a condition are read there as masks (as a select, the compiler would read
+ * them under the condition: slow masked loads). */
 /* The batch's values between the passes and its outputs, each array a value's of every lane
  * (4 g + l for lane l of group g). */
 typedef struct run_tmp {
