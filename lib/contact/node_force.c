@@ -145,7 +145,8 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
  * the same order however the candidates are cut. */
 
 enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
-       A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
+       A_IM, A_M, A_AX, A_AY, A_AZ, A_FX, A_FY, A_FZ, A_GX, A_GY, A_GZ, A_BX, A_BY, A_BZ, A_MX,
+       A_MY, A_MZ, ACT_ARRAYS };
 
 /* A load on a body: force and moment about the CoG; the list's loads take the room of arrays
  * A_BX to A_MZ (cap of them). */
@@ -158,7 +159,8 @@ _Static_assert(sizeof(act_load) == 6 * sizeof(double) && A_MZ == A_BX + 5,
 /* The list: per contact its normal (from the body to the node), lever from the body's CoG to
  * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
  * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
- * found. node and body name the node and the body's slot, slot its place in the loads.
+ * found (A_AX...) with the body's load, force (A_FX...) and moment (A_GX...). node and body
+ * name the node and the body's slot, slot its place in the loads.
  * The loads: per load on a body its force and moment (load) and the body's slot (lbody), nl
  * of them. */
 typedef struct act_list {
@@ -233,21 +235,42 @@ static inline void normal_of(ws_web *web, act_list *L, v3 xi, ws_nodes3 v, uint3
 }
 
 /* Frictions of the contacts [0, 4 nv) of the list, whole vectors (none left over; the list
- * has room, ws_node_scratch): its input arrays at P + k cap, the frictions into ax, ay, az
- * (A_AX...: apart from the inputs, so the loop needs no checks of overlap to run on
- * vectors). */
+ * has room, ws_node_scratch), and the loads on the bodies, each the opposite of the contact
+ * force (friction and normal force) times share, with its moment about the CoG: the input
+ * arrays at P + k cap, the frictions into ax, ay, az (A_AX...), the loads' forces into bx...
+ * (A_FX...) and moments into mx... (A_GX...), all apart from the inputs and from each other,
+ * so the loop needs no checks of overlap to run on vectors. */
 WS_VECTOR_LOOP
-static void act_friction(size_t nv, double h, const double *restrict P, size_t cap,
-                         double *restrict ax, double *restrict ay, double *restrict az)
+static void act_friction(size_t nv, double h, double share, const double *restrict P,
+                         size_t cap, double *restrict ax, double *restrict ay,
+                         double *restrict az, double *restrict bx, double *restrict by,
+                         double *restrict bz, double *restrict mx, double *restrict my,
+                         double *restrict mz)
 {
     const double *nx = P + A_NX * cap, *ny = P + A_NY * cap, *nz = P + A_NZ * cap,
+                 *lx = P + A_LX * cap, *ly = P + A_LY * cap, *lz = P + A_LZ * cap,
                  *tx = P + A_TX * cap, *ty = P + A_TY * cap, *tz = P + A_TZ * cap,
                  *kx = P + A_KX * cap, *ky = P + A_KY * cap, *kz = P + A_KZ * cap,
                  *im = P + A_IM * cap, *mass = P + A_M * cap, *fn = P + A_FN * cap,
                  *mu = P + A_MU * cap, *vl = P + A_VL * cap;
-    for (size_t q = 0; q < 4 * nv; q++)
+    for (size_t q = 0; q < 4 * nv; q++) {
+        double fx, fy, fz;
         friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
-                    mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
+                    mass[q], fn[q], mu[q], vl[q], h, &fx, &fy, &fz);
+        ax[q] = fx;
+        ay[q] = fy;
+        az[q] = fz;
+        /* The contact force on the node, and the body's share of the opposite: -share times
+         * it, as run_kernel takes it. */
+        const double Bx = (fx + nx[q] * fn[q]) * -share, By = (fy + ny[q] * fn[q]) * -share,
+                     Bz = (fz + nz[q] * fn[q]) * -share;
+        bx[q] = Bx;
+        by[q] = By;
+        bz[q] = Bz;
+        mx[q] = ly[q] * Bz - lz[q] * By;
+        my[q] = lz[q] * Bx - lx[q] * Bz;
+        mz[q] = lx[q] * By - ly[q] * Bx;
+    }
 }
 
 /* The list's frictions, then each contact applied: friction to the node, the contact force's
@@ -266,20 +289,18 @@ static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
     }
     /* The lanes past m read what the list held (its first values were zeros), and their
      * frictions are not read. */
-    act_friction((m + 3) / 4, h, web->act, web->act_cap, act_a(L, A_AX), act_a(L, A_AY),
-                 act_a(L, A_AZ));
+    act_friction((m + 3) / 4, h, share, web->act, web->act_cap, act_a(L, A_AX), act_a(L, A_AY),
+                 act_a(L, A_AZ), act_a(L, A_FX), act_a(L, A_FY), act_a(L, A_FZ), act_a(L, A_GX),
+                 act_a(L, A_GY), act_a(L, A_GZ));
     uint32_t *touched = web->fct[web->fck];
     size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
         const uint32_t i = L->node[q], at = L->slot[q];
-        v3 ft = act_get3(L, A_AX, q), n = act_get3(L, A_NX, q), lever = act_get3(L, A_LX, q);
-        double fn = act_a(L, A_FN)[q];
-        nodes_add(f, i, ft);
-        v3 Fnode = v3_madd(ft, n, fn);
-        fc[i] = v3_madd(fc[i], Fnode, share);
+        const v3 Fb = act_get3(L, A_FX, q);
+        nodes_add(f, i, act_get3(L, A_AX, q));
+        fc[i] = v3_sub(fc[i], Fb); /* the share of the contact force: -Fb, to the bit */
         touched[nt++] = i;
-        v3 Fb = v3_scale(Fnode, -share);
-        L->load[at] = (act_load){Fb, v3_cross(lever, Fb)};
+        L->load[at] = (act_load){Fb, act_get3(L, A_GX, q)};
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
