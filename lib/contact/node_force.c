@@ -1145,9 +1145,9 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
-    /* Four more than every candidate (act_friction runs on whole vectors of four); an odd
-     * number of cache lines, so that the arrays' starts fall in different sets of the
-     * first-level cache. */
+    /* Four more than every candidate, a multiple of four (act_apply's passes run on whole
+     * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
+     * different sets of the first-level cache. */
     size_t need = (((ncand + 4 + 7) / 8) | 1) * 8;
     if (need > web->act_cap) {
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
