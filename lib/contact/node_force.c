@@ -1147,9 +1147,13 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
     /* Four more than every candidate, a multiple of four (act_apply's passes run on whole
      * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
-     * different sets of the first-level cache. */
-    size_t need = (((ncand + 4 + 7) / 8) | 1) * 8;
-    if (need > web->act_cap) {
+     * different sets of the first-level cache. Grown by half at least: the candidates of a
+     * web being wrapped grow step by step, and each new room is cleared. */
+    if (ncand + 4 > web->act_cap) {
+        size_t need = ncand + 4 > web->act_cap + web->act_cap / 2
+                          ? ncand + 4
+                          : web->act_cap + web->act_cap / 2;
+        need = (((need + 7) / 8) | 1) * 8;
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
         web->act_cap = 0;
