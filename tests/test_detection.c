@@ -1013,6 +1013,67 @@ START_TEST(corner_edge_tests_spared_only_in_its_region)
 }
 END_TEST
 
+/* A film node in the inner corner of two kinematic unit cubes, A's top face and B's -x face
+ * standing at right angles, 0.5 mm out of both (held by a spring to a node pinned 3 m off), in
+ * a gravity that presses it into both faces and drags it along the corner's line: both faces
+ * push it and it slides. The friction of each face's contact is found from the node's force
+ * with every normal force in, so the motion does not depend on which body was made first (which
+ * puts its contact first): the two orders agree to round-off. A friction taken before the other
+ * face's normal force is in would tilt the node's predicted slip by that force. */
+static ws_world *inner_corner_world(int b_first, ws_web_id *web)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.gravity = (ws_vec3){1.0, 8.0, -3.0};
+    d.dt = 2.5e-4;
+    ws_world *w;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &cube));
+    const ws_vec3 at[2] = {{0.0, 0.0, 0.0}, {1.0, 0.0, 1.0}};
+    for (int k = 0; k < 2; k++) {
+        ws_body_def bd;
+        ws_body_def_init(&bd);
+        bd.type = WS_BODY_KINEMATIC;
+        bd.shape = cube;
+        bd.position = at[b_first ? 1 - k : k];
+        ws_body_id body;
+        ck_ok(w, ws_body_create(w, &bd, &body));
+    }
+    ws_web_def wd;
+    soft_film(w, &wd);
+    const double pos[6] = {0.5 - 1.99e-3, 0.0, 0.5 + 1.99e-3, 0.5, 3.0, 0.5};
+    probe_web(w, &wd, pos, 1, web);
+    return w;
+}
+
+START_TEST(friction_sees_every_normal_force)
+{
+    ws_web_id wa, wb;
+    ws_world *a = inner_corner_world(0, &wa), *b = inner_corner_world(1, &wb);
+    double xa[6], xb[6], fc[6], dev = 0.0;
+    size_t n;
+    for (int k = 0; k < 400; k++) {
+        ck_ok(a, ws_world_step(a));
+        ck_ok(b, ws_world_step(b));
+        ck_ok(a, ws_web_copy_positions(a, wa, xa, 2, &n));
+        ck_ok(b, ws_web_copy_positions(b, wb, xb, 2, &n));
+        for (int i = 0; i < 3; i++)
+            dev = fmax(dev, fabs(xa[i] - xb[i]));
+    }
+    ck_ok(a, ws_web_copy_contact_forces(a, wa, fc, 2, &n));
+    report("node in an inner corner: at (%.6f %.6f %.6f) m, contact force (%.3g %.3g %.3g) N; "
+           "the two orders of the bodies differ by %.1e m",
+           xa[0], xa[1], xa[2], fc[0], fc[1], fc[2], dev);
+    /* Both faces push (B's along -x, A's along +z), and the node slides along y. */
+    ck_assert(fc[0] < 0.0 && fc[2] > 0.0 && fc[1] != 0.0);
+    ck_assert(xa[1] > 1e-3);
+    ck_assert_msg(dev < 1e-12, "the order of the bodies moves the node by %.3e m", dev);
+    ws_world_destroy(a);
+    ws_world_destroy(b);
+}
+END_TEST
+
 /* Whether a node lies well inside a face (a margin or more behind every other face's plane
  * where it projects on the face's plane) takes the projection: out of the face's plane by df,
  * it lies dg - df c out of face g's plane, c the dot product of their normals. By the prism's
@@ -1080,6 +1141,7 @@ int main(void)
     tcase_add_test(tc, corners_need_flat_faces);
     tcase_add_test(tc, corners_are_marked_by_the_detection);
     tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
+    tcase_add_test(tc, friction_sees_every_normal_force);
     tcase_add_test(tc, well_inside_takes_the_projection);
     suite_add_tcase(s, tc);
     return run_suite(s);

@@ -135,35 +135,47 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
     *az = pick(slips, pz * s, 0.0);
 }
 
-/* ---- the pushing contacts of a sweep block
+/* ---- the contacts of a sweep block gone one by one
  *
- * The one-by-one pass puts each node's normal forces into f and lists the contacts that push,
- * in node order, as arrays of web->act_cap (web->act). Once every normal force of the block is
- * in, their frictions go on vectors and they are applied to the nodes. Runs apply theirs in
- * batches (run_flush), into the places in the list of loads they took. The loads on the bodies of
- * both go to one list of loads in node order, which is summed last: the bodies' totals are added in
- * the same order however the candidates are cut. */
+ * The one-by-one pass lists the contacts whose tests it passed, in node order, in groups of
+ * four (web->act). At the block's end their normal forces go on vectors and into f, and once
+ * every normal force of the block is in, their frictions go on vectors and they are applied
+ * to the nodes. Runs apply theirs in batches (run_flush), into the places in the list of loads
+ * they took. The loads on the bodies of both go to one list of loads in node order, which is
+ * summed last: the bodies' totals are added in the same order however the candidates are cut. */
 
-enum { A_NX, A_NY, A_NZ, A_LX, A_LY, A_LZ, A_TX, A_TY, A_TZ, A_FN, A_MU, A_VL, A_KX, A_KY, A_KZ,
-       A_IM, A_M, A_AX, A_AY, A_AZ, A_BX, A_BY, A_BZ, A_MX, A_MY, A_MZ, ACT_ARRAYS };
+/* Four contacts of the list, lane l the list's contact 4 g + l of group g: each value of the four
+ * side by side, so that a pass over the groups runs on vectors with one pointer. As
+ * contacts_general finds it: the normal (from the body to the node), depth, window top and
+ * the node's position. Gathered for the normal force: the node's velocity, the body's CoG,
+ * velocity and spin, the contact's stiffness and damping, mu and v_lim, and the node's 1 / mass
+ * and mass. Found: the normal force's vector (p), the lever from the body's CoG to the contact
+ * point, the tangential velocity relative to the body and the normal force; the node's force
+ * with its normal forces in (k); the friction (a) and the body's load, force (b) and moment
+ * (m). */
+typedef struct act_group {
+    double nx[4], ny[4], nz[4], d[4], hi[4], xx[4], xy[4], xz[4];
+    double ux[4], uy[4], uz[4], rx[4], ry[4], rz[4], vx[4], vy[4], vz[4], wx[4], wy[4], wz[4];
+    double kp[4], cp[4], mu[4], vl[4], im[4], m[4];
+    double px[4], py[4], pz[4], lx[4], ly[4], lz[4], tx[4], ty[4], tz[4], fn[4];
+    double kx[4], ky[4], kz[4], ax[4], ay[4], az[4], bx[4], by[4], bz[4], mx[4], my[4], mz[4];
+} act_group;
 
-/* A load on a body: force and moment about the CoG; the list's loads take the room of arrays
- * A_BX to A_MZ (cap of them). */
+/* The doubles of web->act per contact of its room (act_cap): its group's share, then its load. */
+enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS = ACT_GROUP + 6 };
+
+/* A load on a body: force and moment about the CoG; the list's loads come after its groups. */
 typedef struct act_load {
     v3 f, m;
 } act_load;
-_Static_assert(sizeof(act_load) == 6 * sizeof(double) && A_MZ == A_BX + 5,
-               "a list's loads fill arrays A_BX to A_MZ");
+_Static_assert(sizeof(act_load) == 6 * sizeof(double) && sizeof(act_group) % 32 == 0,
+               "a list's loads take 6 doubles each, its groups whole vectors");
 
-/* The list: per contact its normal (from the body to the node), lever from the body's CoG to
- * the contact point, tangential velocity relative to the body, normal force, mu and v_lim; for
- * the friction the node's force with its normal forces in, 1 / mass and mass; and the friction
- * found. node and body name the node and the body's slot, slot its place in the loads.
- * The loads: per load on a body its force and moment (load) and the body's slot (lbody), nl
- * of them. */
+/* The list: its groups (grp), the contacts' nodes, the bodies' slots and their places in the
+ * loads (node, body, slot), n of them. The loads: per load on a body its force and moment
+ * (load) and the body's slot (lbody), nl of them. */
 typedef struct act_list {
-    double *base; /* array k at base + k cap */
-    size_t cap;
+    act_group *grp;
     uint32_t *node, *body, *slot, *lbody;
     act_load *load;
     size_t n, nl;
@@ -171,119 +183,117 @@ typedef struct act_list {
 
 static act_list act_open(ws_web *web)
 {
-    const size_t cap = web->act_cap;
+    const size_t cap = web->act_cap; /* a multiple of 4 (ws_node_scratch) */
     uint32_t *id = web->act_id;
-    act_list L = {web->act, cap, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
-    L.load = (act_load *)(web->act + A_BX * cap);
+    act_list L = {(act_group *)web->act, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
+    L.load = (act_load *)(web->act + ACT_GROUP * cap);
     return L;
 }
 
-static inline double *act_a(const act_list *L, int k) { return L->base + (size_t)k * L->cap; }
-
-/* A vector in arrays k, k + 1, k + 2 (A_NX, A_NY, A_NZ say) at place q, and back. */
-static inline void act_set3(const act_list *L, int k, size_t q, v3 a)
+/* Contact `node` against body `body` as contacts_general finds it: along n, at depth d, in the
+ * window of top hi, the node at x. Its place in the list of loads is taken now, in node order;
+ * a contact that turns out not to push leaves a load of zero there. */
+static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, double d, double hi,
+                            v3 x)
 {
-    act_a(L, k)[q] = a.x;
-    act_a(L, k + 1)[q] = a.y;
-    act_a(L, k + 2)[q] = a.z;
-}
-
-static inline v3 act_get3(const act_list *L, int k, size_t q)
-{
-    return v3_make(act_a(L, k)[q], act_a(L, k + 1)[q], act_a(L, k + 2)[q]);
-}
-
-/* Contact `node` against body `body`: written at the end of the list, and kept when `keep`
- * (no branch: the list has room for every candidate of the block and one more). */
-static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, v3 lever, v3 vt,
-                            double fn, double mu, double vlim, int keep)
-{
-    const size_t q = L->n;
+    const size_t q = L->n++, l = q & 3;
+    act_group *e = &L->grp[q >> 2];
     L->node[q] = node;
     L->body[q] = body;
-    act_set3(L, A_NX, q, n);
-    act_set3(L, A_LX, q, lever);
-    act_set3(L, A_TX, q, vt);
-    act_a(L, A_FN)[q] = fn;
-    act_a(L, A_MU)[q] = mu;
-    act_a(L, A_VL)[q] = vlim;
-    L->slot[q] = (uint32_t)L->nl;
-    L->n += (size_t)(keep != 0);
-    L->nl += (size_t)(keep != 0);
+    e->nx[l] = n.x;
+    e->ny[l] = n.y;
+    e->nz[l] = n.z;
+    e->d[l] = d;
+    e->hi[l] = hi;
+    e->xx[l] = x.x;
+    e->xy[l] = x.y;
+    e->xz[l] = x.z;
+    L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of node i (at xi) on body bi at depth d along the normal n (from the body to
- * the node), within the window (hi the layers): into f; the contact is listed when it pushes.
- * Penalty on the overlap and damping on its rate, at the contact point midway in the overlap,
- * against the body's velocity there (CoG r, velocity vb, spin wb). A contact never pulls: its
- * force is added times whether it pushes (0 or 1), without a branch. The one-by-one pass uses
- * it; run_kernel has the same arithmetic for a run's nodes. */
-static inline void normal_of(ws_web *web, act_list *L, v3 xi, ws_nodes3 v, uint32_t i,
-                             uint32_t bi, v3 n, double d, double hi, v3 r, v3 vb, v3 wb,
-                             const ws_node_params *p)
+/* The normal force of a node at x (velocity u) against a body (CoG r, velocity v, spin w) at
+ * depth d along the normal n (from the body to the node), within the window (hi the layers),
+ * for the contact's stiffness k and damping c: its vector (p), the lever from the CoG to the
+ * contact point (l), the node's tangential velocity relative to the body (t) and the normal
+ * force (fn). Penalty on the overlap and damping on its rate, at the contact point midway in
+ * the overlap, against the body's velocity there. A contact never pulls: its vector is the
+ * force times whether it pushes (0 or 1), without a branch. Straight-line code, so loops of
+ * it run on vectors; run_kernel has the same arithmetic for a run's nodes. */
+static inline void normal_of(double nx, double ny, double nz, double d, double hi, double xx,
+                             double xy, double xz, double ux, double uy, double uz, double rx,
+                             double ry, double rz, double vx, double vy, double vz, double wx,
+                             double wy, double wz, double k, double c, double *px, double *py,
+                             double *pz, double *lx, double *ly, double *lz, double *tx,
+                             double *ty, double *tz, double *fn)
 {
-    v3 xc = v3_madd(xi, n, -0.5 * d);
-    v3 lever = v3_sub(xc, r);
-    v3 vrel = v3_sub(nodes_get(v, i), v3_add(vb, v3_cross(wb, lever)));
-    double vn = v3_dot(vrel, n);
-    double fn = p->k * (hi - d) - p->c * vn;
-    double push = fn > 0.0;
-    nodes_add(web->f, i, v3_scale(n, fn * push));
-    act_push(L, i, bi, n, lever, v3_madd(vrel, n, -vn), fn, p->mu, p->vlim, fn > 0.0);
+    const double s = -0.5 * d;
+    const double ax = (xx + nx * s) - rx, ay = (xy + ny * s) - ry, az = (xz + nz * s) - rz;
+    const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
+                 bz = vz + (wx * ay - wy * ax);
+    const double vrx = ux - bx, vry = uy - by, vrz = uz - bz;
+    const double vn = vrx * nx + vry * ny + vrz * nz;
+    const double f = k * (hi - d) - c * vn;
+    const double push = f > 0.0, fp = f * push;
+    *px = nx * fp;
+    *py = ny * fp;
+    *pz = nz * fp;
+    *lx = ax;
+    *ly = ay;
+    *lz = az;
+    *tx = vrx + nx * (-vn);
+    *ty = vry + ny * (-vn);
+    *tz = vrz + nz * (-vn);
+    *fn = f;
 }
 
-/* Frictions of the contacts [0, 4 nv) of the list, whole vectors (none left over; the list
- * has room, ws_node_scratch): its input arrays at P + k cap, the frictions into ax, ay, az
- * (A_AX...: apart from the inputs, so the loop needs no checks of overlap to run on
- * vectors). */
+/* The normal forces of the contacts of groups [0, ng) (normal_of). */
 WS_VECTOR_LOOP
-static void act_friction(size_t nv, double h, const double *restrict P, size_t cap,
-                         double *restrict ax, double *restrict ay, double *restrict az)
+static void act_normal(size_t ng, act_group *restrict G)
 {
-    const double *nx = P + A_NX * cap, *ny = P + A_NY * cap, *nz = P + A_NZ * cap,
-                 *tx = P + A_TX * cap, *ty = P + A_TY * cap, *tz = P + A_TZ * cap,
-                 *kx = P + A_KX * cap, *ky = P + A_KY * cap, *kz = P + A_KZ * cap,
-                 *im = P + A_IM * cap, *mass = P + A_M * cap, *fn = P + A_FN * cap,
-                 *mu = P + A_MU * cap, *vl = P + A_VL * cap;
-    for (size_t q = 0; q < 4 * nv; q++)
-        friction_of(nx[q], ny[q], nz[q], tx[q], ty[q], tz[q], kx[q], ky[q], kz[q], im[q],
-                    mass[q], fn[q], mu[q], vl[q], h, &ax[q], &ay[q], &az[q]);
+    for (size_t g = 0; g < ng; g++) {
+        act_group *e = &G[g];
+        for (size_t l = 0; l < 4; l++)
+            normal_of(e->nx[l], e->ny[l], e->nz[l], e->d[l], e->hi[l], e->xx[l], e->xy[l],
+                      e->xz[l], e->ux[l], e->uy[l], e->uz[l], e->rx[l], e->ry[l], e->rz[l],
+                      e->vx[l], e->vy[l], e->vz[l], e->wx[l], e->wy[l], e->wz[l], e->kp[l],
+                      e->cp[l], &e->px[l], &e->py[l], &e->pz[l], &e->lx[l], &e->ly[l],
+                      &e->lz[l], &e->tx[l], &e->ty[l], &e->tz[l], &e->fn[l]);
+    }
 }
 
-/* The list's frictions, then each contact applied: friction to the node, the contact force's
- * share to the node's record, the opposite to its place in the loads. */
-static void act_apply(ws_web *web, act_list *L, double h, double share, v3 *fc)
+/* The frictions of the contacts of groups [0, ng), and the loads on the bodies, each the
+ * opposite of the contact force (friction and normal force) times share, with its moment about
+ * the CoG. */
+WS_VECTOR_LOOP
+static void act_friction(size_t ng, double h, double share, act_group *restrict G)
 {
-    const size_t m = L->n;
-    ws_nodes3 f = web->f;
-    for (size_t q = 0; q < m; q++) { /* each node's force with all its normal forces in */
-        const uint32_t i = L->node[q];
-        act_a(L, A_KX)[q] = f.x[i];
-        act_a(L, A_KY)[q] = f.y[i];
-        act_a(L, A_KZ)[q] = f.z[i];
-        act_a(L, A_IM)[q] = web->inv_m[i];
-        act_a(L, A_M)[q] = web->m[i];
+    for (size_t g = 0; g < ng; g++) {
+        act_group *e = &G[g];
+        for (size_t l = 0; l < 4; l++) {
+            const double nx = e->nx[l], ny = e->ny[l], nz = e->nz[l], fn = e->fn[l];
+            double fx, fy, fz;
+            friction_of(nx, ny, nz, e->tx[l], e->ty[l], e->tz[l], e->kx[l], e->ky[l], e->kz[l],
+                        e->im[l], e->m[l], fn, e->mu[l], e->vl[l], h, &fx, &fy, &fz);
+            /* A contact that does not push adds nothing: -0 to the node's force (which leaves
+             * every value as it was), +0 to the body's (see run_kernel). */
+            const uint64_t push = 0 - (uint64_t)(fn > 0.0);
+            e->ax[l] = pick(push, fx, -0.0);
+            e->ay[l] = pick(push, fy, -0.0);
+            e->az[l] = pick(push, fz, -0.0);
+            /* The contact force on the node, and the body's share of the opposite: -share
+             * times it, as run_kernel takes it. */
+            const double Bx = pick(push, (fx + nx * fn) * -share, 0.0),
+                         By = pick(push, (fy + ny * fn) * -share, 0.0),
+                         Bz = pick(push, (fz + nz * fn) * -share, 0.0);
+            const double lx = e->lx[l], ly = e->ly[l], lz = e->lz[l];
+            e->bx[l] = Bx;
+            e->by[l] = By;
+            e->bz[l] = Bz;
+            e->mx[l] = ly * Bz - lz * By;
+            e->my[l] = lz * Bx - lx * Bz;
+            e->mz[l] = lx * By - ly * Bx;
+        }
     }
-    /* The lanes past m read what the list held (its first values were zeros), and their
-     * frictions are not read. */
-    act_friction((m + 3) / 4, h, web->act, web->act_cap, act_a(L, A_AX), act_a(L, A_AY),
-                 act_a(L, A_AZ));
-    uint32_t *touched = web->fct[web->fck];
-    size_t nt = web->nfct[web->fck];
-    for (size_t q = 0; q < m; q++) {
-        const uint32_t i = L->node[q], at = L->slot[q];
-        v3 ft = act_get3(L, A_AX, q), n = act_get3(L, A_NX, q), lever = act_get3(L, A_LX, q);
-        double fn = act_a(L, A_FN)[q];
-        nodes_add(f, i, ft);
-        v3 Fnode = v3_madd(ft, n, fn);
-        fc[i] = v3_madd(fc[i], Fnode, share);
-        touched[nt++] = i;
-        v3 Fb = v3_scale(Fnode, -share);
-        L->load[at] = (act_load){Fb, v3_cross(lever, Fb)};
-        L->lbody[at] = L->body[q];
-    }
-    web->nfct[web->fck] = nt;
-    L->n = 0;
 }
 
 /* The loads on the bodies, added to their totals in order (the running sums of the body at
@@ -321,7 +331,7 @@ typedef struct corner_memo {
 
 /* What the node contacts of a sweep block read: the bodies and their state, their faces in the
  * global frame, the web and its node state (x, v), the contact parameters by body material and
- * the list of pushing contacts. */
+ * the list of contacts gone one by one. */
 typedef struct node_env {
     const ws_body_store *b;
     const ws_body_state *st;
@@ -333,24 +343,101 @@ typedef struct node_env {
     struct corner_memo *memo;
 } node_env;
 
-/* Kept out of line where GCC would inline it: see node_push. */
+/* Kept out of line where GCC would inline it: see shallowest. */
 #if defined(__GNUC__)
 #define NODE_OUT_OF_LINE __attribute__((noinline))
 #else
 #define NODE_OUT_OF_LINE
 #endif
 
-/* normal_of for node i at (xx, xy, xz) against body bi, along (nx, ny, nz) at depth d, window
- * top hi. Out of line: inlined, its many values crowd the registers of contacts_general's
- * loop, which then keeps its own on the stack (7 k instructions a step more on the reference
- * case). */
-NODE_OUT_OF_LINE static void node_push(const node_env *E, uint32_t i, uint32_t bi, double nx,
-                                       double ny, double nz, double d, double hi, double xx,
-                                       double xy, double xz)
+/* The list's contacts, each node's all in (its candidates lie in one stretch): the values of
+ * the node, the body and the material each needs gathered, their normal forces on vectors and
+ * into f in order, then, with every normal force in, their frictions on vectors and each
+ * contact applied: friction to the node, the contact force's share to the node's record, the
+ * opposite to its place in the loads. The lanes past the last contact compute on what the list
+ * held (its first values were zeros), and are not read. */
+static void act_apply(const node_env *E, double h, double share, v3 *fc)
 {
+    ws_web *web = E->web;
+    act_list *L = E->L;
+    const size_t m = L->n, ng = (m + 3) / 4;
+    if (m == 0)
+        return;
     const ws_body_store *b = E->b;
-    normal_of(E->web, E->L, v3_make(xx, xy, xz), E->v, i, bi, v3_make(nx, ny, nz), d, hi,
-              E->st->r[bi], E->st->v[bi], b->wg[bi], &E->pp[b->material[bi]]);
+    const ws_body_state *st = E->st;
+    const ws_node_params *pp = E->pp;
+    const ws_nodes3 v = E->v, f = web->f;
+    act_group *G = L->grp;
+    /* The body's values kept from one contact to the next, as most are of the body before. */
+    uint32_t body = UINT32_MAX;
+    v3 r = v3_make(0, 0, 0), vb = r, wb = r;
+    ws_node_params p = {0.0, 0.0, 0.0, 0.0};
+    for (size_t q = 0; q < m; q++) {
+        const uint32_t i = L->node[q], bi = L->body[q];
+        if (bi != body) {
+            body = bi;
+            r = st->r[bi];
+            vb = st->v[bi];
+            wb = b->wg[bi];
+            p = pp[b->material[bi]];
+        }
+        act_group *e = &G[q >> 2];
+        const size_t l = q & 3;
+        e->ux[l] = v.x[i];
+        e->uy[l] = v.y[i];
+        e->uz[l] = v.z[i];
+        e->rx[l] = r.x;
+        e->ry[l] = r.y;
+        e->rz[l] = r.z;
+        e->vx[l] = vb.x;
+        e->vy[l] = vb.y;
+        e->vz[l] = vb.z;
+        e->wx[l] = wb.x;
+        e->wy[l] = wb.y;
+        e->wz[l] = wb.z;
+        e->kp[l] = p.k;
+        e->cp[l] = p.c;
+        e->mu[l] = p.mu;
+        e->vl[l] = p.vlim;
+        e->im[l] = web->inv_m[i];
+        e->m[l] = web->m[i];
+    }
+    act_normal(ng, G);
+    /* The normal forces into f in order, and each node's force with all its normal forces in
+     * to each of its contacts (a node's contacts lie side by side in the list): the earlier
+     * ones of a node with more than one take the later one's. */
+    for (size_t q = 0; q < m; q++) {
+        act_group *e = &G[q >> 2];
+        const size_t l = q & 3;
+        const uint32_t i = L->node[q];
+        const v3 k = v3_add(nodes_get(f, i), v3_make(e->px[l], e->py[l], e->pz[l]));
+        nodes_set(f, i, k);
+        e->kx[l] = k.x;
+        e->ky[l] = k.y;
+        e->kz[l] = k.z;
+        for (size_t j = q; j > 0 && L->node[j - 1] == i; j--) {
+            act_group *o = &G[(j - 1) >> 2];
+            o->kx[(j - 1) & 3] = k.x;
+            o->ky[(j - 1) & 3] = k.y;
+            o->kz[(j - 1) & 3] = k.z;
+        }
+    }
+    act_friction(ng, h, share, G);
+    uint32_t *touched = web->fct[web->fck];
+    size_t nt = web->nfct[web->fck];
+    for (size_t q = 0; q < m; q++) {
+        const act_group *e = &G[q >> 2];
+        const size_t l = q & 3;
+        const uint32_t i = L->node[q], at = L->slot[q];
+        const v3 Fb = v3_make(e->bx[l], e->by[l], e->bz[l]);
+        nodes_add(f, i, v3_make(e->ax[l], e->ay[l], e->az[l]));
+        fc[i] = v3_sub(fc[i], Fb); /* the share of the contact force: -Fb, to the bit */
+        touched[nt++] = i;
+        L->load[at] = (act_load){Fb, v3_make(e->mx[l], e->my[l], e->mz[l])};
+        L->lbody[at] = L->body[q];
+    }
+    web->nfct[web->fck] = nt;
+    L->n = 0;
 }
 
 /* Whether the face of candidate c (of body bi, shape sh) is the shallowest for a node at
@@ -423,13 +510,13 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     return a | z << 1 | e << 2;
 }
 
-/* Candidates one by one, in node order: any feature, any body. Normal forces into f, the
- * contacts that push into the list. A corner (marked WS_NCAND_CORNER by the detection, which
+/* Candidates one by one, in node order: any feature, any body. The contacts that pass their
+ * tests into the list, which act_apply evaluates at the block's end. A corner (marked WS_NCAND_CORNER by the detection, which
  * looks at a node's candidates once where this pass would every sub-step) is told apart by its
  * faces' planes first, and only what they leave takes the tests. */
 static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
-    /* E's members are read where used, not copied first: node_push may change what E points
+    /* E's members are read where used, not copied first: shallowest may change what E points
      * to as far as the compiler knows, so they are loaded again after it either way, and
      * copies would be kept on the stack at every call. */
     for (size_t k = 0; k < n;) {
@@ -477,7 +564,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
                     continue;
                 nrm = F->n; /* from the body to the node */
             }
-            node_push(E, i, bi, nrm.x, nrm.y, nrm.z, d, hi, xi.x, xi.y, xi.z);
+            act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
 }
@@ -1048,18 +1135,22 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *checks += tried;
     *next = k;
     run_flush(&E, &B, h, share, fc);
-    act_apply(web, &L, h, share, fc);
+    act_apply(&E, h, share, fc);
     loads_apply(&L, bforce, bmoment);
     node_prefetch(web, cand, k, n1);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
 {
-    /* Four more than every candidate (act_friction runs on whole vectors of four); an odd
-     * number of cache lines, so that the arrays' starts fall in different sets of the
-     * first-level cache. */
-    size_t need = (((ncand + 4 + 7) / 8) | 1) * 8;
-    if (need > web->act_cap) {
+    /* Four more than every candidate, a multiple of four (act_apply's passes run on whole
+     * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
+     * different sets of the first-level cache. Grown by half at least: the candidates of a
+     * web being wrapped grow step by step, and each new room is cleared. */
+    if (ncand + 4 > web->act_cap) {
+        size_t need = ncand + 4 > web->act_cap + web->act_cap / 2
+                          ? ncand + 4
+                          : web->act_cap + web->act_cap / 2;
+        need = (((need + 7) / 8) | 1) * 8;
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
         web->act_cap = 0;
