@@ -511,9 +511,10 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
 }
 
 /* Candidates one by one, in node order: any feature, any body. The contacts that pass their
- * tests into the list, which act_apply evaluates at the block's end. A corner (marked WS_NCAND_CORNER by the detection, which
- * looks at a node's candidates once where this pass would every sub-step) is told apart by its
- * faces' planes first, and only what they leave takes the tests. */
+ * tests go into the list, which act_apply evaluates at the block's end. A corner (marked
+ * WS_NCAND_CORNER by the detection, which looks at a node's candidates once where this pass
+ * would every sub-step) is told apart by its faces' planes first, and only what they leave
+ * takes the tests. */
 static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
 {
     /* E's members are read where used, not copied first: shallowest may change what E points

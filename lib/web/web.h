@@ -135,8 +135,8 @@ typedef struct ws_web {
     /* Node-face candidates: changed only by full detection, into the other list. */
     ws_ncand *cand[2];
     size_t ncand[2], capcand[2];
-    double *act;        /* the pushing contacts of a sweep block (scratch, sized with the */
-    uint32_t *act_id;   /* candidates; contact/node_force.c) */
+    double *act;        /* the contacts of a sweep block gone one by one (scratch, sized */
+    uint32_t *act_id;   /* with the candidates; contact/node_force.c) */
     size_t act_cap;
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
