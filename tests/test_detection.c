@@ -8,6 +8,7 @@
  * candidates. This suite reaches into the world (world_internal.h) to force detection. */
 #include "helpers.h"
 
+#include "contact/node.h"
 #include "world/world_internal.h"
 
 /* Every film node of every web finds its candidates again before the next step. */
@@ -1063,6 +1064,91 @@ START_TEST(film_detection_does_not_change_the_motion)
 }
 END_TEST
 
+/* The reference body of a film (a free box) and four nodes over its top walk at random, a step
+ * of a few um each in turn and position: ws_node_moved must flag every node whose move relative
+ * to the box since it was found reaches a quarter of the margin (one sub-step), however it
+ * tests that move. A test of the nodes' global moves against where they were found, as the box
+ * stood at some earlier step, must allow for how far the box moved and turned since. */
+START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
+{
+    ws_world *w = weightless_world();
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &cube));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.mass = 5.0;
+    bd.name = "box";
+    ws_body_id box;
+    ck_ok(w, ws_body_create(w, &bd, &box));
+    ws_web_def wd;
+    soft_film(w, &wd);
+    /* Over the top (z = 0.1 m) within the layers, at levers of 0 to 0.13 m; the fifth is pinned
+     * far off. */
+    const double top = 0.1 + 1e-3;
+    const double pos[15] = {0, 0, top, 0.09, 0, top, 0.09, 0.09, top,
+                            -0.05, 0.08, top, 0.5, 0.5, top};
+    ws_web_id id;
+    probe_web(w, &wd, pos, 4, &id);
+    ck_ok(w, ws_world_step(w));
+    ws_web *web = only_web(w);
+    ws_body_store *b = &w->bodies;
+    const int cur = w->cur;
+    const uint32_t k = web->ref;
+    ck_assert_uint_ne(k, UINT32_MAX);
+    const double margin = w->def.contact_margin, lim = 0.25 * margin;
+    uint64_t seed = 12345;
+    long flagged = 0, due = 0, epochs = 0;
+    double s0[3 * 5];
+    for (int step = 0; step < 20000; step++) {
+        /* The box turns by up to 35 urad (25 um at the pinned node, 0.7 m off) and moves up
+         * to 17 um; a node moves up to 0.7 mm, so that many reach the bound while the box
+         * drifts. */
+        double rnd[10];
+        for (int j = 0; j < 10; j++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            rnd[j] = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+        }
+        qt dq = qt_from_rotvec(v3_make(4e-5 * rnd[0], 4e-5 * rnd[1], 4e-5 * rnd[2]));
+        b->st[cur].p[k] = qt_normalize(qt_mul(dq, b->st[cur].p[k]));
+        b->A[k] = qt_to_m3(b->st[cur].p[k]);
+        b->st[cur].r[k] =
+            v3_add(b->st[cur].r[k], v3_make(2e-5 * rnd[3], 2e-5 * rnd[4], 2e-5 * rnd[5]));
+        ws_nodes3 x = web->x[cur];
+        const uint32_t i = (uint32_t)(step % 4);
+        x.x[i] += 8e-4 * rnd[6];
+        x.y[i] += 8e-4 * rnd[7];
+        x.z[i] += 8e-4 * rnd[8];
+        for (uint32_t q = 0; q < 5; q++) {
+            s0[3 * q] = web->xdet.x[q];
+            s0[3 * q + 1] = web->xdet.y[q];
+            s0[3 * q + 2] = web->xdet.z[q];
+        }
+        const v3 e0 = web->epoch_r;
+        long moved = ws_node_moved(b, cur, web, x, web->v[cur], w->def.dt, margin);
+        ck_assert_int_ge(moved, 0);
+        epochs += e0.x != web->epoch_r.x || e0.y != web->epoch_r.y || e0.z != web->epoch_r.z;
+        for (uint32_t q = 0; q < 5; q++) {
+            v3 u = v3_sub(m3_tmul_v(&b->A[k], v3_sub(nodes_get(x, q), b->st[cur].r[k])),
+                          v3_make(s0[3 * q], s0[3 * q + 1], s0[3 * q + 2]));
+            if (v3_norm(u) < lim)
+                continue;
+            due++;
+            int found = 0;
+            for (long m = 0; m < moved; m++)
+                found |= web->moved[m] == q;
+            ck_assert_msg(found, "step %d: node %u moved %.4g mm relative to the box, unflagged",
+                          step, q, 1e3 * v3_norm(u));
+        }
+        flagged += moved;
+    }
+    report("nodes walking on a drifting box: %ld flagged, %ld due; %ld new epochs", flagged, due,
+           epochs);
+    ck_assert_msg(due > 100 && epochs > 10, "the walk tests too little");
+    ws_world_destroy(w);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("detection");
@@ -1081,6 +1167,7 @@ int main(void)
     tcase_add_test(tc, corners_are_marked_by_the_detection);
     tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
     tcase_add_test(tc, well_inside_takes_the_projection);
+    tcase_add_test(tc, nodes_moved_relative_to_the_reference_are_flagged);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

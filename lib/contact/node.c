@@ -100,20 +100,79 @@ static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, 
     *p = b->st[cur].p[k];
 }
 
-/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet; all of them, or the listed
- * ones when `only` is set. */
+/* Nodes are turned to the reference frame REF_CHUNK at a time (to_ref). Flags are found
+ * FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
+ * narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector iteration and
+ * runs out of registers. */
+enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
+
+/* m nodes at (px, py, pz) to the reference frame (A, r): s = A^T (x - r) into (sx, sy, sz), and
+ * their place at the epoch (E, e), e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
+WS_VECTOR_LOOP
+static void ref_chunk(size_t m, const double *restrict px, const double *restrict py,
+                      const double *restrict pz, const m3 *A, v3 r, const m3 *E, v3 e,
+                      double *restrict sx, double *restrict sy, double *restrict sz,
+                      double *restrict gx, double *restrict gy, double *restrict gz,
+                      double *restrict l2)
+{
+    const double *a = A->m, *c = E->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
+                 c7 = c[7], c8 = c[8];
+    for (size_t i = 0; i < m; i++) {
+        double qx = px[i] - r.x, qy = py[i] - r.y, qz = pz[i] - r.z;
+        double ux = a0 * qx + a3 * qy + a6 * qz;
+        double uy = a1 * qx + a4 * qy + a7 * qz;
+        double uz = a2 * qx + a5 * qy + a8 * qz;
+        sx[i] = ux;
+        sy[i] = uy;
+        sz[i] = uz;
+        gx[i] = e.x + (c0 * ux + c1 * uy + c2 * uz);
+        gy[i] = e.y + (c3 * ux + c4 * uy + c5 * uz);
+        gz[i] = e.z + (c6 * ux + c7 * uy + c8 * uz);
+        l2[i] = ux * ux + uy * uy + uz * uz;
+    }
+}
+
+/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet, and their place at the
+ * epoch, epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the
+ * listed ones when `only` is set (gathered REF_CHUNK at a time, turned on vectors, put back). */
 static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *only,
                    size_t count)
 {
-    const double *a = A->m;
-    size_t m = only ? count : web->n;
-    for (size_t q = 0; q < m; q++) {
-        size_t i = only ? only[q] : q;
-        double px = x.x[i] - r.x, py = x.y[i] - r.y, pz = x.z[i] - r.z;
-        web->xdet.x[i] = a[0] * px + a[3] * py + a[6] * pz;
-        web->xdet.y[i] = a[1] * px + a[4] * py + a[7] * pz;
-        web->xdet.z[i] = a[2] * px + a[5] * py + a[8] * pz;
+    double t[10][REF_CHUNK];
+    double lever2 = web->lever2;
+    const size_t n = only ? count : web->n;
+    for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
+        const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
+        if (!only) {
+            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &web->epoch_A, web->epoch_r,
+                      web->xdet.x + q0, web->xdet.y + q0, web->xdet.z + q0, web->xep.x + q0,
+                      web->xep.y + q0, web->xep.z + q0, t[9]);
+        } else {
+            const uint32_t *nd = only + q0;
+            for (size_t j = 0; j < m; j++) {
+                t[0][j] = x.x[nd[j]];
+                t[1][j] = x.y[nd[j]];
+                t[2][j] = x.z[nd[j]];
+            }
+            ref_chunk(m, t[0], t[1], t[2], A, r, &web->epoch_A, web->epoch_r, t[3], t[4], t[5],
+                      t[6], t[7], t[8], t[9]);
+            for (size_t j = 0; j < m; j++) {
+                const uint32_t i = nd[j];
+                web->xdet.x[i] = t[3][j];
+                web->xdet.y[i] = t[4][j];
+                web->xdet.z[i] = t[5][j];
+                web->xep.x[i] = t[6][j];
+                web->xep.y[i] = t[7][j];
+                web->xep.z[i] = t[8][j];
+            }
+        }
+        for (size_t j = 0; j < m; j++)
+            lever2 = t[9][j] > lever2 ? t[9][j] : lever2;
     }
+    web->lever2 = lever2;
 }
 
 int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
@@ -160,15 +219,14 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
         t->rho = m3_tmul_v(&A, v3_sub(b->st[cur].r[k], r));
         t->q = qt_mul(pc, b->st[cur].p[k]);
     }
+    web->epoch_A = A;
+    web->epoch_r = r;
+    web->epoch_q = p;
+    web->lever2 = 0.0;
     to_ref(web, x, &A, r, NULL, 0);
     return 0;
 }
 
-
-/* Flags are found FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come
- * from, then narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector
- * iteration and runs out of registers. */
-enum { FLAG_CHUNK = 256 };
 
 /* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
  * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
@@ -213,6 +271,60 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
                 double ux = a0 * px + a3 * py + a6 * pz - ox[i];
                 double uy = a1 * px + a4 * py + a7 * pz - oy[i];
                 double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
+                flag[i] = f;
+                count += f;
+            }
+        }
+        uint8_t *restrict redo = web->redo + i0;
+        if (count == before) {
+            memset(redo, 0, e);
+            continue;
+        }
+        for (size_t i = 0; i < e; i++)
+            redo[i] = (uint8_t)flag[i];
+    }
+    return count;
+}
+
+/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in web->redo for a
+ * node whose distance from its place at the epoch (xep) reaches lim (or is NaN), else 0; how
+ * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
+ * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
+WS_VECTOR_LOOP
+static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim, int renew)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double lim2 = lim * lim;
+    const size_t n = web->n;
+    uint64_t flag[FLAG_CHUNK];
+    size_t count = 0;
+    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
+        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        double *restrict ox = web->xep.x + i0, *restrict oy = web->xep.y + i0,
+                         *restrict oz = web->xep.z + i0;
+        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        const size_t before = count;
+        if (renew) {
+            const double *restrict sx = web->xdet.x + i0, *restrict sy = web->xdet.y + i0,
+                                   *restrict sz = web->xdet.z + i0;
+            for (size_t i = 0; i < e; i++) {
+                double gx = r.x + (a0 * sx[i] + a1 * sy[i] + a2 * sz[i]);
+                double gy = r.y + (a3 * sx[i] + a4 * sy[i] + a5 * sz[i]);
+                double gz = r.z + (a6 * sx[i] + a7 * sy[i] + a8 * sz[i]);
+                ox[i] = gx;
+                oy[i] = gy;
+                oz[i] = gz;
+                double ux = qx[i] - gx, uy = qy[i] - gy, uz = qz[i] - gz;
+                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
+                flag[i] = f;
+                count += f;
+            }
+        } else {
+            for (size_t i = 0; i < e; i++) {
+                double ux = qx[i] - ox[i], uy = qy[i] - oy[i], uz = qz[i] - oz[i];
                 uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
                 flag[i] = f;
                 count += f;
@@ -388,7 +500,32 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * wherever the contacts see it. */
     const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    size_t flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    size_t flagged;
+    if (c > 0.0) {
+        flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    } else {
+        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
+         * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
+         * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
+         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between
+         * the two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2)
+         * |s| <= turn |s|, and lever2 bounds |s|^2 of every node found since the full
+         * detection. So |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches
+         * lim - drift: it stays within lim of where it was found, as above. A new epoch (the
+         * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
+         * node is flagged before it has moved 7/8 of the bound; it costs about what turning
+         * every node costs, and a load that rocks on its film needs one every few steps. */
+        const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(web->epoch_q), p)));
+        double drift = v3_norm(v3_sub(r, web->epoch_r)) + turn * sqrt(web->lever2);
+        const int renew = !(drift < 0.125 * lim);
+        if (renew) {
+            web->epoch_A = A;
+            web->epoch_r = r;
+            web->epoch_q = p;
+            drift = 0.0;
+        }
+        flagged = flag_epoch(web, x, &A, r, lim - drift, renew);
+    }
     for (size_t q = 0; rebase && q < web->ntrack; q++)
         if (web->track[q].rebase)
             rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);

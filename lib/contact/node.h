@@ -66,7 +66,8 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
- * reach 3/16 of the margin (1/4 with one sub-step); and when a near body moved or turned by
+ * reach 3/16 of the margin (1/4 with one sub-step, tested in the global frame from an epoch of
+ * the reference body's pose: then a node may be flagged from 7/8 of that on); and when a near body moved or turned by
  * margin / 8 at its lever relative to the reference, the nodes it may meet (in its box grown
  * by the layers and the margin, or holding a candidate of it), its record starting again from
  * now. They go to web->moved (count returned) with web->redo set, and their xdet is moved to

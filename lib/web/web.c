@@ -35,6 +35,7 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     ok &= nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
     ok &= nodes_alloc(mem, &web->xdet, n);
+    ok &= nodes_alloc(mem, &web->xep, n);
     ok &= nodes_alloc(mem, &web->xsub, n);
     ok &= nodes_alloc(mem, &web->vsub, n);
     ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
@@ -68,6 +69,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     }
     nodes_free(mem, &web->fmem, web->n);
     nodes_free(mem, &web->xdet, web->n);
+    nodes_free(mem, &web->xep, web->n);
     nodes_free(mem, &web->xsub, web->n);
     nodes_free(mem, &web->vsub, web->n);
     ws_mem_free(mem, web->moved, (n ? n : 1) * sizeof(uint32_t));
