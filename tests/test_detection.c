@@ -1149,6 +1149,82 @@ START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
 }
 END_TEST
 
+/* Candidate lists merged at random: nodes found again keep their candidates, lose them, gain
+ * some or change one's feature. ws_node_same must tell whether any changed, ws_node_merge must
+ * give the list a search of every node would (the old candidates of the other nodes, the fresh
+ * ones of those found again) with the nodes that changed, and leave the index that of the
+ * merged list. */
+START_TEST(merged_candidates_equal_the_list_they_stand_for)
+{
+    enum { N = 40 };
+    uint64_t seed = 777;
+    ws_ncand *old = malloc(4 * N * sizeof *old), *fresh = malloc(4 * N * sizeof *fresh),
+             *want = malloc(4 * N * sizeof *want), *out = NULL;
+    size_t *start = malloc((N + 1) * sizeof *start), *index = malloc((N + 1) * sizeof *index);
+    ck_assert(old && fresh && want && start && index);
+    ws_mem mem;
+    ws_mem_init(&mem, NULL);
+    size_t cap = 0, merges = 0, kept = 0;
+    for (int round = 0; round < 2000; round++) {
+        /* Each node holds 0 to 3 candidates; a quarter of the nodes are found again. */
+        size_t nold = 0, nfresh = 0, nwant = 0, count = 0, nchanged = 0, expect = 0;
+        uint32_t nodes[N], changed[N], expected[N];
+        int mode = round % 4; /* 0: all found again as they were */
+        for (uint32_t i = 0; i < N; i++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            const uint32_t r = (uint32_t)(seed >> 33);
+            const uint32_t had = r % 4, again = (r >> 2) % 4 == 0;
+            for (uint32_t j = 0; j < had; j++)
+                old[nold++] = (ws_ncand){i, j, 10 * i + j, j};
+            if (!again) {
+                for (uint32_t j = 0; j < had; j++)
+                    want[nwant++] = (ws_ncand){i, j, 10 * i + j, j};
+                continue;
+            }
+            nodes[count++] = i;
+            /* Found again: the same, one more, one fewer, or one feature changed. */
+            const uint32_t how = mode == 0 ? 0 : (r >> 4) % 4;
+            const uint32_t has = how == 1 ? had + 1 : how == 2 && had ? had - 1 : had;
+            for (uint32_t j = 0; j < has; j++) {
+                ws_ncand c = {i, j, 10 * i + j, j};
+                if (how == 3 && j + 1 == has)
+                    c.local |= WS_NCAND_INSIDE;
+                fresh[nfresh++] = c;
+                want[nwant++] = c;
+            }
+            if (has != had || (how == 3 && had))
+                expected[expect++] = i;
+        }
+        ws_node_index(old, nold, N, start);
+        const int same = ws_node_same(nodes, count, start, old, fresh, nfresh);
+        ck_assert_int_eq(same, expect == 0);
+        if (same) {
+            kept++;
+            continue;
+        }
+        size_t n = 0;
+        ck_assert_int_eq(ws_node_merge(&mem, nodes, count, N, start, old, nold, fresh, nfresh,
+                                       &out, &n, &cap, changed, &nchanged),
+                         0);
+        merges++;
+        ck_assert_uint_eq(n, nwant);
+        ck_assert(n == 0 || !memcmp(out, want, n * sizeof *out));
+        ck_assert_uint_eq(nchanged, expect);
+        ck_assert(!expect || !memcmp(changed, expected, expect * sizeof *changed));
+        ws_node_index(out, n, N, index);
+        ck_assert(!memcmp(start, index, (N + 1) * sizeof *start));
+    }
+    report("candidate lists: %zu merged, %zu kept as they were", merges, kept);
+    ck_assert(merges > 100 && kept > 100);
+    ws_mem_free(&mem, out, cap * sizeof *out);
+    free(old);
+    free(fresh);
+    free(want);
+    free(start);
+    free(index);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("detection");
@@ -1168,6 +1244,7 @@ int main(void)
     tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
     tcase_add_test(tc, well_inside_takes_the_projection);
     tcase_add_test(tc, nodes_moved_relative_to_the_reference_are_flagged);
+    tcase_add_test(tc, merged_candidates_equal_the_list_they_stand_for);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -561,29 +561,15 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     return count;
 }
 
-/* The first index in [a, n) whose candidate's node is not below m, n when none: a galloping
- * search from a, in steps of the logarithm of the distance whether the next node found again
- * is near or far. */
-static size_t first_not_below(const ws_ncand *c, size_t a, size_t n, uint32_t m)
+void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
 {
-    if (a >= n || c[a].node >= m)
-        return a;
-    size_t lo = a, hi = a + 1, step = 1; /* c[lo].node < m */
-    while (hi < n && c[hi].node < m) {
-        lo = hi;
-        step *= 2;
-        hi = lo + step;
+    size_t q = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        start[i] = q;
+        while (q < nc && c[q].node == i)
+            q++;
     }
-    if (hi > n)
-        hi = n;
-    while (hi - lo > 1) { /* c[lo].node < m, and hi is n or c[hi].node >= m */
-        size_t mid = lo + (hi - lo) / 2;
-        if (c[mid].node < m)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return hi;
+    start[n] = nc;
 }
 
 /* Append src[from, from + len) to o at *k (src may be NULL when len is 0). A node has a
@@ -600,53 +586,67 @@ static inline void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_
     *k += len;
 }
 
-int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+/* Whether the len candidates at a and b (of one node) are alike: mostly one, compared in
+ * place. */
+static inline int same_run(const ws_ncand *a, const ws_ncand *b, size_t len)
+{
+    if (len == 1)
+        return a->body == b->body && a->feat == b->feat && a->local == b->local;
+    return !len || !memcmp(a, b, len * sizeof *a);
+}
+
+int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
                  const ws_ncand *fresh, size_t nfresh)
 {
-    size_t a = 0, f = 0;
+    size_t f = 0;
     for (size_t q = 0; q < count; q++) {
         const uint32_t m = nodes[q];
-        size_t a1 = first_not_below(old, a, nold, m), f1 = f;
-        for (a = a1; a < nold && old[a].node == m; a++)
-            ;
+        const size_t a = start[m], len = start[m + 1] - a;
+        size_t f1 = f;
         for (; f1 < nfresh && fresh[f1].node == m; f1++)
             ;
-        if (a - a1 != f1 - f || (f1 > f && memcmp(old + a1, fresh + f, (f1 - f) * sizeof *old)))
+        if (f1 - f != len || !same_run(old + a, fresh + f, len))
             return 0;
         f = f1;
     }
     return 1;
 }
 
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
-                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap, uint32_t *changed, size_t *nchanged)
+/* start[i] += shift for i in [i0, i1) (modulo 2^64: the shift may be negative). On vectors. */
+WS_VECTOR_LOOP
+static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
+{
+    for (size_t i = i0; i < i1; i++)
+        start[i] += shift;
+}
+
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
+                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
+                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged)
 {
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
-    size_t k = 0, a = 0, f = 0, c = 0;
+    size_t k = 0, a = 0, f = 0, c = 0, i0 = 0;
     /* Node by node found again: the old candidates of the nodes before it as they are, its
-     * old ones dropped, its fresh ones in their place. */
+     * old ones dropped, its fresh ones in their place. The nodes from i0 through it start
+     * k - a later in the merged list than in the old one (the shift of their stretch, read
+     * before it is applied: start[m + 1] is still the old list's). */
     for (size_t q = 0; q < count; q++) {
         const uint32_t m = nodes[q];
-        size_t e = first_not_below(old, a, nold, m);
+        const size_t e = start[m];
         append_run(o, &k, old, a, e - a);
-        for (a = e; a < nold && old[a].node == m; a++)
-            ;
+        shift_index(start, i0, (size_t)m + 1, k - e);
+        a = start[m + 1];
         const size_t f0 = f;
         for (; f < nfresh && fresh[f].node == m; f++)
             ;
-        int same = a - e == f - f0;
-        if (same && f - f0 == 1) /* the common case, without a call */
-            same = old[e].body == fresh[f0].body && old[e].feat == fresh[f0].feat &&
-                   old[e].local == fresh[f0].local;
-        else if (same && f > f0)
-            same = !memcmp(old + e, fresh + f0, (f - f0) * sizeof *old);
-        if (!same)
+        if (a - e != f - f0 || !same_run(old + e, fresh + f0, f - f0))
             changed[c++] = m;
         append_run(o, &k, fresh, f0, f - f0);
+        i0 = (size_t)m + 1;
     }
+    shift_index(start, i0, (size_t)nn + 1, k - a);
     append_run(o, &k, old, a, nold - a);
     *n = k;
     *nchanged = c;

@@ -78,18 +78,24 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
+/* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]
+ * is the first of node i or of a later node, start[n] = nc. */
+void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start);
+
 /* Whether the found candidates `fresh` of `nodes` (count of them, in increasing order) are
- * those the committed list `old` holds for them: then it stays as it is. */
-int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+ * those the committed list `old` (indexed by start, ws_node_index) holds for them: then it
+ * stays as it is. */
+int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
                  const ws_ncand *fresh, size_t nfresh);
 
-/* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
- * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
- * into out; the nodes whose fresh candidates are not those they had into `changed` (room for
- * count; it may be `nodes` itself), in order, *nchanged of them. 0, or -1 when out of memory. */
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
-                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap, uint32_t *changed, size_t *nchanged);
+/* Candidates of the committed list `old` (indexed by start, of web->n nodes) for the nodes not
+ * in `nodes` (count of them, in increasing order) and the found ones `fresh` (of those nodes,
+ * in that order), merged by node into out, start becoming its index; the nodes whose fresh
+ * candidates are not those they had into `changed` (room for count; it may be `nodes`
+ * itself), in order, *nchanged of them. 0, or -1 when out of memory (start unchanged). */
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
+                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
+                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand);

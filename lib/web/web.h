@@ -186,6 +186,9 @@ typedef struct ws_web {
     v3 epoch_r;
     qt epoch_q;
     double lever2;
+    /* Where each node's candidates start in the list last found or merged (n + 1, see
+     * ws_node_index). */
+    size_t *cstart;
 } ws_web;
 
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */

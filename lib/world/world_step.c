@@ -202,6 +202,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          w->def.contact_margin, NULL, 0, &web->cand[list],
                                          &web->ncand[list], &web->capcand[list],
                                          &w->stats.narrow_checks);
+                if (!bad)
+                    ws_node_index(web->cand[list], web->ncand[list], web->n, web->cstart);
             } else {
                 bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
                                          w->def.contact_margin, web->moved, (size_t)moved,
@@ -209,16 +211,16 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          &w->stats.narrow_checks);
                 /* Mostly the nodes found again have the candidates they had: then the
                  * committed list serves again, uncopied. */
-                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cand[old],
-                                         web->ncand[old], web->fresh, web->nfresh))
+                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cstart, web->cand[old],
+                                         web->fresh, web->nfresh))
                     list = old;
                 else /* web->moved keeps the nodes whose candidates changed: their sweep
                         blocks alone are cut into stretches again */
                     bad = bad ||
-                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
-                                        web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
-                                        &web->ncand[list], &web->capcand[list], web->moved,
-                                        &changed) ||
+                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->n, web->cstart,
+                                        web->cand[old], web->ncand[old], web->fresh, web->nfresh,
+                                        &web->cand[list], &web->ncand[list], &web->capcand[list],
+                                        web->moved, &changed) ||
                           ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
                                                   list, old, web->moved, changed);
             }
