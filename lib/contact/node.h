@@ -67,14 +67,15 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
  * reach 3/16 of the margin (1/4 with one sub-step, tested in the global frame from an epoch of
- * the reference body's pose: then a node may be flagged from 7/8 of that on); and when a near body moved or turned by
- * margin / 8 at its lever relative to the reference, the nodes it may meet (in its box grown
- * by the layers and the margin, or holding a candidate of it), its record starting again from
- * now. They go to web->moved (count returned) with web->redo set, and their xdet is moved to
- * where they are now. -1: every node must be found again (a body was made since the full
- * detection, or a far body may have come near the web). Until a node is found again its move
- * relative to a near body stays under half the margin, the distance a candidate list is built
- * to cover, and a body it holds no candidate of cannot touch it: see node.c. */
+ * the reference body's pose: a node may then be flagged from 7/8 of that on); and when a near
+ * body moved or turned by margin / 8 at its lever relative to the reference, the nodes it may
+ * meet (in its box grown by the layers and the margin, or holding a candidate of it), its
+ * record starting again from now. They go to web->moved (count returned) with web->redo set,
+ * and their xdet is moved to where they are now. -1: every node must be found again (a body
+ * was made since the full detection, or a far body may have come near the web). Until a node
+ * is found again its move relative to a near body stays under half the margin, the distance a
+ * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
+ * node.c. */
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
