@@ -947,6 +947,10 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                        ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
 {
     *n = 0;
+    if (ws_array_reserve(mem, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1) != 0)
+        return -1;
+    if (!nodes) /* a full search: the list holds no other candidates */
+        memset(web->cbody, 0, web->cbody_cap);
     if (web->n == 0)
         return 0;
     const double pad = web->layer + 0.5 * margin;
@@ -974,6 +978,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
             if (!c)
                 continue;
+            web->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
             if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
                                  sizeof *g->find_node) != 0)
                 return -1;
@@ -1043,6 +1048,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
 
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
 {
+    (void)cur;
     size_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++)
         if (b->alive[k]) {
@@ -1059,52 +1065,71 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
     if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
                          sizeof(uint32_t)) != 0 ||
         ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0)
+                         sizeof(uint32_t)) != 0 ||
+        ws_array_reserve(mem, (void **)&g->ready, &g->ready_cap, b->slots + 1, 1) != 0)
         return -1;
     uint32_t fo = 0, to = 0, eo = 0;
     for (size_t k = 0; k < b->slots; k++) {
+        g->ready[k] = 0;
         if (!b->alive[k])
             continue;
         const ws_shape *sh = b->shape[k];
-        const m3 *A = &b->A[k];
-        v3 r = b->st[cur].r[k];
         g->face_base[k] = fo;
         g->tri_base[k] = to;
-        for (uint32_t f = 0; f < sh->face_count; f++) {
-            const ws_face *F = &sh->faces[f];
-            ws_wface *o = &g->face[fo + f];
-            o->n = m3_mul_v(A, F->normal);
-            o->off = F->offset + v3_dot(o->n, r); /* n . (r + A s) = n' . s + n . r */
-            o->first_tri = to + F->first_tri;
-            o->tri_count = F->tri_count;
-        }
-        for (uint32_t t = 0; t < sh->triangle_count; t++) {
-            const ws_tri *T = &sh->tris[t];
-            ws_wtri *o = &g->tri[to + t];
-            o->p = v3_add(r, m3_mul_v(A, T->p));
-            o->w = m3_mul_v(A, T->w);
-            o->v = m3_mul_v(A, T->v);
-            o->g00 = T->g00; /* the Gram matrix does not change under rotation */
-            o->g01 = T->g01;
-            o->g11 = T->g11;
-        }
         g->edge_base[k] = eo;
-        for (uint32_t e = 0; e < sh->edge_count; e++) {
-            const ws_edge *E = &sh->edges[e];
-            ws_wedge *o = &g->edge[eo + e];
-            v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
-            o->p = v3_add(r, m3_mul_v(A, a));
-            o->e = m3_mul_v(A, d);
-            o->n1 = m3_mul_v(A, E->n1);
-            o->n2 = m3_mul_v(A, E->n2);
-            o->inv_e2 = 1.0 / v3_dot(d, d);
-            o->c = v3_dot(o->n1, o->n2);
-        }
         fo += sh->face_count;
         to += sh->triangle_count;
         eo += sh->edge_count;
     }
     return 0;
+}
+
+/* Body k's faces, triangles and edges in the global frame at state cur. */
+static void prepare_body(const ws_body_store *b, int cur, ws_node_geom *g, uint32_t k)
+{
+    const ws_shape *sh = b->shape[k];
+    const m3 *A = &b->A[k];
+    v3 r = b->st[cur].r[k];
+    const uint32_t fo = g->face_base[k], to = g->tri_base[k], eo = g->edge_base[k];
+    for (uint32_t f = 0; f < sh->face_count; f++) {
+        const ws_face *F = &sh->faces[f];
+        ws_wface *o = &g->face[fo + f];
+        o->n = m3_mul_v(A, F->normal);
+        o->off = F->offset + v3_dot(o->n, r); /* n . (r + A s) = n' . s + n . r */
+        o->first_tri = to + F->first_tri;
+        o->tri_count = F->tri_count;
+    }
+    for (uint32_t t = 0; t < sh->triangle_count; t++) {
+        const ws_tri *T = &sh->tris[t];
+        ws_wtri *o = &g->tri[to + t];
+        o->p = v3_add(r, m3_mul_v(A, T->p));
+        o->w = m3_mul_v(A, T->w);
+        o->v = m3_mul_v(A, T->v);
+        o->g00 = T->g00; /* the Gram matrix does not change under rotation */
+        o->g01 = T->g01;
+        o->g11 = T->g11;
+    }
+    for (uint32_t e = 0; e < sh->edge_count; e++) {
+        const ws_edge *E = &sh->edges[e];
+        ws_wedge *o = &g->edge[eo + e];
+        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        o->p = v3_add(r, m3_mul_v(A, a));
+        o->e = m3_mul_v(A, d);
+        o->n1 = m3_mul_v(A, E->n1);
+        o->n2 = m3_mul_v(A, E->n2);
+        o->inv_e2 = 1.0 / v3_dot(d, d);
+        o->c = v3_dot(o->n1, o->n2);
+    }
+}
+
+void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
+{
+    const size_t m = web->cbody_cap < b->slots ? web->cbody_cap : b->slots;
+    for (uint32_t k = 0; k < m; k++)
+        if (web->cbody[k] && !g->ready[k] && b->alive[k]) {
+            prepare_body(b, cur, g, k);
+            g->ready[k] = 1;
+        }
 }
 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
@@ -1119,4 +1144,5 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->find_val, g->find_val_cap * sizeof *g->find_val);
     ws_mem_free(mem, g->find_mask, g->find_mask_cap * sizeof *g->find_mask);
     ws_mem_free(mem, g->find_node, g->find_node_cap * sizeof *g->find_node);
+    ws_mem_free(mem, g->ready, g->ready_cap);
 }

@@ -45,11 +45,20 @@ typedef struct ws_node_geom {
     uint64_t *find_mask;
     uint32_t *find_node;
     size_t find_cap, find_val_cap, find_mask_cap, find_node_cap;
+    /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
+    uint8_t *ready;
+    size_t ready_cap;
 } ws_node_geom;
 
-/* Fill g for the bodies at state cur. 0, or -1 when out of memory (only when bodies were
- * added since the last call). */
+/* Room in g and the numbers of the bodies' features (face_base, tri_base, edge_base), with no
+ * body prepared yet: a step prepares only the bodies some web's candidates may name
+ * (ws_node_prepare). 0, or -1 when out of memory (only when bodies were added since the last
+ * call). */
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
+
+/* The features, in the global frame at state cur, of the bodies whose candidates web may hold
+ * (web->cbody) and that are not prepared yet in this step. */
+void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Node candidates of a web: every node-face and node-edge pair within the layers + margin, for

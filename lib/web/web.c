@@ -76,6 +76,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->moved, (n ? n : 1) * sizeof(uint32_t));
     ws_mem_free(mem, web->redo, (n ? n : 1) * sizeof(uint8_t));
     ws_mem_free(mem, web->cstart, ((size_t)n + 1) * sizeof(size_t));
+    ws_mem_free(mem, web->cbody, web->cbody_cap);
     ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
     ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
     ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));

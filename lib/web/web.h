@@ -189,6 +189,10 @@ typedef struct ws_web {
     /* Where each node's candidates start in the list last found or merged (n + 1, see
      * ws_node_index). */
     size_t *cstart;
+    /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
+     * some node searched since the full detection, ws_node_candidates). */
+    uint8_t *cbody;
+    size_t cbody_cap;
 } ws_web;
 
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */

@@ -231,6 +231,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
         web->next_list = list;
+        ws_node_prepare(b, cur, &w->node_geom, web);
         /* The list cut into stretches for the evaluation: again whenever it changed (a list
          * that serves again keeps its stretches). */
         if (web->seg_list != list &&
