@@ -586,13 +586,15 @@ static inline void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_
     *k += len;
 }
 
-/* Whether the len candidates at a and b (of one node) are alike: mostly one, compared in
- * place. */
-static inline int same_run(const ws_ncand *a, const ws_ncand *b, size_t len)
+/* Whether the len candidates at a + i and b + j (of one node) are alike: mostly one, compared
+ * in place. The lists may be NULL when len is 0. */
+static inline int same_run(const ws_ncand *a, size_t i, const ws_ncand *b, size_t j, size_t len)
 {
+    if (len == 0)
+        return 1;
     if (len == 1)
-        return a->body == b->body && a->feat == b->feat && a->local == b->local;
-    return !len || !memcmp(a, b, len * sizeof *a);
+        return a[i].body == b[j].body && a[i].feat == b[j].feat && a[i].local == b[j].local;
+    return !memcmp(a + i, b + j, len * sizeof *a);
 }
 
 int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
@@ -605,7 +607,7 @@ int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const
         size_t f1 = f;
         for (; f1 < nfresh && fresh[f1].node == m; f1++)
             ;
-        if (f1 - f != len || !same_run(old + a, fresh + f, len))
+        if (f1 - f != len || !same_run(old, a, fresh, f, len))
             return 0;
         f = f1;
     }
@@ -641,7 +643,7 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn,
         const size_t f0 = f;
         for (; f < nfresh && fresh[f].node == m; f++)
             ;
-        if (a - e != f - f0 || !same_run(old + e, fresh + f0, f - f0))
+        if (a - e != f - f0 || !same_run(old, e, fresh, f0, f - f0))
             changed[c++] = m;
         append_run(o, &k, fresh, f0, f - f0);
         i0 = (size_t)m + 1;
