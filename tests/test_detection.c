@@ -8,6 +8,7 @@
  * candidates. This suite reaches into the world (world_internal.h) to force detection. */
 #include "helpers.h"
 
+#include "contact/node.h"
 #include "world/world_internal.h"
 
 /* Every film node of every web finds its candidates again before the next step. */
@@ -1124,6 +1125,185 @@ START_TEST(film_detection_does_not_change_the_motion)
 }
 END_TEST
 
+/* The reference body of a film (a free box) and a sheet of 400 nodes over its top walk at
+ * random, a step of some um in turn and position for the box and of some tenths of a mm for a
+ * few nodes: ws_node_moved must flag every node whose move relative to the box since it was
+ * found reaches a quarter of the margin (one sub-step), however it tests that move. A test of
+ * the nodes' global moves against where they were found, as the box stood at some earlier step,
+ * must allow for how far the box moved and turned since; and as that allowance stays under 1/8
+ * of the bound, no node that moved less than 3/4 of it may be flagged (nor one whose flag of an
+ * earlier step was left set). */
+START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
+{
+    ws_world *w = weightless_world();
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &cube));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.mass = 5.0;
+    bd.name = "box";
+    ws_body_id box;
+    ck_ok(w, ws_body_create(w, &bd, &box));
+    ws_web_def wd;
+    soft_film(w, &wd);
+    /* 20 x 20 nodes 2 cm apart, 1 mm over the top (z = 0.1 m), at levers up to 0.27 m. */
+    enum { N = 400 };
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 20;
+    sd.spacing_x = sd.spacing_y = 0.02;
+    sd.origin = (ws_vec3){-0.19, -0.19, 0.1 + 1e-3};
+    ws_web_id id;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &id));
+    ck_ok(w, ws_world_step(w));
+    ws_web *web = only_web(w);
+    ck_assert_uint_eq(web->n, N);
+    ws_body_store *b = &w->bodies;
+    const int cur = w->cur;
+    const uint32_t k = web->ref;
+    ck_assert_uint_ne(k, UINT32_MAX);
+    const double margin = w->def.contact_margin, lim = 0.25 * margin;
+    uint64_t seed = 12345;
+    long flagged = 0, due = 0, epochs = 0;
+    double *s0 = malloc(3 * N * sizeof *s0);
+    uint8_t *hit = malloc(N);
+    ck_assert(s0 && hit);
+    for (int step = 0; step < 10000; step++) {
+        /* The box turns by up to 0.17 mrad (46 um at the far corner) and moves up to 17 um;
+         * four nodes move up to 0.7 mm each, so that many reach the bound while the box
+         * drifts. */
+        double rnd[18];
+        for (int j = 0; j < 18; j++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            rnd[j] = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+        }
+        qt dq = qt_from_rotvec(v3_make(2e-4 * rnd[0], 2e-4 * rnd[1], 2e-4 * rnd[2]));
+        b->st[cur].p[k] = qt_normalize(qt_mul(dq, b->st[cur].p[k]));
+        b->A[k] = qt_to_m3(b->st[cur].p[k]);
+        b->st[cur].r[k] =
+            v3_add(b->st[cur].r[k], v3_make(2e-5 * rnd[3], 2e-5 * rnd[4], 2e-5 * rnd[5]));
+        ws_nodes3 x = web->x[cur];
+        for (int j = 0; j < 4; j++) {
+            const uint32_t i = (uint32_t)((rnd[6 + 3 * j] + 0.5) * N) % N;
+            x.x[i] += 8e-4 * rnd[7 + 3 * j];
+            x.y[i] += 8e-4 * rnd[8 + 3 * j];
+            x.z[i] += 8e-4 * rnd[6 + 3 * j];
+        }
+        for (uint32_t q = 0; q < N; q++) {
+            s0[3 * q] = web->xdet.x[q];
+            s0[3 * q + 1] = web->xdet.y[q];
+            s0[3 * q + 2] = web->xdet.z[q];
+        }
+        const v3 e0 = web->epoch_r;
+        long moved = ws_node_moved(b, cur, web, x, web->v[cur], w->def.dt, margin);
+        if (moved < 0)
+            ck_abort_msg("step %d: every node to be found again", step);
+        epochs += e0.x != web->epoch_r.x || e0.y != web->epoch_r.y || e0.z != web->epoch_r.z;
+        memset(hit, 0, N);
+        for (long m = 0; m < moved; m++)
+            hit[web->moved[m]] = 1;
+        for (uint32_t q = 0; q < N; q++) {
+            /* Asserted only when it fails: the checks are many. */
+            v3 u = v3_sub(m3_tmul_v(&b->A[k], v3_sub(nodes_get(x, q), b->st[cur].r[k])),
+                          v3_make(s0[3 * q], s0[3 * q + 1], s0[3 * q + 2]));
+            if (hit[q] && v3_norm(u) < 0.75 * lim)
+                ck_abort_msg("step %d: node %u flagged, moved only %.4g mm relative to the box",
+                             step, q, 1e3 * v3_norm(u));
+            if (v3_norm(u) < lim)
+                continue;
+            due++;
+            if (!hit[q])
+                ck_abort_msg("step %d: node %u moved %.4g mm relative to the box, unflagged",
+                             step, q, 1e3 * v3_norm(u));
+        }
+        flagged += moved;
+    }
+    report("nodes walking on a drifting box: %ld flagged, %ld due; %ld new epochs", flagged, due,
+           epochs);
+    ck_assert_msg(due > 1000 && epochs > 100, "the walk tests too little");
+    free(s0);
+    free(hit);
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* Candidate lists merged at random: nodes found again keep their candidates, lose them, gain
+ * some or change one's feature. ws_node_same must tell whether any changed, ws_node_merge must
+ * give the list a search of every node would (the old candidates of the other nodes, the fresh
+ * ones of those found again) with the nodes that changed, and leave the index that of the
+ * merged list. */
+START_TEST(merged_candidates_equal_the_list_they_stand_for)
+{
+    enum { N = 40 };
+    uint64_t seed = 777;
+    ws_ncand *old = malloc(4 * N * sizeof *old), *fresh = malloc(4 * N * sizeof *fresh),
+             *want = malloc(4 * N * sizeof *want), *out = NULL;
+    size_t *start = malloc((N + 1) * sizeof *start), *index = malloc((N + 1) * sizeof *index);
+    ck_assert(old && fresh && want && start && index);
+    ws_mem mem;
+    ws_mem_init(&mem, NULL);
+    size_t cap = 0, merges = 0, kept = 0;
+    for (int round = 0; round < 2000; round++) {
+        /* Each node holds 0 to 3 candidates; a quarter of the nodes are found again. */
+        size_t nold = 0, nfresh = 0, nwant = 0, count = 0, nchanged = 0, expect = 0;
+        uint32_t nodes[N], changed[N], expected[N];
+        int mode = round % 4; /* 0: all found again as they were */
+        for (uint32_t i = 0; i < N; i++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            const uint32_t r = (uint32_t)(seed >> 33);
+            const uint32_t had = r % 4, again = (r >> 2) % 4 == 0;
+            for (uint32_t j = 0; j < had; j++)
+                old[nold++] = (ws_ncand){i, j, 10 * i + j, j};
+            if (!again) {
+                for (uint32_t j = 0; j < had; j++)
+                    want[nwant++] = (ws_ncand){i, j, 10 * i + j, j};
+                continue;
+            }
+            nodes[count++] = i;
+            /* Found again: the same, one more, one fewer, or one feature changed. */
+            const uint32_t how = mode == 0 ? 0 : (r >> 4) % 4;
+            const uint32_t has = how == 1 ? had + 1 : how == 2 && had ? had - 1 : had;
+            for (uint32_t j = 0; j < has; j++) {
+                ws_ncand c = {i, j, 10 * i + j, j};
+                if (how == 3 && j + 1 == has)
+                    c.local |= WS_NCAND_INSIDE;
+                fresh[nfresh++] = c;
+                want[nwant++] = c;
+            }
+            if (has != had || (how == 3 && had))
+                expected[expect++] = i;
+        }
+        ws_node_index(old, nold, N, start);
+        const int same = ws_node_same(nodes, count, start, old, fresh, nfresh);
+        ck_assert_int_eq(same, expect == 0);
+        if (same) {
+            kept++;
+            continue;
+        }
+        size_t n = 0;
+        ck_assert_int_eq(ws_node_merge(&mem, nodes, count, N, start, old, nold, fresh, nfresh,
+                                       &out, &n, &cap, changed, &nchanged),
+                         0);
+        merges++;
+        ck_assert_uint_eq(n, nwant);
+        ck_assert(n == 0 || !memcmp(out, want, n * sizeof *out));
+        ck_assert_uint_eq(nchanged, expect);
+        ck_assert(!expect || !memcmp(changed, expected, expect * sizeof *changed));
+        ws_node_index(out, n, N, index);
+        ck_assert(!memcmp(start, index, (N + 1) * sizeof *start));
+    }
+    report("candidate lists: %zu merged, %zu kept as they were", merges, kept);
+    ck_assert(merges > 100 && kept > 100);
+    ws_mem_free(&mem, out, cap * sizeof *out);
+    free(old);
+    free(fresh);
+    free(want);
+    free(start);
+    free(index);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("detection");
@@ -1143,6 +1323,8 @@ int main(void)
     tcase_add_test(tc, corner_edge_tests_spared_only_in_its_region);
     tcase_add_test(tc, friction_sees_every_normal_force);
     tcase_add_test(tc, well_inside_takes_the_projection);
+    tcase_add_test(tc, nodes_moved_relative_to_the_reference_are_flagged);
+    tcase_add_test(tc, merged_candidates_equal_the_list_they_stand_for);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -100,20 +100,79 @@ static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, 
     *p = b->st[cur].p[k];
 }
 
-/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet; all of them, or the listed
- * ones when `only` is set. */
+/* Nodes are turned to the reference frame REF_CHUNK at a time (to_ref). Flags are found
+ * FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
+ * narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector iteration and
+ * runs out of registers. */
+enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
+
+/* m nodes at (px, py, pz) to the reference frame (A, r): s = A^T (x - r) into (sx, sy, sz), and
+ * their place at the epoch (E, e), e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
+WS_VECTOR_LOOP
+static void ref_chunk(size_t m, const double *restrict px, const double *restrict py,
+                      const double *restrict pz, const m3 *A, v3 r, const m3 *E, v3 e,
+                      double *restrict sx, double *restrict sy, double *restrict sz,
+                      double *restrict gx, double *restrict gy, double *restrict gz,
+                      double *restrict l2)
+{
+    const double *a = A->m, *c = E->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
+                 c7 = c[7], c8 = c[8];
+    for (size_t i = 0; i < m; i++) {
+        double qx = px[i] - r.x, qy = py[i] - r.y, qz = pz[i] - r.z;
+        double ux = a0 * qx + a3 * qy + a6 * qz;
+        double uy = a1 * qx + a4 * qy + a7 * qz;
+        double uz = a2 * qx + a5 * qy + a8 * qz;
+        sx[i] = ux;
+        sy[i] = uy;
+        sz[i] = uz;
+        gx[i] = e.x + (c0 * ux + c1 * uy + c2 * uz);
+        gy[i] = e.y + (c3 * ux + c4 * uy + c5 * uz);
+        gz[i] = e.z + (c6 * ux + c7 * uy + c8 * uz);
+        l2[i] = ux * ux + uy * uy + uz * uz;
+    }
+}
+
+/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet, and their place at the
+ * epoch, epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the
+ * listed ones when `only` is set (gathered REF_CHUNK at a time, turned on vectors, put back). */
 static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *only,
                    size_t count)
 {
-    const double *a = A->m;
-    size_t m = only ? count : web->n;
-    for (size_t q = 0; q < m; q++) {
-        size_t i = only ? only[q] : q;
-        double px = x.x[i] - r.x, py = x.y[i] - r.y, pz = x.z[i] - r.z;
-        web->xdet.x[i] = a[0] * px + a[3] * py + a[6] * pz;
-        web->xdet.y[i] = a[1] * px + a[4] * py + a[7] * pz;
-        web->xdet.z[i] = a[2] * px + a[5] * py + a[8] * pz;
+    double t[10][REF_CHUNK];
+    double lever2 = web->lever2;
+    const size_t n = only ? count : web->n;
+    for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
+        const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
+        if (!only) {
+            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &web->epoch_A, web->epoch_r,
+                      web->xdet.x + q0, web->xdet.y + q0, web->xdet.z + q0, web->xep.x + q0,
+                      web->xep.y + q0, web->xep.z + q0, t[9]);
+        } else {
+            const uint32_t *nd = only + q0;
+            for (size_t j = 0; j < m; j++) {
+                t[0][j] = x.x[nd[j]];
+                t[1][j] = x.y[nd[j]];
+                t[2][j] = x.z[nd[j]];
+            }
+            ref_chunk(m, t[0], t[1], t[2], A, r, &web->epoch_A, web->epoch_r, t[3], t[4], t[5],
+                      t[6], t[7], t[8], t[9]);
+            for (size_t j = 0; j < m; j++) {
+                const uint32_t i = nd[j];
+                web->xdet.x[i] = t[3][j];
+                web->xdet.y[i] = t[4][j];
+                web->xdet.z[i] = t[5][j];
+                web->xep.x[i] = t[6][j];
+                web->xep.y[i] = t[7][j];
+                web->xep.z[i] = t[8][j];
+            }
+        }
+        for (size_t j = 0; j < m; j++)
+            lever2 = t[9][j] > lever2 ? t[9][j] : lever2;
     }
+    web->lever2 = lever2;
 }
 
 int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
@@ -160,15 +219,14 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
         t->rho = m3_tmul_v(&A, v3_sub(b->st[cur].r[k], r));
         t->q = qt_mul(pc, b->st[cur].p[k]);
     }
+    web->epoch_A = A;
+    web->epoch_r = r;
+    web->epoch_q = p;
+    web->lever2 = 0.0;
     to_ref(web, x, &A, r, NULL, 0);
     return 0;
 }
 
-
-/* Flags are found FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come
- * from, then narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector
- * iteration and runs out of registers. */
-enum { FLAG_CHUNK = 256 };
 
 /* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
  * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
@@ -213,6 +271,60 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
                 double ux = a0 * px + a3 * py + a6 * pz - ox[i];
                 double uy = a1 * px + a4 * py + a7 * pz - oy[i];
                 double uz = a2 * px + a5 * py + a8 * pz - oz[i];
+                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
+                flag[i] = f;
+                count += f;
+            }
+        }
+        uint8_t *restrict redo = web->redo + i0;
+        if (count == before) {
+            memset(redo, 0, e);
+            continue;
+        }
+        for (size_t i = 0; i < e; i++)
+            redo[i] = (uint8_t)flag[i];
+    }
+    return count;
+}
+
+/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in web->redo for a
+ * node whose distance from its place at the epoch (xep) reaches lim (or is NaN), else 0; how
+ * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
+ * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
+WS_VECTOR_LOOP
+static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim, int renew)
+{
+    const double *a = A->m;
+    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
+                 a7 = a[7], a8 = a[8];
+    const double lim2 = lim * lim;
+    const size_t n = web->n;
+    uint64_t flag[FLAG_CHUNK];
+    size_t count = 0;
+    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
+        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        double *restrict ox = web->xep.x + i0, *restrict oy = web->xep.y + i0,
+                         *restrict oz = web->xep.z + i0;
+        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        const size_t before = count;
+        if (renew) {
+            const double *restrict sx = web->xdet.x + i0, *restrict sy = web->xdet.y + i0,
+                                   *restrict sz = web->xdet.z + i0;
+            for (size_t i = 0; i < e; i++) {
+                double gx = r.x + (a0 * sx[i] + a1 * sy[i] + a2 * sz[i]);
+                double gy = r.y + (a3 * sx[i] + a4 * sy[i] + a5 * sz[i]);
+                double gz = r.z + (a6 * sx[i] + a7 * sy[i] + a8 * sz[i]);
+                ox[i] = gx;
+                oy[i] = gy;
+                oz[i] = gz;
+                double ux = qx[i] - gx, uy = qy[i] - gy, uz = qz[i] - gz;
+                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
+                flag[i] = f;
+                count += f;
+            }
+        } else {
+            for (size_t i = 0; i < e; i++) {
+                double ux = qx[i] - ox[i], uy = qy[i] - oy[i], uz = qz[i] - oz[i];
                 uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
                 flag[i] = f;
                 count += f;
@@ -388,7 +500,32 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * wherever the contacts see it. */
     const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    size_t flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    size_t flagged;
+    if (c > 0.0) {
+        flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
+    } else {
+        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
+         * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
+         * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
+         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between
+         * the two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2)
+         * |s| <= turn |s|, and lever2 bounds |s|^2 of every node found since the full
+         * detection. So |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches
+         * lim - drift: it stays within lim of where it was found, as above. A new epoch (the
+         * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
+         * node is flagged before it has moved 7/8 of the bound; it costs about what turning
+         * every node costs, and a load that rocks on its film needs one every few steps. */
+        const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(web->epoch_q), p)));
+        double drift = v3_norm(v3_sub(r, web->epoch_r)) + turn * sqrt(web->lever2);
+        const int renew = !(drift < 0.125 * lim);
+        if (renew) {
+            web->epoch_A = A;
+            web->epoch_r = r;
+            web->epoch_q = p;
+            drift = 0.0;
+        }
+        flagged = flag_epoch(web, x, &A, r, lim - drift, renew);
+    }
     for (size_t q = 0; rebase && q < web->ntrack; q++)
         if (web->track[q].rebase)
             rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);
@@ -424,29 +561,15 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     return count;
 }
 
-/* The first index in [a, n) whose candidate's node is not below m, n when none: a galloping
- * search from a, in steps of the logarithm of the distance whether the next node found again
- * is near or far. */
-static size_t first_not_below(const ws_ncand *c, size_t a, size_t n, uint32_t m)
+void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
 {
-    if (a >= n || c[a].node >= m)
-        return a;
-    size_t lo = a, hi = a + 1, step = 1; /* c[lo].node < m */
-    while (hi < n && c[hi].node < m) {
-        lo = hi;
-        step *= 2;
-        hi = lo + step;
+    size_t q = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        start[i] = q;
+        while (q < nc && c[q].node == i)
+            q++;
     }
-    if (hi > n)
-        hi = n;
-    while (hi - lo > 1) { /* c[lo].node < m, and hi is n or c[hi].node >= m */
-        size_t mid = lo + (hi - lo) / 2;
-        if (c[mid].node < m)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    return hi;
+    start[n] = nc;
 }
 
 /* Append src[from, from + len) to o at *k (src may be NULL when len is 0). A node has a
@@ -463,53 +586,69 @@ static inline void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_
     *k += len;
 }
 
-int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+/* Whether the len candidates at a + i and b + j (of one node) are alike: mostly one, compared
+ * in place. The lists may be NULL when len is 0. */
+static inline int same_run(const ws_ncand *a, size_t i, const ws_ncand *b, size_t j, size_t len)
+{
+    if (len == 0)
+        return 1;
+    if (len == 1)
+        return a[i].body == b[j].body && a[i].feat == b[j].feat && a[i].local == b[j].local;
+    return !memcmp(a + i, b + j, len * sizeof *a);
+}
+
+int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
                  const ws_ncand *fresh, size_t nfresh)
 {
-    size_t a = 0, f = 0;
+    size_t f = 0;
     for (size_t q = 0; q < count; q++) {
         const uint32_t m = nodes[q];
-        size_t a1 = first_not_below(old, a, nold, m), f1 = f;
-        for (a = a1; a < nold && old[a].node == m; a++)
-            ;
+        const size_t a = start[m], len = start[m + 1] - a;
+        size_t f1 = f;
         for (; f1 < nfresh && fresh[f1].node == m; f1++)
             ;
-        if (a - a1 != f1 - f || (f1 > f && memcmp(old + a1, fresh + f, (f1 - f) * sizeof *old)))
+        if (f1 - f != len || !same_run(old, a, fresh, f, len))
             return 0;
         f = f1;
     }
     return 1;
 }
 
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
-                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap, uint32_t *changed, size_t *nchanged)
+/* start[i] += shift for i in [i0, i1) (modulo 2^64: the shift may be negative). On vectors. */
+WS_VECTOR_LOOP
+static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
+{
+    for (size_t i = i0; i < i1; i++)
+        start[i] += shift;
+}
+
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
+                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
+                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged)
 {
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
-    size_t k = 0, a = 0, f = 0, c = 0;
+    size_t k = 0, a = 0, f = 0, c = 0, i0 = 0;
     /* Node by node found again: the old candidates of the nodes before it as they are, its
-     * old ones dropped, its fresh ones in their place. */
+     * old ones dropped, its fresh ones in their place. The nodes from i0 through it start
+     * k - a later in the merged list than in the old one (the shift of their stretch, read
+     * before it is applied: start[m + 1] is still the old list's). */
     for (size_t q = 0; q < count; q++) {
         const uint32_t m = nodes[q];
-        size_t e = first_not_below(old, a, nold, m);
+        const size_t e = start[m];
         append_run(o, &k, old, a, e - a);
-        for (a = e; a < nold && old[a].node == m; a++)
-            ;
+        shift_index(start, i0, (size_t)m + 1, k - e);
+        a = start[m + 1];
         const size_t f0 = f;
         for (; f < nfresh && fresh[f].node == m; f++)
             ;
-        int same = a - e == f - f0;
-        if (same && f - f0 == 1) /* the common case, without a call */
-            same = old[e].body == fresh[f0].body && old[e].feat == fresh[f0].feat &&
-                   old[e].local == fresh[f0].local;
-        else if (same && f > f0)
-            same = !memcmp(old + e, fresh + f0, (f - f0) * sizeof *old);
-        if (!same)
+        if (a - e != f - f0 || !same_run(old, e, fresh, f0, f - f0))
             changed[c++] = m;
         append_run(o, &k, fresh, f0, f - f0);
+        i0 = (size_t)m + 1;
     }
+    shift_index(start, i0, (size_t)nn + 1, k - a);
     append_run(o, &k, old, a, nold - a);
     *n = k;
     *nchanged = c;
@@ -810,6 +949,10 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                        ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
 {
     *n = 0;
+    if (ws_array_reserve(mem, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1) != 0)
+        return -1;
+    if (!nodes) /* a full search: the list holds no other candidates */
+        memset(web->cbody, 0, web->cbody_cap);
     if (web->n == 0)
         return 0;
     const double pad = web->layer + 0.5 * margin;
@@ -837,6 +980,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
             if (!c)
                 continue;
+            web->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
             if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
                                  sizeof *g->find_node) != 0)
                 return -1;
@@ -906,6 +1050,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
 
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
 {
+    (void)cur;
     size_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++)
         if (b->alive[k]) {
@@ -922,52 +1067,71 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
     if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
                          sizeof(uint32_t)) != 0 ||
         ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0)
+                         sizeof(uint32_t)) != 0 ||
+        ws_array_reserve(mem, (void **)&g->ready, &g->ready_cap, b->slots + 1, 1) != 0)
         return -1;
     uint32_t fo = 0, to = 0, eo = 0;
     for (size_t k = 0; k < b->slots; k++) {
+        g->ready[k] = 0;
         if (!b->alive[k])
             continue;
         const ws_shape *sh = b->shape[k];
-        const m3 *A = &b->A[k];
-        v3 r = b->st[cur].r[k];
         g->face_base[k] = fo;
         g->tri_base[k] = to;
-        for (uint32_t f = 0; f < sh->face_count; f++) {
-            const ws_face *F = &sh->faces[f];
-            ws_wface *o = &g->face[fo + f];
-            o->n = m3_mul_v(A, F->normal);
-            o->off = F->offset + v3_dot(o->n, r); /* n . (r + A s) = n' . s + n . r */
-            o->first_tri = to + F->first_tri;
-            o->tri_count = F->tri_count;
-        }
-        for (uint32_t t = 0; t < sh->triangle_count; t++) {
-            const ws_tri *T = &sh->tris[t];
-            ws_wtri *o = &g->tri[to + t];
-            o->p = v3_add(r, m3_mul_v(A, T->p));
-            o->w = m3_mul_v(A, T->w);
-            o->v = m3_mul_v(A, T->v);
-            o->g00 = T->g00; /* the Gram matrix does not change under rotation */
-            o->g01 = T->g01;
-            o->g11 = T->g11;
-        }
         g->edge_base[k] = eo;
-        for (uint32_t e = 0; e < sh->edge_count; e++) {
-            const ws_edge *E = &sh->edges[e];
-            ws_wedge *o = &g->edge[eo + e];
-            v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
-            o->p = v3_add(r, m3_mul_v(A, a));
-            o->e = m3_mul_v(A, d);
-            o->n1 = m3_mul_v(A, E->n1);
-            o->n2 = m3_mul_v(A, E->n2);
-            o->inv_e2 = 1.0 / v3_dot(d, d);
-            o->c = v3_dot(o->n1, o->n2);
-        }
         fo += sh->face_count;
         to += sh->triangle_count;
         eo += sh->edge_count;
     }
     return 0;
+}
+
+/* Body k's faces, triangles and edges in the global frame at state cur. */
+static void prepare_body(const ws_body_store *b, int cur, ws_node_geom *g, uint32_t k)
+{
+    const ws_shape *sh = b->shape[k];
+    const m3 *A = &b->A[k];
+    v3 r = b->st[cur].r[k];
+    const uint32_t fo = g->face_base[k], to = g->tri_base[k], eo = g->edge_base[k];
+    for (uint32_t f = 0; f < sh->face_count; f++) {
+        const ws_face *F = &sh->faces[f];
+        ws_wface *o = &g->face[fo + f];
+        o->n = m3_mul_v(A, F->normal);
+        o->off = F->offset + v3_dot(o->n, r); /* n . (r + A s) = n' . s + n . r */
+        o->first_tri = to + F->first_tri;
+        o->tri_count = F->tri_count;
+    }
+    for (uint32_t t = 0; t < sh->triangle_count; t++) {
+        const ws_tri *T = &sh->tris[t];
+        ws_wtri *o = &g->tri[to + t];
+        o->p = v3_add(r, m3_mul_v(A, T->p));
+        o->w = m3_mul_v(A, T->w);
+        o->v = m3_mul_v(A, T->v);
+        o->g00 = T->g00; /* the Gram matrix does not change under rotation */
+        o->g01 = T->g01;
+        o->g11 = T->g11;
+    }
+    for (uint32_t e = 0; e < sh->edge_count; e++) {
+        const ws_edge *E = &sh->edges[e];
+        ws_wedge *o = &g->edge[eo + e];
+        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+        o->p = v3_add(r, m3_mul_v(A, a));
+        o->e = m3_mul_v(A, d);
+        o->n1 = m3_mul_v(A, E->n1);
+        o->n2 = m3_mul_v(A, E->n2);
+        o->inv_e2 = 1.0 / v3_dot(d, d);
+        o->c = v3_dot(o->n1, o->n2);
+    }
+}
+
+void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
+{
+    const size_t m = web->cbody_cap < b->slots ? web->cbody_cap : b->slots;
+    for (uint32_t k = 0; k < m; k++)
+        if (web->cbody[k] && !g->ready[k] && b->alive[k]) {
+            prepare_body(b, cur, g, k);
+            g->ready[k] = 1;
+        }
 }
 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
@@ -982,4 +1146,5 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->find_val, g->find_val_cap * sizeof *g->find_val);
     ws_mem_free(mem, g->find_mask, g->find_mask_cap * sizeof *g->find_mask);
     ws_mem_free(mem, g->find_node, g->find_node_cap * sizeof *g->find_node);
+    ws_mem_free(mem, g->ready, g->ready_cap);
 }

@@ -45,11 +45,20 @@ typedef struct ws_node_geom {
     uint64_t *find_mask;
     uint32_t *find_node;
     size_t find_cap, find_val_cap, find_mask_cap, find_node_cap;
+    /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
+    uint8_t *ready;
+    size_t ready_cap;
 } ws_node_geom;
 
-/* Fill g for the bodies at state cur. 0, or -1 when out of memory (only when bodies were
- * added since the last call). */
+/* Room in g and the numbers of the bodies' features (face_base, tri_base, edge_base), with no
+ * body prepared yet: a step prepares only the bodies some web's candidates may name
+ * (ws_node_prepare). 0, or -1 when out of memory (only when bodies were added since the last
+ * call). */
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
+
+/* The features, in the global frame at state cur, of the bodies whose candidates web may hold
+ * (web->cbody) and that are not prepared yet in this step. */
+void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Node candidates of a web: every node-face and node-edge pair within the layers + margin, for
@@ -66,29 +75,37 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
- * reach 3/16 of the margin (1/4 with one sub-step); and when a near body moved or turned by
- * margin / 8 at its lever relative to the reference, the nodes it may meet (in its box grown
- * by the layers and the margin, or holding a candidate of it), its record starting again from
- * now. They go to web->moved (count returned) with web->redo set, and their xdet is moved to
- * where they are now. -1: every node must be found again (a body was made since the full
- * detection, or a far body may have come near the web). Until a node is found again its move
- * relative to a near body stays under half the margin, the distance a candidate list is built
- * to cover, and a body it holds no candidate of cannot touch it: see node.c. */
+ * reach 3/16 of the margin (1/4 with one sub-step, tested in the global frame from an epoch of
+ * the reference body's pose: a node may then be flagged from 7/8 of that on); and when a near
+ * body moved or turned by margin / 8 at its lever relative to the reference, the nodes it may
+ * meet (in its box grown by the layers and the margin, or holding a candidate of it), its
+ * record starting again from now. They go to web->moved (count returned) with web->redo set,
+ * and their xdet is moved to where they are now. -1: every node must be found again (a body
+ * was made since the full detection, or a far body may have come near the web). Until a node
+ * is found again its move relative to a near body stays under half the margin, the distance a
+ * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
+ * node.c. */
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin);
 
+/* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]
+ * is the first of node i or of a later node, start[n] = nc. */
+void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start);
+
 /* Whether the found candidates `fresh` of `nodes` (count of them, in increasing order) are
- * those the committed list `old` holds for them: then it stays as it is. */
-int ws_node_same(const uint32_t *nodes, size_t count, const ws_ncand *old, size_t nold,
+ * those the committed list `old` (indexed by start, ws_node_index) holds for them: then it
+ * stays as it is. */
+int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
                  const ws_ncand *fresh, size_t nfresh);
 
-/* Candidates of the committed list `old` for the nodes not in `nodes` (count of them, in
- * increasing order) and the found ones `fresh` (of those nodes, in that order), merged by node
- * into out; the nodes whose fresh candidates are not those they had into `changed` (room for
- * count; it may be `nodes` itself), in order, *nchanged of them. 0, or -1 when out of memory. */
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, const ws_ncand *old,
-                  size_t nold, const ws_ncand *fresh, size_t nfresh, ws_ncand **out, size_t *n,
-                  size_t *cap, uint32_t *changed, size_t *nchanged);
+/* Candidates of the committed list `old` (indexed by start, of web->n nodes) for the nodes not
+ * in `nodes` (count of them, in increasing order) and the found ones `fresh` (of those nodes,
+ * in that order), merged by node into out, start becoming its index; the nodes whose fresh
+ * candidates are not those they had into `changed` (room for count; it may be `nodes`
+ * itself), in order, *nchanged of them. 0, or -1 when out of memory (start unchanged). */
+int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
+                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
+                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand);

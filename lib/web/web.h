@@ -177,6 +177,22 @@ typedef struct ws_web {
     ws_ncand *fresh; /* candidates of the moved nodes (scratch) */
     size_t nfresh, fresh_cap;
     int refresh;
+    /* The same places in the global frame as the reference body stood at an epoch (its pose
+     * then: epoch_r, epoch_A, epoch_q): xep = epoch_r + epoch_A xdet, which a node's global
+     * position is compared with (ws_node_moved); lever2: the largest |xdet|^2 since the full
+     * detection. */
+    ws_nodes3 xep;
+    m3 epoch_A;
+    v3 epoch_r;
+    qt epoch_q;
+    double lever2;
+    /* Where each node's candidates start in the list last found or merged (n + 1, see
+     * ws_node_index). */
+    size_t *cstart;
+    /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
+     * some node searched since the full detection, ws_node_candidates). */
+    uint8_t *cbody;
+    size_t cbody_cap;
 } ws_web;
 
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */

@@ -202,6 +202,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          w->def.contact_margin, NULL, 0, &web->cand[list],
                                          &web->ncand[list], &web->capcand[list],
                                          &w->stats.narrow_checks);
+                if (!bad)
+                    ws_node_index(web->cand[list], web->ncand[list], web->n, web->cstart);
             } else {
                 bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
                                          w->def.contact_margin, web->moved, (size_t)moved,
@@ -209,16 +211,16 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                                          &w->stats.narrow_checks);
                 /* Mostly the nodes found again have the candidates they had: then the
                  * committed list serves again, uncopied. */
-                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cand[old],
-                                         web->ncand[old], web->fresh, web->nfresh))
+                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cstart, web->cand[old],
+                                         web->fresh, web->nfresh))
                     list = old;
                 else /* web->moved keeps the nodes whose candidates changed: their sweep
                         blocks alone are cut into stretches again */
                     bad = bad ||
-                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->cand[old],
-                                        web->ncand[old], web->fresh, web->nfresh, &web->cand[list],
-                                        &web->ncand[list], &web->capcand[list], web->moved,
-                                        &changed) ||
+                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->n, web->cstart,
+                                        web->cand[old], web->ncand[old], web->fresh, web->nfresh,
+                                        &web->cand[list], &web->ncand[list], &web->capcand[list],
+                                        web->moved, &changed) ||
                           ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
                                                   list, old, web->moved, changed);
             }
@@ -229,6 +231,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
         }
         web->next_list = list;
+        ws_node_prepare(b, cur, &w->node_geom, web);
         /* The list cut into stretches for the evaluation: again whenever it changed (a list
          * that serves again keeps its stretches). */
         if (web->seg_list != list &&
@@ -242,8 +245,21 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         /* The node contact forces this step writes: zero where they were not (the nodes that
          * had contacts when fc[nxt] was last written), room to list every contact of every
          * sub-step. */
-        for (size_t q = 0; q < web->nfct[nxt]; q++)
-            web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
+        {
+            /* Four at a time: a store or two each, the loop's own work shared. */
+            v3 *restrict fc = web->fc[nxt];
+            const uint32_t *restrict t = web->fct[nxt];
+            const size_t nt = web->nfct[nxt];
+            size_t q = 0;
+            for (; q + 4 <= nt; q += 4) {
+                fc[t[q]] = v3_make(0, 0, 0);
+                fc[t[q + 1]] = v3_make(0, 0, 0);
+                fc[t[q + 2]] = v3_make(0, 0, 0);
+                fc[t[q + 3]] = v3_make(0, 0, 0);
+            }
+            for (; q < nt; q++)
+                fc[t[q]] = v3_make(0, 0, 0);
+        }
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
