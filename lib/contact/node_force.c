@@ -100,6 +100,28 @@ static inline double friction_scale(double vps, double mass, double fn, double m
     return -(law < stop ? law : stop) / vps;
 }
 
+/* A contact's load on its body: the opposite of the contact force on the node (friction a plus
+ * the normal force fn along n) times share, and its moment about the CoG at lever l, into
+ * b[0..2] (force) and b[3..5] (moment); zero for a contact that does not push (push: all bits
+ * or none). Adding it leaves every sum as it was then: the bodies' sums start at +0 and never
+ * reach -0, and the moment's zero, of either sign, changes no sum. Both paths (act_friction,
+ * run_kernel) take it from here, so their loads agree to the bit. */
+static inline void body_load(uint64_t push, double ax, double ay, double az, double nx,
+                             double ny, double nz, double fn, double share, double lx, double ly,
+                             double lz, double *bx, double *by, double *bz, double *mx,
+                             double *my, double *mz)
+{
+    const double Bx = pick(push, (ax + nx * fn) * -share, 0.0),
+                 By = pick(push, (ay + ny * fn) * -share, 0.0),
+                 Bz = pick(push, (az + nz * fn) * -share, 0.0);
+    *bx = Bx;
+    *by = By;
+    *bz = Bz;
+    *mx = ly * Bz - lz * By;
+    *my = lz * Bx - lx * Bz;
+    *mz = lx * By - ly * Bx;
+}
+
 /* Whether a node slips (at the predicted speed vps): all bits or none, for pick. */
 static inline uint64_t friction_slips(double vps, double im)
 {
@@ -275,23 +297,13 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
             friction_of(nx, ny, nz, e->tx[l], e->ty[l], e->tz[l], e->kx[l], e->ky[l], e->kz[l],
                         e->im[l], e->m[l], fn, e->mu[l], e->vl[l], h, &fx, &fy, &fz);
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
-             * every value as it was), +0 to the body's (see run_kernel). */
+             * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = 0 - (uint64_t)(fn > 0.0);
             e->ax[l] = pick(push, fx, -0.0);
             e->ay[l] = pick(push, fy, -0.0);
             e->az[l] = pick(push, fz, -0.0);
-            /* The contact force on the node, and the body's share of the opposite: -share
-             * times it, as run_kernel takes it. */
-            const double Bx = pick(push, (fx + nx * fn) * -share, 0.0),
-                         By = pick(push, (fy + ny * fn) * -share, 0.0),
-                         Bz = pick(push, (fz + nz * fn) * -share, 0.0);
-            const double lx = e->lx[l], ly = e->ly[l], lz = e->lz[l];
-            e->bx[l] = Bx;
-            e->by[l] = By;
-            e->bz[l] = Bz;
-            e->mx[l] = ly * Bz - lz * By;
-            e->my[l] = lz * Bx - lx * Bz;
-            e->mz[l] = lx * By - ly * Bx;
+            body_load(push, fx, fy, fz, nx, ny, nz, fn, share, e->lx[l], e->ly[l], e->lz[l],
+                      &e->bx[l], &e->by[l], &e->bz[l], &e->mx[l], &e->my[l], &e->mz[l]);
         }
     }
 }
@@ -779,19 +791,8 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             gx[t] = pick(keep, T->kx[e] + ax, gx[t]);
             gy[t] = pick(keep, T->ky[e] + ay, gy[t]);
             gz[t] = pick(keep, T->kz[e] + az, gz[t]);
-            /* The body's share, zero for a contact that does not push: adding +0 leaves every
-             * sum as it was (sums that start at +0 never reach -0), and so does the moment's
-             * zero, of either sign. */
-            const double Bx = pick(push, (ax + nx * fn) * -share, 0.0),
-                         By = pick(push, (ay + ny * fn) * -share, 0.0),
-                         Bz = pick(push, (az + nz * fn) * -share, 0.0);
-            const double lx = T->lx[e], ly = T->ly[e], lz = T->lz[e];
-            T->bx[e] = Bx;
-            T->by[e] = By;
-            T->bz[e] = Bz;
-            T->mx[e] = ly * Bz - lz * By;
-            T->my[e] = lz * Bx - lx * Bz;
-            T->mz[e] = lx * By - ly * Bx;
+            body_load(push, ax, ay, az, nx, ny, nz, fn, share, T->lx[e], T->ly[e], T->lz[e],
+                      &T->bx[e], &T->by[e], &T->bz[e], &T->mx[e], &T->my[e], &T->mz[e]);
         }
     }
 }
