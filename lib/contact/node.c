@@ -228,6 +228,19 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
 }
 
 
+/* The flags of a group of e nodes (0 or 1, as 64-bit values) narrowed into their bytes of redo;
+ * a group with none (any = 0) is cleared, not narrowed. */
+static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict flag, size_t e,
+                             int any)
+{
+    if (!any) {
+        memset(redo, 0, e);
+        return;
+    }
+    for (size_t i = 0; i < e; i++)
+        redo[i] = (uint8_t)flag[i];
+}
+
 /* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
  * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
  * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
@@ -276,13 +289,7 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
                 count += f;
             }
         }
-        uint8_t *restrict redo = web->redo + i0;
-        if (count == before) {
-            memset(redo, 0, e);
-            continue;
-        }
-        for (size_t i = 0; i < e; i++)
-            redo[i] = (uint8_t)flag[i];
+        put_flags(web->redo + i0, flag, e, count != before);
     }
     return count;
 }
@@ -330,13 +337,7 @@ static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim
                 count += f;
             }
         }
-        uint8_t *restrict redo = web->redo + i0;
-        if (count == before) {
-            memset(redo, 0, e);
-            continue;
-        }
-        for (size_t i = 0; i < e; i++)
-            redo[i] = (uint8_t)flag[i];
+        put_flags(web->redo + i0, flag, e, count != before);
     }
     return count;
 }
