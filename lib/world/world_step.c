@@ -245,21 +245,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         /* The node contact forces this step writes: zero where they were not (the nodes that
          * had contacts when fc[nxt] was last written), room to list every contact of every
          * sub-step. */
-        {
-            /* Four at a time: a store or two each, the loop's own work shared. */
-            v3 *restrict fc = web->fc[nxt];
-            const uint32_t *restrict t = web->fct[nxt];
-            const size_t nt = web->nfct[nxt];
-            size_t q = 0;
-            for (; q + 4 <= nt; q += 4) {
-                fc[t[q]] = v3_make(0, 0, 0);
-                fc[t[q + 1]] = v3_make(0, 0, 0);
-                fc[t[q + 2]] = v3_make(0, 0, 0);
-                fc[t[q + 3]] = v3_make(0, 0, 0);
-            }
-            for (; q < nt; q++)
-                fc[t[q]] = v3_make(0, 0, 0);
-        }
+        for (size_t q = 0; q < web->nfct[nxt]; q++)
+            web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
