@@ -617,6 +617,19 @@ static void probe_web(ws_world *w, const ws_web_def *wd, const double *pos, uint
     ck_ok(w, ws_web_create_mesh(w, wd, &mesh, web));
 }
 
+/* A kinematic body of the shape, standing still at `at`. */
+static ws_body_id still_body(ws_world *w, ws_shape_id shape, ws_vec3 at)
+{
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = shape;
+    bd.position = at;
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    return body;
+}
+
 /* A film node just past the top end of a box's vertical edge, within the layers of the edge's
  * line, while the box rises: the edge's span comes to the node within a few steps, before the
  * node or the box has moved far enough to be found again. It must be an edge candidate from the
@@ -860,12 +873,7 @@ START_TEST(corners_are_marked_by_the_detection)
             ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
         else
             ck_ok(w, create_mesh(w, k == 1 ? cube_v : v, 8, cube_t, 12, &shape));
-        ws_body_def bd;
-        ws_body_def_init(&bd);
-        bd.type = WS_BODY_KINEMATIC;
-        bd.shape = shape;
-        ws_body_id body;
-        ck_ok(w, ws_body_create(w, &bd, &body));
+        still_body(w, shape, (ws_vec3){0, 0, 0});
         ws_web_def wd;
         soft_film(w, &wd);
         const double o = 0.5 + 0.5e-3;
@@ -938,12 +946,7 @@ static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_
         ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &shape));
     ws_shape_info si;
     ck_ok(w, ws_shape_get_info(w, shape, &si));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.type = WS_BODY_KINEMATIC;
-    bd.shape = shape;
-    ws_body_id body;
-    ck_ok(w, ws_body_create(w, &bd, &body));
+    still_body(w, shape, (ws_vec3){0, 0, 0});
     ws_web_def wd;
     soft_film(w, &wd);
     /* The edge in the body's frame, which the shape's centroid is the origin of. */
@@ -1032,15 +1035,8 @@ static ws_world *inner_corner_world(int b_first, ws_web_id *web)
     ws_shape_id cube;
     ck_ok(w, ws_shape_create_box(w, 1.0, 1.0, 1.0, &cube));
     const ws_vec3 at[2] = {{0.0, 0.0, 0.0}, {1.0, 0.0, 1.0}};
-    for (int k = 0; k < 2; k++) {
-        ws_body_def bd;
-        ws_body_def_init(&bd);
-        bd.type = WS_BODY_KINEMATIC;
-        bd.shape = cube;
-        bd.position = at[b_first ? 1 - k : k];
-        ws_body_id body;
-        ck_ok(w, ws_body_create(w, &bd, &body));
-    }
+    for (int k = 0; k < 2; k++)
+        still_body(w, cube, at[b_first ? 1 - k : k]);
     ws_web_def wd;
     soft_film(w, &wd);
     const double pos[6] = {0.5 - 1.99e-3, 0.0, 0.5 + 1.99e-3, 0.5, 3.0, 0.5};

@@ -1720,14 +1720,16 @@ END_TEST
  * 10. Springs with any 1D law: history committed after each step, a failing law reported
  * ====================================================================================== */
 
-/* Two pinned nodes 0.11 m apart joined by one spring of rest length 0.1 m (strain 0.1 held). */
-static ws_web_id held_spring(ws_world *w, ws_law_id law)
+/* Two nodes of 1 g on the x axis, `length` apart, joined by one spring of the law (rest
+ * length *rest, or the length when rest is NULL); the first `pins` of them pinned. */
+static ws_web_id spring_pair(ws_world *w, ws_law_id law, double length, const double *rest,
+                             uint32_t pins)
 {
     ws_web_def wd;
     ws_web_def_init(&wd);
     wd.law = law;
     wd.node_mass = 1e-3;
-    double p[6] = {0, 0, 0, 0.11, 0, 0}, l0 = 0.1;
+    double p[6] = {0, 0, 0, length, 0, 0};
     uint32_t sp[2] = {0, 1}, pin[2] = {0, 1};
     ws_web_mesh_def md;
     ws_web_mesh_def_init(&md);
@@ -1735,12 +1737,19 @@ static ws_web_id held_spring(ws_world *w, ws_law_id law)
     md.node_count = 2;
     md.springs = sp;
     md.spring_count = 1;
-    md.rest_lengths = &l0;
+    md.rest_lengths = rest;
     md.pinned = pin;
-    md.pinned_count = 2;
+    md.pinned_count = pins;
     ws_web_id web;
     ck_ok(w, ws_web_create_mesh(w, &wd, &md, &web));
     return web;
+}
+
+/* Two pinned nodes 0.11 m apart joined by one spring of rest length 0.1 m (strain 0.1 held). */
+static ws_web_id held_spring(ws_world *w, ws_law_id law)
+{
+    const double l0 = 0.1;
+    return spring_pair(w, law, 0.11, &l0, 2);
 }
 
 START_TEST(test_spring_relaxation)
@@ -1833,22 +1842,7 @@ START_TEST(test_runaway_without_a_speed_limit)
     ld.user_fn = kicking_law;
     ws_law_id law;
     ck_ok(w, ws_law_create(w, &ld, &law));
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.law = law;
-    wd.node_mass = 1e-3;
-    double p[6] = {0, 0, 0, 0.1, 0, 0};
-    uint32_t sp[2] = {0, 1}, pin[1] = {0};
-    ws_web_mesh_def md;
-    ws_web_mesh_def_init(&md);
-    md.positions = p;
-    md.node_count = 2;
-    md.springs = sp;
-    md.spring_count = 1;
-    md.pinned = pin;
-    md.pinned_count = 1;
-    ws_web_id web;
-    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &web));
+    ws_web_id web = spring_pair(w, law, 0.1, NULL, 1);
     ws_status s = ws_world_step(w);
     char msg[512];
     snprintf(msg, sizeof msg, "%s", ws_world_last_error(w));
