@@ -117,7 +117,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
 
 /* The same for list `list` merged (ws_node_merge) from list `from`, where only the nodes
  * `nodes` (count of them, in increasing order) have other candidates: when the stretches are
- * those of `from`, only the sweep blocks that hold one of the nodes are cut again. 0, or -1 when
+ * those of `from`, only the blocks (rows) that hold one of the nodes are cut again. 0, or -1 when
  * out of memory. */
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
                             int from, const uint32_t *nodes, size_t count);

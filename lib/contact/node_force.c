@@ -942,13 +942,14 @@ static void seg_close_run(seg_cut *sc)
     sc->r0 = sc->r1;
 }
 
-/* Cut the candidates from k on (of n) whose nodes lie below stop, the start of a sweep block of
- * bl nodes; the index past them. A block's stretches depend on its own candidates alone. */
+/* Cut the candidates from k on (of n) whose nodes lie below stop, the start of a block of bl
+ * nodes (seg_block); the index past them. A block's stretches depend on its own candidates
+ * alone. */
 static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t k, size_t n,
                             uint64_t stop)
 {
     const ws_ncand *cand = sc->cand;
-    uint64_t end = 0; /* the end of the sweep block of the current node, at most stop */
+    uint64_t end = 0; /* the end of the block of the current node, at most stop */
     sc->g0 = sc->r0 = sc->r1 = k;
     while (k < n && cand[k].node < stop) {
         const uint32_t node = cand[k].node;
@@ -994,7 +995,8 @@ static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t 
     return k;
 }
 
-/* The sweep blocks' length: a grid web's rows, else the whole web. */
+/* The length of the blocks stretches are cut in: a grid web's rows (a sweep block holds whole
+ * rows, ws_web_block_count), else the whole web. */
 static uint32_t seg_block(const ws_web *web)
 {
     return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
@@ -1074,11 +1076,11 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
     return seg_done(mem, web, &sc, list);
 }
 
-/* The stretches of the next sweep block, from seg[k] on (the block after the one ending at n1),
- * and the first and last of their candidates, asked of the memory now so that they arrive
- * while the block's springs are evaluated: from one step to the next they leave the caches,
- * and a block reads them in a few places (the first candidate of a run, a one-by-one stretch),
- * each a wait for the memory otherwise. */
+/* The stretches of the next row, from seg[k] on (the first row of the sweep block after the one
+ * ending at n1), and the first and last of their candidates, asked of the memory now so that
+ * they arrive while the block's springs are evaluated: from one step to the next they leave
+ * the caches, and a block reads them in a few places (the first candidate of a run, a
+ * one-by-one stretch), each a wait for the memory otherwise. */
 #if defined(__GNUC__)
 /* Inlined: as a call of its own, GCC takes a function that only prefetches for one without
  * effects, and drops the call. */

@@ -500,9 +500,39 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, cons
     }
 }
 
+/* The rows of a grid web's sweep block: at least WS_WEB_BLOCK_NODES nodes (all of them in a
+ * smaller web). */
+static size_t block_rows(const ws_web *web)
+{
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const size_t r = (WS_WEB_BLOCK_NODES + nx - 1) / nx;
+    return r < ny ? r : ny;
+}
+
 uint32_t ws_web_block_count(const ws_web *web)
 {
-    return web->nx > 0 ? (uint32_t)web->ny : 1u;
+    if (web->nx <= 0 || web->ny <= 0)
+        return 1u;
+    const size_t r = block_rows(web);
+    return (uint32_t)(((size_t)web->ny + r - 1) / r);
+}
+
+/* Row j of a grid web complete: row j + 1 started (base forces, its around-springs), then the
+ * up-springs and shear pairs between the two (row 0 is started by the sweep's first block). */
+static void grid_step(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t j,
+                      const ws_spring_form *P)
+{
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const size_t cols = web->closed ? nx : nx - 1;
+    if (j + 1 >= ny)
+        return;
+    grid_row(web, x, v, g, j + 1, P);
+    if (web->law[WS_SPRING_UP])
+        spring_up(web, x, v, nx * j, cols * ny + nx * j, &P[WS_SPRING_UP]);
+    size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
+    if (shear0 < web->ns)
+        for (size_t s = shear0; s < shear0 + 2 * cols; s++)
+            spring_one(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR]);
 }
 
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, double since,
@@ -528,23 +558,15 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
         *n1 = web->n;
         return;
     }
-    /* Row j is complete once the springs to row j + 1 are in: row j + 1 is started (base
-     * forces, its around-springs), then the up-springs and shear pairs between the two. */
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, j = k;
-    const size_t cols = web->closed ? nx : nx - 1;
-    if (j == 0)
+    /* Row j is complete once the springs to row j + 1 are in (grid_step). */
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
+    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
+    if (j0 == 0)
         grid_row(web, x, v, g, 0, P);
-    if (j + 1 < ny) {
-        grid_row(web, x, v, g, j + 1, P);
-        if (web->law[WS_SPRING_UP])
-            spring_up(web, x, v, nx * j, cols * ny + nx * j, &P[WS_SPRING_UP]);
-        size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
-        if (shear0 < web->ns)
-            for (size_t s = shear0; s < shear0 + 2 * cols; s++)
-                spring_one(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR]);
-    }
-    *n0 = (uint32_t)(nx * j);
-    *n1 = (uint32_t)(nx * (j + 1));
+    for (size_t j = j0; j < j1; j++)
+        grid_step(web, x, v, g, j, P);
+    *n0 = (uint32_t)(nx * j0);
+    *n1 = (uint32_t)(nx * j1);
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when

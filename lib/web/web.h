@@ -28,11 +28,12 @@ typedef struct ws_ncand {
 _Static_assert(3ull * WS_ID_MAX_SLOTS / 2 < WS_NCAND_CORNER, "feature numbers reach the flags");
 #define WS_NCAND_FACES 64           /* the most faces of a body whose candidates get INSIDE */
 
-/* The candidates of a web cut into stretches of nodes, in node order, within one sweep block
- * (ws_web_block_count). A run: nodes [n0, n1), each with exactly one candidate, all of the
- * same face and found well inside it (WS_NCAND_INSIDE); node n0 + k has candidate c0 + k. Runs
- * are evaluated on vectors (contact/node_force.c). Otherwise: candidates [c0, c1), of nodes in
- * [n0, n1), evaluated one by one. */
+/* The candidates of a web cut into stretches of nodes, in node order, within one row of a grid
+ * web (a sweep block holds whole rows, ws_web_block_count), within the web otherwise. A run:
+ * nodes [n0, n1), each with exactly one candidate, all of the same face and found well inside it
+ * (WS_NCAND_INSIDE); node n0 + k has candidate c0 + k. Runs are evaluated on vectors
+ * (contact/node_force.c). Otherwise: candidates [c0, c1), of nodes in [n0, n1), evaluated one by
+ * one. */
 typedef struct ws_nseg {
     uint32_t n0, n1, c0, c1;
     int run;
@@ -66,6 +67,7 @@ static inline void nodes_add(ws_nodes3 a, uint32_t i, v3 p)
 #define WS_WEB_CHUNK 256 /* springs evaluated at once */
 #define WS_WEB_PAD 4     /* doubles of padding after node vectors and rest lengths (web.c) */
 #define WS_WEB_WRAPS 4   /* wrap springs of a closed band evaluated at once */
+#define WS_WEB_BLOCK_NODES 384 /* nodes of a sweep block of a grid web, at least (whole rows) */
 #define WS_WEB_TMP (3 * WS_WEB_CHUNK + 4 * WS_WEB_WRAPS) /* doubles of ws_web.tmp */
 
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
@@ -209,8 +211,9 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 /* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays
  * in cache: block k's forces from the springs, node drag and gravity are complete in f once
  * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
- * their contact forces and be integrated. A grid web's blocks are its rows; a mesh web is one
- * block. Every sweep starts at block 0, which takes the laws at (t, since) for all of it. */
+ * their contact forces and be integrated. A grid web's blocks are whole rows, enough of them
+ * for WS_WEB_BLOCK_NODES nodes; a mesh web is one block. Every sweep starts at block 0, which
+ * takes the laws at (t, since) for all of it. */
 uint32_t ws_web_block_count(const ws_web *web);
 void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
                          double since, uint32_t k, uint32_t *n0, uint32_t *n1);
