@@ -511,8 +511,10 @@ static size_t block_rows(const ws_web *web)
 
 uint32_t ws_web_block_count(const ws_web *web)
 {
-    if (web->nx <= 0 || web->ny <= 0)
-        return 1u;
+    if (web->nx <= 0)
+        return 1u; /* a mesh web */
+    if (web->ny <= 0)
+        return 0u;
     const size_t r = block_rows(web);
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
 }
