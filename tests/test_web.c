@@ -1083,6 +1083,29 @@ END_TEST
  * 7. No energy gain without damping
  * ====================================================================================== */
 
+/* A sheet of nx x ny nodes of 1 g with shear springs, one law for every spring, spacing sp and
+ * pre-stretch pre both ways, nodes pins[0, npins) held; *wd its web Def, for a mesh web of the
+ * same film (copy_sheet). */
+static ws_web_id shear_sheet(ws_world *w, ws_law_id law, int nx, int ny, double sp, double pre,
+                             const uint32_t *pins, size_t npins, ws_web_def *wd)
+{
+    ws_web_def_init(wd);
+    wd->node_mass = 1e-3;
+    wd->law = wd->law_cross = wd->law_shear = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = nx;
+    sd.ny = ny;
+    sd.spacing_x = sd.spacing_y = sp;
+    sd.prestretch_x = sd.prestretch_y = pre;
+    sd.shear = 1;
+    sd.pinned = pins;
+    sd.pinned_count = npins;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, wd, &sd, &web));
+    return web;
+}
+
 static uint64_t lcg_state;
 static double lcg(void) /* uniform in [-1, 1) */
 {
@@ -1095,24 +1118,11 @@ START_TEST(test_energy_no_gain)
     /* A free 5 x 5 sheet with shear springs (spacing 0.05 m, rest lengths of a 10 % pre-stretch,
      * linear elastic EA = 50 N, node mass 1 g), no damping, no gravity, no bodies, every node
      * displaced at random by up to 5 mm in x, y, z (a mesh web with the sheet's springs). */
-    const int nx = 5, ny = 5;
-    const double sp = 0.05, pre = 0.1, EA = 50.0, m = 1e-3;
+    const double EA = 50.0;
     ws_world *w = world_g(1e-4, NO_G);
     ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, EA, 0.0, 0.0, 0.0);
     ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = m;
-    wd.law = law;
-    wd.law_shear = law;
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = nx;
-    sd.ny = ny;
-    sd.spacing_x = sd.spacing_y = sp;
-    sd.prestretch_x = sd.prestretch_y = pre;
-    sd.shear = 1;
-    ws_web_id sheet;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &sheet));
+    ws_web_id sheet = shear_sheet(w, law, 5, 5, 0.05, 0.1, NULL, 0, &wd);
     sheet_copy c = copy_sheet(w, sheet);
     ck_ok(w, ws_web_destroy(w, sheet));
     lcg_state = 12345;
@@ -1182,22 +1192,9 @@ START_TEST(test_sheet_in_blocks_moves_as_its_mesh)
     const double dt = 5e-5;
     ws_world *w = world_g(dt, DOWN_G);
     ws_law_id law = make_law(w, WS_LAW_TENSION_COMPRESSION, 50.0, 0.5, 0.02, 1e-3);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
-    wd.law = wd.law_cross = wd.law_shear = law;
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = nx;
-    sd.ny = ny;
-    sd.spacing_x = sd.spacing_y = 0.02;
-    sd.prestretch_x = sd.prestretch_y = 0.1;
-    sd.shear = 1;
     const uint32_t pins[4] = {0, nx - 1, nx * (ny - 1), nx * ny - 1};
-    sd.pinned = pins;
-    sd.pinned_count = 4;
-    ws_web_id sheet, mesh;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &sheet));
+    ws_web_def wd;
+    ws_web_id mesh, sheet = shear_sheet(w, law, nx, ny, 0.02, 0.1, pins, 4, &wd);
     sheet_copy c = copy_sheet(w, sheet);
     c.md.pinned = pins;
     c.md.pinned_count = 4;
