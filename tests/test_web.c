@@ -1940,6 +1940,129 @@ START_TEST(test_runaway_without_a_speed_limit)
 }
 END_TEST
 
+/* A film-like sheet for the advice tests: 6 x 6 nodes at 10 mm, pre-stretch 0.4 / 0.2, Kelvin-
+ * Voigt springs (EA, c_law), node mass m, its material against the ground's (4000 N/m, 1 kg/s
+ * as the reference case's node-body pair), 10 cm above a static ground so nothing touches. */
+static ws_web_id advice_sheet(ws_world *w, ws_law_id law, ws_material_id film, double m,
+                              int substeps)
+{
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = m;
+    wd.material = film;
+    wd.law = law;
+    wd.substeps = substeps;
+    wd.name = "advice";
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 6;
+    sd.origin = (ws_vec3){0, 0, 0.1};
+    sd.spacing_x = sd.spacing_y = 0.01;
+    sd.prestretch_x = 0.4;
+    sd.prestretch_y = 0.2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    return web;
+}
+
+/* Step once with a web of node mass m and `substeps`; the status, the web destroyed again. */
+static ws_status advice_try(ws_world *w, ws_law_id law, ws_material_id film, double m,
+                            int substeps, char *msg, size_t cap)
+{
+    ws_web_id web = advice_sheet(w, law, film, m, substeps);
+    ws_status s = ws_world_step(w);
+    if (msg)
+        snprintf(msg, cap, "%s", ws_world_last_error(w));
+    ck_ok(w, ws_web_destroy(w, web));
+    return s;
+}
+
+START_TEST(test_advice_at_both_limits)
+{
+    /* The real film's node mass, 1.6 mg, at the default dt h = 0.25 ms. The stable step of
+     * symplectic Euler on m x'' + c x' + k x = 0 is (sqrt(c^2 + 4 m k) - c) / k, so the smallest
+     * stable mass is m* = h^2 k / 4 + h c / 2. The stiffest node is an interior one: Gershgorin
+     * k = 2 (2 EA / l0x + 2 EA / l0y) + k_contact, c = 2 (2 c_law / l0x + 2 c_law / l0y) +
+     * c_contact. With EA = 20 N, c_law = 1e-3 N s, l0x = 0.01 / 1.4, l0y = 0.01 / 1.2, the
+     * contact 4000 N/m and 1 kg/s: k = 23600 N/m, c = 2.04 kg/s, m* = 0.3688 + 0.255 g: the
+     * damping term is 40 % of it, which an advice scaled as for an undamped node misses. */
+    const double h = 2.5e-4, EA = 20.0, cl = 1e-3, m_film = 1.6e-6;
+    const double l0x = 0.01 / 1.4, l0y = 0.01 / 1.2;
+    const double k = 2 * (2 * EA / l0x + 2 * EA / l0y) + 4000.0;
+    const double c = 2 * (2 * cl / l0x + 2 * cl / l0y) + 1.0;
+    const double m_star = h * h * k / 4 + h * c / 2;
+    ws_world *w = world_g(h, DOWN_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, cl, 0.0);
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film, ground;
+    ck_ok(w, ws_material_create(w, &md, &film));
+    ck_ok(w, ws_material_create(w, &md, &ground));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    ck_ok(w, ws_world_set_contact(w, film, ground, &cd));
+    add_ground(w, 1.0, ground);
+
+    char msg[512];
+    ck_assert_int_eq(advice_try(w, law, film, m_film, 1, msg, sizeof msg), WS_ERR_NUMERICAL);
+    report("refusal at 1.6 mg: \"%s\"", msg);
+    const char *pm = strstr(msg, "node mass >= "), *ps = strstr(msg, "substeps >= ");
+    ck_assert_msg(pm && ps, "no advice in: %s", msg);
+    double m_adv = strtod(pm + strlen("node mass >= "), NULL);
+    int n_adv = atoi(ps + strlen("substeps >= "));
+    report("advice: node mass %.6g kg (closed form %.6g kg), substeps %d", m_adv, m_star, n_adv);
+    /* The advice is the closed form rounded up in its 4th digit: within 0.1 % above it. */
+    ck_assert_msg(m_adv >= m_star && m_adv <= 1.001 * m_star, "advised %g kg, bound %g kg", m_adv,
+                  m_star);
+    /* Both limits: the named mass runs, 1 % less is refused (the rounding is below 0.1 %). */
+    ck_assert_int_eq(advice_try(w, law, film, m_adv, 1, NULL, 0), WS_OK);
+    ck_assert_int_eq(advice_try(w, law, film, 0.99 * m_adv, 1, NULL, 0), WS_ERR_NUMERICAL);
+    /* Sub-steps: the named count runs at 1.6 mg, one fewer is refused. */
+    ck_assert_int_ge(n_adv, 2);
+    ck_assert_int_eq(advice_try(w, law, film, m_film, n_adv, NULL, 0), WS_OK);
+    ck_assert_int_eq(advice_try(w, law, film, m_film, n_adv - 1, msg, sizeof msg),
+                     WS_ERR_NUMERICAL);
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_advice_bounded)
+{
+    /* A pre-stretch beyond WS_WEB_MAX_PRESTRETCH (10) is refused, naming the limit. */
+    ws_world *w = world_g(2.5e-4, DOWN_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 100.0, 0.0, 0.0, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 3;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    sd.prestretch_x = 1e12;
+    ws_web_id web;
+    ck_assert_int_eq(ws_web_create_sheet(w, &wd, &sd, &web), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "<= 10"), "%s", ws_world_last_error(w));
+    sd.prestretch_x = 10.0; /* the limit itself is allowed */
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    ck_ok(w, ws_web_destroy(w, web));
+    /* A mesh web can still have rest lengths that make the stable step about 0: 1e-200 m gives
+     * k = 2 EA / l0 = 2e202 N/m on 1 g, a stable step of 4.5e-103 s. The advice must say that
+     * no number of sub-steps within the limit helps, with no overflowed count, and no mass. */
+    ws_web_id chain = make_chain(w, &wd, 2, 0.01, 1e-200, NULL, NULL, NULL, 0);
+    ck_assert_int_eq(ws_world_step(w), WS_ERR_NUMERICAL);
+    const char *msg = ws_world_last_error(w);
+    report("rest length 1e-200 m: \"%s\"", msg);
+    ck_assert_msg(strstr(msg, "more than the limit of 100000") &&
+                      !strstr(msg, "substeps >=") && !strstr(msg, "-2147483648"),
+                  "%s", msg);
+    ck_ok(w, ws_web_destroy(w, chain));
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(test_spring_user_law_and_failure)
 {
     /* A spring of a user law gives the user's force; when the callback fails the step fails
@@ -2021,5 +2144,7 @@ int main(void)
     add_case(s, "bulk_copies", test_bulk_copies, 10);
     add_case(s, "spring_relaxation", test_spring_relaxation, 10);
     add_case(s, "spring_user_law_and_failure", test_spring_user_law_and_failure, 10);
+    add_case(s, "advice_at_both_limits", test_advice_at_both_limits, 10);
+    add_case(s, "advice_bounded", test_advice_bounded, 10);
     return run_suite(s);
 }

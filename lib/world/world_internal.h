@@ -115,6 +115,8 @@ int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, 
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
+/* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */
+double ws_world_web_mass_for(ws_world *w, const ws_web *web, double h);
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
 
 /* Copy a caller's Def (of the size it says) over a default one; WS_ERR_UNINITIALIZED_DEF or

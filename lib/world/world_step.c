@@ -12,6 +12,7 @@
 
 #include <float.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -98,26 +99,60 @@ static const char *web_label(const ws_web *web)
     return web->name ? web->name : "(unnamed)";
 }
 
-/* What would make a web stable at sub-step h: sub-steps for the world's dt, or node mass. */
+/* x rounded up to 4 significant digits so that the number as printed (%.4g) and read back is
+ * still >= x: advice that, taken literally, works. */
+static double round_up_4(double x)
+{
+    if (!(x > 0.0 && x < 1e300))
+        return x;
+    double p = pow(10.0, floor(log10(x)) - 3.0);
+    for (double y = ceil(x / p) * p;; y += p) {
+        char txt[32];
+        snprintf(txt, sizeof txt, "%.4g", y);
+        if (strtod(txt, NULL) >= x)
+            return strtod(txt, NULL);
+    }
+}
+
+/* What would make a web stable at sub-step h: sub-steps for the world's dt, or node mass, both
+ * from the bound the check uses (h <= stable), so that the advice taken as given is accepted
+ * and a little less is not. */
 static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double stable,
                               const char *what)
 {
     double mmin, kmax;
     w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
-    double r = h / stable;
-    int need = (int)ceil(w->def.dt / stable);
-    if (r <= 1.0) /* ran away though stable as its laws state them: sub-steps would not help */
+    if (h <= stable) /* ran away though stable as its laws state them: sub-steps would not help */
         return ws_fail(w, WS_ERR_NUMERICAL,
                        "web '%s': %s, though dt/substeps = %.3g s is within its stable step "
                        "%.3g s: a spring law stiffer or stronger than it states (a user or "
                        "table law), or a body that hits the film too fast. Try a smaller dt.",
                        web_label(web), what, h, stable);
+    /* Sub-steps: dt / n <= stable. The quotient is bounded before it becomes an int (a stable
+     * step of about 0 would overflow it). */
+    char sub[192], mass[128];
+    double q = w->def.dt / stable;
+    if (q <= (double)WS_WEB_MAX_SUBSTEPS) {
+        int n = (int)ceil(q);
+        n += w->def.dt / n > stable; /* the division rounded the wrong way */
+        snprintf(sub, sizeof sub, "Use substeps >= %d (ws_web_set_substeps), or", n);
+    } else {
+        snprintf(sub, sizeof sub,
+                 "Sub-steps cannot help (it would take more than the limit of %d: dt / stable "
+                 "step = %.3g); use a softer or less pre-stretched film, or",
+                 WS_WEB_MAX_SUBSTEPS, q);
+    }
+    /* Node mass: the check's own bound inverted (ws_web_mass_for_step), at this sub-step. */
+    double m = round_up_4(ws_world_web_mass_for(w, web, h) * (1.0 + 1e-9)); /* past round-off */
+    if (m > 0.0 && m < 1e300)
+        snprintf(mass, sizeof mass, "node mass >= %.4g kg (every free node)", m);
+    else
+        snprintf(mass, sizeof mass, "a node mass (none is large enough: %.3g kg)", m);
     return ws_fail(w, WS_ERR_NUMERICAL,
                    "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
-                   "(smallest node mass %.3g kg). Use substeps >= %d (ws_web_set_substeps), or "
-                   "node mass >= %.3g kg, or a smaller dt.",
-                   web_label(web), what, h, stable, mmin, need, mmin * fmax(r * r, r));
+                   "(smallest node mass %.3g kg). %s %s, or a smaller dt.",
+                   web_label(web), what, h, stable, mmin, sub, mass);
 }
 
 /* Every web before the step: stable for its sub-step, and room for per-body forces. */
@@ -152,7 +187,7 @@ static ws_status webs_ready(ws_world *w)
         }
         if (w->web_check) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
-            if (h > stable)
+            if (!(h <= stable)) /* NaN refuses too */
                 return web_unstable(w, web, h, stable, "refused before the step");
         }
     }
