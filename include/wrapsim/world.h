@@ -130,7 +130,11 @@ WS_API ws_status ws_world_create(const ws_world_def *def, ws_world **out);
 WS_API void ws_world_destroy(ws_world *world);
 
 /** Advance one step dt. On WS_ERR_NUMERICAL (or a callback error) the world is left exactly as it
- *  was before the call and ws_world_last_error() says which body and what to change. */
+ *  was before the call and ws_world_last_error() says which body and what to change.
+ *  WS_ERR_NUMERICAL: a dt above the bodies' contact stable step (refused before the step), a
+ *  web's sub-step above its stable step, NaN or inf, a speed above max_speed, or runaway energy
+ *  (the bodies' kinetic energy growing in a step by more than the loads' work plus ten times
+ *  the kinetic and contact energy at its start). */
 WS_API ws_status ws_world_step(ws_world *world);
 /** Take up to `steps` steps, stopping at the first error. */
 WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);
@@ -158,10 +162,11 @@ WS_API const char *ws_world_last_error(const ws_world *world);
 WS_API void *ws_world_get_user_data(const ws_world *world);
 
 /** Estimate the largest stable dt (s) for the bodies and contact pairs now in the world: the
- *  explicit limit 2/omega of the stiffest contact on the lightest body, with a safety factor for
- *  several simultaneous contacts (see docs/theory.md), and of the deformable elements on the
- *  bodies they join (docs/elements.md). Films are not counted here: each web has its own
- *  sub-step limit, ws_web_get_stable_dt(). */
+ *  explicit limit 2/omega of each pair of materials that bodies have, on the lightest such
+ *  pair's effective mass, counting 8 simultaneous contacts (see docs/theory.md), and of the
+ *  deformable elements on the bodies they join (docs/elements.md). ws_world_step refuses a dt
+ *  above the contact part of it (WS_ERR_NUMERICAL, naming the pair and the fix). Films are not
+ *  counted here: each web has its own sub-step limit, ws_web_get_stable_dt(). */
 WS_API ws_status ws_world_estimate_stable_dt(const ws_world *world, double *dt);
 
 /** The material every body has unless its Def names another. */

@@ -39,6 +39,7 @@ typedef struct ws_contact_rec {
     uint32_t a, b, kind, slipping;
     v3 x, n, ft, vt;
     double overlap, fn, energy;
+    double energy_t; /* the stick anchor spring's, J (0 for the regularised law) */
 } ws_contact_rec;
 
 /* Contact parameters resolved for evaluation. */

@@ -36,6 +36,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     double vts = v3_norm(vt);
     v3 ft = v3_make(0, 0, 0);
     int slipping = 0;
+    double energy_t = 0.0;
     if (pp->model == WS_FRICTION_REGULARIZED) {
         /* eq. 13 with p(s) = 2s - s^2: below v_lim, F = -mu N (2 - s) vt / v_lim, which is smooth
          * and needs no division by |vt| at rest. */
@@ -67,7 +68,9 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
             v3 xa_new = v3_sub(xb, dt_new);
             c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
             slipping = 1;
+            dt = dt_new;
         }
+        energy_t = 0.5 * pp->kt * v3_norm2(dt);
     }
     v3 F = v3_add(v3_scale(n, fn), ft);
     apply(b, x->cur, ib, xg, F);
@@ -83,6 +86,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     rec->overlap = overlap;
     rec->fn = fn;
     rec->energy = 0.5 * pp->k * overlap * overlap;
+    rec->energy_t = energy_t;
     return 1;
 }
 

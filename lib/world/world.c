@@ -218,6 +218,8 @@ void ws_world_destroy(ws_world *w)
     ws_slots_destroy(m, &w->mat_slots);
     ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);
     ws_mem_free(m, w->pair_index, w->pair_dim * w->pair_dim * sizeof *w->pair_index);
+    ws_mem_free(m, w->mat_mass, w->pair_dim * sizeof *w->mat_mass);
+    ws_mem_free(m, w->guard_f, 2 * w->guard_cap * sizeof *w->guard_f); /* guard_m is in it */
     for (int k = 0; k < 2; k++) {
         ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
         ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
@@ -363,10 +365,15 @@ static ws_status create_material(ws_world *w, const char *name, ws_material_id *
         while (dim < slot + 1)
             dim *= 2;
         uint32_t *pi = ws_mem_calloc(&w->mem, dim * dim, sizeof *pi);
-        if (!pi) {
+        ws_mat_mass *mm = pi ? ws_mem_realloc(&w->mem, w->mat_mass, w->pair_dim * sizeof *mm,
+                                              dim * sizeof *mm)
+                             : NULL;
+        if (!mm) {
+            ws_mem_free(&w->mem, pi, dim * dim * sizeof *pi);
             ws_slots_release(&w->mat_slots, slot);
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
         }
+        w->mat_mass = mm;
         for (size_t a = 0; a < w->pair_dim; a++)
             for (size_t b = 0; b < w->pair_dim; b++)
                 pi[a * dim + b] = w->pair_index[a * w->pair_dim + b];
@@ -492,26 +499,78 @@ ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
     return WS_OK;
 }
 
-double ws_world_stable_dt(const ws_world *w)
+double ws_contact_stable_dt(double k, double c, double m_eff)
 {
-    /* Explicit limit 2/omega for a mass on several penalty springs: omega^2 = n k / m with n = 8
-     * simultaneous contacts (a box face on another: 4 corners each way), reduced by damping:
-     * dt < 2/omega (sqrt(1 + z^2) - z), z = n c / (2 m omega). */
+    /* Explicit limit 2/omega for a mass on several penalty springs: omega^2 = n k / m with n
+     * simultaneous contacts, reduced by damping: dt < 2/omega (sqrt(1 + z^2) - z), z = n c /
+     * (2 m omega); in closed form (sqrt(C^2 + 4 m K) - C) / K with K = n k, C = n c. */
+    double K = WS_CONTACTS_PER_BODY * k, C = WS_CONTACTS_PER_BODY * c;
+    if (!(K > 0.0))
+        return INFINITY;
+    return (sqrt(C * C + 4.0 * m_eff * K) - C) / K;
+}
+
+/* Effective mass of a pair of bodies (a kinematic or absent one counts as infinite). */
+static double pair_mass(const ws_body_store *b, uint32_t i, uint32_t j)
+{
+    double inv = (i == UINT32_MAX ? 0.0 : b->inv_mass[i]) + (j == UINT32_MAX ? 0.0 : b->inv_mass[j]);
+    return 1.0 / inv;
+}
+
+void ws_world_contact_limit(const ws_world *w, ws_contact_limit *lim)
+{
+    /* Every pair of materials that two bodies now in the world have, at its lightest: the two
+     * lightest dynamic bodies of each material, or a dynamic body against a kinematic one.
+     * The stiffness is the larger of the normal and (stick model) tangential springs, the
+     * damping likewise: either direction can run away. */
     const ws_body_store *b = &w->bodies;
-    double best = INFINITY;
-    for (size_t i = 0; i < b->slots; i++) {
-        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+    ws_mat_mass *mm = ((ws_world *)w)->mat_mass; /* scratch, not state */
+    const uint32_t none = UINT32_MAX;
+    for (size_t a = 0; a < w->pair_dim; a++)
+        mm[a].light[0] = mm[a].light[1] = mm[a].kinematic = none;
+    for (uint32_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
             continue;
-        for (size_t p = 0; p < w->nparams; p++) {
-            const ws_pair_params *pp = &w->params[p];
-            double n = 8.0, om = sqrt(n * pp->k / b->mass[i]);
-            double z = n * pp->c / (2.0 * b->mass[i] * om);
-            double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
-            if (dt < best)
-                best = dt;
+        ws_mat_mass *e = &mm[b->material[i]];
+        if (b->type[i] != WS_BODY_DYNAMIC) {
+            e->kinematic = i;
+        } else if (e->light[0] == none || b->mass[i] < b->mass[e->light[0]]) {
+            e->light[1] = e->light[0];
+            e->light[0] = i;
+        } else if (e->light[1] == none || b->mass[i] < b->mass[e->light[1]]) {
+            e->light[1] = i;
         }
     }
-    return fmin(best, ws_world_element_stable_dt(w)); /* the elements' springs too */
+    *lim = (ws_contact_limit){INFINITY, 0, 0, 0, 0, 0, none, none};
+    for (uint32_t ma = 0; ma < w->pair_dim; ma++) {
+        uint32_t i = mm[ma].light[0];
+        if (i == none)
+            continue; /* a pair needs a dynamic body on one side */
+        for (uint32_t mb = 0; mb < w->pair_dim; mb++) {
+            /* The partner: the lightest dynamic body of mb (the second lightest when it is the
+             * same material), else a kinematic one. */
+            uint32_t j = mb == ma ? mm[mb].light[1] : mm[mb].light[0];
+            if (j == none)
+                j = mm[mb].kinematic;
+            if (j == none)
+                continue;
+            const ws_pair_params *p = &w->params[w->pair_index[ma * w->pair_dim + mb]];
+            int stick = p->model == WS_FRICTION_STICK;
+            double k = stick ? fmax(p->k, p->kt) : p->k;
+            double c = stick ? fmax(p->c, p->ct) : p->c;
+            double m = pair_mass(b, i, b->type[j] == WS_BODY_DYNAMIC ? j : none);
+            double dt = ws_contact_stable_dt(k, c, m);
+            if (dt < lim->dt)
+                *lim = (ws_contact_limit){dt, k, c, m, ma, mb, i, j};
+        }
+    }
+}
+
+double ws_world_stable_dt(const ws_world *w)
+{
+    ws_contact_limit lim;
+    ws_world_contact_limit(w, &lim);
+    return fmin(lim.dt, ws_world_element_stable_dt(w)); /* the elements' springs too */
 }
 
 ws_status ws_world_estimate_stable_dt(const ws_world *w, double *dt)
