@@ -293,7 +293,7 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 }
 
 /* Gross slip of body b on its support: every contact between them slips (tangential speed at
- * or above v_lim under the regularised law, anchor sliding under the stick law), and they slip
+ * or above v_lim under the regularised law, the anchor at its cap under the stick law), and they slip
  * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
  * support, as when the platform starts to tilt, slips at every corner but is not sliding. */
 static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *buf, size_t n)
@@ -311,7 +311,7 @@ static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *bu
             sz += sg * v->z;
             size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
             count++;
-            slipping += c->slipping != 0;
+            slipping += c->slipping != 0 || c->at_cap != 0; /* stick: saturated */
         }
     }
     return count > 0 && slipping == count && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;

@@ -1000,6 +1000,79 @@ START_TEST(test_energy_guard_without_speed_limit)
 }
 END_TEST
 
+/* A stack of two 0.25 m, 5 kg cubes on a plane tilting at 0.1 rad/s from t = 1 s (ramp
+ * 0.05 s), stick friction mu = 0.3 with the given absolute tangential damping (0: the default
+ * ratio), run until theta = 0.9 atan(mu) (15.0 deg). Out: the most contacts flagged slipping in
+ * a step, and the largest swing of the top box's support force about m g cos(theta) once the
+ * tilt has started, N. */
+static void tilting_stack(double stick_damping, int *most_slipping, double *swing, int *capped)
+{
+    const double a = 0.25, m = 5.0, dt = 2.5e-4, rate = 0.1, t0 = 1.0;
+    ws_contact_def cd = contact_params(2e5, 10.0, 0.3, WS_FRICTION_STICK);
+    cd.stick_damping = stick_damping;
+    ws_world *w = contact_world(dt, &cd);
+    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
+                                v3(0, 0, 0), "plane");
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_TILT;
+    dd.axis = v3(0, 1, 0);
+    dd.rate = rate;
+    dd.start_time = t0;
+    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    double gap = 2 * DELTA - m * G0 / (4 * 2e5);
+    make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID, v3(0, 0, 0), "bottom");
+    ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 2 * gap), Q_ID,
+                              v3(0, 0, 0), "top");
+    const double theta_end = 0.9 * atan(0.3);
+    const long steps = lround((t0 + theta_end / rate) / dt);
+    ws_contact_info buf[64];
+    *most_slipping = *capped = 0;
+    *swing = 0.0;
+    for (long k = 1; k <= steps; k++) {
+        ck_ok(w, ws_world_step(w));
+        size_t n;
+        ck_ok(w, ws_world_copy_contacts(w, buf, 64, &n));
+        int sl = 0;
+        double fn_top = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            sl += buf[i].slipping != 0;
+            *capped += buf[i].at_cap != 0;
+            if (buf[i].body_b.bits == top.bits || buf[i].body_a.bits == top.bits)
+                fn_top += buf[i].normal_force;
+        }
+        double t = k * dt, theta = t > t0 ? rate * (t - t0) : 0.0;
+        *most_slipping = sl > *most_slipping ? sl : *most_slipping;
+        if (t > t0) /* the stack settled on its layers; from the tilt's start */
+            *swing = fmax(*swing, fabs(fn_top - m * G0 * cos(theta)));
+    }
+    ws_world_destroy(w);
+}
+
+START_TEST(test_stick_stack_settles_on_tilt)
+{
+    /* Below the onset tan(theta) = mu nothing slides: no contact may flag slipping (sliding,
+     * the anchor moving with a slip of v_lim or more), though the friction may touch its cap
+     * for a step (at_cap, counted and reported). Before slipping and at_cap were told apart,
+     * every capped step flagged slipping. Not asserted: the rocking. The top box's support
+     * force swings by up to 18 N about m g cos(theta) after the tilt starts, with the default
+     * damping as with the old 10 kg/s (measured, reported below): the default damping ratio
+     * does not settle this stack (see CHANGELOG, Known limits). */
+    int most, capped;
+    double swing;
+    tilting_stack(0.0, &most, &swing, &capped);
+    report("stick stack, default damping: most slipping %d, capped %d, support swing %.3g N",
+           most, capped, swing);
+    ck_assert_int_eq(most, 0);
+    int most10, capped10;
+    double swing10;
+    tilting_stack(10.0, &most10, &swing10, &capped10);
+    report("stick stack, 10 kg/s: most slipping %d, capped %d, support swing %.3g N", most10,
+           capped10, swing10);
+    ck_assert_int_eq(most10, 0);
+}
+END_TEST
+
 static Suite *contact_suite(void)
 {
     Suite *s = suite_create("contact");
@@ -1038,6 +1111,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_stiff_contact_refused_with_advice);
     tcase_add_test(tc, test_stiff_but_stable_runs);
     tcase_add_test(tc, test_energy_guard_without_speed_limit);
+    tcase_add_test(tc, test_stick_stack_settles_on_tilt);
     suite_add_tcase(s, tc);
     return s;
 }

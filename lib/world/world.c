@@ -78,7 +78,8 @@ void ws_contact_def_init(ws_contact_def *def)
     def->friction_vlim = 0.01;
     def->friction_model = WS_FRICTION_REGULARIZED;
     def->stick_stiffness = 2e5;
-    def->stick_damping = 10.0;
+    def->stick_damping = 0.0; /* from the ratio */
+    def->stick_damping_ratio = 0.5;
 }
 
 void ws_material_def_init(ws_material_def *def)
@@ -108,13 +109,18 @@ static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)
         !(isfinite(c->stick_damping) && c->stick_damping >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "contact: stick_stiffness must be > 0 N/m and stick_damping >= 0 kg/s");
+    if (!(c->stick_damping_ratio >= 0.0 && c->stick_damping_ratio <= 10.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "contact: stick_damping_ratio must be 0..10 (of critical), got %g",
+                       c->stick_damping_ratio);
     return WS_OK;
 }
 
 static ws_pair_params to_params(const ws_contact_def *c)
 {
-    ws_pair_params p = {c->stiffness, c->damping,       c->friction,     c->friction_vlim,
-                        c->stick_stiffness, c->stick_damping, (int)c->friction_model};
+    ws_pair_params p = {c->stiffness,       c->damping,       c->friction,
+                        c->friction_vlim,   c->stick_stiffness, c->stick_damping,
+                        (int)c->friction_model, c->stick_damping_ratio};
     return p;
 }
 
@@ -128,6 +134,7 @@ static ws_contact_def from_params(const ws_pair_params *p)
     c.friction_vlim = p->vlim;
     c.stick_stiffness = p->kt;
     c.stick_damping = p->ct;
+    c.stick_damping_ratio = p->zt;
     c.friction_model = (ws_friction_model)p->model;
     return c;
 }
@@ -557,8 +564,8 @@ void ws_world_contact_limit(const ws_world *w, ws_contact_limit *lim)
             const ws_pair_params *p = &w->params[w->pair_index[ma * w->pair_dim + mb]];
             int stick = p->model == WS_FRICTION_STICK;
             double k = stick ? fmax(p->k, p->kt) : p->k;
-            double c = stick ? fmax(p->c, p->ct) : p->c;
             double m = pair_mass(b, i, b->type[j] == WS_BODY_DYNAMIC ? j : none);
+            double c = stick ? fmax(p->c, ws_stick_damping(p, m)) : p->c;
             double dt = ws_contact_stable_dt(k, c, m);
             if (dt < lim->dt)
                 *lim = (ws_contact_limit){dt, k, c, m, ma, mb, i, j};

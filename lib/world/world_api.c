@@ -651,6 +651,9 @@ ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t
         o->slip_velocity = c->vt;
         o->kind = (int32_t)c->kind;
         o->slipping = (int32_t)c->slipping;
+        o->at_cap = (int32_t)c->at_cap;
+        o->reserved_ = 0;
+        o->anchor_deflection = c->defl;
     }
     if (buf && cap < n)
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,

@@ -140,6 +140,7 @@ class ContactDef(Structure):
         ("friction_model", c_enum),
         ("stick_stiffness", c_double),
         ("stick_damping", c_double),
+        ("stick_damping_ratio", c_double),
     ]
 
 
@@ -254,6 +255,9 @@ class ContactInfo(Structure):
         ("slip_velocity", Vec3),
         ("kind", c_int32),
         ("slipping", c_int32),
+        ("at_cap", c_int32),
+        ("reserved_", c_int32),
+        ("anchor_deflection", Vec3),
     ]
 
 
