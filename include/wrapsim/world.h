@@ -76,14 +76,15 @@ typedef struct ws_contact_def {
     double friction_vlim; /**< regularisation speed v_lim, m/s (> 0); default 0.01 */
     ws_friction_model friction_model; /**< default WS_FRICTION_REGULARIZED */
     double stick_stiffness; /**< tangential spring of the stick model, N/m; default 2e5 */
-    /** Tangential damping of the stick model, kg/s per contact point, when > 0 (0.x releases
-     *  before then defaulted to 10, about 1 % of critical for 5 kg boxes: set 10 to reproduce
+    /** Tangential damping of the stick model, kg/s per contact point, when > 0 (releases
+     *  up to 0.1.0 defaulted to 10, about 1 % of critical for 5 kg boxes: set 10 to reproduce
      *  them). Default 0: from stick_damping_ratio. */
     double stick_damping;
     /** With stick_damping 0: the tangential damping as a fraction of critical for the pair,
      *  c = ratio sqrt(stick_stiffness m), m = m_a m_b / (m_a + m_b) of the two bodies (the
      *  dynamic one's mass against a kinematic body): critical for one of the 4 corner contacts
-     *  of a box face carrying a quarter of m is 2 sqrt(k m / 4). Default 0.5; >= 0, <= 10. */
+     *  of a box face carrying a quarter of m is 2 sqrt(k m / 4). Default 1 (critical for a box
+     *  swaying on its 4 corners); >= 0, <= 10. */
     double stick_damping_ratio;
 } ws_contact_def;
 

@@ -79,7 +79,7 @@ void ws_contact_def_init(ws_contact_def *def)
     def->friction_model = WS_FRICTION_REGULARIZED;
     def->stick_stiffness = 2e5;
     def->stick_damping = 0.0; /* from the ratio */
-    def->stick_damping_ratio = 0.5;
+    def->stick_damping_ratio = 1.0;
 }
 
 void ws_material_def_init(ws_material_def *def)
