@@ -295,7 +295,7 @@ static void report(scene *sc, double peak_run)
 int main(int argc, char **argv)
 {
     double duration = 1.0, film_mass = 1e-3;
-    int substeps = 1, quiet = 0;
+    int substeps = 2, quiet = 0; /* 1 g nodes: 0.35 of the stable sub-step (factor 0.5) */
     const char *vtk_dir = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--duration") && i + 1 < argc) {

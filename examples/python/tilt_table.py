@@ -50,7 +50,7 @@ T_SLIDE = TILT_START + math.atan(0.3) / TILT_RATE              # 3.915 s
 T_TIP = TILT_START + math.atan(0.125 / 0.23) / TILT_RATE       # 5.978 s
 
 
-def build(variant, wrapped, film_mass=1e-3, substeps=1):
+def build(variant, wrapped, film_mass=1e-3, substeps=2):
     """The scene of examples/tilt_table.c (tilt_build + tilt_wrap). Returns a dict."""
     w = ws.World(dt=DT, full_detection_until=0.5, detection_interval=5)
     box_mat, plane_mat = w.material("cardboard"), w.material("platform")

@@ -54,6 +54,11 @@ typedef struct ws_world_def {
     ws_log_fn log;          /**< optional log hook; NULL for none */
     void *log_user;         /**< passed to log */
     void *user_data;        /**< yours; see ws_world_get_user_data() */
+    /** Safety factor of the film's stable-step check: a web runs only while dt / substeps <=
+     *  stable_fraction x its stable sub-step (ws_web_get_stable_dt), the bound's margin against
+     *  what it does not see (a film crumpling, nodes sliding off edges, laws stiffer than they
+     *  state). 0 < it <= 1; default 0.5 (docs/theory.md, section 8). */
+    double stable_fraction;
 } ws_world_def;
 
 /** Friction laws for a pair of materials. */
@@ -114,7 +119,13 @@ typedef struct ws_world_stats {
     double seconds_contacts;   /**< evaluating body-body contacts */
     double seconds_web;        /**< film: springs, node contacts, node integration */
     double seconds_total;      /**< whole steps */
-    uint64_t reserved[4];      /**< zero; room to grow */
+    /** The largest fraction of a web's stable sub-step that dt / substeps uses (0 without
+     *  webs); a web runs while it is <= ws_world_def.stable_fraction. */
+    double web_step_use;
+    /** dt as a fraction of the bodies' contact stable step (ws_world_estimate_stable_dt without
+     *  the elements; 0 when no two bodies can touch); refused above 1. */
+    double body_step_use;
+    uint64_t reserved[2];      /**< zero; room to grow */
 } ws_world_stats;
 
 /** Mechanical energy of the dynamic bodies, J. */

@@ -66,6 +66,7 @@ void ws_world_def_init(ws_world_def *def)
     def->max_speed = 1000.0;
     def->max_angular_speed = 1e5;
     def->use_ccd = 1;
+    def->stable_fraction = 0.5;
 }
 
 void ws_contact_def_init(ws_contact_def *def)
@@ -155,6 +156,7 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         !(isfinite(d.full_detection_until)) || d.detection_interval < 1 ||
         !(isfinite(d.contact_margin) && d.contact_margin >= 0.0) ||
         !(d.max_speed > 0.0) || !(d.max_angular_speed > 0.0) ||
+        !(d.stable_fraction > 0.0 && d.stable_fraction <= 1.0) ||
         (d.integrator != WS_INTEGRATOR_SYMPLECTIC_EULER &&
          d.integrator != WS_INTEGRATOR_PAPER_EXPLICIT))
         return WS_ERR_INVALID_ARGUMENT;
@@ -294,6 +296,18 @@ ws_status ws_world_get_stats(const ws_world *w, ws_world_stats *s)
     s->steps = w->steps;
     s->contacts = w->nrec[w->cur];
     s->candidates = w->ncand[w->cur];
+    /* The margins now (the bounds are asked of scratch, not state: no step is running). */
+    s->web_step_use = 0.0;
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        const ws_web *web = w->webs[k];
+        double use = w->def.dt / web->substeps / ws_world_web_stable_dt((ws_world *)w, web);
+        s->web_step_use = use > s->web_step_use ? use : s->web_step_use;
+    }
+    ws_contact_limit lim;
+    ws_world_contact_limit(w, &lim);
+    s->body_step_use = w->def.dt / lim.dt;
     s->bytes_in_use = w->mem.in_use;
     s->bytes_peak = w->mem.peak;
     s->bodies = w->bodies.alive_count;

@@ -120,22 +120,23 @@ static double round_up_4(double x)
 static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double stable,
                               const char *what)
 {
-    double mmin, kmax;
+    double mmin, kmax, f = w->def.stable_fraction;
     w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
-    if (h <= stable) /* ran away though stable as its laws state them: sub-steps would not help */
+    double allowed = f * stable; /* what the check lets dt/substeps use */
+    if (h <= allowed) /* ran away though stable as its laws state them: sub-steps would not help */
         return ws_fail(w, WS_ERR_NUMERICAL,
-                       "web '%s': %s, though dt/substeps = %.3g s is within its stable step "
-                       "%.3g s: a spring law stiffer or stronger than it states (a user or "
+                       "web '%s': %s, though dt/substeps = %.3g s is within %g of its stable "
+                       "step %.3g s: a spring law stiffer or stronger than it states (a user or "
                        "table law), or a body that hits the film too fast. Try a smaller dt.",
-                       web_label(web), what, h, stable);
-    /* Sub-steps: dt / n <= stable. The quotient is bounded before it becomes an int (a stable
+                       web_label(web), what, h, f, stable);
+    /* Sub-steps: dt / n <= allowed. The quotient is bounded before it becomes an int (a stable
      * step of about 0 would overflow it). */
     char sub[192], mass[128];
-    double q = w->def.dt / stable;
+    double q = w->def.dt / allowed;
     if (q <= (double)WS_WEB_MAX_SUBSTEPS) {
         int n = (int)ceil(q);
-        n += w->def.dt / n > stable; /* the division rounded the wrong way */
+        n += w->def.dt / n > allowed; /* the division rounded the wrong way */
         snprintf(sub, sizeof sub, "Use substeps >= %d (ws_web_set_substeps), or", n);
     } else {
         snprintf(sub, sizeof sub,
@@ -143,16 +144,18 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
                  "step = %.3g); use a softer or less pre-stretched film, or",
                  WS_WEB_MAX_SUBSTEPS, q);
     }
-    /* Node mass: the check's own bound inverted (ws_web_mass_for_step), at this sub-step. */
-    double m = round_up_4(ws_world_web_mass_for(w, web, h) * (1.0 + 1e-9)); /* past round-off */
+    /* Node mass: the check's own bound inverted (ws_web_mass_for_step): a stable sub-step of
+     * h / f. */
+    double m = round_up_4(ws_world_web_mass_for(w, web, h / f) * (1.0 + 1e-9)); /* round-off */
     if (m > 0.0 && m < 1e300)
         snprintf(mass, sizeof mass, "node mass >= %.4g kg (every free node)", m);
     else
         snprintf(mass, sizeof mass, "a node mass (none is large enough: %.3g kg)", m);
     return ws_fail(w, WS_ERR_NUMERICAL,
-                   "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
-                   "(smallest node mass %.3g kg). %s %s, or a smaller dt.",
-                   web_label(web), what, h, stable, mmin, sub, mass);
+                   "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s, "
+                   "of which it may use %g (stable_fraction): %.3g s (smallest node mass %.3g "
+                   "kg). %s %s, or a smaller dt.",
+                   web_label(web), what, h, stable, f, allowed, mmin, sub, mass);
 }
 
 /* Every web before the step: stable for its sub-step, and room for per-body forces. */
@@ -187,7 +190,7 @@ static ws_status webs_ready(ws_world *w)
         }
         if (w->web_check) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
-            if (!(h <= stable)) /* NaN refuses too */
+            if (!(h <= w->def.stable_fraction * stable)) /* NaN refuses too */
                 return web_unstable(w, web, h, stable, "refused before the step");
         }
     }

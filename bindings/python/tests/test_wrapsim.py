@@ -309,7 +309,7 @@ def test_sheet_tensions_are_ea_times_prestretch():
         edge = [i + nx * j for j in range(ny) for i in range(nx)
                 if i in (0, nx - 1) or j in (0, ny - 1)]
         web = w.web_sheet(law, nx=nx, ny=ny, spacing_x=0.01, spacing_y=0.01, prestretch_x=pre,
-                          prestretch_y=pre, node_mass=1e-3, substeps=4, pinned=edge, name="sheet")
+                          prestretch_y=pre, node_mass=1e-3, substeps=8, pinned=edge, name="sheet")
         info = web.info()
         assert (info["nx"], info["ny"], info["closed"]) == (nx, ny, 0)
         assert web.node_count == nx * ny
@@ -404,7 +404,7 @@ def build_tilt(wrapped=False):
         w.set_contact(film_mat, box_mat, **fc)
         w.set_contact(film_mat, plane_mat, **fc)
         film = w.web_band(around, [bottom, top], law_cross=up, node_mass=1e-3,
-                          contact_layer=layer, material=film_mat, substeps=1, name="film",
+                          contact_layer=layer, material=film_mat, substeps=2, name="film",
                           z_bottom=z0, z_top=z1, n_around=n_around, n_up=n_up,
                           prestretch_around=0.4, prestretch_up=0.2)
     return w, plane, stop, bottom, top, film
@@ -548,14 +548,15 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert law.evaluate(0.0, 2.0)[0] == pytest.approx(0.2)
         assert law.evaluate(0.0, 2.0)[2] == pytest.approx(0.1)
         sheet = w.web_sheet(law, law_shear=shear, nx=4, ny=3, spacing_x=0.05, spacing_y=0.05,
-                            shear=1, node_mass=0.01, pinned=[0, 3])
+                            shear=1, node_mass=0.01, substeps=2, pinned=[0, 3])
         pos = np.array([[0, 0, 1], [0.1, 0, 1], [0.2, 0, 1]], float)
         rope = w.web_mesh(law, pos, [[0, 1], [1, 2]], node_masses=[1e-2] * 3,
-                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3)
+                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3,
+                          substeps=2)
         assert rope.node_count == 3 and rope.info()["nx"] == 0
         assert np.allclose(rope.strains(), 0.1 / 0.09 - 1)
         crate = w.body(w.box(0.2, 0.2, 0.2), mass=1.0, position=(1, 1, 0.1))
-        band = w.web_band(law, [crate], node_mass=1e-3, substeps=8, z_bottom=0.02, z_top=0.18,
+        band = w.web_band(law, [crate], node_mass=1e-3, substeps=12, z_bottom=0.02, z_top=0.18,
                           n_around=12, n_up=4, prestretch_around=0.2, prestretch_up=0.1)
         assert band.info()["closed"] == 1
         assert band.containment(2)["hoop_tension"].min() > 0

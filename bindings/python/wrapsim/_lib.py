@@ -127,6 +127,7 @@ class WorldDef(Structure):
         ("log", LogFn),
         ("log_user", c_void_p),
         ("user_data", c_void_p),
+        ("stable_fraction", c_double),
     ]
 
 
@@ -166,7 +167,9 @@ class WorldStats(Structure):
         ("seconds_contacts", c_double),
         ("seconds_web", c_double),
         ("seconds_total", c_double),
-        ("reserved", c_uint64 * 4),
+        ("web_step_use", c_double),
+        ("body_step_use", c_double),
+        ("reserved", c_uint64 * 2),
     ]
 
 
