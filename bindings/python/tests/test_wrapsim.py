@@ -300,6 +300,29 @@ def test_box_rests_at_layer_gap():
         assert f[2] == pytest.approx(m * g, rel=1e-4)
         assert w.energy()["kinetic"] < 1e-9
         assert w.stats()["contacts"] == 4
+        # at rest: nothing slides, nothing at the friction cap, no anchor (regularised law)
+        assert (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        assert (c["anchor_deflection"] == 0).all()
+        # the margin: dt over the pair's bound, 2 / sqrt(8 k / m) for a box on a slab
+        assert w.stats()["body_step_use"] == pytest.approx(
+            w.dt / w.estimate_stable_dt(), rel=1e-12)
+        assert 0 < w.stats()["body_step_use"] < 1
+
+
+def test_stick_contacts_report_their_anchors():
+    # a box on a slab tilted by 10 deg of gravity, stick friction mu = 0.3: it holds, each
+    # anchor spring carrying its share of m g sin(10 deg) (the deflection times stick_stiffness)
+    k, m, g, th = 2e5, 5.0, 9.81, np.radians(10.0)
+    with ws.World(gravity=(g * np.sin(th), 0, -g * np.cos(th))) as w:
+        w.set_default_contact(stiffness=k, damping=50.0, friction=0.3, friction_model="stick")
+        assert w.get_contact(w.default_material, w.default_material)["stick_damping_ratio"] == 1.0
+        w.body(w.box(1.0, 1.0, 0.05), type="kinematic", position=(0, 0, -0.025))
+        w.body(w.box(0.25, 0.25, 0.25), mass=m, position=(0, 0, 0.125 + 2e-3 - m * g / (4 * k)))
+        w.step(4000)
+        c = w.contacts()
+        assert len(c) == 4 and (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        pull = (c["anchor_deflection"][:, 0] * k).sum()  # on the box: -k d, d along +x
+        assert abs(pull) == pytest.approx(m * g * np.sin(th), rel=1e-3)
 
 
 def test_sheet_tensions_are_ea_times_prestretch():
