@@ -294,9 +294,10 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 }
 
 /* Gross slip of body b on its support: every contact between them slips (tangential speed at
- * or above v_lim under the regularised law, the anchor at its cap under the stick law), and they slip
- * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
- * support, as when the platform starts to tilt, slips at every corner but is not sliding. */
+ * or above v_lim under the regularised law, the anchor at its cap under the stick law), and
+ * they slip the same way (|sum of slip velocities| >= half the sum of their sizes): a box
+ * turning on its support, as when the platform starts to tilt, slips at every corner but is not
+ * sliding. */
 static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *buf, size_t n)
 {
     int count = 0, slipping = 0;

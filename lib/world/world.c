@@ -534,8 +534,9 @@ double ws_contact_stable_dt(double k, double c, double m_eff)
 /* Effective mass of a pair of bodies (a kinematic or absent one counts as infinite). */
 static double pair_mass(const ws_body_store *b, uint32_t i, uint32_t j)
 {
-    double inv = (i == UINT32_MAX ? 0.0 : b->inv_mass[i]) + (j == UINT32_MAX ? 0.0 : b->inv_mass[j]);
-    return 1.0 / inv;
+    double inv_i = i == UINT32_MAX ? 0.0 : b->inv_mass[i];
+    double inv_j = j == UINT32_MAX ? 0.0 : b->inv_mass[j];
+    return 1.0 / (inv_i + inv_j);
 }
 
 void ws_world_contact_limit(const ws_world *w, ws_contact_limit *lim)

@@ -434,7 +434,8 @@ static ws_status energy_guard(ws_world *w, int cur, int nxt, size_t nrec)
         t1 += kinetic(b, s1, i);
         v3 f = v3_sub(b->f[i], w->guard_f[i]), m = v3_sub(b->m[i], w->guard_m[i]);
         v3 w1 = m3_mul_v(&b->A[i], s1->w[i]);
-        work += 0.5 * dt * (v3_dot(f, v3_add(s0->v[i], s1->v[i])) + v3_dot(m, v3_add(b->wg[i], w1)));
+        work += 0.5 * dt *
+                (v3_dot(f, v3_add(s0->v[i], s1->v[i])) + v3_dot(m, v3_add(b->wg[i], w1)));
     }
     for (size_t k = 0; k < nrec; k++) {
         const ws_contact_rec *r = &w->rec[nxt][k];
