@@ -114,9 +114,10 @@ def _done_ids(path):
 
 
 def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resume=False,
-          progress=None):
+          progress=None, client=None):
     """Run a study on Dask; append rows to out/results.csv as they finish. Returns the path.
-    `progress(done, total)` is called after every run when given."""
+    `progress(done, total)` is called after every run when given. `client`: a Dask client to
+    use (and leave open) instead of connecting to `scheduler` or starting a LocalCluster."""
     from dask.distributed import Client, LocalCluster, as_completed
 
     out = pathlib.Path(out)
@@ -129,9 +130,10 @@ def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resum
     done = _done_ids(path)
     todo = [(rid, p) for rid, p in runs if rid not in done]
     cluster = None
-    if scheduler:
+    own_client = client is None
+    if own_client and scheduler:
         client = Client(scheduler)
-    else:
+    elif own_client:
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)
         client = Client(cluster)
@@ -150,7 +152,8 @@ def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resum
                 if progress:
                     progress(n, len(todo))
     finally:
-        client.close()
+        if own_client:
+            client.close()
         if cluster is not None:
             cluster.close()
     return path
