@@ -591,11 +591,17 @@ def _candidates():
     if env:
         return [(env, "WRAPSIM_LIBRARY")]
     out = []
-    # The build tree: <repo>/bindings/python/wrapsim/_lib.py -> <repo>/build/lib.
-    repo = pathlib.Path(__file__).resolve().parents[3]
     names = {"darwin": ["libwrapsim.dylib", "libwrapsim.0.dylib"],
              "win32": ["wrapsim.dll", "libwrapsim.dll"]}.get(sys.platform,
                                                             ["libwrapsim.so.0", "libwrapsim.so"])
+    # Installed by pip: the library travels inside the package, next to this module.
+    here = pathlib.Path(__file__).resolve().parent
+    for name in names:
+        p = here / name
+        if p.exists():
+            out.append((str(p), "the package"))
+    # The build tree: <repo>/bindings/python/wrapsim/_lib.py -> <repo>/build/lib.
+    repo = here.parents[2]
     for name in names:
         p = repo / "build" / "lib" / name
         if p.exists():
@@ -634,8 +640,10 @@ def load(path=None):
             tried.append(f"{cand} ({how}): {e}")
     if lib is None:
         raise LibraryError("libwrapsim not found; tried:\n  " + "\n  ".join(tried) +
-                           "\nSet WRAPSIM_LIBRARY to the path of libwrapsim.so.0, or build it with "
-                           "`meson setup build && ninja -C build` in the repository.")
+                           "\nInstall the package with the library inside it (from the repository: "
+                           "`pip install --no-build-isolation .`), set WRAPSIM_LIBRARY to the path "
+                           "of libwrapsim.so.0, or build it with `meson setup build && ninja -C "
+                           "build` in the repository.")
     missing = []
     for name, argtypes, restype in FUNCTIONS:
         try:
