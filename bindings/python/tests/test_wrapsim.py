@@ -238,6 +238,48 @@ def test_buffer_too_small_raw():
         assert n.value == 4
 
 
+def test_contacts_between_and_interface_stiffness():
+    """Two equal 5 kg cubes on a plane, k = 2e5 N/m per point: box-plane 4 points (4k, load
+    2 m g), box-box 8 points (8k, load m g); in the pair's order every normal points from a to
+    b (+z from the plane to the bottom box and from it to the top one), whoever owns the face.
+    Settled 2 s at 100 kg/s per point: the loads are static to far below the 1e-6 asserted."""
+    mg, k, a = 5.0 * 9.81, 2e5, 0.25
+    with ws.World() as w:
+        w.set_default_contact(stiffness=k, damping=100.0)
+        plane = w.body(w.box(1.5, 1.5, 0.05), type="kinematic", position=(0, 0, -0.025))
+        cube = w.box(a, a, a)
+        bottom = w.body(cube, mass=5.0, position=(0, 0, a / 2 + 0.002))
+        top = w.body(cube, mass=5.0, position=(0, 0, 1.5 * a + 0.004))
+        w.step(8000)
+        assert w.interface_stiffness(plane, bottom) == pytest.approx((4 * k, 4))
+        assert w.interface_stiffness(top, bottom) == pytest.approx((8 * k, 8))
+        c = w.contacts_between(bottom, top)
+        assert len(c) == 8
+        assert np.all(c["normal"][:, 2] > 1 - 1e-12)
+        assert sorted(c["kind"]) == [ws.WS_CONTACT_POINT_FACE] * 4 + [ws.WS_CONTACT_FACE_POINT] * 4
+        assert c["normal_force"].sum() == pytest.approx(mg, rel=1e-6)
+        c = w.contacts_between(bottom, plane)
+        assert len(c) == 4 and np.all(c["normal"][:, 2] < -1 + 1e-12)
+        assert c["normal_force"].sum() == pytest.approx(2 * mg, rel=1e-6)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.contacts_between(top, top)
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
+
+
+def test_mesh_centroid_offset_places_body_where_the_mesh_was():
+    """A tetrahedron given at (1, 2, 3): moved by its centroid, (1, 2, 3) + a/4 (1, 1, 1); a
+    body created there puts the vertices back where they were given (1e-12 m, round-off)."""
+    a = 0.5
+    v = np.array([[0, 0, 0], [a, 0, 0], [0, a, 0], [0, 0, a]], dtype=float) + (1.0, 2.0, 3.0)
+    with ws.World() as w:
+        s = w.mesh(v, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        off = s.centroid_offset
+        assert off == pytest.approx(np.array([1, 2, 3]) + a / 4, abs=1e-12)
+        b = w.body(s, mass=1.0, position=off)
+        local, _ = s.copy_mesh()
+        assert local @ b.rotation.T + b.position == pytest.approx(v, abs=1e-12)
+
+
 def test_stale_ids_raise_never_crash():
     with ws.World() as w, ws.World() as other:
         cube = w.box(0.1, 0.1, 0.1)
