@@ -1001,7 +1001,8 @@ END_TEST
  * the box's bottom face, and a rigid stack's CoG passes over the stop's top edge at
  *   tan(theta) = (a/2 + g_x) / (g_z + a + g_bb/2 - h)   = 28.61 deg
  * instead of the 28.52 deg of the layer-free geometry; over the mid-layer point where the stop's
- * force acts (one delta before the edge) at 28.42 deg. The gaps are asserted to 1e-9 m against
+ * force acts (one delta before the edge) at 28.42 deg; a single cube at 49.90 and 49.68 deg
+ * (49.97 without layers). The gaps are asserted to 1e-9 m against
  * the bodies' settled positions (residue ~1e-12 m), the angles to 0.005 deg against the numbers
  * the document prints (they are rounded to 0.01 deg). */
 START_TEST(test_reference_stack_layer_geometry)
@@ -1026,11 +1027,24 @@ START_TEST(test_reference_stack_layer_geometry)
     ck_assert_msg(fabs(gz - gz_th) < 1e-9, "g_z %.9g m, theory %.9g", gz, gz_th);
     ck_assert_msg(fabs(gbb - gbb_th) < 1e-9, "g_bb %.9g m, theory %.9g", gbb, gbb_th);
     ck_assert_msg(fabs(gx - 2 * DELTA) < 1e-9, "g_x %.9g m", gx);
+    /* The rounded values of the document's table. */
+    ck_assert_msg(fabs(1e3 * gz - 1.877) < 5e-4 && fabs(1e3 * gbb - 1.969) < 5e-4 &&
+                      fabs(1e3 * zc - 252.86) < 0.005,
+                  "table: g_z %.4f mm, g_bb %.4f mm, CoG %.3f mm", 1e3 * gz, 1e3 * gbb,
+                  1e3 * zc);
     ck_assert_msg(fabs(1e3 * (h - gz) - 18.12) < 0.005, "stop above the box %.4f mm",
                   1e3 * (h - gz));
     ck_assert_msg(fabs(nominal - 28.52) < 0.005, "layer-free %.4f deg", nominal);
     ck_assert_msg(fabs(edge - 28.61) < 0.005, "over the edge %.4f deg", edge);
     ck_assert_msg(fabs(mid - 28.42) < 0.005, "over the mid-layer point %.4f deg", mid);
+    /* The single cube of the same document, from the resting gap check_resting() validates. */
+    double zc1 = 2 * DELTA - m * G0 / (4 * k) + a / 2;
+    double one_edge = atan((a / 2 + 2 * DELTA) / (zc1 - h)) / DEG;
+    double one_mid = atan((a / 2 + DELTA) / (zc1 - h)) / DEG;
+    double one_free = atan((a / 2) / (a / 2 - h)) / DEG;
+    ck_assert_msg(fabs(one_edge - 49.90) < 0.005 && fabs(one_mid - 49.68) < 0.005 &&
+                      fabs(one_free - 49.97) < 0.005,
+                  "single cube: %.4f, %.4f, %.4f deg", one_edge, one_mid, one_free);
     ws_world_destroy(r.w);
 }
 END_TEST
