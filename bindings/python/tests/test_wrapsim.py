@@ -9,6 +9,7 @@ without one).
 """
 
 import ctypes
+import importlib.util
 import math
 import os
 import pathlib
@@ -490,6 +491,46 @@ def test_tilt_table_matches_c(tilt_exe):
         assert w.time == pytest.approx(7.0)
         # and the physics the example reports: the top box has left the bottom one
         assert np.linalg.norm(top.position - bottom.position) > 0.5
+
+
+TILT_ONSET_MAIN = r"""
+#define TILT_TABLE_NO_MAIN
+#include "tilt_table.c"
+int main(void)
+{
+    tilt_options o;
+    tilt_result r;
+    tilt_default_options(&o);
+    o.quiet = 1;
+    if (tilt_run(&o, &r) != WS_OK)
+        return 1;
+    printf("%.17g %.17g %.17g %.17g\n", r.slide_time[1], r.slide_angle[1], r.off_time[1],
+           r.slide_time[0]);
+    return 0;
+}
+"""
+
+
+def test_tilt_examples_report_the_same_slide_onset(tmp_path):
+    """examples/python/tilt_table.py and examples/tilt_table.c report slide onset by one
+    definition (every contact with the support slipping the same way, |v_t| >= v_lim, for
+    0.2 s), checked on every step in both: on the same steps of the same library they find the
+    same onset, to round-off, and stop the run on the same step when the top box leaves the
+    platform. The onset is that of the theory, tan(theta) = 0.3, within 0.3 deg (the C suite's
+    tolerance: the dynamic lag of a 5 kg box starting to slip)."""
+    exe = compile_c(tmp_path, TILT_ONSET_MAIN, "tilt_onset")
+    c_time, c_angle, c_off, c_bottom = map(float, run_c(exe).split())
+    spec = importlib.util.spec_from_file_location(
+        "tilt_table_example", REPO / "examples" / "python" / "tilt_table.py")
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    r = ex.run_case("R", False, 7.0, [])
+    (p_time, p_angle), p_off = r["slide"][1], r["off"][1]
+    assert r["slide"][0] is None and math.isnan(c_bottom)  # the bottom box rests on the stop
+    assert p_time == pytest.approx(c_time, abs=1e-9)
+    assert p_angle == pytest.approx(c_angle, abs=1e-9)
+    assert p_off == pytest.approx(c_off, abs=1e-9)
+    assert abs(p_angle - math.degrees(math.atan(0.3))) < 0.3
 
 
 def test_tilt_table_wrapped_matches_c(tilt_exe):
