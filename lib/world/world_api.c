@@ -188,6 +188,18 @@ ws_status ws_shape_get_info(const ws_world *w, ws_shape_id id, ws_shape_info *in
     return WS_OK;
 }
 
+ws_status ws_shape_get_centroid_offset(const ws_world *w, ws_shape_id id, ws_vec3 *offset)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, offset, "ws_shape_get_centroid_offset");
+    uint32_t slot;
+    ws_status s = ws_lookup_shape(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    *offset = w->shapes[slot]->centroid;
+    return WS_OK;
+}
+
 ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices, size_t vcap,
                              size_t *vcount, uint32_t *triangles, size_t tcap, size_t *tcount)
 {
@@ -655,5 +667,91 @@ ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t
     if (buf && cap < n)
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
                        "ws_world_copy_contacts: room for %zu contacts, there are %zu", cap, n);
+    return WS_OK;
+}
+
+/* Both ids live, distinct; the slots out. */
+static ws_status pair_call(const ws_world *w, ws_body_id a, ws_body_id b, const char *fn,
+                           uint32_t *ia, uint32_t *ib)
+{
+    ws_status s = ws_lookup_body(w, a, ia);
+    if (s == WS_OK)
+        s = ws_lookup_body(w, b, ib);
+    if (s != WS_OK)
+        return s;
+    if (*ia == *ib)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: body_a and body_b are the same body", fn);
+    return WS_OK;
+}
+
+ws_status ws_world_copy_contacts_between(const ws_world *w, ws_body_id a, ws_body_id b,
+                                         ws_contact_info *buf, size_t cap, size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_world_copy_contacts_between");
+    if (cap && !buf)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_world_copy_contacts_between: buffer is NULL but capacity is not 0");
+    uint32_t ia, ib;
+    ws_status s = pair_call(w, a, b, "ws_world_copy_contacts_between", &ia, &ib);
+    if (s != WS_OK)
+        return s;
+    size_t n = 0;
+    for (size_t k = 0; k < w->nrec[w->cur]; k++) {
+        const ws_contact_rec *c = &w->rec[w->cur][k];
+        int same = c->a == ia && c->b == ib, swapped = c->a == ib && c->b == ia;
+        if (!same && !swapped)
+            continue;
+        if (n < cap) {
+            /* Seen from the caller's order: the record's b is the caller's a when swapped, so
+             * the normal, the force on b and b's slip all change sign. */
+            double sg = swapped ? -1.0 : 1.0;
+            ws_contact_info *o = &buf[n];
+            o->body_a = a;
+            o->body_b = b;
+            o->point = c->x;
+            o->normal = v3_scale(c->n, sg);
+            o->overlap = c->overlap;
+            o->normal_force = c->fn;
+            o->friction_force = v3_scale(c->ft, sg);
+            o->slip_velocity = v3_scale(c->vt, sg);
+            o->kind = (int32_t)c->kind;
+            if (swapped && c->kind == WS_CONTACT_POINT_FACE)
+                o->kind = WS_CONTACT_FACE_POINT;
+            o->slipping = (int32_t)c->slipping;
+        }
+        n++;
+    }
+    *count = n;
+    if (buf && cap < n)
+        return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
+                       "ws_world_copy_contacts_between: room for %zu contacts, there are %zu",
+                       cap, n);
+    return WS_OK;
+}
+
+ws_status ws_world_get_interface_stiffness(const ws_world *w, ws_body_id a, ws_body_id b,
+                                           double *stiffness, size_t *points)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, stiffness, "ws_world_get_interface_stiffness");
+    uint32_t ia, ib;
+    ws_status s = pair_call(w, a, b, "ws_world_get_interface_stiffness", &ia, &ib);
+    if (s != WS_OK)
+        return s;
+    /* Every active contact point is a spring k of the pair in parallel with the others. */
+    const uint32_t *mat = w->bodies.material;
+    double k = w->params[w->pair_index[mat[ia] * w->pair_dim + mat[ib]]].k, sum = 0.0;
+    size_t n = 0;
+    for (size_t q = 0; q < w->nrec[w->cur]; q++) {
+        const ws_contact_rec *c = &w->rec[w->cur][q];
+        if ((c->a == ia && c->b == ib) || (c->a == ib && c->b == ia)) {
+            sum += k;
+            n++;
+        }
+    }
+    *stiffness = sum;
+    if (points)
+        *points = n;
     return WS_OK;
 }

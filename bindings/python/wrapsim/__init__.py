@@ -20,7 +20,7 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD, WS_INTEGRATOR_SYMPLECTIC_EULER,
     WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
-    WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_LAW_LINEAR_ELASTIC,
+    WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT, WS_LAW_LINEAR_ELASTIC,
     WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_LAW_LINEAR_VISCOUS,
     WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP, WS_LAW_RELAXATION, WS_LAW_SUM,
     WS_LAW_SCALED, WS_LAW_USER, WS_LAW_FLAG_ELASTIC, WS_LAW_FLAG_VISCOUS, WS_SPRING_AROUND,
@@ -478,6 +478,26 @@ class World:
             self._call("ws_world_copy_contacts", _ptr(buf, L.ContactInfo), len(buf), byref(n))
         return buf[: n.value]
 
+    def contacts_between(self, a, b):
+        """Active contacts between Bodies a and b, in that order: body_a is a, the normal points
+        from a to b, the forces and slip velocity are b's, whichever body owns the face (kind
+        WS_CONTACT_FACE_POINT: a point of a in a face of b). Same dtype as contacts()."""
+        n = c_size_t()
+        self._call("ws_world_copy_contacts_between", a._id, b._id, None, 0, byref(n))
+        buf = np.zeros(n.value, dtype=CONTACT_DTYPE)
+        if n.value:
+            self._call("ws_world_copy_contacts_between", a._id, b._id,
+                       _ptr(buf, L.ContactInfo), len(buf), byref(n))
+        return buf[: n.value]
+
+    def interface_stiffness(self, a, b):
+        """(stiffness N/m, points): the summed normal stiffness of the active contact points
+        between Bodies a and b and their number (4 for a box on a larger plane, 8 for two equal
+        boxes face to face)."""
+        k, n = c_double(), c_size_t()
+        self._call("ws_world_get_interface_stiffness", a._id, b._id, byref(k), byref(n))
+        return k.value, n.value
+
     # laws and webs
     def law(self, type="linear_elastic", **kwargs):
         """A constitutive law: ws_law_def fields (type, dim, stiffness N, compression_stiffness
@@ -738,6 +758,15 @@ class Shape(_Handle):
         i = L.ShapeInfo()
         self._call("ws_shape_get_info", byref(i))
         return _struct_dict(i)
+
+    @property
+    def centroid_offset(self):
+        """How far the mesh was moved when created (its volume centroid in the frame its
+        vertices were given in), m: create the body at this position to put it where the mesh
+        was."""
+        v = L.Vec3()
+        self._call("ws_shape_get_centroid_offset", byref(v))
+        return np.array([v.x, v.y, v.z])
 
     def copy_mesh(self):
         """The re-centred vertices (n, 3) m and triangles (m, 3)."""

@@ -38,7 +38,7 @@ WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
 WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
 WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
 WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK = 0, 1, 2, 3
-WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE = 0, 1
+WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT = 0, 1, 2
 WS_LAW_LINEAR_ELASTIC, WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION = 0, 1, 2
 WS_LAW_LINEAR_VISCOUS, WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP = 3, 4, 5, 6
 WS_LAW_RELAXATION, WS_LAW_SUM, WS_LAW_SCALED, WS_LAW_USER = 7, 8, 9, 10
@@ -476,6 +476,7 @@ FUNCTIONS = [
     ("ws_shape_destroy", [World_p, ShapeId], _st),
     ("ws_shape_is_valid", [World_p, ShapeId], c_int),
     ("ws_shape_get_info", [World_p, ShapeId, P(ShapeInfo)], _st),
+    ("ws_shape_get_centroid_offset", [World_p, ShapeId, P(Vec3)], _st),
     ("ws_shape_copy_mesh", [World_p, ShapeId, P(c_double), c_size_t, P(c_size_t), P(c_uint32),
                             c_size_t, P(c_size_t)], _st),
     # body.h
@@ -505,6 +506,10 @@ FUNCTIONS = [
     # contact.h
     ("ws_world_get_contact_count", [World_p, P(c_size_t)], _st),
     ("ws_world_copy_contacts", [World_p, P(ContactInfo), c_size_t, P(c_size_t)], _st),
+    ("ws_world_copy_contacts_between", [World_p, BodyId, BodyId, P(ContactInfo), c_size_t,
+                                        P(c_size_t)], _st),
+    ("ws_world_get_interface_stiffness", [World_p, BodyId, BodyId, P(c_double), P(c_size_t)],
+     _st),
     # law.h
     ("ws_law_def_init", [P(LawDef)], None),
     ("ws_law_create", [World_p, P(LawDef), P(LawId)], _st),
