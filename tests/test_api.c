@@ -1352,6 +1352,132 @@ START_TEST(test_tilt_drive_kinematics)
 }
 END_TEST
 
+/* ---- the Def ABI: a program built against an older, smaller Def ---- */
+
+/* ws_body_def as an older header might have laid it out: today's fields up to `velocity`, none
+ * after (angular_velocity, name, user_data came later). */
+typedef struct old_body_def {
+    uint32_t size, magic;
+    ws_body_type type;
+    ws_shape_id shape;
+    ws_material_id material;
+    double mass, density;
+    ws_mat3 inertia;
+    double contact_layer;
+    ws_vec3 position;
+    ws_quat orientation;
+    ws_vec3 velocity;
+} old_body_def;
+
+/* The same for ws_world_def, cut before its last field (user_data). */
+typedef struct old_world_def {
+    uint32_t size, magic;
+    ws_vec3 gravity;
+    double dt;
+    ws_integrator integrator;
+    double full_detection_until;
+    int detection_interval;
+    double contact_margin, max_speed, max_angular_speed;
+    int use_ccd, profile;
+    ws_allocator allocator;
+    ws_log_fn log;
+    void *log_user;
+} old_world_def;
+
+#define CANARY 0xA5
+
+static int canary_intact(const unsigned char *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (c[i] != CANARY)
+            return 0;
+    return 1;
+}
+
+START_TEST(test_old_size_defs)
+{
+    /* The old layouts are prefixes of today's Defs, field for field. */
+    ck_assert_uint_eq(offsetof(old_body_def, velocity), offsetof(ws_body_def, velocity));
+    ck_assert_uint_eq(offsetof(old_world_def, log_user), offsetof(ws_world_def, log_user));
+    ck_assert_uint_lt(sizeof(old_body_def), sizeof(ws_body_def));
+    ck_assert_uint_lt(sizeof(old_world_def), sizeof(ws_world_def));
+
+    /* A guard after each old Def, filled with a pattern that the library must neither write nor
+     * read: read as user_data or angular_velocity it would show (0xA5A5... is not zero). */
+    struct {
+        old_world_def d;
+        unsigned char canary[sizeof(ws_world_def)];
+    } wf;
+    struct {
+        old_body_def d;
+        unsigned char canary[sizeof(ws_body_def)];
+    } bf;
+    memset(&wf, CANARY, sizeof wf);
+    memset(&bf, CANARY, sizeof bf);
+
+    ws_world_def_init_sized((ws_world_def *)&wf.d, sizeof wf.d);
+    ck_assert_msg(canary_intact(wf.canary, sizeof wf.canary), "world init wrote past the Def");
+    ck_assert_uint_eq(wf.d.size, sizeof wf.d);
+    ck_assert(wf.d.dt == 2.5e-4 && wf.d.gravity.z == -9.81 && wf.d.use_ccd == 1);
+    ck_assert(wf.d.log == NULL);
+    wf.d.dt = 1e-4;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create((const ws_world_def *)&wf.d, &w), WS_OK);
+    ck_assert_msg(canary_intact(wf.canary, sizeof wf.canary), "world create wrote the guard");
+    ck_assert_ptr_null(ws_world_get_user_data(w)); /* the missing field: its default */
+    double dt = 0.0;
+    ck_ok(w, ws_world_get_dt(w, &dt));
+    ck_assert(dt == 1e-4);
+
+    ws_body_def_init_sized((ws_body_def *)&bf.d, sizeof bf.d);
+    ck_assert_msg(canary_intact(bf.canary, sizeof bf.canary), "body init wrote past the Def");
+    ck_assert_uint_eq(bf.d.size, sizeof bf.d);
+    ck_assert(bf.d.density == 1000.0 && bf.d.contact_layer == 1e-3 && bf.d.orientation.e0 == 1.0);
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &bf.d.shape));
+    bf.d.mass = 2.0;
+    bf.d.velocity = (ws_vec3){1.0, 2.0, 3.0};
+    ws_body_id b;
+    ck_ok(w, ws_body_create(w, (const ws_body_def *)&bf.d, &b));
+    ck_assert_msg(canary_intact(bf.canary, sizeof bf.canary), "body create wrote the guard");
+    ws_vec3 v, om;
+    ck_ok(w, ws_body_get_velocity(w, b, &v));
+    ck_ok(w, ws_body_get_angular_velocity(w, b, &om));
+    ck_assert(v.x == 1.0 && v.y == 2.0 && v.z == 3.0);
+    ck_assert(om.x == 0.0 && om.y == 0.0 && om.z == 0.0); /* the missing fields: defaults */
+    ck_assert_ptr_null(ws_body_get_user_data(w, b));
+
+    /* A newer, larger caller Def: the library fills its own fields, zeros the rest and records
+     * the size both know, which tells the caller which fields the library reads. */
+    struct newer_frame {
+        ws_body_def d;
+        double newer_field;
+        unsigned char canary[16];
+    } nf;
+    memset(&nf, CANARY, sizeof nf);
+    ws_body_def_init_sized(&nf.d, offsetof(struct newer_frame, canary));
+    ck_assert_uint_eq(nf.d.size, sizeof nf.d);
+    ck_assert(nf.newer_field == 0.0);
+    ck_assert(canary_intact(nf.canary, sizeof nf.canary));
+
+    /* The plain function, for programs built against headers before the sized form, fills
+     * today's layout and not a byte more; a Def smaller than its header is left alone. */
+    struct {
+        ws_body_def d;
+        unsigned char canary[16];
+    } pf;
+    memset(&pf, CANARY, sizeof pf);
+    (ws_body_def_init)(&pf.d);
+    ck_assert(canary_intact(pf.canary, sizeof pf.canary));
+    ck_assert_uint_le(pf.d.size, sizeof pf.d);
+    ck_assert_uint_ge(pf.d.size, offsetof(ws_body_def, user_data) + sizeof(void *));
+    unsigned char tiny[4];
+    memset(tiny, CANARY, sizeof tiny);
+    ws_body_def_init_sized((ws_body_def *)(void *)tiny, sizeof tiny);
+    ck_assert(canary_intact(tiny, sizeof tiny));
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* ---- suite ---- */
 
 static void add(Suite *s, const char *name, const TTest *t, double timeout)
@@ -1378,6 +1504,7 @@ static Suite *api_suite(void)
     add(s, "uninit_contact_def", test_uninit_contact_def, 10);
     add(s, "uninit_material_def", test_uninit_material_def, 10);
     add(s, "uninit_drive_def", test_uninit_drive_def, 10);
+    add(s, "old_size_defs", test_old_size_defs, 10);
     add(s, "bad_world_numbers", test_bad_world_numbers, 10);
     add(s, "bad_body_numbers", test_bad_body_numbers, 10);
     add(s, "bad_contact_numbers", test_bad_contact_numbers, 10);

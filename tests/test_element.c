@@ -1094,7 +1094,7 @@ START_TEST(test_bad_defs)
     d.law = L1;
     expect_err(w, ws_element_create(w, &d, NULL), WS_ERR_INVALID_ARGUMENT, NULL);
     ck_assert_int_eq(ws_element_create(NULL, &d, &e), WS_ERR_INVALID_ARGUMENT);
-    ws_element_def_init(NULL); /* ignored */
+    ws_element_def_init_sized(NULL, sizeof(ws_element_def)); /* ignored */
 
     /* Law dims: each type against the wrong ones. */
     const ws_element_type types[4] = {WS_ELEMENT_ROD, WS_ELEMENT_LINEAR_SPRING,

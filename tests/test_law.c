@@ -1428,7 +1428,7 @@ START_TEST(test_in_use_and_old_def)
     ck_ok(w, ws_law_get_info(w, a, &info));
     ck_assert_uint_eq(info.users, 0);
     ck_ok(w, ws_law_destroy(w, a));
-    /* A Def of the first released layout (ending at `name`) still works: dim 1, defaults. */
+    /* A Def of an older, smaller layout (ending at `name`) still works: dim 1, defaults. */
     ws_law_def_init(&d);
     d.type = WS_LAW_LINEAR_VISCOELASTIC;
     d.stiffness = 10.0;
@@ -1438,7 +1438,12 @@ START_TEST(test_in_use_and_old_def)
     ws_law_id old = create(w, &d);
     ck_ok(w, ws_law_get_info(w, old, &info));
     ck_assert_int_eq(info.dim, 1);
+    /* Any size from the header up reads only that much; one below the header is refused. */
     d.size = (uint32_t)offsetof(ws_law_def, name);
+    ws_law_id older = create(w, &d);
+    ck_ok(w, ws_law_get_info(w, older, &info));
+    ck_assert_int_eq(info.dim, 1);
+    d.size = 4;
     ck_assert_int_eq(ws_law_create(w, &d, &old), WS_ERR_UNINITIALIZED_DEF);
     /* Laws referring to laws that go away with the world: destroy frees them in any order. */
     ws_law_id b = make_law(w, L_SUM, 3, NULL, NULL, NULL);

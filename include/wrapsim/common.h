@@ -69,6 +69,14 @@ typedef struct ws_pose {
     ws_quat orientation; /**< Euler parameters, unit */
 } ws_pose;
 
+/* Defs. Every ws_x_def starts with its size and a magic number. ws_x_def_init(def) is a macro
+ * calling the exported ws_x_def_init_sized(def, sizeof *def): it fills the caller's Def with
+ * defaults, min(size, the library's sizeof) bytes of it and zeros past them, and records that
+ * size in def->size. ws_x_create reads only def->size bytes and gives every later field its
+ * default, so a program built against an older, smaller Def keeps working with a newer library
+ * and its stack is never written past its Def. The plain function ws_x_def_init, reached by
+ * programs built against headers before the sized form, fills the layout of those headers. */
+
 /* Ids: a slot, a generation and a world tag packed into 64 bits; zero is the null id. Each kind
  * has its own type so that a body id cannot be passed where a shape id is expected. */
 /** A rigid body or world element. */

@@ -199,8 +199,14 @@ typedef struct ws_law_info {
 
 /** Fill a law Def with defaults (linear elastic, dim 1, no damping, transition 1e-3, scale 1,
  *  stop_low -INFINITY, stop_high +INFINITY, user_flags elastic and viscous; the stiffness must
- *  be set). NULL is ignored. */
-WS_API void ws_law_def_init(ws_law_def *def);
+ *  be set). NULL is ignored.
+ *  ws_law_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_law_def_init_sized(ws_law_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_law_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_law_def_init)(ws_law_def *def);
+#define ws_law_def_init(def) ws_law_def_init_sized((def), sizeof *(def))
 /** Create a law. Arrays of the Def are copied; laws named by `terms` or `base` count the new
  *  law as a user. @return WS_OK, WS_ERR_INVALID_ARGUMENT (a bad field: the last error names
  *  it), WS_ERR_STALE_HANDLE (a term or base that is not a live law of this world),

@@ -41,8 +41,14 @@ typedef struct ws_shape_info {
     int convex;              /**< 1 if the mesh is convex */
 } ws_shape_info;
 
-/** Fill a mesh Def with defaults (no vertices). */
-WS_API void ws_mesh_def_init(ws_mesh_def *def);
+/** Fill a mesh Def with defaults (no vertices).
+ *  ws_mesh_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_mesh_def_init_sized(ws_mesh_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_mesh_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_mesh_def_init)(ws_mesh_def *def);
+#define ws_mesh_def_init(def) ws_mesh_def_init_sized((def), sizeof *(def))
 
 /** A box with full edge lengths lx, ly, lz (m, each > 0), centred on the origin.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_OUT_OF_MEMORY, WS_ERR_STALE_HANDLE never. */

@@ -115,12 +115,30 @@ typedef struct ws_energy {
     double contact;       /**< elastic energy stored in the penalty springs, k overlap^2 / 2 */
 } ws_energy;
 
-/** Fill a world Def with defaults. `def` must not be NULL. */
-WS_API void ws_world_def_init(ws_world_def *def);
-/** Fill a contact Def with defaults. */
-WS_API void ws_contact_def_init(ws_contact_def *def);
-/** Fill a material Def with defaults. */
-WS_API void ws_material_def_init(ws_material_def *def);
+/** Fill a world Def with defaults. `def` must not be NULL.
+ *  ws_world_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_world_def_init_sized(ws_world_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_world_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_world_def_init)(ws_world_def *def);
+#define ws_world_def_init(def) ws_world_def_init_sized((def), sizeof *(def))
+/** Fill a contact Def with defaults.
+ *  ws_contact_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_contact_def_init_sized(ws_contact_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_contact_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_contact_def_init)(ws_contact_def *def);
+#define ws_contact_def_init(def) ws_contact_def_init_sized((def), sizeof *(def))
+/** Fill a material Def with defaults.
+ *  ws_material_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_material_def_init_sized(ws_material_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_material_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_material_def_init)(ws_material_def *def);
+#define ws_material_def_init(def) ws_material_def_init_sized((def), sizeof *(def))
 
 /** Create a world. On error *out is NULL.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, dt <= 0, NaN...), WS_ERR_UNINITIALIZED_DEF,

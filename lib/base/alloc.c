@@ -133,14 +133,36 @@ int ws_def_reset(void *def, size_t size)
     return 1;
 }
 
-int ws_def_check(const void *def, size_t min_size)
+void ws_def_fill(void *def, size_t size, const void *full, size_t full_size)
 {
-    const uint32_t *hdr = def;
+    if (!def || size < WS_DEF_HEADER_SIZE)
+        return;
+    size_t n = size < full_size ? size : full_size;
+    memcpy(def, full, n);
+    if (size > n)
+        memset((unsigned char *)def + n, 0, size - n);
+    uint32_t hdr = (uint32_t)n;
+    memcpy(def, &hdr, sizeof hdr);
+}
+
+int ws_def_check(const void *def)
+{
+    uint32_t hdr[2];
     if (!def)
         return -1;
-    if (hdr[1] != WS_DEF_MAGIC || hdr[0] < min_size)
+    memcpy(hdr, def, sizeof hdr);
+    if (hdr[1] != WS_DEF_MAGIC || hdr[0] < WS_DEF_HEADER_SIZE)
         return -1;
     return 0;
+}
+
+void ws_def_copy(void *dst, size_t full, const void *src)
+{
+    uint32_t size;
+    memcpy(&size, src, sizeof size);
+    memcpy(dst, src, size < full ? size : full);
+    uint32_t hdr = (uint32_t)full;
+    memcpy(dst, &hdr, sizeof hdr);
 }
 
 void ws_slots_destroy(ws_mem *mem, ws_slot_table *t)

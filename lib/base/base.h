@@ -44,13 +44,30 @@ void ws_mem_free_str(ws_mem *mem, char *s);
  * Returns 0 on success, -1 when out of memory (array unchanged). */
 int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, size_t elem);
 
-/* Start a ws_*_def_init(): zero the Def and write its size/magic header. 0 for a NULL Def (the
- * init then does nothing), 1 otherwise. */
+/* Start filling a Def with defaults: zero it and write its size/magic header. 0 for a NULL Def
+ * (the init then does nothing), 1 otherwise. */
 int ws_def_reset(void *def, size_t size);
 
-/* Checks the size/magic header of a Def: 0 when good. `min_size` is the size of the first
- * released layout; `full` the current one. */
-int ws_def_check(const void *def, size_t min_size);
+/* The size/magic header every Def starts with. */
+#define WS_DEF_HEADER_SIZE (2 * sizeof(uint32_t))
+
+/* The end of a Def's layout up to and including `field`: the size an init fills for a caller
+ * whose Def ends there. */
+#define WS_DEF_END(type, field) (offsetof(type, field) + sizeof(((type *)0)->field))
+
+/* Finish a sized ws_*_def_init(): copy the library's filled Def `full` (of `full_size` bytes) into
+ * the caller's Def of `size` bytes: the first min(size, full_size) bytes, zeros after them, and
+ * that common size in the header, so create reads no byte the caller does not have. A NULL Def
+ * or one smaller than the header is left alone. */
+void ws_def_fill(void *def, size_t size, const void *full, size_t full_size);
+
+/* Checks the size/magic header of a Def: 0 when good (any size from the header up: fields past
+ * the caller's size take their defaults). */
+int ws_def_check(const void *def);
+
+/* Copy a checked caller's Def over a Def of `full` bytes filled with defaults: the caller's
+ * fields, as many as its size says, and the full size in the header. */
+void ws_def_copy(void *dst, size_t full, const void *src);
 
 /* Ids: [tag:16][kind:4][generation:20][slot+1:24]; zero is the null id. */
 enum {

@@ -38,25 +38,21 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
     va_end(ap);
 }
 
-ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
-                      const char *what)
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, const char *what)
 {
     if (!src)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: the Def pointer is NULL", what);
-    if (ws_def_check(src, min_size) != 0)
+    if (ws_def_check(src) != 0)
         return ws_fail(w, WS_ERR_UNINITIALIZED_DEF,
                        "%s: the Def was not filled by ws_%s_def_init() (size/magic header wrong)",
                        what, what);
-    uint32_t size = ((const uint32_t *)src)[0];
-    memcpy(dst, src, size < full ? size : full);
-    ((uint32_t *)dst)[0] = (uint32_t)full;
+    ws_def_copy(dst, full, src);
     return WS_OK;
 }
 
-void ws_world_def_init(ws_world_def *def)
+static void world_defaults(ws_world_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->gravity = v3_make(0.0, 0.0, -9.81);
     def->dt = 2.5e-4;
     def->integrator = WS_INTEGRATOR_SYMPLECTIC_EULER;
@@ -67,11 +63,11 @@ void ws_world_def_init(ws_world_def *def)
     def->max_angular_speed = 1e5;
     def->use_ccd = 1;
 }
+WS_DEF_INITS(ws_world_def, world_defaults, user_data)
 
-void ws_contact_def_init(ws_contact_def *def)
+static void contact_defaults(ws_contact_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->stiffness = 2e5;
     def->damping = 10.0;
     def->friction = 0.3;
@@ -80,12 +76,13 @@ void ws_contact_def_init(ws_contact_def *def)
     def->stick_stiffness = 2e5;
     def->stick_damping = 10.0;
 }
+WS_DEF_INITS(ws_contact_def, contact_defaults, stick_damping)
 
-void ws_material_def_init(ws_material_def *def)
+static void material_defaults(ws_material_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_material_def, material_defaults, name)
 
 static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)
 {
@@ -141,9 +138,12 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
     *out = NULL;
     if (!def)
         return WS_ERR_INVALID_ARGUMENT;
-    if (ws_def_check(def, sizeof *def) != 0)
+    if (ws_def_check(def) != 0)
         return WS_ERR_UNINITIALIZED_DEF;
-    ws_world_def d = *def;
+    /* A caller built against an older, smaller Def has only its own fields: the rest default. */
+    ws_world_def d;
+    ws_world_def_init(&d);
+    ws_def_copy(&d, sizeof d, def);
     if (!(isfinite(d.dt) && d.dt > 0.0) || !ws_is_finite3(&d.gravity) ||
         !(isfinite(d.full_detection_until)) || d.detection_interval < 1 ||
         !(isfinite(d.contact_margin) && d.contact_margin >= 0.0) ||
@@ -394,7 +394,7 @@ ws_status ws_material_create(ws_world *w, const ws_material_def *def, ws_materia
     out->bits = 0;
     ws_material_def d;
     ws_material_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "material");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "material");
     if (s != WS_OK)
         return s;
     return create_material(w, d.name, out);
@@ -447,7 +447,7 @@ ws_status ws_world_set_contact(ws_world *w, ws_material_id a, ws_material_id b,
         return s;
     ws_contact_def d;
     ws_contact_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "contact")) != WS_OK)
         return s;
     if ((s = check_contact_def(w, &d)) != WS_OK)
         return s;
@@ -483,7 +483,7 @@ ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
     ws_contact_def d;
     ws_contact_def_init(&d);
     ws_status s;
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "contact")) != WS_OK)
         return s;
     if ((s = check_contact_def(w, &d)) != WS_OK)
         return s;

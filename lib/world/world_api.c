@@ -59,11 +59,11 @@ int ws_shape_is_valid(const ws_world *w, ws_shape_id id)
 
 /* ---- shapes ---- */
 
-void ws_mesh_def_init(ws_mesh_def *def)
+static void mesh_defaults(ws_mesh_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_mesh_def, mesh_defaults, triangle_count)
 
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
                            size_t nt, const char *fn, ws_shape_id *out)
@@ -141,7 +141,7 @@ ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id 
     out->bits = 0;
     ws_mesh_def d;
     ws_mesh_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "mesh");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "mesh");
     if (s != WS_OK)
         return s;
     return add_shape(w, d.vertices, d.vertex_count, d.triangles, d.triangle_count,
@@ -220,25 +220,25 @@ ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices
 
 /* ---- bodies ---- */
 
-void ws_body_def_init(ws_body_def *def)
+static void body_defaults(ws_body_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_BODY_DYNAMIC;
     def->density = 1000.0;
     def->contact_layer = 1e-3;
     def->orientation = qt_identity();
 }
+WS_DEF_INITS(ws_body_def, body_defaults, user_data)
 
-void ws_drive_def_init(ws_drive_def *def)
+static void drive_defaults(ws_drive_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_DRIVE_STATIC;
     def->ramp_time = 0.05;
     def->axis = v3_make(0, 1, 0);
     def->direction = v3_make(1, 0, 0);
 }
+WS_DEF_INITS(ws_drive_def, drive_defaults, callback_user)
 
 static const char *label(const ws_body_def *d)
 {
@@ -252,7 +252,7 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
     out->bits = 0;
     ws_body_def d;
     ws_body_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "body");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "body");
     if (s != WS_OK)
         return s;
     const char *nm = label(&d);
@@ -405,7 +405,7 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
                        "body '%s': only kinematic bodies (world elements) take a drive", nm);
     ws_drive_def d;
     ws_drive_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "drive")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "drive")) != WS_OK)
         return s;
     ws_body_state *st = &b->st[w->cur];
     ws_pose base = {st->r[slot], st->p[slot]};

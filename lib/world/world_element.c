@@ -49,14 +49,14 @@ int ws_element_is_valid(const ws_world *w, ws_element_id id)
            w->element_slots.generation[s] == ws_id_gen(id.bits);
 }
 
-void ws_element_def_init(ws_element_def *def)
+static void element_defaults(ws_element_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_ELEMENT_ROD;
     def->formulation = WS_ELEMENT_INVARIANT;
     /* frame1 = frame2 = 0: automatic (see the header). */
 }
+WS_DEF_INITS(ws_element_def, element_defaults, user_data)
 
 /* The state of an end in body-state buffer k: a body's, or the world frame at rest. The global
  * angular velocity is formed as the step's prepare() forms it, so the read-out between steps
@@ -155,7 +155,7 @@ ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_i
     out->bits = 0;
     ws_element_def d;
     ws_element_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "element");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "element");
     if (s != WS_OK)
         return s;
     const char *nm = d.name ? d.name : "(unnamed)";

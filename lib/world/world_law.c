@@ -5,10 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 
-void ws_law_def_init(ws_law_def *def)
+static void law_defaults(ws_law_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_LAW_LINEAR_ELASTIC;
     def->transition = 1e-3;
     def->dim = 1;
@@ -17,6 +16,7 @@ void ws_law_def_init(ws_law_def *def)
     def->scale = 1.0;
     def->user_flags = WS_LAW_FLAG_ELASTIC | WS_LAW_FLAG_VISCOUS;
 }
+WS_DEF_INITS(ws_law_def, law_defaults, user_flags)
 
 ws_status ws_lookup_law(const ws_world *w, ws_law_id id, uint32_t *slot)
 {
@@ -50,7 +50,7 @@ ws_status ws_law_create(ws_world *w, const ws_law_def *def, ws_law_id *out)
     ws_law_def_init(&d);
     /* The first released layout ended at `name`; older callers keep working. */
     ws_status s =
-        ws_def_take(w, &d, sizeof d, def, offsetof(ws_law_def, name) + sizeof d.name, "law");
+        ws_def_take(w, &d, sizeof d, def, "law");
     if (s != WS_OK)
         return s;
     const char *label = d.name ? d.name : "(unnamed)";

@@ -154,7 +154,7 @@ def _fill(struct, kwargs):
 def _make(struct_type, kwargs):
     d = struct_type()
     init = {s: n for n, s in L.DEF_INITS}[struct_type]
-    getattr(_c(), init)(byref(d))
+    getattr(_c(), init)(byref(d), ctypes.sizeof(d))
     return _fill(d, kwargs)
 
 
