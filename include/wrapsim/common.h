@@ -77,7 +77,11 @@ typedef struct ws_pose {
  * and its stack is never written past its Def. The plain function ws_x_def_init, reached by
  * programs built against headers before the sized form, fills the layout of those headers. */
 
-/* Ids: a slot, a generation and a world tag packed into 64 bits; zero is the null id. Each kind
+/* Ids: opaque 64-bit values, [kind:4][generation:32][slot+1:28]; zero is the null id. Every call
+ * that takes an id refuses a destroyed one (WS_ERR_STALE_HANDLE) in any lifetime: a slot whose
+ * 32-bit generation would repeat is retired, never reused. An id of another world is refused
+ * except with odds of about 2^-32 per call (generations start from a per-world random salt).
+ * Each kind
  * has its own type so that a body id cannot be passed where a shape id is expected. */
 /** A rigid body or world element. */
 typedef struct ws_body_id {

@@ -95,7 +95,7 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
              (long)nv, (long)nt);
         return WS_ERR_BAD_MESH;
     }
-    if (nv > WS_ID_MAX_SLOTS || nt > WS_ID_MAX_SLOTS) {
+    if (nv > WS_MESH_MAX_ITEMS || nt > WS_MESH_MAX_ITEMS) {
         fail(why, why_len, "mesh: too large (%ld vertices, %ld triangles)", (long)nv, (long)nt);
         return WS_ERR_BAD_MESH;
     }

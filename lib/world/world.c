@@ -163,14 +163,15 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         return WS_ERR_OUT_OF_MEMORY;
     w->mem = mem;
     w->def = d;
-    /* A per-world tag in every id, so an id of another world is refused. Mixed from the address
-     * and the clock: no global counter is needed. */
-    uintptr_t mix = (uintptr_t)w ^ ((uintptr_t)&mix >> 4) ^ (uintptr_t)time(NULL) ^
-                    (uintptr_t)clock();
-    uint64_t h = ws_hash_bytes(WS_HASH_SEED, &mix, sizeof mix);
-    w->tag = (uint16_t)(h ^ (h >> 16) ^ (h >> 32) ^ (h >> 48));
-    if (w->tag == 0)
-        w->tag = 1;
+    /* The salt of every slot's first generation, so an id of another world is refused but
+     * with odds of about 2^-32 (base.h); no global counter is needed. */
+    uint32_t salt = ws_id_salt(w);
+    w->body_slots.salt = salt;
+    w->shape_slots.salt = salt;
+    w->mat_slots.salt = salt;
+    w->law_slots.salt = salt;
+    w->web_slots.salt = salt;
+    w->element_slots.salt = salt;
 
     w->params = ws_mem_alloc(&w->mem, 4 * sizeof *w->params);
     if (!w->params) {
@@ -383,7 +384,7 @@ static ws_status create_material(ws_world *w, const char *name, ws_material_id *
     w->mat_slots.dense[slot] = slot;
     for (size_t k = 0; k < w->pair_dim; k++)
         w->pair_index[slot * w->pair_dim + k] = w->pair_index[k * w->pair_dim + slot] = 0;
-    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->mat_slots, WS_KIND_MATERIAL, slot);
     return WS_OK;
 }
 
@@ -405,13 +406,13 @@ ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slo
     uint32_t s = ws_id_slot(id.bits);
     if (id.bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "material id is null");
-    if (ws_id_tag(id.bits) != w->tag || ws_id_kind(id.bits) != WS_KIND_MATERIAL)
-        return ws_fail(w, WS_ERR_STALE_HANDLE,
-                       "material id 0x%016llx is not a material of this world",
+    if (ws_id_kind(id.bits) != WS_KIND_MATERIAL)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id 0x%016llx is not a material id",
                        (unsigned long long)id.bits);
-    if (s >= w->mat_slots.slot_count || w->mat_slots.dense[s] == UINT32_MAX ||
-        w->mat_slots.generation[s] != ws_id_gen(id.bits))
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id 0x%016llx was destroyed",
+    if (!ws_slots_is_live(&w->mat_slots, id.bits, WS_KIND_MATERIAL))
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "material id 0x%016llx names no live material of this world (destroyed, "
+                       "or another world's)",
                        (unsigned long long)id.bits);
     *slot = s;
     return WS_OK;
@@ -433,7 +434,7 @@ ws_status ws_world_get_default_material(const ws_world *w, ws_material_id *out)
 {
     NEED_WORLD(w);
     NEED_OUT(w, out, "ws_world_get_default_material");
-    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[0], 0);
+    out->bits = ws_slots_id(&w->mat_slots, WS_KIND_MATERIAL, 0);
     return WS_OK;
 }
 

@@ -11,14 +11,15 @@ ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const 
 {
     if (bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id is null", what);
-    if (ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx does not belong to this world",
-                       what, (unsigned long long)bits);
-    uint32_t s = ws_id_slot(bits);
-    if (s >= t->slot_count || t->dense[s] == UINT32_MAX || t->generation[s] != ws_id_gen(bits))
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx was destroyed", what,
-                       (unsigned long long)bits);
-    *slot = s;
+    if (ws_id_kind(bits) != kind)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx is not a %s id", what,
+                       (unsigned long long)bits, what);
+    if (!ws_slots_is_live(t, bits, kind))
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "%s id 0x%016llx names no live %s of this world (destroyed, or another "
+                       "world's)",
+                       what, (unsigned long long)bits, what);
+    *slot = ws_id_slot(bits);
     return WS_OK;
 }
 
@@ -34,17 +35,14 @@ ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot)
 
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot)
 {
-    ws_body_id id = {ws_id_pack(w->tag, WS_KIND_BODY, w->body_slots.generation[slot], slot)};
+    ws_body_id id = {ws_slots_id(&w->body_slots, WS_KIND_BODY, slot)};
     return id;
 }
 
 /* is_valid must not disturb the last error: it is a question, not a failure. */
 static int quiet_valid(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t)
 {
-    if (!w || bits == 0 || ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return 0;
-    uint32_t s = ws_id_slot(bits);
-    return s < t->slot_count && t->dense[s] != UINT32_MAX && t->generation[s] == ws_id_gen(bits);
+    return w && ws_slots_is_live(t, bits, kind);
 }
 
 int ws_body_is_valid(const ws_world *w, ws_body_id id)
@@ -89,7 +87,7 @@ static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint
     }
     w->shapes[slot] = s;
     w->shape_slots.dense[slot] = slot;
-    out->bits = ws_id_pack(w->tag, WS_KIND_SHAPE, w->shape_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->shape_slots, WS_KIND_SHAPE, slot);
     return WS_OK;
 }
 

@@ -43,10 +43,7 @@ int ws_element_is_valid(const ws_world *w, ws_element_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_ELEMENT &&
-           s < w->element_slots.slot_count && w->element_slots.dense[s] != UINT32_MAX &&
-           w->element_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->element_slots, id.bits, WS_KIND_ELEMENT);
 }
 
 static void element_defaults(ws_element_def *def)
@@ -224,7 +221,7 @@ ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_i
     *p = e;
     w->elements[slot] = p;
     L->users++;
-    out->bits = ws_id_pack(w->tag, WS_KIND_ELEMENT, w->element_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->element_slots, WS_KIND_ELEMENT, slot);
     return WS_OK;
 }
 
@@ -537,7 +534,7 @@ ws_status ws_world_copy_element_ids(const ws_world *w, ws_element_id *buf, size_
             continue;
         if (n < cap)
             buf[n].bits =
-                ws_id_pack(w->tag, WS_KIND_ELEMENT, w->element_slots.generation[i], (uint32_t)i);
+                ws_slots_id(&w->element_slots, WS_KIND_ELEMENT, (uint32_t)i);
         n++;
     }
     *count = n;

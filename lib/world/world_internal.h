@@ -20,7 +20,6 @@
 struct ws_world {
     ws_mem mem;
     ws_world_def def;
-    uint16_t tag;
     double time;
     uint64_t steps;
     uint64_t last_full_step;

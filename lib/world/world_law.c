@@ -27,10 +27,7 @@ int ws_law_is_valid(const ws_world *w, ws_law_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_LAW &&
-           s < w->law_slots.slot_count && w->law_slots.dense[s] != UINT32_MAX &&
-           w->law_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->law_slots, id.bits, WS_KIND_LAW);
 }
 
 /* The law of an id, or NULL with the error recorded (status in *s). */
@@ -100,7 +97,7 @@ ws_status ws_law_create(ws_world *w, const ws_law_def *def, ws_law_id *out)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_law_create: out of memory");
     }
     w->laws[slot] = p;
-    out->bits = ws_id_pack(w->tag, WS_KIND_LAW, w->law_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->law_slots, WS_KIND_LAW, slot);
     return WS_OK;
 }
 

@@ -15,10 +15,7 @@ int ws_web_is_valid(const ws_world *w, ws_web_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_WEB &&
-           s < w->web_slots.slot_count && w->web_slots.dense[s] != UINT32_MAX &&
-           w->web_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->web_slots, id.bits, WS_KIND_WEB);
 }
 
 static void web_defaults(ws_web_def *def)
@@ -191,7 +188,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     law_users(keep, +1);
     w->web_check = 1;
     w->cand_valid = 0;
-    out->bits = ws_id_pack(w->tag, WS_KIND_WEB, w->web_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->web_slots, WS_KIND_WEB, slot);
     return WS_OK;
 }
 
