@@ -45,6 +45,14 @@ typedef struct ws_law_id {
 #define WS_LAW_MAX_TERMS 16
 /** Largest number of Prony branches of a WS_LAW_RELAXATION. */
 #define WS_LAW_MAX_PRONY 16
+/** Most doubles of history a law may need per user (ws_law_get_state_size), with everything its
+ *  sums and scalings contain: a sum of 16 dim-6 relaxation laws of 16 branches needs 1632. A
+ *  law that would need more is refused at create. */
+#define WS_LAW_MAX_HISTORY 4096
+/** Most leaf laws (laws that are neither sums nor scalings) one evaluation may visit, counting
+ *  a law each time it appears: a sum of 16 sums of 16 laws has 256. Sums of sums that would
+ *  visit more are refused at create, so the cost of an evaluation stays bounded. */
+#define WS_LAW_MAX_LEAVES 256
 
 /** Kinds of laws. In the formulas u is the strain, u_dot its rate, K the stiffness
  *  (`stiffness` times the identity, or `stiffness_matrix`) and C the damping (`damping` times
