@@ -655,7 +655,7 @@ START_TEST(test_oom_world_create)
     long n;
     int done = 0;
     for (n = 0; n < MAX_ALLOCS && !done; n++) {
-        test_alloc a = {n, 0, 0};
+        test_alloc a = {.allocs_left = n};
         ws_world_def d;
         ws_world_def_init(&d);
         test_alloc_install(&d, &a);
@@ -698,7 +698,7 @@ START_TEST(test_oom_shape_create)
     for (int kind = 0; kind < 3; kind++) {
         int done = 0;
         for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             a.allocs_left = n;
             ws_shape_id s = {777};
@@ -738,7 +738,7 @@ START_TEST(test_oom_body_create)
     for (int variant = 0; variant < 3; variant++) {
         int done = 0;
         for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             ws_shape_id s;
             ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &s));
@@ -795,7 +795,7 @@ START_TEST(test_oom_step)
 {
     int done = 0;
     for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-        test_alloc a = {-1, 0, 0};
+        test_alloc a = {.allocs_left = -1};
         ws_world *w = counted_world(&a);
         box_on_ground(w);
         uint64_t h0 = hash_of(w);
@@ -827,7 +827,7 @@ END_TEST
 /* STYLE rule 9: once warm, a step allocates nothing. */
 START_TEST(test_warm_step_allocates_nothing)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     box_on_ground(w);
     box_at(w, 0.1, 0.5, 0.0, 0.0, 0.2 + 0.05 + 2 * 1.99e-3, "top");
@@ -846,7 +846,7 @@ END_TEST
 
 START_TEST(test_bytes_back_to_zero)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     ws_world_stats st;
     ck_ok(w, ws_world_get_stats(w, &st));

@@ -1337,7 +1337,7 @@ START_TEST(test_out_of_memory_and_bytes)
     for (int variant = 0; variant < 2; variant++) {
         int done = 0;
         for (long n = 0; n < 200 && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world_def wd;
             ws_world_def_init(&wd);
             test_alloc_install(&wd, &a);
@@ -1405,7 +1405,7 @@ END_TEST
 /* A warm step with elements allocates nothing. */
 START_TEST(test_step_allocates_nothing)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world_def wd;
     ws_world_def_init(&wd);
     wd.gravity = v3(0, 0, 0);

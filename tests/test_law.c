@@ -1591,7 +1591,7 @@ START_TEST(test_oom_and_bytes)
          * the n-th allocation failing, until it succeeds. */
         int done = 0;
         for (long n = 0; n < 200 && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             ws_law_id warm = make_law(w, L_ELASTIC, 1, NULL, NULL, NULL);
             ck_ok(w, ws_law_destroy(w, warm));
@@ -1637,7 +1637,7 @@ START_TEST(test_oom_and_bytes)
     /* Every law of every dim made and destroyed, twice: the second round ends where the
      * first did (the pool arrays keep their capacity), and the world's destroy returns every
      * byte. */
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     uint64_t after[2] = {0, 0}, peak = 0;
     int nm = 0;
