@@ -1478,6 +1478,230 @@ START_TEST(test_old_size_defs)
 }
 END_TEST
 
+/* ---- re-entrancy: callbacks inside a step may read the world, never change it ---- */
+
+enum { REENTRY_CALLS = 24 };
+
+typedef struct reentry {
+    ws_world *w;
+    ws_body_id body, kin;
+    ws_shape_id shape;
+    ws_law_id law;
+    ws_element_id element;
+    ws_material_id mat;
+    int calls;                    /* callback calls */
+    ws_status got[REENTRY_CALLS]; /* what each mutating call returned, the first time */
+    int named[REENTRY_CALLS];     /* 1 when its last error named it and the step */
+    int read_ok;                  /* a getter worked inside the step */
+} reentry;
+
+/* Try every kind of call that changes the world; record what each returned. */
+static void try_mutations(reentry *r)
+{
+    ws_world *w = r->w;
+    static const char *const names[REENTRY_CALLS] = {
+        "ws_body_destroy", "ws_body_create", "ws_world_step", "ws_world_step_n",
+        "ws_shape_create_box", "ws_shape_create_cylinder", "ws_shape_create_mesh",
+        "ws_shape_destroy", "ws_law_create", "ws_law_destroy", "ws_element_create",
+        "ws_element_destroy", "ws_body_set_pose", "ws_body_set_velocity", "ws_body_set_drive",
+        "ws_world_set_dt", "ws_world_set_gravity", "ws_material_create", "ws_world_set_contact",
+        "ws_world_set_default_contact", "ws_web_create_sheet", "ws_web_create_band",
+        "ws_web_create_mesh", "ws_world_destroy"};
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = r->shape;
+    bd.mass = 1.0;
+    ws_mesh_def md;
+    ws_mesh_def_init(&md);
+    md.vertices = cube_v;
+    md.vertex_count = 8;
+    md.triangles = cube_t;
+    md.triangle_count = 12;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.stiffness = 1.0;
+    ws_element_def ed;
+    ws_element_def_init(&ed);
+    ed.body2 = r->body;
+    ed.law = r->law;
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    ws_material_def mtd;
+    ws_material_def_init(&mtd);
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 0.01;
+    wd.law = r->law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 2;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    ws_band_def bnd;
+    ws_band_def_init(&bnd);
+    ws_web_mesh_def wm;
+    ws_web_mesh_def_init(&wm);
+    ws_pose pose = {{0, 0, 1}, {1, 0, 0, 0}};
+    ws_vec3 v = {0, 0, 0}, g = {0, 0, -1};
+    ws_body_id b;
+    ws_shape_id sh;
+    ws_law_id l;
+    ws_element_id e;
+    ws_material_id m;
+    ws_web_id web;
+    int k = 0;
+#define TRY(call)                                                                                 \
+    do {                                                                                          \
+        r->got[k] = (call);                                                                       \
+        const char *e_ = ws_world_last_error(w);                                                  \
+        r->named[k] = strstr(e_, names[k]) == e_ &&                                               \
+                      strstr(e_, " called from inside ws_world_step (a callback)") != NULL;       \
+        k++;                                                                                      \
+    } while (0)
+    TRY(ws_body_destroy(w, r->body));
+    TRY(ws_body_create(w, &bd, &b));
+    TRY(ws_world_step(w));
+    TRY(ws_world_step_n(w, 3));
+    TRY(ws_shape_create_box(w, 1, 1, 1, &sh));
+    TRY(ws_shape_create_cylinder(w, 1, 1, 8, &sh));
+    TRY(ws_shape_create_mesh(w, &md, &sh));
+    TRY(ws_shape_destroy(w, r->shape));
+    TRY(ws_law_create(w, &ld, &l));
+    TRY(ws_law_destroy(w, r->law));
+    TRY(ws_element_create(w, &ed, &e));
+    TRY(ws_element_destroy(w, r->element));
+    TRY(ws_body_set_pose(w, r->body, &pose));
+    TRY(ws_body_set_velocity(w, r->body, &v, &v));
+    TRY(ws_body_set_drive(w, r->kin, &dd));
+    TRY(ws_world_set_dt(w, 1e-4));
+    TRY(ws_world_set_gravity(w, &g));
+    TRY(ws_material_create(w, &mtd, &m));
+    TRY(ws_world_set_contact(w, r->mat, r->mat, &cd));
+    TRY(ws_world_set_default_contact(w, &cd));
+    TRY(ws_web_create_sheet(w, &wd, &sd, &web));
+    TRY(ws_web_create_band(w, &wd, &bnd, &web));
+    TRY(ws_web_create_mesh(w, &wd, &wm, &web));
+    /* ws_world_destroy returns nothing: it must leave the world alone and say why. */
+    TRY((ws_world_destroy(w), WS_ERR_IN_STEP));
+#undef TRY
+    ck_assert_int_eq(k, REENTRY_CALLS);
+    ws_vec3 p;
+    r->read_ok = ws_body_get_position(w, r->body, &p) == WS_OK && p.z > 0.0;
+}
+
+static int reentry_drive(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec3 *om)
+{
+    reentry *r = user;
+    if (r->calls++ == 1) /* the first call is ws_body_set_drive's own, outside a step */
+        try_mutations(r);
+    *pose = (ws_pose){{0, 0, -1}, {1, 0, 0, 0}};
+    (void)t;
+    *v = *om = (ws_vec3){0, 0, 0};
+    return 0;
+}
+
+static int reentry_law(void *user, int dim, const double *u, const double *ud, double t,
+                       double *F, double *dFdu, double *dFdud)
+{
+    reentry *r = user;
+    if (r->calls++ == 0)
+        try_mutations(r);
+    (void)dim;
+    (void)ud;
+    (void)t;
+    F[0] = 10.0 * u[0];
+    if (dFdu)
+        dFdu[0] = 10.0;
+    if (dFdud)
+        dFdud[0] = 0.0;
+    return 0;
+}
+
+/* A world with a dynamic box, a kinematic slab and a rod from the world to the box; `law_cb`
+ * puts the re-entering callback in the rod's law, else in the slab's drive. */
+static ws_world *reentry_world(reentry *r, int law_cb)
+{
+    memset(r, 0, sizeof *r);
+    ws_world *w = new_world(2.5e-4);
+    r->w = w;
+    ck_ok(w, ws_world_get_default_material(w, &r->mat));
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &r->shape));
+    r->body = box_at(w, 0.1, 1.0, 0.0, 0.0, 1.0, "box");
+    r->kin = add_ground(w, 1.0, no_material());
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    if (law_cb) {
+        ld.type = WS_LAW_USER;
+        ld.user_fn = reentry_law;
+        ld.user_data = r;
+        ld.stiffness = 10.0;
+    } else {
+        ld.stiffness = 10.0;
+    }
+    ck_ok(w, ws_law_create(w, &ld, &r->law));
+    ws_element_def ed;
+    ws_element_def_init(&ed);
+    ed.body2 = r->body;
+    ed.law = r->law;
+    ed.point1 = (ws_vec3){0, 0, 2.0};
+    ed.global_attachment = 1;
+    ed.point2 = (ws_vec3){0, 0, 1.05};
+    ck_ok(w, ws_element_create(w, &ed, &r->element));
+    if (!law_cb) {
+        ws_drive_def dd;
+        ws_drive_def_init(&dd);
+        dd.type = WS_DRIVE_CALLBACK;
+        dd.callback = reentry_drive;
+        dd.callback_user = r;
+        ck_ok(w, ws_body_set_drive(w, r->kin, &dd));
+    }
+    return w;
+}
+
+static void check_reentry(reentry *r, const char *where)
+{
+    ws_world *w = r->w;
+    ws_world_stats st;
+    ck_ok(w, ws_world_step(w));
+    ck_assert_msg(r->calls >= 1, "%s: the callback was not called", where);
+    for (int k = 0; k < REENTRY_CALLS; k++) {
+        ck_assert_msg(r->got[k] == WS_ERR_IN_STEP, "%s: call %d returned %s", where, k,
+                      ws_status_string(r->got[k]));
+        ck_assert_msg(r->named[k], "%s: call %d's last error does not name it", where, k);
+    }
+    ck_assert_msg(r->read_ok, "%s: a getter failed inside the step", where);
+    /* Nothing changed: the same objects and parameters, and the world steps on; outside a
+     * step the same calls work. */
+    ck_assert(ws_body_is_valid(w, r->body) && ws_element_is_valid(w, r->element));
+    ck_assert(ws_law_is_valid(w, r->law) && ws_shape_is_valid(w, r->shape));
+    ck_ok(w, ws_world_get_stats(w, &st));
+    ck_assert_uint_eq(st.bodies, 2);
+    double dt;
+    ck_ok(w, ws_world_get_dt(w, &dt));
+    ck_assert(dt == 2.5e-4);
+    ck_ok(w, ws_world_step_n(w, 10));
+    ck_ok(w, ws_element_destroy(w, r->element));
+    ck_ok(w, ws_body_destroy(w, r->body));
+    ws_world_destroy(w);
+}
+
+START_TEST(test_reentry_from_drive)
+{
+    reentry r;
+    reentry_world(&r, 0);
+    check_reentry(&r, "drive callback");
+}
+END_TEST
+
+START_TEST(test_reentry_from_law)
+{
+    reentry r;
+    reentry_world(&r, 1);
+    check_reentry(&r, "law callback");
+}
+END_TEST
+
 /* ---- suite ---- */
 
 static void add(Suite *s, const char *name, const TTest *t, double timeout)
@@ -1505,6 +1729,8 @@ static Suite *api_suite(void)
     add(s, "uninit_material_def", test_uninit_material_def, 10);
     add(s, "uninit_drive_def", test_uninit_drive_def, 10);
     add(s, "old_size_defs", test_old_size_defs, 10);
+    add(s, "reentry_from_drive", test_reentry_from_drive, 10);
+    add(s, "reentry_from_law", test_reentry_from_law, 10);
     add(s, "bad_world_numbers", test_bad_world_numbers, 10);
     add(s, "bad_body_numbers", test_bad_body_numbers, 10);
     add(s, "bad_contact_numbers", test_bad_contact_numbers, 10);

@@ -40,7 +40,10 @@ typedef enum ws_status {
     WS_ERR_CALLBACK = 8,          /**< a user callback reported failure */
     WS_ERR_BUFFER_TOO_SMALL = 9,  /**< a bulk copy got less room than it needs; count says how much */
     WS_ERR_IO = 10,               /**< a file could not be written */
-    WS_ERR_UNSUPPORTED = 11       /**< a feature this build does not have (e.g. libccd) */
+    WS_ERR_UNSUPPORTED = 11,      /**< a feature this build does not have (e.g. libccd) */
+    /** a call that changes the world (create, destroy, set, step) made from a callback inside
+     *  ws_world_step; getters are allowed there */
+    WS_ERR_IN_STEP = 12
 } ws_status;
 
 /** A vector in metres, m/s, newtons ... as the call says. */

@@ -144,11 +144,14 @@ WS_API void(ws_material_def_init)(ws_material_def *def);
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, dt <= 0, NaN...), WS_ERR_UNINITIALIZED_DEF,
  *          WS_ERR_OUT_OF_MEMORY. Without a world there is no last error: see the status. */
 WS_API ws_status ws_world_create(const ws_world_def *def, ws_world **out);
-/** Destroy a world and everything in it. NULL is allowed and does nothing. */
+/** Destroy a world and everything in it. NULL is allowed and does nothing. Called from a
+ *  callback inside ws_world_step it does nothing but set the last error (WS_ERR_IN_STEP). */
 WS_API void ws_world_destroy(ws_world *world);
 
 /** Advance one step dt. On WS_ERR_NUMERICAL (or a callback error) the world is left exactly as it
- *  was before the call and ws_world_last_error() says which body and what to change. */
+ *  was before the call and ws_world_last_error() says which body and what to change.
+ *  Callbacks run inside a step (drives, laws, the log hook) may read the world with any getter;
+ *  every call that changes it (create, destroy, set, step) returns WS_ERR_IN_STEP there. */
 WS_API ws_status ws_world_step(ws_world *world);
 /** Take up to `steps` steps, stopping at the first error. */
 WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);

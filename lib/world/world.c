@@ -197,6 +197,12 @@ void ws_world_destroy(ws_world *w)
 {
     if (!w)
         return;
+    if (w->in_step) {
+        /* The step still runs on this world: refuse, saying so (it has no status to return). */
+        ws_fail(w, WS_ERR_IN_STEP, "ws_world_destroy called from inside ws_world_step (a "
+                                   "callback); the world was not destroyed");
+        return;
+    }
     ws_mem *m = &w->mem;
     ws_world_free_elements(w); /* before the laws and bodies they use */
     ws_world_free_webs(w);
@@ -261,6 +267,7 @@ ws_status ws_world_get_dt(const ws_world *w, double *dt)
 ws_status ws_world_set_dt(ws_world *w, double dt)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_dt");
     if (!(isfinite(dt) && dt > 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_dt: dt must be > 0 s, got %g", dt);
     w->def.dt = dt;
@@ -271,6 +278,7 @@ ws_status ws_world_set_dt(ws_world *w, double dt)
 ws_status ws_world_set_gravity(ws_world *w, const ws_vec3 *g)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_gravity");
     if (!g || !ws_is_finite3(g))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_gravity: gravity must be finite");
     w->def.gravity = *g;
@@ -391,6 +399,7 @@ static ws_status create_material(ws_world *w, const char *name, ws_material_id *
 ws_status ws_material_create(ws_world *w, const ws_material_def *def, ws_material_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_material_create");
     NEED_OUT(w, out, "ws_material_create");
     out->bits = 0;
     ws_material_def d;
@@ -442,6 +451,7 @@ ws_status ws_world_set_contact(ws_world *w, ws_material_id a, ws_material_id b,
                                const ws_contact_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_contact");
     uint32_t sa, sb;
     ws_status s;
     if ((s = ws_lookup_material(w, a, &sa)) != WS_OK || (s = ws_lookup_material(w, b, &sb)) != WS_OK)
@@ -481,6 +491,7 @@ ws_status ws_world_get_contact(const ws_world *w, ws_material_id a, ws_material_
 ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_default_contact");
     ws_contact_def d;
     ws_contact_def_init(&d);
     ws_status s;

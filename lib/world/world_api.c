@@ -94,6 +94,7 @@ static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint
 ws_status ws_shape_create_box(ws_world *w, double lx, double ly, double lz, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_box");
     NEED_OUT(w, out, "ws_shape_create_box");
     out->bits = 0;
     if (!(isfinite(lx) && isfinite(ly) && isfinite(lz) && lx > 0.0 && ly > 0.0 && lz > 0.0))
@@ -110,6 +111,7 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
                                    ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_cylinder");
     NEED_OUT(w, out, "ws_shape_create_cylinder");
     out->bits = 0;
     if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024)
@@ -135,6 +137,7 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
 ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_mesh");
     NEED_OUT(w, out, "ws_shape_create_mesh");
     out->bits = 0;
     ws_mesh_def d;
@@ -149,6 +152,7 @@ ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id 
 ws_status ws_shape_destroy(ws_world *w, ws_shape_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_shape(w, id, &slot);
     if (s != WS_OK)
@@ -246,6 +250,7 @@ static const char *label(const ws_body_def *d)
 ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_create");
     NEED_OUT(w, out, "ws_body_create");
     out->bits = 0;
     ws_body_def d;
@@ -371,6 +376,7 @@ void ws_world_forget_body(ws_world *w, uint32_t slot)
 ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -392,6 +398,7 @@ ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_drive");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -536,6 +543,7 @@ ws_status ws_body_get_contact_force(const ws_world *w, ws_body_id id, ws_vec3 *f
 ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_pose");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)
@@ -562,6 +570,7 @@ ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 ws_status ws_body_set_velocity(ws_world *w, ws_body_id id, const ws_vec3 *v, const ws_vec3 *om)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_velocity");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)

@@ -148,6 +148,7 @@ static void free_element(ws_world *w, uint32_t slot)
 ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_element_create");
     NEED_OUT(w, out, "ws_element_create");
     out->bits = 0;
     ws_element_def d;
@@ -228,6 +229,7 @@ ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_i
 ws_status ws_element_destroy(ws_world *w, ws_element_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_element_destroy");
     uint32_t slot;
     ws_status s = lookup_element(w, id, &slot);
     if (s != WS_OK)

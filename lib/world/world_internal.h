@@ -26,6 +26,7 @@ struct ws_world {
     int cand_valid; /* 0 forces a full detection on the next step */
     double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
+    int in_step;    /* 1 while ws_world_step runs: its callbacks may only read */
     char err[WS_ERR_LEN];
 
     ws_body_store bodies;
@@ -94,6 +95,17 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
     do {                                                                                          \
         if (!(p))                                                                                 \
             return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
+    } while (0)
+
+/* Calls that change the world are refused from inside a step (from a drive, law or log
+ * callback); getters stay allowed, they read the committed state, which a step leaves alone. */
+#define NOT_IN_STEP(w, fn)                                                                        \
+    do {                                                                                          \
+        if ((w)->in_step)                                                                         \
+            return ws_fail((w), WS_ERR_IN_STEP,                                                   \
+                           "%s called from inside ws_world_step (a callback); a callback may "    \
+                           "only read the world",                                                 \
+                           fn);                                                                   \
     } while (0)
 
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);

@@ -41,6 +41,7 @@ static ws_law *find(const ws_world *w, ws_law_id id, ws_status *s)
 ws_status ws_law_create(ws_world *w, const ws_law_def *def, ws_law_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_law_create");
     NEED_OUT(w, out, "ws_law_create");
     out->bits = 0;
     ws_law_def d;
@@ -111,6 +112,7 @@ static void free_law(ws_world *w, uint32_t slot, int release_refs)
 ws_status ws_law_destroy(ws_world *w, ws_law_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_law_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_law(w, id, &slot);
     if (s != WS_OK)

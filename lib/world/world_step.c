@@ -346,10 +346,9 @@ static ws_status health(ws_world *w, int nxt)
     return WS_OK;
 }
 
-ws_status ws_world_step(ws_world *w)
+/* One step; ws_world_step guards it against calls from its own callbacks. */
+static ws_status step_once(ws_world *w)
 {
-    if (!w)
-        return WS_ERR_INVALID_ARGUMENT;
     ws_body_store *b = &w->bodies;
     const int cur = w->cur, nxt = cur ^ 1;
     const double dt = w->def.dt, t = w->time;
@@ -462,10 +461,22 @@ ws_status ws_world_step(ws_world *w)
     return WS_OK;
 }
 
+ws_status ws_world_step(ws_world *w)
+{
+    NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_step");
+    /* A callback (drive, law, log hook) that changed the world would pull pools and buffers
+     * from under the step: every call that changes the world checks this flag. */
+    w->in_step = 1;
+    ws_status s = step_once(w);
+    w->in_step = 0;
+    return s;
+}
+
 ws_status ws_world_step_n(ws_world *w, int64_t steps)
 {
-    if (!w)
-        return WS_ERR_INVALID_ARGUMENT;
+    NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_step_n");
     if (steps < 0)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_step_n: steps must be >= 0, got %lld",
                        (long long)steps);

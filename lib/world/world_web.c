@@ -203,6 +203,7 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
                               ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_sheet");
     NEED_OUT(w, out, "ws_web_create_sheet");
     out->bits = 0;
     web_common c;
@@ -242,6 +243,7 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
                              ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_band");
     NEED_OUT(w, out, "ws_web_create_band");
     out->bits = 0;
     web_common c;
@@ -320,6 +322,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
                              ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_mesh");
     NEED_OUT(w, out, "ws_web_create_mesh");
     out->bits = 0;
     web_common c;
@@ -372,6 +375,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
 ws_status ws_web_destroy(ws_world *w, ws_web_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_web(w, id, &slot);
     if (s != WS_OK)
@@ -476,6 +480,7 @@ ws_status ws_web_get_stable_dt(const ws_world *w, ws_web_id id, double *dt)
 ws_status ws_web_set_substeps(ws_world *w, ws_web_id id, int substeps)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_set_substeps");
     uint32_t slot;
     ws_status s = ws_lookup_web(w, id, &slot);
     if (s != WS_OK)
