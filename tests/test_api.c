@@ -1702,6 +1702,128 @@ START_TEST(test_reentry_from_law)
 }
 END_TEST
 
+/* ---- small refusals: each says what is really wrong ---- */
+
+static int ends_with(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    return n >= m && strcmp(s + n - m, tail) == 0;
+}
+
+#define ck_err_ends(w, tail)                                                                      \
+    ck_assert_msg(ends_with(ws_world_last_error(w), tail), "last error '%s' does not end in '%s'", \
+                  ws_world_last_error(w), tail)
+
+START_TEST(test_mesh_messages)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_shape_id s;
+    static const uint32_t tet[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    static const uint32_t tet_in[12] = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
+    static const uint32_t tet_deg[12] = {0, 2, 2, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    double v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    /* Every message ends in its own words, not in stray numbers. */
+    ck_assert_int_eq(create_mesh(w, NULL, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_ends(w, "vertices and triangles must not be NULL");
+    ck_assert_int_eq(create_mesh(w, v, 4, tet_deg, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "triangle 0 is degenerate (zero area)");
+    ck_assert_int_eq(create_mesh(w, v, 4, tet_in, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "counter-clockwise seen from outside");
+    double same[12] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    ck_assert_int_eq(create_mesh(w, same, 4, tet, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "all vertices coincide");
+    v[4] = NAN;
+    ck_assert_int_eq(create_mesh(w, v, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_ends(w, "vertex 1 has a coordinate that is not finite");
+    /* Sizes: a 1e200 box is too large, not "degenerate"; a 1e-200 one too small. */
+    ck_assert_int_eq(ws_shape_create_box(w, 1e200, 1e200, 1e200, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "WS_MESH_MAX_COORD");
+    ck_assert_int_eq(ws_shape_create_cylinder(w, 1e200, 1.0, 8, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "WS_MESH_MAX_COORD");
+    double big[12] = {0, 0, 0, 1e200, 0, 0, 0, 1e200, 0, 0, 0, 1e200};
+    ck_assert_int_eq(create_mesh(w, big, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "beyond WS_MESH_MAX_COORD (1e+06 m)");
+    double tiny[12] = {0, 0, 0, 1e-200, 0, 0, 0, 1e-200, 0, 0, 0, 1e-200};
+    ck_assert_int_eq(create_mesh(w, tiny, 4, tet, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_has(w, "below WS_MESH_MIN_EXTENT (1e-06 m)");
+    /* At the bounds they are taken: a 2e6 m box, a 1 mm one. */
+    ck_ok(w, ws_shape_create_box(w, 2e6, 2e6, 2e6, &s));
+    ck_ok(w, ws_shape_create_box(w, 1e-3, 1e-3, 1e-3, &s));
+    ws_world_destroy(w);
+}
+END_TEST
+
+static ws_status body_with(ws_world *w, ws_shape_id s, double mass, const double *jdiag)
+{
+    ws_body_def d;
+    ws_body_def_init(&d);
+    d.shape = s;
+    d.mass = mass;
+    if (jdiag) {
+        d.inertia.m[0] = jdiag[0];
+        d.inertia.m[4] = jdiag[1];
+        d.inertia.m[8] = jdiag[2];
+    }
+    ws_body_id b;
+    return ws_body_create(w, &d, &b);
+}
+
+START_TEST(test_body_mass_and_inertia)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &s));
+    /* Masses outside the sane range are named as such, not as an inertia problem. */
+    const double bad_mass[] = {1e300, 1e-300, 2e9, 1e-7};
+    for (size_t k = 0; k < sizeof bad_mass / sizeof *bad_mass; k++) {
+        ck_assert_int_eq(body_with(w, s, bad_mass[k], NULL), WS_ERR_INVALID_ARGUMENT);
+        ck_err_has(w, "is outside [WS_BODY_MIN_MASS, WS_BODY_MAX_MASS] = [1e-06, 1e+09] kg");
+        ck_assert_ptr_null(strstr(ws_world_last_error(w), "positive definite"));
+    }
+    ck_ok(w, body_with(w, s, WS_BODY_MAX_MASS, NULL));
+    ck_ok(w, body_with(w, s, WS_BODY_MIN_MASS, NULL));
+    /* Density x volume out of range says so. */
+    ws_body_def d;
+    ws_body_def_init(&d);
+    d.shape = s;
+    d.density = 1e300;
+    ws_body_id b;
+    ck_assert_int_eq(ws_body_create(w, &d, &b), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "(density x volume)");
+    /* Principal moments: J1 + J2 >= J3 for any rigid body (a flat plate is the equality). */
+    const double no_body[3] = {1, 1, 5}, no_body2[3] = {5, 1, 1}, plate[3] = {1, 1, 2},
+                 solid[3] = {1, 2, 2.9};
+    ck_assert_int_eq(body_with(w, s, 1.0, no_body), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "each must be at most the sum of the other two (J1 + J2 >= J3)");
+    ck_assert_int_eq(body_with(w, s, 1.0, no_body2), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "J1 + J2 >= J3");
+    ck_ok(w, body_with(w, s, 1.0, plate));
+    ck_ok(w, body_with(w, s, 1.0, solid));
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_vtk_series_directory)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_vtk_series *series = (ws_vtk_series *)w;
+    const char *missing = "/nonexistent-wrapsim-test-dir/frames";
+    ck_assert_int_eq(ws_vtk_series_create(w, missing, "run", &series), WS_ERR_IO);
+    ck_assert_ptr_null(series);
+    ck_err_has(w, missing);
+    /* Something that is not a directory where the directory should be. */
+    FILE *f = fopen("/dev/null", "r");
+    if (f) {
+        fclose(f);
+        ck_assert_int_eq(ws_vtk_series_create(w, "/dev/null", "run", &series), WS_ERR_IO);
+        ck_err_has(w, "'/dev/null' is not a directory");
+    }
+    ck_ok(w, ws_vtk_series_create(w, ".", "run", &series));
+    ws_vtk_series_destroy(series);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* ---- suite ---- */
 
 static void add(Suite *s, const char *name, const TTest *t, double timeout)
@@ -1730,6 +1852,9 @@ static Suite *api_suite(void)
     add(s, "uninit_drive_def", test_uninit_drive_def, 10);
     add(s, "old_size_defs", test_old_size_defs, 10);
     add(s, "reentry_from_drive", test_reentry_from_drive, 10);
+    add(s, "mesh_messages", test_mesh_messages, 10);
+    add(s, "body_mass_and_inertia", test_body_mass_and_inertia, 10);
+    add(s, "vtk_series_directory", test_vtk_series_directory, 10);
     add(s, "reentry_from_law", test_reentry_from_law, 10);
     add(s, "bad_world_numbers", test_bad_world_numbers, 10);
     add(s, "bad_body_numbers", test_bad_body_numbers, 10);

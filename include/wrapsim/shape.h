@@ -50,7 +50,15 @@ WS_API void ws_mesh_def_init_sized(ws_mesh_def *def, size_t size);
 WS_API void(ws_mesh_def_init)(ws_mesh_def *def);
 #define ws_mesh_def_init(def) ws_mesh_def_init_sized((def), sizeof *(def))
 
-/** A box with full edge lengths lx, ly, lz (m, each > 0), centred on the origin.
+/** Largest magnitude of a mesh vertex coordinate, m. Beyond it a mesh's areas and volumes
+ *  overflow, and no load is that large; such a vertex is refused (WS_ERR_INVALID_ARGUMENT). */
+#define WS_MESH_MAX_COORD 1e6
+/** Smallest extent (largest side of the bounding box) of a mesh, m; a smaller one is refused
+ *  (WS_ERR_BAD_MESH). */
+#define WS_MESH_MIN_EXTENT 1e-6
+
+/** A box with full edge lengths lx, ly, lz (m, each > 0 and at most 2 WS_MESH_MAX_COORD),
+ *  centred on the origin.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_OUT_OF_MEMORY, WS_ERR_STALE_HANDLE never. */
 WS_API ws_status ws_shape_create_box(ws_world *world, double lx, double ly, double lz,
                                      ws_shape_id *out);

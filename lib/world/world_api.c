@@ -101,6 +101,12 @@ ws_status ws_shape_create_box(ws_world *w, double lx, double ly, double lz, ws_s
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_shape_create_box: edge lengths must be > 0 m, got %g x %g x %g", lx, ly,
                        lz);
+    if (lx > 2.0 * WS_MESH_MAX_COORD || ly > 2.0 * WS_MESH_MAX_COORD ||
+        lz > 2.0 * WS_MESH_MAX_COORD)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_create_box: edge lengths must be at most 2 WS_MESH_MAX_COORD "
+                       "(%g m), got %g x %g x %g",
+                       2.0 * WS_MESH_MAX_COORD, lx, ly, lz);
     double xyz[24];
     uint32_t tri[36];
     ws_shape_box_mesh(lx, ly, lz, xyz, tri);
@@ -114,11 +120,12 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
     NOT_IN_STEP(w, "ws_shape_create_cylinder");
     NEED_OUT(w, out, "ws_shape_create_cylinder");
     out->bits = 0;
-    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024)
+    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024 ||
+        r > WS_MESH_MAX_COORD || h > 2.0 * WS_MESH_MAX_COORD)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "ws_shape_create_cylinder: need radius > 0, height > 0 and 3..1024 "
-                       "segments, got %g, %g, %d",
-                       r, h, segments);
+                       "ws_shape_create_cylinder: need 0 < radius <= WS_MESH_MAX_COORD (%g m), "
+                       "0 < height <= 2 WS_MESH_MAX_COORD and 3..1024 segments, got %g, %g, %d",
+                       WS_MESH_MAX_COORD, r, h, segments);
     size_t nv = 2 * (size_t)segments, nt = 4 * (size_t)segments - 4;
     double *xyz = ws_mem_alloc(&w->mem, 3 * nv * sizeof *xyz);
     uint32_t *tri = ws_mem_alloc(&w->mem, 3 * nt * sizeof *tri);
@@ -295,6 +302,12 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
         } else {
             mass = d.mass;
         }
+        if (!(mass >= WS_BODY_MIN_MASS && mass <= WS_BODY_MAX_MASS))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': mass %g kg%s is outside [WS_BODY_MIN_MASS, "
+                           "WS_BODY_MAX_MASS] = [%g, %g] kg",
+                           nm, mass, d.mass == 0.0 ? " (density x volume)" : "",
+                           WS_BODY_MIN_MASS, WS_BODY_MAX_MASS);
         int zero = 1;
         for (int k = 0; k < 9; k++) {
             if (!isfinite(d.inertia.m[k]))
@@ -303,11 +316,28 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
                 zero = 0;
         }
         J = zero ? ws_body_inertia_from_shape(sh, mass) : d.inertia;
-        if (!m3_is_spd(&J) || m3_inverse(&J, &Jinv) != 0)
+        if (!m3_is_spd(&J))
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                            "body '%s': inertia must be symmetric positive definite "
                            "(diagonal %g, %g, %g kg m^2)",
                            nm, J.m[0], J.m[4], J.m[8]);
+        /* The principal moments of a rigid body: J1 = integral of (y^2 + z^2) dm and so on,
+         * so J1 + J2 = J3 + 2 integral of z^2 dm >= J3; a flat plate is the equality. */
+        m3 axes;
+        v3 pm;
+        m3_sym_eigen(&J, &axes, &pm);
+        double jmax = fmax(pm.x, fmax(pm.y, pm.z)), jsum = pm.x + pm.y + pm.z;
+        if (jsum - jmax < jmax * (1.0 - 1e-9))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': principal moments of inertia %g, %g, %g kg m^2 are no "
+                           "rigid body's: each must be at most the sum of the other two "
+                           "(J1 + J2 >= J3)",
+                           nm, pm.x, pm.y, pm.z);
+        if (m3_inverse(&J, &Jinv) != 0)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': inertia (principal moments %g, %g, %g kg m^2) cannot be "
+                           "inverted in double precision",
+                           nm, pm.x, pm.y, pm.z);
     }
 
     uint32_t slot;
