@@ -157,7 +157,7 @@ START_TEST(steady_state_steps_allocate_nothing)
 {
     /* Buffers grow while the contact set grows, then stay: after warm-up a step must make no
      * call to the allocator (STYLE.md: no heap allocation inside a step). */
-    test_alloc ta = {1000000000L, 0, 0};
+    test_alloc ta = {.allocs_left = 1000000000L};
     ws_world_def d;
     ws_world_def_init(&d);
     d.full_detection_until = 0.1;

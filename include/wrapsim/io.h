@@ -38,7 +38,7 @@ WS_API ws_status ws_web_write_vtp(ws_world *world, ws_web_id web, const char *pa
  *  their details through ws_world_last_error() of the world the series was created on. */
 typedef struct ws_vtk_series ws_vtk_series;
 
-/** Start a series in `directory` (it must exist). Each frame writes `basename`_NNNNNN.vtp (the
+/** Start a series in `directory`, which must exist (else WS_ERR_IO naming it). Each frame writes `basename`_NNNNNN.vtp (the
  *  bodies, as ws_world_write_vtp) and `basename`_web<k>_NNNNNN.vtp for every web alive then (as
  *  ws_web_write_vtp; k is the web's slot in the world: 0, 1, ... in the order webs are created,
  *  a destroyed web's slot taken again by the next one). `basename`.pvd collects them: the bodies

@@ -41,10 +41,24 @@ typedef struct ws_shape_info {
     int convex;              /**< 1 if the mesh is convex */
 } ws_shape_info;
 
-/** Fill a mesh Def with defaults (no vertices). */
-WS_API void ws_mesh_def_init(ws_mesh_def *def);
+/** Fill a mesh Def with defaults (no vertices).
+ *  ws_mesh_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_mesh_def_init_sized(ws_mesh_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_mesh_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_mesh_def_init)(ws_mesh_def *def);
+#define ws_mesh_def_init(def) ws_mesh_def_init_sized((def), sizeof *(def))
 
-/** A box with full edge lengths lx, ly, lz (m, each > 0), centred on the origin.
+/** Largest magnitude of a mesh vertex coordinate, m. Beyond it a mesh's areas and volumes
+ *  overflow, and no load is that large; such a vertex is refused (WS_ERR_INVALID_ARGUMENT). */
+#define WS_MESH_MAX_COORD 1e6
+/** Smallest extent (largest side of the bounding box) of a mesh, m; a smaller one is refused
+ *  (WS_ERR_BAD_MESH). */
+#define WS_MESH_MIN_EXTENT 1e-6
+
+/** A box with full edge lengths lx, ly, lz (m, each > 0 and at most 2 WS_MESH_MAX_COORD),
+ *  centred on the origin.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_OUT_OF_MEMORY, WS_ERR_STALE_HANDLE never. */
 WS_API ws_status ws_shape_create_box(ws_world *world, double lx, double ly, double lz,
                                      ws_shape_id *out);

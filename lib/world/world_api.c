@@ -11,14 +11,15 @@ ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const 
 {
     if (bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id is null", what);
-    if (ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx does not belong to this world",
-                       what, (unsigned long long)bits);
-    uint32_t s = ws_id_slot(bits);
-    if (s >= t->slot_count || t->dense[s] == UINT32_MAX || t->generation[s] != ws_id_gen(bits))
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx was destroyed", what,
-                       (unsigned long long)bits);
-    *slot = s;
+    if (ws_id_kind(bits) != kind)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx is not a %s id", what,
+                       (unsigned long long)bits, what);
+    if (!ws_slots_is_live(t, bits, kind))
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "%s id 0x%016llx names no live %s of this world (destroyed, or another "
+                       "world's)",
+                       what, (unsigned long long)bits, what);
+    *slot = ws_id_slot(bits);
     return WS_OK;
 }
 
@@ -34,17 +35,14 @@ ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot)
 
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot)
 {
-    ws_body_id id = {ws_id_pack(w->tag, WS_KIND_BODY, w->body_slots.generation[slot], slot)};
+    ws_body_id id = {ws_slots_id(&w->body_slots, WS_KIND_BODY, slot)};
     return id;
 }
 
 /* is_valid must not disturb the last error: it is a question, not a failure. */
 static int quiet_valid(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t)
 {
-    if (!w || bits == 0 || ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return 0;
-    uint32_t s = ws_id_slot(bits);
-    return s < t->slot_count && t->dense[s] != UINT32_MAX && t->generation[s] == ws_id_gen(bits);
+    return w && ws_slots_is_live(t, bits, kind);
 }
 
 int ws_body_is_valid(const ws_world *w, ws_body_id id)
@@ -59,11 +57,11 @@ int ws_shape_is_valid(const ws_world *w, ws_shape_id id)
 
 /* ---- shapes ---- */
 
-void ws_mesh_def_init(ws_mesh_def *def)
+static void mesh_defaults(ws_mesh_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_mesh_def, mesh_defaults, triangle_count)
 
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
                            size_t nt, const char *fn, ws_shape_id *out)
@@ -89,19 +87,26 @@ static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint
     }
     w->shapes[slot] = s;
     w->shape_slots.dense[slot] = slot;
-    out->bits = ws_id_pack(w->tag, WS_KIND_SHAPE, w->shape_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->shape_slots, WS_KIND_SHAPE, slot);
     return WS_OK;
 }
 
 ws_status ws_shape_create_box(ws_world *w, double lx, double ly, double lz, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_box");
     NEED_OUT(w, out, "ws_shape_create_box");
     out->bits = 0;
     if (!(isfinite(lx) && isfinite(ly) && isfinite(lz) && lx > 0.0 && ly > 0.0 && lz > 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_shape_create_box: edge lengths must be > 0 m, got %g x %g x %g", lx, ly,
                        lz);
+    if (lx > 2.0 * WS_MESH_MAX_COORD || ly > 2.0 * WS_MESH_MAX_COORD ||
+        lz > 2.0 * WS_MESH_MAX_COORD)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_create_box: edge lengths must be at most 2 WS_MESH_MAX_COORD "
+                       "(%g m), got %g x %g x %g",
+                       2.0 * WS_MESH_MAX_COORD, lx, ly, lz);
     double xyz[24];
     uint32_t tri[36];
     ws_shape_box_mesh(lx, ly, lz, xyz, tri);
@@ -112,13 +117,15 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
                                    ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_cylinder");
     NEED_OUT(w, out, "ws_shape_create_cylinder");
     out->bits = 0;
-    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024)
+    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024 ||
+        r > WS_MESH_MAX_COORD || h > 2.0 * WS_MESH_MAX_COORD)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "ws_shape_create_cylinder: need radius > 0, height > 0 and 3..1024 "
-                       "segments, got %g, %g, %d",
-                       r, h, segments);
+                       "ws_shape_create_cylinder: need 0 < radius <= WS_MESH_MAX_COORD (%g m), "
+                       "0 < height <= 2 WS_MESH_MAX_COORD and 3..1024 segments, got %g, %g, %d",
+                       WS_MESH_MAX_COORD, r, h, segments);
     size_t nv = 2 * (size_t)segments, nt = 4 * (size_t)segments - 4;
     double *xyz = ws_mem_alloc(&w->mem, 3 * nv * sizeof *xyz);
     uint32_t *tri = ws_mem_alloc(&w->mem, 3 * nt * sizeof *tri);
@@ -137,11 +144,12 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
 ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_mesh");
     NEED_OUT(w, out, "ws_shape_create_mesh");
     out->bits = 0;
     ws_mesh_def d;
     ws_mesh_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "mesh");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "mesh");
     if (s != WS_OK)
         return s;
     return add_shape(w, d.vertices, d.vertex_count, d.triangles, d.triangle_count,
@@ -151,6 +159,7 @@ ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id 
 ws_status ws_shape_destroy(ws_world *w, ws_shape_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_shape(w, id, &slot);
     if (s != WS_OK)
@@ -232,25 +241,25 @@ ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices
 
 /* ---- bodies ---- */
 
-void ws_body_def_init(ws_body_def *def)
+static void body_defaults(ws_body_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_BODY_DYNAMIC;
     def->density = 1000.0;
     def->contact_layer = 1e-3;
     def->orientation = qt_identity();
 }
+WS_DEF_INITS(ws_body_def, body_defaults, user_data)
 
-void ws_drive_def_init(ws_drive_def *def)
+static void drive_defaults(ws_drive_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_DRIVE_STATIC;
     def->ramp_time = 0.05;
     def->axis = v3_make(0, 1, 0);
     def->direction = v3_make(1, 0, 0);
 }
+WS_DEF_INITS(ws_drive_def, drive_defaults, callback_user)
 
 static const char *label(const ws_body_def *d)
 {
@@ -260,11 +269,12 @@ static const char *label(const ws_body_def *d)
 ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_create");
     NEED_OUT(w, out, "ws_body_create");
     out->bits = 0;
     ws_body_def d;
     ws_body_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "body");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "body");
     if (s != WS_OK)
         return s;
     const char *nm = label(&d);
@@ -304,6 +314,12 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
         } else {
             mass = d.mass;
         }
+        if (!(mass >= WS_BODY_MIN_MASS && mass <= WS_BODY_MAX_MASS))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': mass %g kg%s is outside [WS_BODY_MIN_MASS, "
+                           "WS_BODY_MAX_MASS] = [%g, %g] kg",
+                           nm, mass, d.mass == 0.0 ? " (density x volume)" : "",
+                           WS_BODY_MIN_MASS, WS_BODY_MAX_MASS);
         int zero = 1;
         for (int k = 0; k < 9; k++) {
             if (!isfinite(d.inertia.m[k]))
@@ -312,11 +328,28 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
                 zero = 0;
         }
         J = zero ? ws_body_inertia_from_shape(sh, mass) : d.inertia;
-        if (!m3_is_spd(&J) || m3_inverse(&J, &Jinv) != 0)
+        if (!m3_is_spd(&J))
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                            "body '%s': inertia must be symmetric positive definite "
                            "(diagonal %g, %g, %g kg m^2)",
                            nm, J.m[0], J.m[4], J.m[8]);
+        /* The principal moments of a rigid body: J1 = integral of (y^2 + z^2) dm and so on,
+         * so J1 + J2 = J3 + 2 integral of z^2 dm >= J3; a flat plate is the equality. */
+        m3 axes;
+        v3 pm;
+        m3_sym_eigen(&J, &axes, &pm);
+        double jmax = fmax(pm.x, fmax(pm.y, pm.z)), jsum = pm.x + pm.y + pm.z;
+        if (jsum - jmax < jmax * (1.0 - 1e-9))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': principal moments of inertia %g, %g, %g kg m^2 are no "
+                           "rigid body's: each must be at most the sum of the other two "
+                           "(J1 + J2 >= J3)",
+                           nm, pm.x, pm.y, pm.z);
+        if (m3_inverse(&J, &Jinv) != 0)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': inertia (principal moments %g, %g, %g kg m^2) cannot be "
+                           "inverted in double precision",
+                           nm, pm.x, pm.y, pm.z);
     }
 
     uint32_t slot;
@@ -385,6 +418,7 @@ void ws_world_forget_body(ws_world *w, uint32_t slot)
 ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -406,6 +440,7 @@ ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_drive");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -417,7 +452,7 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
                        "body '%s': only kinematic bodies (world elements) take a drive", nm);
     ws_drive_def d;
     ws_drive_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "drive")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "drive")) != WS_OK)
         return s;
     ws_body_state *st = &b->st[w->cur];
     ws_pose base = {st->r[slot], st->p[slot]};
@@ -550,6 +585,7 @@ ws_status ws_body_get_contact_force(const ws_world *w, ws_body_id id, ws_vec3 *f
 ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_pose");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)
@@ -576,6 +612,7 @@ ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 ws_status ws_body_set_velocity(ws_world *w, ws_body_id id, const ws_vec3 *v, const ws_vec3 *om)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_velocity");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)

@@ -403,6 +403,44 @@ def test_drive_callback_and_its_errors():
             b.set_drive("callback")
 
 
+def test_callbacks_may_not_change_the_world():
+    """A drive callback that steps the world or destroys a body inside the step gets
+    WS_ERR_IN_STEP (a WrapsimError) for that call; getters work there."""
+    seen = []
+    with ws.World(gravity=(0, 0, 0)) as w:
+        box = w.body(w.box(0.1, 0.1, 0.1), mass=1.0, position=(0, 0, 1))
+        table = w.body(w.box(0.1, 0.1, 0.1), type="kinematic")
+
+        def drive(t):
+            if t > 0.0:
+                for call in (lambda: w.step(1), box.destroy):
+                    try:
+                        call()
+                        seen.append("no error")
+                    except ws.WrapsimError as e:
+                        seen.append((e.status, e.detail))
+                seen.append(box.position[2])
+            return (0, 0, 0), (1, 0, 0, 0)
+        table.set_drive("callback", callback=drive)
+        w.step(1)
+        assert [s[0] for s in seen[:2]] == [ws.WS_ERR_IN_STEP, ws.WS_ERR_IN_STEP]
+        assert "ws_world_step called from inside ws_world_step" in seen[0][1]
+        assert "ws_body_destroy called from inside ws_world_step" in seen[1][1]
+        assert seen[2] == pytest.approx(1.0)
+        box.destroy()  # outside the step it works
+
+
+def test_def_inits_take_the_callers_size():
+    """The sized inits write no more than the size passed and record it."""
+    lib = ws._c()
+    d = L.BodyDef()
+    ctypes.memset(ctypes.byref(d), 0xA5, ctypes.sizeof(d))
+    lib.ws_body_def_init_sized(ctypes.byref(d), L.BodyDef.density.offset)
+    assert d.size == L.BodyDef.density.offset
+    raw = bytes(ctypes.string_at(ctypes.byref(d), ctypes.sizeof(d)))
+    assert set(raw[L.BodyDef.density.offset:]) == {0xA5}  # nothing past the size written
+
+
 # --- the tilt table: Python against C ------------------------------------------------------------
 def build_tilt(wrapped=False):
     """examples/tilt_table.c's tilt_build() with the default options (variant R)."""

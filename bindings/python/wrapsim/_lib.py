@@ -31,6 +31,7 @@ WS_ERR_CALLBACK = 8
 WS_ERR_BUFFER_TOO_SMALL = 9
 WS_ERR_IO = 10
 WS_ERR_UNSUPPORTED = 11
+WS_ERR_IN_STEP = 12
 
 WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
 WS_FEATURE_CCD = 1
@@ -445,9 +446,9 @@ FUNCTIONS = [
     ("ws_version_string", [], c_char_p),
     ("ws_build_features", [], c_uint),
     # world.h
-    ("ws_world_def_init", [P(WorldDef)], None),
-    ("ws_contact_def_init", [P(ContactDef)], None),
-    ("ws_material_def_init", [P(MaterialDef)], None),
+    ("ws_world_def_init_sized", [P(WorldDef), c_size_t], None),
+    ("ws_contact_def_init_sized", [P(ContactDef), c_size_t], None),
+    ("ws_material_def_init_sized", [P(MaterialDef), c_size_t], None),
     ("ws_world_create", [P(WorldDef), P(World_p)], _st),
     ("ws_world_destroy", [World_p], None),
     ("ws_world_step", [World_p], _st),
@@ -469,7 +470,7 @@ FUNCTIONS = [
     ("ws_world_get_contact", [World_p, MaterialId, MaterialId, P(ContactDef)], _st),
     ("ws_world_set_default_contact", [World_p, P(ContactDef)], _st),
     # shape.h
-    ("ws_mesh_def_init", [P(MeshDef)], None),
+    ("ws_mesh_def_init_sized", [P(MeshDef), c_size_t], None),
     ("ws_shape_create_box", [World_p, c_double, c_double, c_double, P(ShapeId)], _st),
     ("ws_shape_create_cylinder", [World_p, c_double, c_double, c_int, P(ShapeId)], _st),
     ("ws_shape_create_mesh", [World_p, P(MeshDef), P(ShapeId)], _st),
@@ -480,8 +481,8 @@ FUNCTIONS = [
     ("ws_shape_copy_mesh", [World_p, ShapeId, P(c_double), c_size_t, P(c_size_t), P(c_uint32),
                             c_size_t, P(c_size_t)], _st),
     # body.h
-    ("ws_body_def_init", [P(BodyDef)], None),
-    ("ws_drive_def_init", [P(DriveDef)], None),
+    ("ws_body_def_init_sized", [P(BodyDef), c_size_t], None),
+    ("ws_drive_def_init_sized", [P(DriveDef), c_size_t], None),
     ("ws_body_create", [World_p, P(BodyDef), P(BodyId)], _st),
     ("ws_body_destroy", [World_p, BodyId], _st),
     ("ws_body_is_valid", [World_p, BodyId], c_int),
@@ -511,7 +512,7 @@ FUNCTIONS = [
     ("ws_world_get_interface_stiffness", [World_p, BodyId, BodyId, P(c_double), P(c_size_t)],
      _st),
     # law.h
-    ("ws_law_def_init", [P(LawDef)], None),
+    ("ws_law_def_init_sized", [P(LawDef), c_size_t], None),
     ("ws_law_create", [World_p, P(LawDef), P(LawId)], _st),
     ("ws_law_destroy", [World_p, LawId], _st),
     ("ws_law_is_valid", [World_p, LawId], c_int),
@@ -528,10 +529,10 @@ FUNCTIONS = [
     ("ws_law_energy_state", [World_p, LawId, P(c_double), P(c_double), c_double, P(c_double)],
      _st),
     # web.h
-    ("ws_web_def_init", [P(WebDef)], None),
-    ("ws_sheet_def_init", [P(SheetDef)], None),
-    ("ws_band_def_init", [P(BandDef)], None),
-    ("ws_web_mesh_def_init", [P(WebMeshDef)], None),
+    ("ws_web_def_init_sized", [P(WebDef), c_size_t], None),
+    ("ws_sheet_def_init_sized", [P(SheetDef), c_size_t], None),
+    ("ws_band_def_init_sized", [P(BandDef), c_size_t], None),
+    ("ws_web_mesh_def_init_sized", [P(WebMeshDef), c_size_t], None),
     ("ws_web_create_sheet", [World_p, P(WebDef), P(SheetDef), P(WebId)], _st),
     ("ws_web_create_band", [World_p, P(WebDef), P(BandDef), P(WebId)], _st),
     ("ws_web_create_mesh", [World_p, P(WebDef), P(WebMeshDef), P(WebId)], _st),
@@ -550,7 +551,7 @@ FUNCTIONS = [
     ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
     ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
     # element.h
-    ("ws_element_def_init", [P(ElementDef)], None),
+    ("ws_element_def_init_sized", [P(ElementDef), c_size_t], None),
     ("ws_element_create", [World_p, P(ElementDef), P(ElementId)], _st),
     ("ws_element_destroy", [World_p, ElementId], _st),
     ("ws_element_is_valid", [World_p, ElementId], c_int),
@@ -569,20 +570,22 @@ FUNCTIONS = [
     ("ws_vtk_series_destroy", [Series_p], None),
 ]
 
-#: The Defs whose ws_*_def_init writes `size`: checked against ctypes.sizeof when loading.
+#: The Defs and their sized inits (ws_*_def_init_sized(def, size)): the binding passes its
+#: struct's ctypes.sizeof, so the library never writes past it, and the size the library records
+#: (the bytes both know) is checked against it when loading.
 DEF_INITS = [
-    ("ws_world_def_init", WorldDef),
-    ("ws_contact_def_init", ContactDef),
-    ("ws_material_def_init", MaterialDef),
-    ("ws_mesh_def_init", MeshDef),
-    ("ws_body_def_init", BodyDef),
-    ("ws_drive_def_init", DriveDef),
-    ("ws_law_def_init", LawDef),
-    ("ws_web_def_init", WebDef),
-    ("ws_sheet_def_init", SheetDef),
-    ("ws_band_def_init", BandDef),
-    ("ws_web_mesh_def_init", WebMeshDef),
-    ("ws_element_def_init", ElementDef),
+    ("ws_world_def_init_sized", WorldDef),
+    ("ws_contact_def_init_sized", ContactDef),
+    ("ws_material_def_init_sized", MaterialDef),
+    ("ws_mesh_def_init_sized", MeshDef),
+    ("ws_body_def_init_sized", BodyDef),
+    ("ws_drive_def_init_sized", DriveDef),
+    ("ws_law_def_init_sized", LawDef),
+    ("ws_web_def_init_sized", WebDef),
+    ("ws_sheet_def_init_sized", SheetDef),
+    ("ws_band_def_init_sized", BandDef),
+    ("ws_web_mesh_def_init_sized", WebMeshDef),
+    ("ws_element_def_init_sized", ElementDef),
 ]
 
 
@@ -619,14 +622,14 @@ def _candidates():
 
 
 def _check_defs(lib, path):
-    """Refuse a library whose Def structs differ in size from the ones above."""
+    """Refuse a library whose Def structs are smaller than the ones above (fields the binding
+    sets would be ignored). The sized init writes no more than the struct's own size."""
     for name, struct in DEF_INITS:
-        buf = ctypes.create_string_buffer(max(4096, 4 * ctypes.sizeof(struct)))
-        getattr(lib, name)(ctypes.cast(buf, POINTER(struct)))
-        size = c_uint32.from_buffer(buf).value
-        if size != ctypes.sizeof(struct):
+        d = struct()
+        getattr(lib, name)(ctypes.byref(d), ctypes.sizeof(struct))
+        if d.size != ctypes.sizeof(struct):
             raise LibraryError(
-                f"{path}: {name} fills {size} bytes but the binding's {struct.__name__} has "
+                f"{path}: {name} knows {d.size} bytes of the binding's {struct.__name__} of "
                 f"{ctypes.sizeof(struct)}: the library and the binding disagree on the headers")
 
 
