@@ -624,7 +624,10 @@ ws_status ws_drive_setup(ws_drive *d, ws_mem *mem, const ws_drive_def *def, cons
     }
     case WS_DRIVE_SINE: {
         double om = 2.0 * WS_PI * c->frequency;
-        if (!isfinite(c->amplitude) || !isfinite(c->phase) || fabs(c->phase) > 1e6 ||
+        if (!(isfinite(c->amplitude) && fabs(c->amplitude) <= 1e6))
+            return bad(why, why_len, "drive: sine amplitude must be within +-1e6 m, got %g",
+                       c->amplitude);
+        if (!isfinite(c->phase) || fabs(c->phase) > 1e6 ||
             !(isfinite(c->frequency) && c->frequency >= 0.0 && c->frequency <= 1e6))
             return bad(why, why_len, "drive: sine needs a finite amplitude, a phase within "
                                      "+-1e6 rad and a frequency in [0, 1e6] Hz, got frequency %g",
