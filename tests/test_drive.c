@@ -6,6 +6,7 @@
 #include "helpers.h"
 
 #include <float.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "drive/drive.h"
@@ -208,7 +209,8 @@ START_TEST(test_impact_half_sine)
     double want_peak = WS_PI_TEST * v0 / (2.0 * T);
     report("impact %.2f m/s: speed before %.6f, after %.2e m/s; integral of a %.6f m/s; peak "
            "%.2f m/s^2 (%.2f g; pi v/(2T) = %.2f); lasted %.3f ms",
-           v0, v_before, v_after, dv, -peak, -peak / G0, want_peak, 1e3 * (r[i1 + 1].t - r[i0 - 1].t));
+           v0, v_before, v_after, dv, -peak, -peak / G0, want_peak,
+           1e3 * (r[i1 + 1].t - r[i0 - 1].t));
     ck_assert_double_eq_tol(v_before, v0, 1e-9);
     ck_assert_double_eq_tol(v_after, 0.0, 1e-9);
     ck_assert_double_eq_tol(-dv, v0, 0.01 * v0);
@@ -258,8 +260,8 @@ START_TEST(test_table_integrates_and_ends_at_rest)
         } else {
             ck_assert_double_eq_tol(r[2500].v, 0.0, 1e-12);
             ck_assert_double_eq_tol(r[2500].x, 0.0, 1e-12);
-            report("table: a %.3f m/s sled pulse played back to rest: end v %.1e m/s, x %.1e m",
-                   dv, r[2500].v, r[2500].x);
+            report("table: a %.3f m/s sled pulse played back to rest: end v %.1e m/s, x %.1e m", dv,
+                   r[2500].v, r[2500].x);
         }
         free(r);
         ws_world_destroy(w);
@@ -300,7 +302,8 @@ static void fft_rec(double *re, double *im, size_t n, double *tre, double *tim)
 static long welch(const double *x, size_t n, double fs, size_t L, double *out)
 {
     double *re = malloc(L * sizeof *re), *im = malloc(L * sizeof *im);
-    double *t1 = malloc(L * sizeof *t1), *t2 = malloc(L * sizeof *t2), *win = malloc(L * sizeof *win);
+    double *t1 = malloc(L * sizeof *t1), *t2 = malloc(L * sizeof *t2),
+           *win = malloc(L * sizeof *win);
     double u = 0.0;
     for (size_t j = 0; j < L; j++) {
         win[j] = 0.5 * (1.0 - cos(2.0 * WS_PI_TEST * (double)j / (double)L));
@@ -349,7 +352,8 @@ START_TEST(test_random_psd_grms_and_seed)
 {
     const size_t n = (size_t)1 << 18, L = 1024;
     const double fs = 512.0;
-    double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y), *pxx = malloc(L / 2 * sizeof *pxx);
+    double *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y),
+           *pxx = malloc(L / 2 * sizeof *pxx);
     static const double want_grms[] = {0.0, 0.40, 0.54, 0.70};
     /* Under WS_TEST_SHORT (sanitizer and valgrind runs) the medium level only. */
     int lo = getenv("WS_TEST_SHORT") ? WS_TRUCK_MEDIUM : WS_TRUCK_LOW;
@@ -699,6 +703,9 @@ static int nan_drive(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec3 *o
     return 0;
 }
 
+/* Parameters whose products overflow, or that leave a time, angle or phase with no digit, are
+ * refused when the drive is set, the error naming the parameter; the world is untouched. A
+ * callback that gives a non-finite velocity mid-run fails that step with WS_ERR_CALLBACK. */
 START_TEST(test_drive_overflow_refused)
 {
     ws_world *w = new_world(2.5e-4);
@@ -830,6 +837,62 @@ START_TEST(test_drive_eval_reports_non_finite)
 }
 END_TEST
 
+/* ---- the Def of 0.1 ---- */
+
+/* A caller built against 0.1 passes a smaller ws_drive_def (its size says so): it is taken, and
+ * the fields it does not have take their defaults, whatever lies in memory past its end. Its
+ * tilt stops with the new default stop ramp (1 s): at the stop time the angle is short of
+ * max_angle by rate T S(1/2), S the integral of the smoothstep (S(1/2) = 3/32): 0.1 x 1 x
+ * 0.09375 rad (with 0.1's 50 ms stop it would be 20 times less). */
+START_TEST(test_old_size_def_is_taken)
+{
+    ws_world *w = new_world(1e-3);
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_TILT;
+    dd.rate = 0.1;
+    dd.start_time = 0.0;
+    dd.max_angle = 0.5;
+    dd.size = (uint32_t)offsetof(ws_drive_def, stop_ramp_time);
+    dd.stop_ramp_time = -1.0; /* garbage past the old end: must not be read */
+    dd.table_count = 12345;
+    ws_body_id p = platform(w, &dd);
+    ck_ok(w, ws_world_step_n(w, 5000)); /* t = 5 s: the free angle reaches 0.5 rad */
+    ws_drive_state st;
+    ck_ok(w, ws_body_get_drive_state(w, p, &st));
+    ck_assert_double_eq_tol(st.angle, 0.5 - 0.1 * 1.0 * 0.09375, 1e-12);
+    ck_ok(w, ws_world_step_n(w, 1000));
+    ck_ok(w, ws_body_get_drive_state(w, p, &st));
+    ck_assert_double_eq_tol(st.angle, 0.5, 1e-12);
+    /* Smaller than 0.1's Def: not filled by ws_drive_def_init. */
+    dd.size = 8;
+    ck_assert_int_eq(ws_body_set_drive(w, p, &dd), WS_ERR_UNINITIALIZED_DEF);
+    /* The vibration calls' argument checks. */
+    size_t n = 0;
+    ck_assert_int_eq(ws_vibration_truck_psd(WS_TRUCK_HIGH, NULL, NULL, 0, &n),
+                     WS_ERR_BUFFER_TOO_SMALL);
+    ck_assert_uint_gt(n, 2);
+    ck_assert_int_eq(ws_vibration_truck_psd((ws_truck_level)4, NULL, NULL, 0, &n),
+                     WS_ERR_INVALID_ARGUMENT);
+    double f[2] = {1.0, 100.0}, g[2] = {0.01, 0.01}, buf[16], grms = 0.0;
+    ck_assert_int_eq(ws_vibration_grms(f, g, 2, &grms), WS_OK);
+    ck_assert_double_eq_tol(grms, sqrt(0.01 * 99.0), 1e-12);
+    ck_assert_int_eq(ws_vibration_grms(f, g, 1, &grms), WS_ERR_INVALID_ARGUMENT);
+    ws_drive_def_init(&dd);
+    dd.psd_frequency = f;
+    dd.psd_level = g;
+    dd.psd_count = 2;
+    dd.sample_rate = 150.0; /* not above twice 100 Hz */
+    ck_assert_int_eq(ws_vibration_synthesize(w, &dd, buf, 16), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "sample_rate"));
+    dd.sample_rate = 1024.0;
+    ck_assert_int_eq(ws_vibration_synthesize(w, &dd, buf, 12), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "power of two"));
+    ck_assert_int_eq(ws_vibration_synthesize(NULL, &dd, buf, 16), WS_OK);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* ---- memory ---- */
 
 /* A table and a random drive own memory from the world's allocator: an allocation failure is
@@ -895,6 +958,7 @@ static Suite *drive_suite(void)
     add_case(s, "tilt_stop_is_gentle", test_tilt_stop_is_gentle, 300);
     add_case(s, "drive_overflow_refused", test_drive_overflow_refused, 30);
     add_case(s, "drive_eval_reports_non_finite", test_drive_eval_reports_non_finite, 10);
+    add_case(s, "old_size_def_is_taken", test_old_size_def_is_taken, 30);
     add_case(s, "drive_memory", test_drive_memory, 30);
     return s;
 }
