@@ -169,6 +169,47 @@ START_TEST(test_pulse_brake_variant)
 }
 END_TEST
 
+/* The pulse moves a load through friction as physics says: a 10 kg box (mu = 0.3, regularised
+ * friction, v_lim = 10 mm/s) on the platform. At k = 0.2 < mu the friction holds it: over the
+ * middle of the plateau its acceleration is the platform's, k g (it creeps at a constant slip
+ * speed, which adds no acceleration). At k = 0.5 > mu it slides, the slip speed soon far above
+ * v_lim, and kinetic friction accelerates it at mu g whatever k is. Measured as the change of
+ * the box's velocity over 0.2 s of the plateau; 1 % allows the penalty contact's oscillation
+ * (its period, 2 pi sqrt(m / 4k) ~ 14 ms, is damped out before the window opens) and the
+ * regularisation (at the slip speeds of the k = 0.5 window, >= 0.15 m/s, p(s) = 1). */
+static double box_accel_on_pulse(double k)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_PULSE;
+    dd.start_time = 0.3; /* the box settles first */
+    dd.acceleration = k * G0;
+    ws_body_id p = platform(w, &dd);
+    (void)p;
+    ws_body_id box =
+        add_box(w, 0.3, 0.3, 0.3, 10.0, (ws_vec3){0, 0, 0.15 + 0.002}, no_material(), "box");
+    /* The plateau: 0.35 to 0.65 s; the window 0.4 to 0.6 s. */
+    ck_ok(w, ws_world_step_n(w, 1600));
+    ws_vec3 v1, v2;
+    ck_ok(w, ws_body_get_velocity(w, box, &v1));
+    ck_ok(w, ws_world_step_n(w, 800));
+    ck_ok(w, ws_body_get_velocity(w, box, &v2));
+    ws_world_destroy(w);
+    return (v2.x - v1.x) / 0.2;
+}
+
+START_TEST(test_pulse_box_sticks_or_slides_at_mu_g)
+{
+    double a_stick = box_accel_on_pulse(0.2), a_slide = box_accel_on_pulse(0.5);
+    report("box on the EUMOS pulse (mu = 0.3): at k = 0.2 it accelerates at %.4f m/s^2 (k g = "
+           "%.4f), at k = 0.5 at %.4f m/s^2 (mu g = %.4f)",
+           a_stick, 0.2 * G0, a_slide, 0.3 * G0);
+    ck_assert_double_eq_tol(a_stick, 0.2 * G0, 0.01 * 0.2 * G0);
+    ck_assert_double_eq_tol(a_slide, 0.3 * G0, 0.01 * 0.3 * G0);
+}
+END_TEST
+
 /* ---- horizontal impact ---- */
 
 /* ASTM D4003 / D5414: the carriage at 1.75 m/s stopped by a half-sine of 10 ms. The velocity
@@ -948,6 +989,7 @@ static Suite *drive_suite(void)
     Suite *s = suite_create("drive");
     add_case(s, "pulse_delivers_eumos_profile", test_pulse_delivers_eumos_profile, 60);
     add_case(s, "pulse_brake_variant", test_pulse_brake_variant, 60);
+    add_case(s, "pulse_box_sticks_or_slides_at_mu_g", test_pulse_box_sticks_or_slides_at_mu_g, 60);
     add_case(s, "impact_half_sine", test_impact_half_sine, 60);
     add_case(s, "table_integrates_and_ends_at_rest", test_table_integrates_and_ends_at_rest, 60);
     add_case(s, "random_psd_grms_and_seed", test_random_psd_grms_and_seed, 120);
