@@ -118,7 +118,7 @@ typedef enum ws_sweep_law {
 
 /** The ASTM D4169 truck levels (D4169-16 calls them low, medium, high). */
 typedef enum ws_truck_level {
-    WS_TRUCK_LOW = 1,    /**< 0.40 Grms (formerly assurance level III's place) */
+    WS_TRUCK_LOW = 1,    /**< 0.40 Grms */
     WS_TRUCK_MEDIUM = 2, /**< 0.54 Grms */
     WS_TRUCK_HIGH = 3    /**< 0.70 Grms */
 } ws_truck_level;
