@@ -26,7 +26,7 @@ import sys
 import time
 
 TESTS = ["test_dynamics", "test_contact", "test_web", "test_tilt_table", "test_law",
-         "test_element", "test_detection"]
+         "test_element", "test_detection", "test_drive"]
 EXAMPLE_RUNS = [
     ("P", False),
     ("P", True),
