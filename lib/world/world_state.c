@@ -362,6 +362,24 @@ static void check_ncand(ws_walk *k, const ws_web *web, const ws_ncand *c, uint32
              q, c->node, c->body, local);
 }
 
+/* A candidate marked as a corner starts three of one node and body, two faces and the edge
+ * between them on a flat convex shape (contact/node.c, mark_corner): the contacts read all
+ * three, so a marked one must have them. c: the three. */
+static int corner_ok(const ws_world *w, const ws_ncand *c)
+{
+    if (c[1].node != c[0].node || c[2].node != c[0].node || c[1].body != c[0].body ||
+        c[2].body != c[0].body)
+        return 0;
+    const ws_shape *sh = w->bodies.shape[c[0].body];
+    const uint32_t a = c[0].local, z = c[1].local, e = c[2].local;
+    if (!sh->convex || !sh->flat || ((a | z) & (WS_NCAND_EDGE | WS_NCAND_INSIDE)) ||
+        !(e & WS_NCAND_EDGE) || (z & WS_NCAND_CORNER) || (e & WS_NCAND_CORNER))
+        return 0;
+    const ws_edge *E = &sh->edges[e & ~WS_NCAND_FLAGS];
+    const uint32_t fa = a & ~WS_NCAND_FLAGS, fz = z & ~WS_NCAND_FLAGS;
+    return (E->f1 == fa && E->f2 == fz) || (E->f1 == fz && E->f2 == fa);
+}
+
 static void walk_track(ws_walk *k, ws_track *t)
 {
     u32v(k, &t->body);
@@ -450,16 +468,27 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
             total[0] += b->shape[i]->face_count;
             total[1] += b->shape[i]->edge_count;
         }
+    ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
     for (size_t q = 0; q < nc && !failed(k); q++) {
         ws_ncand c = reading(k) ? (ws_ncand){0} : web->cand[web->list][q];
         u32v(k, &c.node);
         u32v(k, &c.body);
         u32v(k, &c.feat);
         u32v(k, &c.local);
-        if (k->mode == WS_WALK_CHECK)
+        if (k->mode == WS_WALK_CHECK) {
             check_ncand(k, web, &c, prev, q, total);
-        else if (k->mode == WS_WALK_READ)
+            last[0] = last[1];
+            last[1] = last[2];
+            last[2] = c;
+            if (!failed(k) && q >= 2 && (last[0].local & WS_NCAND_CORNER) && !corner_ok(w, last))
+                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
+                     q - 2);
+            if (!failed(k) && q + 2 >= nc && (c.local & WS_NCAND_CORNER))
+                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
+                     q);
+        } else if (k->mode == WS_WALK_READ) {
             web->cand[list][q] = c;
+        }
         prev = c.node;
     }
     f64s(k, web->xdet.x, 3 * (size_t)web->n, 0);
