@@ -150,6 +150,55 @@ static void build_relax_std(scene *sc, int variant)
     build_relax(sc, 16);
 }
 
+/* A box resting on the ground under a sheet held still (every node pinned) a little wider than
+ * the box, 1 mm above its top: the nodes over the top face and its edges have candidates, and
+ * as nothing moves no step finds them again. */
+static void build_pinned(scene *sc, int variant)
+{
+    (void)variant;
+    ws_world_def wd;
+    ws_world_def_init(&wd);
+    wd.dt = 2.5e-4;
+    ck_assert_int_eq(ws_world_create(&wd, &sc->world), WS_OK);
+    ws_world *w = sc->world;
+    ws_material_id def;
+    ck_ok(w, ws_world_get_default_material(w, &def));
+    add_ground(w, 1.0, def);
+    sc->box = add_box(w, 0.25, 0.25, 0.25, 5.0, (ws_vec3){0, 0, 0.126}, def, "box");
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.stiffness = 100.0;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    md.name = "film";
+    ws_material_id film;
+    ck_ok(w, ws_material_create(w, &md, &film));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    ck_ok(w, ws_world_set_contact(w, film, def, &cd));
+    enum { N = 9 };
+    uint32_t pinned[N * N];
+    for (uint32_t i = 0; i < N * N; i++)
+        pinned[i] = i;
+    ws_web_def d;
+    ws_web_def_init(&d);
+    d.law = law;
+    d.node_mass = 5e-3;
+    d.material = film;
+    ws_sheet_def sh;
+    ws_sheet_def_init(&sh);
+    sh.nx = sh.ny = N;
+    sh.spacing_x = sh.spacing_y = 0.04;
+    sh.origin = (ws_vec3){-0.16, -0.16, 0.2525};
+    sh.pinned = pinned;
+    sh.pinned_count = N * N;
+    ck_ok(w, ws_web_create_sheet(w, &d, &sh, &sc->web));
+}
+
 /* ---- continuation ---- */
 
 /* Build, step `before` steps, save; step on `after` steps recording the hash of each. Build the
@@ -226,6 +275,18 @@ START_TEST(wrapped_film_one_substep)
      * contacts and candidates come and go. */
     long before = short_run() ? 120 : 300, after = short_run() ? 100 : 300;
     check_continuation(build_tilt, 1, before, after, 77, "case P wrapped, 1 sub-step");
+}
+END_TEST
+
+START_TEST(into_a_fresh_world)
+{
+    /* Restored into a world built and never stepped: nothing it has in room or caches comes
+     * from a run of its own (its contacts' room for node candidates is empty). */
+    long before = short_run() ? 120 : 300, after = short_run() ? 50 : 100;
+    check_continuation(build_tilt, 1, before, after, 0, "case P wrapped, into a fresh world");
+    /* A film held still over a box: no step after the restore finds its candidates again, so
+     * the restore itself must make the contacts' room for them. */
+    check_continuation(build_pinned, 0, 200, 50, 0, "pinned film, into a fresh world");
 }
 END_TEST
 
@@ -595,6 +656,7 @@ int main(void)
              bodies_stick_slip_restore_between_full_detections, 120);
     add_case(s, "bodies_regularised_sliding", bodies_regularised_sliding, 120);
     add_case(s, "wrapped_film_one_substep", wrapped_film_one_substep, 300);
+    add_case(s, "into_a_fresh_world", into_a_fresh_world, 300);
     add_case(s, "wrapped_film_substeps_stick", wrapped_film_substeps_stick, 300);
     add_case(s, "relaxing_film_and_element", relaxing_film_and_element, 120);
     add_case(s, "restore_rewinds", restore_rewinds, 60);
