@@ -96,10 +96,15 @@ static void emit(ws_walk *k, const unsigned char *b, size_t n, int hashed)
 /* n doubles at p, little-endian (the bits of each, so the walk is exact). */
 static void f64s(ws_walk *k, double *p, size_t n, int hashed)
 {
-    if (failed(k) || (k->mode == WS_WALK_HASH && !hashed))
+    if (failed(k) || (k->mode == WS_WALK_HASH && !hashed) || n == 0) /* p may be NULL then */
         return;
     if (reading(k)) {
         const unsigned char *b = take(k, 8 * n);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        if (b && k->mode == WS_WALK_READ && n)
+            memcpy(p, b, 8 * n);
+        return;
+#endif
         if (b && k->mode == WS_WALK_READ)
             for (size_t i = 0; i < n; i++) {
                 uint64_t u = dec64(b + 8 * i);
@@ -107,6 +112,11 @@ static void f64s(ws_walk *k, double *p, size_t n, int hashed)
             }
         return;
     }
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    /* The doubles' bytes in memory are the little-endian bytes already. */
+    emit(k, (const unsigned char *)p, 8 * n, hashed);
+    return;
+#endif
     unsigned char chunk[8 * 64];
     for (size_t i0 = 0; i0 < n; i0 += 64) {
         size_t m = n - i0 < 64 ? n - i0 : 64;
