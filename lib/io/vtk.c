@@ -1,10 +1,16 @@
 /* VTK XML PolyData frames (bodies; each web apart) and a ParaView .pvd collection. Reads the
  * world, writes files only when asked. */
+#define _POSIX_C_SOURCE 200809L /* stat, to check the series' directory */
 #include "world/world_internal.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#if !defined(S_ISDIR) && defined(S_IFDIR)
+#define S_ISDIR(m) (((m) & S_IFMT) == S_IFDIR)
+#endif
 
 struct ws_vtk_series {
     ws_world *world;
@@ -298,6 +304,13 @@ ws_status ws_vtk_series_create(ws_world *w, const char *directory, const char *b
     if (!directory || !basename || !*basename || strchr(basename, '/'))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_vtk_series_create: need a directory and a basename without '/'");
+    /* Refused now rather than at the first frame, minutes into a run. */
+    struct stat st;
+    if (stat(directory, &st) != 0)
+        return ws_fail(w, WS_ERR_IO, "ws_vtk_series_create: directory '%s': %s", directory,
+                       strerror(errno));
+    if (!S_ISDIR(st.st_mode))
+        return ws_fail(w, WS_ERR_IO, "ws_vtk_series_create: '%s' is not a directory", directory);
     ws_vtk_series *s = ws_mem_calloc(&w->mem, 1, sizeof *s);
     if (!s)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_vtk_series_create: out of memory");

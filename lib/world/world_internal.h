@@ -41,13 +41,13 @@ typedef struct ws_contact_limit {
 struct ws_world {
     ws_mem mem;
     ws_world_def def;
-    uint16_t tag;
     double time;
     uint64_t steps;
     uint64_t last_full_step;
     int cand_valid; /* 0 forces a full detection on the next step */
     double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
+    int in_step;    /* 1 while ws_world_step runs: its callbacks may only read */
     char err[WS_ERR_LEN];
 
     ws_body_store bodies;
@@ -124,6 +124,17 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
             return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
     } while (0)
 
+/* Calls that change the world are refused from inside a step (from a drive, law or log
+ * callback); getters stay allowed, they read the committed state, which a step leaves alone. */
+#define NOT_IN_STEP(w, fn)                                                                        \
+    do {                                                                                          \
+        if ((w)->in_step)                                                                         \
+            return ws_fail((w), WS_ERR_IN_STEP,                                                   \
+                           "%s called from inside ws_world_step (a callback); a callback may "    \
+                           "only read the world",                                                 \
+                           fn);                                                                   \
+    } while (0)
+
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);
 ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot);
 ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot);
@@ -146,10 +157,23 @@ double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 double ws_world_web_mass_for(ws_world *w, const ws_web *web, double h);
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
 
+/* The two exported inits of a Def type `type` (ws_x_def) whose defaults `defaults` writes:
+ * ws_x_def_init_sized(def, size), which the header's ws_x_def_init(def) macro calls with the
+ * caller's sizeof, and the plain function ws_x_def_init(def) for programs built against headers
+ * before the sized form. Those headers' Defs ended at `v0_last`, so the plain one fills up to
+ * there and never past the end of such a caller's Def. */
+#define WS_DEF_INITS(type, defaults, v0_last)                                                    \
+    void type##_init_sized(type *def, size_t size)                                                \
+    {                                                                                             \
+        type full;                                                                                \
+        defaults(&full);                                                                          \
+        ws_def_fill(def, size, &full, sizeof full);                                               \
+    }                                                                                             \
+    void(type##_init)(type * def) { type##_init_sized(def, WS_DEF_END(type, v0_last)); }
+
 /* Copy a caller's Def (of the size it says) over a default one; WS_ERR_UNINITIALIZED_DEF or
  * WS_ERR_INVALID_ARGUMENT (NULL) with the message set. */
-ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
-                      const char *what);
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, const char *what);
 
 /* Body bookkeeping after a change of the committed state outside a step. */
 void ws_world_refresh_body(ws_world *w, uint32_t slot);
@@ -174,7 +198,24 @@ void ws_world_free_elements(ws_world *w);
 ws_status ws_world_body_free_of_elements(const ws_world *w, uint32_t slot);
 /* The elements' explicit step limit on the bodies they join (INFINITY without elements). */
 double ws_world_element_stable_dt(const ws_world *w);
-/* The elements' committed law histories, hashed on from h. */
-uint64_t ws_world_hash_elements(const ws_world *w, uint64_t h);
+
+/* One walk over every piece of the world's state that its future depends on
+ * (world_state.c): HASH feeds the hashed part of it to an FNV-1a hash (ws_world_get_state_hash);
+ * WRITE puts it into `out` as little-endian bytes (only counts them, in pos, when out is NULL);
+ * CHECK reads `in` (len bytes) and checks every count and index against the world, changing no
+ * state (it only grows arrays for READ, WS_ERR_OUT_OF_MEMORY when it cannot); READ, after a
+ * CHECK that passed, writes it into the world. WS_ERR_FORMAT (or WS_ERR_OUT_OF_MEMORY) with
+ * the last error set when a CHECK fails. */
+typedef enum ws_walk_mode { WS_WALK_HASH, WS_WALK_WRITE, WS_WALK_CHECK, WS_WALK_READ } ws_walk_mode;
+typedef struct ws_walk {
+    ws_walk_mode mode;
+    uint64_t hash;           /* HASH: start with WS_HASH_SEED */
+    unsigned char *out;      /* WRITE */
+    const unsigned char *in; /* CHECK, READ */
+    size_t pos, len;         /* bytes walked; bytes in `in` */
+    ws_status status;
+    ws_world *w;
+} ws_walk;
+ws_status ws_world_walk(ws_world *w, ws_walk *k);
 
 #endif
