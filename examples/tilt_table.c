@@ -13,7 +13,8 @@
  *   the stop's edge: tan(theta) = (a/2) / (a - 0.02), theta = 28.52 deg, t = 5.978 s.
  *
  * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
- * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] [--no-ccd]
+ * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--no-ccd]
+ *                      [--vtk DIR [--vtk-every S] [--vtk-stride N] [--vtk-springs] [--vtk-ascii]]
  *                      [--paper-integrator] [--duration S] [--quiet]
  *                      [--wrapped [--film-mass KG] [--substeps N]]
  *
@@ -40,6 +41,10 @@ typedef struct tilt_options {
     double duration;      /* s; 0 = 6 s for P, 7 s for R */
     const char *csv;      /* time series file, or NULL */
     const char *vtk_dir;  /* directory for VTK frames, or NULL */
+    double vtk_every;     /* s between VTK frames (the series' time stride); default 0.1 s */
+    int vtk_stride;       /* offer a frame every vtk_stride-th step (frame stride); default 1 */
+    int vtk_springs;      /* 1: add the film's springs as their own block */
+    int vtk_ascii;        /* 1: ASCII files instead of compressed binary */
     int quiet;            /* no progress, no summary */
     int wrapped;          /* 1: stretch film around the stack */
     double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
@@ -80,6 +85,8 @@ static void tilt_default_options(tilt_options *o)
     memset(o, 0, sizeof *o);
     o->variant = 'R';
     o->use_ccd = 1;
+    o->vtk_every = 0.1; /* 0.57 deg of tilt a frame: 71 frames of a 7 s run */
+    o->vtk_stride = 1;
 }
 
 /* The film of the reference case: a band from 30 mm above the plane to 20 mm below the top,
@@ -393,7 +400,15 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                      "bottom_x,bottom_y,bottom_z,bottom_vx,bottom_vy,bottom_vz,bottom_tilt_deg,"
                      "bottom_slip,top_x,top_y,top_z,top_vx,top_vy,top_vz,top_tilt_deg,top_slip,"
                      "cog_distance\n");
-    if (o->vtk_dir && (s = ws_vtk_series_create(w, o->vtk_dir, "tilt_table", &vtk)) != WS_OK) {
+    ws_vtk_series_def vd;
+    ws_vtk_series_def_init(&vd);
+    vd.directory = o->vtk_dir;
+    vd.basename = "tilt_table";
+    vd.time_stride = o->vtk_every;
+    vd.frame_stride = o->vtk_stride;
+    vd.springs = o->vtk_springs;
+    vd.format = o->vtk_ascii ? WS_VTK_ASCII : WS_VTK_COMPRESSED;
+    if (o->vtk_dir && (s = ws_vtk_series_create_def(w, &vd, &vtk)) != WS_OK) {
         snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
         if (csv)
             fclose(csv);
@@ -402,7 +417,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     }
 
     long steps = lround(sc.duration / sc.dt);
-    long csv_every = lround(0.01 / sc.dt), vtk_every = lround(0.05 / sc.dt);
+    long csv_every = lround(0.01 / sc.dt);
     ws_vec3 start[2];
     for (int k = 0; k < 2; k++) {
         ws_vec3 r;
@@ -501,7 +516,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                     t, DEG(theta), r[0].x, r[0].y, r[0].z, v[0].x, v[0].y, v[0].z, DEG(tilt[0]),
                     slip[0], r[1].x, r[1].y, r[1].z, v[1].x, v[1].y, v[1].z, DEG(tilt[1]),
                     slip[1], distance(w, sc.box[0], sc.box[1]));
-        if (vtk && n % vtk_every == 0 && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
+        /* Offered every step: the series' strides choose the frames. */
+        if (vtk && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
             break;
         if (n == steps) {
             res->final_slip[0] = slip[0];
@@ -537,8 +553,10 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
 #ifndef TILT_TABLE_NO_MAIN
 static void usage(void)
 {
-    fprintf(stderr, "usage: tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] "
-                    "[--no-ccd] [--paper-integrator] [--duration S] [--quiet]\n"
+    fprintf(stderr, "usage: tilt_table [--variant P|R] [--stick] [--csv FILE] [--no-ccd]\n"
+                    "                  [--vtk DIR [--vtk-every S] [--vtk-stride N] [--vtk-springs]"
+                    " [--vtk-ascii]]\n"
+                    "                  [--paper-integrator] [--duration S] [--quiet]\n"
                     "                  [--wrapped [--film-mass KG] [--substeps N]]\n");
 }
 
@@ -579,6 +597,14 @@ int main(int argc, char **argv)
             o.csv = argv[++i];
         } else if (!strcmp(a, "--vtk") && i + 1 < argc) {
             o.vtk_dir = argv[++i];
+        } else if (!strcmp(a, "--vtk-every") && i + 1 < argc) {
+            o.vtk_every = atof(argv[++i]);
+        } else if (!strcmp(a, "--vtk-stride") && i + 1 < argc) {
+            o.vtk_stride = atoi(argv[++i]);
+        } else if (!strcmp(a, "--vtk-springs")) {
+            o.vtk_springs = 1;
+        } else if (!strcmp(a, "--vtk-ascii")) {
+            o.vtk_ascii = 1;
         } else if (!strcmp(a, "--duration") && i + 1 < argc) {
             o.duration = atof(argv[++i]);
         } else if (!strcmp(a, "--quiet")) {
