@@ -145,7 +145,7 @@ static void emit_ascii(vtk_file *f, vtk_type t)
         } else if (t == T_F32) {
             float v;
             memcpy(&v, p + 4 * i, 4);
-            xml(f, "%.7g%s", (double)v, sep);
+            xml(f, "%.9g%s", (double)v, sep); /* 9 digits: the float back exactly */
         } else if (t == T_I32) {
             int32_t v;
             memcpy(&v, p + 4 * i, 4);

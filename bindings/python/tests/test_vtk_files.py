@@ -25,6 +25,7 @@ from vtk.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 N_AROUND, N_UP = 24, 9
+BANDS = min(ws.WS_VTK_DEFAULT_BANDS, N_UP)  # the writer caps the bands at the rows
 DT = 2.5e-4
 
 
@@ -86,7 +87,7 @@ def run_series(tmp_path, **options):
                                        tension=film.tensions().copy(),
                                        springs=film.springs().copy(),
                                        contacts=len(w.contacts()),
-                                       hoop=film.containment(ws.WS_VTK_DEFAULT_BANDS),
+                                       hoop=film.containment(BANDS),
                                        body=[b.position.copy() for b in boxes]))
                 w.step(1)
             assert s.frame_count == 3
@@ -164,7 +165,7 @@ def test_series_reads_back_with_every_block_array_and_time(tmp_path, fmt):
         np.testing.assert_allclose(arr(film, "field", "band_hoop_tension"),
                                    st["hoop"]["hoop_tension"], rtol=rtol, atol=atol)
         for name in ("band_z_low", "band_z_high", "band_line_load", "band_contact_force"):
-            assert arr(film, "field", name).shape == (ws.WS_VTK_DEFAULT_BANDS,)
+            assert arr(film, "field", name).shape == (BANDS,)
         # springs: every spring a line with its own tension
         springs = springs_blk.GetBlock(0)
         assert springs.GetNumberOfCells() == len(st["tension"])
@@ -182,8 +183,9 @@ def test_series_reads_back_with_every_block_array_and_time(tmp_path, fmt):
             np.testing.assert_allclose(np.linalg.norm(arr(contacts, "point", "normal_force"),
                                                       axis=1),
                                        arr(contacts, "point", "normal_force_N"), rtol=1e-6)
-    # the stack is in contact with the platform after settling 0.1 s
-    assert states[-1]["contacts"] > 0
+    # Frames with and without contacts (the stack starts a layer's width above the platform and
+    # bounces while it settles), so both an empty and a full contacts block were read.
+    assert min(s["contacts"] for s in states) == 0 < max(s["contacts"] for s in states)
 
 
 def test_compressed_is_smaller_than_ascii(tmp_path):
