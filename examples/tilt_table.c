@@ -396,10 +396,12 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         return res->status = WS_ERR_IO;
     }
     if (csv)
-        fprintf(csv, "t,plane_angle_deg,"
-                     "bottom_x,bottom_y,bottom_z,bottom_vx,bottom_vy,bottom_vz,bottom_tilt_deg,"
-                     "bottom_slip,top_x,top_y,top_z,top_vx,top_vy,top_vz,top_tilt_deg,top_slip,"
-                     "cog_distance\n");
+        /* Each column's unit at the end of its name: s, deg, m, m/s (m_s). */
+        fprintf(csv, "t_s,plane_angle_deg,"
+                     "bottom_x_m,bottom_y_m,bottom_z_m,bottom_vx_m_s,bottom_vy_m_s,bottom_vz_m_s,"
+                     "bottom_tilt_deg,bottom_slip_m,"
+                     "top_x_m,top_y_m,top_z_m,top_vx_m_s,top_vy_m_s,top_vz_m_s,top_tilt_deg,"
+                     "top_slip_m,cog_distance_m\n");
     ws_vtk_series_def vd;
     ws_vtk_series_def_init(&vd);
     vd.directory = o->vtk_dir;
