@@ -435,6 +435,54 @@ class World:
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
 
+    def mesh_from_file(self, path, scale=1.0, file_format=None):
+        """A closed mesh shape read from a file: STL (ASCII or binary), OBJ, PLY, or any other
+        surface format meshio reads (Debian python3-meshio; `file_format` overrides the guess
+        from the extension). `scale` multiplies the coordinates into metres (0.001 for a file in
+        millimetres). Points shared by faces are merged where their coordinates are equal (STL
+        repeats them per facet), polygons are split into triangles from their first corner, and
+        a surface that is closed and consistently wound but inside out is turned outside out.
+        A mesh that is open, non-manifold or inconsistently wound raises WrapsimError
+        (WS_ERR_BAD_MESH) naming the offending edge, with a hint to repair the file."""
+        try:
+            import meshio
+        except ImportError as e:  # pragma: no cover - depends on the machine
+            raise ImportError("World.mesh_from_file needs meshio (Debian: python3-meshio)") from e
+        m = meshio.read(str(path), file_format=file_format)
+        points = np.asarray(m.points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] < 3:
+            raise WrapsimError(WS_ERR_BAD_MESH, f"{path}: needs 3D points, got shape "
+                               f"{points.shape}")
+        tris = []
+        for block in m.cells:
+            faces = np.asarray(block.data)
+            if block.type in ("triangle", "quad") or block.type.startswith("polygon"):
+                # a fan from each face's first corner: (0, k, k + 1)
+                for k in range(1, faces.shape[1] - 1):
+                    tris.append(faces[:, [0, k, k + 1]])
+        if not tris:
+            raise WrapsimError(WS_ERR_BAD_MESH, f"{path}: no surface faces (triangles, quads or "
+                               "polygons) in the file")
+        tri = np.concatenate(tris).astype(np.int64)
+        pts = points[:, :3] * float(scale)
+        # Equal coordinates are one vertex (exact equality: what STL writers repeat).
+        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
+        tri = inverse.reshape(-1)[tri]
+        # Signed volume by the divergence theorem: negative for a surface wound inside out.
+        a, b, c = uniq[tri[:, 0]], uniq[tri[:, 1]], uniq[tri[:, 2]]
+        if np.einsum("ij,ij->", a, np.cross(b, c)) < 0.0:
+            tri = tri[:, ::-1]
+        try:
+            return self.mesh(uniq, tri)
+        except WrapsimError as e:
+            if e.status != WS_ERR_BAD_MESH:
+                raise
+            raise WrapsimError(e.status, f"{path}: {e.detail} (vertex numbers after merging equal "
+                               "points). Repair the file: close its holes, merge duplicate "
+                               "points, remove faces that share an edge with more than one "
+                               "other, and make the faces' winding consistent (a mesh editor's "
+                               "'repair' or 'make manifold' tools do this)") from None
+
     # bodies
     def body(self, shape, **kwargs):
         """Create a body: ws_body_def fields as keywords (type 'dynamic'/'kinematic', material,
