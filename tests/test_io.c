@@ -235,6 +235,45 @@ START_TEST(frame_has_named_blocks_in_its_form)
 }
 END_TEST
 
+/* The .pvd grows in place frame by frame; one that no longer ends as the series left it (cut
+ * short, edited) is written whole again at the next frame, listing every frame. */
+START_TEST(pvd_is_appended_or_rewritten)
+{
+    ws_world *w = new_world(1e-3);
+    char dir[512], path[600];
+    temp_dir(dir, sizeof dir);
+    ws_vtk_series *s;
+    ck_ok(w, ws_vtk_series_create(w, dir, "p", &s));
+    snprintf(path, sizeof path, "%s/p.pvd", dir);
+    for (int k = 0; k < 4; k++) {
+        if (k == 2) { /* cut short after its first entry, longer than the closing tags */
+            FILE *f = fopen(path, "w");
+            ck_assert_ptr_nonnull(f);
+            fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\">\n"
+                  "<Collection>\n<DataSet timestep=\"0.001\" part=\"0\" file=\"p_000000.vtm\"/>\n",
+                  f);
+            fclose(f);
+        }
+        ck_ok(w, ws_world_step(w));
+        ck_ok(w, ws_vtk_series_write_frame(s));
+        char *pvd = slurp(path);
+        ck_assert_ptr_nonnull(pvd);
+        size_t listed = 0;
+        for (const char *p = pvd; (p = strstr(p, "<DataSet ")) != NULL; p++)
+            listed++;
+        ck_assert_uint_eq(listed, (size_t)k + 1);
+        size_t n = strlen(pvd);
+        ck_assert_str_eq(pvd + n - strlen("</Collection>\n</VTKFile>\n"),
+                         "</Collection>\n</VTKFile>\n");
+        ck_assert_ptr_nonnull(strstr(pvd, "file=\"p_000000.vtm\""));
+        free(pvd);
+    }
+    ws_vtk_series_destroy(s);
+    ws_world_destroy(w);
+    remove_dir(dir);
+}
+END_TEST
+
 START_TEST(unwritable_directory_is_an_io_error)
 {
     ws_world *w = wrapped_box(NULL);
@@ -288,6 +327,7 @@ int main(void)
     add_case(s, "def", def_is_checked, 10);
     add_case(s, "strides", strides_choose_the_frames, 60);
     add_case(s, "blocks", frame_has_named_blocks_in_its_form, 30);
+    add_case(s, "pvd", pvd_is_appended_or_rewritten, 10);
     add_case(s, "io_error", unwritable_directory_is_an_io_error, 10);
     add_case(s, "oom", allocation_failures_are_reported_and_freed, 120);
     return run_suite(s);

@@ -875,12 +875,36 @@ ws_status ws_vtk_series_create(ws_world *w, const char *directory, const char *b
     return ws_vtk_series_create_def(w, &def, out);
 }
 
+static const char pvd_tail[] = "</Collection>\n</VTKFile>\n";
+
+/* Add the newest frame to the .pvd in place: over its closing tags, the new entry and the tags
+ * again, so a long series costs the same per frame as a short one. 0 when done; -1 when the file
+ * does not end as this series left it (or cannot be read), and it must be written whole. */
+static int append_pvd(const ws_vtk_series *s, const char *path)
+{
+    size_t k = s->count - 1, tail = sizeof pvd_tail - 1;
+    char end[sizeof pvd_tail];
+    FILE *f = fopen(path, "r+b");
+    if (!f)
+        return -1;
+    int ok = fseek(f, -(long)tail, SEEK_END) == 0 && fread(end, 1, tail, f) == tail &&
+             memcmp(end, pvd_tail, tail) == 0 && fseek(f, -(long)tail, SEEK_END) == 0;
+    if (ok) {
+        fprintf(f, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s_%06zu.vtm\"/>\n%s",
+                s->times[k], s->basename, k, pvd_tail);
+        ok = !ferror(f);
+    }
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 static ws_status write_pvd(ws_vtk_series *s)
 {
     char path[4096];
     ws_world *w = s->world;
     if (snprintf(path, sizeof path, "%s/%s.pvd", s->directory, s->basename) >= (int)sizeof path)
         return ws_fail(w, WS_ERR_IO, "path too long for '%s'", s->basename);
+    if (s->count > 1 && append_pvd(s, path) == 0)
+        return WS_OK;
     FILE *f = fopen(path, "w");
     if (!f)
         return ws_fail(w, WS_ERR_IO, "cannot open '%s' for writing: %s", path, strerror(errno));
@@ -889,7 +913,7 @@ static ws_status write_pvd(ws_vtk_series *s)
     for (size_t k = 0; k < s->count; k++)
         fprintf(f, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s_%06zu.vtm\"/>\n", s->times[k],
                 s->basename, k);
-    fprintf(f, "</Collection>\n</VTKFile>\n");
+    fputs(pvd_tail, f);
     int bad = ferror(f);
     if (fclose(f) != 0 || bad)
         return ws_fail(w, WS_ERR_IO, "error while writing '%s'", path);
