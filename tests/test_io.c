@@ -46,7 +46,7 @@ static void remove_dir(const char *dir)
 }
 
 /* A box on the ground wrapped in a 12 x 4 band: bodies, film and contacts to write. */
-static ws_world *wrapped_box(test_alloc *a)
+static ws_world *wrapped_box_named(test_alloc *a, const char *film_name)
 {
     ws_world_def d;
     ws_world_def_init(&d);
@@ -68,7 +68,7 @@ static ws_world *wrapped_box(test_alloc *a)
     wd.law = law;
     wd.node_mass = 1e-3;
     wd.substeps = 12; /* its stable step is 0.099 ms */
-    wd.name = "wrap";
+    wd.name = film_name;
     ws_band_def bd;
     ws_band_def_init(&bd);
     bd.bodies = &box;
@@ -82,6 +82,11 @@ static ws_world *wrapped_box(test_alloc *a)
     ws_web_id web;
     ck_ok(w, ws_web_create_band(w, &wd, &bd, &web));
     return w;
+}
+
+static ws_world *wrapped_box(test_alloc *a)
+{
+    return wrapped_box_named(a, "wrap");
 }
 
 START_TEST(def_is_checked)
@@ -111,12 +116,24 @@ START_TEST(def_is_checked)
         ws_vtk_series_def e = d;
         const char *field = "";
         switch (k) {
-        case 0: e.format = 3, field = "format"; break;
-        case 1: e.format = -1, field = "format"; break;
-        case 2: e.frame_stride = 0, field = "frame_stride"; break;
-        case 3: e.time_stride = -0.1, field = "time_stride"; break;
-        case 4: e.time_stride = NAN, field = "time_stride"; break;
-        default: e.containment_bands = WS_VTK_MAX_BANDS + 1, field = "containment_bands"; break;
+        case 0:
+            e.format = 3, field = "format";
+            break;
+        case 1:
+            e.format = -1, field = "format";
+            break;
+        case 2:
+            e.frame_stride = 0, field = "frame_stride";
+            break;
+        case 3:
+            e.time_stride = -0.1, field = "time_stride";
+            break;
+        case 4:
+            e.time_stride = NAN, field = "time_stride";
+            break;
+        default:
+            e.containment_bands = WS_VTK_MAX_BANDS + 1, field = "containment_bands";
+            break;
         }
         ck_assert_int_eq(ws_vtk_series_create_def(w, &e, &s), WS_ERR_INVALID_ARGUMENT);
         ck_assert_ptr_null(s);
@@ -274,6 +291,31 @@ START_TEST(pvd_is_appended_or_rewritten)
 }
 END_TEST
 
+/* A web's name is free text: in the .vtm it is written as XML wants it, and an unnamed web is
+ * called web<slot>. */
+START_TEST(names_are_escaped_in_the_vtm)
+{
+    for (int named = 0; named < 2; named++) {
+        ws_world *w = wrapped_box_named(NULL, named ? "film \"A\" & <B>'s" : NULL);
+        char dir[512], path[600];
+        temp_dir(dir, sizeof dir);
+        ws_vtk_series *s;
+        ck_ok(w, ws_vtk_series_create(w, dir, "e", &s));
+        ck_ok(w, ws_vtk_series_write_frame(s));
+        snprintf(path, sizeof path, "%s/e_000000.vtm", dir);
+        char *vtm = slurp(path);
+        ck_assert_ptr_nonnull(vtm);
+        const char *want =
+            named ? "name=\"film &quot;A&quot; &amp; &lt;B&gt;&apos;s\"" : "name=\"web0\"";
+        ck_assert_msg(strstr(vtm, want) != NULL, "%s not in\n%s", want, vtm);
+        free(vtm);
+        ws_vtk_series_destroy(s);
+        ws_world_destroy(w);
+        remove_dir(dir);
+    }
+}
+END_TEST
+
 START_TEST(unwritable_directory_is_an_io_error)
 {
     ws_world *w = wrapped_box(NULL);
@@ -328,6 +370,7 @@ int main(void)
     add_case(s, "strides", strides_choose_the_frames, 60);
     add_case(s, "blocks", frame_has_named_blocks_in_its_form, 30);
     add_case(s, "pvd", pvd_is_appended_or_rewritten, 10);
+    add_case(s, "names", names_are_escaped_in_the_vtm, 10);
     add_case(s, "io_error", unwritable_directory_is_an_io_error, 10);
     add_case(s, "oom", allocation_failures_are_reported_and_freed, 120);
     return run_suite(s);

@@ -23,7 +23,7 @@
 
 typedef enum vtk_type { T_F64, T_I32, T_U64, T_U8, T_STR, T_F32 } vtk_type;
 
-static const char *const vtk_type_name[] = {"Float64", "Int32", "UInt64",
+static const char *const vtk_type_name[] = {"Float64", "Int32",  "UInt64",
                                             "UInt8",   "String", "Float32"};
 static const size_t vtk_type_size[] = {8, 4, 8, 1, 1, 4};
 
@@ -277,8 +277,9 @@ static void file_begin(vtk_file *f, const char *type)
 {
     f->xml.len = f->blob.len = 0;
     f->oom = 0;
-    xml(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"%s\" version=\"1.0\" byte_order=\"%s\" "
-           "header_type=\"UInt64\"%s>\n",
+    xml(f,
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"%s\" version=\"1.0\" byte_order=\"%s\" "
+        "header_type=\"UInt64\"%s>\n",
         type, little_endian() ? "LittleEndian" : "BigEndian",
         f->format == WS_VTK_COMPRESSED ? " compressor=\"vtkZLibDataCompressor\"" : "");
 }
@@ -452,8 +453,7 @@ static void compose_contacts(vtk_file *f, const ws_contact_info *ci, size_t n)
     file_begin(f, "PolyData");
     xml(f, "<PolyData>\n<FieldData>\n");
     emit_scalar(f, "TimeValue", f->w->time);
-    xml(f, "</FieldData>\n<Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\">\n<Points>\n", n,
-        n);
+    xml(f, "</FieldData>\n<Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\">\n<Points>\n", n, n);
     double *d;
     int32_t *c;
     /* One array of the contacts' vectors: what 0 point, 1 normal, 2 normal force, 3 friction
@@ -792,10 +792,10 @@ struct ws_vtk_series {
     ws_vtk_series_def def;
     char *directory;
     char *basename;
-    double *times;      /* of the frames written */
-    size_t count, cap;  /* frames written; room in times */
-    uint64_t calls;     /* ws_vtk_series_write_frame calls */
-    double last_slot;   /* time-stride slot of the last frame written */
+    double *times;     /* of the frames written */
+    size_t count, cap; /* frames written; room in times */
+    uint64_t calls;    /* ws_vtk_series_write_frame calls */
+    double last_slot;  /* time-stride slot of the last frame written */
     ws_contact_info *contacts;
     size_t contact_cap;
     vtk_file file;
@@ -814,8 +814,7 @@ void ws_vtk_series_def_init(ws_vtk_series_def *def)
     def->double_precision = 0;
 }
 
-ws_status ws_vtk_series_create_def(ws_world *w, const ws_vtk_series_def *def,
-                                   ws_vtk_series **out)
+ws_status ws_vtk_series_create_def(ws_world *w, const ws_vtk_series_def *def, ws_vtk_series **out)
 {
     NEED_WORLD(w);
     NEED_OUT(w, out, "ws_vtk_series_create_def");
@@ -875,6 +874,42 @@ ws_status ws_vtk_series_create(ws_world *w, const char *directory, const char *b
     return ws_vtk_series_create_def(w, &def, out);
 }
 
+/* Text into an XML attribute value: the five characters XML reserves as entities. */
+static void put_attr(FILE *f, const char *text)
+{
+    for (const char *c = text; *c; c++) {
+        switch (*c) {
+        case '&':
+            fputs("&amp;", f);
+            break;
+        case '<':
+            fputs("&lt;", f);
+            break;
+        case '>':
+            fputs("&gt;", f);
+            break;
+        case '"':
+            fputs("&quot;", f);
+            break;
+        case '\'':
+            fputs("&apos;", f);
+            break;
+        default:
+            fputc(*c, f);
+        }
+    }
+}
+
+/* One frame's line of the .pvd. */
+static void put_pvd_entry(FILE *f, const ws_vtk_series *s, size_t k)
+{
+    char file[64];
+    fprintf(f, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"", s->times[k]);
+    put_attr(f, s->basename);
+    snprintf(file, sizeof file, "_%06zu.vtm", k);
+    fprintf(f, "%s\"/>\n", file);
+}
+
 static const char pvd_tail[] = "</Collection>\n</VTKFile>\n";
 
 /* Add the newest frame to the .pvd in place: over its closing tags, the new entry and the tags
@@ -890,8 +925,8 @@ static int append_pvd(const ws_vtk_series *s, const char *path)
     int ok = fseek(f, -(long)tail, SEEK_END) == 0 && fread(end, 1, tail, f) == tail &&
              memcmp(end, pvd_tail, tail) == 0 && fseek(f, -(long)tail, SEEK_END) == 0;
     if (ok) {
-        fprintf(f, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s_%06zu.vtm\"/>\n%s",
-                s->times[k], s->basename, k, pvd_tail);
+        put_pvd_entry(f, s, k);
+        fputs(pvd_tail, f);
         ok = !ferror(f);
     }
     return fclose(f) == 0 && ok ? 0 : -1;
@@ -911,8 +946,7 @@ static ws_status write_pvd(ws_vtk_series *s)
     fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\">\n"
                "<Collection>\n");
     for (size_t k = 0; k < s->count; k++)
-        fprintf(f, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s_%06zu.vtm\"/>\n", s->times[k],
-                s->basename, k);
+        put_pvd_entry(f, s, k);
     fputs(pvd_tail, f);
     int bad = ferror(f);
     if (fclose(f) != 0 || bad)
@@ -920,12 +954,12 @@ static ws_status write_pvd(ws_vtk_series *s)
     return WS_OK;
 }
 
-/* Compose and write one block file of frame `frame`: `what` names it in the file name. */
-static ws_status frame_path(ws_vtk_series *s, char *path, size_t cap, const char *what,
-                            size_t slot)
+/* The path of a block file of the frame being written: `what` names the block, `slot` the web
+ * (SIZE_MAX: none). */
+static ws_status frame_path(ws_vtk_series *s, char *path, size_t cap, const char *what, size_t slot)
 {
-    int n = slot == SIZE_MAX ? snprintf(path, cap, "%s/%s_%06zu_%s.vtp", s->directory,
-                                        s->basename, s->count, what)
+    int n = slot == SIZE_MAX ? snprintf(path, cap, "%s/%s_%06zu_%s.vtp", s->directory, s->basename,
+                                        s->count, what)
                              : snprintf(path, cap, "%s/%s_%06zu_%s%zu.vtp", s->directory,
                                         s->basename, s->count, what, slot);
     if (n < 0 || (size_t)n >= cap)
@@ -939,6 +973,19 @@ static const char *leaf(const ws_vtk_series *s, const char *path)
     return path + strlen(s->directory) + 1;
 }
 
+/* One dataset of the .vtm: <DataSet index="index" name="name" file="leaf of path"/>. */
+static void put_dataset(FILE *vtm, const ws_vtk_series *s, unsigned index, const char *name,
+                        const char *path)
+{
+    fprintf(vtm, "<DataSet index=\"%u\" name=\"", index);
+    put_attr(vtm, name);
+    fputs("\" file=\"", vtm);
+    put_attr(vtm, leaf(s, path));
+    fputs("\"/>\n", vtm);
+}
+
+/* Write the block files of the frame and the .vtm that names them: bodies, film, contacts
+ * (when asked), springs (when asked), numbered in that order. */
 static ws_status write_vtm(ws_vtk_series *s)
 {
     ws_world *w = s->world;
@@ -959,11 +1006,11 @@ static ws_status write_vtm(ws_vtk_series *s)
     compose_bodies(f);
     if ((st = file_write(f, path)) != WS_OK)
         goto done;
-    fprintf(vtm, "<DataSet index=\"0\" name=\"bodies\" file=\"%s\"/>\n", leaf(s, path));
-    /* film and springs: one block each, a dataset per web alive */
+    unsigned block = 0;
+    put_dataset(vtm, s, block++, "bodies", path);
+    /* film and springs: one block each, a dataset per web alive; contacts between them */
     for (int springs = 0; springs < 1 + (s->def.springs != 0); springs++) {
-        fprintf(vtm, "<Block index=\"%d\" name=\"%s\">\n", springs ? 3 : 1,
-                springs ? "springs" : "film");
+        fprintf(vtm, "<Block index=\"%u\" name=\"%s\">\n", block++, springs ? "springs" : "film");
         unsigned m = 0;
         for (size_t k = 0; k < w->web_slots.slot_count; k++) {
             if (w->web_slots.dense[k] == UINT32_MAX)
@@ -975,14 +1022,9 @@ static ws_status write_vtm(ws_vtk_series *s)
             if ((st = file_write(f, path)) != WS_OK)
                 goto done;
             const ws_web *web = w->webs[k];
-            if (web->name)
-                fprintf(vtm, "<DataSet index=\"%u\" name=\"%s\" file=\"%s\"/>\n", m++, web->name,
-                        leaf(s, path));
-            else {
+            if (!web->name)
                 snprintf(name, sizeof name, "web%zu", k);
-                fprintf(vtm, "<DataSet index=\"%u\" name=\"%s\" file=\"%s\"/>\n", m++, name,
-                        leaf(s, path));
-            }
+            put_dataset(vtm, s, m++, web->name ? web->name : name, path);
         }
         fprintf(vtm, "</Block>\n");
         if (!springs && s->def.contacts) {
@@ -999,7 +1041,7 @@ static ws_status write_vtm(ws_vtk_series *s)
             compose_contacts(f, s->contacts, nc);
             if ((st = file_write(f, path)) != WS_OK)
                 goto done;
-            fprintf(vtm, "<DataSet index=\"2\" name=\"contacts\" file=\"%s\"/>\n", leaf(s, path));
+            put_dataset(vtm, s, block++, "contacts", path);
         }
     }
     fprintf(vtm, "</vtkMultiBlockDataSet>\n</VTKFile>\n");
@@ -1007,8 +1049,8 @@ done:;
     int bad = ferror(vtm);
     if (fclose(vtm) != 0 || bad) {
         if (st == WS_OK)
-            st = ws_fail(w, WS_ERR_IO, "error while writing the frame's .vtm in '%s'",
-                         s->directory);
+            st =
+                ws_fail(w, WS_ERR_IO, "error while writing the frame's .vtm in '%s'", s->directory);
     }
     return st;
 }
@@ -1030,8 +1072,7 @@ ws_status ws_vtk_series_write_frame(ws_vtk_series *s)
             return WS_OK;
         s->last_slot = slot;
     }
-    if (ws_array_reserve(&w->mem, (void **)&s->times, &s->cap, s->count + 1, sizeof *s->times) !=
-        0)
+    if (ws_array_reserve(&w->mem, (void **)&s->times, &s->cap, s->count + 1, sizeof *s->times) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_vtk_series_write_frame: out of memory");
     ws_status st = write_vtm(s);
     if (st != WS_OK)
