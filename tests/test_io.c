@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "helpers.h"
@@ -316,13 +317,23 @@ START_TEST(names_are_escaped_in_the_vtm)
 }
 END_TEST
 
+/* A directory that is not there is refused when the series starts, naming it; a file that
+ * cannot be written is WS_ERR_IO with its path, and no frame is counted. */
 START_TEST(unwritable_directory_is_an_io_error)
 {
     ws_world *w = wrapped_box(NULL);
-    ws_vtk_series *s;
-    ck_ok(w, ws_vtk_series_create(w, "/nonexistent/wrapsim", "r", &s));
+    ws_vtk_series *s = NULL;
+    ck_assert_int_eq(ws_vtk_series_create(w, "/nonexistent/wrapsim", "r", &s), WS_ERR_IO);
+    ck_assert_ptr_null(s);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "/nonexistent/wrapsim"));
+    /* A directory that exists but whose frame file cannot be created: a directory in its way. */
+    char dir[512], path[600];
+    temp_dir(dir, sizeof dir);
+    snprintf(path, sizeof path, "%s/r_000000_bodies.vtp", dir);
+    ck_assert_int_eq(mkdir(path, 0700), 0);
+    ck_ok(w, ws_vtk_series_create(w, dir, "r", &s));
     ck_assert_int_eq(ws_vtk_series_write_frame(s), WS_ERR_IO);
-    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "/nonexistent/wrapsim/r_000000"));
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "r_000000_bodies.vtp"));
     size_t n = 1;
     ck_ok(w, ws_vtk_series_get_frame_count(s, &n));
     ck_assert_uint_eq(n, 0);
@@ -330,6 +341,7 @@ START_TEST(unwritable_directory_is_an_io_error)
     ck_assert_int_eq(ws_world_write_vtp(w, ""), WS_ERR_INVALID_ARGUMENT);
     ws_vtk_series_destroy(s);
     ws_world_destroy(w);
+    remove_dir(dir);
 }
 END_TEST
 
@@ -341,7 +353,7 @@ START_TEST(allocation_failures_are_reported_and_freed)
     temp_dir(dir, sizeof dir);
     int succeeded = 0;
     for (long fail = 0; fail < 400 && !succeeded; fail++) {
-        test_alloc a = {-1, 0, 0};
+        test_alloc a = {.allocs_left = -1, .track = 1};
         ws_world *w = wrapped_box(&a);
         ck_ok(w, ws_world_step_n(w, 5));
         a.allocs_left = fail;
@@ -355,8 +367,11 @@ START_TEST(allocation_failures_are_reported_and_freed)
         a.allocs_left = -1;
         ws_vtk_series_destroy(s);
         ws_world_destroy(w);
+        ck_assert_msg(a.size_errors == 0, "fail after %ld: %ld wrong sizes, first: %s", fail,
+                      a.size_errors, a.size_error);
         ck_assert_int_eq(a.live, 0);
         ck_assert_int_eq(a.bytes, 0);
+        test_alloc_done(&a);
     }
     ck_assert_msg(succeeded, "never succeeded in 400 allocations");
     remove_dir(dir);

@@ -41,7 +41,8 @@ if [[ $mode == test ]]; then
     packages+=(valgrind)
     if [[ ${WS_PYTHON_TESTS:-1} != 0 ]]; then
         python_tests=1
-        packages+=(python3 python3-numpy python3-pytest python3-tqdm)
+        packages+=(python3 python3-numpy python3-pytest python3-tqdm python3-matplotlib
+            python3-distributed python3-yaml python3-jsonschema chromium)
     fi
 fi
 ensure_packages "${packages[@]}"

@@ -92,10 +92,16 @@ typedef struct ws_vtk_series_def {
 } ws_vtk_series_def;
 
 /** Fill a series Def with its defaults (compressed, Float32, every call, contacts, no
- *  springs). */
-WS_API void ws_vtk_series_def_init(ws_vtk_series_def *def);
+ *  springs). ws_vtk_series_def_init(def) calls this with size = sizeof *def as the caller
+ *  compiled it (see "Defs" in common.h). */
+WS_API void ws_vtk_series_def_init_sized(ws_vtk_series_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_vtk_series_def_init)(ws_vtk_series_def *def);
+#define ws_vtk_series_def_init(def) ws_vtk_series_def_init_sized((def), sizeof *(def))
 
-/** Start a series. Each frame written is `basename`_NNNNNN.vtm, a VTK multiblock whose named
+/** Start a series in def->directory, which must exist (else WS_ERR_IO naming it). Each frame
+ *  written is `basename`_NNNNNN.vtm, a VTK multiblock whose named
  *  blocks are, in this order:
  *  - "bodies": `basename`_NNNNNN_bodies.vtp, as ws_world_write_vtp;
  *  - "film": a dataset per web alive then, named after the web ("web<k>" for an unnamed one, k its
@@ -111,7 +117,8 @@ WS_API void ws_vtk_series_def_init(ws_vtk_series_def *def);
  *  Uses the world's allocator.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (world or out NULL, no directory or basename, '/' in
  *  the basename, a value out of its range: the last error names it),
- *  WS_ERR_UNINITIALIZED_DEF, WS_ERR_OUT_OF_MEMORY. */
+ *  WS_ERR_UNINITIALIZED_DEF, WS_ERR_IO (the directory does not exist or is not one),
+ *  WS_ERR_OUT_OF_MEMORY. */
 WS_API ws_status ws_vtk_series_create_def(ws_world *world, const ws_vtk_series_def *def,
                                           ws_vtk_series **out);
 

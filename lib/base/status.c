@@ -15,6 +15,7 @@ const char *ws_status_string(ws_status status)
     case WS_ERR_BUFFER_TOO_SMALL: return "WS_ERR_BUFFER_TOO_SMALL: the buffer holds fewer items than there are";
     case WS_ERR_IO: return "WS_ERR_IO: a file could not be written";
     case WS_ERR_UNSUPPORTED: return "WS_ERR_UNSUPPORTED: this build lacks the feature";
+    case WS_ERR_IN_STEP: return "WS_ERR_IN_STEP: a call that changes the world was made from a callback inside ws_world_step";
     }
     return "unknown ws_status";
 }

@@ -1160,8 +1160,14 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
         web->act_cap = 0;
         web->act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
         web->act_id = ws_mem_calloc(mem, need * 4, sizeof(uint32_t));
-        if (!web->act || !web->act_id)
+        if (!web->act || !web->act_id) {
+            /* Both go, so that no block outlives the capacity its free will be given. */
+            ws_mem_free(mem, web->act, web->act ? need * ACT_ARRAYS * sizeof(double) : 0);
+            ws_mem_free(mem, web->act_id, web->act_id ? need * 4 * sizeof(uint32_t) : 0);
+            web->act = NULL;
+            web->act_id = NULL;
             return -1;
+        }
         web->act_cap = need;
     }
     return 0;

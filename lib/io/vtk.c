@@ -6,6 +6,7 @@
  * offsets the XML must name before the data follows. Every array is first laid out as raw values
  * in a scratch buffer, then written in the chosen form (ASCII text, raw binary, or zlib blocks), so
  * the code that gathers an array knows nothing of the format. */
+#define _POSIX_C_SOURCE 200809L /* stat, to check the series' directory */
 #include "world/world_internal.h"
 
 #include <errno.h>
@@ -13,6 +14,11 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#if !defined(S_ISDIR) && defined(S_IFDIR)
+#define S_ISDIR(m) (((m) & S_IFMT) == S_IFDIR)
+#endif
 
 #ifdef WS_HAVE_ZLIB
 #include <zlib.h>
@@ -614,7 +620,7 @@ static void web_fields(vtk_file *f, ws_web *web, uint32_t slot, int bands)
         emit(f, T_STR, "web_name", 1, 1);
     }
     uint64_t *id = raw_take(f, T_U64, 1);
-    ws_web_id wid = {ws_id_pack(w->tag, WS_KIND_WEB, w->web_slots.generation[slot], slot)};
+    ws_web_id wid = {ws_slots_id(&w->web_slots, WS_KIND_WEB, slot)};
     if (id) {
         id[0] = wid.bits;
         emit(f, T_U64, "web_id", 1, 1);
@@ -801,10 +807,9 @@ struct ws_vtk_series {
     vtk_file file;
 };
 
-void ws_vtk_series_def_init(ws_vtk_series_def *def)
+static void vtk_series_defaults(ws_vtk_series_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->format = WS_VTK_COMPRESSED;
     def->frame_stride = 1;
     def->time_stride = 0.0;
@@ -813,6 +818,7 @@ void ws_vtk_series_def_init(ws_vtk_series_def *def)
     def->containment_bands = WS_VTK_DEFAULT_BANDS;
     def->double_precision = 0;
 }
+WS_DEF_INITS(ws_vtk_series_def, vtk_series_defaults, double_precision)
 
 ws_status ws_vtk_series_create_def(ws_world *w, const ws_vtk_series_def *def, ws_vtk_series **out)
 {
@@ -821,7 +827,7 @@ ws_status ws_vtk_series_create_def(ws_world *w, const ws_vtk_series_def *def, ws
     *out = NULL;
     ws_vtk_series_def d;
     ws_vtk_series_def_init(&d);
-    ws_status st = ws_def_take(w, &d, sizeof d, def, sizeof d, "vtk_series");
+    ws_status st = ws_def_take(w, &d, sizeof d, def, "vtk_series");
     if (st != WS_OK)
         return st;
     if (!d.directory || !d.basename || !*d.basename || strchr(d.basename, '/'))
@@ -840,6 +846,14 @@ ws_status ws_vtk_series_create_def(ws_world *w, const ws_vtk_series_def *def, ws
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "vtk_series: containment_bands must be 0..%d, got %d", WS_VTK_MAX_BANDS,
                        d.containment_bands);
+    /* Refused now rather than at the first frame, minutes into a run. */
+    struct stat dir;
+    if (stat(d.directory, &dir) != 0)
+        return ws_fail(w, WS_ERR_IO, "ws_vtk_series_create: directory '%s': %s", d.directory,
+                       strerror(errno));
+    if (!S_ISDIR(dir.st_mode))
+        return ws_fail(w, WS_ERR_IO, "ws_vtk_series_create: '%s' is not a directory",
+                       d.directory);
 #ifndef WS_HAVE_ZLIB
     /* Without zlib the binary form is the raw one: the same files, uncompressed. */
     if (d.format == WS_VTK_COMPRESSED)
