@@ -98,6 +98,7 @@ WS_API void ws_vtk_series_def_init_sized(ws_vtk_series_def *def, size_t size);
 /** The plain form of the init (the whole Def of these headers). New code reaches the macro
  *  below. */
 WS_API void(ws_vtk_series_def_init)(ws_vtk_series_def *def);
+/** Fill a series Def with its defaults: ws_vtk_series_def_init_sized with the caller's sizeof. */
 #define ws_vtk_series_def_init(def) ws_vtk_series_def_init_sized((def), sizeof *(def))
 
 /** Start a series in def->directory, which must exist (else WS_ERR_IO naming it). Each frame
