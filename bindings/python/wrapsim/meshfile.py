@@ -227,7 +227,8 @@ def refused(path, err, vertices, triangles, scale, weld_tol):
     m = re.search(r"triangle (\d+) is degenerate", detail)
     if m and int(m.group(1)) < len(triangles):
         tri = tuple(v[int(k)] for k in triangles[int(m.group(1))])
-        extra = "; its corners are " + ", ".join(_fmt(c) for c in tri) + " in the file's coordinates"
+        extra = ("; its corners are " + ", ".join(_fmt(c) for c in tri)
+                 + " in the file's coordinates")
     if edge is not None and "not closed" in detail:
         extra += (f" (vertices closer than {weld_tol:g} of the mesh's size were welded: a larger "
                   "weld_tol closes gaps a writer left)")
