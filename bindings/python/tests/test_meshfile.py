@@ -244,13 +244,17 @@ def test_quads_are_split_into_triangles(tmp_path):
 
 def test_files_that_are_not_meshes(tmp_path, monkeypatch):
     """A missing file, a directory, text in an .stl, an OBJ without faces, a file type not
-    read: WS_ERR_IO naming the file. Without meshio: WS_ERR_UNSUPPORTED naming the package."""
+    read, an OBJ with relative indices: WS_ERR_IO naming the file. Without meshio:
+    WS_ERR_UNSUPPORTED naming the package."""
     (tmp_path / "junk.stl").write_text("this is not a mesh\n")
     (tmp_path / "points.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n")
     (tmp_path / "notes.txt").write_text("v 0 0 0\n")
+    (tmp_path / "relative.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                           "f -4 -2 -3\nf -4 -3 -1\nf -4 -1 -2\nf -3 -2 -1\n")
     cases = [("missing.stl", "no such file"), (".", "directory"),
              ("junk.stl", "not a readable STL"), ("points.obj", "no triangles"),
-             ("notes.txt", "unknown mesh file type")]
+             ("notes.txt", "unknown mesh file type"),
+             ("relative.obj", "relative \\(negative\\) indices are not read")]
     with ws.World() as w:
         for name, words in cases:
             path = tmp_path / name

@@ -188,8 +188,11 @@ def read_mesh(path, scale=1.0, weld_tol=DEFAULT_WELD, flip=False, file_format=No
     bad = (tri < 0) | (tri >= len(pts))
     if bad.any():
         f = int(np.nonzero(bad.any(axis=1))[0][0])
-        raise _error(WS_ERR_IO, path, f"a face refers to vertex {int(tri[bad][0])}, and the file "
-                     f"has {len(pts)} (face {f} after splitting polygons into triangles)")
+        k = int(tri[bad][0])
+        raise _error(WS_ERR_IO, path, f"a face (triangle {f} after splitting polygons) refers to "
+                     f"vertex {k} counting from 0 ({k + 1} from 1), and the file has "
+                     f"{len(pts)}" + (": relative (negative) indices are not read" if k < 0
+                                       else ""))
     if not np.isfinite(pts).all():
         raise _error(WS_ERR_IO, path, "a vertex coordinate is not a finite number")
     pts = pts * scale
