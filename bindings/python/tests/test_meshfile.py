@@ -300,3 +300,29 @@ def test_bottles_example_smoke():
     assert r["angle"] == pytest.approx(2.0, abs=0.01)
     assert len(r["slide"]) == 4 and max(r["slide"]) < 1e-3 and max(r["lean"]) < 0.5
     assert r["stayed"] and 0 < r["tension"] < 100
+
+
+def test_the_c_example_reads_stl_as_python_does(tmp_path):
+    """examples/stl_shape.c (built in build/examples/) reads the bottle as binary STL and as
+    ASCII STL (the same float32 corners printed in full) to the volume mesh_from_file gives,
+    to its 10 printed digits; an open copy exits with status 1 and names the edge's ends."""
+    import subprocess
+    exe = REPO / "build" / "examples" / "stl_shape"
+    if not exe.exists():
+        pytest.skip("build/examples/stl_shape is not built")
+    binary = REPO / "examples" / "data" / "bottle.stl"
+    m = meshio.read(str(binary))
+    pts, tri = np.asarray(m.points, dtype=np.float64), m.cells_dict["triangle"]
+    ascii_path = write(tmp_path / "bottle_ascii.stl", pts, tri, binary=False)
+    with ws.World() as w:
+        want = w.mesh_from_file(binary, scale=0.001).info()["volume"]
+        for path in (binary, ascii_path):
+            out = subprocess.run([str(exe), str(path), "--scale", "0.001"], capture_output=True,
+                                 text=True, timeout=60)
+            assert out.returncode == 0, out.stderr
+            got = float(out.stdout.split("volume ")[1].split()[0])
+            assert rel(got, want) < 1e-9
+            assert "1536 corners welded into 258 vertices" in out.stdout
+    open_path = write(tmp_path / "open.stl", pts, tri[1:], binary=True)
+    out = subprocess.run([str(exe), str(open_path)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 1 and "not closed" in out.stderr and "the edge runs from" in out.stderr
