@@ -90,7 +90,7 @@ static int read_binary(FILE *f, long size, mesh *m, const char *path)
 }
 
 /* An ASCII STL: every "vertex x y z" line is a corner; three make a triangle. */
-static int read_ascii(FILE *f, mesh *m, const char *path)
+static int read_ascii(FILE *f, long size, mesh *m, const char *path)
 {
     char line[512];
     long lineno = 0;
@@ -118,9 +118,16 @@ static int read_ascii(FILE *f, mesh *m, const char *path)
             return -1;
         }
     }
-    if (m->count == 0 || m->count % 3 != 0) {
-        fprintf(stderr, "%s: not an STL file (%lu vertex lines; a mesh needs a multiple of 3)\n",
-                path, (unsigned long)m->count);
+    if (m->count == 0) {
+        fprintf(stderr,
+                "%s: not an STL file: no 'vertex' lines, and %ld bytes is not the size of a "
+                "binary STL (84 + 50 per triangle, as its count says)\n",
+                path, size);
+        return -1;
+    }
+    if (m->count % 3 != 0) {
+        fprintf(stderr, "%s: %lu vertex lines: a triangle mesh needs a multiple of 3\n", path,
+                (unsigned long)m->count);
         return -1;
     }
     return 0;
@@ -205,7 +212,7 @@ int main(int argc, char **argv)
     mesh m = {0};
     int r = size < 0 ? -1 : read_binary(f, size, &m, path);
     if (r > 0)
-        r = read_ascii(f, &m, path);
+        r = read_ascii(f, size, &m, path);
     fclose(f);
     for (size_t i = 0; r == 0 && i < m.count; i++) {
         const corner *c = &m.corners[i];
