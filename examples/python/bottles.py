@@ -11,7 +11,8 @@ for START s, then the platform tilts about y at RATE up to --angle and holds the
 
 It reports, per bottle, how far it slid along the platform and how far it leans from the
 platform's normal, and whether the tray stayed (every bottle within 5 mm and 2 deg). Below the
-friction angle (atan 0.3 = 16.7 deg) and the tipping angle of a bottle (about 23 deg) it does.
+friction angle (atan 0.3 = 16.7 deg) and the tipping angle of a lone bottle (atan(40/89) =
+24 deg: its centroid is 89 mm up) it does.
 
 Run (from the repository root, the library built in build/; needs python3-meshio):
   PYTHONPATH=bindings/python python3 examples/python/bottles.py [--angle 10] [--no-film]
