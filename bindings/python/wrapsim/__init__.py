@@ -548,6 +548,25 @@ class World:
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
 
+    def mesh_from_file(self, path, scale=1.0, weld_tol=1e-6, flip=False, file_format=None):
+        """A closed mesh shape read from an STL (ASCII or binary), OBJ or PLY file (needs
+        meshio). `scale` turns the file's numbers into metres (0.001 for a file in mm);
+        vertices closer than `weld_tol` times the mesh's size are welded into one (STL repeats
+        every vertex in each of its triangles); `flip` reverses an inside-out mesh. Like every
+        mesh, the shape is re-centred on its volume centroid: create its body at
+        `shape.centroid_offset` (identity orientation) to put it where the file had it. Raises
+        wrapsim.meshfile.MeshFileError (a WrapsimError) naming the file, and for a mesh the
+        library refuses, the offending edge's vertex positions in the file's units."""
+        from . import meshfile
+        v, t = meshfile.read_mesh(path, scale=scale, weld_tol=weld_tol, flip=flip,
+                                  file_format=file_format)
+        try:
+            return self.mesh(v, t)
+        except WrapsimError as e:
+            if e.status != WS_ERR_BAD_MESH:
+                raise
+            raise meshfile.refused(str(path), e, v, t, float(scale), float(weld_tol)) from e
+
     # bodies
     def body(self, shape, **kwargs):
         """Create a body: ws_body_def fields as keywords (type 'dynamic'/'kinematic', material,
