@@ -1180,7 +1180,9 @@ START_TEST(test_version_and_status_strings)
                              WS_ERR_CALLBACK,
                              WS_ERR_BUFFER_TOO_SMALL,
                              WS_ERR_IO,
-                             WS_ERR_UNSUPPORTED};
+                             WS_ERR_UNSUPPORTED,
+                             WS_ERR_IN_STEP,
+                             WS_ERR_FORMAT};
     const size_t n = sizeof all / sizeof all[0];
     for (size_t i = 0; i < n; i++) {
         const char *si = ws_status_string(all[i]);
@@ -1726,9 +1728,11 @@ START_TEST(test_mesh_messages)
     ck_assert_int_eq(create_mesh(w, NULL, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
     ck_err_ends(w, "vertices and triangles must not be NULL");
     ck_assert_int_eq(create_mesh(w, v, 4, tet_deg, 4, &s), WS_ERR_BAD_MESH);
-    ck_err_ends(w, "triangle 0 is degenerate (zero area)");
+    ck_err_ends(w, "triangle 0 is degenerate (zero area): remove it, or repair the mesh in a mesh "
+                   "tool (merge duplicate vertices, remove degenerate faces)");
     ck_assert_int_eq(create_mesh(w, v, 4, tet_in, 4, &s), WS_ERR_BAD_MESH);
-    ck_err_ends(w, "counter-clockwise seen from outside");
+    ck_err_ends(w, "counter-clockwise seen from outside (the mesh is inside out): reverse every "
+                   "triangle, or repair it in a mesh tool (flip the normals)");
     double same[12] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
     ck_assert_int_eq(create_mesh(w, same, 4, tet, 4, &s), WS_ERR_BAD_MESH);
     ck_err_ends(w, "all vertices coincide");

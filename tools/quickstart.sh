@@ -42,7 +42,7 @@ if [[ $mode == test ]]; then
     if [[ ${WS_PYTHON_TESTS:-1} != 0 ]]; then
         python_tests=1
         packages+=(python3 python3-numpy python3-pytest python3-tqdm python3-matplotlib
-            python3-distributed python3-yaml python3-jsonschema chromium)
+            python3-distributed python3-yaml python3-jsonschema python3-meshio chromium)
     fi
 fi
 ensure_packages "${packages[@]}"

@@ -169,8 +169,10 @@ WS_API ws_status ws_world_get_stats(const ws_world *world, ws_world_stats *stats
 /** Energy of the dynamic bodies (contact energy from the last step's contacts). */
 WS_API ws_status ws_world_get_energy(const ws_world *world, ws_energy *energy);
 /** A 64-bit hash of the whole dynamic state (time, every body's pose and velocities, friction
- *  anchors, every film node's position and velocity, the law histories of the elements). Equal
- *  hashes after equal inputs: the determinism check. */
+ *  anchors, every film node's position and velocity, the law histories of the film's springs and
+ *  of the elements): FNV-1a over the little-endian bytes of the state a save holds
+ *  (ws_world_save), less the contact caches' bookkeeping, which a failed step may change. Equal
+ *  hashes after equal inputs, on every machine: the determinism check. */
 WS_API ws_status ws_world_get_state_hash(const ws_world *world, uint64_t *hash);
 /** The detail of the last error in this world ("body 'top': mass must be > 0, got -1"); ""
  *  when there was none. Valid until the next call on the world. NULL world gives a static text. */

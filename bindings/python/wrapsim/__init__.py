@@ -7,6 +7,7 @@ text. See README.md next to this package.
 """
 
 import ctypes
+import os
 from ctypes import byref, c_double, c_int, c_size_t, c_uint32, c_uint64, POINTER
 
 import numpy as np
@@ -16,8 +17,9 @@ from ._lib import LibraryError, BINDING_VERSION as __version__  # noqa: F401
 from ._lib import (  # noqa: F401  (re-exported constants)
     WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE,
     WS_ERR_OUT_OF_MEMORY, WS_ERR_NUMERICAL, WS_ERR_BAD_MESH, WS_ERR_IN_USE, WS_ERR_CALLBACK,
-    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_IN_STEP, WS_LOG_DEBUG,
-    WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD, WS_INTEGRATOR_SYMPLECTIC_EULER,
+    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_IN_STEP, WS_ERR_FORMAT,
+    WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD,
+    WS_INTEGRATOR_SYMPLECTIC_EULER,
     WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
     WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT, WS_LAW_LINEAR_ELASTIC,
@@ -358,6 +360,19 @@ class World:
         except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
 
+    # A World owns its C world: a copy would share it, and closing one would free it under the
+    # other. Copying and pickling are refused; save() and restore() carry a state across.
+    def __copy__(self):
+        raise TypeError("a wrapsim.World cannot be copied (the copy would share its C world); "
+                        "build another World and restore() a save() into it")
+
+    def __deepcopy__(self, memo):
+        self.__copy__()
+
+    def __reduce_ex__(self, protocol):
+        raise TypeError("a wrapsim.World cannot be pickled or copied; save() gives its state as "
+                        "bytes, which restore() takes in a World built the same way")
+
     @property
     def closed(self):
         return not self._ptr
@@ -440,6 +455,32 @@ class World:
         self._call("ws_world_get_state_hash", byref(h))
         return h.value
 
+    def save(self, path=None):
+        """The world's state (ws_world_save): as bytes when `path` is None, else written to the
+        file `path` (ws_world_save_file; then None is returned). It holds the state, not the
+        structure: restore() it into a World built the same way."""
+        if path is not None:
+            self._call("ws_world_save_file", os.fsencode(path))
+            return None
+        n = c_size_t()
+        self._call("ws_world_save", None, 0, byref(n))
+        buf = ctypes.create_string_buffer(n.value)
+        self._call("ws_world_save", buf, n.value, byref(n))
+        return buf.raw[:n.value]
+
+    def restore(self, data_or_path):
+        """Restore a state from save(): bytes (or a bytearray, memoryview) or a file path. The
+        world must have been built as the saved one was; a save that is truncated, corrupted,
+        newer or of another structure raises WrapsimError (WS_ERR_FORMAT) and changes nothing."""
+        if isinstance(data_or_path, (bytes, bytearray, memoryview)):
+            data = bytes(data_or_path)
+            self._call("ws_world_restore", data, len(data))
+        elif isinstance(data_or_path, (str, os.PathLike)):
+            self._call("ws_world_restore_file", os.fsencode(data_or_path))
+        else:
+            raise TypeError("restore() takes bytes from save() or a path, got %s"
+                            % type(data_or_path).__name__)
+
     def estimate_stable_dt(self):
         """Largest stable dt (s) estimated for the bodies and contact pairs now in the world."""
         t = c_double()
@@ -510,53 +551,24 @@ class World:
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
 
-    def mesh_from_file(self, path, scale=1.0, file_format=None):
-        """A closed mesh shape read from a file: STL (ASCII or binary), OBJ, PLY, or any other
-        surface format meshio reads (Debian python3-meshio; `file_format` overrides the guess
-        from the extension). `scale` multiplies the coordinates into metres (0.001 for a file in
-        millimetres). Points shared by faces are merged where their coordinates are equal (STL
-        repeats them per facet), polygons are split into triangles from their first corner, and
-        a surface that is closed and consistently wound but inside out is turned outside out.
-        A mesh that is open, non-manifold or inconsistently wound raises WrapsimError
-        (WS_ERR_BAD_MESH) naming the offending edge, with a hint to repair the file."""
+    def mesh_from_file(self, path, scale=1.0, weld_tol=1e-6, flip=False, file_format=None):
+        """A closed mesh shape read from an STL (ASCII or binary), OBJ or PLY file (needs
+        meshio). `scale` turns the file's numbers into metres (0.001 for a file in mm);
+        vertices closer than `weld_tol` times the mesh's size are welded into one (STL repeats
+        every vertex in each of its triangles); `flip` reverses an inside-out mesh. Like every
+        mesh, the shape is re-centred on its volume centroid: create its body at
+        `shape.centroid_offset` (identity orientation) to put it where the file had it. Raises
+        wrapsim.meshfile.MeshFileError (a WrapsimError) naming the file, and for a mesh the
+        library refuses, the offending edge's vertex positions in the file's units."""
+        from . import meshfile
+        v, t = meshfile.read_mesh(path, scale=scale, weld_tol=weld_tol, flip=flip,
+                                  file_format=file_format)
         try:
-            import meshio
-        except ImportError as e:  # pragma: no cover - depends on the machine
-            raise ImportError("World.mesh_from_file needs meshio (Debian: python3-meshio)") from e
-        m = meshio.read(str(path), file_format=file_format)
-        points = np.asarray(m.points, dtype=np.float64)
-        if points.ndim != 2 or points.shape[1] < 3:
-            raise WrapsimError(WS_ERR_BAD_MESH, f"{path}: needs 3D points, got shape "
-                               f"{points.shape}")
-        tris = []
-        for block in m.cells:
-            faces = np.asarray(block.data)
-            if block.type in ("triangle", "quad") or block.type.startswith("polygon"):
-                # a fan from each face's first corner: (0, k, k + 1)
-                for k in range(1, faces.shape[1] - 1):
-                    tris.append(faces[:, [0, k, k + 1]])
-        if not tris:
-            raise WrapsimError(WS_ERR_BAD_MESH, f"{path}: no surface faces (triangles, quads or "
-                               "polygons) in the file")
-        tri = np.concatenate(tris).astype(np.int64)
-        pts = points[:, :3] * float(scale)
-        # Equal coordinates are one vertex (exact equality: what STL writers repeat).
-        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
-        tri = inverse.reshape(-1)[tri]
-        # Signed volume by the divergence theorem: negative for a surface wound inside out.
-        a, b, c = uniq[tri[:, 0]], uniq[tri[:, 1]], uniq[tri[:, 2]]
-        if np.einsum("ij,ij->", a, np.cross(b, c)) < 0.0:
-            tri = tri[:, ::-1]
-        try:
-            return self.mesh(uniq, tri)
+            return self.mesh(v, t)
         except WrapsimError as e:
             if e.status != WS_ERR_BAD_MESH:
                 raise
-            raise WrapsimError(e.status, f"{path}: {e.detail} (vertex numbers after merging equal "
-                               "points). Repair the file: close its holes, merge duplicate "
-                               "points, remove faces that share an edge with more than one "
-                               "other, and make the faces' winding consistent (a mesh editor's "
-                               "'repair' or 'make manifold' tools do this)") from None
+            raise meshfile.refused(str(path), e, v, t, float(scale), float(weld_tol)) from e
 
     # bodies
     def body(self, shape, **kwargs):
