@@ -35,7 +35,7 @@ source tools/count_tests.sh
 # shellcheck source=tools/ensure_packages.sh
 source tools/ensure_packages.sh
 
-packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev)
+packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev zlib1g-dev)
 python_tests=0
 if [[ $mode == test ]]; then
     packages+=(valgrind)
