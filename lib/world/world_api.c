@@ -68,7 +68,7 @@ WS_DEF_INITS(ws_mesh_def, mesh_defaults, triangle_count)
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
                            size_t nt, const char *fn, ws_shape_id *out)
 {
-    char why[256] = "";
+    char why[400] = ""; /* a refused mesh's reason and repair hint; fits the error text */
     ws_shape *s = ws_mem_alloc(&w->mem, sizeof *s);
     if (!s)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);

@@ -126,7 +126,7 @@ STRUCTS = {
     "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo, "ws_law_info": L.LawInfo,
     "ws_containment_band": L.ContainmentBand,
     "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
-    "ws_element_output": L.ElementOutput,
+    "ws_element_output": L.ElementOutput, "ws_vtk_series_def": L.VtkSeriesDef,
 }
 
 
@@ -172,7 +172,7 @@ def test_struct_fields_match_headers():
 def test_version_and_features():
     assert ws.version_number() >= L.REQUIRED_VERSION
     assert ws.version().count(".") == 2
-    assert ws.build_features() & ~ws.WS_FEATURE_CCD == 0
+    assert ws.build_features() & ~(ws.WS_FEATURE_CCD | ws.WS_FEATURE_ZLIB) == 0
     assert ws.status_string(ws.WS_ERR_STALE_HANDLE).startswith("WS_ERR_STALE_HANDLE")
 
 
@@ -868,6 +868,19 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert (tmp_path / "run.pvd").exists()
         sheet.write_vtp(tmp_path / "sheet.vtp")
         assert (tmp_path / "sheet.vtp").exists()
+        # Strides: a call every 10 ms from t = 17.5 ms, every 2nd call offered (17.5, 37.5,
+        # 57.5, 77.5, 97.5 ms) and at most one frame per 25 ms slot (slots 0, 1, 2, 3, 3).
+        with w.vtk_series(tmp_path, "strided", format="ascii", frame_stride=2,
+                          time_stride=0.025, springs=1) as strided:
+            for _ in range(10):
+                w.step(40)  # 10 ms at dt 0.25 ms
+                strided.write_frame()
+            assert strided.frame_count == 4
+        assert (tmp_path / "strided_000000_springs1.vtp").exists()
+        with pytest.raises(ws.WrapsimError) as err:
+            w.vtk_series(tmp_path, "bad", frame_stride=0)
+        assert err.value.status == ws.WS_ERR_INVALID_ARGUMENT
+        assert "frame_stride" in err.value.detail
         open_series = w.vtk_series(tmp_path, "left-open")  # closed with the world
         open_series.write_frame()
         with pytest.raises(ws.WrapsimError) as err:

@@ -34,6 +34,9 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_DRIVE_PULSE, WS_DRIVE_IMPACT, WS_DRIVE_TABLE, WS_DRIVE_RANDOM, WS_DRIVE_SWEEP,
     WS_PULSE_ACCELERATE, WS_PULSE_BRAKE, WS_SWEEP_LOG, WS_SWEEP_LINEAR, WS_TRUCK_LOW,
     WS_TRUCK_MEDIUM, WS_TRUCK_HIGH, WS_STANDARD_GRAVITY)
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_FEATURE_ZLIB, WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII, WS_VTK_DEFAULT_BANDS,
+    WS_VTK_MAX_BANDS)
 from ._run import run  # noqa: F401
 
 __all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
@@ -550,6 +553,25 @@ class World:
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
 
+    def mesh_from_file(self, path, scale=1.0, weld_tol=1e-6, flip=False, file_format=None):
+        """A closed mesh shape read from an STL (ASCII or binary), OBJ or PLY file (needs
+        meshio). `scale` turns the file's numbers into metres (0.001 for a file in mm);
+        vertices closer than `weld_tol` times the mesh's size are welded into one (STL repeats
+        every vertex in each of its triangles); `flip` reverses an inside-out mesh. Like every
+        mesh, the shape is re-centred on its volume centroid: create its body at
+        `shape.centroid_offset` (identity orientation) to put it where the file had it. Raises
+        wrapsim.meshfile.MeshFileError (a WrapsimError) naming the file, and for a mesh the
+        library refuses, the offending edge's vertex positions in the file's units."""
+        from . import meshfile
+        v, t = meshfile.read_mesh(path, scale=scale, weld_tol=weld_tol, flip=flip,
+                                  file_format=file_format)
+        try:
+            return self.mesh(v, t)
+        except WrapsimError as e:
+            if e.status != WS_ERR_BAD_MESH:
+                raise
+            raise meshfile.refused(str(path), e, v, t, float(scale), float(weld_tol)) from e
+
     # bodies
     def body(self, shape, **kwargs):
         """Create a body: ws_body_def fields as keywords (type 'dynamic'/'kinematic', material,
@@ -816,11 +838,23 @@ class World:
         """Write the bodies as one VTK PolyData file."""
         self._call("ws_world_write_vtp", str(path).encode())
 
-    def vtk_series(self, directory, basename):
-        """Start a .vtp/.pvd time series in `directory` (must exist). A context manager."""
+    def vtk_series(self, directory, basename, **kwargs):
+        """Start a time series for ParaView in `directory` (must exist): a .pvd over per-frame
+        .vtm multiblocks with the blocks bodies, film, contacts (and springs). Keyword arguments
+        are ws_vtk_series_def fields: format (WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII or
+        "compressed", "binary", "ascii"), frame_stride, time_stride (s), springs, contacts,
+        containment_bands, double_precision. A context manager."""
+        if isinstance(kwargs.get("format"), str):
+            kwargs["format"] = {"compressed": L.WS_VTK_COMPRESSED, "binary": L.WS_VTK_BINARY,
+                                "ascii": L.WS_VTK_ASCII}[kwargs["format"].lower()]
+        d = _make(L.VtkSeriesDef, kwargs)
+        directory, basename = str(directory).encode(), str(basename).encode()
+        d.directory, d.basename = directory, basename
         p = L.Series_p()
-        self._call("ws_vtk_series_create", str(directory).encode(), str(basename).encode(),
-                   byref(p))
+        if kwargs:
+            self._call("ws_vtk_series_create_def", byref(d), byref(p))
+        else:
+            self._call("ws_vtk_series_create", directory, basename, byref(p))
         s = VtkSeries(self, p)
         self._series.append(s)
         return s
@@ -1330,7 +1364,7 @@ class VtkSeries:
             raise WrapsimError(s, _c().ws_world_last_error(self.world.ptr).decode())
 
     def write_frame(self):
-        """Write the world now as the next frame."""
+        """Offer the world now as the next frame: written when the series' strides allow it."""
         if not self._ptr:
             raise WrapsimError(WS_ERR_STALE_HANDLE, "the VTK series was closed")
         self._check(_c().ws_vtk_series_write_frame(self._ptr))

@@ -36,6 +36,7 @@ WS_ERR_FORMAT = 13
 
 WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
 WS_FEATURE_CCD = 1
+WS_FEATURE_ZLIB = 2
 WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
 WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
 WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
@@ -445,6 +446,29 @@ class ContainmentBand(Structure):
     ]
 
 
+# --- io.h ----------------------------------------------------------------------------------------
+WS_VTK_COMPRESSED = 0
+WS_VTK_BINARY = 1
+WS_VTK_ASCII = 2
+WS_VTK_DEFAULT_BANDS = 10
+WS_VTK_MAX_BANDS = 256
+
+
+class VtkSeriesDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("directory", c_char_p),
+        ("basename", c_char_p),
+        ("format", c_int),
+        ("frame_stride", c_int),
+        ("time_stride", c_double),
+        ("springs", c_int),
+        ("contacts", c_int),
+        ("containment_bands", c_int),
+        ("double_precision", c_int),
+    ]
+
+
 # --- element.h -----------------------------------------------------------------------------------
 class ElementDef(Structure):
     _fields_ = [
@@ -620,6 +644,8 @@ FUNCTIONS = [
     ("ws_world_write_vtp", [World_p, c_char_p], _st),
     ("ws_web_write_vtp", [World_p, WebId, c_char_p], _st),
     ("ws_vtk_series_create", [World_p, c_char_p, c_char_p, P(Series_p)], _st),
+    ("ws_vtk_series_def_init_sized", [P(VtkSeriesDef), c_size_t], None),
+    ("ws_vtk_series_create_def", [World_p, P(VtkSeriesDef), P(Series_p)], _st),
     ("ws_vtk_series_write_frame", [Series_p], _st),
     ("ws_vtk_series_get_frame_count", [Series_p, P(c_size_t)], _st),
     ("ws_vtk_series_destroy", [Series_p], None),
@@ -645,6 +671,7 @@ DEF_INITS = [
     ("ws_band_def_init_sized", BandDef),
     ("ws_web_mesh_def_init_sized", WebMeshDef),
     ("ws_element_def_init_sized", ElementDef),
+    ("ws_vtk_series_def_init_sized", VtkSeriesDef),
 ]
 
 

@@ -30,7 +30,8 @@ def _info(args):
     except L.LibraryError as e:
         return _err(e)
     features = lib.ws_build_features()
-    names = [name for bit, name in ((L.WS_FEATURE_CCD, "libccd"),) if features & bit]
+    names = [name for bit, name in ((L.WS_FEATURE_CCD, "libccd"), (L.WS_FEATURE_ZLIB, "zlib"))
+             if features & bit]
     print(f"libwrapsim {lib.ws_version_string().decode()}")
     print(f"library:  {lib._wrapsim_path}")
     print(f"binding:  {L.BINDING_VERSION}")
