@@ -64,8 +64,10 @@ typedef struct tilt_options {
     int vtk_ascii;        /* 1: ASCII files instead of compressed binary */
     int quiet;            /* no progress, no summary */
     int wrapped;          /* 1: stretch film around the stack */
-    double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
-    int substeps;         /* film sub-steps per step; 0 = 1 */
+    double film_mass;     /* kg per node; 0 = 1 g */
+    int substeps;         /* film sub-steps per step; 0 = 2 (1 g nodes then use 0.34 of their
+                             stable sub-step, within the default safety factor 0.5) */
+    double stable_fraction; /* the film check's safety factor (world.h); 0 = the default */
     int profile;          /* 1: the library times its phases (ws_world_stats) */
 } tilt_options;
 
@@ -170,7 +172,7 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
     wd.material = film_mat;
     wd.law = around;
     wd.law_cross = up;
-    wd.substeps = o->substeps > 0 ? o->substeps : 1;
+    wd.substeps = o->substeps > 0 ? o->substeps : 2;
     wd.name = "film";
     ws_band_def bd;
     ws_band_def_init(&bd);
@@ -201,6 +203,8 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.detection_interval = 5;     /* ... then every 5th step */
     wd.use_ccd = o->use_ccd;
     wd.profile = o->profile;
+    if (o->stable_fraction > 0)
+        wd.stable_fraction = o->stable_fraction;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
     ws_status s = ws_world_create(&wd, &sc->world);
@@ -326,10 +330,11 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 }
 
 /* Gross slip of body b on its support: every contact between them slips (tangential speed at
- * or above v_lim under the regularised law, anchor sliding under the stick law), and they slip
- * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
- * support, as when the platform starts to tilt, slips at every corner but is not sliding. The
- * pair's report gives every slip velocity as b's on its support, whichever owns the face. */
+ * or above v_lim under the regularised law, the anchor at its cap under the stick law), and
+ * they slip the same way (|sum of slip velocities| >= half the sum of their sizes): a box
+ * turning on its support, as when the platform starts to tilt, slips at every corner but is not
+ * sliding. The pair's report gives every slip velocity as b's on its support, whichever owns
+ * the face. */
 static int slides_on(ws_world *w, ws_body_id b, ws_body_id support)
 {
     ws_contact_info buf[64];
@@ -345,7 +350,7 @@ static int slides_on(ws_world *w, ws_body_id b, ws_body_id support)
         sy += v->y;
         sz += v->z;
         size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
-        slipping += buf[k].slipping != 0;
+        slipping += buf[k].slipping != 0 || buf[k].at_cap != 0; /* stick: saturated */
     }
     return n > 0 && slipping == n && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;
 }

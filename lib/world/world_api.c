@@ -829,6 +829,9 @@ ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t
         o->slip_velocity = c->vt;
         o->kind = (int32_t)c->kind;
         o->slipping = (int32_t)c->slipping;
+        o->at_cap = (int32_t)c->at_cap;
+        o->reserved_ = 0;
+        o->anchor_deflection = c->defl;
     }
     if (buf && cap < n)
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
@@ -885,6 +888,10 @@ ws_status ws_world_copy_contacts_between(const ws_world *w, ws_body_id a, ws_bod
             if (swapped && c->kind == WS_CONTACT_POINT_FACE)
                 o->kind = WS_CONTACT_FACE_POINT;
             o->slipping = (int32_t)c->slipping;
+            o->at_cap = (int32_t)c->at_cap;
+            o->reserved_ = 0;
+            /* The deflection is b's point less its anchor on a: swapped, a's less b's. */
+            o->anchor_deflection = v3_scale(c->defl, sg);
         }
         n++;
     }

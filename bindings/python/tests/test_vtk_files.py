@@ -49,7 +49,7 @@ def build():
                 damping=0.003)
     film = w.web_band(law, boxes, node_mass=1e-3, contact_layer=layer, material=film_mat,
                       name="film", z_bottom=0.03, z_top=0.48, n_around=N_AROUND, n_up=N_UP,
-                      prestretch_around=0.4, prestretch_up=0.2)
+                      prestretch_around=0.4, prestretch_up=0.2, substeps=2)
     return w, boxes, film
 
 

@@ -343,6 +343,29 @@ def test_box_rests_at_layer_gap():
         assert f[2] == pytest.approx(m * g, rel=1e-4)
         assert w.energy()["kinetic"] < 1e-9
         assert w.stats()["contacts"] == 4
+        # at rest: nothing slides, nothing at the friction cap, no anchor (regularised law)
+        assert (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        assert (c["anchor_deflection"] == 0).all()
+        # the margin: dt over the pair's bound, 2 / sqrt(8 k / m) for a box on a slab
+        assert w.stats()["body_step_use"] == pytest.approx(
+            w.dt / w.estimate_stable_dt(), rel=1e-12)
+        assert 0 < w.stats()["body_step_use"] < 1
+
+
+def test_stick_contacts_report_their_anchors():
+    # a box on a slab tilted by 10 deg of gravity, stick friction mu = 0.3: it holds, each
+    # anchor spring carrying its share of m g sin(10 deg) (the deflection times stick_stiffness)
+    k, m, g, th = 2e5, 5.0, 9.81, np.radians(10.0)
+    with ws.World(gravity=(g * np.sin(th), 0, -g * np.cos(th))) as w:
+        w.set_default_contact(stiffness=k, damping=50.0, friction=0.3, friction_model="stick")
+        assert w.get_contact(w.default_material, w.default_material)["stick_damping_ratio"] == 1.0
+        w.body(w.box(1.0, 1.0, 0.05), type="kinematic", position=(0, 0, -0.025))
+        w.body(w.box(0.25, 0.25, 0.25), mass=m, position=(0, 0, 0.125 + 2e-3 - m * g / (4 * k)))
+        w.step(4000)
+        c = w.contacts()
+        assert len(c) == 4 and (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        pull = (c["anchor_deflection"][:, 0] * k).sum()  # on the box: -k d, d along +x
+        assert abs(pull) == pytest.approx(m * g * np.sin(th), rel=1e-3)
 
 
 def test_sheet_tensions_are_ea_times_prestretch():
@@ -352,7 +375,7 @@ def test_sheet_tensions_are_ea_times_prestretch():
         edge = [i + nx * j for j in range(ny) for i in range(nx)
                 if i in (0, nx - 1) or j in (0, ny - 1)]
         web = w.web_sheet(law, nx=nx, ny=ny, spacing_x=0.01, spacing_y=0.01, prestretch_x=pre,
-                          prestretch_y=pre, node_mass=1e-3, substeps=4, pinned=edge, name="sheet")
+                          prestretch_y=pre, node_mass=1e-3, substeps=8, pinned=edge, name="sheet")
         info = web.info()
         assert (info["nx"], info["ny"], info["closed"]) == (nx, ny, 0)
         assert web.node_count == nx * ny
@@ -548,7 +571,7 @@ def build_tilt(wrapped=False):
         w.set_contact(film_mat, box_mat, **fc)
         w.set_contact(film_mat, plane_mat, **fc)
         film = w.web_band(around, [bottom, top], law_cross=up, node_mass=1e-3,
-                          contact_layer=layer, material=film_mat, substeps=1, name="film",
+                          contact_layer=layer, material=film_mat, substeps=2, name="film",
                           z_bottom=z0, z_top=z1, n_around=n_around, n_up=n_up,
                           prestretch_around=0.4, prestretch_up=0.2)
     return w, plane, stop, bottom, top, film
@@ -658,8 +681,9 @@ def test_tilt_table_wrapped_matches_c(tilt_exe):
 # --- save and restore ----------------------------------------------------------------------------
 def build_relaxing_sheet(n=8):
     """A box on the ground under a falling sheet whose springs relax (a Prony law: a history in
-    every spring), full detection every 3rd step."""
-    w = ws.World(dt=2.5e-4, detection_interval=3)
+    every spring), full detection every 3rd step; one film sub-step near its bound (the check at
+    the bound itself, as the C suite's twin)."""
+    w = ws.World(dt=2.5e-4, detection_interval=3, stable_fraction=1.0)
     ground = w.body(w.box(2.0, 2.0, 0.05), type="kinematic", position=(0, 0, -0.025))
     box = w.body(w.box(0.25, 0.25, 0.25), mass=5.0, position=(0, 0, 0.126))
     law = w.law("relaxation", stiffness=100.0, prony_stiffness=[300.0, 200.0],
@@ -819,14 +843,15 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert law.evaluate(0.0, 2.0)[0] == pytest.approx(0.2)
         assert law.evaluate(0.0, 2.0)[2] == pytest.approx(0.1)
         sheet = w.web_sheet(law, law_shear=shear, nx=4, ny=3, spacing_x=0.05, spacing_y=0.05,
-                            shear=1, node_mass=0.01, pinned=[0, 3])
+                            shear=1, node_mass=0.01, substeps=2, pinned=[0, 3])
         pos = np.array([[0, 0, 1], [0.1, 0, 1], [0.2, 0, 1]], float)
         rope = w.web_mesh(law, pos, [[0, 1], [1, 2]], node_masses=[1e-2] * 3,
-                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3)
+                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3,
+                          substeps=2)
         assert rope.node_count == 3 and rope.info()["nx"] == 0
         assert np.allclose(rope.strains(), 0.1 / 0.09 - 1)
         crate = w.body(w.box(0.2, 0.2, 0.2), mass=1.0, position=(1, 1, 0.1))
-        band = w.web_band(law, [crate], node_mass=1e-3, substeps=8, z_bottom=0.02, z_top=0.18,
+        band = w.web_band(law, [crate], node_mass=1e-3, substeps=12, z_bottom=0.02, z_top=0.18,
                           n_around=12, n_up=4, prestretch_around=0.2, prestretch_up=0.1)
         assert band.info()["closed"] == 1
         assert band.containment(2)["hoop_tension"].min() > 0

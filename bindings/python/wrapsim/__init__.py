@@ -217,7 +217,8 @@ CONTACT_DTYPE = np.dtype([
     ("body_a", np.uint64), ("body_b", np.uint64), ("point", np.float64, 3),
     ("normal", np.float64, 3), ("overlap", np.float64), ("normal_force", np.float64),
     ("friction_force", np.float64, 3), ("slip_velocity", np.float64, 3), ("kind", np.int32),
-    ("slipping", np.int32)])
+    ("slipping", np.int32), ("at_cap", np.int32), ("reserved_", np.int32),
+    ("anchor_deflection", np.float64, 3)])
 assert CONTACT_DTYPE.itemsize == ctypes.sizeof(L.ContactInfo)
 
 #: numpy layout of ws_containment_band.
@@ -504,7 +505,8 @@ class World:
     def set_contact(self, a, b, **params):
         """Contact parameters between materials a and b: ws_contact_def fields (stiffness N/m,
         damping kg/s, friction, friction_vlim m/s, friction_model, stick_stiffness,
-        stick_damping); the others keep ws_contact_def_init's defaults."""
+        stick_damping kg/s, or 0 for stick_damping_ratio of critical); the others keep
+        ws_contact_def_init's defaults."""
         d = _make(L.ContactDef, params)
         self._call("ws_world_set_contact", _id_of(a, L.MaterialId), _id_of(b, L.MaterialId),
                    byref(d))
@@ -608,7 +610,8 @@ class World:
     def contacts(self):
         """Active contacts of the last step as a numpy structured array (CONTACT_DTYPE): body_a,
         body_b (id bits; see body_by_id), point, normal, overlap, normal_force, friction_force,
-        slip_velocity, kind, slipping. Forces are those on body_b."""
+        slip_velocity, kind, slipping (sliding), at_cap (friction at mu N this step),
+        anchor_deflection (stick model, m). Forces are those on body_b."""
         n = c_size_t()
         self._call("ws_world_copy_contacts", None, 0, byref(n))
         buf = np.zeros(n.value, dtype=CONTACT_DTYPE)

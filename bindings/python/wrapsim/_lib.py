@@ -135,6 +135,7 @@ class WorldDef(Structure):
         ("log", LogFn),
         ("log_user", c_void_p),
         ("user_data", c_void_p),
+        ("stable_fraction", c_double),
     ]
 
 
@@ -148,6 +149,7 @@ class ContactDef(Structure):
         ("friction_model", c_enum),
         ("stick_stiffness", c_double),
         ("stick_damping", c_double),
+        ("stick_damping_ratio", c_double),
     ]
 
 
@@ -173,7 +175,9 @@ class WorldStats(Structure):
         ("seconds_contacts", c_double),
         ("seconds_web", c_double),
         ("seconds_total", c_double),
-        ("reserved", c_uint64 * 4),
+        ("web_step_use", c_double),
+        ("body_step_use", c_double),
+        ("reserved", c_uint64 * 2),
     ]
 
 
@@ -300,6 +304,9 @@ class ContactInfo(Structure):
         ("slip_velocity", Vec3),
         ("kind", c_int32),
         ("slipping", c_int32),
+        ("at_cap", c_int32),
+        ("reserved_", c_int32),
+        ("anchor_deflection", Vec3),
     ]
 
 
