@@ -1180,7 +1180,8 @@ START_TEST(test_version_and_status_strings)
                              WS_ERR_CALLBACK,
                              WS_ERR_BUFFER_TOO_SMALL,
                              WS_ERR_IO,
-                             WS_ERR_UNSUPPORTED};
+                             WS_ERR_UNSUPPORTED,
+                             WS_ERR_FORMAT};
     const size_t n = sizeof all / sizeof all[0];
     for (size_t i = 0; i < n; i++) {
         const char *si = ws_status_string(all[i]);

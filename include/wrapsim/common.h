@@ -39,8 +39,10 @@ typedef enum ws_status {
     WS_ERR_IN_USE = 7,            /**< an object still referenced (a shape used by a body) */
     WS_ERR_CALLBACK = 8,          /**< a user callback reported failure */
     WS_ERR_BUFFER_TOO_SMALL = 9,  /**< a bulk copy got less room than it needs; count says how much */
-    WS_ERR_IO = 10,               /**< a file could not be written */
-    WS_ERR_UNSUPPORTED = 11       /**< a feature this build does not have (e.g. libccd) */
+    WS_ERR_IO = 10,               /**< a file could not be read or written */
+    WS_ERR_UNSUPPORTED = 11,      /**< a feature this build does not have (e.g. libccd) */
+    WS_ERR_FORMAT = 12            /**< a saved state that is truncated, corrupted, of a newer
+                                       format or of a world built otherwise; nothing changed */
 } ws_status;
 
 /** A vector in metres, m/s, newtons ... as the call says. */

@@ -3,6 +3,17 @@
  * @brief Output engineers open: VTK PolyData frames (.vtp) and a ParaView collection (.pvd).
  *
  * These calls write files only when asked; nothing else in the library touches the file system.
+ *
+ * And a world's state saved and restored (checkpoint/restart): ws_world_save() and
+ * ws_world_restore() to and from memory, ws_world_save_file() and ws_world_restore_file() to and
+ * from a file. A save holds the state, not the structure: restore into a world that the program
+ * has built as it built the saved one (the same shapes, bodies, webs, elements and laws, created
+ * in the same order), then stepping it gives, bit for bit, the steps the saved world would have
+ * taken. Parameters (dt, gravity, materials and contact parameters, masses, drives, laws) are the
+ * program's: a study may change them after a restore. The format: a 32-byte header (the magic
+ * "WSSTATE" and a zero byte, the format version as a 32-bit number, the byte-order mark
+ * 0x01020304, the state's length in bytes as a 64-bit number, the 64-bit FNV-1a hash of the
+ * state), then the state; every number little-endian, doubles as their IEEE 754 bits.
  */
 #ifndef WRAPSIM_IO_H
 #define WRAPSIM_IO_H
@@ -54,6 +65,41 @@ WS_API ws_status ws_vtk_series_write_frame(ws_vtk_series *series);
 WS_API ws_status ws_vtk_series_get_frame_count(const ws_vtk_series *series, size_t *count);
 /** Close the series (the files stay). NULL is allowed. Destroy it before its world. */
 WS_API void ws_vtk_series_destroy(ws_vtk_series *series);
+
+/** The save format this library writes; it reads this one and the older ones. */
+#define WS_SAVE_FORMAT_VERSION 1
+
+/** Save the world's state into `buf` (`cap` bytes): the time and step count, every body's
+ *  position, orientation and velocities, every web's node positions and velocities and its
+ *  springs' law histories, every element's law history, the stick-friction anchors, the contact
+ *  caches of bodies and webs with their detection bookkeeping (how many steps since the last
+ *  full detection, how far the bodies may have moved since), and what the last step reported
+ *  (contacts, the film's contact forces and loads on the bodies). Call it with `buf` NULL (and
+ *  `cap` 0) to learn the size first.
+ *  @param needed receives the bytes the save takes (always).
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (world or needed NULL, buf NULL with cap > 0),
+ *  WS_ERR_BUFFER_TOO_SMALL (cap < *needed; nothing written). */
+WS_API ws_status ws_world_save(const ws_world *world, void *buf, size_t cap, size_t *needed);
+
+/** Restore a state saved by ws_world_save() into a world built as the saved one was. Everything
+ *  in the buffer is checked before anything changes: on any error the world is as it was.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (world NULL, buf NULL), WS_ERR_FORMAT with the reason
+ *  in the last error: truncated, not a saved state, "checksum mismatch", "version 3 is newer than
+ *  this library's 1", or a structure that differs ("web 2 has 5856 nodes in the file, 100
+ *  here"); WS_ERR_OUT_OF_MEMORY (room for the contact caches). */
+WS_API ws_status ws_world_restore(ws_world *world, const void *buf, size_t len);
+
+/** ws_world_save() into a file: written whole to `path`.tmp, then renamed over `path`, so a
+ *  crash while saving leaves any older file at `path` as it was. Uses the world's allocator for
+ *  one buffer of the save's size.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL or empty path), WS_ERR_OUT_OF_MEMORY, WS_ERR_IO
+ *  (the path and the system's reason in the last error). */
+WS_API ws_status ws_world_save_file(const ws_world *world, const char *path);
+
+/** ws_world_restore() from a file written by ws_world_save_file(); on any error the world is as
+ *  it was.
+ *  @return as ws_world_restore(), and WS_ERR_IO (cannot open or read `path`). */
+WS_API ws_status ws_world_restore_file(ws_world *world, const char *path);
 
 #ifdef __cplusplus
 }

@@ -13,8 +13,9 @@ const char *ws_status_string(ws_status status)
     case WS_ERR_IN_USE: return "WS_ERR_IN_USE: the object is still used";
     case WS_ERR_CALLBACK: return "WS_ERR_CALLBACK: a user callback reported failure";
     case WS_ERR_BUFFER_TOO_SMALL: return "WS_ERR_BUFFER_TOO_SMALL: the buffer holds fewer items than there are";
-    case WS_ERR_IO: return "WS_ERR_IO: a file could not be written";
+    case WS_ERR_IO: return "WS_ERR_IO: a file could not be read or written";
     case WS_ERR_UNSUPPORTED: return "WS_ERR_UNSUPPORTED: this build lacks the feature";
+    case WS_ERR_FORMAT: return "WS_ERR_FORMAT: the saved state is truncated, corrupted, of a newer format or of another world's structure";
     }
     return "unknown ws_status";
 }

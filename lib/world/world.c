@@ -314,34 +314,12 @@ ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
 {
     NEED_WORLD(w);
     NEED_OUT(w, hash, "ws_world_get_state_hash");
-    const ws_body_store *b = &w->bodies;
-    const ws_body_state *st = &b->st[w->cur];
-    uint64_t h = ws_hash_bytes(WS_HASH_SEED, &w->time, sizeof w->time);
-    for (size_t i = 0; i < b->slots; i++) {
-        if (!b->alive[i])
-            continue;
-        h = ws_hash_bytes(h, &st->r[i], sizeof st->r[i]);
-        h = ws_hash_bytes(h, &st->p[i], sizeof st->p[i]);
-        h = ws_hash_bytes(h, &st->v[i], sizeof st->v[i]);
-        h = ws_hash_bytes(h, &st->w[i], sizeof st->w[i]);
-    }
-    for (size_t k = 0; k < w->ncand[w->cur]; k++) {
-        const ws_cand *c = &w->cand[w->cur][k];
-        if (c->anchored) {
-            h = ws_hash_bytes(h, &c->anchor_a, sizeof c->anchor_a);
-            h = ws_hash_bytes(h, &c->anchor_b, sizeof c->anchor_b);
-        }
-    }
-    /* The film is state too. */
-    for (size_t k = 0; k < w->web_cap && k < w->web_slots.slot_count; k++) {
-        const ws_web *web = w->webs[k];
-        if (w->web_slots.dense[k] == UINT32_MAX || !web)
-            continue;
-        /* Each state is one block of 3 n doubles: x, y, z components. */
-        h = ws_hash_bytes(h, web->x[w->cur].x, 3 * (size_t)web->n * sizeof(double));
-        h = ws_hash_bytes(h, web->v[w->cur].x, 3 * (size_t)web->n * sizeof(double));
-    }
-    h = ws_world_hash_elements(w, h); /* their law histories */
+    /* The hashed part of the walk that save and restore make (world_state.c): every piece
+     * of state that follows the physics, the detection bookkeeping left out (a failed step may
+     * change that, and the hash is the same as long as the motion is). The walk only reads. */
+    ws_walk k = {WS_WALK_HASH, WS_HASH_SEED, NULL, NULL, 0, 0, WS_OK, NULL};
+    ws_world_walk((ws_world *)w, &k);
+    uint64_t h = k.hash;
     *hash = h;
     return WS_OK;
 }

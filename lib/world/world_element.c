@@ -335,16 +335,6 @@ void ws_world_commit_elements(ws_world *w, double t)
     }
 }
 
-uint64_t ws_world_hash_elements(const ws_world *w, uint64_t h)
-{
-    for (size_t i = 0; i < w->element_slots.slot_count; i++) {
-        const ws_element *e = live(w, i);
-        if (e && e->nstate)
-            h = ws_hash_bytes(h, e->state, e->nstate * sizeof *e->state);
-    }
-    return h;
-}
-
 /* ---- stable step ---- */
 
 /* Frobenius norm of the 3x3 block (r, c) of a 6x6 row-major matrix. */

@@ -141,7 +141,24 @@ void ws_world_free_elements(ws_world *w);
 ws_status ws_world_body_free_of_elements(const ws_world *w, uint32_t slot);
 /* The elements' explicit step limit on the bodies they join (INFINITY without elements). */
 double ws_world_element_stable_dt(const ws_world *w);
-/* The elements' committed law histories, hashed on from h. */
-uint64_t ws_world_hash_elements(const ws_world *w, uint64_t h);
+
+/* One walk over every piece of the world's state that its future depends on
+ * (world_state.c): HASH feeds the hashed part of it to an FNV-1a hash (ws_world_get_state_hash);
+ * WRITE puts it into `out` as little-endian bytes (only counts them, in pos, when out is NULL);
+ * CHECK reads `in` (len bytes) and checks every count and index against the world, changing no
+ * state (it only grows arrays for READ, WS_ERR_OUT_OF_MEMORY when it cannot); READ, after a
+ * CHECK that passed, writes it into the world. WS_ERR_FORMAT (or WS_ERR_OUT_OF_MEMORY) with
+ * the last error set when a CHECK fails. */
+typedef enum ws_walk_mode { WS_WALK_HASH, WS_WALK_WRITE, WS_WALK_CHECK, WS_WALK_READ } ws_walk_mode;
+typedef struct ws_walk {
+    ws_walk_mode mode;
+    uint64_t hash;           /* HASH: start with WS_HASH_SEED */
+    unsigned char *out;      /* WRITE */
+    const unsigned char *in; /* CHECK, READ */
+    size_t pos, len;         /* bytes walked; bytes in `in` */
+    ws_status status;
+    ws_world *w;
+} ws_walk;
+ws_status ws_world_walk(ws_world *w, ws_walk *k);
 
 #endif

@@ -471,6 +471,93 @@ def test_tilt_table_wrapped_matches_c(tilt_exe):
         assert film.velocities().shape == (96 * 61, 3)
 
 
+# --- save and restore ----------------------------------------------------------------------------
+def build_relaxing_sheet(n=8):
+    """A box on the ground under a falling sheet whose springs relax (a Prony law: a history in
+    every spring), full detection every 3rd step."""
+    w = ws.World(dt=2.5e-4, detection_interval=3)
+    ground = w.body(w.box(2.0, 2.0, 0.05), type="kinematic", position=(0, 0, -0.025))
+    box = w.body(w.box(0.25, 0.25, 0.25), mass=5.0, position=(0, 0, 0.126))
+    law = w.law("relaxation", stiffness=100.0, prony_stiffness=[300.0, 200.0],
+                prony_time=[0.02, 0.2])
+    film = w.material("film")
+    w.set_contact(film, w.default_material, stiffness=4000.0, damping=1.0, friction=0.9)
+    sheet = w.web_sheet(law, nx=n, ny=n, spacing_x=0.36 / (n - 1), spacing_y=0.36 / (n - 1),
+                        origin=(-0.18, -0.17, 0.26), prestretch_x=0.1, node_mass=5e-3,
+                        node_damping=1e-3, material=film)
+    return w, ground, box, sheet
+
+
+def test_save_restore_continues_bit_identically(tmp_path):
+    # A world restored from a save and stepped takes the saved world's steps, bit for bit: the
+    # state hash compared at every step for 300 steps, in memory and through a file, restored
+    # into a world that has been stepped elsewhere meanwhile.
+    a = build_relaxing_sheet()[0]
+    b = build_relaxing_sheet()[0]
+    with a, b:
+        a.step(250)
+        data = a.save()
+        assert isinstance(data, bytes) and data[:7] == b"WSSTATE"
+        path = tmp_path / "state.wss"
+        assert a.save(path) is None
+        assert path.read_bytes() == data
+        want = []
+        for _ in range(300):
+            a.step()
+            want.append(a.state_hash())
+        for source in (data, bytearray(data), str(path), path):
+            b.step(37)
+            b.restore(source)
+            got = []
+            for _ in range(300):
+                b.step()
+                got.append(b.state_hash())
+            assert got == want
+        assert b.save() == a.save()
+
+
+def test_restore_refuses_bad_saves_and_changes_nothing():
+    a = build_relaxing_sheet()[0]
+    b = build_relaxing_sheet()[0]
+    other = build_relaxing_sheet(10)[0]
+    with a, b, other:
+        a.step(100)
+        data = a.save()
+        b.step(20)
+        before = b.save()
+        newer = bytearray(data)
+        newer[8] = 3
+        flipped = bytearray(data)
+        flipped[len(data) // 2] ^= 1
+        for bad, text in ((data[:-1], "truncated"), (bytes(newer), "version 3 is newer"),
+                          (bytes(flipped), "checksum mismatch"), (b"nonsense" * 8, "not a saved")):
+            with pytest.raises(ws.WrapsimError) as e:
+                b.restore(bad)
+            assert e.value.status == ws.WS_ERR_FORMAT and text in e.value.detail
+            assert b.save() == before
+        with pytest.raises(ws.WrapsimError) as e:
+            other.restore(data)
+        assert "web 0 has 64 nodes in the file, 100 here" in e.value.detail
+        with pytest.raises(ws.WrapsimError) as e:
+            b.restore("/no/such/file.wss")
+        assert e.value.status == ws.WS_ERR_IO
+        with pytest.raises(TypeError):
+            b.restore(12)
+        assert b.save() == before
+
+
+def test_world_cannot_be_copied():
+    # A copy would share the C world and free it twice: refused, and the world stays usable.
+    import copy
+    import pickle
+    with ws.World() as w:
+        for f in (copy.copy, copy.deepcopy, pickle.dumps):
+            with pytest.raises(TypeError, match="cannot be"):
+                f(w)
+        w.step(3)
+        assert w.time == pytest.approx(3 * w.dt)
+
+
 # --- the rest of the API -------------------------------------------------------------------------
 def test_world_and_body_api(tmp_path):
     messages = []

@@ -7,6 +7,7 @@ text. See README.md next to this package.
 """
 
 import ctypes
+import os
 from ctypes import byref, c_double, c_int, c_size_t, c_uint32, c_uint64, POINTER
 
 import numpy as np
@@ -16,7 +17,7 @@ from ._lib import LibraryError, BINDING_VERSION as __version__  # noqa: F401
 from ._lib import (  # noqa: F401  (re-exported constants)
     WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE,
     WS_ERR_OUT_OF_MEMORY, WS_ERR_NUMERICAL, WS_ERR_BAD_MESH, WS_ERR_IN_USE, WS_ERR_CALLBACK,
-    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_LOG_DEBUG, WS_LOG_INFO,
+    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_FORMAT, WS_LOG_DEBUG, WS_LOG_INFO,
     WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD, WS_INTEGRATOR_SYMPLECTIC_EULER,
     WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
@@ -280,6 +281,19 @@ class World:
         except Exception:  # noqa: BLE001 - interpreter shutdown
             pass
 
+    # A World owns its C world: a copy would share it, and closing one would free it under the
+    # other. Copying and pickling are refused; save() and restore() carry a state across.
+    def __copy__(self):
+        raise TypeError("a wrapsim.World cannot be copied (the copy would share its C world); "
+                        "build another World and restore() a save() into it")
+
+    def __deepcopy__(self, memo):
+        self.__copy__()
+
+    def __reduce_ex__(self, protocol):
+        raise TypeError("a wrapsim.World cannot be pickled or copied; save() gives its state as "
+                        "bytes, which restore() takes in a World built the same way")
+
     @property
     def closed(self):
         return not self._ptr
@@ -361,6 +375,32 @@ class World:
         h = c_uint64()
         self._call("ws_world_get_state_hash", byref(h))
         return h.value
+
+    def save(self, path=None):
+        """The world's state (ws_world_save): as bytes when `path` is None, else written to the
+        file `path` (ws_world_save_file; then None is returned). It holds the state, not the
+        structure: restore() it into a World built the same way."""
+        if path is not None:
+            self._call("ws_world_save_file", os.fsencode(path))
+            return None
+        n = c_size_t()
+        self._call("ws_world_save", None, 0, byref(n))
+        buf = ctypes.create_string_buffer(n.value)
+        self._call("ws_world_save", buf, n.value, byref(n))
+        return buf.raw[:n.value]
+
+    def restore(self, data_or_path):
+        """Restore a state from save(): bytes (or a bytearray, memoryview) or a file path. The
+        world must have been built as the saved one was; a save that is truncated, corrupted,
+        newer or of another structure raises WrapsimError (WS_ERR_FORMAT) and changes nothing."""
+        if isinstance(data_or_path, (bytes, bytearray, memoryview)):
+            data = bytes(data_or_path)
+            self._call("ws_world_restore", data, len(data))
+        elif isinstance(data_or_path, (str, os.PathLike)):
+            self._call("ws_world_restore_file", os.fsencode(data_or_path))
+        else:
+            raise TypeError("restore() takes bytes from save() or a path, got %s"
+                            % type(data_or_path).__name__)
 
     def estimate_stable_dt(self):
         """Largest stable dt (s) estimated for the bodies and contact pairs now in the world."""

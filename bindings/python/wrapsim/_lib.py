@@ -31,6 +31,7 @@ WS_ERR_CALLBACK = 8
 WS_ERR_BUFFER_TOO_SMALL = 9
 WS_ERR_IO = 10
 WS_ERR_UNSUPPORTED = 11
+WS_ERR_FORMAT = 12
 
 WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
 WS_FEATURE_CCD = 1
@@ -562,6 +563,10 @@ FUNCTIONS = [
     ("ws_vtk_series_write_frame", [Series_p], _st),
     ("ws_vtk_series_get_frame_count", [Series_p, P(c_size_t)], _st),
     ("ws_vtk_series_destroy", [Series_p], None),
+    ("ws_world_save", [World_p, c_void_p, c_size_t, P(c_size_t)], _st),
+    ("ws_world_restore", [World_p, c_void_p, c_size_t], _st),
+    ("ws_world_save_file", [World_p, c_char_p], _st),
+    ("ws_world_restore_file", [World_p, c_char_p], _st),
 ]
 
 #: The Defs whose ws_*_def_init writes `size`: checked against ctypes.sizeof when loading.

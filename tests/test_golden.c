@@ -1,0 +1,84 @@
+/* Golden state hashes: the reference cases (DESIGN.md) stepped a stored number of steps must end
+ * in the stored state hash, so a change of any result, on any machine or compiler, is seen here
+ * and not only run against run. The scenes are built by the example program's own builder
+ * (examples/tilt_table.c), the one the benchmarks use.
+ *
+ * When a change of results is intended (a new physics option as default, a fix), run this suite,
+ * take the measured hashes it prints and update the one table below, saying why in the
+ * CHANGELOG. A hash is the FNV-1a of the state as ws_world_get_state_hash walks it, every double
+ * by its bits: there is no tolerance, the step is deterministic (-ffp-contract=off, no
+ * reassociation), with libccd or without (its gate only skips pairs that cannot touch). */
+#define TILT_TABLE_NO_MAIN
+#include "../examples/tilt_table.c"
+
+#include "helpers.h"
+
+typedef struct golden {
+    char variant; /* 'P' or 'R' */
+    int wrapped;
+    int use_ccd;      /* the libccd gate asked for (it skips only pairs that cannot touch) */
+    long steps;       /* stored run */
+    uint64_t hash;    /* its state hash */
+    long short_steps; /* the run under WS_TEST_SHORT=1 (sanitizer and valgrind stages) */
+    uint64_t short_hash;
+} golden;
+
+/* THE TABLE. Unwrapped: the whole reference run (6 s of P, 7 s of R: both boxes slide in P,
+ * the top one slides off in R). Wrapped: the first second (the film settles, the stack stands
+ * while the platform waits), 0.1 s under WS_TEST_SHORT. */
+static const golden table[] = {
+    {'P', 0, 1, 24000, 0x18046ff93a247f35ull, 4000, 0x3fe9381be67d2471ull},
+    {'R', 0, 1, 28000, 0x9a09ce79d7e3ea87ull, 4000, 0xf83061787ded36efull},
+    {'P', 1, 1, 4000, 0x0dea2fe20ef29448ull, 400, 0x035c1cc5f121f232ull},
+    {'R', 1, 1, 4000, 0x68291693c4643dabull, 400, 0xd3b702663551a686ull},
+    /* The same without the gate: the same hashes. */
+    {'P', 0, 0, 24000, 0x18046ff93a247f35ull, 4000, 0x3fe9381be67d2471ull},
+    {'R', 0, 0, 28000, 0x9a09ce79d7e3ea87ull, 4000, 0xf83061787ded36efull},
+};
+#define NGOLDEN (sizeof table / sizeof table[0])
+
+static int short_run(void)
+{
+    const char *e = getenv("WS_TEST_SHORT");
+    return e && *e && strcmp(e, "0") != 0;
+}
+
+START_TEST(reference_case_hash)
+{
+    const golden *g = &table[_i];
+    long steps = short_run() ? g->short_steps : g->steps;
+    uint64_t want = short_run() ? g->short_hash : g->hash;
+    tilt_options o;
+    tilt_default_options(&o);
+    o.variant = g->variant;
+    o.wrapped = g->wrapped;
+    o.use_ccd = g->use_ccd;
+    o.quiet = 1;
+    tilt_scene sc;
+    ck_assert_int_eq(tilt_build(&o, &sc), WS_OK);
+    ck_ok(sc.world, ws_world_step_n(sc.world, steps));
+    uint64_t h = 0;
+    ck_ok(sc.world, ws_world_get_state_hash(sc.world, &h));
+    ws_world_destroy(sc.world);
+    report("golden: case %c %s%s, %ld steps: state hash 0x%016llxull", g->variant,
+           g->wrapped ? "wrapped" : "unwrapped", g->use_ccd ? "" : " (no libccd gate)", steps,
+           (unsigned long long)h);
+    ck_assert_msg(h == want,
+                  "case %c %s after %ld steps: state hash 0x%016llxull, the table in "
+                  "tests/test_golden.c stores 0x%016llxull (update it if the change of results "
+                  "is intended, and say why in the CHANGELOG)",
+                  g->variant, g->wrapped ? "wrapped" : "unwrapped", steps,
+                  (unsigned long long)h, (unsigned long long)want);
+}
+END_TEST
+
+int main(void)
+{
+    (void)tilt_run; /* the example's runner is not used here */
+    Suite *s = suite_create("golden");
+    TCase *tc = tcase_create("reference_case_hash");
+    tcase_set_timeout(tc, 300);
+    tcase_add_loop_test(tc, reference_case_hash, 0, (int)NGOLDEN);
+    suite_add_tcase(s, tc);
+    return run_suite(s);
+}
