@@ -55,9 +55,12 @@ int ws_bodies_reserve(ws_mem *mem, ws_body_store *b, size_t n)
 
 void ws_bodies_free(ws_mem *mem, ws_body_store *b)
 {
-    for (size_t i = 0; i < b->slots; i++)
+    for (size_t i = 0; i < b->slots; i++) {
         if (b->name && b->name[i])
             ws_mem_free_str(mem, b->name[i]);
+        if (b->has_drive && b->has_drive[i] && b->alive[i])
+            ws_drive_release(&b->drive[i], mem);
+    }
     void **arrs[32];
     size_t elems[32];
     int k = list_arrays(b, arrs, elems);

@@ -1,6 +1,8 @@
 /* Public calls on shapes, bodies and contact reports: validation, id lookup, delegation. */
 #include "world/world_internal.h"
 
+#include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 
@@ -238,6 +240,16 @@ void ws_drive_def_init(ws_drive_def *def)
     def->ramp_time = 0.05;
     def->axis = v3_make(0, 1, 0);
     def->direction = v3_make(1, 0, 0);
+    def->stop_ramp_time = 1.0;
+    def->rise_time = 0.05;
+    def->hold_time = 0.3;
+    def->pulse_mode = WS_PULSE_ACCELERATE;
+    def->gentle_acceleration = 1.0;
+    def->coast_time = 0.5;
+    def->pulse_duration = 0.01;
+    def->table_end_at_rest = 1;
+    def->sample_rate = 1024.0;
+    def->sweep_law = WS_SWEEP_LOG;
 }
 
 static const char *label(const ws_body_def *d)
@@ -383,6 +395,9 @@ ws_status ws_body_destroy(ws_world *w, ws_body_id id)
     ws_world_forget_body(w, slot);
     b->shape[slot]->users--;
     b->shape[slot] = NULL;
+    if (b->has_drive[slot])
+        ws_drive_release(&b->drive[slot], &w->mem);
+    b->has_drive[slot] = 0;
     ws_mem_free_str(&w->mem, b->name[slot]);
     b->name[slot] = NULL;
     b->alive[slot] = 0;
@@ -405,7 +420,10 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
                        "body '%s': only kinematic bodies (world elements) take a drive", nm);
     ws_drive_def d;
     ws_drive_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "drive")) != WS_OK)
+    /* A Def of 0.1 (without the fields from stop_ramp_time on) is taken with the defaults of
+     * the rest. */
+    if ((s = ws_def_take(w, &d, sizeof d, def, offsetof(ws_drive_def, stop_ramp_time), "drive")) !=
+        WS_OK)
         return s;
     ws_body_state *st = &b->st[w->cur];
     ws_pose base = {st->r[slot], st->p[slot]};
@@ -413,13 +431,23 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
         base = b->drive[slot].base;
     char why[256] = "";
     ws_drive drv;
-    if ((s = ws_drive_setup(&drv, &d, &base, why, sizeof why)) != WS_OK)
+    if ((s = ws_drive_setup(&drv, &w->mem, &d, &base, why, sizeof why)) != WS_OK)
         return ws_fail(w, s, "body '%s': %s", nm, why);
     ws_pose pose;
     v3 v, om;
-    if (ws_drive_eval(&drv, w->time, &pose, &v, &om) != 0)
-        return ws_fail(w, WS_ERR_CALLBACK, "body '%s': the drive callback failed at t = %g s", nm,
+    int rc = ws_drive_eval(&drv, w->time, &pose, &v, &om);
+    if (rc != 0) {
+        ws_drive_release(&drv, &w->mem);
+        if (d.type == WS_DRIVE_CALLBACK)
+            return ws_fail(w, WS_ERR_CALLBACK,
+                           "body '%s': the drive callback failed at t = %g s (it returned "
+                           "non-zero or gave a non-finite pose)", nm, w->time);
+        return ws_fail(w, WS_ERR_NUMERICAL,
+                       "body '%s': the drive gives a non-finite pose or velocity at t = %g s", nm,
                        w->time);
+    }
+    if (b->has_drive[slot])
+        ws_drive_release(&b->drive[slot], &w->mem);
     b->drive[slot] = drv;
     b->has_drive[slot] = 1;
     st->r[slot] = pose.position;
@@ -428,6 +456,110 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
     m3 A = qt_to_m3(pose.orientation);
     st->w[slot] = m3_tmul_v(&A, om);
     w->cand_valid = 0;
+    return WS_OK;
+}
+
+ws_status ws_body_get_drive_state(const ws_world *w, ws_body_id id, ws_drive_state *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_body_get_drive_state");
+    uint32_t slot;
+    ws_status s = ws_lookup_body(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    const ws_body_store *b = &w->bodies;
+    if (b->type[slot] != WS_BODY_KINEMATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "body '%s': a dynamic body has no drive state",
+                       b->name[slot] ? b->name[slot] : "(unnamed)");
+    const ws_body_state *st = &b->st[w->cur];
+    memset(out, 0, sizeof *out);
+    out->time = w->time;
+    out->type = WS_DRIVE_STATIC;
+    out->position = st->r[slot];
+    out->has_acceleration = 1;
+    if (!b->has_drive[slot])
+        return WS_OK;
+    const ws_drive *d = &b->drive[slot];
+    out->type = d->def.type;
+    m3 A = qt_to_m3(st->p[slot]);
+    if (d->def.type == WS_DRIVE_CALLBACK) {
+        /* The committed state is what the callback gave; no second call from a getter. */
+        out->velocity = st->v[slot];
+        out->angular_velocity = m3_mul_v(&A, st->w[slot]);
+        out->has_acceleration = 0;
+        return WS_OK;
+    }
+    ws_drive_motion m;
+    if (ws_drive_motion_at(d, w->time, &m) != 0) /* a committed state was finite */
+        return ws_fail(w, WS_ERR_NUMERICAL, "body '%s': the drive is not finite at t = %g s",
+                       b->name[slot] ? b->name[slot] : "(unnamed)", w->time);
+    out->position = m.pose.position;
+    out->displacement = v3_sub(m.pose.position, d->base.position);
+    out->velocity = m.v;
+    out->acceleration = m.a;
+    out->angular_velocity = m.w;
+    out->angle = m.angle;
+    out->angular_rate = m.rate;
+    out->angular_acceleration = m.angacc;
+    return WS_OK;
+}
+
+ws_status ws_vibration_synthesize(ws_world *w, const ws_drive_def *def, double *accel,
+                                  size_t count)
+{
+    char why[256] = "";
+    ws_status s;
+    if (!def) {
+        s = WS_ERR_INVALID_ARGUMENT;
+        snprintf(why, sizeof why, "ws_vibration_synthesize: def is NULL");
+    } else if (ws_def_check(def, offsetof(ws_drive_def, stop_ramp_time)) != 0) {
+        s = WS_ERR_UNINITIALIZED_DEF;
+        snprintf(why, sizeof why, "ws_vibration_synthesize: the Def was not filled by "
+                                  "ws_drive_def_init()");
+    } else if (def->size < sizeof *def) {
+        s = WS_ERR_INVALID_ARGUMENT;
+        snprintf(why, sizeof why, "ws_vibration_synthesize: the Def is too old to hold a PSD");
+    } else {
+        s = ws_drive_synthesize(def, accel, count, why, sizeof why);
+    }
+    if (s != WS_OK && w)
+        return ws_fail(w, s, "ws_vibration_synthesize: %s", why);
+    return s;
+}
+
+ws_status ws_vibration_grms(const double *frequency, const double *level, size_t count,
+                            double *grms)
+{
+    if (!grms)
+        return WS_ERR_INVALID_ARGUMENT;
+    return ws_drive_psd_grms(frequency, level, count, grms, NULL, 0);
+}
+
+/* The truck spectrum's shape (see docs/guide.md, "Random vibration"): the suspension's hump at
+ * 3-4 Hz, a plateau to 12 Hz, the axles' hump at 16-25 Hz, a fall to 200 Hz. Scaled to the
+ * level's Grms by ws_vibration_truck_psd. */
+static const double truck_f[] = {1.0, 3.0, 4.0, 6.0, 12.0, 16.0, 25.0, 30.0, 40.0, 80.0, 200.0};
+static const double truck_g[] = {0.0001, 0.005, 0.005, 0.001, 0.001, 0.003, 0.003, 0.001,
+                                 0.001, 0.0003, 0.00003};
+
+ws_status ws_vibration_truck_psd(ws_truck_level level, double *frequency, double *level_g2hz,
+                                 size_t capacity, size_t *count)
+{
+    static const double grms_of[] = {0.0, 0.40, 0.54, 0.70};
+    const size_t n = sizeof truck_f / sizeof truck_f[0];
+    if (!count || level < WS_TRUCK_LOW || level > WS_TRUCK_HIGH)
+        return WS_ERR_INVALID_ARGUMENT;
+    *count = n;
+    if (capacity < n || !frequency || !level_g2hz)
+        return WS_ERR_BUFFER_TOO_SMALL;
+    double shape;
+    ws_drive_psd_grms(truck_f, truck_g, n, &shape, NULL, 0);
+    double k = grms_of[level] / shape;
+    for (size_t i = 0; i < n; i++) {
+        frequency[i] = truck_f[i];
+        level_g2hz[i] = truck_g[i] * k * k;
+    }
     return WS_OK;
 }
 

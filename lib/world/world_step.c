@@ -416,12 +416,19 @@ ws_status ws_world_step(ws_world *w)
         }
         ws_pose pose;
         v3 v, om;
-        if (ws_drive_eval(&b->drive[i], t + dt, &pose, &v, &om) != 0)
-            return ws_fail(w, WS_ERR_CALLBACK,
-                           "step at t = %.6g s: the drive of body '%s' (index %zu) failed: its "
-                           "callback returned non-zero or gave a non-finite pose; the step was "
-                           "undone",
-                           t, body_label(w, i), i);
+        if (ws_drive_eval(&b->drive[i], t + dt, &pose, &v, &om) != 0) {
+            if (b->drive[i].def.type == WS_DRIVE_CALLBACK)
+                return ws_fail(w, WS_ERR_CALLBACK,
+                               "step at t = %.6g s: the drive of body '%s' (index %zu) failed: "
+                               "its callback returned non-zero or gave a non-finite pose or "
+                               "velocity at t = %.6g s; the step was undone",
+                               t, body_label(w, i), i, t + dt);
+            w->stats.numerical_errors++;
+            return ws_fail(w, WS_ERR_NUMERICAL,
+                           "step at t = %.6g s: the drive of body '%s' (index %zu) gives a "
+                           "non-finite pose or velocity at t = %.6g s; the step was undone",
+                           t, body_label(w, i), i, t + dt);
+        }
         m3 A = qt_to_m3(pose.orientation);
         n->r[i] = pose.position;
         n->p[i] = pose.orientation;

@@ -360,6 +360,69 @@ def test_drive_callback_and_its_errors():
             b.set_drive("callback")
 
 
+def test_platform_test_drives():
+    """The packaging tests' drives through the binding: the EUMOS pulse's plateau, the impact's
+    velocity change, a table back at rest, the truck spectrum's Grms and its history's
+    reproducibility, and the drive state's tilt angle."""
+    g0 = ws.WS_STANDARD_GRAVITY
+    with ws.World(gravity=(0, 0, 0), dt=1e-3) as w:
+        p = w.body(w.box(1, 1, 0.05), type="kinematic")
+        p.set_drive("pulse", acceleration=0.4 * g0, start_time=0.0, coast_time=0.1)
+        w.step(250)  # mid-plateau: 0.05 s rise, 0.3 s hold
+        st = p.drive_state()
+        assert st["type"] == ws.WS_DRIVE_PULSE and st["has_acceleration"]
+        assert st["acceleration"][0] == pytest.approx(0.4 * g0, rel=1e-12)
+        # The speed A (rise + hold) after the pulse, exactly.
+        w.step(200)
+        assert p.drive_state()["velocity"][0] == pytest.approx(0.4 * g0 * 0.35, rel=1e-12)
+
+        q = w.body(w.box(1, 1, 0.05), type="kinematic", position=(0, 3, 0))
+        q.set_drive("impact", speed=1.2, pulse_duration=0.01, gentle_acceleration=4.0,
+                    coast_time=0.0, start_time=w.time)
+        w.step(int(round((2 * 1.2 / 4.0) / 1e-3)))  # the run-up
+        assert q.drive_state()["velocity"][0] == pytest.approx(1.2, rel=1e-9)
+        w.step(12)
+        assert q.drive_state()["velocity"][0] == pytest.approx(0.0, abs=1e-9)
+
+        r = w.body(w.box(1, 1, 0.05), type="kinematic", position=(0, 6, 0))
+        r.set_drive("table", table=[0.0, 2.0, 2.0, -1.0, 0.0], table_interval=0.01,
+                    start_time=w.time, direction=(0, 0, 1))
+        w.step(60)
+        st = r.drive_state()
+        assert st["velocity"][2] == pytest.approx(0.0, abs=1e-12)
+        assert st["displacement"][2] == pytest.approx(0.0, abs=1e-12)
+
+        t = w.body(w.box(1, 1, 0.05), type="kinematic", position=(0, 9, 0))
+        t.set_drive("tilt", rate=0.1, start_time=w.time, max_angle=0.05)
+        w.step(2000)
+        assert t.drive_state()["angle"] == pytest.approx(0.05, rel=1e-12)
+        assert t.drive_state()["angular_rate"] == 0.0
+
+    f, lv = ws.truck_psd("medium")
+    assert ws.vibration_grms(f, lv) == pytest.approx(0.54, rel=1e-12)
+    a = ws.synthesize_vibration(f, lv, 2 ** 14, seed=3, sample_rate=512.0)
+    b = ws.synthesize_vibration(f, lv, 2 ** 14, seed=3, sample_rate=512.0)
+    assert np.array_equal(a, b)
+    assert np.sqrt(np.mean(a ** 2)) / g0 == pytest.approx(0.54, rel=0.02)
+    assert not np.array_equal(a, ws.synthesize_vibration(f, lv, 2 ** 14, seed=4,
+                                                         sample_rate=512.0))
+    with pytest.raises(ValueError):
+        ws.synthesize_vibration(f, lv, 1000)
+    with pytest.raises(ws.WrapsimError):
+        ws.synthesize_vibration(f[::-1], lv, 1024)
+    with ws.World() as w:
+        p = w.body(w.box(1, 1, 0.05), type="kinematic")
+        p.set_drive("random", psd_frequency=f, psd_level=lv, seed=1, duration=2.0,
+                    sample_rate=512.0, ramp_time=0.2, direction=(0, 0, 1))
+        w.step(100)
+        assert p.drive_state()["type"] == ws.WS_DRIVE_RANDOM
+        p.set_drive("sweep", acceleration=1.0, frequency=2.0, frequency_end=20.0, duration=5.0,
+                    sweep_law="linear")
+        with pytest.raises(ws.WrapsimError) as e:
+            p.set_drive("sine", amplitude=0.01, frequency=1e308)
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT and "frequency" in e.value.detail
+
+
 # --- the tilt table: Python against C ------------------------------------------------------------
 def build_tilt(wrapped=False):
     """examples/tilt_table.c's tilt_build() with the default options (variant R)."""

@@ -29,12 +29,17 @@ from ._lib import (  # noqa: F401  (re-exported constants)
 from ._lib import (  # noqa: F401  (re-exported constants)
     WS_ELEMENT_ROD, WS_ELEMENT_LINEAR_SPRING, WS_ELEMENT_ANGULAR_SPRING, WS_ELEMENT_BUSHING,
     WS_ELEMENT_INVARIANT, WS_ELEMENT_ATTACHED, WS_ELEMENT_POTENTIAL)
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_DRIVE_PULSE, WS_DRIVE_IMPACT, WS_DRIVE_TABLE, WS_DRIVE_RANDOM, WS_DRIVE_SWEEP,
+    WS_PULSE_ACCELERATE, WS_PULSE_BRAKE, WS_SWEEP_LOG, WS_SWEEP_LINEAR, WS_TRUCK_LOW,
+    WS_TRUCK_MEDIUM, WS_TRUCK_HIGH, WS_STANDARD_GRAVITY)
 from ._run import run  # noqa: F401
 
 __all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
            "LibraryError", "run", "version", "version_number", "build_features",
            "status_string", "CONTACT_DTYPE", "CONTAINMENT_DTYPE"]
 __all__ += ["Element", "ELEMENT_OUTPUT_DTYPE"]
+__all__ += ["synthesize_vibration", "vibration_grms", "truck_psd"]
 
 
 class WrapsimError(RuntimeError):
@@ -77,7 +82,10 @@ _ENUMS = {
     (L.WorldDef, "integrator"): {"symplectic_euler": 0, "paper_explicit": 1},
     (L.ContactDef, "friction_model"): {"regularized": 0, "stick": 1},
     (L.BodyDef, "type"): {"dynamic": 0, "kinematic": 1},
-    (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3},
+    (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3, "pulse": 4,
+                           "impact": 5, "table": 6, "random": 7, "sweep": 8},
+    (L.DriveDef, "pulse_mode"): {"accelerate": 0, "brake": 1},
+    (L.DriveDef, "sweep_law"): {"log": 0, "linear": 1},
     (L.LawDef, "type"): {"linear_elastic": 0, "linear_viscoelastic": 1,
                          "tension_compression": 2, "linear_viscous": 3, "cubic_elastic": 4,
                          "table": 5, "stop": 6, "relaxation": 7, "sum": 8, "scaled": 9,
@@ -231,6 +239,73 @@ assert ELEMENT_OUTPUT_DTYPE.itemsize == ctypes.sizeof(L.ElementOutput)
 
 
 # --- World ---------------------------------------------------------------------------------------
+def _doubles(value, what):
+    a = np.ascontiguousarray(np.asarray(value, dtype=float).reshape(-1))
+    if a.size == 0:
+        raise ValueError(f"{what}: no values")
+    return a
+
+
+def _psd_def(psd_frequency, psd_level, kwargs):
+    """A DriveDef holding a PSD (the arrays returned too: they must outlive the call)."""
+    f = _doubles(psd_frequency, "psd_frequency")
+    g = _doubles(psd_level, "psd_level")
+    if f.size != g.size:
+        raise ValueError(f"psd_frequency has {f.size} values, psd_level {g.size}")
+    d = _make(L.DriveDef, kwargs)
+    d.psd_frequency = _ptr(f, c_double)
+    d.psd_level = _ptr(g, c_double)
+    d.psd_count = f.size
+    return d, (f, g)
+
+
+def synthesize_vibration(psd_frequency, psd_level, count, seed=0, sample_rate=1024.0):
+    """The random vibration history (m/s^2, numpy array of `count` samples, a power of two) that
+    a 'random' drive with these parameters plays (before its taper): the one-sided PSD
+    (g^2/Hz at the breakpoints, Hz; log-log between) by the inverse FFT with phases from
+    `seed`. The same arguments give the same history to the bit."""
+    count = int(count)
+    if count < 16 or count & (count - 1):
+        raise ValueError(f"count must be a power of two >= 16, got {count}")
+    d, keep = _psd_def(psd_frequency, psd_level, {"seed": int(seed),
+                                                  "sample_rate": float(sample_rate)})
+    out = np.empty(count)
+    s = _c().ws_vibration_synthesize(None, byref(d), _ptr(out, c_double), count)
+    if s != WS_OK:
+        raise WrapsimError(s, "ws_vibration_synthesize: bad PSD, sample rate or count")
+    del keep
+    return out
+
+
+def vibration_grms(psd_frequency, psd_level):
+    """The Grms (g) of a PSD given by breakpoints (Hz, g^2/Hz, log-log between them)."""
+    f = _doubles(psd_frequency, "psd_frequency")
+    g = _doubles(psd_level, "psd_level")
+    if f.size != g.size:
+        raise ValueError(f"psd_frequency has {f.size} values, psd_level {g.size}")
+    out = c_double()
+    s = _c().ws_vibration_grms(_ptr(f, c_double), _ptr(g, c_double), f.size, byref(out))
+    if s != WS_OK:
+        raise WrapsimError(s, "ws_vibration_grms: frequencies must be > 0 and increasing, "
+                              "levels > 0, at least 2")
+    return out.value
+
+
+def truck_psd(level="medium"):
+    """The library's ASTM D4169 truck spectrum at a level ('low' 0.40, 'medium' 0.54, 'high'
+    0.70 Grms, or 1, 2, 3): (frequencies Hz, levels g^2/Hz) as numpy arrays."""
+    levels = {"low": 1, "medium": 2, "high": 3}
+    lv = levels.get(level, level) if isinstance(level, str) else int(level)
+    if lv not in (1, 2, 3):
+        raise ValueError(f"unknown truck level {level!r} (low, medium, high)")
+    n = ctypes.c_size_t()
+    f, g = np.empty(64), np.empty(64)
+    s = _c().ws_vibration_truck_psd(lv, _ptr(f, c_double), _ptr(g, c_double), 64, byref(n))
+    if s != WS_OK:
+        raise WrapsimError(s)
+    return f[:n.value].copy(), g[:n.value].copy()
+
+
 class World:
     """A world: owner of every shape, body, material, law and web. Use as a context manager, or
     call close(). Keyword arguments are the fields of ws_world_def (dt, gravity, integrator,
@@ -987,14 +1062,46 @@ class Body(_Handle):
         """Set the velocities (m/s, rad/s global) of a dynamic body between steps."""
         self._call("ws_body_set_velocity", byref(_vec3(velocity)), byref(_vec3(angular_velocity)))
 
-    def set_drive(self, type="static", callback=None, **kwargs):
+    def set_drive(self, type="static", callback=None, table=None, psd_frequency=None,
+                  psd_level=None, **kwargs):
         """Set the drive of a kinematic body: type 'static', 'tilt' (axis, point, rate rad/s,
-        start_time s, ramp_time s, max_angle rad), 'sine' (direction, amplitude m, frequency Hz,
-        phase rad, start_time, ramp_time) or 'callback' with `callback(t)` returning
+        start_time s, ramp_time s, max_angle rad, stop_ramp_time s), 'sine' (direction,
+        amplitude m, frequency Hz, phase rad, start_time, ramp_time), 'pulse' (EUMOS 40509:
+        direction, acceleration m/s^2, rise_time, hold_time, pulse_mode 'accelerate' or 'brake',
+        gentle_acceleration, coast_time), 'impact' (direction, speed m/s, pulse_duration s,
+        gentle_acceleration, coast_time), 'table' (direction, table: accelerations m/s^2,
+        table_interval s, table_end_at_rest), 'random' (direction, psd_frequency Hz, psd_level
+        g^2/Hz, seed, duration s, sample_rate Hz, ramp_time: the taper), 'sweep' (direction,
+        acceleration m/s^2, frequency Hz, frequency_end Hz, duration s, sweep_law 'log' or
+        'linear', ramp_time) or 'callback' with `callback(t)` returning
         (position, orientation[, velocity[, angular_velocity]]) in the global frame. An exception
-        in the callback fails the step with WS_ERR_CALLBACK and is chained to the WrapsimError."""
+        in the callback fails the step with WS_ERR_CALLBACK and is chained to the WrapsimError.
+        The library copies the table and the PSD."""
+        keep = []
+        if psd_frequency is not None or psd_level is not None:
+            kwargs["type"] = type
+            d, arrays = _psd_def(psd_frequency if psd_frequency is not None else [],
+                                 psd_level if psd_level is not None else [], kwargs)
+            keep.append(arrays)
+            kwargs = {}
+        else:
+            d = None
+        if table is not None:
+            t = _doubles(table, "table")
+            keep.append(t)
+            if d is None:
+                kwargs["type"] = type
+                d = _make(L.DriveDef, kwargs)
+                kwargs = {}
+            d.table = _ptr(t, c_double)
+            d.table_count = t.size
+        if d is not None:
+            self._set_drive_def(d, callback)
+            return
         kwargs["type"] = type
-        d = _make(L.DriveDef, kwargs)
+        self._set_drive_def(_make(L.DriveDef, kwargs), callback)
+
+    def _set_drive_def(self, d, callback):
         cfn = None
         if callback is not None:
             world = self.world
@@ -1019,6 +1126,17 @@ class Body(_Handle):
             # have kept it even when the call below fails).
             self.world._callbacks.setdefault(self.id, []).append(cfn)
         self._call("ws_body_set_drive", byref(d))
+
+    def drive_state(self):
+        """What the body's drive delivers now, a dict: time s, type (int), position,
+        displacement (since the drive was set) m, velocity m/s, acceleration m/s^2 (of the
+        CoG, global), angular_velocity rad/s, and for a tilt angle rad, angular_rate rad/s,
+        angular_acceleration rad/s^2; has_acceleration is False for a callback drive."""
+        st = L.DriveState()
+        self._call("ws_body_get_drive_state", byref(st))
+        d = _struct_dict(st)
+        d["has_acceleration"] = bool(d["has_acceleration"])
+        return d
 
     def destroy(self):
         """Destroy the body; its contacts go with it."""

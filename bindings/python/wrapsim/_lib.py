@@ -39,6 +39,11 @@ WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
 WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
 WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
 WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK = 0, 1, 2, 3
+WS_DRIVE_PULSE, WS_DRIVE_IMPACT, WS_DRIVE_TABLE, WS_DRIVE_RANDOM, WS_DRIVE_SWEEP = 4, 5, 6, 7, 8
+WS_PULSE_ACCELERATE, WS_PULSE_BRAKE = 0, 1
+WS_SWEEP_LOG, WS_SWEEP_LINEAR = 0, 1
+WS_TRUCK_LOW, WS_TRUCK_MEDIUM, WS_TRUCK_HIGH = 1, 2, 3
+WS_STANDARD_GRAVITY = 9.80665
 WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE = 0, 1
 WS_LAW_LINEAR_ELASTIC, WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION = 0, 1, 2
 WS_LAW_LINEAR_VISCOUS, WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP = 3, 4, 5, 6
@@ -239,6 +244,44 @@ class DriveDef(Structure):
         ("phase", c_double),
         ("callback", DriveFn),
         ("callback_user", c_void_p),
+        # added in 0.2
+        ("stop_ramp_time", c_double),
+        ("acceleration", c_double),
+        ("rise_time", c_double),
+        ("hold_time", c_double),
+        ("pulse_mode", c_enum),
+        ("gentle_acceleration", c_double),
+        ("coast_time", c_double),
+        ("speed", c_double),
+        ("pulse_duration", c_double),
+        ("table", POINTER(c_double)),
+        ("table_count", c_size_t),
+        ("table_interval", c_double),
+        ("table_end_at_rest", c_int),
+        ("psd_frequency", POINTER(c_double)),
+        ("psd_level", POINTER(c_double)),
+        ("psd_count", c_size_t),
+        ("seed", c_uint64),
+        ("duration", c_double),
+        ("sample_rate", c_double),
+        ("frequency_end", c_double),
+        ("sweep_law", c_enum),
+    ]
+
+
+class DriveState(Structure):
+    _fields_ = [
+        ("time", c_double),
+        ("type", c_enum),
+        ("position", Vec3),
+        ("displacement", Vec3),
+        ("velocity", Vec3),
+        ("acceleration", Vec3),
+        ("angular_velocity", Vec3),
+        ("angle", c_double),
+        ("angular_rate", c_double),
+        ("angular_acceleration", c_double),
+        ("has_acceleration", c_int),
     ]
 
 
@@ -486,6 +529,10 @@ FUNCTIONS = [
     ("ws_body_destroy", [World_p, BodyId], _st),
     ("ws_body_is_valid", [World_p, BodyId], c_int),
     ("ws_body_set_drive", [World_p, BodyId, P(DriveDef)], _st),
+    ("ws_body_get_drive_state", [World_p, BodyId, P(DriveState)], _st),
+    ("ws_vibration_synthesize", [World_p, P(DriveDef), P(c_double), c_size_t], _st),
+    ("ws_vibration_grms", [P(c_double), P(c_double), c_size_t, P(c_double)], _st),
+    ("ws_vibration_truck_psd", [c_enum, P(c_double), P(c_double), c_size_t, P(c_size_t)], _st),
     ("ws_body_get_type", [World_p, BodyId, P(c_enum)], _st),
     ("ws_body_get_position", [World_p, BodyId, P(Vec3)], _st),
     ("ws_body_get_orientation", [World_p, BodyId, P(Quat)], _st),
