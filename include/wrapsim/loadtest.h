@@ -27,6 +27,7 @@
 #ifndef WRAPSIM_LOADTEST_H
 #define WRAPSIM_LOADTEST_H
 
+#include <wrapsim/body.h>
 #include <wrapsim/world.h>
 
 #ifdef __cplusplus
@@ -233,7 +234,9 @@ typedef struct ws_loadtest_interface_state {
  *  call only. */
 typedef struct ws_loadtest_sample {
     double time;          /**< s, from the start of the run */
-    double level;         /**< the platform's acceleration along the direction, in g */
+    /** the platform's acceleration along the direction, in g, as its drive delivered it
+     *  (ws_body_get_drive_state()); negative while it brakes */
+    double level;
     double platform_velocity; /**< m/s along the direction */
     double platform_position; /**< m along the direction, from where it started */
     size_t cartons;       /**< entries of carton[] */
@@ -244,26 +247,34 @@ typedef struct ws_loadtest_sample {
     const ws_loadtest_interface_state *interface; /**< per interface */
 } ws_loadtest_sample;
 
-/** The acceleration test of EUMOS 40509: the platform accelerates horizontally at k g, reached
- *  within 50 ms, held at least 0.3 s, and is then stopped gently. The pulse is smooth: every
- *  change of acceleration is a half-cosine blend. Fill with ws_eumos_def_init(). */
+/** The acceleration test of EUMOS 40509 as the platform's WS_DRIVE_PULSE drive: the platform
+ *  accelerates horizontally at k g, reached within 50 ms, held at least 0.3 s, and is then
+ *  stopped gently; or, in the run-up-then-brake variant, it runs up gently and brakes at k g.
+ *  Fill with ws_eumos_def_init(). */
 typedef struct ws_eumos_def {
     uint32_t size;  /**< set by ws_eumos_def_init() */
     uint32_t magic; /**< set by ws_eumos_def_init() */
-    double k;                 /**< plateau acceleration in g (> 0); default 0.5 */
-    double g;                 /**< the g of k g, m/s^2 (> 0); default 9.81 */
-    double rise_time;         /**< s, 0 -> k g (> 0, <= 0.05 for the standard); default 0.04 */
-    double hold_time;         /**< s at k g (>= 0.3 for the standard); default 0.35 */
-    double fall_time;         /**< s, k g -> 0 (> 0); default 0.05 */
-    /** The gentle stop after the pulse, in g (> 0): the platform brakes at this until it stands,
-     *  with blends of `fall_time`. Default 0.1. */
+    double k;                 /**< plateau acceleration in g (> 0, <= 10); default 0.5 */
+    /** The g of k g, m/s^2 (> 0); default 9.81, the world's default gravity, so that k compares
+     *  with the friction coefficients of the load as the world sees them. */
+    double g;
+    /** s, the half-cosine rise 0 -> k g and the fall back (> 0; <= 0.05 for the standard);
+     *  default 0.04 */
+    double rise_time;
+    double hold_time;         /**< s at k g (>= 0; >= 0.3 for the standard); default 0.35 */
+    ws_pulse_mode mode;       /**< default WS_PULSE_ACCELERATE; WS_PULSE_BRAKE: run up, brake */
+    /** The gentle phase (the stop after the pulse, or the run-up before the braking), in g
+     *  (> 0): the peak of its raised-cosine acceleration. The run uses min(stop_level, k / 2),
+     *  so the gentle phase never pushes the load harder than half the pulse. Default 0.2. */
     double stop_level;
-    double rest_before;       /**< s at rest before the pulse (>= 0); default 0.05 */
+    double coast_time;        /**< s at constant speed between pulse and gentle phase (>= 0);
+                                   default 0.1 */
+    double rest_before;       /**< s at rest before the drive starts (>= 0); default 0.05 */
     /** s at rest after the platform stands, before the permanent displacement is read (>= 0);
      *  default 0.5 */
     double rest_after;
-    ws_vec3 direction;        /**< of the acceleration, in the platform's frame; horizontal;
-                                   normalised; default (1, 0, 0) */
+    ws_vec3 direction;        /**< of the pulse's acceleration, in the platform's frame;
+                                   horizontal; normalised; default (1, 0, 0) */
     double slip_speed;        /**< m/s (> 0): an interface whose load-weighted mean slip speed
                                    passes this is slipping (event); default 0.005 */
     int sample_interval;      /**< steps between measurements (>= 1); default 4 */
@@ -329,8 +340,13 @@ typedef struct ws_eumos_verdict {
 typedef struct ws_eumos_result {
     double k;             /**< the level the run used, g */
     double duration;      /**< s simulated */
-    double peak_level;    /**< largest platform acceleration along the direction, g */
-    double time_at_level; /**< s the platform spent within 1 % of k g */
+    /** largest |platform acceleration| along the direction the drive delivered, g */
+    double peak_level;
+    /** s from the start of the pulse's rise until the delivered |acceleration| first reached
+     *  0.99 k g (the standard: within 0.05 s) */
+    double rise_measured;
+    /** s the delivered |acceleration| stayed within 1 % of k g (the standard: >= 0.3 s) */
+    double time_at_level;
     int layers;           /**< entries used in the per-layer arrays */
     double layer_max[WS_LOAD_MAX_LAYERS];       /**< per layer: largest horizontal displacement
                                                      of its cartons during the test, m */
@@ -348,14 +364,17 @@ typedef struct ws_eumos_result {
 
 /** Fill a EUMOS Def with the defaults above. NULL is ignored. */
 WS_API void ws_eumos_def_init(ws_eumos_def *def);
-/** The platform's acceleration (m/s^2), velocity (m/s) and position (m) along the direction at
- *  time t (s) from the start of the run, as a run drives it; any output may be NULL. The
- *  duration of the whole run (s) in *duration (may be NULL).
- *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (a bad Def), WS_ERR_UNINITIALIZED_DEF. */
-WS_API ws_status ws_eumos_profile(const ws_eumos_def *def, double t, double *acceleration,
-                                  double *velocity, double *position, double *duration);
+/** The platform drive a EUMOS run sets (a WS_DRIVE_PULSE along `direction`, given in global
+ *  axes for a platform whose frame is the global one, starting at start_time 0: add the world's
+ *  time) and the run's duration in s (rest before, the drive, rest after); either output may
+ *  be NULL.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (a bad Def; no last error: there is no world),
+ *  WS_ERR_UNINITIALIZED_DEF. */
+WS_API ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive,
+                                    double *duration);
 /** Run EUMOS 40509 on a load from the world's present state: the platform's drive is replaced by
- *  the pulse (a callback drive) and set back to static at the end, where the platform stopped.
+ *  the pulse (ws_eumos_get_drive()) and set back to static at the end, where the platform
+ *  stopped.
  *  The reference of the measurements is taken at the start (ws_load_set_reference()). Fills
  *  *result (events, per-layer and per-interface figures, the verdict).
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world),
@@ -388,9 +407,9 @@ typedef struct ws_kvalue_result {
 WS_API void ws_kvalue_def_init(ws_kvalue_def *def);
 /** Find the load's k-value: the largest k at which it passes EUMOS 40509, by bisection between
  *  k_low and k_high. Every run starts from the same settled load: a world is created from
- *  `world_def`, the load built from `load_def` and settled for settle_time, then EUMOS is run at
- *  k with the rest of `eumos_def`; runs are deterministic, so each starts from the same state to
- *  the bit.
+ *  `world_def`, the load built from `load_def` and settled for settle_time, and its state saved
+ *  (ws_world_save()); each run restores it (ws_world_restore()) and runs EUMOS at its k with the
+ *  rest of `eumos_def`, so each starts from the same state to the bit.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, and any error of a run (its
  *  text in result->error). */
 WS_API ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *load_def,

@@ -17,8 +17,9 @@ void ws_eumos_def_init(ws_eumos_def *def)
     def->g = 9.81;
     def->rise_time = 0.04;
     def->hold_time = 0.35;
-    def->fall_time = 0.05;
+    def->mode = WS_PULSE_ACCELERATE;
     def->stop_level = 0.2;
+    def->coast_time = 0.1;
     def->rest_before = 0.05;
     def->rest_after = 0.5;
     def->direction = v3_make(1, 0, 0);
@@ -38,15 +39,6 @@ void ws_kvalue_def_init(ws_kvalue_def *def)
 
 /* ---- the pulse ---------------------------------------------------------------------------- */
 
-/* The pulse as segments over which the acceleration blends from a0 to a1 by a half cosine,
- * s(tau) = (1 - cos(pi tau / T)) / 2, so the acceleration is continuous and its rate bounded. */
-typedef struct pulse {
-    int n;
-    double t[8], a0[8], a1[8]; /* durations, start and end accelerations (m/s^2) */
-    double v0[8], x0[8];       /* velocity and position at each segment's start */
-    double total;
-} pulse;
-
 static int pulse_check(const ws_eumos_def *d, char *why, size_t len)
 {
 #define NEED(cond, ...)                                                                          \
@@ -56,20 +48,23 @@ static int pulse_check(const ws_eumos_def *d, char *why, size_t len)
             return -1;                                                                            \
         }                                                                                         \
     } while (0)
-    NEED(isfinite(d->k) && d->k > 0 && d->k <= 100, "k must be in (0, 100] g, got %g", d->k);
-    NEED(isfinite(d->g) && d->g > 0, "g must be > 0 m/s^2, got %g", d->g);
-    NEED(isfinite(d->rise_time) && d->rise_time > 0, "rise_time must be > 0 s, got %g",
-         d->rise_time);
-    NEED(isfinite(d->hold_time) && d->hold_time >= 0, "hold_time must be >= 0 s, got %g",
-         d->hold_time);
-    NEED(isfinite(d->fall_time) && d->fall_time > 0, "fall_time must be > 0 s, got %g",
-         d->fall_time);
-    NEED(isfinite(d->stop_level) && d->stop_level > 0, "stop_level must be > 0 g, got %g",
-         d->stop_level);
-    NEED(isfinite(d->rest_before) && d->rest_before >= 0, "rest_before must be >= 0 s, got %g",
-         d->rest_before);
-    NEED(isfinite(d->rest_after) && d->rest_after >= 0, "rest_after must be >= 0 s, got %g",
-         d->rest_after);
+    NEED(isfinite(d->k) && d->k > 0 && d->k <= 10, "k must be in (0, 10] g, got %g", d->k);
+    NEED(isfinite(d->g) && d->g > 0 && d->g <= 1e3, "g must be in (0, 1000] m/s^2, got %g",
+         d->g);
+    NEED(isfinite(d->rise_time) && d->rise_time > 0 && d->rise_time <= 1e3,
+         "rise_time must be in (0, 1000] s, got %g", d->rise_time);
+    NEED(isfinite(d->hold_time) && d->hold_time >= 0 && d->hold_time <= 1e3,
+         "hold_time must be in [0, 1000] s, got %g", d->hold_time);
+    NEED(d->mode == WS_PULSE_ACCELERATE || d->mode == WS_PULSE_BRAKE, "unknown mode %d",
+         (int)d->mode);
+    NEED(isfinite(d->stop_level) && d->stop_level > 0 && d->stop_level <= 10,
+         "stop_level must be in (0, 10] g, got %g", d->stop_level);
+    NEED(isfinite(d->coast_time) && d->coast_time >= 0 && d->coast_time <= 1e3,
+         "coast_time must be in [0, 1000] s, got %g", d->coast_time);
+    NEED(isfinite(d->rest_before) && d->rest_before >= 0 && d->rest_before <= 1e3,
+         "rest_before must be in [0, 1000] s, got %g", d->rest_before);
+    NEED(isfinite(d->rest_after) && d->rest_after >= 0 && d->rest_after <= 1e3,
+         "rest_after must be in [0, 1000] s, got %g", d->rest_after);
     double n = hypot(d->direction.x, d->direction.y);
     NEED(isfinite(n) && n > 0 && isfinite(d->direction.z) && fabs(d->direction.z) <= 1e-12 * n,
          "direction must be horizontal in the platform's frame and not zero");
@@ -80,117 +75,48 @@ static int pulse_check(const ws_eumos_def *d, char *why, size_t len)
     return 0;
 }
 
-static void pulse_add(pulse *p, double t, double a0, double a1)
+/* The platform's drive, its direction in the platform's frame (the caller turns it into the
+ * global frame), and the run's length: rest, the drive (two rises, the hold, the coast and the
+ * gentle phase, a raised cosine of peak G whose mean is G / 2, so it takes 2 V / G to undo the
+ * speed V = k g (rise + hold) the pulse gives), rest. */
+static void pulse_drive(const ws_eumos_def *d, ws_drive_def *dd, double *duration)
 {
-    p->t[p->n] = t;
-    p->a0[p->n] = a0;
-    p->a1[p->n] = a1;
-    p->n++;
+    double A = d->k * d->g, G = fmin(d->stop_level, 0.5 * d->k) * d->g;
+    ws_drive_def_init(dd);
+    dd->type = WS_DRIVE_PULSE;
+    dd->start_time = d->rest_before;
+    dd->direction = d->direction;
+    dd->acceleration = A;
+    dd->rise_time = d->rise_time;
+    dd->hold_time = d->hold_time;
+    dd->pulse_mode = d->mode;
+    dd->gentle_acceleration = G;
+    dd->coast_time = d->coast_time;
+    double v = A * (d->rise_time + d->hold_time);
+    *duration = d->rest_before + 2 * d->rise_time + d->hold_time + d->coast_time + 2 * v / G +
+                d->rest_after;
 }
 
-/* Velocity and position after tau of a blend from a0 to a1 over T, from v0 and x0. */
-static void blend(double tau, double T, double a0, double a1, double v0, double x0, double *a,
-                  double *v, double *x)
-{
-    double w = WS_PI * tau / T, da = a1 - a0;
-    *a = a0 + da * 0.5 * (1 - cos(w));
-    *v = v0 + a0 * tau + da * (0.5 * tau - T / (2 * WS_PI) * sin(w));
-    *x = x0 + v0 * tau + 0.5 * a0 * tau * tau +
-         da * (0.25 * tau * tau + T * T / (2 * WS_PI * WS_PI) * (cos(w) - 1));
-}
-
-/* The braking level is min(stop_level, k / 2) g: a stop never pushes the load harder than half
- * the pulse, so it does not add a test of its own. */
-static void pulse_make(const ws_eumos_def *d, pulse *p)
-{
-    memset(p, 0, sizeof *p);
-    double A = d->k * d->g, tf = d->fall_time;
-    double B = fmin(d->stop_level, 0.5 * d->k) * d->g;
-    double v = A * (0.5 * d->rise_time + d->hold_time + 0.5 * tf);
-    double tb = v / B - tf; /* braking held at B: the blends in and out take B tf together */
-    if (tb < 0) {
-        tb = 0;
-        B = v / tf;
-    }
-    pulse_add(p, d->rest_before, 0, 0);
-    pulse_add(p, d->rise_time, 0, A);
-    pulse_add(p, d->hold_time, A, A);
-    pulse_add(p, tf, A, 0);
-    pulse_add(p, tf, 0, -B);
-    pulse_add(p, tb, -B, -B);
-    pulse_add(p, tf, -B, 0);
-    pulse_add(p, d->rest_after, 0, 0);
-    double vv = 0, xx = 0, a;
-    for (int i = 0; i < p->n; i++) {
-        p->v0[i] = vv;
-        p->x0[i] = xx;
-        if (p->t[i] > 0)
-            blend(p->t[i], p->t[i], p->a0[i], p->a1[i], p->v0[i], p->x0[i], &a, &vv, &xx);
-        p->total += p->t[i];
-    }
-}
-
-static void pulse_at(const pulse *p, double t, double *a, double *v, double *x)
-{
-    double start = 0;
-    for (int i = 0; i < p->n; i++) {
-        if (p->t[i] > 0 && (t < start + p->t[i] || i == p->n - 1)) {
-            double tau = fmin(fmax(t - start, 0), p->t[i]);
-            blend(tau, p->t[i], p->a0[i], p->a1[i], p->v0[i], p->x0[i], a, v, x);
-            if (t > start + p->t[i]) /* past the end: at rest where it stopped */
-                *a = 0, *v = 0;
-            return;
-        }
-        start += p->t[i];
-    }
-    *a = 0;
-    *v = 0;
-    *x = p->x0[p->n - 1];
-}
-
-ws_status ws_eumos_profile(const ws_eumos_def *def, double t, double *acceleration,
-                           double *velocity, double *position, double *duration)
+ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive, double *duration)
 {
     if (!def)
         return WS_ERR_INVALID_ARGUMENT;
     if (ws_def_check(def, sizeof *def) != 0)
         return WS_ERR_UNINITIALIZED_DEF;
     char why[160];
-    if (pulse_check(def, why, sizeof why) != 0 || !isfinite(t))
+    if (pulse_check(def, why, sizeof why) != 0)
         return WS_ERR_INVALID_ARGUMENT;
-    pulse p;
-    pulse_make(def, &p);
-    double a, v, x;
-    pulse_at(&p, t, &a, &v, &x);
-    if (acceleration)
-        *acceleration = a;
-    if (velocity)
-        *velocity = v;
-    if (position)
-        *position = x;
+    ws_eumos_def d = *def;
+    double n = hypot(d.direction.x, d.direction.y);
+    d.direction = v3_make(d.direction.x / n, d.direction.y / n, 0);
+    ws_drive_def dd;
+    double t;
+    pulse_drive(&d, &dd, &t);
+    if (drive)
+        *drive = dd;
     if (duration)
-        *duration = p.total;
+        *duration = t;
     return WS_OK;
-}
-
-/* The platform's drive during a run: its pose at the start moved along the direction. */
-typedef struct sled {
-    pulse p;
-    double t0;
-    ws_vec3 r0, dir;
-    ws_quat q0;
-} sled;
-
-static int sled_drive(void *user, double t, ws_pose *pose, ws_vec3 *velocity, ws_vec3 *omega)
-{
-    const sled *s = user;
-    double a, v, x;
-    pulse_at(&s->p, t - s->t0, &a, &v, &x);
-    pose->position = v3_madd(s->r0, s->dir, x);
-    pose->orientation = s->q0;
-    *velocity = v3_scale(s->dir, v);
-    *omega = v3_make(0, 0, 0);
-    return 0;
 }
 
 /* ---- the run ------------------------------------------------------------------------------ */
@@ -356,8 +282,8 @@ static ws_status sample(ws_world *w, run_state *rs, double t, double a, double v
     if (s != WS_OK || (s = read_contacts(w, rs)) != WS_OK)
         return s;
     double level = a / rs->d.g;
-    if (level > r->peak_level)
-        r->peak_level = level;
+    if (fabs(level) > r->peak_level)
+        r->peak_level = fabs(level);
     find_tips(rs, t, level);
     v3 dir = rs->d.direction;
     for (int l = 0; l < ld->info.layers; l++) {
@@ -481,13 +407,21 @@ static ws_status run_alloc(ws_world *w, run_state *rs)
     return WS_OK;
 }
 
-/* Step the whole pulse, sampling every sample_interval steps. */
-static ws_status run_steps(ws_world *w, run_state *rs, sled *sl, double dt)
+/* The platform's drive during a run and where the run stands. */
+typedef struct sled {
+    double t0, duration, rise_start;
+    ws_vec3 r0, dir; /* where the platform started, the direction in global axes */
+} sled;
+
+/* Step the whole run, sampling every sample_interval steps; the level is what the platform's
+ * drive delivered, read back from the world. */
+static ws_status run_steps(ws_world *w, run_state *rs, const sled *sl, double dt)
 {
     ws_eumos_result *r = rs->res;
     const double kg = rs->d.k * rs->d.g;
-    int64_t total = (int64_t)ceil(sl->p.total / dt - 1e-9);
+    int64_t total = (int64_t)ceil(sl->duration / dt - 1e-9);
     ws_status s;
+    r->rise_measured = -1;
     for (int64_t done = 0; done < total;) {
         int64_t chunk = rs->d.sample_interval;
         if (chunk > total - done)
@@ -495,13 +429,16 @@ static ws_status run_steps(ws_world *w, run_state *rs, sled *sl, double dt)
         if ((s = ws_world_step_n(w, chunk)) != WS_OK)
             return s;
         done += chunk;
-        double t, a, v, x;
-        if ((s = ws_world_get_time(w, &t)) != WS_OK)
+        ws_drive_state ds;
+        if ((s = ws_body_get_drive_state(w, rs->ld->info.platform, &ds)) != WS_OK)
             return s;
-        t -= sl->t0;
-        pulse_at(&sl->p, t, &a, &v, &x);
-        if (fabs(a - kg) <= 0.01 * kg)
+        double t = ds.time - sl->t0;
+        double a = v3_dot(ds.acceleration, sl->dir), v = v3_dot(ds.velocity, sl->dir);
+        double x = v3_dot(v3_sub(ds.position, sl->r0), sl->dir);
+        if (fabs(fabs(a) - kg) <= 0.01 * kg)
             r->time_at_level += (double)chunk * dt;
+        if (r->rise_measured < 0 && fabs(a) >= 0.99 * kg)
+            r->rise_measured = t - sl->rise_start;
         if ((s = sample(w, rs, t, a, v, x)) != WS_OK)
             return s;
         r->duration = t;
@@ -539,25 +476,28 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
     sled sl;
     double dt;
     ws_mat3 a_pf;
+    ws_drive_def dd;
     if ((s = ws_world_get_dt(w, &dt)) != WS_OK ||
         (s = ws_world_get_time(w, &sl.t0)) != WS_OK ||
         (s = ws_body_get_position(w, ld->info.platform, &sl.r0)) != WS_OK ||
-        (s = ws_body_get_orientation(w, ld->info.platform, &sl.q0)) != WS_OK ||
         (s = ws_body_get_rotation(w, ld->info.platform, &a_pf)) != WS_OK ||
         (s = ws_load_set_reference(w, ld)) != WS_OK)
         return s;
-    pulse_make(&rs.d, &sl.p);
+    pulse_drive(&rs.d, &dd, &sl.duration);
     sl.dir = m3_mul_v(&a_pf, rs.d.direction);
+    dd.direction = sl.dir;
+    dd.start_time += sl.t0;
+    /* The pulse's rise starts after the gentle run-up in the braking variant. */
+    sl.rise_start = rs.d.rest_before;
+    if (rs.d.mode == WS_PULSE_BRAKE)
+        sl.rise_start += rs.d.coast_time + 2 * dd.acceleration *
+                                               (rs.d.rise_time + rs.d.hold_time) /
+                                               dd.gentle_acceleration;
     if ((s = run_alloc(w, &rs)) != WS_OK)
         return s;
-    ws_drive_def dd;
-    ws_drive_def_init(&dd);
-    dd.type = WS_DRIVE_CALLBACK;
-    dd.callback = sled_drive;
-    dd.callback_user = &sl;
     if ((s = ws_body_set_drive(w, ld->info.platform, &dd)) == WS_OK) {
         s = run_steps(w, &rs, &sl, dt);
-        /* The callback's data lives on this stack: the platform stays where it stopped. */
+        /* The platform stays where it stopped. */
         ws_drive_def_init(&dd);
         ws_status s2 = ws_body_set_drive(w, ld->info.platform, &dd);
         if (s == WS_OK)
@@ -571,28 +511,88 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
 
 /* ---- the k-value -------------------------------------------------------------------------- */
 
-/* One run at k from a fresh world: build, settle for a fixed time, run. */
-static ws_status run_at(const ws_world_def *wd, const ws_load_def *ldef, const ws_eumos_def *ed,
-                        double settle, double k, ws_eumos_result *res, char *err, size_t len)
+/* The k-value search's world: the load built and settled once, its state saved; every run
+ * restores that state first, so each starts from the same settled load to the bit. */
+typedef struct kworld {
+    ws_world *w;
+    ws_load *ld;
+    void *state;
+    size_t len;
+} kworld;
+
+static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_def *ldef,
+                             double settle)
 {
-    ws_world *w = NULL;
-    ws_load *ld = NULL;
-    ws_status s = ws_world_create(wd, &w);
-    if (s != WS_OK) {
-        snprintf(err, len, "world: %s", ws_status_string(s));
+    memset(kw, 0, sizeof *kw);
+    ws_status s = ws_world_create(wd, &kw->w);
+    if (s != WS_OK)
         return s;
-    }
+    double dt;
+    if ((s = ws_load_build(kw->w, ldef, &kw->ld)) != WS_OK ||
+        (s = ws_world_get_dt(kw->w, &dt)) != WS_OK ||
+        (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK ||
+        (s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
+        return s;
+    kw->state = ws_mem_alloc(&kw->ld->mem, kw->len);
+    if (!kw->state)
+        return ws_fail(kw->w, WS_ERR_OUT_OF_MEMORY, "k-value: no room for a saved state of %zu "
+                                                    "bytes", kw->len);
+    return ws_world_save(kw->w, kw->state, kw->len, &kw->len);
+}
+
+static void kworld_free(kworld *kw)
+{
+    if (kw->ld)
+        ws_mem_free(&kw->ld->mem, kw->state, kw->len);
+    ws_load_destroy(kw->ld);
+    ws_world_destroy(kw->w);
+}
+
+static ws_status run_at(kworld *kw, const ws_eumos_def *ed, double k, ws_eumos_result *res)
+{
     ws_eumos_def d = *ed;
     d.k = k;
-    double dt;
-    if ((s = ws_load_build(w, ldef, &ld)) == WS_OK && (s = ws_world_get_dt(w, &dt)) == WS_OK &&
-        (s = ws_world_step_n(w, (int64_t)ceil(settle / dt - 1e-9))) == WS_OK)
-        s = ws_loadtest_run_eumos(w, ld, &d, res);
-    if (s != WS_OK)
-        snprintf(err, len, "%s", ws_world_last_error(w));
-    ws_load_destroy(ld);
-    ws_world_destroy(w);
-    return s;
+    ws_status s = ws_world_restore(kw->w, kw->state, kw->len);
+    return s != WS_OK ? s : ws_loadtest_run_eumos(kw->w, kw->ld, &d, res);
+}
+
+static ws_status search(kworld *kw, const ws_eumos_def *ed, const ws_kvalue_def *kd,
+                        ws_kvalue_result *result)
+{
+    ws_eumos_result *res = &result->last_pass, trial;
+    ws_status s;
+    double lo = kd->k_low, hi = kd->k_high;
+    result->runs++;
+    if ((s = run_at(kw, ed, lo, &trial)) != WS_OK)
+        return s;
+    if (!trial.verdict.pass) {
+        result->k_fail = lo;
+        return WS_OK;
+    }
+    *res = trial;
+    result->runs++;
+    if ((s = run_at(kw, ed, hi, &trial)) != WS_OK)
+        return s;
+    if (trial.verdict.pass) {
+        result->k_value = hi;
+        *res = trial;
+        return WS_OK;
+    }
+    while (hi - lo > kd->tolerance) {
+        double mid = 0.5 * (lo + hi);
+        result->runs++;
+        if ((s = run_at(kw, ed, mid, &trial)) != WS_OK)
+            return s;
+        if (trial.verdict.pass) {
+            lo = mid;
+            *res = trial;
+        } else {
+            hi = mid;
+        }
+    }
+    result->k_value = lo;
+    result->k_fail = hi;
+    return WS_OK;
 }
 
 ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *load_def,
@@ -618,44 +618,13 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
                  "got %g, %g, %g, %g", kd.k_low, kd.k_high, kd.tolerance, kd.settle_time);
         return WS_ERR_INVALID_ARGUMENT;
     }
-    ws_eumos_result *res = &result->last_pass, trial;
-    char *err = result->error;
-    size_t len = sizeof result->error;
-    ws_status s;
-    double lo = kd.k_low, hi = kd.k_high;
-    result->runs++;
-    if ((s = run_at(world_def, load_def, eumos_def, kd.settle_time, lo, &trial, err, len)) !=
-        WS_OK)
-        return s;
-    if (!trial.verdict.pass) {
-        result->k_fail = lo;
-        memset(res, 0, sizeof *res);
-        return WS_OK;
-    }
-    *res = trial;
-    result->runs++;
-    if ((s = run_at(world_def, load_def, eumos_def, kd.settle_time, hi, &trial, err, len)) !=
-        WS_OK)
-        return s;
-    if (trial.verdict.pass) {
-        result->k_value = hi;
-        *res = trial;
-        return WS_OK;
-    }
-    while (hi - lo > kd.tolerance) {
-        double mid = 0.5 * (lo + hi);
-        result->runs++;
-        if ((s = run_at(world_def, load_def, eumos_def, kd.settle_time, mid, &trial, err, len)) !=
-            WS_OK)
-            return s;
-        if (trial.verdict.pass) {
-            lo = mid;
-            *res = trial;
-        } else {
-            hi = mid;
-        }
-    }
-    result->k_value = lo;
-    result->k_fail = hi;
-    return WS_OK;
+    kworld kw;
+    ws_status s = kworld_make(&kw, world_def, load_def, kd.settle_time);
+    if (s == WS_OK)
+        s = search(&kw, eumos_def, &kd, result);
+    if (s != WS_OK)
+        snprintf(result->error, sizeof result->error, "%s",
+                 kw.w ? ws_world_last_error(kw.w) : ws_status_string(s));
+    kworld_free(&kw);
+    return s;
 }
