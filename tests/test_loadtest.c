@@ -150,6 +150,65 @@ START_TEST(the_reference_load_has_33_bodies_by_layer_and_place)
 }
 END_TEST
 
+/* Allocation failures: the load's own object (its allocator hooks) and the world's (its
+ * bodies), at every allocation in turn; each failure is WS_ERR_OUT_OF_MEMORY with nothing of the
+ * load left in the world and every byte of the load's allocator given back. */
+START_TEST(allocation_failures_leave_nothing_behind)
+{
+    ws_load_def d;
+    ws_load_def_init(&d);
+    d.layers = 2;
+    for (long n = 0; n < 6; n++) {
+        ws_world *w = load_world();
+        test_alloc ta = {n, 0, 0};
+        d.allocator.alloc = ta_alloc;
+        d.allocator.realloc = ta_realloc;
+        d.allocator.free = ta_free;
+        d.allocator.user = &ta;
+        ws_load *ld = NULL;
+        ws_status s = ws_load_build(w, &d, &ld);
+        if (s == WS_OK) {
+            ck_assert_int_ge(n, 5); /* the load takes 5 blocks */
+            ws_load_destroy(ld);
+        } else {
+            ck_assert_int_eq(s, WS_ERR_OUT_OF_MEMORY);
+            ck_assert_ptr_null(ld);
+        }
+        ck_assert_int_eq(ta.live, 0);
+        ck_assert_int_eq(ta.bytes, 0);
+        ws_world_destroy(w);
+    }
+    ws_load_def_init(&d);
+    d.layers = 2;
+    int failed = 0;
+    for (long n = 0; n < 400; n += 7) {
+        ws_world_def wd;
+        ws_world_def_init(&wd);
+        test_alloc ta = {-1, 0, 0};
+        test_alloc_install(&wd, &ta);
+        ws_world *w = NULL;
+        ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+        ta.allocs_left = n;
+        ws_load *ld = NULL;
+        ws_status s = ws_load_build(w, &d, &ld);
+        ta.allocs_left = -1;
+        if (s != WS_OK) {
+            failed++;
+            ck_assert_int_eq(s, WS_ERR_OUT_OF_MEMORY);
+            ck_assert_ptr_null(ld);
+            size_t nb = 9;
+            ck_ok(w, ws_world_copy_body_ids(w, NULL, 0, &nb));
+            ck_assert_uint_eq(nb, 0);
+        }
+        ws_load_destroy(ld);
+        ws_world_destroy(w);
+        ck_assert_int_eq(ta.live, 0);
+        ck_assert_int_eq(ta.bytes, 0);
+    }
+    ck_assert_int_gt(failed, 0);
+}
+END_TEST
+
 START_TEST(interlocked_patterns_bridge_and_turn)
 {
     ws_world *w = load_world();
@@ -543,6 +602,7 @@ int main(void)
     Suite *s = suite_create("loadtest");
     add_case(s, "bad_defs", bad_defs_are_refused_with_a_reason, 30);
     add_case(s, "reference_load", the_reference_load_has_33_bodies_by_layer_and_place, 30);
+    add_case(s, "allocation", allocation_failures_leave_nothing_behind, 60);
     add_case(s, "interlocked", interlocked_patterns_bridge_and_turn, 30);
     add_case(s, "settles", the_pallet_load_settles_and_stands_still, 300);
     add_case(s, "pulse", the_eumos_pulse_is_what_the_standard_asks, 30);
