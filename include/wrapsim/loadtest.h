@@ -28,6 +28,7 @@
 #define WRAPSIM_LOADTEST_H
 
 #include <wrapsim/body.h>
+#include <wrapsim/web.h>
 #include <wrapsim/world.h>
 
 #ifdef __cplusplus
@@ -139,6 +140,7 @@ typedef struct ws_load_info {
     double load_height;         /**< from the platform's top face to the top of the load, m */
     double pallet_top;          /**< height of the pallet's deck above the platform's top, m */
     double total_mass;          /**< pallet + cartons, kg */
+    ws_web_id film;             /**< the film of ws_load_wrap_band(); null when unwrapped */
 } ws_load_info;
 
 /** One carton as built. */
@@ -217,6 +219,47 @@ WS_API ws_status ws_load_get_drift(const ws_world *world, const ws_load *load, d
  *  NULL) is the simulated time stepped, s. Errors of the step are returned as they are. */
 WS_API ws_status ws_load_settle(ws_world *world, const ws_load *load, double min_time,
                                 double max_time, double speed, int *settled, double *time_taken);
+
+/** A band of stretch film around the load: `layers` layers of film everywhere on the band,
+ *  laid with an on-load strain, from low on the pallet (the film-to-pallet lock) to near the
+ *  top. A simple wrap, not yet a spiral recipe of a machine (no overlaps, roping or top sheet).
+ *  Fill with ws_wrap_def_init(). */
+typedef struct ws_wrap_def {
+    uint32_t size;  /**< set by ws_wrap_def_init() */
+    uint32_t magic; /**< set by ws_wrap_def_init() */
+    double gauge;         /**< thickness of one film layer, m (> 0); default 20e-6 */
+    double modulus;       /**< Young's modulus of the film, Pa (> 0); default 150e6 */
+    double density;       /**< of the film, kg/m^3 (> 0); default 920 */
+    int layers;           /**< film layers on top of each other (>= 1); default 3 */
+    /** Strain the film holds on the load around it, the tension the pre-stretch leaves (> -1,
+     *  < 10); default 0.1 */
+    double strain_around;
+    double strain_up;     /**< the same up the load; default 0.02 */
+    /** Lowest row, m above the platform's top (>= 0): below the deck's top the film locks the
+     *  load to the pallet. Default 0.03. */
+    double z_bottom;
+    double top_margin;    /**< the highest row this far below the load's top, m (>= 0);
+                               default 0.03 */
+    double node_pitch;    /**< node spacing on the load, m (> 0); default 0.05 */
+    /** kg per node (>= 0); 0 = the film's real mass (density x gauge x layers x area), which
+     *  needs many sub-steps. Default 2e-3: 3.5 kg for the reference load's film, stable at
+     *  dt 0.25 ms with 2 sub-steps; its inertia is still small beside the load's. */
+    double node_mass;
+    int substeps;         /**< film sub-steps per world step (>= 1); default 2 */
+} ws_wrap_def;
+
+/** Fill a wrap Def with the defaults above. NULL is ignored. */
+WS_API void ws_wrap_def_init(ws_wrap_def *def);
+/** Wrap a band of film around the load as it stands (ws_web_create_band() around the pallet and
+ *  every carton) with the load's film material. The springs follow a tension-compression law
+ *  (1 % stiffness in compression: film buckles) of EA = modulus x gauge x layers x the strip
+ *  a spring stands for, per unit strain. The platform must be level and its frame the global
+ *  one (the band's rows are at global heights).
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world, a load
+ *  already wrapped), WS_ERR_UNINITIALIZED_DEF, WS_ERR_OUT_OF_MEMORY, errors of the web's
+ *  creation. */
+WS_API ws_status ws_load_wrap_band(ws_world *world, ws_load *load, const ws_wrap_def *def,
+                                   ws_web_id *out);
 
 /* ---------------------------------------------------------------------------------------- */
 /* EUMOS 40509 */

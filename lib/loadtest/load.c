@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <wrapsim/law.h>
+
 #include "loadtest/loadtest.h"
 #include "math/wmath.h"
 #include "world/world_internal.h"
@@ -476,6 +478,7 @@ ws_status ws_load_build(ws_world *w, const ws_load_def *def, ws_load **out)
     ld->pallet_size = d.pallet_size;
     ld->info.layers = d.layers;
     ld->carton_mass = d.carton_mass;
+    ld->contact_layer = d.contact_layer;
     ld->carton_shape = d.carton_size;
     ld->info.total_mass = d.pallet_mass + (double)cartons * d.carton_mass;
     ws_shape_id shapes[4] = {{0}, {0}, {0}, {0}};
@@ -694,4 +697,127 @@ ws_status ws_load_settle(ws_world *w, const ws_load *ld, double min_time, double
     if (time_taken)
         *time_taken = t - t0;
     return WS_OK;
+}
+
+/* ---- wrapping ----------------------------------------------------------------------------- */
+
+void ws_wrap_def_init(ws_wrap_def *def)
+{
+    if (!ws_def_reset(def, sizeof *def))
+        return;
+    def->gauge = 20e-6;
+    def->modulus = 150e6;
+    def->density = 920.0;
+    def->layers = 3;
+    def->strain_around = 0.1;
+    def->strain_up = 0.02;
+    def->z_bottom = 0.03;
+    def->top_margin = 0.03;
+    def->node_pitch = 0.05;
+    def->node_mass = 2e-3;
+    def->substeps = 2;
+}
+
+static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_load *ld)
+{
+    const char *bad = NULL;
+    if (!(isfinite(d->gauge) && d->gauge > 0))
+        bad = "gauge must be > 0 m";
+    else if (!(isfinite(d->modulus) && d->modulus > 0))
+        bad = "modulus must be > 0 Pa";
+    else if (!(isfinite(d->density) && d->density > 0))
+        bad = "density must be > 0 kg/m^3";
+    else if (d->layers < 1)
+        bad = "layers must be >= 1";
+    else if (!(isfinite(d->strain_around) && d->strain_around > -1 && d->strain_around < 10) ||
+             !(isfinite(d->strain_up) && d->strain_up > -1 && d->strain_up < 10))
+        bad = "strain_around and strain_up must be in (-1, 10)";
+    else if (!(isfinite(d->z_bottom) && d->z_bottom >= 0 && isfinite(d->top_margin) &&
+               d->top_margin >= 0 &&
+               d->z_bottom + d->top_margin < ld->info.load_height - 1e-3))
+        bad = "z_bottom and top_margin must be >= 0 m and leave room on the load";
+    else if (!(isfinite(d->node_pitch) && d->node_pitch > 0 &&
+               d->node_pitch < 0.25 * ld->info.load_height))
+        bad = "node_pitch must be > 0 m and under a quarter of the load's height";
+    else if (!(isfinite(d->node_mass) && d->node_mass >= 0))
+        bad = "node_mass must be >= 0 kg";
+    else if (d->substeps < 1)
+        bad = "substeps must be >= 1";
+    if (bad)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "wrap: %s", bad);
+    if (ld->info.film.bits)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "wrap: the load is wrapped already");
+    return WS_OK;
+}
+
+static ws_status film_law(ws_world *w, double ea, const char *name, ws_law_id *out)
+{
+    ws_law_def l;
+    ws_law_def_init(&l);
+    l.type = WS_LAW_TENSION_COMPRESSION;
+    l.stiffness = ea;
+    l.compression_stiffness = 0.01 * ea; /* film buckles */
+    l.damping = 1e-5 * ea; /* a trace of internal damping: its period's worth at 10 us */
+    l.name = name;
+    return ws_law_create(w, &l, out);
+}
+
+ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws_web_id *out)
+{
+    ws_status s = check_world(w, ld, "ws_load_wrap_band");
+    if (s != WS_OK)
+        return s;
+    NEED_OUT(w, out, "ws_load_wrap_band");
+    ws_wrap_def d;
+    ws_wrap_def_init(&d);
+    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "wrap")) != WS_OK ||
+        (s = check_wrap(w, &d, ld)) != WS_OK)
+        return s;
+    size_t n = (size_t)ld->info.cartons + 1;
+    ws_body_id *bodies = ws_mem_calloc(&ld->mem, n, sizeof *bodies);
+    if (!bodies)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "wrap: out of memory");
+    bodies[0] = ld->info.pallet;
+    for (size_t c = 1; c < n; c++)
+        bodies[c] = ld->carton[c - 1].body;
+    /* Rows at global heights over the platform's top under the pallet. */
+    ws_vec3 top;
+    double zp = 0;
+    if ((s = ws_body_get_position(w, ld->info.pallet, &top)) == WS_OK)
+        zp = top.z - 0.5 * ld->pallet_size.z - 2 * ld->contact_layer;
+    double z0 = zp + d.z_bottom, z1 = zp + ld->info.load_height - d.top_margin;
+    double perimeter = 2 * (ld->pallet_size.x + ld->pallet_size.y);
+    int n_around = (int)ceil(perimeter / d.node_pitch);
+    int n_up = (int)ceil((z1 - z0) / d.node_pitch) + 1;
+    double strip_up = (z1 - z0) / (n_up - 1), strip_around = perimeter / n_around;
+    double eh = d.modulus * d.gauge * d.layers;
+    ws_law_id around, up;
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = d.node_mass;
+    wd.areal_density = d.density * d.gauge * d.layers;
+    wd.contact_layer = ld->contact_layer;
+    wd.material = ld->info.film_material;
+    wd.substeps = d.substeps;
+    wd.name = "film";
+    ws_band_def bd;
+    ws_band_def_init(&bd);
+    bd.bodies = bodies;
+    bd.body_count = n;
+    bd.z_bottom = z0;
+    bd.z_top = z1;
+    bd.n_around = n_around;
+    bd.n_up = n_up;
+    bd.prestretch_around = d.strain_around;
+    bd.prestretch_up = d.strain_up;
+    if (s == WS_OK && (s = film_law(w, eh * strip_up, "film around", &around)) == WS_OK &&
+        (s = film_law(w, eh * strip_around, "film up", &up)) == WS_OK) {
+        wd.law = around;
+        wd.law_cross = up;
+        s = ws_web_create_band(w, &wd, &bd, &ld->info.film);
+    }
+    ws_mem_free(&ld->mem, bodies, n * sizeof *bodies);
+    if (s == WS_OK)
+        *out = ld->info.film;
+    return s;
 }

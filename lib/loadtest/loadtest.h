@@ -46,6 +46,7 @@ struct ws_load {
     int points[WS_IF_KINDS];
     double friction[WS_IF_KINDS];
     double carton_mass;
+    double contact_layer;
     ws_vec3 carton_shape; /* the carton's size in its own frame */
 };
 
