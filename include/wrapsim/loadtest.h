@@ -434,7 +434,10 @@ typedef struct ws_kvalue_def {
     double k_low;      /**< lowest k tried, g (> 0); default 0.05 */
     double k_high;     /**< highest k tried, g (> k_low); default 1.0 */
     double tolerance;  /**< the search stops when the bracket is narrower, g (> 0); default 0.01 */
-    double settle_time;  /**< s the fresh load settles before each run (> 0); default 1.0 */
+    double settle_time;  /**< s the fresh load settles before the runs (> 0); default 1.0 */
+    /** A wrap to put on the load after it settled (it then settles settle_time again before the
+     *  state is saved); NULL (default) for the load unwrapped. Read during the call only. */
+    const ws_wrap_def *wrap;
 } ws_kvalue_def;
 
 /** What the k-value search found. */
@@ -450,7 +453,8 @@ typedef struct ws_kvalue_result {
 WS_API void ws_kvalue_def_init(ws_kvalue_def *def);
 /** Find the load's k-value: the largest k at which it passes EUMOS 40509, by bisection between
  *  k_low and k_high. Every run starts from the same settled load: a world is created from
- *  `world_def`, the load built from `load_def` and settled for settle_time, and its state saved
+ *  `world_def`, the load built from `load_def` and settled for settle_time (then wrapped and
+ *  settled again when def->wrap is given), and its state saved
  *  (ws_world_save()); each run restores it (ws_world_restore()) and runs EUMOS at its k with the
  *  rest of `eumos_def`, so each starts from the same state to the bit.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, and any error of a run (its

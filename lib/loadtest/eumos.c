@@ -521,8 +521,9 @@ typedef struct kworld {
 } kworld;
 
 static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_def *ldef,
-                             double settle)
+                             const ws_kvalue_def *kd)
 {
+    double settle = kd->settle_time;
     memset(kw, 0, sizeof *kw);
     ws_status s = ws_world_create(wd, &kw->w);
     if (s != WS_OK)
@@ -530,8 +531,13 @@ static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_d
     double dt;
     if ((s = ws_load_build(kw->w, ldef, &kw->ld)) != WS_OK ||
         (s = ws_world_get_dt(kw->w, &dt)) != WS_OK ||
-        (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK ||
-        (s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
+        (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK)
+        return s;
+    ws_web_id film;
+    if (kd->wrap && ((s = ws_load_wrap_band(kw->w, kw->ld, kd->wrap, &film)) != WS_OK ||
+                     (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
+        return s;
+    if ((s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
         return s;
     kw->state = ws_mem_alloc(&kw->ld->mem, kw->len);
     if (!kw->state)
@@ -619,7 +625,7 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
         return WS_ERR_INVALID_ARGUMENT;
     }
     kworld kw;
-    ws_status s = kworld_make(&kw, world_def, load_def, kd.settle_time);
+    ws_status s = kworld_make(&kw, world_def, load_def, &kd);
     if (s == WS_OK)
         s = search(&kw, eumos_def, &kd, result);
     if (s != WS_OK)
