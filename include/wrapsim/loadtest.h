@@ -242,7 +242,7 @@ typedef struct ws_wrap_def {
                                default 0.03 */
     double node_pitch;    /**< node spacing on the load, m (> 0); default 0.05 */
     /** kg per node (>= 0); 0 = the film's real mass (density x gauge x layers x area), which
-     *  needs many sub-steps. Default 2e-3: 3.5 kg for the reference load's film, stable at
+     *  needs many sub-steps. Default 2e-3: 3.7 kg for the reference load's film, stable at
      *  dt 0.25 ms with 2 sub-steps; its inertia is still small beside the load's. */
     double node_mass;
     int substeps;         /**< film sub-steps per world step (>= 1); default 2 */
