@@ -403,6 +403,11 @@ typedef struct ws_eumos_result {
     int events_dropped;   /**< events beyond WS_LOADTEST_MAX_EVENTS */
     ws_loadtest_event events[WS_LOADTEST_MAX_EVENTS]; /**< in time order */
     ws_eumos_verdict verdict; /**< the verdict */
+    /** Wrapped loads (ws_load_wrap_band()): the film's containment at the start of the run in
+     *  three equal height bands, bottom, middle, top (ws_web_get_containment(): hoop tension,
+     *  N, line load, N/m, and the bodies' normal force on it, N); zero when unwrapped. */
+    ws_containment_band containment[3];
+    double film_peak_strain; /**< largest spring strain of the film during the run (0: none) */
 } ws_eumos_result;
 
 /** Fill a EUMOS Def with the defaults above. NULL is ignored. */

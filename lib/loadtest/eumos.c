@@ -140,6 +140,8 @@ typedef struct run_state {
     double layer_disp[WS_LOAD_MAX_LAYERS];
     ws_loadtest_interface_state ifs[WS_LOAD_MAX_LAYERS + 1];
     double ifs_use[WS_LOAD_MAX_LAYERS + 1];
+    double *strain; /* the film's spring strains (wrapped loads) */
+    size_t springs;
 } run_state;
 
 static void add_event(ws_eumos_result *r, int type, int layer, int index, double t, double level,
@@ -281,6 +283,14 @@ static ws_status sample(ws_world *w, run_state *rs, double t, double a, double v
     ws_status s = ws_load_measure(w, ld, rs->cs, (size_t)ld->info.cartons, &n);
     if (s != WS_OK || (s = read_contacts(w, rs)) != WS_OK)
         return s;
+    if (rs->strain) {
+        size_t ns;
+        if ((s = ws_web_copy_spring_strains(w, ld->info.film, rs->strain, rs->springs, &ns)) !=
+            WS_OK)
+            return s;
+        for (size_t i = 0; i < ns; i++)
+            r->film_peak_strain = fmax(r->film_peak_strain, rs->strain[i]);
+    }
     double level = a / rs->d.g;
     if (fabs(level) > r->peak_level)
         r->peak_level = fabs(level);
@@ -389,6 +399,7 @@ static void run_free(run_state *rs)
     ws_mem_free(&ld->mem, rs->ref_bins, nb * sizeof *rs->ref_bins);
     ws_mem_free(&ld->mem, rs->tipped, nb);
     ws_mem_free(&ld->mem, rs->lost, nb);
+    ws_mem_free(&ld->mem, rs->strain, rs->springs * sizeof *rs->strain);
 }
 
 static ws_status run_alloc(ws_world *w, run_state *rs)
@@ -400,7 +411,13 @@ static ws_status run_alloc(ws_world *w, run_state *rs)
     rs->ref_bins = ws_mem_calloc(&ld->mem, nb, sizeof *rs->ref_bins);
     rs->tipped = ws_mem_calloc(&ld->mem, nb, 1);
     rs->lost = ws_mem_calloc(&ld->mem, nb, 1);
-    if (!rs->cs || !rs->bins || !rs->ref_bins || !rs->tipped || !rs->lost) {
+    ws_web_info wi;
+    if (ld->info.film.bits && ws_web_get_info(w, ld->info.film, &wi) == WS_OK) {
+        rs->springs = wi.spring_count;
+        rs->strain = ws_mem_calloc(&ld->mem, rs->springs, sizeof *rs->strain);
+    }
+    if (!rs->cs || !rs->bins || !rs->ref_bins || !rs->tipped || !rs->lost ||
+        (rs->springs && !rs->strain)) {
         run_free(rs);
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "EUMOS run: out of memory for %zu bodies", nb);
     }
@@ -495,6 +512,11 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
                                                dd.gentle_acceleration;
     if ((s = run_alloc(w, &rs)) != WS_OK)
         return s;
+    if (ld->info.film.bits &&
+        (s = ws_web_get_containment(w, ld->info.film, result->containment, 3)) != WS_OK) {
+        run_free(&rs);
+        return s;
+    }
     if ((s = ws_body_set_drive(w, ld->info.platform, &dd)) == WS_OK) {
         s = run_steps(w, &rs, &sl, dt);
         /* The platform stays where it stopped. */
