@@ -209,6 +209,52 @@ START_TEST(allocation_failures_leave_nothing_behind)
 }
 END_TEST
 
+/* On a platform of the user's: a kinematic slab whose top is at z = 0.5 m, turned 90 degrees
+ * about the vertical; the load is built in its frame (the pallet's length along the slab's x,
+ * which is the global y) and stands on it. */
+START_TEST(a_load_builds_on_a_given_platform)
+{
+    ws_world *w = load_world();
+    ws_shape_id slab;
+    ck_ok(w, ws_shape_create_box(w, 3, 2, 0.1, &slab));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = slab;
+    bd.position = (ws_vec3){1, 2, 0.45};
+    bd.orientation = (ws_quat){sqrt(0.5), 0, 0, sqrt(0.5)};
+    ws_body_id platform;
+    ck_ok(w, ws_body_create(w, &bd, &platform));
+    ws_load_def d;
+    ws_load_def_init(&d);
+    d.layers = 1;
+    d.platform = platform;
+    d.origin = (ws_vec3){1, 2, 0.5};
+    ws_load *ld;
+    ck_ok(w, ws_load_build(w, &d, &ld));
+    ws_load_info in;
+    ck_assert_int_eq(ws_load_get_info(ld, &in), WS_OK);
+    ck_assert_uint_eq(in.platform.bits, platform.bits);
+    ws_vec3 p;
+    ck_ok(w, ws_body_get_position(w, in.pallet, &p));
+    ck_assert_double_eq_tol(p.z, 0.5 + 0.002 + 0.072, 1e-12);
+    ws_load_carton c;
+    ck_assert_int_eq(ws_load_get_carton(ld, 0, 0, &c), WS_OK); /* ix = 0: platform x = -0.45 */
+    ck_ok(w, ws_body_get_position(w, c.body, &p));
+    ck_assert_double_eq_tol(p.x, 1 + 0.2, 1e-12);  /* platform y = -0.2 lies along global -x */
+    ck_assert_double_eq_tol(p.y, 2 - 0.45, 1e-12); /* platform x lies along global y */
+    /* It stands: 0.3 s later nothing has moved more than 0.1 mm relative to the pallet. */
+    ck_ok(w, ws_world_step_n(w, 1200));
+    ws_load_carton_state st[8];
+    size_t n;
+    ck_ok(w, ws_load_measure(w, ld, st, 8, &n));
+    for (size_t i = 0; i < n; i++)
+        ck_assert(st[i].horizontal < 1e-4);
+    ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(interlocked_patterns_bridge_and_turn)
 {
     ws_world *w = load_world();
@@ -696,6 +742,7 @@ int main(void)
     add_case(s, "bad_defs", bad_defs_are_refused_with_a_reason, 30);
     add_case(s, "reference_load", the_reference_load_has_33_bodies_by_layer_and_place, 30);
     add_case(s, "allocation", allocation_failures_leave_nothing_behind, 60);
+    add_case(s, "given_platform", a_load_builds_on_a_given_platform, 60);
     add_case(s, "interlocked", interlocked_patterns_bridge_and_turn, 30);
     add_case(s, "settles", the_pallet_load_settles_and_stands_still, 300);
     add_case(s, "pulse", the_eumos_pulse_is_what_the_standard_asks, 30);
