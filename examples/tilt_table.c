@@ -10,27 +10,45 @@
  *   --wrapped: a band of stretch film around both boxes (96 x 61 nodes, pre-stretch 40 %
  *   around and 20 % up, springs of 2000 N/m, film-box contact 4000 N/m, mu 0.9). The film holds
  *   the top box; in R the stack then tips as one over the stop when its centre of mass passes
- *   the stop's edge: tan(theta) = (a/2) / (a - 0.02), theta = 28.52 deg, t = 5.978 s.
+ *   the stop's edge: tan(theta) = (a/2) / (a - 0.02), theta = 28.52 deg, t = 5.978 s, without
+ *   the layers; 28.61 deg with them (docs/theory.md 4.1); about 29.5-29.7 deg with Coulomb
+ *   friction at the base. The example reports the angle where the load's CoG (boxes and film)
+ *   passes over the stop's top edge, found in 10 ms samples and interpolated.
+ *
+ * Definitions it reports by (the same in examples/python/tilt_table.py):
+ *   slide onset: every contact of a box with its support slips (|v_t| >= v_lim = 10 mm/s, or the
+ *   stick anchor slides), the same way, without a break for 0.2 s; the onset is where that run
+ *   began. A box turning on its support slips at every corner but not the same way.
+ *   The run stops early when a box leaves the platform (its CoG below the platform's surface):
+ *   the world has no floor, and a falling box says nothing more about the load.
  *
  * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
- * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] [--no-ccd]
+ * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--no-ccd]
+ *                      [--vtk DIR [--vtk-every S] [--vtk-stride N] [--vtk-springs] [--vtk-ascii]]
  *                      [--paper-integrator] [--duration S] [--quiet]
  *                      [--wrapped [--film-mass KG] [--substeps N]]
+ *         ./tilt_table --help
+ *         Exit status 0 when the run ends, 1 when it fails (the library or a file), 2 on a bad
+ *         option.
  *
  * Copy this file as the start of your own load: build the scene in tilt_build(), read results
  * in tilt_run(). Compile with -DTILT_TABLE_NO_MAIN to use the two functions from another file.
  */
 #define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include <wrapsim/wrapsim.h>
 
 #define TILT_PI 3.14159265358979323846
 #define DEG(x) ((x) * 180.0 / TILT_PI)
+#define TILT_SLIDE_HOLD 0.2 /* s: gross slip must last this long to count as a slide */
 
 typedef struct tilt_options {
     char variant;         /* 'P' or 'R' */
@@ -40,6 +58,10 @@ typedef struct tilt_options {
     double duration;      /* s; 0 = 6 s for P, 7 s for R */
     const char *csv;      /* time series file, or NULL */
     const char *vtk_dir;  /* directory for VTK frames, or NULL */
+    double vtk_every;     /* s between VTK frames (the series' time stride); default 0.1 s */
+    int vtk_stride;       /* offer a frame every vtk_stride-th step (frame stride); default 1 */
+    int vtk_springs;      /* 1: add the film's springs as their own block */
+    int vtk_ascii;        /* 1: ASCII files instead of compressed binary */
     int quiet;            /* no progress, no summary */
     int wrapped;          /* 1: stretch film around the stack */
     double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
@@ -59,15 +81,24 @@ typedef struct tilt_result {
     char error[512];
     long steps;
     double wall_seconds;
-    double slide_time[2], slide_angle[2]; /* s, deg: onset of gross slip that lasted 0.2 s;
-                                              NaN when it never slid */
+    double slide_time[2], slide_angle[2]; /* s, deg: onset of gross slip that lasted 0.2 s
+                                              (TILT_SLIDE_HOLD); NaN when it never slid */
     int slide_confirmed[2];
     double tip_time[2], tip_angle[2];     /* first time a box leans > 2 deg on its support */
     double lift_time, lift_angle;         /* the bottom box's uphill edge lifts off the
                                              platform: the stack starts to tip (NaN: never) */
     double final_slip[2];                 /* m along the platform, downhill positive */
     double off_time[2];                   /* when its CoG went below the platform's surface:
-                                             it left the platform (NaN: never) */
+                                             it left the platform and the run stopped (NaN:
+                                             never) */
+    double over_time, over_angle;         /* wrapped R: the load's CoG (boxes and film) passes
+                                             over the stop's top edge: the physical tip (NaN:
+                                             never) */
+    double over_theory;                   /* deg: where a rigid load would tip, from its CoG
+                                             and the stop edge when the uphill edge lifts
+                                             (layers included); NaN when not wrapped R */
+    double end_time;                      /* s, the run's last time (earlier than the duration
+                                             when a box left the platform) */
     double cog_distance_start, cog_distance_end; /* m */
     double final_angle;                   /* plane angle at the end, deg */
     double max_relative_slip;             /* m, largest move of the top box on the bottom one */
@@ -80,6 +111,8 @@ static void tilt_default_options(tilt_options *o)
     memset(o, 0, sizeof *o);
     o->variant = 'R';
     o->use_ccd = 1;
+    o->vtk_every = 0.1; /* 0.57 deg of tilt a frame: 71 frames of a 7 s run */
+    o->vtk_stride = 1;
 }
 
 /* The film of the reference case: a band from 30 mm above the plane to 20 mm below the top,
@@ -295,44 +328,81 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 /* Gross slip of body b on its support: every contact between them slips (tangential speed at
  * or above v_lim under the regularised law, anchor sliding under the stick law), and they slip
  * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
- * support, as when the platform starts to tilt, slips at every corner but is not sliding. */
-static int slides_on(ws_body_id b, ws_body_id support, const ws_contact_info *buf, size_t n)
+ * support, as when the platform starts to tilt, slips at every corner but is not sliding. The
+ * pair's report gives every slip velocity as b's on its support, whichever owns the face. */
+static int slides_on(ws_world *w, ws_body_id b, ws_body_id support)
 {
-    int count = 0, slipping = 0;
+    ws_contact_info buf[64];
+    size_t n = 0;
+    ws_world_copy_contacts_between(w, support, b, buf, 64, &n); /* 64 are plenty here */
+    if (n > 64)
+        n = 64;
+    size_t slipping = 0;
     double sx = 0, sy = 0, sz = 0, size = 0;
     for (size_t k = 0; k < n; k++) {
-        const ws_contact_info *c = &buf[k];
-        if ((c->body_a.bits == support.bits && c->body_b.bits == b.bits) ||
-            (c->body_a.bits == b.bits && c->body_b.bits == support.bits)) {
-            const ws_vec3 *v = &c->slip_velocity;
-            double sg = c->body_b.bits == b.bits ? 1.0 : -1.0; /* b's slip on its support */
-            sx += sg * v->x;
-            sy += sg * v->y;
-            sz += sg * v->z;
-            size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
-            count++;
-            slipping += c->slipping != 0;
-        }
+        const ws_vec3 *v = &buf[k].slip_velocity;
+        sx += v->x;
+        sy += v->y;
+        sz += v->z;
+        size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
+        slipping += buf[k].slipping != 0;
     }
-    return count > 0 && slipping == count && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;
+    return n > 0 && slipping == n && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;
 }
 
 /* 1 when body b touches the platform only on the downhill half of its bottom (x in the
  * platform's frame greater than its CoG's) or not at all: its uphill edge has lifted. */
-static int uphill_lifted(ws_world *w, ws_body_id plane, ws_body_id b, const ws_contact_info *buf,
-                         size_t n)
+static int uphill_lifted(ws_world *w, ws_body_id plane, ws_body_id b)
 {
+    ws_contact_info buf[64];
+    size_t n = 0;
+    ws_world_copy_contacts_between(w, plane, b, buf, 64, &n);
+    if (n > 64)
+        n = 64;
     ws_vec3 r;
     ws_body_get_position(w, b, &r);
     double xc = in_plane_frame(w, plane, r).x;
-    for (size_t k = 0; k < n; k++) {
-        const ws_contact_info *c = &buf[k];
-        int pair = (c->body_a.bits == plane.bits && c->body_b.bits == b.bits) ||
-                   (c->body_a.bits == b.bits && c->body_b.bits == plane.bits);
-        if (pair && in_plane_frame(w, plane, c->point).x < xc)
+    for (size_t k = 0; k < n; k++)
+        if (in_plane_frame(w, plane, buf[k].point).x < xc)
             return 0;
-    }
     return 1;
+}
+
+/* The load's centre of mass: the boxes and, when wrapped, the film's nodes (xyz: room for them). */
+static ws_vec3 load_cog(ws_world *w, const tilt_scene *sc, double *xyz, size_t nodes,
+                        double node_mass)
+{
+    double m = 0, x = 0, y = 0, z = 0;
+    for (int k = 0; k < 2; k++) {
+        ws_vec3 r;
+        double mk;
+        ws_body_get_position(w, sc->box[k], &r);
+        ws_body_get_mass(w, sc->box[k], &mk);
+        x += mk * r.x, y += mk * r.y, z += mk * r.z, m += mk;
+    }
+    if (nodes && ws_web_copy_positions(w, sc->film, xyz, nodes, &nodes) == WS_OK) {
+        for (size_t q = 0; q < nodes; q++) {
+            x += node_mass * xyz[3 * q];
+            y += node_mass * xyz[3 * q + 1];
+            z += node_mass * xyz[3 * q + 2];
+        }
+        m += node_mass * (double)nodes;
+    }
+    return (ws_vec3){x / m, y / m, z / m};
+}
+
+/* How far the load's CoG is past the stop's top uphill edge, horizontally and downhill (m): it
+ * passes over the edge, and gravity tips a rigid load, when this turns positive. */
+static double past_stop_edge(ws_world *w, const tilt_scene *sc, ws_vec3 cog)
+{
+    const ws_vec3 edge_local = {-0.01, 0, 0.01}; /* in the 20 x 20 mm bar's frame */
+    ws_vec3 e;
+    ws_mat3 A;
+    ws_body_get_world_point(w, sc->stop, &edge_local, &e);
+    ws_body_get_rotation(w, sc->plane, &A);
+    /* Downhill along the level: the platform's x axis with its vertical part removed. */
+    double hx = A.m[0], hy = A.m[3], hn = sqrt(hx * hx + hy * hy);
+    return ((cog.x - e.x) * hx + (cog.y - e.y) * hy) / hn;
 }
 
 /* CoG of body b in the frame of body a. */
@@ -366,7 +436,37 @@ static double now(void)
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-/* Run the case and fill the result. Returns the last status (WS_OK when it ran to the end). */
+/* mkdir -p: create the directory and its missing parents. Returns 0, or -1 with errno. */
+static int make_dirs(const char *path)
+{
+    char buf[4096];
+    size_t n = strlen(path);
+    if (n == 0 || n >= sizeof buf) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    memcpy(buf, path, n + 1);
+    for (size_t k = 1; k <= n; k++) {
+        if (buf[k] != '/' && buf[k] != '\0')
+            continue;
+        char c = buf[k];
+        buf[k] = '\0';
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+            return -1;
+        buf[k] = c;
+    }
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return -1;
+    if (!S_ISDIR(st.st_mode)) {
+        errno = ENOTDIR;
+        return -1;
+    }
+    return 0;
+}
+
+/* Run the case and fill the result. Returns the last status (WS_OK when it ran to the end or
+ * stopped because a box left the platform). */
 static ws_status tilt_run(const tilt_options *o, tilt_result *res)
 {
     memset(res, 0, sizeof *res);
@@ -374,6 +474,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         res->slide_time[k] = res->slide_angle[k] = res->tip_time[k] = res->tip_angle[k] =
             res->off_time[k] = NAN;
     res->lift_time = res->lift_angle = NAN;
+    res->over_time = res->over_angle = res->over_theory = NAN;
     tilt_scene sc;
     ws_status s = tilt_build(o, &sc);
     if (s != WS_OK) {
@@ -384,17 +485,33 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     FILE *csv = NULL;
     ws_vtk_series *vtk = NULL;
     if (o->csv && !(csv = fopen(o->csv, "w"))) {
-        snprintf(res->error, sizeof res->error, "cannot write %s", o->csv);
+        snprintf(res->error, sizeof res->error, "cannot write %s: %s", o->csv, strerror(errno));
         ws_world_destroy(w);
         return res->status = WS_ERR_IO;
     }
     if (csv)
-        fprintf(csv, "t,plane_angle_deg,"
-                     "bottom_x,bottom_y,bottom_z,bottom_vx,bottom_vy,bottom_vz,bottom_tilt_deg,"
-                     "bottom_slip,top_x,top_y,top_z,top_vx,top_vy,top_vz,top_tilt_deg,top_slip,"
-                     "cog_distance\n");
-    if (o->vtk_dir && (s = ws_vtk_series_create(w, o->vtk_dir, "tilt_table", &vtk)) != WS_OK) {
+        /* Each column's unit at the end of its name: s, deg, m, m/s (m_s). */
+        fprintf(csv, "t_s,plane_angle_deg,"
+                     "bottom_x_m,bottom_y_m,bottom_z_m,bottom_vx_m_s,bottom_vy_m_s,bottom_vz_m_s,"
+                     "bottom_tilt_deg,bottom_slip_m,"
+                     "top_x_m,top_y_m,top_z_m,top_vx_m_s,top_vy_m_s,top_vz_m_s,top_tilt_deg,"
+                     "top_slip_m,cog_distance_m\n");
+    ws_vtk_series_def vd;
+    ws_vtk_series_def_init(&vd);
+    vd.directory = o->vtk_dir;
+    vd.basename = "tilt_table";
+    vd.time_stride = o->vtk_every;
+    vd.frame_stride = o->vtk_stride;
+    vd.springs = o->vtk_springs;
+    vd.format = o->vtk_ascii ? WS_VTK_ASCII : WS_VTK_COMPRESSED;
+    if (o->vtk_dir && make_dirs(o->vtk_dir) != 0) {
+        snprintf(res->error, sizeof res->error, "cannot create the directory %s: %s",
+                 o->vtk_dir, strerror(errno));
+        s = WS_ERR_IO;
+    } else if (o->vtk_dir && (s = ws_vtk_series_create_def(w, &vd, &vtk)) != WS_OK) {
         snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
+    }
+    if (s != WS_OK) {
         if (csv)
             fclose(csv);
         ws_world_destroy(w);
@@ -402,7 +519,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     }
 
     long steps = lround(sc.duration / sc.dt);
-    long csv_every = lround(0.01 / sc.dt), vtk_every = lround(0.05 / sc.dt);
+    long csv_every = lround(0.01 / sc.dt);
     ws_vec3 start[2];
     for (int k = 0; k < 2; k++) {
         ws_vec3 r;
@@ -411,38 +528,43 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     }
     res->cog_distance_start = distance(w, sc.box[0], sc.box[1]);
     ws_vec3 top_on_bottom0 = box_local(w, sc.box[0], sc.box[1]);
-    size_t nspr = 0;
-    double *tension = NULL, *strain = NULL;
+    size_t nspr = 0, nodes = 0;
+    double *tension = NULL, *strain = NULL, *xyz = NULL, node_mass = 0;
     if (sc.film.bits) {
+        ws_web_info wi;
+        ws_web_get_info(w, sc.film, &wi);
+        nodes = wi.node_count;
+        node_mass = wi.mass / (double)nodes; /* the band's nodes are all alike */
         ws_web_copy_springs(w, sc.film, NULL, 0, &nspr);
         tension = malloc(nspr * sizeof *tension);
         strain = malloc(nspr * sizeof *strain);
-        if (!tension || !strain) {
+        xyz = malloc(3 * nodes * sizeof *xyz);
+        if (!tension || !strain || !xyz) {
             free(tension);
             free(strain);
+            free(xyz);
             ws_world_destroy(w);
             snprintf(res->error, sizeof res->error, "out of memory");
             return res->status = WS_ERR_OUT_OF_MEMORY;
         }
     }
+    /* The physical tip is watched in the wrapped R case, where the stack pivots on the stop. */
+    int watch_tip = sc.film.bits && sc.stop.bits;
+    double past_prev = NAN, theta_prev = 0, t_prev = 0, rigid_now = NAN, rigid_at_lift = NAN;
     double t0 = now(), next_report = t0 + 1.0;
     ws_body_id support[2] = {sc.plane, sc.box[0]};
-    ws_contact_info contacts[256];
     long slipping_steps[2] = {0, 0};
     /* Gross slip must last 0.2 s: the stack rocking as the platform starts to turn slips its
      * bottom face for a while (longer when wrapped, the film adding inertia); a slide goes on. */
-    const long sustained = lround(0.2 / sc.dt);
+    const long sustained = lround(TILT_SLIDE_HOLD / sc.dt);
     long lifted_steps = 0;
     int lift_confirmed = 0;
     for (long n = 0; n <= steps; n++) {
         double t, theta = plane_angle(w, sc.plane);
         ws_world_get_time(w, &t);
         double slip[2], tilt[2];
-        size_t nc = 0;
-        ws_world_copy_contacts(w, contacts, 256, &nc); /* the first 256 are plenty here */
-        if (nc > 256)
-            nc = 256;
         ws_vec3 r[2], v[2];
+        int off = 0;
         for (int k = 0; k < 2; k++) {
             ws_body_get_position(w, sc.box[k], &r[k]);
             ws_body_get_velocity(w, sc.box[k], &v[k]);
@@ -450,12 +572,13 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
             slip[k] = local.x - start[k].x;
             if (isnan(res->off_time[k]) && local.z < 0.0)
                 res->off_time[k] = t;
+            off |= !isnan(res->off_time[k]);
             tilt[k] = relative_tilt(w, sc.box[k], support[k]);
             /* Sliding: every contact with its support slips the same way, for 0.2 s in a row. */
             /* Slides are of a standing stack: not once it has tipped or the box left. */
             int standing = !lift_confirmed && isnan(res->off_time[k]);
             slipping_steps[k] =
-                standing && slides_on(sc.box[k], support[k], contacts, nc) ? slipping_steps[k] + 1 : 0;
+                standing && slides_on(w, sc.box[k], support[k]) ? slipping_steps[k] + 1 : 0;
             if (isnan(res->slide_time[k]) && t > 1.0 && slipping_steps[k] == 1)
                 res->slide_time[k] = t, res->slide_angle[k] = DEG(theta); /* candidate onset */
             if (isnan(res->slide_angle[k]) == 0 && slipping_steps[k] == 0 &&
@@ -470,12 +593,15 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         }
         /* Tipping: the uphill edge stays off for 50 ms (a knock lifts it for less). */
         if (!lift_confirmed) {
-            if (t > 1.0 && uphill_lifted(w, sc.plane, sc.box[0], contacts, nc)) {
+            if (t > 1.0 && uphill_lifted(w, sc.plane, sc.box[0])) {
                 if (lifted_steps++ == 0) {
                     res->lift_time = t;
                     res->lift_angle = DEG(theta);
+                    rigid_at_lift = rigid_now;
                 }
                 lift_confirmed = lifted_steps >= lround(0.05 / sc.dt);
+                if (lift_confirmed && watch_tip)
+                    res->over_theory = rigid_at_lift;
             } else {
                 lifted_steps = 0;
                 res->lift_time = res->lift_angle = NAN;
@@ -495,18 +621,42 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                 res->peak_strain = fmax(res->peak_strain, strain[q]);
             }
         }
+        /* The physical tip, in 10 ms samples: the load's CoG crosses the vertical through the
+         * stop's edge; the angle is interpolated between the two samples around the crossing.
+         * rigid_now is where a rigid load would tip with the geometry of this sample (CoG and
+         * stop edge in the platform's frame); it is kept from the last sample before the
+         * uphill edge lifted, when the stack rests against the stop, layers and film included
+         * (at rest on the flat platform the film holds the stack a few mm off the stop). */
+        if (watch_tip && n % csv_every == 0) {
+            ws_vec3 cog = load_cog(w, &sc, xyz, nodes, node_mass);
+            double past = past_stop_edge(w, &sc, cog);
+            const ws_vec3 edge_local = {-0.01, 0, 0.01};
+            ws_vec3 e;
+            ws_body_get_world_point(w, sc.stop, &edge_local, &e);
+            ws_vec3 ce = in_plane_frame(w, sc.plane, cog), ee = in_plane_frame(w, sc.plane, e);
+            rigid_now = DEG(atan((ee.x - ce.x) / (ce.z - ee.z)));
+            if (isnan(res->over_time) && past >= 0.0 && !isnan(past_prev) && past_prev < 0.0) {
+                double f = -past_prev / (past - past_prev);
+                res->over_time = t_prev + f * (t - t_prev);
+                res->over_angle = DEG(theta_prev + f * (theta - theta_prev));
+            }
+            past_prev = past, theta_prev = theta, t_prev = t;
+        }
         if (csv && n % csv_every == 0)
             fprintf(csv, "%.4f,%.5f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,"
                          "%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.6f,%.6f\n",
                     t, DEG(theta), r[0].x, r[0].y, r[0].z, v[0].x, v[0].y, v[0].z, DEG(tilt[0]),
                     slip[0], r[1].x, r[1].y, r[1].z, v[1].x, v[1].y, v[1].z, DEG(tilt[1]),
                     slip[1], distance(w, sc.box[0], sc.box[1]));
-        if (vtk && n % vtk_every == 0 && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
+        /* Offered every step: the series' strides choose the frames. */
+        if (vtk && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
             break;
-        if (n == steps) {
+        /* The end, or a box left the platform: the world has no floor, so it would only fall. */
+        if (n == steps || off) {
             res->final_slip[0] = slip[0];
             res->final_slip[1] = slip[1];
             res->final_angle = DEG(theta);
+            res->end_time = t;
             break;
         }
         if ((s = ws_world_step(w)) != WS_OK)
@@ -517,9 +667,13 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
             next_report = now() + 0.5;
         }
     }
+    /* A gross slip still short of 0.2 s when the run ended is not a slide. */
+    for (int k = 0; k < 2; k++)
+        if (!res->slide_confirmed[k])
+            res->slide_time[k] = res->slide_angle[k] = NAN;
     res->wall_seconds = now() - t0;
     if (!o->quiet && res->wall_seconds > 1.0)
-        fprintf(stderr, "\r  t = %.2f s of %.2f s: done\n", sc.duration, sc.duration);
+        fprintf(stderr, "\r  t = %.2f s of %.2f s: done\n", res->end_time, sc.duration);
     res->cog_distance_end = distance(w, sc.box[0], sc.box[1]);
     ws_world_get_state_hash(w, &res->hash);
     if (s != WS_OK)
@@ -527,6 +681,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     res->status = s;
     free(tension);
     free(strain);
+    free(xyz);
     ws_vtk_series_destroy(vtk);
     if (csv)
         fclose(csv);
@@ -535,11 +690,41 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
 }
 
 #ifndef TILT_TABLE_NO_MAIN
-static void usage(void)
+static void usage(FILE *f)
 {
-    fprintf(stderr, "usage: tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] "
-                    "[--no-ccd] [--paper-integrator] [--duration S] [--quiet]\n"
-                    "                  [--wrapped [--film-mass KG] [--substeps N]]\n");
+    fprintf(f,
+            "usage: tilt_table [options]\n"
+            "  --variant P|R      P: the paper's case (6 s); R: with the stop bar (7 s). Default R\n"
+            "  --stick            stick friction instead of the paper's regularised law\n"
+            "  --wrapped          a band of stretch film around the stack\n"
+            "  --film-mass KG     kg per film node (> 0; default 0.001)\n"
+            "  --substeps N       film sub-steps per step (1..1000; default 1)\n"
+            "  --duration S       simulated time, s (> 0; default 6 for P, 7 for R)\n"
+            "  --csv FILE         time series every 10 ms\n"
+            "  --vtk DIR          VTK frames for ParaView (DIR is created)\n"
+            "  --vtk-every S      s between frames (>= 0; default 0.1; 0: every --vtk-stride)\n"
+            "  --vtk-stride N     offer a frame every Nth step (>= 1; default 1)\n"
+            "  --vtk-springs      the film's springs as a block of their own\n"
+            "  --vtk-ascii        ASCII files instead of compressed binary\n"
+            "  --no-ccd           without the libccd gate\n"
+            "  --paper-integrator the paper's explicit scheme\n"
+            "  --quiet            no progress, no summary\n"
+            "  --help             this text\n"
+            "Exit status: 0 done, 1 the run failed (the library or a file), 2 a bad option.\n");
+}
+
+/* A number > 0 from the whole of `text`, or an error message and 0. */
+static int positive(const char *name, const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    double x = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(x) || x <= 0) {
+        fprintf(stderr, "tilt_table: %s must be a number > 0, got '%s'\n", name, text);
+        return 0;
+    }
+    *out = x;
+    return 1;
 }
 
 static void print_box(const char *name, const tilt_result *r, int k)
@@ -553,7 +738,8 @@ static void print_box(const char *name, const tilt_result *r, int k)
         printf("  %-6s box: leans > 2 deg on its support from %.2f deg (t = %.3f s)\n", name,
                r->tip_angle[k], r->tip_time[k]);
     if (!isnan(r->off_time[k]))
-        printf("  %-6s box: left the platform at t = %.3f s\n", name, r->off_time[k]);
+        printf("  %-6s box: left the platform at t = %.3f s (slip %.0f mm); the run stops there\n",
+               name, r->off_time[k], 1e3 * r->final_slip[k]);
     else
         printf("  %-6s box: slip along the platform at the end %.1f mm\n", name,
                1e3 * r->final_slip[k]);
@@ -563,45 +749,105 @@ int main(int argc, char **argv)
 {
     tilt_options o;
     tilt_default_options(&o);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "--variant") && i + 1 < argc) {
-            o.variant = (char)(argv[++i][0] & ~0x20); /* upper case */
-            if (o.variant != 'P' && o.variant != 'R')
-                return usage(), 2;
-        } else if (!strcmp(a, "--stick")) {
-            o.stick = 1;
-        } else if (!strcmp(a, "--no-ccd")) {
-            o.use_ccd = 0;
-        } else if (!strcmp(a, "--paper-integrator")) {
-            o.paper_integrator = 1;
-        } else if (!strcmp(a, "--csv") && i + 1 < argc) {
-            o.csv = argv[++i];
-        } else if (!strcmp(a, "--vtk") && i + 1 < argc) {
-            o.vtk_dir = argv[++i];
-        } else if (!strcmp(a, "--duration") && i + 1 < argc) {
-            o.duration = atof(argv[++i]);
-        } else if (!strcmp(a, "--quiet")) {
-            o.quiet = 1;
-        } else if (!strcmp(a, "--wrapped")) {
-            o.wrapped = 1;
-        } else if (!strcmp(a, "--film-mass") && i + 1 < argc) {
-            o.film_mass = atof(argv[++i]);
-        } else if (!strcmp(a, "--substeps") && i + 1 < argc) {
-            o.substeps = atoi(argv[++i]);
-        } else {
-            return usage(), 2;
+    enum { O_VARIANT = 1, O_STICK, O_NO_CCD, O_PAPER, O_CSV, O_VTK, O_DURATION, O_QUIET,
+           O_WRAPPED, O_FILM_MASS, O_SUBSTEPS, O_HELP, O_VTK_EVERY, O_VTK_STRIDE, O_VTK_SPRINGS,
+           O_VTK_ASCII };
+    static const struct option longopts[] = {
+        {"variant", required_argument, NULL, O_VARIANT},
+        {"stick", no_argument, NULL, O_STICK},
+        {"no-ccd", no_argument, NULL, O_NO_CCD},
+        {"paper-integrator", no_argument, NULL, O_PAPER},
+        {"csv", required_argument, NULL, O_CSV},
+        {"vtk", required_argument, NULL, O_VTK},
+        {"vtk-every", required_argument, NULL, O_VTK_EVERY},
+        {"vtk-stride", required_argument, NULL, O_VTK_STRIDE},
+        {"vtk-springs", no_argument, NULL, O_VTK_SPRINGS},
+        {"vtk-ascii", no_argument, NULL, O_VTK_ASCII},
+        {"duration", required_argument, NULL, O_DURATION},
+        {"quiet", no_argument, NULL, O_QUIET},
+        {"wrapped", no_argument, NULL, O_WRAPPED},
+        {"film-mass", required_argument, NULL, O_FILM_MASS},
+        {"substeps", required_argument, NULL, O_SUBSTEPS},
+        {"help", no_argument, NULL, O_HELP},
+        {NULL, 0, NULL, 0}};
+    int c;
+    double x;
+    while ((c = getopt_long(argc, argv, "h", longopts, NULL)) != -1) {
+        switch (c) {
+        case O_VARIANT:
+            o.variant = (char)(optarg[0] & ~0x20); /* upper case */
+            if ((o.variant != 'P' && o.variant != 'R') || optarg[1] != '\0') {
+                fprintf(stderr, "tilt_table: --variant must be P or R, got '%s'\n", optarg);
+                return 2;
+            }
+            break;
+        case O_STICK: o.stick = 1; break;
+        case O_NO_CCD: o.use_ccd = 0; break;
+        case O_PAPER: o.paper_integrator = 1; break;
+        case O_CSV: o.csv = optarg; break;
+        case O_VTK: o.vtk_dir = optarg; break;
+        case O_VTK_SPRINGS: o.vtk_springs = 1; break;
+        case O_VTK_ASCII: o.vtk_ascii = 1; break;
+        case O_VTK_EVERY: {
+            char *end;
+            errno = 0;
+            o.vtk_every = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || errno == ERANGE || !isfinite(o.vtk_every) ||
+                o.vtk_every < 0) {
+                fprintf(stderr, "tilt_table: --vtk-every must be a number >= 0, got '%s'\n",
+                        optarg);
+                return 2;
+            }
+            break;
         }
+        case O_VTK_STRIDE:
+            if (!positive("--vtk-stride", optarg, &x) || x != floor(x) || x > 1e9) {
+                fprintf(stderr, "tilt_table: --vtk-stride must be a whole number >= 1\n");
+                return 2;
+            }
+            o.vtk_stride = (int)x;
+            break;
+        case O_QUIET: o.quiet = 1; break;
+        case O_WRAPPED: o.wrapped = 1; break;
+        case O_DURATION:
+            if (!positive("--duration", optarg, &o.duration))
+                return 2;
+            break;
+        case O_FILM_MASS:
+            if (!positive("--film-mass", optarg, &o.film_mass))
+                return 2;
+            break;
+        case O_SUBSTEPS:
+            if (!positive("--substeps", optarg, &x) || x != floor(x) || x > 1000) {
+                fprintf(stderr, "tilt_table: --substeps must be a whole number 1..1000\n");
+                return 2;
+            }
+            o.substeps = (int)x;
+            break;
+        case 'h':
+        case O_HELP: usage(stdout); return 0;
+        default: usage(stderr); return 2; /* getopt_long said what was wrong */
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "tilt_table: unexpected argument '%s'\n", argv[optind]);
+        usage(stderr);
+        return 2;
     }
     double theory = DEG(atan(0.3));
     if (!o.quiet)
         printf("libwrapsim %s - tilt table, variant %c, %s, %s friction\n"
-               "  theory: sliding starts at tan(theta) = mu = 0.3, theta = %.2f deg, t = %.3f s\n",
+               "  theory: sliding starts at tan(theta) = mu = 0.3, theta = %.2f deg, t = %.3f s\n"
+               "  slide onset: every contact with its support slips (|v_t| >= v_lim = %.0f mm/s)"
+               " the same way, for %.1f s\n",
                ws_version_string(), o.variant, o.wrapped ? "wrapped" : "unwrapped",
-               o.stick ? "stick" : "regularised (paper)", theory, 1.0 + atan(0.3) / 0.1);
+               o.stick ? "stick" : "regularised (paper)", theory, 1.0 + atan(0.3) / 0.1,
+               1e3 * 0.01, TILT_SLIDE_HOLD);
     if (!o.quiet && o.wrapped && o.variant == 'R')
-        printf("  theory, wrapped: the stack tips as one over the stop at tan(theta) = "
-               "0.125/0.23, theta = %.2f deg, t = %.3f s\n",
+        printf("  theory, wrapped: the stack tips as one when its CoG passes over the stop's "
+               "edge, tan(theta) = 0.125/0.23, theta = %.2f deg, t = %.3f s, without the layers; "
+               "28.61 deg with them (docs/theory.md 4.1); about 29.5-29.7 deg with Coulomb "
+               "friction at the base\n",
                DEG(atan(0.125 / 0.23)), 1.0 + atan(0.125 / 0.23) / 0.1);
     tilt_result r;
     ws_status s = tilt_run(&o, &r);
@@ -619,13 +865,20 @@ int main(int argc, char **argv)
                    "    a rigid stack unloads it at tan(theta) = (a/2) / CoG height = 0.125/0.252, "
                    "%.2f deg\n",
                    r.lift_angle, r.lift_time, DEG(atan(0.125 / 0.252)));
+        if (!isnan(r.over_theory))
+            printf("  the load's CoG (boxes and film) passes over the stop's edge at %.2f deg "
+                   "(t = %.3f s);\n"
+                   "    a rigid load with the geometry it had when its uphill edge lifted "
+                   "would at %.2f deg\n",
+                   r.over_angle, r.over_time, r.over_theory);
         printf("  top box on the bottom one: largest move %.1f mm while the stack stands\n",
                1e3 * r.max_relative_slip);
         if (o.wrapped)
             printf("  film: peak strain %.3f, peak spring tension %.2f N\n", r.peak_strain,
                    r.peak_tension);
-        printf("  plane angle at the end %.2f deg; %ld steps in %.3f s (%.0f steps/s)\n",
-               r.final_angle, r.steps, r.wall_seconds, r.steps / r.wall_seconds);
+        printf("  plane angle at the end %.2f deg (t = %.3f s); %ld steps in %.3f s "
+               "(%.0f steps/s)\n",
+               r.final_angle, r.end_time, r.steps, r.wall_seconds, r.steps / r.wall_seconds);
         if (o.csv)
             printf("  time series: %s\n", o.csv);
         if (o.vtk_dir)

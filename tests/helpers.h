@@ -21,12 +21,71 @@
                       ws_world_last_error(w));                                                    \
     } while (0)
 
-/* A counting allocator that can be told to fail after N allocations. */
+/* A counting allocator that can be told to fail after N allocations. With `track` set it also
+ * records every live block's size and checks the size the library passes to each free and each
+ * realloc (as the old size) against it, as a sized or pool allocator would need: mismatches are
+ * counted in size_errors, the first described in size_error. Call test_alloc_done() after the
+ * world is gone to release the records. */
+typedef struct ta_block {
+    void *p;
+    size_t n;
+} ta_block;
+
 typedef struct test_alloc {
     long allocs_left; /* < 0: never fail */
     long live;        /* blocks alive */
     long long bytes;  /* bytes alive by the sizes the library reports */
+    int track;        /* 1: record sizes and check frees and reallocs */
+    ta_block *blocks; /* live blocks (track) */
+    size_t nblocks, capblocks;
+    long size_errors;
+    char size_error[160];
 } test_alloc;
+
+static inline ta_block *ta_find(test_alloc *a, void *p)
+{
+    for (size_t i = a->nblocks; i-- > 0;)
+        if (a->blocks[i].p == p)
+            return &a->blocks[i];
+    return NULL;
+}
+
+static inline void ta_size_error(test_alloc *a, const char *what, void *p, size_t given,
+                                 size_t real)
+{
+    if (a->size_errors++ == 0)
+        snprintf(a->size_error, sizeof a->size_error, "%s of %p with %zu bytes, allocated %zu",
+                 what, p, given, real);
+}
+
+static inline void ta_record(test_alloc *a, void *p, size_t n)
+{
+    if (a->nblocks == a->capblocks) {
+        size_t cap = a->capblocks ? 2 * a->capblocks : 256;
+        ta_block *b = realloc(a->blocks, cap * sizeof *b);
+        if (!b)
+            abort(); /* the test's own bookkeeping, not the library's */
+        a->blocks = b;
+        a->capblocks = cap;
+    }
+    a->blocks[a->nblocks].p = p;
+    a->blocks[a->nblocks].n = n;
+    a->nblocks++;
+}
+
+/* Check the size given for block p; with `drop`, forget the block. */
+static inline void ta_check(test_alloc *a, const char *what, void *p, size_t given, int drop)
+{
+    ta_block *b = ta_find(a, p);
+    if (!b) {
+        ta_size_error(a, what, p, given, 0);
+        return;
+    }
+    if (b->n != given)
+        ta_size_error(a, what, p, given, b->n);
+    if (drop)
+        *b = a->blocks[--a->nblocks];
+}
 
 static inline void *ta_alloc(void *u, size_t n)
 {
@@ -39,19 +98,33 @@ static inline void *ta_alloc(void *u, size_t n)
     if (p) {
         a->live++;
         a->bytes += (long long)n;
+        if (a->track)
+            ta_record(a, p, n);
     }
     return p;
 }
 static inline void *ta_realloc(void *u, void *p, size_t o, size_t n)
 {
     test_alloc *a = u;
+    if (a->track)
+        ta_check(a, "realloc", p, o, 0);
     if (a->allocs_left == 0)
         return NULL;
     if (a->allocs_left > 0)
         a->allocs_left--;
     void *q = realloc(p, n);
-    if (q)
+    if (q) {
         a->bytes += (long long)n - (long long)o;
+        if (a->track) {
+            ta_block *b = ta_find(a, p);
+            if (b) {
+                b->p = q;
+                b->n = n;
+            } else {
+                ta_record(a, q, n);
+            }
+        }
+    }
     return q;
 }
 static inline void ta_free(void *u, void *p, size_t n)
@@ -60,6 +133,8 @@ static inline void ta_free(void *u, void *p, size_t n)
     if (p) {
         a->live--;
         a->bytes -= (long long)n;
+        if (a->track)
+            ta_check(a, "free", p, n, 1);
     }
     free(p);
 }
@@ -69,6 +144,12 @@ static inline void test_alloc_install(ws_world_def *d, test_alloc *a)
     d->allocator.realloc = ta_realloc;
     d->allocator.free = ta_free;
     d->allocator.user = a;
+}
+static inline void test_alloc_done(test_alloc *a)
+{
+    free(a->blocks);
+    a->blocks = NULL;
+    a->nblocks = a->capblocks = 0;
 }
 
 static inline ws_world *new_world(double dt)

@@ -655,7 +655,7 @@ START_TEST(test_oom_world_create)
     long n;
     int done = 0;
     for (n = 0; n < MAX_ALLOCS && !done; n++) {
-        test_alloc a = {n, 0, 0};
+        test_alloc a = {.allocs_left = n};
         ws_world_def d;
         ws_world_def_init(&d);
         test_alloc_install(&d, &a);
@@ -698,7 +698,7 @@ START_TEST(test_oom_shape_create)
     for (int kind = 0; kind < 3; kind++) {
         int done = 0;
         for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             a.allocs_left = n;
             ws_shape_id s = {777};
@@ -738,7 +738,7 @@ START_TEST(test_oom_body_create)
     for (int variant = 0; variant < 3; variant++) {
         int done = 0;
         for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             ws_shape_id s;
             ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &s));
@@ -795,7 +795,7 @@ START_TEST(test_oom_step)
 {
     int done = 0;
     for (long n = 0; n < MAX_ALLOCS && !done; n++) {
-        test_alloc a = {-1, 0, 0};
+        test_alloc a = {.allocs_left = -1};
         ws_world *w = counted_world(&a);
         box_on_ground(w);
         uint64_t h0 = hash_of(w);
@@ -827,7 +827,7 @@ END_TEST
 /* STYLE rule 9: once warm, a step allocates nothing. */
 START_TEST(test_warm_step_allocates_nothing)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     box_on_ground(w);
     box_at(w, 0.1, 0.5, 0.0, 0.0, 0.2 + 0.05 + 2 * 1.99e-3, "top");
@@ -846,7 +846,7 @@ END_TEST
 
 START_TEST(test_bytes_back_to_zero)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     ws_world_stats st;
     ck_ok(w, ws_world_get_stats(w, &st));
@@ -1167,7 +1167,7 @@ START_TEST(test_version_and_status_strings)
     int ma = -1, mi = -1, pa = -1;
     ck_assert_int_eq(sscanf(ws_version_string(), "%d.%d.%d", &ma, &mi, &pa), 3);
     ck_assert_int_eq(ws_version_number(), ma * 10000 + mi * 100 + pa);
-    ck_assert_uint_eq(ws_build_features() & ~(unsigned)WS_FEATURE_CCD, 0);
+    ck_assert_uint_eq(ws_build_features() & ~(unsigned)(WS_FEATURE_CCD | WS_FEATURE_ZLIB), 0);
 
     const ws_status all[] = {WS_OK,
                              WS_ERR_INVALID_ARGUMENT,
@@ -1181,6 +1181,7 @@ START_TEST(test_version_and_status_strings)
                              WS_ERR_BUFFER_TOO_SMALL,
                              WS_ERR_IO,
                              WS_ERR_UNSUPPORTED,
+                             WS_ERR_IN_STEP,
                              WS_ERR_FORMAT};
     const size_t n = sizeof all / sizeof all[0];
     for (size_t i = 0; i < n; i++) {
@@ -1353,6 +1354,480 @@ START_TEST(test_tilt_drive_kinematics)
 }
 END_TEST
 
+/* ---- the Def ABI: a program built against an older, smaller Def ---- */
+
+/* ws_body_def as an older header might have laid it out: today's fields up to `velocity`, none
+ * after (angular_velocity, name, user_data came later). */
+typedef struct old_body_def {
+    uint32_t size, magic;
+    ws_body_type type;
+    ws_shape_id shape;
+    ws_material_id material;
+    double mass, density;
+    ws_mat3 inertia;
+    double contact_layer;
+    ws_vec3 position;
+    ws_quat orientation;
+    ws_vec3 velocity;
+} old_body_def;
+
+/* The same for ws_world_def, cut before its last field (user_data). */
+typedef struct old_world_def {
+    uint32_t size, magic;
+    ws_vec3 gravity;
+    double dt;
+    ws_integrator integrator;
+    double full_detection_until;
+    int detection_interval;
+    double contact_margin, max_speed, max_angular_speed;
+    int use_ccd, profile;
+    ws_allocator allocator;
+    ws_log_fn log;
+    void *log_user;
+} old_world_def;
+
+#define CANARY 0xA5
+
+static int canary_intact(const unsigned char *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (c[i] != CANARY)
+            return 0;
+    return 1;
+}
+
+START_TEST(test_old_size_defs)
+{
+    /* The old layouts are prefixes of today's Defs, field for field. */
+    ck_assert_uint_eq(offsetof(old_body_def, velocity), offsetof(ws_body_def, velocity));
+    ck_assert_uint_eq(offsetof(old_world_def, log_user), offsetof(ws_world_def, log_user));
+    ck_assert_uint_lt(sizeof(old_body_def), sizeof(ws_body_def));
+    ck_assert_uint_lt(sizeof(old_world_def), sizeof(ws_world_def));
+
+    /* A guard after each old Def, filled with a pattern that the library must neither write nor
+     * read: read as user_data or angular_velocity it would show (0xA5A5... is not zero). */
+    struct {
+        old_world_def d;
+        unsigned char canary[sizeof(ws_world_def)];
+    } wf;
+    struct {
+        old_body_def d;
+        unsigned char canary[sizeof(ws_body_def)];
+    } bf;
+    memset(&wf, CANARY, sizeof wf);
+    memset(&bf, CANARY, sizeof bf);
+
+    ws_world_def_init_sized((ws_world_def *)&wf.d, sizeof wf.d);
+    ck_assert_msg(canary_intact(wf.canary, sizeof wf.canary), "world init wrote past the Def");
+    ck_assert_uint_eq(wf.d.size, sizeof wf.d);
+    ck_assert(wf.d.dt == 2.5e-4 && wf.d.gravity.z == -9.81 && wf.d.use_ccd == 1);
+    ck_assert(wf.d.log == NULL);
+    wf.d.dt = 1e-4;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create((const ws_world_def *)&wf.d, &w), WS_OK);
+    ck_assert_msg(canary_intact(wf.canary, sizeof wf.canary), "world create wrote the guard");
+    ck_assert_ptr_null(ws_world_get_user_data(w)); /* the missing field: its default */
+    double dt = 0.0;
+    ck_ok(w, ws_world_get_dt(w, &dt));
+    ck_assert(dt == 1e-4);
+
+    ws_body_def_init_sized((ws_body_def *)&bf.d, sizeof bf.d);
+    ck_assert_msg(canary_intact(bf.canary, sizeof bf.canary), "body init wrote past the Def");
+    ck_assert_uint_eq(bf.d.size, sizeof bf.d);
+    ck_assert(bf.d.density == 1000.0 && bf.d.contact_layer == 1e-3 && bf.d.orientation.e0 == 1.0);
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &bf.d.shape));
+    bf.d.mass = 2.0;
+    bf.d.velocity = (ws_vec3){1.0, 2.0, 3.0};
+    ws_body_id b;
+    ck_ok(w, ws_body_create(w, (const ws_body_def *)&bf.d, &b));
+    ck_assert_msg(canary_intact(bf.canary, sizeof bf.canary), "body create wrote the guard");
+    ws_vec3 v, om;
+    ck_ok(w, ws_body_get_velocity(w, b, &v));
+    ck_ok(w, ws_body_get_angular_velocity(w, b, &om));
+    ck_assert(v.x == 1.0 && v.y == 2.0 && v.z == 3.0);
+    ck_assert(om.x == 0.0 && om.y == 0.0 && om.z == 0.0); /* the missing fields: defaults */
+    ck_assert_ptr_null(ws_body_get_user_data(w, b));
+
+    /* A newer, larger caller Def: the library fills its own fields, zeros the rest and records
+     * the size both know, which tells the caller which fields the library reads. */
+    struct newer_frame {
+        ws_body_def d;
+        double newer_field;
+        unsigned char canary[16];
+    } nf;
+    memset(&nf, CANARY, sizeof nf);
+    ws_body_def_init_sized(&nf.d, offsetof(struct newer_frame, canary));
+    ck_assert_uint_eq(nf.d.size, sizeof nf.d);
+    ck_assert(nf.newer_field == 0.0);
+    ck_assert(canary_intact(nf.canary, sizeof nf.canary));
+
+    /* The plain function, for programs built against headers before the sized form, fills
+     * today's layout and not a byte more; a Def smaller than its header is left alone. */
+    struct {
+        ws_body_def d;
+        unsigned char canary[16];
+    } pf;
+    memset(&pf, CANARY, sizeof pf);
+    (ws_body_def_init)(&pf.d);
+    ck_assert(canary_intact(pf.canary, sizeof pf.canary));
+    ck_assert_uint_le(pf.d.size, sizeof pf.d);
+    ck_assert_uint_ge(pf.d.size, offsetof(ws_body_def, user_data) + sizeof(void *));
+    unsigned char tiny[4];
+    memset(tiny, CANARY, sizeof tiny);
+    ws_body_def_init_sized((ws_body_def *)(void *)tiny, sizeof tiny);
+    ck_assert(canary_intact(tiny, sizeof tiny));
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* ---- re-entrancy: callbacks inside a step may read the world, never change it ---- */
+
+enum { REENTRY_CALLS = 24 };
+
+typedef struct reentry {
+    ws_world *w;
+    ws_body_id body, kin;
+    ws_shape_id shape;
+    ws_law_id law;
+    ws_element_id element;
+    ws_material_id mat;
+    int calls;                    /* callback calls */
+    ws_status got[REENTRY_CALLS]; /* what each mutating call returned, the first time */
+    int named[REENTRY_CALLS];     /* 1 when its last error named it and the step */
+    int read_ok;                  /* a getter worked inside the step */
+} reentry;
+
+/* Try every kind of call that changes the world; record what each returned. */
+static void try_mutations(reentry *r)
+{
+    ws_world *w = r->w;
+    static const char *const names[REENTRY_CALLS] = {
+        "ws_body_destroy", "ws_body_create", "ws_world_step", "ws_world_step_n",
+        "ws_shape_create_box", "ws_shape_create_cylinder", "ws_shape_create_mesh",
+        "ws_shape_destroy", "ws_law_create", "ws_law_destroy", "ws_element_create",
+        "ws_element_destroy", "ws_body_set_pose", "ws_body_set_velocity", "ws_body_set_drive",
+        "ws_world_set_dt", "ws_world_set_gravity", "ws_material_create", "ws_world_set_contact",
+        "ws_world_set_default_contact", "ws_web_create_sheet", "ws_web_create_band",
+        "ws_web_create_mesh", "ws_world_destroy"};
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = r->shape;
+    bd.mass = 1.0;
+    ws_mesh_def md;
+    ws_mesh_def_init(&md);
+    md.vertices = cube_v;
+    md.vertex_count = 8;
+    md.triangles = cube_t;
+    md.triangle_count = 12;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.stiffness = 1.0;
+    ws_element_def ed;
+    ws_element_def_init(&ed);
+    ed.body2 = r->body;
+    ed.law = r->law;
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    ws_material_def mtd;
+    ws_material_def_init(&mtd);
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 0.01;
+    wd.law = r->law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 2;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    ws_band_def bnd;
+    ws_band_def_init(&bnd);
+    ws_web_mesh_def wm;
+    ws_web_mesh_def_init(&wm);
+    ws_pose pose = {{0, 0, 1}, {1, 0, 0, 0}};
+    ws_vec3 v = {0, 0, 0}, g = {0, 0, -1};
+    ws_body_id b;
+    ws_shape_id sh;
+    ws_law_id l;
+    ws_element_id e;
+    ws_material_id m;
+    ws_web_id web;
+    int k = 0;
+#define TRY(call)                                                                                 \
+    do {                                                                                          \
+        r->got[k] = (call);                                                                       \
+        const char *e_ = ws_world_last_error(w);                                                  \
+        r->named[k] = strstr(e_, names[k]) == e_ &&                                               \
+                      strstr(e_, " called from inside ws_world_step (a callback)") != NULL;       \
+        k++;                                                                                      \
+    } while (0)
+    TRY(ws_body_destroy(w, r->body));
+    TRY(ws_body_create(w, &bd, &b));
+    TRY(ws_world_step(w));
+    TRY(ws_world_step_n(w, 3));
+    TRY(ws_shape_create_box(w, 1, 1, 1, &sh));
+    TRY(ws_shape_create_cylinder(w, 1, 1, 8, &sh));
+    TRY(ws_shape_create_mesh(w, &md, &sh));
+    TRY(ws_shape_destroy(w, r->shape));
+    TRY(ws_law_create(w, &ld, &l));
+    TRY(ws_law_destroy(w, r->law));
+    TRY(ws_element_create(w, &ed, &e));
+    TRY(ws_element_destroy(w, r->element));
+    TRY(ws_body_set_pose(w, r->body, &pose));
+    TRY(ws_body_set_velocity(w, r->body, &v, &v));
+    TRY(ws_body_set_drive(w, r->kin, &dd));
+    TRY(ws_world_set_dt(w, 1e-4));
+    TRY(ws_world_set_gravity(w, &g));
+    TRY(ws_material_create(w, &mtd, &m));
+    TRY(ws_world_set_contact(w, r->mat, r->mat, &cd));
+    TRY(ws_world_set_default_contact(w, &cd));
+    TRY(ws_web_create_sheet(w, &wd, &sd, &web));
+    TRY(ws_web_create_band(w, &wd, &bnd, &web));
+    TRY(ws_web_create_mesh(w, &wd, &wm, &web));
+    /* ws_world_destroy returns nothing: it must leave the world alone and say why. */
+    TRY((ws_world_destroy(w), WS_ERR_IN_STEP));
+#undef TRY
+    ck_assert_int_eq(k, REENTRY_CALLS);
+    ws_vec3 p;
+    r->read_ok = ws_body_get_position(w, r->body, &p) == WS_OK && p.z > 0.0;
+}
+
+static int reentry_drive(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec3 *om)
+{
+    reentry *r = user;
+    if (r->calls++ == 1) /* the first call is ws_body_set_drive's own, outside a step */
+        try_mutations(r);
+    *pose = (ws_pose){{0, 0, -1}, {1, 0, 0, 0}};
+    (void)t;
+    *v = *om = (ws_vec3){0, 0, 0};
+    return 0;
+}
+
+static int reentry_law(void *user, int dim, const double *u, const double *ud, double t,
+                       double *F, double *dFdu, double *dFdud)
+{
+    reentry *r = user;
+    if (r->calls++ == 0)
+        try_mutations(r);
+    (void)dim;
+    (void)ud;
+    (void)t;
+    F[0] = 10.0 * u[0];
+    if (dFdu)
+        dFdu[0] = 10.0;
+    if (dFdud)
+        dFdud[0] = 0.0;
+    return 0;
+}
+
+/* A world with a dynamic box, a kinematic slab and a rod from the world to the box; `law_cb`
+ * puts the re-entering callback in the rod's law, else in the slab's drive. */
+static ws_world *reentry_world(reentry *r, int law_cb)
+{
+    memset(r, 0, sizeof *r);
+    ws_world *w = new_world(2.5e-4);
+    r->w = w;
+    ck_ok(w, ws_world_get_default_material(w, &r->mat));
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &r->shape));
+    r->body = box_at(w, 0.1, 1.0, 0.0, 0.0, 1.0, "box");
+    r->kin = add_ground(w, 1.0, no_material());
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    if (law_cb) {
+        ld.type = WS_LAW_USER;
+        ld.user_fn = reentry_law;
+        ld.user_data = r;
+        ld.stiffness = 10.0;
+    } else {
+        ld.stiffness = 10.0;
+    }
+    ck_ok(w, ws_law_create(w, &ld, &r->law));
+    ws_element_def ed;
+    ws_element_def_init(&ed);
+    ed.body2 = r->body;
+    ed.law = r->law;
+    ed.point1 = (ws_vec3){0, 0, 2.0};
+    ed.global_attachment = 1;
+    ed.point2 = (ws_vec3){0, 0, 1.05};
+    ck_ok(w, ws_element_create(w, &ed, &r->element));
+    if (!law_cb) {
+        ws_drive_def dd;
+        ws_drive_def_init(&dd);
+        dd.type = WS_DRIVE_CALLBACK;
+        dd.callback = reentry_drive;
+        dd.callback_user = r;
+        ck_ok(w, ws_body_set_drive(w, r->kin, &dd));
+    }
+    return w;
+}
+
+static void check_reentry(reentry *r, const char *where)
+{
+    ws_world *w = r->w;
+    ws_world_stats st;
+    ck_ok(w, ws_world_step(w));
+    ck_assert_msg(r->calls >= 1, "%s: the callback was not called", where);
+    for (int k = 0; k < REENTRY_CALLS; k++) {
+        ck_assert_msg(r->got[k] == WS_ERR_IN_STEP, "%s: call %d returned %s", where, k,
+                      ws_status_string(r->got[k]));
+        ck_assert_msg(r->named[k], "%s: call %d's last error does not name it", where, k);
+    }
+    ck_assert_msg(r->read_ok, "%s: a getter failed inside the step", where);
+    /* Nothing changed: the same objects and parameters, and the world steps on; outside a
+     * step the same calls work. */
+    ck_assert(ws_body_is_valid(w, r->body) && ws_element_is_valid(w, r->element));
+    ck_assert(ws_law_is_valid(w, r->law) && ws_shape_is_valid(w, r->shape));
+    ck_ok(w, ws_world_get_stats(w, &st));
+    ck_assert_uint_eq(st.bodies, 2);
+    double dt;
+    ck_ok(w, ws_world_get_dt(w, &dt));
+    ck_assert(dt == 2.5e-4);
+    ck_ok(w, ws_world_step_n(w, 10));
+    ck_ok(w, ws_element_destroy(w, r->element));
+    ck_ok(w, ws_body_destroy(w, r->body));
+    ws_world_destroy(w);
+}
+
+START_TEST(test_reentry_from_drive)
+{
+    reentry r;
+    reentry_world(&r, 0);
+    check_reentry(&r, "drive callback");
+}
+END_TEST
+
+START_TEST(test_reentry_from_law)
+{
+    reentry r;
+    reentry_world(&r, 1);
+    check_reentry(&r, "law callback");
+}
+END_TEST
+
+/* ---- small refusals: each says what is really wrong ---- */
+
+static int ends_with(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    return n >= m && strcmp(s + n - m, tail) == 0;
+}
+
+#define ck_err_ends(w, tail)                                                                      \
+    ck_assert_msg(ends_with(ws_world_last_error(w), tail), "last error '%s' does not end in '%s'", \
+                  ws_world_last_error(w), tail)
+
+START_TEST(test_mesh_messages)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_shape_id s;
+    static const uint32_t tet[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    static const uint32_t tet_in[12] = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2};
+    static const uint32_t tet_deg[12] = {0, 2, 2, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    double v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    /* Every message ends in its own words, not in stray numbers. */
+    ck_assert_int_eq(create_mesh(w, NULL, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_ends(w, "vertices and triangles must not be NULL");
+    ck_assert_int_eq(create_mesh(w, v, 4, tet_deg, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "triangle 0 is degenerate (zero area): remove it, or repair the mesh in a mesh "
+                   "tool (merge duplicate vertices, remove degenerate faces)");
+    ck_assert_int_eq(create_mesh(w, v, 4, tet_in, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "counter-clockwise seen from outside (the mesh is inside out): reverse every "
+                   "triangle, or repair it in a mesh tool (flip the normals)");
+    double same[12] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    ck_assert_int_eq(create_mesh(w, same, 4, tet, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_ends(w, "all vertices coincide");
+    v[4] = NAN;
+    ck_assert_int_eq(create_mesh(w, v, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_ends(w, "vertex 1 has a coordinate that is not finite");
+    /* Sizes: a 1e200 box is too large, not "degenerate"; a 1e-200 one too small. */
+    ck_assert_int_eq(ws_shape_create_box(w, 1e200, 1e200, 1e200, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "WS_MESH_MAX_COORD");
+    ck_assert_int_eq(ws_shape_create_cylinder(w, 1e200, 1.0, 8, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "WS_MESH_MAX_COORD");
+    double big[12] = {0, 0, 0, 1e200, 0, 0, 0, 1e200, 0, 0, 0, 1e200};
+    ck_assert_int_eq(create_mesh(w, big, 4, tet, 4, &s), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "beyond WS_MESH_MAX_COORD (1e+06 m)");
+    double tiny[12] = {0, 0, 0, 1e-200, 0, 0, 0, 1e-200, 0, 0, 0, 1e-200};
+    ck_assert_int_eq(create_mesh(w, tiny, 4, tet, 4, &s), WS_ERR_BAD_MESH);
+    ck_err_has(w, "below WS_MESH_MIN_EXTENT (1e-06 m)");
+    /* At the bounds they are taken: a 2e6 m box, a 1 mm one. */
+    ck_ok(w, ws_shape_create_box(w, 2e6, 2e6, 2e6, &s));
+    ck_ok(w, ws_shape_create_box(w, 1e-3, 1e-3, 1e-3, &s));
+    ws_world_destroy(w);
+}
+END_TEST
+
+static ws_status body_with(ws_world *w, ws_shape_id s, double mass, const double *jdiag)
+{
+    ws_body_def d;
+    ws_body_def_init(&d);
+    d.shape = s;
+    d.mass = mass;
+    if (jdiag) {
+        d.inertia.m[0] = jdiag[0];
+        d.inertia.m[4] = jdiag[1];
+        d.inertia.m[8] = jdiag[2];
+    }
+    ws_body_id b;
+    return ws_body_create(w, &d, &b);
+}
+
+START_TEST(test_body_mass_and_inertia)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &s));
+    /* Masses outside the sane range are named as such, not as an inertia problem. */
+    const double bad_mass[] = {1e300, 1e-300, 2e9, 1e-7};
+    for (size_t k = 0; k < sizeof bad_mass / sizeof *bad_mass; k++) {
+        ck_assert_int_eq(body_with(w, s, bad_mass[k], NULL), WS_ERR_INVALID_ARGUMENT);
+        ck_err_has(w, "is outside [WS_BODY_MIN_MASS, WS_BODY_MAX_MASS] = [1e-06, 1e+09] kg");
+        ck_assert_ptr_null(strstr(ws_world_last_error(w), "positive definite"));
+    }
+    ck_ok(w, body_with(w, s, WS_BODY_MAX_MASS, NULL));
+    ck_ok(w, body_with(w, s, WS_BODY_MIN_MASS, NULL));
+    /* Density x volume out of range says so. */
+    ws_body_def d;
+    ws_body_def_init(&d);
+    d.shape = s;
+    d.density = 1e300;
+    ws_body_id b;
+    ck_assert_int_eq(ws_body_create(w, &d, &b), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "(density x volume)");
+    /* Principal moments: J1 + J2 >= J3 for any rigid body (a flat plate is the equality). */
+    const double no_body[3] = {1, 1, 5}, no_body2[3] = {5, 1, 1}, plate[3] = {1, 1, 2},
+                 solid[3] = {1, 2, 2.9};
+    ck_assert_int_eq(body_with(w, s, 1.0, no_body), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "each must be at most the sum of the other two (J1 + J2 >= J3)");
+    ck_assert_int_eq(body_with(w, s, 1.0, no_body2), WS_ERR_INVALID_ARGUMENT);
+    ck_err_has(w, "J1 + J2 >= J3");
+    ck_ok(w, body_with(w, s, 1.0, plate));
+    ck_ok(w, body_with(w, s, 1.0, solid));
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_vtk_series_directory)
+{
+    ws_world *w = new_world(2.5e-4);
+    ws_vtk_series *series = (ws_vtk_series *)w;
+    const char *missing = "/nonexistent-wrapsim-test-dir/frames";
+    ck_assert_int_eq(ws_vtk_series_create(w, missing, "run", &series), WS_ERR_IO);
+    ck_assert_ptr_null(series);
+    ck_err_has(w, missing);
+    /* Something that is not a directory where the directory should be. */
+    FILE *f = fopen("/dev/null", "r");
+    if (f) {
+        fclose(f);
+        ck_assert_int_eq(ws_vtk_series_create(w, "/dev/null", "run", &series), WS_ERR_IO);
+        ck_err_has(w, "'/dev/null' is not a directory");
+    }
+    ck_ok(w, ws_vtk_series_create(w, ".", "run", &series));
+    ws_vtk_series_destroy(series);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* ---- suite ---- */
 
 static void add(Suite *s, const char *name, const TTest *t, double timeout)
@@ -1379,6 +1854,12 @@ static Suite *api_suite(void)
     add(s, "uninit_contact_def", test_uninit_contact_def, 10);
     add(s, "uninit_material_def", test_uninit_material_def, 10);
     add(s, "uninit_drive_def", test_uninit_drive_def, 10);
+    add(s, "old_size_defs", test_old_size_defs, 10);
+    add(s, "reentry_from_drive", test_reentry_from_drive, 10);
+    add(s, "mesh_messages", test_mesh_messages, 10);
+    add(s, "body_mass_and_inertia", test_body_mass_and_inertia, 10);
+    add(s, "vtk_series_directory", test_vtk_series_directory, 10);
+    add(s, "reentry_from_law", test_reentry_from_law, 10);
     add(s, "bad_world_numbers", test_bad_world_numbers, 10);
     add(s, "bad_body_numbers", test_bad_body_numbers, 10);
     add(s, "bad_contact_numbers", test_bad_contact_numbers, 10);

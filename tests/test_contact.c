@@ -832,6 +832,223 @@ START_TEST(test_impact_comes_to_rest)
 }
 END_TEST
 
+/* ======================================================================================== */
+/* Contact geometry: interface stiffness, reports by pair, the layers in the reference stack  */
+/* ======================================================================================== */
+
+/* Count of the reports of each kind in a between-report. */
+static void count_kinds(const ws_contact_info *c, size_t n, int counts[3])
+{
+    counts[0] = counts[1] = counts[2] = 0;
+    for (size_t i = 0; i < n; i++)
+        if (c[i].kind >= 0 && c[i].kind < 3)
+            counts[c[i].kind]++;
+}
+
+/* The reference stack of DESIGN.md (two 0.25 m, 5 kg cubes on a plane, k = 2e5 N/m per point,
+ * delta = 1 mm), flat, with its 20 x 20 mm stop bar along the downhill (+x) face of the bottom
+ * box, one touching gap 2 delta away; settled for 2 s with 100 kg/s per point (every vertical
+ * mode decays at >= 4c/(2m) = 40 1/s: e^-80 of the 0.1 mm start offsets is left). */
+typedef struct ref_stack {
+    ws_world *w;
+    ws_body_id ground, stop, bot, top;
+} ref_stack;
+
+static ref_stack make_ref_stack(int boxes_first)
+{
+    const double a = 0.25, m = 5.0;
+    ws_contact_def cd = contact_params(2e5, 100.0, 0.3, WS_FRICTION_REGULARIZED);
+    ref_stack r;
+    r.w = contact_world(2.5e-4, &cd);
+    if (boxes_first) {
+        r.bot = make_box(r.w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + 2 * DELTA), Q_ID,
+                         v3(0, 0, 0), "bottom");
+        r.top = make_box(r.w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 4 * DELTA), Q_ID,
+                         v3(0, 0, 0), "top");
+    }
+    r.ground = add_ground(r.w, 0.75, no_material());
+    r.stop = make_box(r.w, WS_BODY_KINEMATIC, 0.02, 0.5, 0.02, 0,
+                      v3(a / 2 + 2 * DELTA + 0.01, 0, 0.01), Q_ID, v3(0, 0, 0), "stop");
+    if (!boxes_first) {
+        r.bot = make_box(r.w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + 2 * DELTA), Q_ID,
+                         v3(0, 0, 0), "bottom");
+        r.top = make_box(r.w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 4 * DELTA), Q_ID,
+                         v3(0, 0, 0), "top");
+    }
+    ck_ok(r.w, ws_world_step_n(r.w, 8000));
+    return r;
+}
+
+/* Every active point between two bodies is a spring k in parallel: a box on a larger plane
+ * touches it at its 4 bottom corners (4k); two equal boxes face to face touch at 8 points, the 4
+ * corners of either box lying in the other's face (8k), found from both sides (4 point-face and
+ * 4 face-point reports in the pair's order). The resting overlaps follow: the load over the
+ * interface stiffness, m g / (8k) between the boxes, 2 m g / (4k) under the stack; asserted to
+ * 1e-9 m (the settled residue is ~1e-12 m, see make_ref_stack). */
+START_TEST(test_interface_stiffness)
+{
+    const double k = 2e5, m = 5.0;
+    ref_stack r = make_ref_stack(0);
+    double kn;
+    size_t np;
+    ck_ok(r.w, ws_world_get_interface_stiffness(r.w, r.ground, r.bot, &kn, &np));
+    ck_assert_uint_eq(np, 4);
+    ck_assert_double_eq_tol(kn, 4 * k, 1e-6);
+    ck_ok(r.w, ws_world_get_interface_stiffness(r.w, r.bot, r.top, &kn, &np));
+    ck_assert_uint_eq(np, 8);
+    ck_assert_double_eq_tol(kn, 8 * k, 1e-6);
+    ck_ok(r.w, ws_world_get_interface_stiffness(r.w, r.top, r.bot, &kn, NULL));
+    ck_assert_double_eq_tol(kn, 8 * k, 1e-6);
+    /* Not touching: the top box and the ground; the stop is one touching gap away, not in. */
+    ck_ok(r.w, ws_world_get_interface_stiffness(r.w, r.top, r.ground, &kn, &np));
+    ck_assert_uint_eq(np, 0);
+    ck_assert_double_eq(kn, 0.0);
+
+    ws_contact_info c[16];
+    size_t n;
+    int kinds[3];
+    ck_ok(r.w, ws_world_copy_contacts_between(r.w, r.bot, r.top, c, 16, &n));
+    ck_assert_uint_eq(n, 8);
+    count_kinds(c, n, kinds);
+    ck_assert_int_eq(kinds[WS_CONTACT_POINT_FACE], 4);
+    ck_assert_int_eq(kinds[WS_CONTACT_FACE_POINT], 4);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_msg(fabs(c[i].overlap - m * G0 / (8 * k)) < 1e-9, "box-box overlap %.9g m",
+                      c[i].overlap);
+    ck_ok(r.w, ws_world_copy_contacts_between(r.w, r.ground, r.bot, c, 16, &n));
+    ck_assert_uint_eq(n, 4);
+    for (size_t i = 0; i < n; i++)
+        ck_assert_msg(fabs(c[i].overlap - 2 * m * G0 / (4 * k)) < 1e-9, "base overlap %.9g m",
+                      c[i].overlap);
+    report("interface stiffness: box on plane %d points, box on equal box %d points (k = %g)", 4,
+           8, k);
+    ws_world_destroy(r.w);
+}
+END_TEST
+
+/* The same physical contact reports the same normal whichever body was created first and
+ * whichever owns the face: between(ground, bottom) points up (+z) from the ground to the box,
+ * between(bottom, ground) down, and the two creation orders give the same reports (the
+ * physics does not depend on the order: same forces to 1e-9 N). */
+START_TEST(test_contacts_between_normal_convention)
+{
+    double fz[2][2];
+    for (int order = 0; order < 2; order++) {
+        ref_stack r = make_ref_stack(order);
+        ws_contact_info c[16];
+        size_t n;
+        ck_ok(r.w, ws_world_copy_contacts_between(r.w, r.ground, r.bot, c, 16, &n));
+        ck_assert_uint_eq(n, 4);
+        fz[order][0] = 0;
+        for (size_t i = 0; i < n; i++) {
+            ck_assert(same_body(c[i].body_a, r.ground) && same_body(c[i].body_b, r.bot));
+            ck_assert_msg(c[i].normal.z > 1.0 - 1e-12, "ground->bottom normal z = %g",
+                          c[i].normal.z);
+            fz[order][0] += c[i].normal_force * c[i].normal.z;
+        }
+        ck_ok(r.w, ws_world_copy_contacts_between(r.w, r.bot, r.ground, c, 16, &n));
+        ck_assert_uint_eq(n, 4);
+        for (size_t i = 0; i < n; i++)
+            ck_assert_msg(c[i].normal.z < -1.0 + 1e-12, "bottom->ground normal z = %g",
+                          c[i].normal.z);
+        /* Between the equal boxes half the raw reports point each way; here all point up. */
+        ck_ok(r.w, ws_world_copy_contacts_between(r.w, r.bot, r.top, c, 16, &n));
+        ck_assert_uint_eq(n, 8);
+        fz[order][1] = 0;
+        for (size_t i = 0; i < n; i++) {
+            ck_assert_msg(c[i].normal.z > 1.0 - 1e-12, "bottom->top normal z = %g",
+                          c[i].normal.z);
+            fz[order][1] += c[i].normal_force * c[i].normal.z;
+        }
+        /* Errors: the same body twice, a small buffer, a stale id. */
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, r.bot, c, 16, &n),
+                         WS_ERR_INVALID_ARGUMENT);
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, r.top, c, 3, &n),
+                         WS_ERR_BUFFER_TOO_SMALL);
+        ck_assert_uint_eq(n, 8);
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, r.top, NULL, 0, &n), WS_OK);
+        ck_assert_uint_eq(n, 8);
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, r.top, NULL, 2, &n),
+                         WS_ERR_INVALID_ARGUMENT);
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, r.top, c, 16, NULL),
+                         WS_ERR_INVALID_ARGUMENT);
+        double kn;
+        ck_assert_int_eq(ws_world_get_interface_stiffness(r.w, r.bot, r.top, NULL, NULL),
+                         WS_ERR_INVALID_ARGUMENT);
+        ws_body_id gone = r.top;
+        ck_ok(r.w, ws_body_destroy(r.w, r.top));
+        ck_assert_int_eq(ws_world_copy_contacts_between(r.w, r.bot, gone, c, 16, &n),
+                         WS_ERR_STALE_HANDLE);
+        ck_assert_int_eq(ws_world_get_interface_stiffness(r.w, gone, r.bot, &kn, NULL),
+                         WS_ERR_STALE_HANDLE);
+        ws_world_destroy(r.w);
+    }
+    const double mg = 5.0 * G0;
+    report("contacts between: ground->bottom sum N_z %.9g / %.9g N, bottom->top %.9g / %.9g N "
+           "(creation orders 1 / 2)",
+           fz[0][0], fz[1][0], fz[0][1], fz[1][1]);
+    ck_assert_msg(fabs(fz[0][0] - 2 * mg) < 1e-6 * mg && fabs(fz[0][1] - mg) < 1e-6 * mg,
+                  "loads %.9g, %.9g N", fz[0][0], fz[0][1]);
+    ck_assert_msg(fabs(fz[0][0] - fz[1][0]) < 1e-9 && fabs(fz[0][1] - fz[1][1]) < 1e-9,
+                  "the creation order changed the loads");
+}
+END_TEST
+
+/* The worked example of docs/theory.md ("Contact geometry"): in the settled reference stack the
+ * layers put the bottom box g_z = 2 delta - 2 m g/(4k) = 1.877 mm above the plane, the boxes
+ * g_bb = 2 delta - m g/(8k) = 1.969 mm apart, and the stop's uphill face g_x = 2 delta from the
+ * box (it carries no load on the flat plane). So the 20 mm stop stands h - g_z = 18.12 mm above
+ * the box's bottom face, and a rigid stack's CoG passes over the stop's top edge at
+ *   tan(theta) = (a/2 + g_x) / (g_z + a + g_bb/2 - h)   = 28.61 deg
+ * instead of the 28.52 deg of the layer-free geometry; over the mid-layer point where the stop's
+ * force acts (one delta before the edge) at 28.42 deg; a single cube at 49.90 and 49.68 deg
+ * (49.97 without layers). The gaps are asserted to 1e-9 m against
+ * the bodies' settled positions (residue ~1e-12 m), the angles to 0.005 deg against the numbers
+ * the document prints (they are rounded to 0.01 deg). */
+START_TEST(test_reference_stack_layer_geometry)
+{
+    const double a = 0.25, m = 5.0, k = 2e5, h = 0.02;
+    ref_stack r = make_ref_stack(0);
+    ws_vec3 pb, pt, ps;
+    ck_ok(r.w, ws_body_get_position(r.w, r.bot, &pb));
+    ck_ok(r.w, ws_body_get_position(r.w, r.top, &pt));
+    ck_ok(r.w, ws_body_get_position(r.w, r.stop, &ps));
+    double gz = pb.z - a / 2, gbb = pt.z - pb.z - a, gx = (ps.x - 0.01) - (pb.x + a / 2);
+    double gz_th = 2 * DELTA - 2 * m * G0 / (4 * k), gbb_th = 2 * DELTA - m * G0 / (8 * k);
+    double zc = 0.5 * (pb.z + pt.z), xc = 0.5 * (pb.x + pt.x);
+    double edge = atan((ps.x - 0.01 - xc) / (zc - h)) / DEG;
+    double mid = atan((ps.x - 0.01 - DELTA - xc) / (zc - h)) / DEG;
+    double nominal = atan((a / 2) / (a - h)) / DEG;
+    report("reference stack layers: g_z %.6f mm (theory %.6f), g_bb %.6f mm (theory %.6f), g_x "
+           "%.6f mm; stop %.3f mm above the box bottom; CoG over the stop edge at %.3f deg, over "
+           "the mid-layer point at %.3f deg, layer-free %.3f deg",
+           1e3 * gz, 1e3 * gz_th, 1e3 * gbb, 1e3 * gbb_th, 1e3 * gx, 1e3 * (h - gz), edge, mid,
+           nominal);
+    ck_assert_msg(fabs(gz - gz_th) < 1e-9, "g_z %.9g m, theory %.9g", gz, gz_th);
+    ck_assert_msg(fabs(gbb - gbb_th) < 1e-9, "g_bb %.9g m, theory %.9g", gbb, gbb_th);
+    ck_assert_msg(fabs(gx - 2 * DELTA) < 1e-9, "g_x %.9g m", gx);
+    /* The rounded values of the document's table. */
+    ck_assert_msg(fabs(1e3 * gz - 1.877) < 5e-4 && fabs(1e3 * gbb - 1.969) < 5e-4 &&
+                      fabs(1e3 * zc - 252.86) < 0.005,
+                  "table: g_z %.4f mm, g_bb %.4f mm, CoG %.3f mm", 1e3 * gz, 1e3 * gbb,
+                  1e3 * zc);
+    ck_assert_msg(fabs(1e3 * (h - gz) - 18.12) < 0.005, "stop above the box %.4f mm",
+                  1e3 * (h - gz));
+    ck_assert_msg(fabs(nominal - 28.52) < 0.005, "layer-free %.4f deg", nominal);
+    ck_assert_msg(fabs(edge - 28.61) < 0.005, "over the edge %.4f deg", edge);
+    ck_assert_msg(fabs(mid - 28.42) < 0.005, "over the mid-layer point %.4f deg", mid);
+    /* The single cube of the same document, from the resting gap check_resting() validates. */
+    double zc1 = 2 * DELTA - m * G0 / (4 * k) + a / 2;
+    double one_edge = atan((a / 2 + 2 * DELTA) / (zc1 - h)) / DEG;
+    double one_mid = atan((a / 2 + DELTA) / (zc1 - h)) / DEG;
+    double one_free = atan((a / 2) / (a / 2 - h)) / DEG;
+    ck_assert_msg(fabs(one_edge - 49.90) < 0.005 && fabs(one_mid - 49.68) < 0.005 &&
+                      fabs(one_free - 49.97) < 0.005,
+                  "single cube: %.4f, %.4f, %.4f deg", one_edge, one_mid, one_free);
+    ws_world_destroy(r.w);
+}
+END_TEST
+
 static Suite *contact_suite(void)
 {
     Suite *s = suite_create("contact");
@@ -858,6 +1075,13 @@ static Suite *contact_suite(void)
     tcase_set_timeout(tc, 30);
     tcase_add_test(tc, test_tipping_not_sliding);
     tcase_add_test(tc, test_tipping_regularized_creep);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("geometry");
+    tcase_set_timeout(tc, 30);
+    tcase_add_test(tc, test_interface_stiffness);
+    tcase_add_test(tc, test_contacts_between_normal_convention);
+    tcase_add_test(tc, test_reference_stack_layer_geometry);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("impact");

@@ -1094,7 +1094,7 @@ START_TEST(test_bad_defs)
     d.law = L1;
     expect_err(w, ws_element_create(w, &d, NULL), WS_ERR_INVALID_ARGUMENT, NULL);
     ck_assert_int_eq(ws_element_create(NULL, &d, &e), WS_ERR_INVALID_ARGUMENT);
-    ws_element_def_init(NULL); /* ignored */
+    ws_element_def_init_sized(NULL, sizeof(ws_element_def)); /* ignored */
 
     /* Law dims: each type against the wrong ones. */
     const ws_element_type types[4] = {WS_ELEMENT_ROD, WS_ELEMENT_LINEAR_SPRING,
@@ -1337,7 +1337,7 @@ START_TEST(test_out_of_memory_and_bytes)
     for (int variant = 0; variant < 2; variant++) {
         int done = 0;
         for (long n = 0; n < 200 && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world_def wd;
             ws_world_def_init(&wd);
             test_alloc_install(&wd, &a);
@@ -1405,7 +1405,7 @@ END_TEST
 /* A warm step with elements allocates nothing. */
 START_TEST(test_step_allocates_nothing)
 {
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world_def wd;
     ws_world_def_init(&wd);
     wd.gravity = v3(0, 0, 0);

@@ -1159,6 +1159,125 @@ END_TEST
 
 /* ---- 9. user law ---- */
 
+static ws_law_id sum_of(ws_world *w, int dim, const ws_law_id *terms, size_t n, ws_status *st)
+{
+    ws_law_def d;
+    ws_law_def_init(&d);
+    d.type = WS_LAW_SUM;
+    d.dim = dim;
+    d.terms = terms;
+    d.term_count = n;
+    ws_law_id id = {0};
+    *st = ws_law_create(w, &d, &id);
+    return id;
+}
+
+/* Nested sums are bounded in the history they keep and in the laws one evaluation visits.
+ * Unbounded, ten nested sums reported 16 doubles of history but used 2^32 + 16 (the 32-bit
+ * count wrapped) and a sum of 16 copies nested 8 deep visited 16^8 leaves. */
+START_TEST(test_nested_sum_bounds)
+{
+    ws_world *w = new_world(1e-3);
+    ws_status st;
+    size_t n = 0;
+
+    /* History. A dim-6 relaxation law of 16 branches keeps 6 (16 + 1) = 102 doubles. */
+    double pk[WS_LAW_MAX_PRONY], pt[WS_LAW_MAX_PRONY];
+    for (int j = 0; j < WS_LAW_MAX_PRONY; j++) {
+        pk[j] = 10.0 * (j + 1);
+        pt[j] = 0.01 * (j + 1);
+    }
+    ws_law_def d;
+    ws_law_def_init(&d);
+    d.type = WS_LAW_RELAXATION;
+    d.dim = 6;
+    d.stiffness = 100.0;
+    d.prony_stiffness = pk;
+    d.prony_time = pt;
+    d.prony_count = WS_LAW_MAX_PRONY;
+    ws_law_id relax = create(w, &d);
+    ck_ok(w, ws_law_get_state_size(w, relax, &n));
+    ck_assert_uint_eq(n, 102);
+    ws_law_id t16[WS_LAW_MAX_TERMS];
+    for (int j = 0; j < WS_LAW_MAX_TERMS; j++)
+        t16[j] = relax;
+    ws_law_id s1 = sum_of(w, 6, t16, 16, &st);
+    ck_ok(w, st);
+    ck_ok(w, ws_law_get_state_size(w, s1, &n));
+    ck_assert_uint_eq(n, 1632);
+    /* 2 x 1632 + 8 x 102 = 4080 <= 4096 is taken; one term more (4182) is refused. */
+    ws_law_id mix[11] = {s1, s1, relax, relax, relax, relax, relax, relax, relax, relax, relax};
+    ws_law_id full = sum_of(w, 6, mix, 10, &st);
+    ck_ok(w, st);
+    ck_ok(w, ws_law_get_state_size(w, full, &n));
+    ck_assert_uint_eq(n, 4080);
+    sum_of(w, 6, mix, 11, &st);
+    ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "4182 doubles"));
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "WS_LAW_MAX_HISTORY (4096)"));
+    for (int j = 0; j < WS_LAW_MAX_TERMS; j++)
+        t16[j] = s1;
+    sum_of(w, 6, t16, 16, &st); /* 26112 doubles */
+    ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "WS_LAW_MAX_HISTORY"));
+
+    /* The largest law keeps exactly what it reports: evaluated and committed from a buffer of
+     * that size with a guard after it, the guard stays intact and the force is the elastic
+     * sum, (2 x 16 + 8)(100 + sum of the branches) u at dt = 0 (no relaxation yet). */
+    double *state = malloc((n + 8) * sizeof *state);
+    ck_assert_ptr_nonnull(state);
+    for (size_t i = n; i < n + 8; i++)
+        state[i] = 12345.0;
+    ck_ok(w, ws_law_init_state(w, full, state));
+    double u[6] = {1e-3, -2e-3, 0, 0, 0, 4e-3}, F[6];
+    ck_ok(w, ws_law_commit_state(w, full, state, u, NULL, 0.01, 0.01));
+    ck_ok(w, ws_law_evaluate_state(w, full, NULL, u, NULL, 0.0, 0.0, F, NULL, NULL));
+    for (size_t i = n; i < n + 8; i++)
+        ck_assert(state[i] == 12345.0);
+    double k_one = 100.0;
+    for (int j = 0; j < WS_LAW_MAX_PRONY; j++)
+        k_one += pk[j];
+    /* Forty relaxation laws each give k_one u; a sum of 40 terms rounds within 40 ulp. */
+    for (int i = 0; i < 6; i++)
+        ck_assert_double_eq_tol(F[i], 40.0 * k_one * u[i], 1e-12 * 40.0 * k_one);
+    free(state);
+
+    /* Leaves. 16 copies of a spring, summed 16 times over: 256 leaves, the bound, is taken and
+     * gives 256 k; one level more (4096) is refused. */
+    ws_law_def_init(&d);
+    d.stiffness = 3.0;
+    ws_law_id lin = create(w, &d);
+    for (int j = 0; j < WS_LAW_MAX_TERMS; j++)
+        t16[j] = lin;
+    ws_law_id l1 = sum_of(w, 1, t16, 16, &st);
+    ck_ok(w, st);
+    for (int j = 0; j < WS_LAW_MAX_TERMS; j++)
+        t16[j] = l1;
+    ws_law_id l2 = sum_of(w, 1, t16, 16, &st);
+    ck_ok(w, st);
+    double f, k;
+    ck_ok(w, ws_law_evaluate(w, l2, 0.5, 0.0, &f, &k, NULL));
+    ck_assert(k == 256.0 * 3.0 && f == 256.0 * 3.0 * 0.5); /* exact: small integers and halves */
+    for (int j = 0; j < WS_LAW_MAX_TERMS; j++)
+        t16[j] = l2;
+    sum_of(w, 1, t16, 16, &st);
+    ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "4096 leaf laws"));
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "WS_LAW_MAX_LEAVES (256)"));
+    /* A scaling adds no leaves: a scaled l2 is taken, a sum of it and the spring is not. */
+    ws_law_def_init(&d);
+    d.type = WS_LAW_SCALED;
+    d.base = l2;
+    d.scale = 2.0;
+    ws_law_id sc = create(w, &d);
+    ws_law_id two[2] = {sc, lin};
+    sum_of(w, 1, two, 2, &st);
+    ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "257 leaf laws"));
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(test_user_law)
 {
     ws_world *w = new_world(1e-3);
@@ -1428,7 +1547,7 @@ START_TEST(test_in_use_and_old_def)
     ck_ok(w, ws_law_get_info(w, a, &info));
     ck_assert_uint_eq(info.users, 0);
     ck_ok(w, ws_law_destroy(w, a));
-    /* A Def of the first released layout (ending at `name`) still works: dim 1, defaults. */
+    /* A Def of an older, smaller layout (ending at `name`) still works: dim 1, defaults. */
     ws_law_def_init(&d);
     d.type = WS_LAW_LINEAR_VISCOELASTIC;
     d.stiffness = 10.0;
@@ -1438,7 +1557,12 @@ START_TEST(test_in_use_and_old_def)
     ws_law_id old = create(w, &d);
     ck_ok(w, ws_law_get_info(w, old, &info));
     ck_assert_int_eq(info.dim, 1);
+    /* Any size from the header up reads only that much; one below the header is refused. */
     d.size = (uint32_t)offsetof(ws_law_def, name);
+    ws_law_id older = create(w, &d);
+    ck_ok(w, ws_law_get_info(w, older, &info));
+    ck_assert_int_eq(info.dim, 1);
+    d.size = 4;
     ck_assert_int_eq(ws_law_create(w, &d, &old), WS_ERR_UNINITIALIZED_DEF);
     /* Laws referring to laws that go away with the world: destroy frees them in any order. */
     ws_law_id b = make_law(w, L_SUM, 3, NULL, NULL, NULL);
@@ -1467,7 +1591,7 @@ START_TEST(test_oom_and_bytes)
          * the n-th allocation failing, until it succeeds. */
         int done = 0;
         for (long n = 0; n < 200 && !done; n++) {
-            test_alloc a = {-1, 0, 0};
+            test_alloc a = {.allocs_left = -1};
             ws_world *w = counted_world(&a);
             ws_law_id warm = make_law(w, L_ELASTIC, 1, NULL, NULL, NULL);
             ck_ok(w, ws_law_destroy(w, warm));
@@ -1513,7 +1637,7 @@ START_TEST(test_oom_and_bytes)
     /* Every law of every dim made and destroyed, twice: the second round ends where the
      * first did (the pool arrays keep their capacity), and the world's destroy returns every
      * byte. */
-    test_alloc a = {-1, 0, 0};
+    test_alloc a = {.allocs_left = -1};
     ws_world *w = counted_world(&a);
     uint64_t after[2] = {0, 0}, peak = 0;
     int nm = 0;
@@ -1640,6 +1764,7 @@ int main(void)
     add_case(s, "stop", test_stop, 30);
     add_case(s, "history_pure_and_per_user", test_history_pure_and_per_user, 30);
     add_case(s, "sum_and_scaled", test_sum_and_scaled, 30);
+    add_case(s, "nested_sum_bounds", test_nested_sum_bounds, 30);
     add_case(s, "user_law", test_user_law, 30);
     add_case(s, "energy_1d", test_energy_1d, 120);
     add_case(s, "bad_defs", test_bad_defs, 30);

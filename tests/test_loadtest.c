@@ -77,7 +77,7 @@ END_TEST
 START_TEST(the_reference_load_has_33_bodies_by_layer_and_place)
 {
     ws_world *w = load_world();
-    test_alloc ta = {-1, 0, 0};
+    test_alloc ta = {.allocs_left = -1};
     ws_load_def d;
     ws_load_def_init(&d);
     d.allocator.alloc = ta_alloc;
@@ -160,7 +160,7 @@ START_TEST(allocation_failures_leave_nothing_behind)
     d.layers = 2;
     for (long n = 0; n < 6; n++) {
         ws_world *w = load_world();
-        test_alloc ta = {n, 0, 0};
+        test_alloc ta = {.allocs_left = n};
         d.allocator.alloc = ta_alloc;
         d.allocator.realloc = ta_realloc;
         d.allocator.free = ta_free;
@@ -184,7 +184,7 @@ START_TEST(allocation_failures_leave_nothing_behind)
     for (long n = 0; n < 400; n += 7) {
         ws_world_def wd;
         ws_world_def_init(&wd);
-        test_alloc ta = {-1, 0, 0};
+        test_alloc ta = {.allocs_left = -1};
         test_alloc_install(&wd, &ta);
         ws_world *w = NULL;
         ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);

@@ -150,6 +150,55 @@ static void build_relax_std(scene *sc, int variant)
     build_relax(sc, 16);
 }
 
+/* A box resting on the ground under a sheet held still (every node pinned) a little wider than
+ * the box, 1 mm above its top: the nodes over the top face and its edges have candidates, and
+ * as nothing moves no step finds them again. */
+static void build_pinned(scene *sc, int variant)
+{
+    (void)variant;
+    ws_world_def wd;
+    ws_world_def_init(&wd);
+    wd.dt = 2.5e-4;
+    ck_assert_int_eq(ws_world_create(&wd, &sc->world), WS_OK);
+    ws_world *w = sc->world;
+    ws_material_id def;
+    ck_ok(w, ws_world_get_default_material(w, &def));
+    add_ground(w, 1.0, def);
+    sc->box = add_box(w, 0.25, 0.25, 0.25, 5.0, (ws_vec3){0, 0, 0.126}, def, "box");
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.stiffness = 100.0;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    md.name = "film";
+    ws_material_id film;
+    ck_ok(w, ws_material_create(w, &md, &film));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    ck_ok(w, ws_world_set_contact(w, film, def, &cd));
+    enum { N = 9 };
+    uint32_t pinned[N * N];
+    for (uint32_t i = 0; i < N * N; i++)
+        pinned[i] = i;
+    ws_web_def d;
+    ws_web_def_init(&d);
+    d.law = law;
+    d.node_mass = 5e-3;
+    d.material = film;
+    ws_sheet_def sh;
+    ws_sheet_def_init(&sh);
+    sh.nx = sh.ny = N;
+    sh.spacing_x = sh.spacing_y = 0.04;
+    sh.origin = (ws_vec3){-0.16, -0.16, 0.2525};
+    sh.pinned = pinned;
+    sh.pinned_count = N * N;
+    ck_ok(w, ws_web_create_sheet(w, &d, &sh, &sc->web));
+}
+
 /* ---- continuation ---- */
 
 /* Build, step `before` steps, save; step on `after` steps recording the hash of each. Build the
@@ -201,15 +250,41 @@ START_TEST(bodies_stick_slip_restore_between_full_detections)
     /* Case R unwrapped with stick friction, restored at t = 3.9005 s: the top box is at the
      * onset of slip (theta_c = 16.70 deg at 3.915 s), its stick anchors loaded, and the step is
      * the 2nd after a full detection (every 5th step from 0.5 s on: 15602 - 2000 = 13602 = 5 k
-     * + 2). 800 steps take it through the break-away. */
-    check_continuation(build_tilt, 8 | 2, 15602, 800, 15000, "case R unwrapped, stick");
+     * + 2). 800 steps take it through the break-away. Under WS_TEST_SHORT: at 0.6 s (the
+     * boxes stand on their anchors), the 2nd step after a full detection too. */
+    long at = short_run() ? 2402 : 15602;
+    scene sc;
+    build_tilt(&sc, 8 | 2);
+    ck_ok(sc.world, ws_world_step_n(sc.world, at));
+    size_t n;
+    unsigned char *buf = save_of(sc.world, &n);
+    /* The step count and the last full detection's follow the time and the 4 bodies. */
+    size_t o = 32 + 8 + 8 + 4 * (8 + 8 + 3 * 8 + 13 * 8);
+    uint64_t steps = 0, last = 0;
+    for (int i = 7; i >= 0; i--) {
+        steps = steps << 8 | buf[o + (size_t)i];
+        last = last << 8 | buf[o + 8 + (size_t)i];
+    }
+    ck_assert_uint_eq(steps, (uint64_t)at);
+    ck_assert_msg(steps - last >= 2 && steps - last < 5,
+                  "saved %llu steps after the last full detection: not between two",
+                  (unsigned long long)(steps - last));
+    free(buf);
+    ws_world_destroy(sc.world);
+    if (short_run())
+        check_continuation(build_tilt, 8 | 2, 2402, 200, 900, "case R unwrapped, stick");
+    else
+        check_continuation(build_tilt, 8 | 2, 15602, 800, 15000, "case R unwrapped, stick");
 }
 END_TEST
 
 START_TEST(bodies_regularised_sliding)
 {
     /* Case P unwrapped, regularised friction, restored as both boxes slide (4.5 s). */
-    check_continuation(build_tilt, 0, 18003, 600, 17000, "case P unwrapped, regularised");
+    if (short_run())
+        check_continuation(build_tilt, 0, 2403, 200, 900, "case P unwrapped, regularised");
+    else
+        check_continuation(build_tilt, 0, 18003, 600, 17000, "case P unwrapped, regularised");
 }
 END_TEST
 
@@ -219,6 +294,18 @@ START_TEST(wrapped_film_one_substep)
      * contacts and candidates come and go. */
     long before = short_run() ? 120 : 300, after = short_run() ? 100 : 300;
     check_continuation(build_tilt, 1, before, after, 77, "case P wrapped, 1 sub-step");
+}
+END_TEST
+
+START_TEST(into_a_fresh_world)
+{
+    /* Restored into a world built and never stepped: nothing it has in room or caches comes
+     * from a run of its own (its contacts' room for node candidates is empty). */
+    long before = short_run() ? 120 : 300, after = short_run() ? 50 : 100;
+    check_continuation(build_tilt, 1, before, after, 0, "case P wrapped, into a fresh world");
+    /* A film held still over a box: no step after the restore finds its candidates again, so
+     * the restore itself must make the contacts' room for them. */
+    check_continuation(build_pinned, 0, 200, 50, 0, "pinned film, into a fresh world");
 }
 END_TEST
 
@@ -390,7 +477,7 @@ START_TEST(refuses_bad_saves)
      * first body candidate's body a (after time, 2 body slots of structure and state, steps,
      * last full step, valid flag, travel and the candidate count) set to body 7. */
     memcpy(c, buf, n);
-    size_t body_bytes = 8 + 2 * (8 + 8 + 4 * 8 + 13 * 8);
+    size_t body_bytes = 8 + 2 * (8 + 8 + 3 * 8 + 13 * 8);
     size_t cand = 32 + 8 + body_bytes + 8 + 8 + 4 + 8;
     uint64_t ncand = 0;
     for (int i = 7; i >= 0; i--)
@@ -398,7 +485,7 @@ START_TEST(refuses_bad_saves)
     ck_assert_uint_gt(ncand, 0); /* the box stands on the ground: there are candidates */
     c[cand + 8] = 7;
     reseal(c, n);
-    expect_refused(b.world, c, n, WS_ERR_FORMAT, "names no feature pair");
+    expect_refused(b.world, c, n, WS_ERR_FORMAT, "contact candidate 0 (bodies 7, 1");
     ck_assert_int_eq(ws_world_restore(b.world, NULL, 5), WS_ERR_INVALID_ARGUMENT);
     ck_assert_int_eq(ws_world_restore(NULL, buf, n), WS_ERR_INVALID_ARGUMENT);
 
@@ -418,6 +505,50 @@ START_TEST(refuses_bad_saves)
     /* After all that, the good save is taken. */
     ck_ok(b.world, ws_world_restore(b.world, buf, n));
     ck_assert(hash_of(b.world) == hash_of(a.world));
+    free(c);
+    free(buf);
+    ws_world_destroy(a.world);
+    ws_world_destroy(b.world);
+}
+END_TEST
+
+START_TEST(every_byte_changed_is_refused_or_safe)
+{
+    /* A save whose checksum holds (made so, as a crafted file would be) with any one byte
+     * changed: the restore either refuses it, leaving the world as it was, or takes it, and
+     * then stepping never crashes (it may fail with WS_ERR_NUMERICAL on a value gone wild).
+     * Every byte of the state (every 29th under WS_TEST_SHORT). */
+    scene a, b;
+    build_relax(&a, 8);
+    ck_ok(a.world, ws_world_step_n(a.world, 250));
+    size_t n;
+    unsigned char *buf = save_of(a.world, &n), *c = malloc(n);
+    build_relax(&b, 8);
+    ck_ok(b.world, ws_world_restore(b.world, buf, n));
+    size_t stride = short_run() ? 29 : 1, refused = 0, taken = 0;
+    for (size_t i = 32; i < n; i += stride) {
+        memcpy(c, buf, n);
+        c[i] ^= (unsigned char)(0x5a ^ (i & 0xff));
+        reseal(c, n);
+        ws_status s = ws_world_restore(b.world, c, n);
+        if (s != WS_OK) {
+            ck_assert_int_eq(s, WS_ERR_FORMAT);
+            ck_assert(hash_of(b.world) == hash_of(a.world));
+            refused++;
+            continue;
+        }
+        taken++;
+        for (int k = 0; k < 3; k++) {
+            s = ws_world_step(b.world);
+            ck_assert_msg(s == WS_OK || s == WS_ERR_NUMERICAL,
+                          "byte %zu changed: a step gave %s (%s)", i, ws_status_string(s),
+                          ws_world_last_error(b.world));
+        }
+        ck_ok(b.world, ws_world_restore(b.world, buf, n));
+    }
+    report("one byte changed in a %zu-byte save (resealed): %zu refused, %zu taken and stepped",
+           n, refused, taken);
+    ck_assert_uint_gt(refused, 0);
     free(c);
     free(buf);
     ws_world_destroy(a.world);
@@ -502,7 +633,7 @@ START_TEST(out_of_memory_leaves_world)
     unsigned char *buf = save_of(a.world, &n);
     long k = 0;
     for (;; k++) {
-        test_alloc ta = {-1, 0, 0};
+        test_alloc ta = {.allocs_left = -1};
         scene b;
         build_relax_with(&b, 8, &ta);
         ta.allocs_left = k;
@@ -544,11 +675,14 @@ int main(void)
              bodies_stick_slip_restore_between_full_detections, 120);
     add_case(s, "bodies_regularised_sliding", bodies_regularised_sliding, 120);
     add_case(s, "wrapped_film_one_substep", wrapped_film_one_substep, 300);
+    add_case(s, "into_a_fresh_world", into_a_fresh_world, 300);
     add_case(s, "wrapped_film_substeps_stick", wrapped_film_substeps_stick, 300);
     add_case(s, "relaxing_film_and_element", relaxing_film_and_element, 120);
     add_case(s, "restore_rewinds", restore_rewinds, 60);
     add_case(s, "hash_covers_film_histories", hash_covers_film_histories, 60);
     add_case(s, "refuses_bad_saves", refuses_bad_saves, 60);
+    add_case(s, "every_byte_changed_is_refused_or_safe", every_byte_changed_is_refused_or_safe,
+             300);
     add_case(s, "save_sizes", save_sizes, 30);
     add_case(s, "files", files, 60);
     add_case(s, "out_of_memory_leaves_world", out_of_memory_leaves_world, 60);

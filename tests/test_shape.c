@@ -138,6 +138,73 @@ START_TEST(test_mesh_recentred)
 }
 END_TEST
 
+/* ---- placing a body where its mesh was ---- */
+
+/* A corner tetrahedron given in the global frame at (1, 2, 3): its volume centroid is the mean
+ * of its four corners, (1, 2, 3) + (a/4)(1, 1, 1). The offset the create call moved it by is
+ * that centroid, and a body created at position = offset (identity orientation) puts every
+ * original vertex back where it was given; turned by A about its CoG, at offset + A (v - offset).
+ * Coordinates ~3: 1e-12 m is a few hundred ulp. */
+START_TEST(test_centroid_offset_places_mesh)
+{
+    ws_world *w = new_world(2.5e-4);
+    const double a = 0.5, c[3] = {1.0, 2.0, 3.0};
+    double v[12] = {0, 0, 0, a, 0, 0, 0, a, 0, 0, 0, a};
+    static const uint32_t t[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    for (int k = 0; k < 12; k++)
+        v[k] += c[k % 3];
+    ws_shape_id s;
+    ck_ok(w, create_mesh(w, v, 4, t, 4, &s));
+    ws_vec3 off;
+    ck_ok(w, ws_shape_get_centroid_offset(w, s, &off));
+    ck_assert_double_eq_tol(off.x, c[0] + a / 4, 1e-12);
+    ck_assert_double_eq_tol(off.y, c[1] + a / 4, 1e-12);
+    ck_assert_double_eq_tol(off.z, c[2] + a / 4, 1e-12);
+    ws_shape_info i = info_of(w, s);
+    ck_assert(off.x == i.centroid.x && off.y == i.centroid.y && off.z == i.centroid.z);
+
+    double rv[12];
+    uint32_t rt[12];
+    size_t nv, nt;
+    ck_ok(w, ws_shape_copy_mesh(w, s, rv, 4, &nv, rt, 4, &nt));
+    const double h = 0.5 * sqrt(2.0); /* 90 deg about z: (x, y) -> (-y, x) */
+    const ws_quat q[2] = {{1, 0, 0, 0}, {h, 0, 0, h}};
+    for (int r = 0; r < 2; r++) {
+        ws_body_def bd;
+        ws_body_def_init(&bd);
+        bd.shape = s;
+        bd.mass = 1.0;
+        bd.position = off;
+        bd.orientation = q[r];
+        ws_body_id b;
+        ck_ok(w, ws_body_create(w, &bd, &b));
+        for (int k = 0; k < 4; k++) {
+            ws_vec3 local = {rv[3 * k], rv[3 * k + 1], rv[3 * k + 2]}, g;
+            ck_ok(w, ws_body_get_world_point(w, b, &local, &g));
+            /* The input vertex, turned about the offset point by the body's orientation. */
+            double dx = v[3 * k] - off.x, dy = v[3 * k + 1] - off.y, dz = v[3 * k + 2] - off.z;
+            ws_vec3 want = r == 0 ? (ws_vec3){v[3 * k], v[3 * k + 1], v[3 * k + 2]}
+                                  : (ws_vec3){off.x - dy, off.y + dx, off.z + dz};
+            ck_assert_msg(fabs(g.x - want.x) < 1e-12 && fabs(g.y - want.y) < 1e-12 &&
+                              fabs(g.z - want.z) < 1e-12,
+                          "orientation %d, vertex %d at (%.15g %.15g %.15g), want (%.15g %.15g "
+                          "%.15g)",
+                          r, k, g.x, g.y, g.z, want.x, want.y, want.z);
+        }
+    }
+    /* The builders are centred already; bad calls are errors, not crashes. */
+    ws_shape_id box;
+    ck_ok(w, ws_shape_create_box(w, 1, 2, 3, &box));
+    ck_ok(w, ws_shape_get_centroid_offset(w, box, &off));
+    ck_assert(fabs(off.x) + fabs(off.y) + fabs(off.z) < 1e-15);
+    ck_assert_int_eq(ws_shape_get_centroid_offset(w, box, NULL), WS_ERR_INVALID_ARGUMENT);
+    ck_ok(w, ws_shape_destroy(w, box));
+    ck_assert_int_eq(ws_shape_get_centroid_offset(w, box, &off), WS_ERR_STALE_HANDLE);
+    ck_assert_int_eq(ws_shape_get_centroid_offset(NULL, s, &off), WS_ERR_INVALID_ARGUMENT);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* ---- tetrahedron ---- */
 
 START_TEST(test_tetrahedron)
@@ -224,6 +291,18 @@ static void expect_rejected(ws_world *w, const double *v, size_t nv, const uint3
     ck_assert_msg(st == want, "expected %s ('%s'), got %s (%s)", ws_status_string(want), word,
                   ws_status_string(st), ws_world_last_error(w));
     ck_err_has(w, word);
+    /* A refused mesh says what to do about it, and the text ends with that hint (or with the
+     * reason), not with stray digits of a format's padding arguments. */
+    const char *e = ws_world_last_error(w);
+    size_t n = strlen(e);
+    if (want == WS_ERR_BAD_MESH && strstr(e, "triangles, got") == NULL &&
+        strstr(e, "does not exist") == NULL) {
+        ck_err_has(w, "repair");
+        ck_assert_msg(e[n - 1] == ')', "error does not end with its hint: '%s'", e);
+    }
+    if (want == WS_ERR_INVALID_ARGUMENT)
+        ck_assert_msg(n > strlen(word) && strcmp(e + n - strlen(word), word) == 0,
+                      "error does not end with '%s': '%s'", word, e);
     ck_assert_int_eq(ws_shape_is_valid(w, s), 0);
     /* Whatever was allocated for the checks was given back. */
     ck_ok(w, ws_world_get_stats(w, &after));
@@ -240,6 +319,15 @@ START_TEST(test_rejected_meshes)
 
     /* Open: the last triangle removed. */
     expect_rejected(w, cube_v, 8, cube_t, 11, WS_ERR_BAD_MESH, "closed");
+
+    /* Open, named by the edge the removed triangle left. */
+    expect_rejected(w, cube_v, 8, cube_t, 11, WS_ERR_BAD_MESH, "edge (");
+
+    /* Non-manifold: a triangle listed twice puts three triangles on each of its edges. */
+    memcpy(t, cube_t, sizeof cube_t);
+    memcpy(t + 36, cube_t, 3 * sizeof *cube_t);
+    expect_rejected(w, cube_v, 8, t, 13, WS_ERR_BAD_MESH, "not manifold");
+    ck_err_has(w, "belongs to 3 triangles");
 
     /* One triangle flipped: its edges run the same way as their neighbours'. */
     memcpy(t, cube_t, sizeof cube_t);
@@ -432,6 +520,7 @@ static Suite *shape_suite(void)
     /* Each case builds a few small meshes: well under a second; 10 s leaves room for slow CI. */
     add(s, "box", test_box, 10);
     add(s, "mesh_recentred", test_mesh_recentred, 10);
+    add(s, "centroid_offset_places_mesh", test_centroid_offset_places_mesh, 10);
     add(s, "tetrahedron", test_tetrahedron, 10);
     add(s, "cylinder_prism", test_cylinder_prism, 10);
     add(s, "rejected_meshes", test_rejected_meshes, 10);

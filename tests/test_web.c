@@ -1996,6 +1996,78 @@ START_TEST(test_spring_user_law_and_failure)
 }
 END_TEST
 
+/* A sheet lying on a box on the ground, in a world whose allocator records every block's size
+ * and checks the size of each free and realloc against it. */
+static ws_world *draped_world(test_alloc *a)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 1e-4;
+    a->track = 1;
+    a->allocs_left = -1;
+    test_alloc_install(&d, a);
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    add_ground(w, 1.0, no_material());
+    add_box(w, 0.2, 0.2, 0.2, 5.0, (ws_vec3){0, 0, 0.1 + 2e-3}, no_material(), "box");
+    ws_law_id law = make_law(w, WS_LAW_TENSION_COMPRESSION, 100.0, 1.0, 0.01, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 0.01;
+    wd.law = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = 12;
+    sd.spacing_x = sd.spacing_y = 0.02;
+    /* 0.22 m square, centred over the box, its nodes 0.5 mm above the touching layers. */
+    sd.origin = (ws_vec3){-0.11, -0.11, 0.2 + 2e-3 + 2e-3 + 0.5e-3};
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    return w;
+}
+
+/* Out of memory at each allocation of a film step in turn: the step fails with
+ * WS_ERR_OUT_OF_MEMORY and changes nothing, the world steps on once memory is back, and every
+ * free and realloc is given the size its block was allocated with (before the fix, the node
+ * contact scratch kept one array while its capacity read zero, and the web's per-body force
+ * arrays kept the old capacity when only some of them had grown). */
+START_TEST(test_oom_film_step_sizes)
+{
+    int done = 0;
+    long n, failures = 0;
+    for (n = 0; n < 400 && !done; n++) {
+        test_alloc a = {.allocs_left = -1};
+        ws_world *w = draped_world(&a);
+        uint64_t h0;
+        ck_ok(w, ws_world_get_state_hash(w, &h0));
+        a.allocs_left = n;
+        ws_status st = ws_world_step(w);
+        a.allocs_left = -1;
+        if (st == WS_OK) {
+            done = 1;
+        } else {
+            failures++;
+            ck_assert_msg(st == WS_ERR_OUT_OF_MEMORY, "N = %ld: %s (%s)", n, ws_status_string(st),
+                          ws_world_last_error(w));
+            uint64_t h1;
+            ck_ok(w, ws_world_get_state_hash(w, &h1));
+            ck_assert_msg(h1 == h0, "N = %ld: a failed step changed the state", n);
+        }
+        ck_ok(w, ws_world_step_n(w, 20));
+        ws_world_destroy(w);
+        ck_assert_msg(a.size_errors == 0, "N = %ld: %ld wrong sizes, first: %s", n, a.size_errors,
+                      a.size_error);
+        ck_assert_msg(a.live == 0 && a.bytes == 0, "N = %ld: %ld blocks, %lld bytes left", n,
+                      a.live, a.bytes);
+        test_alloc_done(&a);
+    }
+    ck_assert_msg(done, "the film step never succeeded");
+    report("film step: out of memory at each of its %ld allocations in turn, every free and "
+           "realloc given its block's size",
+           failures);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("web");
@@ -2021,5 +2093,6 @@ int main(void)
     add_case(s, "bulk_copies", test_bulk_copies, 10);
     add_case(s, "spring_relaxation", test_spring_relaxation, 10);
     add_case(s, "spring_user_law_and_failure", test_spring_user_law_and_failure, 10);
+    add_case(s, "oom_film_step_sizes", test_oom_film_step_sizes, 60);
     return run_suite(s);
 }

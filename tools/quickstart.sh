@@ -35,13 +35,14 @@ source tools/count_tests.sh
 # shellcheck source=tools/ensure_packages.sh
 source tools/ensure_packages.sh
 
-packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev)
+packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev zlib1g-dev)
 python_tests=0
 if [[ $mode == test ]]; then
     packages+=(valgrind)
     if [[ ${WS_PYTHON_TESTS:-1} != 0 ]]; then
         python_tests=1
-        packages+=(python3 python3-numpy python3-pytest python3-tqdm)
+        packages+=(python3 python3-numpy python3-pytest python3-tqdm python3-matplotlib
+            python3-distributed python3-yaml python3-jsonschema python3-meshio chromium)
     fi
 fi
 ensure_packages "${packages[@]}"

@@ -26,7 +26,7 @@ import sys
 import time
 
 TESTS = ["test_dynamics", "test_contact", "test_web", "test_tilt_table", "test_law",
-         "test_element", "test_detection"]
+         "test_element", "test_detection", "test_drive"]
 EXAMPLE_RUNS = [
     ("P", False),
     ("P", True),
@@ -1070,6 +1070,12 @@ def example_errors(text, wrapped, variant):
             notes.append("%s box slides at %s deg: %+.2f deg from tan(theta) = mu (%s deg)"
                          % (box, ang, d, th.group(1)))
     if tw:
+        m = re.search(r"passes over the stop's edge at (" + NUM + r") deg", text)
+        if m:
+            d = float(m.group(1)) - float(tw.group(1))
+            notes.append("the load's CoG passes over the stop's edge (the physical tip) at %s deg: "
+                         "%+.2f deg from the rigid-stack tipping angle %s deg"
+                         % (m.group(1), d, tw.group(1)))
         m = re.search(r"^\s*bottom\s+box: leans > 2 deg on its support from (" + NUM + r") deg", text, re.M)
         if m:
             d = float(m.group(1)) - float(tw.group(1))

@@ -10,7 +10,16 @@ theta = 16.70 deg, t = 3.915 s.
   of the bottom box, 7 s.
   Wrapped: a band of stretch film around both boxes (96 x 61 nodes, pre-stretch 40 % around and
   20 % up, springs of 2000 N/m, film-box contact 4000 N/m, mu 0.9). In R the wrapped stack tips
-  as one over the stop at tan(theta) = 0.125 / 0.23, theta = 28.52 deg, t = 5.978 s.
+  as one over the stop when its CoG passes over the stop's edge: tan(theta) = 0.125 / 0.23,
+  theta = 28.52 deg, t = 5.978 s, without the contact layers; 28.61 deg with them
+  (docs/theory.md 4.1); about 29.5-29.7 deg with Coulomb friction at the base.
+
+Definitions (the same as examples/tilt_table.c, checked on every step as it does):
+  slide onset: every contact of a box with its support slips (|v_t| >= v_lim = 10 mm/s, or the
+  stick anchor slides), the same way, without a break for 0.2 s; the onset is where that began.
+  physical tip (wrapped R): the load's CoG (boxes and film) passes over the stop's top edge,
+  interpolated between the samples around the crossing.
+  The run stops when a box leaves the platform (its CoG below the platform): no floor.
 
 Figures (PNG, in --out):
   cog_distance.png   distance between the two boxes' CoGs against time (the paper's Fig. 8)
@@ -30,13 +39,16 @@ import time
 
 import numpy as np
 
-import matplotlib
+import wrapsim as ws
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+try:  # the figures need matplotlib; the runs (run_case) do not
+    import matplotlib
 
-import wrapsim as ws  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+except ImportError:  # pragma: no cover - reported by main()
+    plt = None
 
 A = 0.25          # box edge, m
 MASS = 5.0        # kg per box
@@ -48,6 +60,9 @@ TILT_START = 1.0  # s
 TILT_RATE = 0.1   # rad/s
 T_SLIDE = TILT_START + math.atan(0.3) / TILT_RATE              # 3.915 s
 T_TIP = TILT_START + math.atan(0.125 / 0.23) / TILT_RATE       # 5.978 s
+SLIDE_HOLD = 0.2  # s: gross slip must last this long to count as a slide
+LIFT_HOLD = 0.05  # s: the uphill edge must stay off this long to count as tipping
+STOP_EDGE = (-0.01, 0.0, 0.01)  # the stop's top uphill edge in the 20 x 20 mm bar's frame, m
 
 
 def build(variant, wrapped, film_mass=1e-3, substeps=1):
@@ -106,30 +121,99 @@ def box_triangles(shape_mesh, body):
     return g[tris]
 
 
+def slides_on(w, box, support):
+    """Gross slip of box on its support: every contact between them slips, and they slip the
+    same way (|sum of slip velocities| >= half the sum of their sizes). The pair's report gives
+    each slip velocity as the box's on its support, whichever body owns the face."""
+    c = w.contacts_between(support, box)
+    if len(c) == 0 or not np.all(c["slipping"]):
+        return False
+    v = c["slip_velocity"]
+    return np.linalg.norm(v.sum(axis=0)) >= 0.5 * np.linalg.norm(v, axis=1).sum()
+
+
+def uphill_lifted(w, plane, box, R, r0):
+    """The bottom box touches the platform only downhill of its CoG, or not at all."""
+    c = w.contacts_between(plane, box)
+    xc = R.T @ (box.position - r0)
+    return bool(np.all((c["point"] - r0) @ R[:, 0] >= xc[0]))
+
+
+def load_cog(boxes, film, node_mass):
+    """Centre of mass of the boxes and, when wrapped, the film's nodes."""
+    m = sum(b.mass for b in boxes)
+    x = sum(b.mass * b.position for b in boxes)
+    if film is not None:
+        p = film.positions()
+        m += node_mass * len(p)
+        x = x + node_mass * p.sum(axis=0)
+    return x / m
+
+
 def run_case(variant, wrapped, duration, snap_times, every=0.01):
-    """Run one case; returns its time series and snapshots."""
+    """Run one case; returns its time series, snapshots and the onsets it found."""
     sc = build(variant, wrapped)
     w, plane, (bottom, top), film = sc["world"], sc["plane"], sc["boxes"], sc["film"]
+    stop = sc["stop"]
     mesh = sc["cube"].copy_mesh()
     plane_mesh = sc["slab"].copy_mesh()
-    stop_mesh = sc["bar"].copy_mesh() if sc["stop"] is not None else None
+    stop_mesh = sc["bar"].copy_mesh() if stop is not None else None
     chunk = int(round(every / DT))
     n_samples = int(round(duration / every)) + 1
+    node_mass = film.info()["mass"] / film.node_count if film is not None else 0.0
+    watch_tip = film is not None and stop is not None
 
     t = np.empty(n_samples)
     pos = np.empty((n_samples, 2, 3))
     vel = np.empty((n_samples, 2, 3))
     local = np.empty((n_samples, 2, 3))   # CoG in the platform's frame, m
     angle = np.empty(n_samples)           # platform angle, rad
+    past = np.full(n_samples, np.nan)     # load CoG past the stop edge, horizontally downhill, m
     peak_tension = np.zeros(n_samples) if film is not None else None
     tension = np.empty(film.spring_count) if film is not None else None
     snaps = []
     snap_steps = {int(round(s / every)): s for s in snap_times if 0 <= s <= duration}
 
+    # The slide and lift detectors of examples/tilt_table.c, run on every step's state like it.
+    hold_steps, lift_steps = int(round(SLIDE_HOLD / DT)), int(round(LIFT_HOLD / DT))
+    slipping_steps, slide, confirmed = [0, 0], [None, None], [False, False]
+    lifted_steps, lift_confirmed, off = 0, False, [None, None]
+
+    def observe(tn):
+        nonlocal lifted_steps, lift_confirmed
+        R, r0 = plane.rotation, plane.position
+        q = plane.orientation
+        theta = 2.0 * math.atan2(q[2], q[0])
+        for k, (b, support) in enumerate(((bottom, plane), (top, bottom))):
+            if off[k] is None and (R.T @ (b.position - r0))[2] < 0.0:
+                off[k] = tn
+            standing = not lift_confirmed and off[k] is None
+            slipping_steps[k] = slipping_steps[k] + 1 if standing and slides_on(w, b, support) \
+                else 0
+            if slide[k] is None and tn > TILT_START and slipping_steps[k] == 1:
+                slide[k] = (tn, math.degrees(theta))  # candidate onset
+            if slide[k] is not None and slipping_steps[k] == 0 and not confirmed[k]:
+                slide[k] = None  # it did not last
+            if slipping_steps[k] >= hold_steps:
+                confirmed[k] = True
+        if not lift_confirmed:
+            if tn > TILT_START and uphill_lifted(w, plane, bottom, R, r0):
+                lifted_steps += 1
+                lift_confirmed = lifted_steps >= lift_steps
+            else:
+                lifted_steps = 0
+
     t0 = time.monotonic()
+    n = 0
     for n in range(n_samples):
         if n:
-            w.step(chunk)
+            for _ in range(chunk):
+                w.step(1)
+                observe(w.time)
+                if off[0] is not None or off[1] is not None:
+                    break
+        else:
+            observe(w.time)
         t[n] = w.time
         R, r0 = plane.rotation, plane.position
         q = plane.orientation
@@ -138,28 +222,50 @@ def run_case(variant, wrapped, duration, snap_times, every=0.01):
             pos[n, k] = b.position
             vel[n, k] = b.velocity
             local[n, k] = R.T @ (pos[n, k] - r0)
+        if watch_tip:
+            e = stop.world_point(STOP_EDGE)
+            h = np.array([R[0, 0], R[1, 0]]) / math.hypot(R[0, 0], R[1, 0])  # downhill, level
+            past[n] = (load_cog((bottom, top), film, node_mass) - e)[:2] @ h
         if film is not None:
             peak_tension[n] = film.tensions(out=tension).max()
         if n in snap_steps:
             snap = dict(t=t[n], boxes=[box_triangles(mesh, b) for b in (bottom, top)],
                         plane=box_triangles(plane_mesh, plane),
-                        stop=(box_triangles(stop_mesh, sc["stop"]) if stop_mesh else None),
+                        stop=(box_triangles(stop_mesh, stop) if stop_mesh else None),
                         film=film.positions().copy() if film is not None else None,
                         film_grid=(film.info()["ny"], film.info()["nx"]) if film else None)
             snaps.append(snap)
         if n and n % 100 == 0:
             sys.stderr.write(f"\r  {variant} {'wrapped' if wrapped else 'unwrapped'}: "
                              f"t = {t[n]:.2f} s of {duration:.2f} s")
+        if off[0] is not None or off[1] is not None:
+            break  # a box left the platform: the world has no floor, it would only fall
     wall = time.monotonic() - t0
     sys.stderr.write(f"\r  {variant} {'wrapped' if wrapped else 'unwrapped'}: "
-                     f"{duration:.2f} s simulated in {wall:.1f} s wall\n")
+                     f"{t[n]:.2f} s simulated in {wall:.1f} s wall\n")
     h = w.state_hash()
     w.close()
+    end = n + 1
+    t, pos, vel, local, angle = t[:end], pos[:end], vel[:end], local[:end], angle[:end]
+    past = past[:end]
+    if peak_tension is not None:
+        peak_tension = peak_tension[:end]
+    slide = [sl if ok else None for sl, ok in zip(slide, confirmed)]
+
+    # Physical tip: the first crossing of the stop edge, interpolated in the angle.
+    tip = None
+    if watch_tip:
+        idx = np.nonzero((past[1:] >= 0) & (past[:-1] < 0))[0]
+        if len(idx):
+            i = idx[0]
+            f = -past[i] / (past[i + 1] - past[i])
+            tip = (t[i] + f * (t[i + 1] - t[i]),
+                   math.degrees(angle[i] + f * (angle[i + 1] - angle[i])))
     slip = local[:, :, 0] - local[0, :, 0]
     return dict(variant=variant, wrapped=wrapped, t=t, pos=pos, vel=vel, local=local,
                 slip=slip, angle=angle, dist=np.linalg.norm(pos[:, 1] - pos[:, 0], axis=1),
                 speed=np.linalg.norm(vel, axis=2), peak_tension=peak_tension, snaps=snaps,
-                wall=wall, hash=h)
+                wall=wall, hash=h, slide=slide, tip=tip, off=off)
 
 
 def label(r):
@@ -209,7 +315,7 @@ def plot_per_box(results, variant, path, series, scale, ylabel, title, legend, c
     if clip is not None and top > clip:
         low = min(scale * r[series].min() for r in results)
         ax.set_ylim(min(low, 0.0) - 0.05 * clip, clip)
-        ax.text(0.99, 0.02, f"clipped at {clip:g} (largest {top:.0f})", transform=ax.transAxes,
+        ax.text(0.99, 0.02, f"clipped at {clip:g} (largest {top:.3g})", transform=ax.transAxes,
                 ha="right", va="bottom", fontsize=8, color="0.3")
     ax.set_xlabel("time t [s]")
     ax.set_ylabel(ylabel)
@@ -224,7 +330,7 @@ def plot_per_box(results, variant, path, series, scale, ylabel, title, legend, c
 def plot_velocities(results, variant, path):
     plot_per_box(results, variant, path, "speed", 1.0, "box speed |v| [m/s]",
                  f"Tilt table, variant {variant}: speed of the boxes' CoGs",
-                 dict(loc="upper left", fontsize=8))
+                 dict(loc="upper left", fontsize=8), clip=1.0)
 
 
 def plot_slip(results, variant, path):
@@ -274,11 +380,6 @@ def plot_snapshots(results, variant, path):
     plt.close(fig)
 
 
-def first_crossing(t, y, level):
-    idx = np.nonzero(y > level)[0]
-    return t[idx[0]] if len(idx) else float("nan")
-
-
 def summary(r):
     t = r["t"]
     print(f"{label(r)}: {r['t'][-1]:.2f} s simulated, {r['wall']:.1f} s wall, "
@@ -286,10 +387,16 @@ def summary(r):
     print(f"  CoG distance: {1e3 * r['dist'][0]:.1f} mm at start, "
           f"{1e3 * r['dist'][-1]:.1f} mm at the end (max {1e3 * r['dist'].max():.1f} mm)")
     for k, name in enumerate(("bottom", "top")):
-        ts = first_crossing(t, r["slip"][:, k], 0.005)
-        print(f"  {name:6s}: slip > 5 mm from t = {ts:.3f} s; final slip "
-              f"{1e3 * r['slip'][-1, k]:.1f} mm; peak speed {r['speed'][:, k].max():.3f} m/s "
-              f"(t = {t[np.argmax(r['speed'][:, k])]:.2f} s)")
+        sl = r["slide"][k]
+        onset = (f"starts to slide at {sl[1]:.2f} deg (t = {sl[0]:.3f} s)"
+                 if sl is not None else "did not slide on its support")
+        print(f"  {name:6s}: {onset}; final slip {1e3 * r['slip'][-1, k]:.1f} mm; peak speed "
+              f"{r['speed'][:, k].max():.3f} m/s (t = {t[np.argmax(r['speed'][:, k])]:.2f} s)")
+        if r["off"][k] is not None:
+            print(f"  {name:6s}: left the platform at t = {r['off'][k]:.2f} s; the run stops there")
+    if r["tip"] is not None:
+        print(f"  the load's CoG (boxes and film) passes over the stop's edge at "
+              f"{r['tip'][1]:.2f} deg (t = {r['tip'][0]:.3f} s)")
     if r["peak_tension"] is not None:
         print(f"  film: peak spring tension {r['peak_tension'].max():.2f} N")
 
@@ -307,6 +414,8 @@ def main(argv=None):
                    help="times (s) of the 3D views (default 1.0, 4.5, 6.2 for R; "
                         "1.0, 3.5, 4.5 for P)")
     a = p.parse_args(argv)
+    if plt is None:
+        p.error("the figures need matplotlib (Debian: apt-get install python3-matplotlib)")
     variant = a.variant.upper()
     duration = a.duration if a.duration > 0 else (6.0 if variant == "P" else 7.0)
     cases = []
@@ -320,8 +429,12 @@ def main(argv=None):
 
     print(f"libwrapsim {ws.version()}: tilt table, variant {variant}, {duration:.2f} s")
     print(f"  theory: sliding at tan(theta) = 0.3, theta = 16.70 deg, t = {T_SLIDE:.3f} s")
+    print(f"  slide onset: every contact with its support slips (|v_t| >= v_lim = "
+          f"{1e3 * VLIM:.0f} mm/s) the same way, for {SLIDE_HOLD:.1f} s")
     if variant == "R" and True in cases:
-        print(f"  theory, wrapped: tips over the stop at theta = 28.52 deg, t = {T_TIP:.3f} s")
+        print(f"  theory, wrapped: the CoG passes over the stop's edge at 28.52 deg "
+              f"(t = {T_TIP:.3f} s) without layers, 28.61 deg with them (docs/theory.md 4.1), "
+              f"about 29.5-29.7 deg with Coulomb friction at the base")
     results = [run_case(variant, wr, duration, snaps) for wr in cases]
     for r in results:
         summary(r)

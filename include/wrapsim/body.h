@@ -118,7 +118,7 @@ typedef enum ws_sweep_law {
 
 /** The ASTM D4169 truck levels (D4169-16 calls them low, medium, high). */
 typedef enum ws_truck_level {
-    WS_TRUCK_LOW = 1,    /**< 0.40 Grms (formerly assurance level III's place) */
+    WS_TRUCK_LOW = 1,    /**< 0.40 Grms */
     WS_TRUCK_MEDIUM = 2, /**< 0.54 Grms */
     WS_TRUCK_HIGH = 3    /**< 0.70 Grms */
 } ws_truck_level;
@@ -218,15 +218,35 @@ typedef struct ws_drive_state {
 } ws_drive_state;
 
 /** Fill a body Def with defaults (dynamic, density 1000 kg/m^3, layer 1 mm, identity
- *  orientation). `def` must not be NULL (NULL is ignored). */
-WS_API void ws_body_def_init(ws_body_def *def);
+ *  orientation). `def` must not be NULL (NULL is ignored).
+ *  ws_body_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_body_def_init_sized(ws_body_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_body_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_body_def_init)(ws_body_def *def);
+#define ws_body_def_init(def) ws_body_def_init_sized((def), sizeof *(def))
 /** Fill a drive Def with defaults (static, ramp 0.05 s, axis y, direction x, stop ramp 1 s, rise
  *  0.05 s, hold 0.3 s, gentle acceleration 1 m/s^2, coast 0.5 s, impact pulse 0.01 s, table
- *  ending at rest, sample rate 1024 Hz, log sweep). NULL is ignored. */
-WS_API void ws_drive_def_init(ws_drive_def *def);
+ *  ending at rest, sample rate 1024 Hz, log sweep). NULL is ignored.
+ *  ws_drive_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_drive_def_init_sized(ws_drive_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_drive_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_drive_def_init)(ws_drive_def *def);
+#define ws_drive_def_init(def) ws_drive_def_init_sized((def), sizeof *(def))
+
+/** Smallest mass of a dynamic body, kg (a milligram): lighter ones are refused. */
+#define WS_BODY_MIN_MASS 1e-6
+/** Largest mass of a dynamic body, kg (a million tonnes): heavier ones are refused. Between the
+ *  two, a body's inertia and its inverse stay far from overflow and underflow. */
+#define WS_BODY_MAX_MASS 1e9
 
 /** Create a body.
- *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (mass <= 0, inertia not positive definite, NaN, zero
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (mass <= 0 or outside [WS_BODY_MIN_MASS,
+ *  WS_BODY_MAX_MASS], inertia not symmetric positive definite or its principal moments J1, J2,
+ *  J3 not a rigid body's (each must be at most the sum of the other two), NaN, zero
  *  quaternion...), WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE (shape or material),
  *  WS_ERR_OUT_OF_MEMORY. */
 WS_API ws_status ws_body_create(ws_world *world, const ws_body_def *def, ws_body_id *out);

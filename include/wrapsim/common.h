@@ -41,7 +41,10 @@ typedef enum ws_status {
     WS_ERR_BUFFER_TOO_SMALL = 9,  /**< a bulk copy got less room than it needs; count says how much */
     WS_ERR_IO = 10,               /**< a file could not be read or written */
     WS_ERR_UNSUPPORTED = 11,      /**< a feature this build does not have (e.g. libccd) */
-    WS_ERR_FORMAT = 12            /**< a saved state that is truncated, corrupted, of a newer
+    /** a call that changes the world (create, destroy, set, step) made from a callback inside
+     *  ws_world_step; getters are allowed there */
+    WS_ERR_IN_STEP = 12,
+    WS_ERR_FORMAT = 13            /**< a saved state that is truncated, corrupted, of a newer
                                        format or of a world built otherwise; nothing changed */
 } ws_status;
 
@@ -71,7 +74,19 @@ typedef struct ws_pose {
     ws_quat orientation; /**< Euler parameters, unit */
 } ws_pose;
 
-/* Ids: a slot, a generation and a world tag packed into 64 bits; zero is the null id. Each kind
+/* Defs. Every ws_x_def starts with its size and a magic number. ws_x_def_init(def) is a macro
+ * calling the exported ws_x_def_init_sized(def, sizeof *def): it fills the caller's Def with
+ * defaults, min(size, the library's sizeof) bytes of it and zeros past them, and records that
+ * size in def->size. ws_x_create reads only def->size bytes and gives every later field its
+ * default, so a program built against an older, smaller Def keeps working with a newer library
+ * and its stack is never written past its Def. The plain function ws_x_def_init, reached by
+ * programs built against headers before the sized form, fills the layout of those headers. */
+
+/* Ids: opaque 64-bit values, [kind:4][generation:32][slot+1:28]; zero is the null id. Every call
+ * that takes an id refuses a destroyed one (WS_ERR_STALE_HANDLE) in any lifetime: a slot whose
+ * 32-bit generation would repeat is retired, never reused. An id of another world is refused
+ * except with odds of about 2^-32 per call (generations start from a per-world random salt).
+ * Each kind
  * has its own type so that a body id cannot be passed where a shape id is expected. */
 /** A rigid body or world element. */
 typedef struct ws_body_id {
@@ -117,7 +132,8 @@ WS_API const char *ws_version_string(void);
 
 /** Optional features built in. */
 enum {
-    WS_FEATURE_CCD = 1 /**< libccd narrow-phase gate available */
+    WS_FEATURE_CCD = 1, /**< libccd narrow-phase gate available */
+    WS_FEATURE_ZLIB = 2 /**< zlib-compressed VTK output (WS_VTK_COMPRESSED) available */
 };
 /** Bit set of WS_FEATURE_* compiled into this library. */
 WS_API unsigned ws_build_features(void);

@@ -121,8 +121,14 @@ typedef struct ws_element_output {
 } ws_element_output;
 
 /** Fill an element Def with defaults (a rod, invariant formulation, points at the bodies'
- *  origins, frames automatic, rest length from the geometry). NULL is ignored. */
-WS_API void ws_element_def_init(ws_element_def *def);
+ *  origins, frames automatic, rest length from the geometry). NULL is ignored.
+ *  ws_element_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_element_def_init_sized(ws_element_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_element_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_element_def_init)(ws_element_def *def);
+#define ws_element_def_init(def) ws_element_def_init_sized((def), sizeof *(def))
 /** Create an element. The law's history (if any) starts relaxed at the world's time; the
  *  element counts as a user of its law and of its bodies, which cannot be destroyed before it.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (a law of the wrong dim, both ends the world, the

@@ -45,6 +45,14 @@ typedef struct ws_law_id {
 #define WS_LAW_MAX_TERMS 16
 /** Largest number of Prony branches of a WS_LAW_RELAXATION. */
 #define WS_LAW_MAX_PRONY 16
+/** Most doubles of history a law may need per user (ws_law_get_state_size), with everything its
+ *  sums and scalings contain: a sum of 16 dim-6 relaxation laws of 16 branches needs 1632. A
+ *  law that would need more is refused at create. */
+#define WS_LAW_MAX_HISTORY 4096
+/** Most leaf laws (laws that are neither sums nor scalings) one evaluation may visit, counting
+ *  a law each time it appears: a sum of 16 sums of 16 laws has 256. Sums of sums that would
+ *  visit more are refused at create, so the cost of an evaluation stays bounded. */
+#define WS_LAW_MAX_LEAVES 256
 
 /** Kinds of laws. In the formulas u is the strain, u_dot its rate, K the stiffness
  *  (`stiffness` times the identity, or `stiffness_matrix`) and C the damping (`damping` times
@@ -199,8 +207,14 @@ typedef struct ws_law_info {
 
 /** Fill a law Def with defaults (linear elastic, dim 1, no damping, transition 1e-3, scale 1,
  *  stop_low -INFINITY, stop_high +INFINITY, user_flags elastic and viscous; the stiffness must
- *  be set). NULL is ignored. */
-WS_API void ws_law_def_init(ws_law_def *def);
+ *  be set). NULL is ignored.
+ *  ws_law_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_law_def_init_sized(ws_law_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_law_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_law_def_init)(ws_law_def *def);
+#define ws_law_def_init(def) ws_law_def_init_sized((def), sizeof *(def))
 /** Create a law. Arrays of the Def are copied; laws named by `terms` or `base` count the new
  *  law as a user. @return WS_OK, WS_ERR_INVALID_ARGUMENT (a bad field: the last error names
  *  it), WS_ERR_STALE_HANDLE (a term or base that is not a live law of this world),

@@ -120,14 +120,38 @@ typedef struct ws_containment_band {
     double contact_force;  /**< total normal force of the bodies on its nodes, N */
 } ws_containment_band;
 
-/** Fill a web Def with defaults (layer 1 mm, 1 sub-step; the law and a mass must be set). */
-WS_API void ws_web_def_init(ws_web_def *def);
-/** Fill a sheet Def with defaults (axes x and y; sizes and spacings must be set). */
-WS_API void ws_sheet_def_init(ws_sheet_def *def);
-/** Fill a band Def with defaults (no pre-stretch, no gap; bodies, heights, counts must be set). */
-WS_API void ws_band_def_init(ws_band_def *def);
-/** Fill a mesh-web Def with defaults (empty). */
-WS_API void ws_web_mesh_def_init(ws_web_mesh_def *def);
+/** Fill a web Def with defaults (layer 1 mm, 1 sub-step; the law and a mass must be set).
+ *  ws_web_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_web_def_init_sized(ws_web_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_web_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_web_def_init)(ws_web_def *def);
+#define ws_web_def_init(def) ws_web_def_init_sized((def), sizeof *(def))
+/** Fill a sheet Def with defaults (axes x and y; sizes and spacings must be set).
+ *  ws_sheet_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_sheet_def_init_sized(ws_sheet_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_sheet_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_sheet_def_init)(ws_sheet_def *def);
+#define ws_sheet_def_init(def) ws_sheet_def_init_sized((def), sizeof *(def))
+/** Fill a band Def with defaults (no pre-stretch, no gap; bodies, heights, counts must be set).
+ *  ws_band_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_band_def_init_sized(ws_band_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_band_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_band_def_init)(ws_band_def *def);
+#define ws_band_def_init(def) ws_band_def_init_sized((def), sizeof *(def))
+/** Fill a mesh-web Def with defaults (empty).
+ *  ws_web_mesh_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_web_mesh_def_init_sized(ws_web_mesh_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_web_mesh_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_web_mesh_def_init)(ws_web_mesh_def *def);
+#define ws_web_mesh_def_init(def) ws_web_mesh_def_init_sized((def), sizeof *(def))
 
 /** Create a sheet. @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF,
  *  WS_ERR_STALE_HANDLE (a law or material), WS_ERR_OUT_OF_MEMORY. */

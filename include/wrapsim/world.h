@@ -115,22 +115,43 @@ typedef struct ws_energy {
     double contact;       /**< elastic energy stored in the penalty springs, k overlap^2 / 2 */
 } ws_energy;
 
-/** Fill a world Def with defaults. `def` must not be NULL. */
-WS_API void ws_world_def_init(ws_world_def *def);
-/** Fill a contact Def with defaults. */
-WS_API void ws_contact_def_init(ws_contact_def *def);
-/** Fill a material Def with defaults. */
-WS_API void ws_material_def_init(ws_material_def *def);
+/** Fill a world Def with defaults. `def` must not be NULL.
+ *  ws_world_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_world_def_init_sized(ws_world_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_world_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_world_def_init)(ws_world_def *def);
+#define ws_world_def_init(def) ws_world_def_init_sized((def), sizeof *(def))
+/** Fill a contact Def with defaults.
+ *  ws_contact_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_contact_def_init_sized(ws_contact_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_contact_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_contact_def_init)(ws_contact_def *def);
+#define ws_contact_def_init(def) ws_contact_def_init_sized((def), sizeof *(def))
+/** Fill a material Def with defaults.
+ *  ws_material_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_material_def_init_sized(ws_material_def *def, size_t size);
+/** The plain form, for programs built against headers before ws_material_def_init_sized: fills
+ *  the Def as those headers laid it out, never more. New code reaches the macro below. */
+WS_API void(ws_material_def_init)(ws_material_def *def);
+#define ws_material_def_init(def) ws_material_def_init_sized((def), sizeof *(def))
 
 /** Create a world. On error *out is NULL.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, dt <= 0, NaN...), WS_ERR_UNINITIALIZED_DEF,
  *          WS_ERR_OUT_OF_MEMORY. Without a world there is no last error: see the status. */
 WS_API ws_status ws_world_create(const ws_world_def *def, ws_world **out);
-/** Destroy a world and everything in it. NULL is allowed and does nothing. */
+/** Destroy a world and everything in it. NULL is allowed and does nothing. Called from a
+ *  callback inside ws_world_step it does nothing but set the last error (WS_ERR_IN_STEP). */
 WS_API void ws_world_destroy(ws_world *world);
 
 /** Advance one step dt. On WS_ERR_NUMERICAL (or a callback error) the world is left exactly as it
- *  was before the call and ws_world_last_error() says which body and what to change. */
+ *  was before the call and ws_world_last_error() says which body and what to change.
+ *  Callbacks run inside a step (drives, laws, the log hook) may read the world with any getter;
+ *  every call that changes it (create, destroy, set, step) returns WS_ERR_IN_STEP there. */
 WS_API ws_status ws_world_step(ws_world *world);
 /** Take up to `steps` steps, stopping at the first error. */
 WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);
@@ -148,8 +169,10 @@ WS_API ws_status ws_world_get_stats(const ws_world *world, ws_world_stats *stats
 /** Energy of the dynamic bodies (contact energy from the last step's contacts). */
 WS_API ws_status ws_world_get_energy(const ws_world *world, ws_energy *energy);
 /** A 64-bit hash of the whole dynamic state (time, every body's pose and velocities, friction
- *  anchors, every film node's position and velocity, the law histories of the elements). Equal
- *  hashes after equal inputs: the determinism check. */
+ *  anchors, every film node's position and velocity, the law histories of the film's springs and
+ *  of the elements): FNV-1a over the little-endian bytes of the state a save holds
+ *  (ws_world_save), less the contact caches' bookkeeping, which a failed step may change. Equal
+ *  hashes after equal inputs, on every machine: the determinism check. */
 WS_API ws_status ws_world_get_state_hash(const ws_world *world, uint64_t *hash);
 /** The detail of the last error in this world ("body 'top': mass must be > 0, got -1"); ""
  *  when there was none. Valid until the next call on the world. NULL world gives a static text. */

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static void *default_alloc(void *user, size_t bytes)
 {
@@ -133,14 +134,67 @@ int ws_def_reset(void *def, size_t size)
     return 1;
 }
 
-int ws_def_check(const void *def, size_t min_size)
+void ws_def_fill(void *def, size_t size, const void *full, size_t full_size)
 {
-    const uint32_t *hdr = def;
+    if (!def || size < WS_DEF_HEADER_SIZE)
+        return;
+    size_t n = size < full_size ? size : full_size;
+    memcpy(def, full, n);
+    if (size > n)
+        memset((unsigned char *)def + n, 0, size - n);
+    uint32_t hdr = (uint32_t)n;
+    memcpy(def, &hdr, sizeof hdr);
+}
+
+int ws_def_check(const void *def)
+{
+    uint32_t hdr[2];
     if (!def)
         return -1;
-    if (hdr[1] != WS_DEF_MAGIC || hdr[0] < min_size)
+    memcpy(hdr, def, sizeof hdr);
+    if (hdr[1] != WS_DEF_MAGIC || hdr[0] < WS_DEF_HEADER_SIZE)
         return -1;
     return 0;
+}
+
+void ws_def_copy(void *dst, size_t full, const void *src)
+{
+    uint32_t size;
+    memcpy(&size, src, sizeof size);
+    memcpy(dst, src, size < full ? size : full);
+    uint32_t hdr = (uint32_t)full;
+    memcpy(dst, &hdr, sizeof hdr);
+}
+
+/* A 64-bit finaliser (splitmix64's): every input bit moves about half of the output bits. */
+static uint64_t mix64(uint64_t x)
+{
+    x ^= x >> 30;
+    x *= 0xbf58476d1ce4e5b9ull;
+    x ^= x >> 27;
+    x *= 0x94d049bb133111ebull;
+    x ^= x >> 31;
+    return x;
+}
+
+uint32_t ws_id_salt(const void *world)
+{
+    /* Two worlds made one after the other at the same address differ in the wall clock, read
+     * to the nanosecond; the processor clock and a stack address add what they can. */
+    struct timespec ts = {0, 0};
+    (void)timespec_get(&ts, TIME_UTC);
+    uint64_t h = mix64((uint64_t)(uintptr_t)world);
+    h = mix64(h ^ (uint64_t)ts.tv_sec);
+    h = mix64(h ^ (uint64_t)ts.tv_nsec);
+    h = mix64(h ^ (uint64_t)clock());
+    h = mix64(h ^ (uint64_t)(uintptr_t)&ts);
+    return (uint32_t)(h ^ (h >> 32));
+}
+
+uint32_t ws_slots_first_generation(const ws_slot_table *t, uint32_t slot)
+{
+    uint64_t h = mix64(((uint64_t)t->salt << 32) | slot);
+    return (uint32_t)(h ^ (h >> 32));
 }
 
 void ws_slots_destroy(ws_mem *mem, ws_slot_table *t)
@@ -148,7 +202,9 @@ void ws_slots_destroy(ws_mem *mem, ws_slot_table *t)
     ws_mem_free(mem, t->dense, t->capacity * sizeof *t->dense);
     ws_mem_free(mem, t->generation, t->capacity * sizeof *t->generation);
     ws_mem_free(mem, t->free_list, t->capacity * sizeof *t->free_list);
+    uint32_t salt = t->salt;
     memset(t, 0, sizeof *t);
+    t->salt = salt;
 }
 
 int ws_slots_take(ws_mem *mem, ws_slot_table *t, uint32_t *slot)
@@ -184,7 +240,7 @@ int ws_slots_take(ws_mem *mem, ws_slot_table *t, uint32_t *slot)
         t->capacity = cap;
     }
     *slot = (uint32_t)t->slot_count;
-    t->generation[*slot] = 1;
+    t->generation[*slot] = ws_slots_first_generation(t, *slot);
     t->dense[*slot] = UINT32_MAX;
     t->slot_count++;
     return 0;
@@ -193,9 +249,13 @@ int ws_slots_take(ws_mem *mem, ws_slot_table *t, uint32_t *slot)
 void ws_slots_release(ws_slot_table *t, uint32_t slot)
 {
     t->dense[slot] = UINT32_MAX;
-    t->generation[slot] = (t->generation[slot] + 1u) & 0xFFFFFu;
-    if (t->generation[slot] == 0)
-        t->generation[slot] = 1;
+    t->generation[slot]++; /* modulo 2^32 */
+    /* Back at the first generation: every id this slot could carry has been used; reusing it
+     * would let a long-dead id name the new occupant. */
+    if (t->generation[slot] == ws_slots_first_generation(t, slot)) {
+        t->retired++;
+        return;
+    }
     t->free_list[t->free_count++] = slot;
 }
 

@@ -15,6 +15,7 @@ const char *ws_status_string(ws_status status)
     case WS_ERR_BUFFER_TOO_SMALL: return "WS_ERR_BUFFER_TOO_SMALL: the buffer holds fewer items than there are";
     case WS_ERR_IO: return "WS_ERR_IO: a file could not be read or written";
     case WS_ERR_UNSUPPORTED: return "WS_ERR_UNSUPPORTED: this build lacks the feature";
+    case WS_ERR_IN_STEP: return "WS_ERR_IN_STEP: a call that changes the world was made from a callback inside ws_world_step";
     case WS_ERR_FORMAT: return "WS_ERR_FORMAT: the saved state is truncated, corrupted, of a newer format or of another world's structure";
     }
     return "unknown ws_status";
@@ -32,9 +33,12 @@ const char *ws_version_string(void)
 
 unsigned ws_build_features(void)
 {
+    unsigned features = 0;
 #ifdef WS_HAVE_CCD
-    return WS_FEATURE_CCD;
-#else
-    return 0;
+    features |= WS_FEATURE_CCD;
 #endif
+#ifdef WS_HAVE_ZLIB
+    features |= WS_FEATURE_ZLIB;
+#endif
+    return features;
 }

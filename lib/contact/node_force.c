@@ -1155,13 +1155,18 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
                           ? ncand + 4
                           : web->act_cap + web->act_cap / 2;
         need = (((need + 7) / 8) | 1) * 8;
+        /* The new room is taken before the old is let go: out of memory, the web keeps the
+         * room it had, of the size it had (a restore that fails leaves the world as it was). */
+        double *act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
+        uint32_t *act_id = act ? ws_mem_calloc(mem, need * 4, sizeof(uint32_t)) : NULL;
+        if (!act_id) {
+            ws_mem_free(mem, act, act ? need * ACT_ARRAYS * sizeof(double) : 0);
+            return -1;
+        }
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
-        web->act_cap = 0;
-        web->act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
-        web->act_id = ws_mem_calloc(mem, need * 4, sizeof(uint32_t));
-        if (!web->act || !web->act_id)
-            return -1;
+        web->act = act;
+        web->act_id = act_id;
         web->act_cap = need;
     }
     return 0;

@@ -65,10 +65,19 @@ void ws_drive_tilt_angle(const ws_drive_def *def, double stop_ramp, double t, do
     *angacc = ac;
 }
 
+/* WS_ERR_INVALID_ARGUMENT with the reason: `fmt` takes the offending value (%g). */
 static ws_status bad(char *why, size_t n, const char *fmt, double value)
 {
     if (why && n)
         snprintf(why, n, fmt, value);
+    return WS_ERR_INVALID_ARGUMENT;
+}
+
+/* The same with a reason that names no value. */
+static ws_status bad_text(char *why, size_t n, const char *text)
+{
+    if (why && n)
+        snprintf(why, n, "%s", text);
     return WS_ERR_INVALID_ARGUMENT;
 }
 
@@ -189,10 +198,9 @@ static void end_at_rest(double *a, size_t n, double h, double *v, double *x)
     ve = v[n - 1];
     xe = x[n - 1];
     for (int k = 0; k < 2; k++) {
+        /* The shape's end velocity and displacement, by the same integration as the table. */
         for (size_t i = 0; i < n; i++)
             v[i] = sin((double)(k + 1) * WS_PI * ((double)i * h) / T);
-        /* v holds the shape; integrate it into x and a spare copy at the end is not needed:
-         * only its end values are used. */
         double vv = 0.0, xx = 0.0;
         for (size_t i = 0; i + 1 < n; i++) {
             xx += h * vv + h * h * (v[i] / 3.0 + v[i + 1] / 6.0);
@@ -274,7 +282,10 @@ ws_status ws_drive_psd_grms(const double *f, const double *g, size_t n, double *
         if (!(isfinite(g[i]) && g[i] > 0.0 && g[i] < 1e12))
             return bad(why, why_len, "PSD: levels must be in (0, 1e12) g^2/Hz, got %g", g[i]);
         if (i && !(f[i] > f[i - 1]))
-            return bad(why, why_len, "PSD: frequencies must increase strictly, got %g after a larger or equal one", f[i]);
+            return bad(
+                why, why_len,
+                "PSD: frequencies must increase strictly, got %g after a larger or equal one",
+                f[i]);
     }
     /* The exact integral of G1 (f/f1)^b over each segment. */
     double sum = 0.0;
@@ -326,10 +337,21 @@ static void ifft_inplace(double *z, size_t m)
     }
 }
 
+/* Z_k = X + conj Y + i W^k (X - conj Y) for X = X_k, Y = X_{m-k}, W = exp(2 pi i / n). */
+static void pack_bin(const double x[2], const double y[2], size_t k, size_t n, double z[2])
+{
+    double e = 2.0 * WS_PI * (double)k / (double)n, wr = cos(e), wi = sin(e);
+    double sr = x[0] + y[0], si = x[1] - y[1];              /* X + conj Y */
+    double dr = x[0] - y[0], di = x[1] + y[1];              /* X - conj Y */
+    double pr = wr * dr - wi * di, pim = wr * di + wi * dr; /* W^k (X - conj Y) */
+    z[0] = sr - pim;                                        /* i (pr + i pim) = -pim + i pr */
+    z[1] = si + pr;
+}
+
 static ws_status check_random(const ws_drive_def *c, char *why, size_t why_len)
 {
-    ws_status s = ws_drive_psd_grms(c->psd_frequency, c->psd_level, c->psd_count, NULL, why,
-                                    why_len);
+    ws_status s =
+        ws_drive_psd_grms(c->psd_frequency, c->psd_level, c->psd_count, NULL, why, why_len);
     if (s != WS_OK)
         return s;
     double fmax = c->psd_frequency[c->psd_count - 1];
@@ -345,7 +367,7 @@ ws_status ws_drive_synthesize(const ws_drive_def *c, double *accel, size_t count
                               size_t why_len)
 {
     if (!accel)
-        return bad(why, why_len, "random: the output buffer is NULL%.0g", 0.0);
+        return bad_text(why, why_len, "random: the output buffer is NULL");
     if (count < 16 || (count & (count - 1)) != 0)
         return bad(why, why_len, "random: count must be a power of two >= 16, got %g",
                    (double)count);
@@ -360,35 +382,24 @@ ws_status ws_drive_synthesize(const ws_drive_def *c, double *accel, size_t count
      * Nyquist term). Stored as complex values at slot k. */
     accel[0] = accel[1] = 0.0;
     for (size_t k = 1; k < m; k++) {
-        double amp = 0.5 * g0 * sqrt(2.0 * psd_at(c->psd_frequency, c->psd_level, c->psd_count,
-                                                  (double)k * df) * df);
+        double amp =
+            0.5 * g0 *
+            sqrt(2.0 * psd_at(c->psd_frequency, c->psd_level, c->psd_count, (double)k * df) * df);
         double ph = 2.0 * WS_PI * uniform01(&state);
         accel[2 * k] = amp * cos(ph);
         accel[2 * k + 1] = amp * sin(ph);
     }
     /* A real inverse FFT of n points as a complex one of m points on the even and odd samples:
-     * Z_k = X_k + conj X_{m-k} + i W^k (X_k - conj X_{m-k}), W = exp(2 pi i / n); then
-     * z_l = x_{2l} + i x_{2l+1}. Pairs (k, m-k) are rewritten together in place. */
+     * z_l = x_{2l} + i x_{2l+1} = sum_k Z_k exp(2 pi i l k / m) with
+     * Z_k = X_k + conj X_{m-k} + i W^k (X_k - conj X_{m-k}), W = exp(2 pi i / n), X_m = 0.
+     * Z_k and Z_{m-k} need the same two inputs, so each pair is rewritten together in place. */
     for (size_t k = 0; k <= m / 2; k++) {
-        size_t j = (m - k) % m;
-        double ar = accel[2 * k], ai = accel[2 * k + 1];
-        double br = k == 0 ? 0.0 : accel[2 * j], bi = k == 0 ? 0.0 : accel[2 * j + 1];
-        /* for k = 0 the partner is X_m = 0 */
+        size_t j = k == 0 ? 0 : m - k;
+        double xk[2] = {accel[2 * k], accel[2 * k + 1]};
+        double xj[2] = {k == 0 ? 0.0 : accel[2 * j], k == 0 ? 0.0 : accel[2 * j + 1]};
         double zk[2], zj[2];
-        for (int pass = 0; pass < 2; pass++) {
-            size_t kk = pass == 0 ? k : j;
-            double xr = pass == 0 ? ar : br, xi = pass == 0 ? ai : bi;
-            double yr = pass == 0 ? br : ar, yi = pass == 0 ? bi : ai; /* X_{m-kk} */
-            if (k == 0 && pass == 1)
-                break;
-            double e = 2.0 * WS_PI * (double)kk / (double)n, wr = cos(e), wi = sin(e);
-            double sr = xr + yr, si = xi - yi; /* X + conj Y */
-            double dr = xr - yr, di = xi + yi; /* X - conj Y */
-            double pr = wr * dr - wi * di, pi = wr * di + wi * dr; /* W^k (X - conj Y) */
-            double *out = pass == 0 ? zk : zj;
-            out[0] = sr - pi; /* + i * (pr + i pi) */
-            out[1] = si + pr;
-        }
+        pack_bin(xk, xj, k, n, zk);
+        pack_bin(xj, xk, j, n, zj);
         accel[2 * k] = zk[0];
         accel[2 * k + 1] = zk[1];
         if (k != 0 && j != k) {
@@ -426,8 +437,10 @@ static ws_status setup_pulse(ws_drive *d, char *why, size_t n)
         return bad(why, n, "pulse: unknown pulse_mode %g", (double)c->pulse_mode);
     double V = A * (Tr + Th), Tg = 2.0 * V / G;
     if (!isfinite(Tg) || Tg > TIME_LIMIT)
-        return bad(why, n, "pulse: the gentle phase would last %g s (> 1e9 s); raise "
-                           "gentle_acceleration", Tg);
+        return bad(why, n,
+                   "pulse: the gentle phase would last %g s (> 1e9 s); raise "
+                   "gentle_acceleration",
+                   Tg);
     d->nseg = 0;
     if (c->pulse_mode == WS_PULSE_ACCELERATE) {
         add_seg(d, WS_SEG_RISE, Tr, A);
@@ -463,8 +476,10 @@ static ws_status setup_impact(ws_drive *d, char *why, size_t n)
         return bad(why, n, "impact: coast_time must be in [0, 1e9] s, got %g", Tc);
     double Tg = 2.0 * V / G;
     if (Tg > TIME_LIMIT)
-        return bad(why, n, "impact: the run-up would last %g s (> 1e9 s); raise "
-                           "gentle_acceleration", Tg);
+        return bad(why, n,
+                   "impact: the run-up would last %g s (> 1e9 s); raise "
+                   "gentle_acceleration",
+                   Tg);
     d->nseg = 0;
     add_seg(d, WS_SEG_LOBE, Tg, G);
     if (Tc > 0.0)
@@ -482,8 +497,7 @@ static ws_status take_table(ws_drive *d, ws_mem *mem, size_t count)
     return WS_OK;
 }
 
-static ws_status setup_table(ws_drive *d, ws_mem *mem, const ws_drive_def *def, char *why,
-                             size_t n)
+static ws_status setup_table(ws_drive *d, ws_mem *mem, const ws_drive_def *def, char *why, size_t n)
 {
     ws_drive_def *c = &d->def;
     if (!def->table || def->table_count < 2 || def->table_count > ((size_t)1 << 28))
@@ -491,12 +505,16 @@ static ws_status setup_table(ws_drive *d, ws_mem *mem, const ws_drive_def *def, 
                    def->table ? (double)def->table_count : 0.0);
     if (!(isfinite(c->table_interval) && c->table_interval >= 1e-9 &&
           c->table_interval * (double)def->table_count <= TIME_LIMIT))
-        return bad(why, n, "table: table_interval must be >= 1e-9 s with the table no longer "
-                           "than 1e9 s, got %g s", c->table_interval);
+        return bad(why, n,
+                   "table: table_interval must be >= 1e-9 s with the table no longer "
+                   "than 1e9 s, got %g s",
+                   c->table_interval);
     for (size_t i = 0; i < def->table_count; i++)
         if (!(isfinite(def->table[i]) && fabs(def->table[i]) <= 1e6))
-            return bad(why, n, "table: accelerations must be finite and within 1e6 m/s^2 "
-                               "(sample %g is not)", (double)i);
+            return bad(why, n,
+                       "table: accelerations must be finite and within 1e6 m/s^2 "
+                       "(sample %g is not)",
+                       (double)i);
     ws_status s = take_table(d, mem, def->table_count);
     if (s != WS_OK)
         return s;
@@ -514,8 +532,10 @@ static ws_status setup_random(ws_drive *d, ws_mem *mem, const ws_drive_def *def,
         return s;
     double samples = c->duration * c->sample_rate;
     if (!(isfinite(c->duration) && c->duration > 0.0 && samples >= 16.0 && samples <= 0x1p26))
-        return bad(why, n, "random: duration x sample_rate must give 16 to 2^26 samples, got "
-                           "duration %g s", c->duration);
+        return bad(why, n,
+                   "random: duration x sample_rate must give 16 to 2^26 samples, got "
+                   "duration %g s",
+                   c->duration);
     if (!(2.0 * c->ramp_time <= c->duration))
         return bad(why, n, "random: the taper ramp_time (%g s) must be at most half the duration",
                    c->ramp_time);
@@ -580,15 +600,13 @@ ws_status ws_drive_setup(ws_drive *d, ws_mem *mem, const ws_drive_def *def, cons
     d->base = *base;
     ws_status s = WS_OK;
     if (!(isfinite(c->start_time) && fabs(c->start_time) <= TIME_LIMIT))
-        return bad(why, why_len, "drive: start_time must be within +-1e9 s, got %g",
-                   c->start_time);
+        return bad(why, why_len, "drive: start_time must be within +-1e9 s, got %g", c->start_time);
     if (!(isfinite(c->ramp_time) && c->ramp_time >= 0.0 && c->ramp_time <= TIME_LIMIT))
         return bad(why, why_len, "drive: ramp_time must be in [0, 1e9] s, got %g", c->ramp_time);
     if (c->type != WS_DRIVE_TILT && c->type != WS_DRIVE_STATIC && c->type != WS_DRIVE_CALLBACK) {
         double n = v3_norm(c->direction);
         if (!(n > 0.0) || !isfinite(n))
-            return bad(why, why_len, "drive: direction must be a non-zero finite vector%.0g",
-                       0.0);
+            return bad_text(why, why_len, "drive: direction must be a non-zero finite vector");
         c->direction = v3_scale(c->direction, 1.0 / n);
     }
     switch (c->type) {
@@ -597,21 +615,25 @@ ws_status ws_drive_setup(ws_drive *d, ws_mem *mem, const ws_drive_def *def, cons
     case WS_DRIVE_TILT: {
         double n = v3_norm(c->axis);
         if (!(n > 0.0) || !isfinite(n) || !ws_is_finite3(&c->point))
-            return bad(why, why_len, "drive: tilt needs a non-zero finite axis and a finite "
-                                     "point%.0g", 0.0);
+            return bad_text(why, why_len,
+                            "drive: tilt needs a non-zero finite axis and a finite point");
         if (!(isfinite(c->rate) && fabs(c->rate) <= 1e6))
             return bad(why, why_len, "drive: tilt rate must be within +-1e6 rad/s, got %g",
                        c->rate);
         if (!(isfinite(c->max_angle) && c->max_angle >= 0.0 && c->max_angle <= 1e6))
-            return bad(why, why_len, "drive: max_angle must be in [0, 1e6] rad (0 = no limit), "
-                                     "got %g", c->max_angle);
+            return bad(why, why_len,
+                       "drive: max_angle must be in [0, 1e6] rad (0 = no limit), "
+                       "got %g",
+                       c->max_angle);
         if (!(isfinite(c->stop_ramp_time) && c->stop_ramp_time >= 0.0 &&
               c->stop_ramp_time <= TIME_LIMIT))
             return bad(why, why_len, "drive: stop_ramp_time must be in [0, 1e9] s, got %g",
                        c->stop_ramp_time);
         if (c->max_angle > 0.0 && c->max_angle < fabs(c->rate) * c->ramp_time)
-            return bad(why, why_len, "drive: max_angle (%g rad) is reached before the start "
-                                     "ramp ends; lower ramp_time", c->max_angle);
+            return bad(why, why_len,
+                       "drive: max_angle (%g rad) is reached before the start "
+                       "ramp ends; lower ramp_time",
+                       c->max_angle);
         d->stop_ramp = c->stop_ramp_time;
         if (c->max_angle > 0.0 && c->rate != 0.0) {
             /* The stop ramp may not begin before the start ramp has ended. */
@@ -629,20 +651,22 @@ ws_status ws_drive_setup(ws_drive *d, ws_mem *mem, const ws_drive_def *def, cons
                        c->amplitude);
         if (!isfinite(c->phase) || fabs(c->phase) > 1e6 ||
             !(isfinite(c->frequency) && c->frequency >= 0.0 && c->frequency <= 1e6))
-            return bad(why, why_len, "drive: sine needs a finite amplitude, a phase within "
-                                     "+-1e6 rad and a frequency in [0, 1e6] Hz, got frequency %g",
+            return bad(why, why_len,
+                       "drive: sine needs a finite amplitude, a phase within "
+                       "+-1e6 rad and a frequency in [0, 1e6] Hz, got frequency %g",
                        c->frequency);
         /* The acceleration amplitude omega^2 A and its product with the ramp's slopes must
          * stay finite. */
         if (!(fabs(c->amplitude) * om * om < 1e12))
-            return bad(why, why_len, "drive: sine acceleration amplitude (2 pi f)^2 amplitude "
-                                     "must be < 1e12 m/s^2, got amplitude %g m",
+            return bad(why, why_len,
+                       "drive: sine acceleration amplitude (2 pi f)^2 amplitude "
+                       "must be < 1e12 m/s^2, got amplitude %g m",
                        c->amplitude);
         break;
     }
     case WS_DRIVE_CALLBACK:
         if (!c->callback)
-            return bad(why, why_len, "drive: WS_DRIVE_CALLBACK needs a callback%.0g", 0.0);
+            return bad_text(why, why_len, "drive: WS_DRIVE_CALLBACK needs a callback");
         break;
     case WS_DRIVE_PULSE:
         s = setup_pulse(d, why, why_len);
@@ -765,10 +789,10 @@ static void sine_at(const ws_drive_def *c, double tau, double *x, double *v, dou
 static int motion_finite(const ws_drive_motion *m)
 {
     return ws_is_finite3(&m->pose.position) && ws_is_finite3(&m->v) && ws_is_finite3(&m->w) &&
-           ws_is_finite3(&m->a) && ws_is_finite3(&m->alpha) &&
-           isfinite(m->pose.orientation.e0) && isfinite(m->pose.orientation.e1) &&
-           isfinite(m->pose.orientation.e2) && isfinite(m->pose.orientation.e3) &&
-           isfinite(m->angle) && isfinite(m->rate) && isfinite(m->angacc);
+           ws_is_finite3(&m->a) && ws_is_finite3(&m->alpha) && isfinite(m->pose.orientation.e0) &&
+           isfinite(m->pose.orientation.e1) && isfinite(m->pose.orientation.e2) &&
+           isfinite(m->pose.orientation.e3) && isfinite(m->angle) && isfinite(m->rate) &&
+           isfinite(m->angacc);
 }
 
 int ws_drive_motion_at(const ws_drive *d, double t, ws_drive_motion *m)

@@ -11,12 +11,12 @@
 /* One phase of a translating profile (pulse, impact): its acceleration law a(tau) over
  * [t0, t0 + T], and the velocity and displacement at its start. */
 typedef enum ws_seg_kind {
-    WS_SEG_RISE = 0,  /* A/2 (1 - cos(pi tau / T)) */
-    WS_SEG_HOLD,      /* A */
-    WS_SEG_FALL,      /* A/2 (1 + cos(pi tau / T)) */
-    WS_SEG_COAST,     /* 0 */
-    WS_SEG_LOBE,      /* A/2 (1 - cos(2 pi tau / T)): a raised cosine, velocity change A T / 2 */
-    WS_SEG_HALF_SINE  /* A sin(pi tau / T): velocity change 2 A T / pi */
+    WS_SEG_RISE = 0, /* A/2 (1 - cos(pi tau / T)) */
+    WS_SEG_HOLD,     /* A */
+    WS_SEG_FALL,     /* A/2 (1 + cos(pi tau / T)) */
+    WS_SEG_COAST,    /* 0 */
+    WS_SEG_LOBE,     /* A/2 (1 - cos(2 pi tau / T)): a raised cosine, velocity change A T / 2 */
+    WS_SEG_HALF_SINE /* A sin(pi tau / T): velocity change 2 A T / pi */
 } ws_seg_kind;
 
 typedef struct ws_seg {

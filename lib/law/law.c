@@ -844,6 +844,21 @@ static ws_status check_def(const ws_law_def *d, ws_law *const *refs, size_t nref
         depth = refs[j]->depth > depth ? refs[j]->depth : depth;
     if (depth >= MAX_DEPTH)
         FAIL("law: sums and scalings nested deeper than %d", MAX_DEPTH);
+    /* Every part's history and leaves are within the bounds, so these sums cannot overflow. */
+    uint64_t history = d->type == WS_LAW_RELAXATION ? (uint64_t)n * (d->prony_count + 1) : 0;
+    uint64_t leaves = nrefs ? 0 : 1;
+    for (size_t j = 0; j < nrefs; j++) {
+        history += refs[j]->nstate;
+        leaves += refs[j]->leaves;
+    }
+    if (history > WS_LAW_MAX_HISTORY)
+        FAIL("law: it would need %llu doubles of history per user, more than "
+             "WS_LAW_MAX_HISTORY (%d)",
+             (unsigned long long)history, WS_LAW_MAX_HISTORY);
+    if (leaves > WS_LAW_MAX_LEAVES)
+        FAIL("law: one evaluation would visit %llu leaf laws through its sums, more than "
+             "WS_LAW_MAX_LEAVES (%d)",
+             (unsigned long long)leaves, WS_LAW_MAX_LEAVES);
     return WS_OK;
 }
 
@@ -895,8 +910,11 @@ ws_status ws_law_new(ws_mem *mem, const ws_law_def *d, ws_law *const *refs, size
     L->type = d->type;
     L->dim = n;
     L->depth = 1;
-    for (size_t j = 0; j < nrefs; j++)
+    L->leaves = nrefs ? 0 : 1;
+    for (size_t j = 0; j < nrefs; j++) {
         L->depth = refs[j]->depth + 1 > L->depth ? refs[j]->depth + 1 : L->depth;
+        L->leaves += refs[j]->leaves;
+    }
 
     /* The linear parts; a 1 x 1 matrix is a scalar. */
     if (kmat) {

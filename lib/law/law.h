@@ -36,6 +36,7 @@ struct ws_law {
     uint32_t nstate; /* doubles of history per user */
     int film;        /* 1: the film form above is the whole law */
     int depth;       /* 1 + the depth of the laws it refers to (SUM, SCALED) */
+    uint32_t leaves; /* leaf laws an evaluation visits (<= WS_LAW_MAX_LEAVES) */
 
     /* Linear parts: K (elastic, Kelvin-Voigt, cubic) and C (every damped law). A NULL matrix
      * means the scalar times the identity. */

@@ -101,7 +101,7 @@ ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive, doubl
 {
     if (!def)
         return WS_ERR_INVALID_ARGUMENT;
-    if (ws_def_check(def, sizeof *def) != 0)
+    if (ws_def_check(def) != 0)
         return WS_ERR_UNINITIALIZED_DEF;
     char why[160];
     if (pulse_check(def, why, sizeof why) != 0)
@@ -476,7 +476,7 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
     run_state rs;
     memset(&rs, 0, sizeof rs);
     ws_eumos_def_init(&rs.d);
-    ws_status s = ws_def_take(w, &rs.d, sizeof rs.d, def, sizeof rs.d, "eumos");
+    ws_status s = ws_def_take(w, &rs.d, sizeof rs.d, def, "eumos");
     if (s != WS_OK)
         return s;
     char why[160];
@@ -630,7 +630,7 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
     if (!world_def || !load_def || !eumos_def || !def || !result)
         return WS_ERR_INVALID_ARGUMENT;
     memset(result, 0, sizeof *result);
-    if (ws_def_check(def, sizeof *def) != 0 || ws_def_check(eumos_def, sizeof *eumos_def) != 0) {
+    if (ws_def_check(def) != 0 || ws_def_check(eumos_def) != 0) {
         snprintf(result->error, sizeof result->error,
                  "ws_loadtest_find_k: a Def was not filled by its ws_*_def_init()");
         return WS_ERR_UNINITIALIZED_DEF;

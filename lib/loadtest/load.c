@@ -463,7 +463,7 @@ ws_status ws_load_build(ws_world *w, const ws_load_def *def, ws_load **out)
     *out = NULL;
     ws_load_def d;
     ws_load_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "load");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "load");
     if (s != WS_OK || (s = check_def(w, &d)) != WS_OK)
         return s;
     size_t cartons = 0;
@@ -770,7 +770,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     NEED_OUT(w, out, "ws_load_wrap_band");
     ws_wrap_def d;
     ws_wrap_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "wrap")) != WS_OK ||
+    if ((s = ws_def_take(w, &d, sizeof d, def, "wrap")) != WS_OK ||
         (s = check_wrap(w, &d, ld)) != WS_OK)
         return s;
     size_t n = (size_t)ld->info.cartons + 1;

@@ -1,5 +1,7 @@
 #include "shape/shape.h"
 
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,10 +27,21 @@ static int cmp_half_edge(const void *pa, const void *pb)
     return 0;
 }
 
-static void fail(char *why, size_t n, const char *msg, long a, long b)
+/* The reason a mesh is refused, with what to do about it: a mesh from a file is usually fixed
+ * in a mesh tool, not in code. */
+static void fail(char *why, size_t n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void fail(char *why, size_t n, const char *fmt, ...)
 {
-    if (why && n)
-        snprintf(why, n, msg, a, b);
+    if (!why || !n)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(why, n, fmt, ap);
+    va_end(ap);
 }
 
 void ws_shape_free(ws_mem *mem, ws_shape *s)
@@ -87,7 +100,7 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
 {
     memset(out, 0, sizeof *out);
     if (!xyz || !tri) {
-        fail(why, why_len, "mesh: vertices and triangles must not be NULL%ld%ld", 0, 0);
+        fail(why, why_len, "mesh: vertices and triangles must not be NULL");
         return WS_ERR_INVALID_ARGUMENT;
     }
     if (nv < 4 || nt < 4) {
@@ -95,14 +108,21 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
              (long)nv, (long)nt);
         return WS_ERR_BAD_MESH;
     }
-    if (nv > WS_ID_MAX_SLOTS || nt > WS_ID_MAX_SLOTS) {
+    if (nv > WS_MESH_MAX_ITEMS || nt > WS_MESH_MAX_ITEMS) {
         fail(why, why_len, "mesh: too large (%ld vertices, %ld triangles)", (long)nv, (long)nt);
         return WS_ERR_BAD_MESH;
     }
     for (size_t i = 0; i < 3 * nv; i++) {
         if (!isfinite(xyz[i])) {
-            fail(why, why_len, "mesh: vertex %ld has a coordinate that is not finite%ld",
-                 (long)(i / 3), 0);
+            fail(why, why_len, "mesh: vertex %ld has a coordinate that is not finite",
+                 (long)(i / 3));
+            return WS_ERR_INVALID_ARGUMENT;
+        }
+        /* Beyond this the areas and volumes of the checks below overflow. */
+        if (fabs(xyz[i]) > WS_MESH_MAX_COORD) {
+            fail(why, why_len,
+                 "mesh: vertex %ld has coordinate %g m, beyond WS_MESH_MAX_COORD (%g m)",
+                 (long)(i / 3), xyz[i], WS_MESH_MAX_COORD);
             return WS_ERR_INVALID_ARGUMENT;
         }
     }
@@ -147,12 +167,23 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         lo = v3_min(lo, out->vertices[i]);
         hi = v3_max(hi, out->vertices[i]);
     }
-    double diag = v3_norm(v3_sub(hi, lo));
-    if (!(diag > 0.0)) {
-        fail(why, why_len, "mesh: all vertices coincide%ld%ld", 0, 0);
+    /* The extent by the largest side of the bounding box: its diagonal would underflow to 0
+     * for a mesh of 1e-200 m and call it a point. */
+    double ext = fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
+    if (!(ext > 0.0)) {
+        fail(why, why_len, "mesh: all vertices coincide");
         st = WS_ERR_BAD_MESH;
         goto done;
     }
+    if (ext < WS_MESH_MIN_EXTENT) {
+        fail(why, why_len,
+             "mesh: its extent (largest side of its bounding box) is %g m, below "
+             "WS_MESH_MIN_EXTENT (%g m)",
+             ext, WS_MESH_MIN_EXTENT);
+        st = WS_ERR_BAD_MESH;
+        goto done;
+    }
+    double diag = v3_norm(v3_sub(hi, lo));
 
     /* Degenerate triangles: area below 1e-12 of the squared size. */
     for (size_t t = 0; t < nt; t++) {
@@ -160,7 +191,10 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         v3 n = tri_normal_raw(out->vertices, tt);
         if (tt[0] == tt[1] || tt[1] == tt[2] || tt[0] == tt[2] ||
             !(v3_norm(n) > 1e-12 * diag * diag)) {
-            fail(why, why_len, "mesh: triangle %ld is degenerate (zero area)%ld", (long)t, 0);
+            fail(why, why_len,
+                 "mesh: triangle %ld is degenerate (zero area): remove it, or repair the mesh "
+                 "in a mesh tool (merge duplicate vertices, remove degenerate faces)",
+                 (long)t);
             st = WS_ERR_BAD_MESH;
             goto done;
         }
@@ -183,17 +217,28 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         size_t j = i;
         while (j < nhe && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
             j++;
-        if (j - i != 2) {
+        if (j - i == 1) {
             fail(why, why_len,
-                 j - i == 1 ? "mesh: not closed: edge (%ld, %ld) belongs to one triangle only"
-                            : "mesh: not manifold: edge (%ld, %ld) belongs to more than two triangles",
+                 "mesh: not closed: edge (%ld, %ld) belongs to one triangle only: close the mesh, "
+                 "or repair it in a mesh tool (merge duplicate vertices, fill holes)",
                  (long)he[i].lo, (long)he[i].hi);
+            st = WS_ERR_BAD_MESH;
+            goto done;
+        }
+        if (j - i > 2) {
+            fail(why, why_len,
+                 "mesh: not manifold: edge (%ld, %ld) belongs to %ld triangles, not two: give each "
+                 "solid its own shape, or repair it in a mesh tool (remove duplicate faces, split "
+                 "non-manifold edges)",
+                 (long)he[i].lo, (long)he[i].hi, (long)(j - i));
             st = WS_ERR_BAD_MESH;
             goto done;
         }
         if (he[i].forward == he[i + 1].forward) {
             fail(why, why_len,
-                 "mesh: inconsistent winding: the two triangles at edge (%ld, %ld) run the same way",
+                 "mesh: inconsistent winding: the two triangles at edge (%ld, %ld) run the same "
+                 "way: turn one of them, or repair the mesh in a mesh tool (unify or recalculate "
+                 "the normals)",
                  (long)he[i].lo, (long)he[i].hi);
             st = WS_ERR_BAD_MESH;
             goto done;
@@ -207,8 +252,9 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
                     &out->inertia_unit);
     if (!(vol > 1e-12 * diag * diag * diag)) {
         fail(why, why_len,
-             "mesh: volume is not positive: triangles must run counter-clockwise seen from outside%ld%ld",
-             0, 0);
+             "mesh: volume is not positive: triangles must run counter-clockwise seen from outside "
+             "(the mesh is inside out): reverse every triangle, or repair it in a mesh tool "
+             "(flip the normals)");
         st = WS_ERR_BAD_MESH;
         goto done;
     }
@@ -389,7 +435,7 @@ done:
     ws_mem_free(mem, order, order ? nt * sizeof *order : 0);
     if (st != WS_OK) {
         if (st == WS_ERR_OUT_OF_MEMORY)
-            fail(why, why_len, "mesh: out of memory%ld%ld", 0, 0);
+            fail(why, why_len, "mesh: out of memory");
         ws_shape_free(mem, out);
     }
     return st;

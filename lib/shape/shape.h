@@ -6,6 +6,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <wrapsim/shape.h>
+
 #include "base/base.h"
 #include "math/wmath.h"
 

@@ -23,9 +23,9 @@ typedef struct ws_ncand {
  * shape and then the edge between them (the contacts tell the three apart by the planes). */
 #define WS_NCAND_CORNER 0x20000000u
 #define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE | WS_NCAND_CORNER)
-/* A shape's faces and edges (at most its triangles and 3/2 of them, under WS_ID_MAX_SLOTS)
+/* A shape's faces and edges (at most its triangles and 3/2 of them, under WS_MESH_MAX_ITEMS)
  * are numbered below the flags. */
-_Static_assert(3ull * WS_ID_MAX_SLOTS / 2 < WS_NCAND_CORNER, "feature numbers reach the flags");
+_Static_assert(3ull * WS_MESH_MAX_ITEMS / 2 < WS_NCAND_CORNER, "feature numbers reach the flags");
 #define WS_NCAND_FACES 64           /* the most faces of a body whose candidates get INSIDE */
 
 /* The candidates of a web cut into stretches of nodes, in node order, within one row of a grid

@@ -38,25 +38,21 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
     va_end(ap);
 }
 
-ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
-                      const char *what)
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, const char *what)
 {
     if (!src)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: the Def pointer is NULL", what);
-    if (ws_def_check(src, min_size) != 0)
+    if (ws_def_check(src) != 0)
         return ws_fail(w, WS_ERR_UNINITIALIZED_DEF,
                        "%s: the Def was not filled by ws_%s_def_init() (size/magic header wrong)",
                        what, what);
-    uint32_t size = ((const uint32_t *)src)[0];
-    memcpy(dst, src, size < full ? size : full);
-    ((uint32_t *)dst)[0] = (uint32_t)full;
+    ws_def_copy(dst, full, src);
     return WS_OK;
 }
 
-void ws_world_def_init(ws_world_def *def)
+static void world_defaults(ws_world_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->gravity = v3_make(0.0, 0.0, -9.81);
     def->dt = 2.5e-4;
     def->integrator = WS_INTEGRATOR_SYMPLECTIC_EULER;
@@ -67,11 +63,11 @@ void ws_world_def_init(ws_world_def *def)
     def->max_angular_speed = 1e5;
     def->use_ccd = 1;
 }
+WS_DEF_INITS(ws_world_def, world_defaults, user_data)
 
-void ws_contact_def_init(ws_contact_def *def)
+static void contact_defaults(ws_contact_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->stiffness = 2e5;
     def->damping = 10.0;
     def->friction = 0.3;
@@ -80,12 +76,13 @@ void ws_contact_def_init(ws_contact_def *def)
     def->stick_stiffness = 2e5;
     def->stick_damping = 10.0;
 }
+WS_DEF_INITS(ws_contact_def, contact_defaults, stick_damping)
 
-void ws_material_def_init(ws_material_def *def)
+static void material_defaults(ws_material_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_material_def, material_defaults, name)
 
 static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)
 {
@@ -141,9 +138,12 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
     *out = NULL;
     if (!def)
         return WS_ERR_INVALID_ARGUMENT;
-    if (ws_def_check(def, sizeof *def) != 0)
+    if (ws_def_check(def) != 0)
         return WS_ERR_UNINITIALIZED_DEF;
-    ws_world_def d = *def;
+    /* A caller built against an older, smaller Def has only its own fields: the rest default. */
+    ws_world_def d;
+    ws_world_def_init(&d);
+    ws_def_copy(&d, sizeof d, def);
     if (!(isfinite(d.dt) && d.dt > 0.0) || !ws_is_finite3(&d.gravity) ||
         !(isfinite(d.full_detection_until)) || d.detection_interval < 1 ||
         !(isfinite(d.contact_margin) && d.contact_margin >= 0.0) ||
@@ -163,14 +163,15 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         return WS_ERR_OUT_OF_MEMORY;
     w->mem = mem;
     w->def = d;
-    /* A per-world tag in every id, so an id of another world is refused. Mixed from the address
-     * and the clock: no global counter is needed. */
-    uintptr_t mix = (uintptr_t)w ^ ((uintptr_t)&mix >> 4) ^ (uintptr_t)time(NULL) ^
-                    (uintptr_t)clock();
-    uint64_t h = ws_hash_bytes(WS_HASH_SEED, &mix, sizeof mix);
-    w->tag = (uint16_t)(h ^ (h >> 16) ^ (h >> 32) ^ (h >> 48));
-    if (w->tag == 0)
-        w->tag = 1;
+    /* The salt of every slot's first generation, so an id of another world is refused but
+     * with odds of about 2^-32 (base.h); no global counter is needed. */
+    uint32_t salt = ws_id_salt(w);
+    w->body_slots.salt = salt;
+    w->shape_slots.salt = salt;
+    w->mat_slots.salt = salt;
+    w->law_slots.salt = salt;
+    w->web_slots.salt = salt;
+    w->element_slots.salt = salt;
 
     w->params = ws_mem_alloc(&w->mem, 4 * sizeof *w->params);
     if (!w->params) {
@@ -196,6 +197,12 @@ void ws_world_destroy(ws_world *w)
 {
     if (!w)
         return;
+    if (w->in_step) {
+        /* The step still runs on this world: refuse, saying so (it has no status to return). */
+        ws_fail(w, WS_ERR_IN_STEP, "ws_world_destroy called from inside ws_world_step (a "
+                                   "callback); the world was not destroyed");
+        return;
+    }
     ws_mem *m = &w->mem;
     ws_world_free_elements(w); /* before the laws and bodies they use */
     ws_world_free_webs(w);
@@ -260,6 +267,7 @@ ws_status ws_world_get_dt(const ws_world *w, double *dt)
 ws_status ws_world_set_dt(ws_world *w, double dt)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_dt");
     if (!(isfinite(dt) && dt > 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_dt: dt must be > 0 s, got %g", dt);
     w->def.dt = dt;
@@ -270,6 +278,7 @@ ws_status ws_world_set_dt(ws_world *w, double dt)
 ws_status ws_world_set_gravity(ws_world *w, const ws_vec3 *g)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_gravity");
     if (!g || !ws_is_finite3(g))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_set_gravity: gravity must be finite");
     w->def.gravity = *g;
@@ -361,18 +370,19 @@ static ws_status create_material(ws_world *w, const char *name, ws_material_id *
     w->mat_slots.dense[slot] = slot;
     for (size_t k = 0; k < w->pair_dim; k++)
         w->pair_index[slot * w->pair_dim + k] = w->pair_index[k * w->pair_dim + slot] = 0;
-    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->mat_slots, WS_KIND_MATERIAL, slot);
     return WS_OK;
 }
 
 ws_status ws_material_create(ws_world *w, const ws_material_def *def, ws_material_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_material_create");
     NEED_OUT(w, out, "ws_material_create");
     out->bits = 0;
     ws_material_def d;
     ws_material_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "material");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "material");
     if (s != WS_OK)
         return s;
     return create_material(w, d.name, out);
@@ -383,13 +393,13 @@ ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slo
     uint32_t s = ws_id_slot(id.bits);
     if (id.bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "material id is null");
-    if (ws_id_tag(id.bits) != w->tag || ws_id_kind(id.bits) != WS_KIND_MATERIAL)
-        return ws_fail(w, WS_ERR_STALE_HANDLE,
-                       "material id 0x%016llx is not a material of this world",
+    if (ws_id_kind(id.bits) != WS_KIND_MATERIAL)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id 0x%016llx is not a material id",
                        (unsigned long long)id.bits);
-    if (s >= w->mat_slots.slot_count || w->mat_slots.dense[s] == UINT32_MAX ||
-        w->mat_slots.generation[s] != ws_id_gen(id.bits))
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "material id 0x%016llx was destroyed",
+    if (!ws_slots_is_live(&w->mat_slots, id.bits, WS_KIND_MATERIAL))
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "material id 0x%016llx names no live material of this world (destroyed, "
+                       "or another world's)",
                        (unsigned long long)id.bits);
     *slot = s;
     return WS_OK;
@@ -411,7 +421,7 @@ ws_status ws_world_get_default_material(const ws_world *w, ws_material_id *out)
 {
     NEED_WORLD(w);
     NEED_OUT(w, out, "ws_world_get_default_material");
-    out->bits = ws_id_pack(w->tag, WS_KIND_MATERIAL, w->mat_slots.generation[0], 0);
+    out->bits = ws_slots_id(&w->mat_slots, WS_KIND_MATERIAL, 0);
     return WS_OK;
 }
 
@@ -419,13 +429,14 @@ ws_status ws_world_set_contact(ws_world *w, ws_material_id a, ws_material_id b,
                                const ws_contact_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_contact");
     uint32_t sa, sb;
     ws_status s;
     if ((s = ws_lookup_material(w, a, &sa)) != WS_OK || (s = ws_lookup_material(w, b, &sb)) != WS_OK)
         return s;
     ws_contact_def d;
     ws_contact_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "contact")) != WS_OK)
         return s;
     if ((s = check_contact_def(w, &d)) != WS_OK)
         return s;
@@ -458,10 +469,11 @@ ws_status ws_world_get_contact(const ws_world *w, ws_material_id a, ws_material_
 ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_set_default_contact");
     ws_contact_def d;
     ws_contact_def_init(&d);
     ws_status s;
-    if ((s = ws_def_take(w, &d, sizeof d, def, sizeof d, "contact")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "contact")) != WS_OK)
         return s;
     if ((s = check_contact_def(w, &d)) != WS_OK)
         return s;

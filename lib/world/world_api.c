@@ -13,14 +13,15 @@ ws_status ws_lookup_slot(const ws_world *w, uint64_t bits, unsigned kind, const 
 {
     if (bits == 0)
         return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id is null", what);
-    if (ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx does not belong to this world",
-                       what, (unsigned long long)bits);
-    uint32_t s = ws_id_slot(bits);
-    if (s >= t->slot_count || t->dense[s] == UINT32_MAX || t->generation[s] != ws_id_gen(bits))
-        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx was destroyed", what,
-                       (unsigned long long)bits);
-    *slot = s;
+    if (ws_id_kind(bits) != kind)
+        return ws_fail(w, WS_ERR_STALE_HANDLE, "%s id 0x%016llx is not a %s id", what,
+                       (unsigned long long)bits, what);
+    if (!ws_slots_is_live(t, bits, kind))
+        return ws_fail(w, WS_ERR_STALE_HANDLE,
+                       "%s id 0x%016llx names no live %s of this world (destroyed, or another "
+                       "world's)",
+                       what, (unsigned long long)bits, what);
+    *slot = ws_id_slot(bits);
     return WS_OK;
 }
 
@@ -36,17 +37,14 @@ ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot)
 
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot)
 {
-    ws_body_id id = {ws_id_pack(w->tag, WS_KIND_BODY, w->body_slots.generation[slot], slot)};
+    ws_body_id id = {ws_slots_id(&w->body_slots, WS_KIND_BODY, slot)};
     return id;
 }
 
 /* is_valid must not disturb the last error: it is a question, not a failure. */
 static int quiet_valid(const ws_world *w, uint64_t bits, unsigned kind, const ws_slot_table *t)
 {
-    if (!w || bits == 0 || ws_id_tag(bits) != w->tag || ws_id_kind(bits) != kind)
-        return 0;
-    uint32_t s = ws_id_slot(bits);
-    return s < t->slot_count && t->dense[s] != UINT32_MAX && t->generation[s] == ws_id_gen(bits);
+    return w && ws_slots_is_live(t, bits, kind);
 }
 
 int ws_body_is_valid(const ws_world *w, ws_body_id id)
@@ -61,16 +59,16 @@ int ws_shape_is_valid(const ws_world *w, ws_shape_id id)
 
 /* ---- shapes ---- */
 
-void ws_mesh_def_init(ws_mesh_def *def)
+static void mesh_defaults(ws_mesh_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_mesh_def, mesh_defaults, triangle_count)
 
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
                            size_t nt, const char *fn, ws_shape_id *out)
 {
-    char why[256] = "";
+    char why[400] = ""; /* a refused mesh's reason and repair hint; fits the error text */
     ws_shape *s = ws_mem_alloc(&w->mem, sizeof *s);
     if (!s)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
@@ -91,19 +89,26 @@ static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint
     }
     w->shapes[slot] = s;
     w->shape_slots.dense[slot] = slot;
-    out->bits = ws_id_pack(w->tag, WS_KIND_SHAPE, w->shape_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->shape_slots, WS_KIND_SHAPE, slot);
     return WS_OK;
 }
 
 ws_status ws_shape_create_box(ws_world *w, double lx, double ly, double lz, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_box");
     NEED_OUT(w, out, "ws_shape_create_box");
     out->bits = 0;
     if (!(isfinite(lx) && isfinite(ly) && isfinite(lz) && lx > 0.0 && ly > 0.0 && lz > 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_shape_create_box: edge lengths must be > 0 m, got %g x %g x %g", lx, ly,
                        lz);
+    if (lx > 2.0 * WS_MESH_MAX_COORD || ly > 2.0 * WS_MESH_MAX_COORD ||
+        lz > 2.0 * WS_MESH_MAX_COORD)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_shape_create_box: edge lengths must be at most 2 WS_MESH_MAX_COORD "
+                       "(%g m), got %g x %g x %g",
+                       2.0 * WS_MESH_MAX_COORD, lx, ly, lz);
     double xyz[24];
     uint32_t tri[36];
     ws_shape_box_mesh(lx, ly, lz, xyz, tri);
@@ -114,13 +119,15 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
                                    ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_cylinder");
     NEED_OUT(w, out, "ws_shape_create_cylinder");
     out->bits = 0;
-    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024)
+    if (!(isfinite(r) && isfinite(h) && r > 0.0 && h > 0.0) || segments < 3 || segments > 1024 ||
+        r > WS_MESH_MAX_COORD || h > 2.0 * WS_MESH_MAX_COORD)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "ws_shape_create_cylinder: need radius > 0, height > 0 and 3..1024 "
-                       "segments, got %g, %g, %d",
-                       r, h, segments);
+                       "ws_shape_create_cylinder: need 0 < radius <= WS_MESH_MAX_COORD (%g m), "
+                       "0 < height <= 2 WS_MESH_MAX_COORD and 3..1024 segments, got %g, %g, %d",
+                       WS_MESH_MAX_COORD, r, h, segments);
     size_t nv = 2 * (size_t)segments, nt = 4 * (size_t)segments - 4;
     double *xyz = ws_mem_alloc(&w->mem, 3 * nv * sizeof *xyz);
     uint32_t *tri = ws_mem_alloc(&w->mem, 3 * nt * sizeof *tri);
@@ -139,11 +146,12 @@ ws_status ws_shape_create_cylinder(ws_world *w, double r, double h, int segments
 ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_create_mesh");
     NEED_OUT(w, out, "ws_shape_create_mesh");
     out->bits = 0;
     ws_mesh_def d;
     ws_mesh_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "mesh");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "mesh");
     if (s != WS_OK)
         return s;
     return add_shape(w, d.vertices, d.vertex_count, d.triangles, d.triangle_count,
@@ -153,6 +161,7 @@ ws_status ws_shape_create_mesh(ws_world *w, const ws_mesh_def *def, ws_shape_id 
 ws_status ws_shape_destroy(ws_world *w, ws_shape_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_shape_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_shape(w, id, &slot);
     if (s != WS_OK)
@@ -190,6 +199,18 @@ ws_status ws_shape_get_info(const ws_world *w, ws_shape_id id, ws_shape_info *in
     return WS_OK;
 }
 
+ws_status ws_shape_get_centroid_offset(const ws_world *w, ws_shape_id id, ws_vec3 *offset)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, offset, "ws_shape_get_centroid_offset");
+    uint32_t slot;
+    ws_status s = ws_lookup_shape(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    *offset = w->shapes[slot]->centroid;
+    return WS_OK;
+}
+
 ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices, size_t vcap,
                              size_t *vcount, uint32_t *triangles, size_t tcap, size_t *tcount)
 {
@@ -222,20 +243,19 @@ ws_status ws_shape_copy_mesh(const ws_world *w, ws_shape_id id, double *vertices
 
 /* ---- bodies ---- */
 
-void ws_body_def_init(ws_body_def *def)
+static void body_defaults(ws_body_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_BODY_DYNAMIC;
     def->density = 1000.0;
     def->contact_layer = 1e-3;
     def->orientation = qt_identity();
 }
+WS_DEF_INITS(ws_body_def, body_defaults, user_data)
 
-void ws_drive_def_init(ws_drive_def *def)
+static void drive_defaults(ws_drive_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_DRIVE_STATIC;
     def->ramp_time = 0.05;
     def->axis = v3_make(0, 1, 0);
@@ -251,6 +271,7 @@ void ws_drive_def_init(ws_drive_def *def)
     def->sample_rate = 1024.0;
     def->sweep_law = WS_SWEEP_LOG;
 }
+WS_DEF_INITS(ws_drive_def, drive_defaults, callback_user)
 
 static const char *label(const ws_body_def *d)
 {
@@ -260,11 +281,12 @@ static const char *label(const ws_body_def *d)
 ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_create");
     NEED_OUT(w, out, "ws_body_create");
     out->bits = 0;
     ws_body_def d;
     ws_body_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "body");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "body");
     if (s != WS_OK)
         return s;
     const char *nm = label(&d);
@@ -304,6 +326,12 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
         } else {
             mass = d.mass;
         }
+        if (!(mass >= WS_BODY_MIN_MASS && mass <= WS_BODY_MAX_MASS))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': mass %g kg%s is outside [WS_BODY_MIN_MASS, "
+                           "WS_BODY_MAX_MASS] = [%g, %g] kg",
+                           nm, mass, d.mass == 0.0 ? " (density x volume)" : "",
+                           WS_BODY_MIN_MASS, WS_BODY_MAX_MASS);
         int zero = 1;
         for (int k = 0; k < 9; k++) {
             if (!isfinite(d.inertia.m[k]))
@@ -312,11 +340,28 @@ ws_status ws_body_create(ws_world *w, const ws_body_def *def, ws_body_id *out)
                 zero = 0;
         }
         J = zero ? ws_body_inertia_from_shape(sh, mass) : d.inertia;
-        if (!m3_is_spd(&J) || m3_inverse(&J, &Jinv) != 0)
+        if (!m3_is_spd(&J))
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                            "body '%s': inertia must be symmetric positive definite "
                            "(diagonal %g, %g, %g kg m^2)",
                            nm, J.m[0], J.m[4], J.m[8]);
+        /* The principal moments of a rigid body: J1 = integral of (y^2 + z^2) dm and so on,
+         * so J1 + J2 = J3 + 2 integral of z^2 dm >= J3; a flat plate is the equality. */
+        m3 axes;
+        v3 pm;
+        m3_sym_eigen(&J, &axes, &pm);
+        double jmax = fmax(pm.x, fmax(pm.y, pm.z)), jsum = pm.x + pm.y + pm.z;
+        if (jsum - jmax < jmax * (1.0 - 1e-9))
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': principal moments of inertia %g, %g, %g kg m^2 are no "
+                           "rigid body's: each must be at most the sum of the other two "
+                           "(J1 + J2 >= J3)",
+                           nm, pm.x, pm.y, pm.z);
+        if (m3_inverse(&J, &Jinv) != 0)
+            return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                           "body '%s': inertia (principal moments %g, %g, %g kg m^2) cannot be "
+                           "inverted in double precision",
+                           nm, pm.x, pm.y, pm.z);
     }
 
     uint32_t slot;
@@ -385,6 +430,7 @@ void ws_world_forget_body(ws_world *w, uint32_t slot)
 ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -409,6 +455,7 @@ ws_status ws_body_destroy(ws_world *w, ws_body_id id)
 ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_drive");
     uint32_t slot;
     ws_status s = ws_lookup_body(w, id, &slot);
     if (s != WS_OK)
@@ -420,10 +467,7 @@ ws_status ws_body_set_drive(ws_world *w, ws_body_id id, const ws_drive_def *def)
                        "body '%s': only kinematic bodies (world elements) take a drive", nm);
     ws_drive_def d;
     ws_drive_def_init(&d);
-    /* A Def of 0.1 (without the fields from stop_ramp_time on) is taken with the defaults of
-     * the rest. */
-    if ((s = ws_def_take(w, &d, sizeof d, def, offsetof(ws_drive_def, stop_ramp_time), "drive")) !=
-        WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "drive")) != WS_OK)
         return s;
     ws_body_state *st = &b->st[w->cur];
     ws_pose base = {st->r[slot], st->p[slot]};
@@ -513,7 +557,7 @@ ws_status ws_vibration_synthesize(ws_world *w, const ws_drive_def *def, double *
     if (!def) {
         s = WS_ERR_INVALID_ARGUMENT;
         snprintf(why, sizeof why, "ws_vibration_synthesize: def is NULL");
-    } else if (ws_def_check(def, offsetof(ws_drive_def, stop_ramp_time)) != 0) {
+    } else if (ws_def_check(def) != 0) {
         s = WS_ERR_UNINITIALIZED_DEF;
         snprintf(why, sizeof why, "ws_vibration_synthesize: the Def was not filled by "
                                   "ws_drive_def_init()");
@@ -670,6 +714,7 @@ ws_status ws_body_get_contact_force(const ws_world *w, ws_body_id id, ws_vec3 *f
 ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_pose");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)
@@ -696,6 +741,7 @@ ws_status ws_body_set_pose(ws_world *w, ws_body_id id, const ws_pose *pose)
 ws_status ws_body_set_velocity(ws_world *w, ws_body_id id, const ws_vec3 *v, const ws_vec3 *om)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_body_set_velocity");
     uint32_t i;
     ws_status s = ws_lookup_body(w, id, &i);
     if (s != WS_OK)
@@ -787,5 +833,91 @@ ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t
     if (buf && cap < n)
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
                        "ws_world_copy_contacts: room for %zu contacts, there are %zu", cap, n);
+    return WS_OK;
+}
+
+/* Both ids live, distinct; the slots out. */
+static ws_status pair_call(const ws_world *w, ws_body_id a, ws_body_id b, const char *fn,
+                           uint32_t *ia, uint32_t *ib)
+{
+    ws_status s = ws_lookup_body(w, a, ia);
+    if (s == WS_OK)
+        s = ws_lookup_body(w, b, ib);
+    if (s != WS_OK)
+        return s;
+    if (*ia == *ib)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "%s: body_a and body_b are the same body", fn);
+    return WS_OK;
+}
+
+ws_status ws_world_copy_contacts_between(const ws_world *w, ws_body_id a, ws_body_id b,
+                                         ws_contact_info *buf, size_t cap, size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_world_copy_contacts_between");
+    if (cap && !buf)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_world_copy_contacts_between: buffer is NULL but capacity is not 0");
+    uint32_t ia, ib;
+    ws_status s = pair_call(w, a, b, "ws_world_copy_contacts_between", &ia, &ib);
+    if (s != WS_OK)
+        return s;
+    size_t n = 0;
+    for (size_t k = 0; k < w->nrec[w->cur]; k++) {
+        const ws_contact_rec *c = &w->rec[w->cur][k];
+        int same = c->a == ia && c->b == ib, swapped = c->a == ib && c->b == ia;
+        if (!same && !swapped)
+            continue;
+        if (n < cap) {
+            /* Seen from the caller's order: the record's b is the caller's a when swapped, so
+             * the normal, the force on b and b's slip all change sign. */
+            double sg = swapped ? -1.0 : 1.0;
+            ws_contact_info *o = &buf[n];
+            o->body_a = a;
+            o->body_b = b;
+            o->point = c->x;
+            o->normal = v3_scale(c->n, sg);
+            o->overlap = c->overlap;
+            o->normal_force = c->fn;
+            o->friction_force = v3_scale(c->ft, sg);
+            o->slip_velocity = v3_scale(c->vt, sg);
+            o->kind = (int32_t)c->kind;
+            if (swapped && c->kind == WS_CONTACT_POINT_FACE)
+                o->kind = WS_CONTACT_FACE_POINT;
+            o->slipping = (int32_t)c->slipping;
+        }
+        n++;
+    }
+    *count = n;
+    if (buf && cap < n)
+        return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
+                       "ws_world_copy_contacts_between: room for %zu contacts, there are %zu",
+                       cap, n);
+    return WS_OK;
+}
+
+ws_status ws_world_get_interface_stiffness(const ws_world *w, ws_body_id a, ws_body_id b,
+                                           double *stiffness, size_t *points)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, stiffness, "ws_world_get_interface_stiffness");
+    uint32_t ia, ib;
+    ws_status s = pair_call(w, a, b, "ws_world_get_interface_stiffness", &ia, &ib);
+    if (s != WS_OK)
+        return s;
+    /* Every active contact point is a spring k of the pair in parallel with the others. */
+    const uint32_t *mat = w->bodies.material;
+    double k = w->params[w->pair_index[mat[ia] * w->pair_dim + mat[ib]]].k, sum = 0.0;
+    size_t n = 0;
+    for (size_t q = 0; q < w->nrec[w->cur]; q++) {
+        const ws_contact_rec *c = &w->rec[w->cur][q];
+        if ((c->a == ia && c->b == ib) || (c->a == ib && c->b == ia)) {
+            sum += k;
+            n++;
+        }
+    }
+    *stiffness = sum;
+    if (points)
+        *points = n;
     return WS_OK;
 }

@@ -43,20 +43,17 @@ int ws_element_is_valid(const ws_world *w, ws_element_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_ELEMENT &&
-           s < w->element_slots.slot_count && w->element_slots.dense[s] != UINT32_MAX &&
-           w->element_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->element_slots, id.bits, WS_KIND_ELEMENT);
 }
 
-void ws_element_def_init(ws_element_def *def)
+static void element_defaults(ws_element_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_ELEMENT_ROD;
     def->formulation = WS_ELEMENT_INVARIANT;
     /* frame1 = frame2 = 0: automatic (see the header). */
 }
+WS_DEF_INITS(ws_element_def, element_defaults, user_data)
 
 /* The state of an end in body-state buffer k: a body's, or the world frame at rest. The global
  * angular velocity is formed as the step's prepare() forms it, so the read-out between steps
@@ -151,11 +148,12 @@ static void free_element(ws_world *w, uint32_t slot)
 ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_element_create");
     NEED_OUT(w, out, "ws_element_create");
     out->bits = 0;
     ws_element_def d;
     ws_element_def_init(&d);
-    ws_status s = ws_def_take(w, &d, sizeof d, def, sizeof d, "element");
+    ws_status s = ws_def_take(w, &d, sizeof d, def, "element");
     if (s != WS_OK)
         return s;
     const char *nm = d.name ? d.name : "(unnamed)";
@@ -224,13 +222,14 @@ ws_status ws_element_create(ws_world *w, const ws_element_def *def, ws_element_i
     *p = e;
     w->elements[slot] = p;
     L->users++;
-    out->bits = ws_id_pack(w->tag, WS_KIND_ELEMENT, w->element_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->element_slots, WS_KIND_ELEMENT, slot);
     return WS_OK;
 }
 
 ws_status ws_element_destroy(ws_world *w, ws_element_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_element_destroy");
     uint32_t slot;
     ws_status s = lookup_element(w, id, &slot);
     if (s != WS_OK)
@@ -527,7 +526,7 @@ ws_status ws_world_copy_element_ids(const ws_world *w, ws_element_id *buf, size_
             continue;
         if (n < cap)
             buf[n].bits =
-                ws_id_pack(w->tag, WS_KIND_ELEMENT, w->element_slots.generation[i], (uint32_t)i);
+                ws_slots_id(&w->element_slots, WS_KIND_ELEMENT, (uint32_t)i);
         n++;
     }
     *count = n;

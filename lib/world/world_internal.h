@@ -20,13 +20,13 @@
 struct ws_world {
     ws_mem mem;
     ws_world_def def;
-    uint16_t tag;
     double time;
     uint64_t steps;
     uint64_t last_full_step;
     int cand_valid; /* 0 forces a full detection on the next step */
     double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
+    int in_step;    /* 1 while ws_world_step runs: its callbacks may only read */
     char err[WS_ERR_LEN];
 
     ws_body_store bodies;
@@ -97,6 +97,17 @@ void ws_log(const ws_world *w, ws_log_level level, const char *fmt, ...)
             return ws_fail((w), WS_ERR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);       \
     } while (0)
 
+/* Calls that change the world are refused from inside a step (from a drive, law or log
+ * callback); getters stay allowed, they read the committed state, which a step leaves alone. */
+#define NOT_IN_STEP(w, fn)                                                                        \
+    do {                                                                                          \
+        if ((w)->in_step)                                                                         \
+            return ws_fail((w), WS_ERR_IN_STEP,                                                   \
+                           "%s called from inside ws_world_step (a callback); a callback may "    \
+                           "only read the world",                                                 \
+                           fn);                                                                   \
+    } while (0)
+
 ws_status ws_lookup_body(const ws_world *w, ws_body_id id, uint32_t *slot);
 ws_status ws_lookup_shape(const ws_world *w, ws_shape_id id, uint32_t *slot);
 ws_status ws_lookup_material(const ws_world *w, ws_material_id id, uint32_t *slot);
@@ -117,10 +128,23 @@ int ws_world_node_params(ws_world *w, uint32_t web_material);
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
 
+/* The two exported inits of a Def type `type` (ws_x_def) whose defaults `defaults` writes:
+ * ws_x_def_init_sized(def, size), which the header's ws_x_def_init(def) macro calls with the
+ * caller's sizeof, and the plain function ws_x_def_init(def) for programs built against headers
+ * before the sized form. Those headers' Defs ended at `v0_last`, so the plain one fills up to
+ * there and never past the end of such a caller's Def. */
+#define WS_DEF_INITS(type, defaults, v0_last)                                                    \
+    void type##_init_sized(type *def, size_t size)                                                \
+    {                                                                                             \
+        type full;                                                                                \
+        defaults(&full);                                                                          \
+        ws_def_fill(def, size, &full, sizeof full);                                               \
+    }                                                                                             \
+    void(type##_init)(type * def) { type##_init_sized(def, WS_DEF_END(type, v0_last)); }
+
 /* Copy a caller's Def (of the size it says) over a default one; WS_ERR_UNINITIALIZED_DEF or
  * WS_ERR_INVALID_ARGUMENT (NULL) with the message set. */
-ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, size_t min_size,
-                      const char *what);
+ws_status ws_def_take(const ws_world *w, void *dst, size_t full, const void *src, const char *what);
 
 /* Body bookkeeping after a change of the committed state outside a step. */
 void ws_world_refresh_body(ws_world *w, uint32_t slot);

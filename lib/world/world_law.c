@@ -5,10 +5,9 @@
 #include <stdio.h>
 #include <string.h>
 
-void ws_law_def_init(ws_law_def *def)
+static void law_defaults(ws_law_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->type = WS_LAW_LINEAR_ELASTIC;
     def->transition = 1e-3;
     def->dim = 1;
@@ -17,6 +16,7 @@ void ws_law_def_init(ws_law_def *def)
     def->scale = 1.0;
     def->user_flags = WS_LAW_FLAG_ELASTIC | WS_LAW_FLAG_VISCOUS;
 }
+WS_DEF_INITS(ws_law_def, law_defaults, user_flags)
 
 ws_status ws_lookup_law(const ws_world *w, ws_law_id id, uint32_t *slot)
 {
@@ -27,10 +27,7 @@ int ws_law_is_valid(const ws_world *w, ws_law_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_LAW &&
-           s < w->law_slots.slot_count && w->law_slots.dense[s] != UINT32_MAX &&
-           w->law_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->law_slots, id.bits, WS_KIND_LAW);
 }
 
 /* The law of an id, or NULL with the error recorded (status in *s). */
@@ -44,13 +41,14 @@ static ws_law *find(const ws_world *w, ws_law_id id, ws_status *s)
 ws_status ws_law_create(ws_world *w, const ws_law_def *def, ws_law_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_law_create");
     NEED_OUT(w, out, "ws_law_create");
     out->bits = 0;
     ws_law_def d;
     ws_law_def_init(&d);
     /* The first released layout ended at `name`; older callers keep working. */
     ws_status s =
-        ws_def_take(w, &d, sizeof d, def, offsetof(ws_law_def, name) + sizeof d.name, "law");
+        ws_def_take(w, &d, sizeof d, def, "law");
     if (s != WS_OK)
         return s;
     const char *label = d.name ? d.name : "(unnamed)";
@@ -100,7 +98,7 @@ ws_status ws_law_create(ws_world *w, const ws_law_def *def, ws_law_id *out)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_law_create: out of memory");
     }
     w->laws[slot] = p;
-    out->bits = ws_id_pack(w->tag, WS_KIND_LAW, w->law_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->law_slots, WS_KIND_LAW, slot);
     return WS_OK;
 }
 
@@ -114,6 +112,7 @@ static void free_law(ws_world *w, uint32_t slot, int release_refs)
 ws_status ws_law_destroy(ws_world *w, ws_law_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_law_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_law(w, id, &slot);
     if (s != WS_OK)

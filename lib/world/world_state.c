@@ -96,10 +96,15 @@ static void emit(ws_walk *k, const unsigned char *b, size_t n, int hashed)
 /* n doubles at p, little-endian (the bits of each, so the walk is exact). */
 static void f64s(ws_walk *k, double *p, size_t n, int hashed)
 {
-    if (failed(k) || (k->mode == WS_WALK_HASH && !hashed))
+    if (failed(k) || (k->mode == WS_WALK_HASH && !hashed) || n == 0) /* p may be NULL then */
         return;
     if (reading(k)) {
         const unsigned char *b = take(k, 8 * n);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        if (b && k->mode == WS_WALK_READ && n)
+            memcpy(p, b, 8 * n);
+        return;
+#endif
         if (b && k->mode == WS_WALK_READ)
             for (size_t i = 0; i < n; i++) {
                 uint64_t u = dec64(b + 8 * i);
@@ -107,6 +112,11 @@ static void f64s(ws_walk *k, double *p, size_t n, int hashed)
             }
         return;
     }
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+    /* The doubles' bytes in memory are the little-endian bytes already. */
+    emit(k, (const unsigned char *)p, 8 * n, hashed);
+    return;
+#endif
     unsigned char chunk[8 * 64];
     for (size_t i0 = 0; i0 < n; i0 += 64) {
         size_t m = n - i0 < 64 ? n - i0 : 64;
@@ -201,13 +211,19 @@ static int same(ws_walk *k, uint64_t here, const char *obj, uint32_t index, cons
     return -1;
 }
 
-/* The length of a list: written, then read and bounded by `most`. */
-static void count(ws_walk *k, size_t *n, size_t most, const char *what)
+/* The length of a list of items `each` bytes long in the file: written, then read and bounded
+ * by `most` and by what is left of the state (so a wrong count asks for no memory). */
+static void count(ws_walk *k, size_t *n, size_t most, size_t each, const char *what)
 {
     uint64_t v = *n;
     u64v(k, &v);
     if (!reading(k) || failed(k))
         return;
+    if (v > (k->len - k->pos) / each) {
+        fail(k, WS_ERR_FORMAT, "%s: %llu in the file, more than its %zu bytes left can hold",
+             what, (unsigned long long)v, k->len - k->pos);
+        return;
+    }
     if (v > most) {
         fail(k, WS_ERR_FORMAT, "%s: %llu in the file, more than the %zu this world can have",
              what, (unsigned long long)v, most);
@@ -297,7 +313,7 @@ static void walk_contacts(ws_walk *k)
     f64s(k, &w->travel, 1, 0);
     /* The candidate feature pairs, with the stick anchors (in the hash). */
     size_t nc = w->ncand[cur];
-    count(k, &nc, SIZE_MAX / sizeof(ws_cand) / 2, "contact candidates");
+    count(k, &nc, SIZE_MAX / sizeof(ws_cand) / 2, 6 * 4 + 6 * 8, "contact candidates");
     room(k, (void **)&w->cand[cur], &w->capcand[cur], nc + 1, sizeof(ws_cand));
     for (size_t q = 0; q < nc && !failed(k); q++) {
         ws_cand c = reading(k) ? (ws_cand){0} : w->cand[cur][q];
@@ -318,7 +334,7 @@ static void walk_contacts(ws_walk *k)
         w->ncand[cur] = nc;
     /* The contacts of the last step: what the contact and energy reports read. */
     size_t nr = w->nrec[cur];
-    count(k, &nr, SIZE_MAX / sizeof(ws_contact_rec) / 2, "contact records");
+    count(k, &nr, SIZE_MAX / sizeof(ws_contact_rec) / 2, 4 * 4 + 15 * 8, "contact records");
     room(k, (void **)&w->rec[cur], &w->caprec[cur], nr + 1, sizeof(ws_contact_rec));
     for (size_t q = 0; q < nr && !failed(k); q++) {
         ws_contact_rec r = reading(k) ? (ws_contact_rec){0} : w->rec[cur][q];
@@ -345,16 +361,18 @@ static void walk_contacts(ws_walk *k)
 
 /* ---- webs ---- */
 
+/* base: by body slot, where its faces (base[2 slot]) and edges (base[2 slot + 1]) start among
+ * the features the step prepares (as ws_node_geometry numbers them). */
 static void check_ncand(ws_walk *k, const ws_web *web, const ws_ncand *c, uint32_t prev_node,
-                        size_t q, const uint32_t total[2])
+                        size_t q, const uint32_t *base)
 {
     const ws_world *w = k->w;
     int edge = (c->local & WS_NCAND_EDGE) != 0;
     uint32_t local = c->local & ~WS_NCAND_FLAGS;
     int ok = c->node < web->n && c->node >= prev_node && body_ok(w, c->body) &&
-             c->feat < total[edge] &&
              local < (edge ? w->bodies.shape[c->body]->edge_count
-                           : w->bodies.shape[c->body]->face_count);
+                           : w->bodies.shape[c->body]->face_count) &&
+             c->feat == base[2 * (size_t)c->body + (size_t)edge] + local;
     if (!ok)
         fail(k, WS_ERR_FORMAT,
              "node candidate %zu (node %u, body %u, feature %u) names no node-feature pair of "
@@ -459,15 +477,47 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
     int list = web->list, refresh = web->refresh;
     intv(k, &list, 2, "a web's committed candidate list");
     intv(k, &refresh, 2, "a web's refresh flag");
-    size_t nc = web->ncand[web->list];
-    count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, "node candidates");
-    room(k, (void **)&web->cand[list], &web->capcand[list], nc + 1, sizeof(ws_ncand));
-    uint32_t total[2] = {0, 0}, prev = 0;
-    for (size_t i = 0; i < b->slots; i++)
-        if (b->alive[i]) {
-            total[0] += b->shape[i]->face_count;
-            total[1] += b->shape[i]->edge_count;
+    /* Which bodies the candidates may name, by body slot: the step prepares the features of
+     * those alone, so a candidate of another would read features never prepared. A check
+     * keeps them to test the candidates with. */
+    size_t had = web->cbody_cap;
+    room(k, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1);
+    if (k->mode == WS_WALK_CHECK && web->cbody_cap > had) /* a new body flag is clear */
+        memset(web->cbody + had, 0, web->cbody_cap - had);
+    /* A check's scratch: the flags as read, then where each body's features start. */
+    uint8_t *named = NULL;
+    const size_t scratch = (b->slots + 1) * (1 + 2 * sizeof(uint32_t)) + 4;
+    if (k->mode == WS_WALK_CHECK && !failed(k) &&
+        !(named = ws_mem_calloc(&w->mem, scratch, 1)))
+        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory checking a web's candidates");
+    uint32_t base[2] = {0, 0}, *bases = NULL;
+    if (named) {
+        bases = (uint32_t *)(void *)(named + ((b->slots + 1 + 3) & ~(size_t)3));
+        for (size_t i = 0; i < b->slots; i++) {
+            bases[2 * i] = base[0];
+            bases[2 * i + 1] = base[1];
+            if (b->alive[i]) {
+                base[0] += b->shape[i]->face_count;
+                base[1] += b->shape[i]->edge_count;
+            }
         }
+    }
+    for (size_t i = 0; i < b->slots && !failed(k); i++) {
+        int on = !reading(k) && i < web->cbody_cap && web->cbody[i];
+        intv(k, &on, 2, "a web's body flag");
+        if (k->mode == WS_WALK_READ)
+            web->cbody[i] = (uint8_t)on;
+        else if (named)
+            named[i] = (uint8_t)on;
+    }
+    size_t nc = web->ncand[web->list];
+    count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, 4 * 4, "node candidates");
+    room(k, (void **)&web->cand[list], &web->capcand[list], nc + 1, sizeof(ws_ncand));
+    /* The contacts' room for that many candidates: a step that does not search takes it as
+     * it is. */
+    if (k->mode == WS_WALK_CHECK && !failed(k) && ws_node_scratch(&w->mem, web, nc) != 0)
+        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory for %zu node candidates", nc);
+    uint32_t prev = 0;
     ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
     for (size_t q = 0; q < nc && !failed(k); q++) {
         ws_ncand c = reading(k) ? (ws_ncand){0} : web->cand[web->list][q];
@@ -476,7 +526,12 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
         u32v(k, &c.feat);
         u32v(k, &c.local);
         if (k->mode == WS_WALK_CHECK) {
-            check_ncand(k, web, &c, prev, q, total);
+            check_ncand(k, web, &c, prev, q, bases);
+            /* After a failed step the list may name bodies the flags no longer do; the next
+             * step then finds every candidate again (refresh) and reads none of them. */
+            if (!failed(k) && !refresh && !named[c.body])
+                fail(k, WS_ERR_FORMAT, "node candidate %zu names body %u, which the web's "
+                     "flags say it has no candidate of", q, c.body);
             last[0] = last[1];
             last[1] = last[2];
             last[2] = c;
@@ -500,7 +555,7 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
     if (k->mode == WS_WALK_CHECK && ref != UINT32_MAX && !body_ok(w, ref))
         fail(k, WS_ERR_FORMAT, "web %u's reference body %u is not of this world", slot, ref);
     size_t nt = web->ntrack;
-    count(k, &nt, b->slots, "a web's tracked bodies");
+    count(k, &nt, b->slots, 3 * 4 + 11 * 8, "a web's tracked bodies");
     room(k, (void **)&web->track, &web->track_cap, nt + 1, sizeof(ws_track));
     for (size_t q = 0; q < nt && !failed(k); q++) {
         ws_track t = reading(k) ? (ws_track){0} : web->track[q];
@@ -512,17 +567,8 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
     v3s(k, &web->epoch_r, 0);
     qts(k, &web->epoch_q, 0);
     f64s(k, &web->lever2, 1, 0);
-    /* Which bodies the candidates may name, by body slot. */
-    size_t had = web->cbody_cap;
-    room(k, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1);
-    if (k->mode == WS_WALK_CHECK && web->cbody_cap > had) /* a new body flag is clear */
-        memset(web->cbody + had, 0, web->cbody_cap - had);
-    for (size_t i = 0; i < b->slots && !failed(k); i++) {
-        int on = !reading(k) && i < web->cbody_cap && web->cbody[i];
-        intv(k, &on, 2, "a web's body flag");
-        if (k->mode == WS_WALK_READ)
-            web->cbody[i] = (uint8_t)on;
-    }
+    if (named)
+        ws_mem_free(&w->mem, named, scratch);
     if (k->mode != WS_WALK_READ || failed(k))
         return;
     /* Read: what follows from the above. */

@@ -128,25 +128,29 @@ static ws_status webs_ready(ws_world *w)
             continue;
         ws_web *web = w->webs[k];
         if (web->bcap < w->bodies.slots) {
+            /* All four arrays share one capacity: grow them into new blocks and keep the old
+             * ones until every new one is there, so an out-of-memory leaves them as they were
+             * (a partial grow would leave blocks larger than bcap says, and the free hook would
+             * be told the wrong sizes). */
             size_t cap = w->bodies.capacity;
-            for (int b = 0; b < 2; b++) {
-                v3 *f = ws_mem_realloc(&w->mem, web->bforce[b], web->bcap * sizeof(v3),
-                                       cap * sizeof(v3));
-                if (f)
-                    web->bforce[b] = f;
-                v3 *m = f ? ws_mem_realloc(&w->mem, web->bmoment[b], web->bcap * sizeof(v3),
-                                           cap * sizeof(v3))
-                          : NULL;
-                if (m)
-                    web->bmoment[b] = m;
-                if (!f || !m) {
-                    /* Keep the sizes consistent: shrink what grew back is not possible, so
-                     * record the smaller capacity for both by re-growing next time. */
-                    return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                                   web_label(web));
-                }
-                for (size_t i = web->bcap; i < cap; i++)
-                    web->bforce[b][i] = web->bmoment[b][i] = v3_make(0, 0, 0);
+            v3 *grown[4] = {NULL, NULL, NULL, NULL};
+            v3 **arr[4] = {&web->bforce[0], &web->bforce[1], &web->bmoment[0], &web->bmoment[1]};
+            int ok = 1;
+            for (int i = 0; i < 4 && ok; i++)
+                ok = (grown[i] = ws_mem_alloc(&w->mem, cap * sizeof(v3))) != NULL;
+            if (!ok) {
+                for (int i = 0; i < 4; i++)
+                    ws_mem_free(&w->mem, grown[i], grown[i] ? cap * sizeof(v3) : 0);
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                               web_label(web));
+            }
+            for (int i = 0; i < 4; i++) {
+                if (web->bcap)
+                    memcpy(grown[i], *arr[i], web->bcap * sizeof(v3));
+                for (size_t j = web->bcap; j < cap; j++)
+                    grown[i][j] = v3_make(0, 0, 0);
+                ws_mem_free(&w->mem, *arr[i], web->bcap * sizeof(v3));
+                *arr[i] = grown[i];
             }
             web->bcap = cap;
         }
@@ -342,10 +346,9 @@ static ws_status health(ws_world *w, int nxt)
     return WS_OK;
 }
 
-ws_status ws_world_step(ws_world *w)
+/* One step; ws_world_step guards it against calls from its own callbacks. */
+static ws_status step_once(ws_world *w)
 {
-    if (!w)
-        return WS_ERR_INVALID_ARGUMENT;
     ws_body_store *b = &w->bodies;
     const int cur = w->cur, nxt = cur ^ 1;
     const double dt = w->def.dt, t = w->time;
@@ -465,10 +468,22 @@ ws_status ws_world_step(ws_world *w)
     return WS_OK;
 }
 
+ws_status ws_world_step(ws_world *w)
+{
+    NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_step");
+    /* A callback (drive, law, log hook) that changed the world would pull pools and buffers
+     * from under the step: every call that changes the world checks this flag. */
+    w->in_step = 1;
+    ws_status s = step_once(w);
+    w->in_step = 0;
+    return s;
+}
+
 ws_status ws_world_step_n(ws_world *w, int64_t steps)
 {
-    if (!w)
-        return WS_ERR_INVALID_ARGUMENT;
+    NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_world_step_n");
     if (steps < 0)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_world_step_n: steps must be >= 0, got %lld",
                        (long long)steps);

@@ -15,39 +15,36 @@ int ws_web_is_valid(const ws_world *w, ws_web_id id)
 {
     if (!w)
         return 0;
-    uint32_t s = ws_id_slot(id.bits);
-    return id.bits != 0 && ws_id_tag(id.bits) == w->tag && ws_id_kind(id.bits) == WS_KIND_WEB &&
-           s < w->web_slots.slot_count && w->web_slots.dense[s] != UINT32_MAX &&
-           w->web_slots.generation[s] == ws_id_gen(id.bits);
+    return ws_slots_is_live(&w->web_slots, id.bits, WS_KIND_WEB);
 }
 
-void ws_web_def_init(ws_web_def *def)
+static void web_defaults(ws_web_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->contact_layer = 1e-3;
     def->substeps = 1;
 }
+WS_DEF_INITS(ws_web_def, web_defaults, name)
 
-void ws_sheet_def_init(ws_sheet_def *def)
+static void sheet_defaults(ws_sheet_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->axis_x = v3_make(1, 0, 0);
     def->axis_y = v3_make(0, 1, 0);
 }
+WS_DEF_INITS(ws_sheet_def, sheet_defaults, pinned_count)
 
-void ws_band_def_init(ws_band_def *def)
+static void band_defaults(ws_band_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_band_def, band_defaults, shear)
 
-void ws_web_mesh_def_init(ws_web_mesh_def *def)
+static void web_mesh_defaults(ws_web_mesh_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
 }
+WS_DEF_INITS(ws_web_mesh_def, web_mesh_defaults, pinned_count)
 
 /* What every generator shares: the checked web Def and the laws it names. */
 typedef struct web_common {
@@ -62,7 +59,7 @@ typedef struct web_common {
 static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, int grid)
 {
     ws_web_def_init(&c->d);
-    ws_status s = ws_def_take(w, &c->d, sizeof c->d, def, sizeof c->d, "web");
+    ws_status s = ws_def_take(w, &c->d, sizeof c->d, def, "web");
     if (s != WS_OK)
         return s;
     const ws_web_def *d = &c->d;
@@ -191,7 +188,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     law_users(keep, +1);
     w->web_check = 1;
     w->cand_valid = 0;
-    out->bits = ws_id_pack(w->tag, WS_KIND_WEB, w->web_slots.generation[slot], slot);
+    out->bits = ws_slots_id(&w->web_slots, WS_KIND_WEB, slot);
     return WS_OK;
 }
 
@@ -206,6 +203,7 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
                               ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_sheet");
     NEED_OUT(w, out, "ws_web_create_sheet");
     out->bits = 0;
     web_common c;
@@ -214,7 +212,7 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
         return s;
     ws_sheet_def g;
     ws_sheet_def_init(&g);
-    if ((s = ws_def_take(w, &g, sizeof g, sheet, sizeof g, "sheet")) != WS_OK)
+    if ((s = ws_def_take(w, &g, sizeof g, sheet, "sheet")) != WS_OK)
         return s;
     double nax = v3_norm(g.axis_x), nay = v3_norm(g.axis_y);
     if (g.nx < 1 || g.ny < 1 || (long)g.nx * g.ny < 2 || (long)g.nx * g.ny > 50000000L ||
@@ -245,6 +243,7 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
                              ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_band");
     NEED_OUT(w, out, "ws_web_create_band");
     out->bits = 0;
     web_common c;
@@ -253,7 +252,7 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
         return s;
     ws_band_def g;
     ws_band_def_init(&g);
-    if ((s = ws_def_take(w, &g, sizeof g, band, sizeof g, "band")) != WS_OK)
+    if ((s = ws_def_take(w, &g, sizeof g, band, "band")) != WS_OK)
         return s;
     if (!g.bodies || g.body_count == 0 || g.n_around < 3 || g.n_up < 1 ||
         (long)g.n_around * g.n_up > 50000000L || !isfinite(g.z_bottom) || !isfinite(g.z_top) ||
@@ -323,6 +322,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
                              ws_web_id *out)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_create_mesh");
     NEED_OUT(w, out, "ws_web_create_mesh");
     out->bits = 0;
     web_common c;
@@ -331,7 +331,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
         return s;
     ws_web_mesh_def g;
     ws_web_mesh_def_init(&g);
-    if ((s = ws_def_take(w, &g, sizeof g, mesh, sizeof g, "web_mesh")) != WS_OK)
+    if ((s = ws_def_take(w, &g, sizeof g, mesh, "web_mesh")) != WS_OK)
         return s;
     if (!g.positions || g.node_count == 0 || g.node_count > 50000000u ||
         (g.spring_count && !g.springs) || g.spring_count > 200000000u)
@@ -375,6 +375,7 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
 ws_status ws_web_destroy(ws_world *w, ws_web_id id)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_destroy");
     uint32_t slot;
     ws_status s = ws_lookup_web(w, id, &slot);
     if (s != WS_OK)
@@ -479,6 +480,7 @@ ws_status ws_web_get_stable_dt(const ws_world *w, ws_web_id id, double *dt)
 ws_status ws_web_set_substeps(ws_world *w, ws_web_id id, int substeps)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_set_substeps");
     uint32_t slot;
     ws_status s = ws_lookup_web(w, id, &slot);
     if (s != WS_OK)

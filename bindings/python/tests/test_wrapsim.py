@@ -9,6 +9,7 @@ without one).
 """
 
 import ctypes
+import importlib.util
 import math
 import os
 import pathlib
@@ -125,7 +126,7 @@ STRUCTS = {
     "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo, "ws_law_info": L.LawInfo,
     "ws_containment_band": L.ContainmentBand,
     "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
-    "ws_element_output": L.ElementOutput,
+    "ws_element_output": L.ElementOutput, "ws_vtk_series_def": L.VtkSeriesDef,
     "ws_load_interface": L.LoadInterface, "ws_load_def": L.LoadDef, "ws_load_info": L.LoadInfo,
     "ws_load_carton": L.LoadCarton, "ws_load_carton_state": L.LoadCartonState,
     "ws_wrap_def": L.WrapDef, "ws_loadtest_interface_state": L.LoadtestInterfaceState,
@@ -178,7 +179,7 @@ def test_struct_fields_match_headers():
 def test_version_and_features():
     assert ws.version_number() >= L.REQUIRED_VERSION
     assert ws.version().count(".") == 2
-    assert ws.build_features() & ~ws.WS_FEATURE_CCD == 0
+    assert ws.build_features() & ~(ws.WS_FEATURE_CCD | ws.WS_FEATURE_ZLIB) == 0
     assert ws.status_string(ws.WS_ERR_STALE_HANDLE).startswith("WS_ERR_STALE_HANDLE")
 
 
@@ -243,6 +244,48 @@ def test_buffer_too_small_raw():
         assert LIB.ws_world_copy_contacts(w.ptr, buf, 1, ctypes.byref(n)) == \
             ws.WS_ERR_BUFFER_TOO_SMALL
         assert n.value == 4
+
+
+def test_contacts_between_and_interface_stiffness():
+    """Two equal 5 kg cubes on a plane, k = 2e5 N/m per point: box-plane 4 points (4k, load
+    2 m g), box-box 8 points (8k, load m g); in the pair's order every normal points from a to
+    b (+z from the plane to the bottom box and from it to the top one), whoever owns the face.
+    Settled 2 s at 100 kg/s per point: the loads are static to far below the 1e-6 asserted."""
+    mg, k, a = 5.0 * 9.81, 2e5, 0.25
+    with ws.World() as w:
+        w.set_default_contact(stiffness=k, damping=100.0)
+        plane = w.body(w.box(1.5, 1.5, 0.05), type="kinematic", position=(0, 0, -0.025))
+        cube = w.box(a, a, a)
+        bottom = w.body(cube, mass=5.0, position=(0, 0, a / 2 + 0.002))
+        top = w.body(cube, mass=5.0, position=(0, 0, 1.5 * a + 0.004))
+        w.step(8000)
+        assert w.interface_stiffness(plane, bottom) == pytest.approx((4 * k, 4))
+        assert w.interface_stiffness(top, bottom) == pytest.approx((8 * k, 8))
+        c = w.contacts_between(bottom, top)
+        assert len(c) == 8
+        assert np.all(c["normal"][:, 2] > 1 - 1e-12)
+        assert sorted(c["kind"]) == [ws.WS_CONTACT_POINT_FACE] * 4 + [ws.WS_CONTACT_FACE_POINT] * 4
+        assert c["normal_force"].sum() == pytest.approx(mg, rel=1e-6)
+        c = w.contacts_between(bottom, plane)
+        assert len(c) == 4 and np.all(c["normal"][:, 2] < -1 + 1e-12)
+        assert c["normal_force"].sum() == pytest.approx(2 * mg, rel=1e-6)
+        with pytest.raises(ws.WrapsimError) as e:
+            w.contacts_between(top, top)
+        assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
+
+
+def test_mesh_centroid_offset_places_body_where_the_mesh_was():
+    """A tetrahedron given at (1, 2, 3): moved by its centroid, (1, 2, 3) + a/4 (1, 1, 1); a
+    body created there puts the vertices back where they were given (1e-12 m, round-off)."""
+    a = 0.5
+    v = np.array([[0, 0, 0], [a, 0, 0], [0, a, 0], [0, 0, a]], dtype=float) + (1.0, 2.0, 3.0)
+    with ws.World() as w:
+        s = w.mesh(v, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+        off = s.centroid_offset
+        assert off == pytest.approx(np.array([1, 2, 3]) + a / 4, abs=1e-12)
+        b = w.body(s, mass=1.0, position=off)
+        local, _ = s.copy_mesh()
+        assert local @ b.rotation.T + b.position == pytest.approx(v, abs=1e-12)
 
 
 def test_stale_ids_raise_never_crash():
@@ -365,6 +408,44 @@ def test_drive_callback_and_its_errors():
         b.set_drive("static")
         with pytest.raises(ValueError):
             b.set_drive("callback")
+
+
+def test_callbacks_may_not_change_the_world():
+    """A drive callback that steps the world or destroys a body inside the step gets
+    WS_ERR_IN_STEP (a WrapsimError) for that call; getters work there."""
+    seen = []
+    with ws.World(gravity=(0, 0, 0)) as w:
+        box = w.body(w.box(0.1, 0.1, 0.1), mass=1.0, position=(0, 0, 1))
+        table = w.body(w.box(0.1, 0.1, 0.1), type="kinematic")
+
+        def drive(t):
+            if t > 0.0:
+                for call in (lambda: w.step(1), box.destroy):
+                    try:
+                        call()
+                        seen.append("no error")
+                    except ws.WrapsimError as e:
+                        seen.append((e.status, e.detail))
+                seen.append(box.position[2])
+            return (0, 0, 0), (1, 0, 0, 0)
+        table.set_drive("callback", callback=drive)
+        w.step(1)
+        assert [s[0] for s in seen[:2]] == [ws.WS_ERR_IN_STEP, ws.WS_ERR_IN_STEP]
+        assert "ws_world_step called from inside ws_world_step" in seen[0][1]
+        assert "ws_body_destroy called from inside ws_world_step" in seen[1][1]
+        assert seen[2] == pytest.approx(1.0)
+        box.destroy()  # outside the step it works
+
+
+def test_def_inits_take_the_callers_size():
+    """The sized inits write no more than the size passed and record it."""
+    lib = ws._c()
+    d = L.BodyDef()
+    ctypes.memset(ctypes.byref(d), 0xA5, ctypes.sizeof(d))
+    lib.ws_body_def_init_sized(ctypes.byref(d), L.BodyDef.density.offset)
+    assert d.size == L.BodyDef.density.offset
+    raw = bytes(ctypes.string_at(ctypes.byref(d), ctypes.sizeof(d)))
+    assert set(raw[L.BodyDef.density.offset:]) == {0xA5}  # nothing past the size written
 
 
 def test_platform_test_drives():
@@ -518,6 +599,46 @@ def test_tilt_table_matches_c(tilt_exe):
         assert w.time == pytest.approx(7.0)
         # and the physics the example reports: the top box has left the bottom one
         assert np.linalg.norm(top.position - bottom.position) > 0.5
+
+
+TILT_ONSET_MAIN = r"""
+#define TILT_TABLE_NO_MAIN
+#include "tilt_table.c"
+int main(void)
+{
+    tilt_options o;
+    tilt_result r;
+    tilt_default_options(&o);
+    o.quiet = 1;
+    if (tilt_run(&o, &r) != WS_OK)
+        return 1;
+    printf("%.17g %.17g %.17g %.17g\n", r.slide_time[1], r.slide_angle[1], r.off_time[1],
+           r.slide_time[0]);
+    return 0;
+}
+"""
+
+
+def test_tilt_examples_report_the_same_slide_onset(tmp_path):
+    """examples/python/tilt_table.py and examples/tilt_table.c report slide onset by one
+    definition (every contact with the support slipping the same way, |v_t| >= v_lim, for
+    0.2 s), checked on every step in both: on the same steps of the same library they find the
+    same onset, to round-off, and stop the run on the same step when the top box leaves the
+    platform. The onset is that of the theory, tan(theta) = 0.3, within 0.3 deg (the C suite's
+    tolerance: the dynamic lag of a 5 kg box starting to slip)."""
+    exe = compile_c(tmp_path, TILT_ONSET_MAIN, "tilt_onset")
+    c_time, c_angle, c_off, c_bottom = map(float, run_c(exe).split())
+    spec = importlib.util.spec_from_file_location(
+        "tilt_table_example", REPO / "examples" / "python" / "tilt_table.py")
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    r = ex.run_case("R", False, 7.0, [])
+    (p_time, p_angle), p_off = r["slide"][1], r["off"][1]
+    assert r["slide"][0] is None and math.isnan(c_bottom)  # the bottom box rests on the stop
+    assert p_time == pytest.approx(c_time, abs=1e-9)
+    assert p_angle == pytest.approx(c_angle, abs=1e-9)
+    assert p_off == pytest.approx(c_off, abs=1e-9)
+    assert abs(p_angle - math.degrees(math.atan(0.3))) < 0.3
 
 
 def test_tilt_table_wrapped_matches_c(tilt_exe):
@@ -729,6 +850,19 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert (tmp_path / "run.pvd").exists()
         sheet.write_vtp(tmp_path / "sheet.vtp")
         assert (tmp_path / "sheet.vtp").exists()
+        # Strides: a call every 10 ms from t = 17.5 ms, every 2nd call offered (17.5, 37.5,
+        # 57.5, 77.5, 97.5 ms) and at most one frame per 25 ms slot (slots 0, 1, 2, 3, 3).
+        with w.vtk_series(tmp_path, "strided", format="ascii", frame_stride=2,
+                          time_stride=0.025, springs=1) as strided:
+            for _ in range(10):
+                w.step(40)  # 10 ms at dt 0.25 ms
+                strided.write_frame()
+            assert strided.frame_count == 4
+        assert (tmp_path / "strided_000000_springs1.vtp").exists()
+        with pytest.raises(ws.WrapsimError) as err:
+            w.vtk_series(tmp_path, "bad", frame_stride=0)
+        assert err.value.status == ws.WS_ERR_INVALID_ARGUMENT
+        assert "frame_stride" in err.value.detail
         open_series = w.vtk_series(tmp_path, "left-open")  # closed with the world
         open_series.write_frame()
         with pytest.raises(ws.WrapsimError) as err:

@@ -17,11 +17,12 @@ from ._lib import LibraryError, BINDING_VERSION as __version__  # noqa: F401
 from ._lib import (  # noqa: F401  (re-exported constants)
     WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE,
     WS_ERR_OUT_OF_MEMORY, WS_ERR_NUMERICAL, WS_ERR_BAD_MESH, WS_ERR_IN_USE, WS_ERR_CALLBACK,
-    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_FORMAT, WS_LOG_DEBUG, WS_LOG_INFO,
-    WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD, WS_INTEGRATOR_SYMPLECTIC_EULER,
+    WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_IN_STEP, WS_ERR_FORMAT,
+    WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD,
+    WS_INTEGRATOR_SYMPLECTIC_EULER,
     WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
-    WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_LAW_LINEAR_ELASTIC,
+    WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT, WS_LAW_LINEAR_ELASTIC,
     WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_LAW_LINEAR_VISCOUS,
     WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP, WS_LAW_RELAXATION, WS_LAW_SUM,
     WS_LAW_SCALED, WS_LAW_USER, WS_LAW_FLAG_ELASTIC, WS_LAW_FLAG_VISCOUS, WS_SPRING_AROUND,
@@ -33,6 +34,9 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_DRIVE_PULSE, WS_DRIVE_IMPACT, WS_DRIVE_TABLE, WS_DRIVE_RANDOM, WS_DRIVE_SWEEP,
     WS_PULSE_ACCELERATE, WS_PULSE_BRAKE, WS_SWEEP_LOG, WS_SWEEP_LINEAR, WS_TRUCK_LOW,
     WS_TRUCK_MEDIUM, WS_TRUCK_HIGH, WS_STANDARD_GRAVITY)
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_FEATURE_ZLIB, WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII, WS_VTK_DEFAULT_BANDS,
+    WS_VTK_MAX_BANDS)
 from ._run import run  # noqa: F401
 
 __all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
@@ -163,7 +167,7 @@ def _fill(struct, kwargs):
 def _make(struct_type, kwargs):
     d = struct_type()
     init = {s: n for n, s in L.DEF_INITS}[struct_type]
-    getattr(_c(), init)(byref(d))
+    getattr(_c(), init)(byref(d), ctypes.sizeof(d))
     return _fill(d, kwargs)
 
 
@@ -547,6 +551,25 @@ class World:
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
 
+    def mesh_from_file(self, path, scale=1.0, weld_tol=1e-6, flip=False, file_format=None):
+        """A closed mesh shape read from an STL (ASCII or binary), OBJ or PLY file (needs
+        meshio). `scale` turns the file's numbers into metres (0.001 for a file in mm);
+        vertices closer than `weld_tol` times the mesh's size are welded into one (STL repeats
+        every vertex in each of its triangles); `flip` reverses an inside-out mesh. Like every
+        mesh, the shape is re-centred on its volume centroid: create its body at
+        `shape.centroid_offset` (identity orientation) to put it where the file had it. Raises
+        wrapsim.meshfile.MeshFileError (a WrapsimError) naming the file, and for a mesh the
+        library refuses, the offending edge's vertex positions in the file's units."""
+        from . import meshfile
+        v, t = meshfile.read_mesh(path, scale=scale, weld_tol=weld_tol, flip=flip,
+                                  file_format=file_format)
+        try:
+            return self.mesh(v, t)
+        except WrapsimError as e:
+            if e.status != WS_ERR_BAD_MESH:
+                raise
+            raise meshfile.refused(str(path), e, v, t, float(scale), float(weld_tol)) from e
+
     # bodies
     def body(self, shape, **kwargs):
         """Create a body: ws_body_def fields as keywords (type 'dynamic'/'kinematic', material,
@@ -592,6 +615,26 @@ class World:
         if n.value:
             self._call("ws_world_copy_contacts", _ptr(buf, L.ContactInfo), len(buf), byref(n))
         return buf[: n.value]
+
+    def contacts_between(self, a, b):
+        """Active contacts between Bodies a and b, in that order: body_a is a, the normal points
+        from a to b, the forces and slip velocity are b's, whichever body owns the face (kind
+        WS_CONTACT_FACE_POINT: a point of a in a face of b). Same dtype as contacts()."""
+        n = c_size_t()
+        self._call("ws_world_copy_contacts_between", a._id, b._id, None, 0, byref(n))
+        buf = np.zeros(n.value, dtype=CONTACT_DTYPE)
+        if n.value:
+            self._call("ws_world_copy_contacts_between", a._id, b._id,
+                       _ptr(buf, L.ContactInfo), len(buf), byref(n))
+        return buf[: n.value]
+
+    def interface_stiffness(self, a, b):
+        """(stiffness N/m, points): the summed normal stiffness of the active contact points
+        between Bodies a and b and their number (4 for a box on a larger plane, 8 for two equal
+        boxes face to face)."""
+        k, n = c_double(), c_size_t()
+        self._call("ws_world_get_interface_stiffness", a._id, b._id, byref(k), byref(n))
+        return k.value, n.value
 
     # laws and webs
     def law(self, type="linear_elastic", **kwargs):
@@ -792,11 +835,23 @@ class World:
         """Write the bodies as one VTK PolyData file."""
         self._call("ws_world_write_vtp", str(path).encode())
 
-    def vtk_series(self, directory, basename):
-        """Start a .vtp/.pvd time series in `directory` (must exist). A context manager."""
+    def vtk_series(self, directory, basename, **kwargs):
+        """Start a time series for ParaView in `directory` (must exist): a .pvd over per-frame
+        .vtm multiblocks with the blocks bodies, film, contacts (and springs). Keyword arguments
+        are ws_vtk_series_def fields: format (WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII or
+        "compressed", "binary", "ascii"), frame_stride, time_stride (s), springs, contacts,
+        containment_bands, double_precision. A context manager."""
+        if isinstance(kwargs.get("format"), str):
+            kwargs["format"] = {"compressed": L.WS_VTK_COMPRESSED, "binary": L.WS_VTK_BINARY,
+                                "ascii": L.WS_VTK_ASCII}[kwargs["format"].lower()]
+        d = _make(L.VtkSeriesDef, kwargs)
+        directory, basename = str(directory).encode(), str(basename).encode()
+        d.directory, d.basename = directory, basename
         p = L.Series_p()
-        self._call("ws_vtk_series_create", str(directory).encode(), str(basename).encode(),
-                   byref(p))
+        if kwargs:
+            self._call("ws_vtk_series_create_def", byref(d), byref(p))
+        else:
+            self._call("ws_vtk_series_create", directory, basename, byref(p))
         s = VtkSeries(self, p)
         self._series.append(s)
         return s
@@ -853,6 +908,15 @@ class Shape(_Handle):
         i = L.ShapeInfo()
         self._call("ws_shape_get_info", byref(i))
         return _struct_dict(i)
+
+    @property
+    def centroid_offset(self):
+        """How far the mesh was moved when created (its volume centroid in the frame its
+        vertices were given in), m: create the body at this position to put it where the mesh
+        was."""
+        v = L.Vec3()
+        self._call("ws_shape_get_centroid_offset", byref(v))
+        return np.array([v.x, v.y, v.z])
 
     def copy_mesh(self):
         """The re-centred vertices (n, 3) m and triangles (m, 3)."""
@@ -1297,7 +1361,7 @@ class VtkSeries:
             raise WrapsimError(s, _c().ws_world_last_error(self.world.ptr).decode())
 
     def write_frame(self):
-        """Write the world now as the next frame."""
+        """Offer the world now as the next frame: written when the series' strides allow it."""
         if not self._ptr:
             raise WrapsimError(WS_ERR_STALE_HANDLE, "the VTK series was closed")
         self._check(_c().ws_vtk_series_write_frame(self._ptr))

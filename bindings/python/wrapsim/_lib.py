@@ -31,10 +31,12 @@ WS_ERR_CALLBACK = 8
 WS_ERR_BUFFER_TOO_SMALL = 9
 WS_ERR_IO = 10
 WS_ERR_UNSUPPORTED = 11
-WS_ERR_FORMAT = 12
+WS_ERR_IN_STEP = 12
+WS_ERR_FORMAT = 13
 
 WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
 WS_FEATURE_CCD = 1
+WS_FEATURE_ZLIB = 2
 WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
 WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
 WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
@@ -44,7 +46,7 @@ WS_PULSE_ACCELERATE, WS_PULSE_BRAKE = 0, 1
 WS_SWEEP_LOG, WS_SWEEP_LINEAR = 0, 1
 WS_TRUCK_LOW, WS_TRUCK_MEDIUM, WS_TRUCK_HIGH = 1, 2, 3
 WS_STANDARD_GRAVITY = 9.80665
-WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE = 0, 1
+WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT = 0, 1, 2
 WS_LAW_LINEAR_ELASTIC, WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION = 0, 1, 2
 WS_LAW_LINEAR_VISCOUS, WS_LAW_CUBIC_ELASTIC, WS_LAW_TABLE, WS_LAW_STOP = 3, 4, 5, 6
 WS_LAW_RELAXATION, WS_LAW_SUM, WS_LAW_SCALED, WS_LAW_USER = 7, 8, 9, 10
@@ -437,6 +439,29 @@ class ContainmentBand(Structure):
     ]
 
 
+# --- io.h ----------------------------------------------------------------------------------------
+WS_VTK_COMPRESSED = 0
+WS_VTK_BINARY = 1
+WS_VTK_ASCII = 2
+WS_VTK_DEFAULT_BANDS = 10
+WS_VTK_MAX_BANDS = 256
+
+
+class VtkSeriesDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("directory", c_char_p),
+        ("basename", c_char_p),
+        ("format", c_int),
+        ("frame_stride", c_int),
+        ("time_stride", c_double),
+        ("springs", c_int),
+        ("contacts", c_int),
+        ("containment_bands", c_int),
+        ("double_precision", c_int),
+    ]
+
+
 # --- element.h -----------------------------------------------------------------------------------
 class ElementDef(Structure):
     _fields_ = [
@@ -633,9 +658,9 @@ FUNCTIONS = [
     ("ws_version_string", [], c_char_p),
     ("ws_build_features", [], c_uint),
     # world.h
-    ("ws_world_def_init", [P(WorldDef)], None),
-    ("ws_contact_def_init", [P(ContactDef)], None),
-    ("ws_material_def_init", [P(MaterialDef)], None),
+    ("ws_world_def_init_sized", [P(WorldDef), c_size_t], None),
+    ("ws_contact_def_init_sized", [P(ContactDef), c_size_t], None),
+    ("ws_material_def_init_sized", [P(MaterialDef), c_size_t], None),
     ("ws_world_create", [P(WorldDef), P(World_p)], _st),
     ("ws_world_destroy", [World_p], None),
     ("ws_world_step", [World_p], _st),
@@ -657,18 +682,19 @@ FUNCTIONS = [
     ("ws_world_get_contact", [World_p, MaterialId, MaterialId, P(ContactDef)], _st),
     ("ws_world_set_default_contact", [World_p, P(ContactDef)], _st),
     # shape.h
-    ("ws_mesh_def_init", [P(MeshDef)], None),
+    ("ws_mesh_def_init_sized", [P(MeshDef), c_size_t], None),
     ("ws_shape_create_box", [World_p, c_double, c_double, c_double, P(ShapeId)], _st),
     ("ws_shape_create_cylinder", [World_p, c_double, c_double, c_int, P(ShapeId)], _st),
     ("ws_shape_create_mesh", [World_p, P(MeshDef), P(ShapeId)], _st),
     ("ws_shape_destroy", [World_p, ShapeId], _st),
     ("ws_shape_is_valid", [World_p, ShapeId], c_int),
     ("ws_shape_get_info", [World_p, ShapeId, P(ShapeInfo)], _st),
+    ("ws_shape_get_centroid_offset", [World_p, ShapeId, P(Vec3)], _st),
     ("ws_shape_copy_mesh", [World_p, ShapeId, P(c_double), c_size_t, P(c_size_t), P(c_uint32),
                             c_size_t, P(c_size_t)], _st),
     # body.h
-    ("ws_body_def_init", [P(BodyDef)], None),
-    ("ws_drive_def_init", [P(DriveDef)], None),
+    ("ws_body_def_init_sized", [P(BodyDef), c_size_t], None),
+    ("ws_drive_def_init_sized", [P(DriveDef), c_size_t], None),
     ("ws_body_create", [World_p, P(BodyDef), P(BodyId)], _st),
     ("ws_body_destroy", [World_p, BodyId], _st),
     ("ws_body_is_valid", [World_p, BodyId], c_int),
@@ -697,8 +723,12 @@ FUNCTIONS = [
     # contact.h
     ("ws_world_get_contact_count", [World_p, P(c_size_t)], _st),
     ("ws_world_copy_contacts", [World_p, P(ContactInfo), c_size_t, P(c_size_t)], _st),
+    ("ws_world_copy_contacts_between", [World_p, BodyId, BodyId, P(ContactInfo), c_size_t,
+                                        P(c_size_t)], _st),
+    ("ws_world_get_interface_stiffness", [World_p, BodyId, BodyId, P(c_double), P(c_size_t)],
+     _st),
     # law.h
-    ("ws_law_def_init", [P(LawDef)], None),
+    ("ws_law_def_init_sized", [P(LawDef), c_size_t], None),
     ("ws_law_create", [World_p, P(LawDef), P(LawId)], _st),
     ("ws_law_destroy", [World_p, LawId], _st),
     ("ws_law_is_valid", [World_p, LawId], c_int),
@@ -715,10 +745,10 @@ FUNCTIONS = [
     ("ws_law_energy_state", [World_p, LawId, P(c_double), P(c_double), c_double, P(c_double)],
      _st),
     # web.h
-    ("ws_web_def_init", [P(WebDef)], None),
-    ("ws_sheet_def_init", [P(SheetDef)], None),
-    ("ws_band_def_init", [P(BandDef)], None),
-    ("ws_web_mesh_def_init", [P(WebMeshDef)], None),
+    ("ws_web_def_init_sized", [P(WebDef), c_size_t], None),
+    ("ws_sheet_def_init_sized", [P(SheetDef), c_size_t], None),
+    ("ws_band_def_init_sized", [P(BandDef), c_size_t], None),
+    ("ws_web_mesh_def_init_sized", [P(WebMeshDef), c_size_t], None),
     ("ws_web_create_sheet", [World_p, P(WebDef), P(SheetDef), P(WebId)], _st),
     ("ws_web_create_band", [World_p, P(WebDef), P(BandDef), P(WebId)], _st),
     ("ws_web_create_mesh", [World_p, P(WebDef), P(WebMeshDef), P(WebId)], _st),
@@ -737,7 +767,7 @@ FUNCTIONS = [
     ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
     ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
     # element.h
-    ("ws_element_def_init", [P(ElementDef)], None),
+    ("ws_element_def_init_sized", [P(ElementDef), c_size_t], None),
     ("ws_element_create", [World_p, P(ElementDef), P(ElementId)], _st),
     ("ws_element_destroy", [World_p, ElementId], _st),
     ("ws_element_is_valid", [World_p, ElementId], c_int),
@@ -751,6 +781,8 @@ FUNCTIONS = [
     ("ws_world_write_vtp", [World_p, c_char_p], _st),
     ("ws_web_write_vtp", [World_p, WebId, c_char_p], _st),
     ("ws_vtk_series_create", [World_p, c_char_p, c_char_p, P(Series_p)], _st),
+    ("ws_vtk_series_def_init_sized", [P(VtkSeriesDef), c_size_t], None),
+    ("ws_vtk_series_create_def", [World_p, P(VtkSeriesDef), P(Series_p)], _st),
     ("ws_vtk_series_write_frame", [Series_p], _st),
     ("ws_vtk_series_get_frame_count", [Series_p, P(c_size_t)], _st),
     ("ws_vtk_series_destroy", [Series_p], None),
@@ -782,20 +814,23 @@ FUNCTIONS = [
      _st),
 ]
 
-#: The Defs whose ws_*_def_init writes `size`: checked against ctypes.sizeof when loading.
+#: The Defs and their sized inits (ws_*_def_init_sized(def, size)): the binding passes its
+#: struct's ctypes.sizeof, so the library never writes past it, and the size the library records
+#: (the bytes both know) is checked against it when loading.
 DEF_INITS = [
-    ("ws_world_def_init", WorldDef),
-    ("ws_contact_def_init", ContactDef),
-    ("ws_material_def_init", MaterialDef),
-    ("ws_mesh_def_init", MeshDef),
-    ("ws_body_def_init", BodyDef),
-    ("ws_drive_def_init", DriveDef),
-    ("ws_law_def_init", LawDef),
-    ("ws_web_def_init", WebDef),
-    ("ws_sheet_def_init", SheetDef),
-    ("ws_band_def_init", BandDef),
-    ("ws_web_mesh_def_init", WebMeshDef),
-    ("ws_element_def_init", ElementDef),
+    ("ws_world_def_init_sized", WorldDef),
+    ("ws_contact_def_init_sized", ContactDef),
+    ("ws_material_def_init_sized", MaterialDef),
+    ("ws_mesh_def_init_sized", MeshDef),
+    ("ws_body_def_init_sized", BodyDef),
+    ("ws_drive_def_init_sized", DriveDef),
+    ("ws_law_def_init_sized", LawDef),
+    ("ws_web_def_init_sized", WebDef),
+    ("ws_sheet_def_init_sized", SheetDef),
+    ("ws_band_def_init_sized", BandDef),
+    ("ws_web_mesh_def_init_sized", WebMeshDef),
+    ("ws_element_def_init_sized", ElementDef),
+    ("ws_vtk_series_def_init_sized", VtkSeriesDef),
 ]
 
 
@@ -809,11 +844,17 @@ def _candidates():
     if env:
         return [(env, "WRAPSIM_LIBRARY")]
     out = []
-    # The build tree: <repo>/bindings/python/wrapsim/_lib.py -> <repo>/build/lib.
-    repo = pathlib.Path(__file__).resolve().parents[3]
     names = {"darwin": ["libwrapsim.dylib", "libwrapsim.0.dylib"],
              "win32": ["wrapsim.dll", "libwrapsim.dll"]}.get(sys.platform,
                                                             ["libwrapsim.so.0", "libwrapsim.so"])
+    # Installed by pip: the library travels inside the package, next to this module.
+    here = pathlib.Path(__file__).resolve().parent
+    for name in names:
+        p = here / name
+        if p.exists():
+            out.append((str(p), "the package"))
+    # The build tree: <repo>/bindings/python/wrapsim/_lib.py -> <repo>/build/lib.
+    repo = here.parents[2]
     for name in names:
         p = repo / "build" / "lib" / name
         if p.exists():
@@ -826,14 +867,14 @@ def _candidates():
 
 
 def _check_defs(lib, path):
-    """Refuse a library whose Def structs differ in size from the ones above."""
+    """Refuse a library whose Def structs are smaller than the ones above (fields the binding
+    sets would be ignored). The sized init writes no more than the struct's own size."""
     for name, struct in DEF_INITS:
-        buf = ctypes.create_string_buffer(max(4096, 4 * ctypes.sizeof(struct)))
-        getattr(lib, name)(ctypes.cast(buf, POINTER(struct)))
-        size = c_uint32.from_buffer(buf).value
-        if size != ctypes.sizeof(struct):
+        d = struct()
+        getattr(lib, name)(ctypes.byref(d), ctypes.sizeof(struct))
+        if d.size != ctypes.sizeof(struct):
             raise LibraryError(
-                f"{path}: {name} fills {size} bytes but the binding's {struct.__name__} has "
+                f"{path}: {name} knows {d.size} bytes of the binding's {struct.__name__} of "
                 f"{ctypes.sizeof(struct)}: the library and the binding disagree on the headers")
 
 
@@ -852,8 +893,10 @@ def load(path=None):
             tried.append(f"{cand} ({how}): {e}")
     if lib is None:
         raise LibraryError("libwrapsim not found; tried:\n  " + "\n  ".join(tried) +
-                           "\nSet WRAPSIM_LIBRARY to the path of libwrapsim.so.0, or build it with "
-                           "`meson setup build && ninja -C build` in the repository.")
+                           "\nInstall the package with the library inside it (from the repository: "
+                           "`pip install --no-build-isolation .`), set WRAPSIM_LIBRARY to the path "
+                           "of libwrapsim.so.0, or build it with `meson setup build && ninja -C "
+                           "build` in the repository.")
     missing = []
     for name, argtypes, restype in FUNCTIONS:
         try:

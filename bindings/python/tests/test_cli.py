@@ -1,0 +1,190 @@
+"""The load file, the `wrapsim` command and studies on a Dask LocalCluster."""
+
+import csv
+import json
+import math
+import pathlib
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from wrapsim import cli, loadfile, study
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+LOADS = ROOT / "examples" / "loads"
+
+
+def short_tilt(**changes):
+    """A quick tilt test: two 0.25 m cubes, the tilt from 0.1 s at 20 deg/s to 30 deg (1.6 s).
+    Theory for the stick model, regularised friction aside: slip at atan(0.3) = 16.7 deg."""
+    d = json.loads((LOADS / "two_cubes_R.json").read_text())
+    d["simulation"]["full_detection_until_s"] = 0.1
+    d["test"].update(start_s=0.1, rate_deg_per_s=20.0, duration_s=1.6, target_angle_deg=10.0)
+    d["output"]["sample_interval_s"] = 0.005
+    for k, v in changes.items():
+        loadfile.set_path(d, k, v)
+    return d
+
+
+def write(tmp_path, d, name="load.json"):
+    p = tmp_path / name
+    p.write_text(json.dumps(d))
+    return p
+
+
+@pytest.mark.parametrize("path,value,message", [
+    ("wrap.prestretch_around_percent", -20,
+     "wrap.prestretch_around_percent: -20 is below 0 %"),
+    ("stack.layers", 0, "stack.layers: 0 is below 1"),
+    ("stack.layers", 2.5, "stack.layers: 2.5 is not a whole number"),
+    ("stack.carton.mass_kg", "heavy", "stack.carton.mass_kg: 'heavy' is not a number"),
+    ("stack.carton.mass_kg", 0, "stack.carton.mass_kg: 0 is not above 0 kg"),
+    ("materials.carton_carton.mu", -0.1, "materials.carton_carton.mu: -0.1 is below 0"),
+    ("materials.carton_platform.friction_model", "sticky",
+     "materials.carton_platform.friction_model: 'sticky' is not one of regularized, stick"),
+    ("simulation.dt_s", 0, "simulation.dt_s: 0 is not above 0 s"),
+    ("simulation.detection_interval", 0, "simulation.detection_interval: 0 is below 1"),
+    ("platform.stop.height_m", -1, "platform.stop.height_m: -1 is not above 0 m"),
+    ("test.type", "drop", "test.type: 'drop' is not one of tilt"),
+    ("test.target_angle_deg", 95, "test.target_angle_deg: 95 is above 89 deg"),
+    ("output.sample_interval_s", 0, "output.sample_interval_s: 0 is not above 0 s"),
+    ("stack.colour", "brown", "stack.colour: unknown key"),
+    ("format", "wrapsim-load 9", "format: 'wrapsim-load 9' is not one of wrapsim-load 1"),
+])
+def test_bad_values_name_their_path_and_exit_2(tmp_path, capsys, path, value, message):
+    d = short_tilt()
+    d["wrap"] = json.loads((LOADS / "two_cubes_R_wrapped.json").read_text())["wrap"]
+    loadfile.set_path(d, path, value)
+    assert cli.main(["run", str(write(tmp_path, d)), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert message in err, err
+    assert not (tmp_path / "out").exists(), "nothing may run for a bad file"
+
+
+def test_missing_required_value_and_cross_checks(tmp_path, capsys):
+    d = short_tilt()
+    del d["stack"]["carton"]["mass_kg"]
+    assert cli.main(["check", str(write(tmp_path, d))]) == 2
+    assert "stack.carton.mass_kg: missing (a required value, in kg)" in capsys.readouterr().err
+    d = short_tilt()
+    d["wrap"] = {"z_bottom_m": 0.3, "top_margin_m": 0.3}
+    assert cli.main(["check", str(write(tmp_path, d))]) == 2
+    assert "wrap.z_bottom_m: the band" in capsys.readouterr().err
+    (tmp_path / "bad.json").write_text("{\"name\": ")
+    assert cli.main(["check", str(tmp_path / "bad.json")]) == 2
+    assert "not valid JSON: line 1" in capsys.readouterr().err
+    assert cli.main(["check", str(tmp_path / "absent.json")]) == 2
+    assert cli.main(["run"]) == 2  # argparse: a missing argument
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in LOADS.glob("*.json")))
+def test_shipped_load_files_are_valid(name):
+    d = loadfile.load(LOADS / name)
+    assert d["format"] == loadfile.FORMAT
+
+
+def test_schema_agrees_with_the_checker():
+    s = loadfile.json_schema()
+    wrap = s["properties"]["wrap"]["anyOf"][0]["properties"]
+    assert wrap["prestretch_around_percent"]["minimum"] == 0.0
+    assert "[%]" in wrap["prestretch_around_percent"]["description"]
+    assert s["properties"]["stack"]["properties"]["carton"]["required"] == [
+        "length_m", "width_m", "height_m", "mass_kg"]
+    shipped = json.loads((ROOT / "docs" / "load.schema.json").read_text())
+    assert shipped == s, "docs/load.schema.json is stale: regenerate with `wrapsim schema`"
+    try:
+        import jsonschema
+    except ImportError:
+        return
+    for p in LOADS.glob("*.json"):
+        jsonschema.validate(json.loads(p.read_text()), s)
+
+
+def test_run_pass_and_fail_exit_codes_and_outputs(tmp_path):
+    # Below the slip angle the column stands: pass (0); asked for 25 deg it slips: fail (1).
+    ok = cli.main(["run", str(write(tmp_path, short_tilt())), "-o", str(tmp_path / "a"), "-q"])
+    assert ok == 0
+    v = json.loads((tmp_path / "a" / "verdict.json").read_text())
+    assert v["passed"] is True and all(c["passed"] for c in v["criteria"])
+    d = short_tilt(**{"test.target_angle_deg": 25.0})
+    assert cli.main(["run", str(write(tmp_path, d)), "-o", str(tmp_path / "b"), "-q"]) == 1
+    v = json.loads((tmp_path / "b" / "verdict.json").read_text())
+    slip = v["slip_events"]["carton 2 on carton 1"]
+    # The top cube slides on the bottom one from tan(theta0) = mu = 0.3, theta0 = 16.70 deg.
+    # Past theta0 its relative acceleration grows as g (sin - mu cos) ~ g (cos + mu sin) w t,
+    # w = 20 deg/s, so 5 mm takes t = (6 x / (g w (cos + mu sin)))^(1/3) = 0.203 s, 4.06 deg:
+    # 5 mm by 20.76 deg at the latest. Regularised friction creeps below vlim, which can only
+    # bring the 5 mm earlier; its creep (a few mm/s) cannot make 5 mm before about 12 deg.
+    theta0 = math.atan(0.3)
+    w = math.radians(20.0)
+    lag = (6 * 0.005 / (9.81 * w * (math.cos(theta0) + 0.3 * math.sin(theta0)))) ** (1 / 3)
+    latest = math.degrees(theta0 + w * lag)
+    assert slip is not None and 12.0 < slip["angle_deg"] <= latest + 0.1, (slip, latest)
+    assert v["passed"] is False
+    with open(tmp_path / "b" / "timeseries.csv") as f:
+        header = next(csv.reader(f))
+    assert header[:2] == ["t [s]", "platform_angle [deg]"]
+    assert all("[" in h for h in header), header
+    for name in ("report.html", "slip.png", "drive.png"):
+        assert (tmp_path / "b" / name).stat().st_size > 1000, name
+
+
+def test_report_renders_in_a_browser(tmp_path):
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        pytest.skip("chromium is not installed (Debian: chromium)")
+    assert cli.main(["run", str(write(tmp_path, short_tilt())), "-o", str(tmp_path), "-q"]) == 0
+    page = (tmp_path / "report.html").resolve()
+    dom = subprocess.run(
+        [browser, "--headless", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=5000",
+         "--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120).stdout
+    assert 'data-plots="2 loaded"' in dom, dom[-2000:]
+    assert dom.count("<tr class=\"pass\">") == 4, dom
+    shot = tmp_path / "shot.png"
+    subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu",
+                    f"--screenshot={shot}", "--window-size=1000,1400", page.as_uri()],
+                   capture_output=True, timeout=120)
+    assert shot.stat().st_size > 20000  # a page of text, a table and two plots
+
+
+def test_sweep_on_a_local_cluster(tmp_path):
+    pytest.importorskip("dask.distributed")
+    base = short_tilt()
+    base["test"]["duration_s"] = 0.6
+    # Two names that change nothing physical: the same run on whichever worker gives the same
+    # state hash. A layer count of 0 is a bad combination: a row with its error.
+    varies = [study.parse_vary("name=\"a\",\"b\""), study.parse_vary("stack.layers=0:2")]
+    path = study.sweep(base, varies, tmp_path, workers=2)
+    rows = list(csv.DictReader(open(path)))
+    assert len(rows) == 6
+    bad = [r for r in rows if r["stack.layers"] == "0"]
+    assert len(bad) == 2 and all("stack.layers: 0 is below 1" in r["error"] for r in bad)
+    good = [r for r in rows if r["stack.layers"] != "0"]
+    assert all(r["error"] == "" and len(r["state_hash"]) == 16 for r in good)
+    for layers in ("1", "2"):
+        hashes = {r["state_hash"] for r in good if r["stack.layers"] == layers}
+        assert len(hashes) == 1, hashes
+    # Resume: the rows already there are kept and not run again.
+    rows_before = path.read_text()
+    study.sweep(base, varies + [], tmp_path, workers=1, resume=True)
+    assert path.read_text() == rows_before
+
+
+def test_module_and_help_exit_codes():
+    r = subprocess.run([sys.executable, "-m", "wrapsim", "--help"], capture_output=True,
+                       text=True)
+    assert r.returncode == 0 and "sweep" in r.stdout
+    r = subprocess.run([sys.executable, "-m", "wrapsim", "bogus"], capture_output=True)
+    assert r.returncode == 2
+
+
+def test_yaml_load_file(tmp_path):
+    yaml = pytest.importorskip("yaml")
+    d = short_tilt()
+    (tmp_path / "load.yaml").write_text(yaml.safe_dump(d))
+    assert loadfile.load(tmp_path / "load.yaml") == loadfile.validate(d)
+    (tmp_path / "bad.yaml").write_text("stack: [unclosed")
+    with pytest.raises(loadfile.LoadFileError, match="not valid YAML"):
+        loadfile.load(tmp_path / "bad.yaml")

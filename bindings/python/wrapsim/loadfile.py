@@ -1,0 +1,279 @@
+"""Load files: a description of a load, its wrap and its test, in JSON (or YAML).
+
+Every quantity is in SI units, or in the unit its key names (`_percent`, `_deg`, `_deg_per_s`);
+the unit of each key is in SPEC below, from which the JSON Schema (`wrapsim/load.schema.json`,
+`json_schema()`) is made, so the two cannot disagree. `load()` reads a file, fills the
+defaults and checks every value; a bad file raises LoadFileError whose message names the exact
+path and what is wrong, e.g. "wrap.prestretch_around_percent: -20 is below 0 %".
+
+The form of this version: a column of cartons (`stack`) on a platform (`platform`, optionally
+with a stop bar on its downhill side), the materials of each interface (`materials`), an
+optional film band (`wrap`), and the test (`test`, a tilt table) with its criteria.
+"""
+
+import copy
+import json
+import math
+import pathlib
+
+FORMAT = "wrapsim-load 1"
+
+
+class LoadFileError(ValueError):
+    """A load file that cannot be used; the message names the path of the bad value."""
+
+
+def _num(unit, default=None, minimum=None, maximum=None, exclusive_min=False, doc=""):
+    return dict(kind="number", unit=unit, default=default, minimum=minimum, maximum=maximum,
+                exclusive_min=exclusive_min, doc=doc)
+
+
+def _int(default=None, minimum=None, maximum=None, doc=""):
+    return dict(kind="integer", unit="", default=default, minimum=minimum, maximum=maximum,
+                exclusive_min=False, doc=doc)
+
+
+def _str(choices, default=None, doc=""):
+    return dict(kind="string", choices=choices, default=default, doc=doc)
+
+
+def _section(fields, optional=False, doc=""):
+    return dict(kind="object", fields=fields, optional=optional, doc=doc)
+
+
+def _interface(mu, stiffness, damping):
+    return _section({
+        "friction_model": _str(["regularized", "stick"], "regularized",
+                               doc="regularized Coulomb (eq. 13; creeps below vlim) or the "
+                                   "stick model (a tangential spring anchored at the contact)"),
+        "mu": _num("", mu, 0.0, 10.0, doc="Coulomb friction coefficient"),
+        "vlim_m_per_s": _num("m/s", 0.01, 0.0, 10.0, True,
+                             doc="friction regularisation speed (eq. 13)"),
+        "stiffness_N_per_m": _num("N/m", stiffness, 0.0, 1e12, True,
+                                  doc="normal penalty stiffness per contact point"),
+        "damping_kg_per_s": _num("kg/s", damping, 0.0, 1e9,
+                                 doc="normal damping per contact point"),
+    })
+
+
+#: The load file's fields: kind, unit, default (None: required), range, and what it means.
+SPEC = _section({
+    "format": _str([FORMAT], FORMAT, doc="the format and its version"),
+    "name": dict(kind="string", choices=None, default="load", doc="a name for the report"),
+    "simulation": _section({
+        "dt_s": _num("s", 2.5e-4, 0.0, 0.01, True, doc="time step"),
+        "full_detection_until_s": _num("s", 0.5, 0.0, 1e6,
+                                       doc="full contact detection every step until then"),
+        "detection_interval": _int(5, 1, 1000, doc="then full detection every Nth step"),
+    }),
+    "platform": _section({
+        "length_m": _num("m", 1.5, 0.0, 100.0, True, doc="extent along x (the tilt's downhill)"),
+        "width_m": _num("m", 1.5, 0.0, 100.0, True, doc="extent along y"),
+        "thickness_m": _num("m", 0.05, 0.0, 10.0, True),
+        "stop": _section({
+            "height_m": _num("m", 0.02, 0.0, 10.0, True, doc="height above the platform"),
+            "thickness_m": _num("m", 0.02, 0.0, 10.0, True, doc="extent along x"),
+        }, optional=True, doc="a bar along the downhill face of the bottom carton"),
+    }),
+    "stack": _section({
+        "carton": _section({
+            "length_m": _num("m", None, 0.0, 10.0, True),
+            "width_m": _num("m", None, 0.0, 10.0, True),
+            "height_m": _num("m", None, 0.0, 10.0, True),
+            "mass_kg": _num("kg", None, 0.0, 1e5, True),
+        }),
+        "layers": _int(None, 1, 50, doc="cartons stacked in one column"),
+        "contact_layer_m": _num("m", 1e-3, 0.0, 0.1, True, doc="contact layer of every body"),
+    }),
+    "materials": _section({
+        "carton_carton": _interface(0.3, 2e5, 10.0),
+        "carton_platform": _interface(0.3, 2e5, 10.0),
+        "film_carton": _interface(0.9, 4000.0, 1.0),
+    }),
+    "wrap": _section({
+        "z_bottom_m": _num("m", 0.03, 0.0, 100.0, doc="band's lower edge above the platform"),
+        "top_margin_m": _num("m", 0.02, 0.0, 100.0, doc="band's upper edge below the top"),
+        "nodes_around": _int(96, 8, 100000),
+        "nodes_up": _int(61, 2, 100000),
+        "prestretch_around_percent": _num("%", 40.0, 0.0, 1000.0),
+        "prestretch_up_percent": _num("%", 20.0, 0.0, 1000.0),
+        "spring_stiffness_N_per_m": _num("N/m", 2000.0, 0.0, 1e9, True),
+        "spring_damping_kg_per_s": _num("kg/s", 0.1, 0.0, 1e6),
+        "node_mass_kg": _num("kg", 1e-3, 0.0, 10.0, True),
+    }, optional=True, doc="a band of film around the stack (absent: unwrapped)"),
+    "test": _section({
+        "type": _str(["tilt"], "tilt", doc="tilt table (ISO 10531)"),
+        "start_s": _num("s", 1.0, 0.0, 1e6, doc="the tilt starts (smoothly) at this time"),
+        "rate_deg_per_s": _num("deg/s", math.degrees(0.1), 0.0, 90.0, True),
+        "duration_s": _num("s", 7.0, 0.0, 1e6, True, doc="simulated time"),
+        "target_angle_deg": _num("deg", 20.0, 0.0, 89.0, True,
+                                 doc="the load passes when nothing slips or tips below it"),
+        "slip_limit_mm": _num("mm", 5.0, 0.0, 1e4, True,
+                              doc="relative slip that counts as slipping"),
+    }),
+    "output": _section({
+        "sample_interval_s": _num("s", 0.01, 0.0, 10.0, True, doc="time series sampling"),
+    }),
+})
+
+
+def _unit_text(unit):
+    return f" {unit}" if unit else ""
+
+
+def _check_value(spec, value, path):
+    kind = spec["kind"]
+    if kind in ("number", "integer"):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise LoadFileError(f"{path}: {value!r} is not a number")
+        if kind == "integer" and not (isinstance(value, int) or float(value).is_integer()):
+            raise LoadFileError(f"{path}: {value!r} is not a whole number")
+        if not math.isfinite(value):
+            raise LoadFileError(f"{path}: {value!r} is not finite")
+        lo, hi, unit = spec["minimum"], spec["maximum"], _unit_text(spec["unit"])
+        if lo is not None and (value < lo or (spec["exclusive_min"] and value == lo)):
+            word = "not above" if spec["exclusive_min"] else "below"
+            raise LoadFileError(f"{path}: {value:g} is {word} {lo:g}{unit}")
+        if hi is not None and value > hi:
+            raise LoadFileError(f"{path}: {value:g} is above {hi:g}{unit}")
+        return int(value) if kind == "integer" else float(value)
+    if kind == "string":
+        if not isinstance(value, str):
+            raise LoadFileError(f"{path}: {value!r} is not a string")
+        if spec["choices"] is not None and value not in spec["choices"]:
+            raise LoadFileError(f"{path}: {value!r} is not one of {', '.join(spec['choices'])}")
+        return value
+    return _check_section(spec, value, path)
+
+
+def _check_section(spec, value, path):
+    if not isinstance(value, dict):
+        raise LoadFileError(f"{path or 'the file'}: expected an object (a section), "
+                            f"got {type(value).__name__}")
+    unknown = sorted(set(value) - set(spec["fields"]))
+    if unknown:
+        where = f"{path}." if path else ""
+        raise LoadFileError(f"{where}{unknown[0]}: unknown key (known: "
+                            f"{', '.join(spec['fields'])})")
+    out = {}
+    for key, sub in spec["fields"].items():
+        sub_path = f"{path}.{key}" if path else key
+        if key not in value or value[key] is None:
+            if sub["kind"] == "object":
+                if sub["optional"]:
+                    out[key] = None
+                else:
+                    out[key] = _check_section(sub, {}, sub_path)
+            elif sub["default"] is None:
+                raise LoadFileError(f"{sub_path}: missing (a required value"
+                                    f"{', in ' + sub['unit'] if sub.get('unit') else ''})")
+            else:
+                out[key] = sub["default"]
+        else:
+            out[key] = _check_value(sub, value[key], sub_path)
+    return out
+
+
+def _cross_checks(d):
+    """What one key alone cannot say."""
+    c = d["stack"]["carton"]
+    height = d["stack"]["layers"] * c["height_m"]
+    w = d["wrap"]
+    if w is not None and w["z_bottom_m"] + w["top_margin_m"] >= height:
+        raise LoadFileError(f"wrap.z_bottom_m: the band ({w['z_bottom_m']:g} m from the bottom, "
+                            f"{w['top_margin_m']:g} m below the top) has no height on a stack "
+                            f"{height:g} m high")
+    p = d["platform"]
+    if max(c["length_m"], c["width_m"]) > min(p["length_m"], p["width_m"]):
+        raise LoadFileError(f"platform.length_m: the platform ({p['length_m']:g} x "
+                            f"{p['width_m']:g} m) is smaller than the carton")
+
+
+def validate(data):
+    """Check a parsed load file and fill its defaults; return the complete copy.
+    Raise LoadFileError naming the path of the first bad value."""
+    d = _check_section(SPEC, copy.deepcopy(data), "")
+    _cross_checks(d)
+    return d
+
+
+def parse(path):
+    """The raw content of a JSON (or, with PyYAML installed, YAML) load file."""
+    p = pathlib.Path(path)
+    try:
+        text = p.read_text()
+    except OSError as e:
+        raise LoadFileError(f"{path}: cannot read: {e.strerror}") from None
+    if p.suffix.lower() in (".yaml", ".yml"):
+        try:
+            import yaml
+        except ImportError:
+            raise LoadFileError(f"{path}: YAML needs PyYAML (Debian: python3-yaml)") from None
+        try:
+            return yaml.safe_load(text)
+        except yaml.YAMLError as e:
+            raise LoadFileError(f"{path}: not valid YAML: {e}") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as e:
+        raise LoadFileError(f"{path}: not valid JSON: line {e.lineno}, column {e.colno}: "
+                            f"{e.msg}") from None
+
+
+def load(path):
+    """Read, check and complete a load file (see validate)."""
+    return validate(parse(path))
+
+
+def set_path(d, dotted, value):
+    """Set `a.b.c` in a nested dict (creating sections), as `--vary` does; return d."""
+    keys = dotted.split(".")
+    node = d
+    for k in keys[:-1]:
+        if node.get(k) is None:
+            node[k] = {}
+        node = node[k]
+    node[keys[-1]] = value
+    return d
+
+
+def _schema_of(spec):
+    kind = spec["kind"]
+    if kind == "object":
+        props = {k: _schema_of(v) for k, v in spec["fields"].items()}
+        required = [k for k, v in spec["fields"].items()
+                    if v["kind"] != "object" and v.get("default") is None]
+        out = {"type": "object", "properties": props, "additionalProperties": False}
+        if required:
+            out["required"] = required
+        if spec.get("optional"):
+            out = {"anyOf": [out, {"type": "null"}]}
+        if spec.get("doc"):
+            out["description"] = spec["doc"]
+        return out
+    if kind == "string":
+        out = {"type": "string"}
+        if spec["choices"]:
+            out["enum"] = list(spec["choices"])
+    else:
+        out = {"type": kind}
+        if spec["minimum"] is not None:
+            out["exclusiveMinimum" if spec["exclusive_min"] else "minimum"] = spec["minimum"]
+        if spec["maximum"] is not None:
+            out["maximum"] = spec["maximum"]
+    desc = spec.get("doc", "")
+    if spec.get("unit"):
+        desc = f"{desc} [{spec['unit']}]".strip()
+    if desc:
+        out["description"] = desc
+    if spec.get("default") is not None:
+        out["default"] = spec["default"]
+    return out
+
+
+def json_schema():
+    """The JSON Schema (draft 2020-12) of a load file, made from SPEC."""
+    s = _schema_of(SPEC)
+    s["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    s["title"] = f"libwrapsim load file ({FORMAT})"
+    return s

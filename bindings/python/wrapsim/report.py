@@ -1,0 +1,126 @@
+"""What `wrapsim run` leaves in its output folder: verdict.json, timeseries.csv (units in every
+header), PNG plots (with matplotlib) and report.html, one page to file."""
+
+import html
+import json
+import pathlib
+
+import numpy as np
+
+
+def _unit_header(col):
+    """`carton1_slip_mm` -> `carton1_slip [mm]`: the unit in every header."""
+    for suffix, unit in (("_mm", "mm"), ("_deg", "deg"), ("_s", "s"), ("_N", "N")):
+        if col.endswith(suffix):
+            return f"{col[:-len(suffix)]} [{unit}]"
+    return col
+
+
+def write_series(path, series):
+    cols = list(series)
+    data = np.column_stack([series[c] for c in cols])
+    header = ",".join(_unit_header(c) for c in cols)
+    np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
+
+
+def write_plots(folder, d, result, series):
+    """The plots as PNG files; returns their names (none without matplotlib)."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return []
+    t, angle = series["t_s"], series["platform_angle_deg"]
+    n = d["stack"]["layers"]
+    target = result["target_angle_deg"]
+    names = []
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for k in range(n):
+        ax.plot(angle, series[f"carton{k + 1}_relative_slip_mm"],
+                label=f"carton {k + 1}, relative to what it stands on")
+    lim = d["test"]["slip_limit_mm"]
+    ax.axhline(lim, color="tab:red", ls="--", lw=1, label=f"slip limit {lim:g} mm")
+    ax.axvline(target, color="0.3", ls=":", lw=1, label=f"target {target:g}°")
+    for name, ev in result["slip_events"].items():
+        if ev:
+            ax.axvline(ev["angle_deg"], color="tab:orange", lw=0.8)
+    ax.set_ylim(min(-1.0, ax.get_ylim()[0]), max(3 * lim, 1.0))
+    ax.set_xlabel("platform angle [deg]")
+    ax.set_ylabel("slip along the platform [mm]")
+    ax.set_title("Slip of each carton against the platform angle")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(folder / "slip.png", dpi=110)
+    plt.close(fig)
+    names.append("slip.png")
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.plot(t, angle, label="platform angle")
+    if result["tip_event"]:
+        ax.axvline(result["tip_event"]["t_s"], color="tab:red", ls="--", lw=1,
+                   label=f"tip at {result['tip_event']['angle_deg']:.2f}°")
+    ax.axhline(target, color="0.3", ls=":", lw=1, label=f"target {target:g}°")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("platform angle [deg]")
+    ax.set_title("The drive as delivered")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(folder / "drive.png", dpi=110)
+    plt.close(fig)
+    names.append("drive.png")
+    return names
+
+
+def write_report(folder, d, result, plots):
+    rows = []
+    for c in result["criteria"]:
+        m = "—" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}"
+        verdict = "pass" if c["passed"] else "FAIL"
+        rows.append(f"<tr class='{verdict.lower()}'><td>{html.escape(c['criterion'])}</td>"
+                    f"<td>{m}</td><td>{c['limit']:g} {c['unit']}</td><td>{verdict}</td></tr>")
+    imgs = "".join(f"<figure><img src='{p}' alt='{p}'><figcaption>{p}</figcaption></figure>"
+                   for p in plots)
+    load = html.escape(json.dumps({k: d[k] for k in ("platform", "stack", "materials", "wrap")},
+                                  indent=2))
+    test = html.escape(json.dumps(d["test"], indent=2))
+    overall = "PASS" if result["passed"] else "FAIL"
+    page = f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{html.escape(d['name'])}: {overall}</title>
+<style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}
+table{{border-collapse:collapse}}td,th{{border:1px solid #999;padding:.3em .6em}}
+tr.fail td{{background:#fdd}}tr.pass td{{background:#dfd}}img{{max-width:100%}}
+pre{{background:#f4f4f4;padding:.5em}}</style></head>
+<body><h1>{html.escape(d['name'])}</h1>
+<p id="verdict">Verdict: <strong>{overall}</strong> ({html.escape(result['test'])} test,
+{result['simulated_s']:.2f} s simulated, state hash {result['state_hash']})</p>
+<h2>Criteria</h2>
+<table id="criteria"><tr><th>criterion</th><th>measured</th><th>limit</th><th>verdict</th></tr>
+{''.join(rows)}</table>
+<h2>Plots</h2>{imgs}
+<h2>The load and its wrap</h2><pre>{load}</pre>
+<h2>The test</h2><pre>{test}</pre>
+<script>
+// For a headless check: mark the page once every plot has loaded with a non-empty size.
+window.addEventListener("load", function () {{
+  var imgs = Array.prototype.slice.call(document.images);
+  var ok = imgs.every(function (i) {{ return i.complete && i.naturalWidth > 0; }});
+  document.body.setAttribute("data-plots", ok ? imgs.length + " loaded" : "missing");
+}});
+</script>
+</body></html>
+"""
+    (folder / "report.html").write_text(page)
+
+
+def write_all(folder, d, result, series):
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "verdict.json").write_text(json.dumps(result, indent=2) + "\n")
+    write_series(folder / "timeseries.csv", series)
+    plots = write_plots(folder, d, result, series)
+    write_report(folder, d, result, plots)
+    return plots
