@@ -10,7 +10,7 @@
  * and place, and carries the reference the measurements are taken from. It uses only the public
  * calls of the world underneath, so everything it does can be done by hand.
  *
- * Interface stiffness (docs/guide.md, "Unit loads"): by default the stiffness and damping of an
+ * Interface stiffness (docs/guide.md, chapter 11): by default the stiffness and damping of an
  * interface are given for the interface as a whole, as a packaging engineer measures them (the
  * force per metre of compression of one carton bearing on what carries it), and the builder
  * divides them by the number of contact points a face pair of the load touches with: 4, the
@@ -148,7 +148,8 @@ typedef struct ws_load_carton {
     ws_body_id body;  /**< its id */
     int layer;        /**< 0 = bottom layer */
     int index;        /**< place in its layer, row-major: index = iy * nx + ix */
-    int ix, iy;       /**< column and row in its layer */
+    int ix;           /**< column in its layer */
+    int iy;           /**< row in its layer */
     int turned;       /**< 1 if turned 90 degrees about the vertical */
     ws_vec3 size;     /**< its extent along the platform's x, y, z, m */
 } ws_load_carton;
@@ -162,8 +163,15 @@ typedef struct ws_load_carton_state {
     ws_vec3 velocity;   /**< CoG velocity relative to the pallet, platform frame, m/s */
 } ws_load_carton_state;
 
-/** Fill a load Def with the defaults above. NULL is ignored. */
-WS_API void ws_load_def_init(ws_load_def *def);
+/** Fill a load Def with the defaults above. NULL is ignored.
+ *  ws_load_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_load_def_init_sized(ws_load_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_load_def_init)(ws_load_def *def);
+/** Fill with defaults: ws_load_def_init_sized with the caller's sizeof. */
+#define ws_load_def_init(def) ws_load_def_init_sized((def), sizeof *(def))
 
 /** Build a load in a world: materials (carton, pallet, film; platform when created), the
  *  contact parameters of every pair of them (carton-carton, carton-pallet, carton-platform,
@@ -171,6 +179,8 @@ WS_API void ws_load_def_init(ws_load_def *def);
  *  cartons, layer by layer from the bottom, each resting on the one below with the contact layers
  *  just touching. Sets the reference of the measurements (ws_load_set_reference()) to the load
  *  as built.
+ *  @param world the world to build in
+ *  @param def the load; copied, may be freed after the call
  *  @param out receives the load; destroy it with ws_load_destroy() (the bodies stay in the
  *  world). On error *out is NULL and the bodies already created are destroyed.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a size or mass <= 0, NaN, too many layers or
@@ -248,8 +258,15 @@ typedef struct ws_wrap_def {
     int substeps;         /**< film sub-steps per world step (>= 1); default 2 */
 } ws_wrap_def;
 
-/** Fill a wrap Def with the defaults above. NULL is ignored. */
-WS_API void ws_wrap_def_init(ws_wrap_def *def);
+/** Fill a wrap Def with the defaults above. NULL is ignored.
+ *  ws_wrap_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_wrap_def_init_sized(ws_wrap_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_wrap_def_init)(ws_wrap_def *def);
+/** Fill with defaults: ws_wrap_def_init_sized with the caller's sizeof. */
+#define ws_wrap_def_init(def) ws_wrap_def_init_sized((def), sizeof *(def))
 /** Wrap a band of film around the load as it stands (ws_web_create_band() around the pallet and
  *  every carton) with the load's film material. The springs follow a tension-compression law
  *  (1 % stiffness in compression: film buckles) of EA = modulus x gauge x layers x the strip
@@ -410,8 +427,15 @@ typedef struct ws_eumos_result {
     double film_peak_strain; /**< largest spring strain of the film during the run (0: none) */
 } ws_eumos_result;
 
-/** Fill a EUMOS Def with the defaults above. NULL is ignored. */
-WS_API void ws_eumos_def_init(ws_eumos_def *def);
+/** Fill a EUMOS Def with the defaults above. NULL is ignored.
+ *  ws_eumos_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_eumos_def_init_sized(ws_eumos_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_eumos_def_init)(ws_eumos_def *def);
+/** Fill with defaults: ws_eumos_def_init_sized with the caller's sizeof. */
+#define ws_eumos_def_init(def) ws_eumos_def_init_sized((def), sizeof *(def))
 /** The platform drive a EUMOS run sets (a WS_DRIVE_PULSE along `direction`, given in global
  *  axes for a platform whose frame is the global one, starting at start_time 0: add the world's
  *  time) and the run's duration in s (rest before, the drive, rest after); either output may
@@ -454,8 +478,15 @@ typedef struct ws_kvalue_result {
     char error[256];  /**< the world's last error when a run failed, else "" */
 } ws_kvalue_result;
 
-/** Fill a k-value Def with the defaults above. NULL is ignored. */
-WS_API void ws_kvalue_def_init(ws_kvalue_def *def);
+/** Fill a k-value Def with the defaults above. NULL is ignored.
+ *  ws_kvalue_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_kvalue_def_init_sized(ws_kvalue_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_kvalue_def_init)(ws_kvalue_def *def);
+/** Fill with defaults: ws_kvalue_def_init_sized with the caller's sizeof. */
+#define ws_kvalue_def_init(def) ws_kvalue_def_init_sized((def), sizeof *(def))
 /** Find the load's k-value: the largest k at which it passes EUMOS 40509, by bisection between
  *  k_low and k_high. Every run starts from the same settled load: a world is created from
  *  `world_def`, the load built from `load_def` and settled for settle_time (then wrapped and

@@ -9,10 +9,9 @@
 #include "math/wmath.h"
 #include "world/world_internal.h"
 
-void ws_eumos_def_init(ws_eumos_def *def)
+static void eumos_defaults(ws_eumos_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->k = 0.5;
     def->g = 9.81;
     def->rise_time = 0.04;
@@ -27,15 +26,18 @@ void ws_eumos_def_init(ws_eumos_def *def)
     def->sample_interval = 4;
 }
 
-void ws_kvalue_def_init(ws_kvalue_def *def)
+WS_DEF_INITS(ws_eumos_def, eumos_defaults, sample_user)
+
+static void kvalue_defaults(ws_kvalue_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->k_low = 0.05;
     def->k_high = 1.0;
     def->tolerance = 0.01;
     def->settle_time = 1.0;
 }
+
+WS_DEF_INITS(ws_kvalue_def, kvalue_defaults, wrap)
 
 /* ---- the pulse ---------------------------------------------------------------------------- */
 
@@ -103,10 +105,12 @@ ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive, doubl
         return WS_ERR_INVALID_ARGUMENT;
     if (ws_def_check(def) != 0)
         return WS_ERR_UNINITIALIZED_DEF;
+    ws_eumos_def d;
+    ws_eumos_def_init(&d);
+    ws_def_copy(&d, sizeof d, def);
     char why[160];
-    if (pulse_check(def, why, sizeof why) != 0)
+    if (pulse_check(&d, why, sizeof why) != 0)
         return WS_ERR_INVALID_ARGUMENT;
-    ws_eumos_def d = *def;
     double n = hypot(d.direction.x, d.direction.y);
     d.direction = v3_make(d.direction.x / n, d.direction.y / n, 0);
     ws_drive_def dd;
@@ -637,7 +641,10 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
     }
     ws_kvalue_def kd;
     ws_kvalue_def_init(&kd);
-    memcpy(&kd, def, sizeof kd < def->size ? sizeof kd : def->size);
+    ws_def_copy(&kd, sizeof kd, def);
+    ws_eumos_def ed;
+    ws_eumos_def_init(&ed);
+    ws_def_copy(&ed, sizeof ed, eumos_def);
     if (!(isfinite(kd.k_low) && kd.k_low > 0 && isfinite(kd.k_high) && kd.k_high > kd.k_low &&
           isfinite(kd.tolerance) && kd.tolerance > 0 && isfinite(kd.settle_time) &&
           kd.settle_time > 0)) {
@@ -649,7 +656,7 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
     kworld kw;
     ws_status s = kworld_make(&kw, world_def, load_def, &kd);
     if (s == WS_OK)
-        s = search(&kw, eumos_def, &kd, result);
+        s = search(&kw, &ed, &kd, result);
     if (s != WS_OK)
         snprintf(result->error, sizeof result->error, "%s",
                  kw.w ? ws_world_last_error(kw.w) : ws_status_string(s));

@@ -26,10 +26,9 @@ static ws_load_interface interface_default(double k, double c, double mu)
     return f;
 }
 
-void ws_load_def_init(ws_load_def *def)
+static void load_defaults(ws_load_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->pallet_size = v3_make(1.2, 0.8, 0.144);
     def->pallet_mass = 25.0;
     def->carton_size = v3_make(0.3, 0.4, 0.25);
@@ -51,6 +50,8 @@ void ws_load_def_init(ws_load_def *def)
     def->film_carton = interface_default(4000.0, 1.0, 0.9);
     def->film_carton.friction_model = WS_FRICTION_REGULARIZED;
 }
+
+WS_DEF_INITS(ws_load_def, load_defaults, allocator)
 
 /* ---- validation --------------------------------------------------------------------------- */
 
@@ -701,10 +702,9 @@ ws_status ws_load_settle(ws_world *w, const ws_load *ld, double min_time, double
 
 /* ---- wrapping ----------------------------------------------------------------------------- */
 
-void ws_wrap_def_init(ws_wrap_def *def)
+static void wrap_defaults(ws_wrap_def *def)
 {
-    if (!ws_def_reset(def, sizeof *def))
-        return;
+    ws_def_reset(def, sizeof *def);
     def->gauge = 20e-6;
     def->modulus = 150e6;
     def->density = 920.0;
@@ -717,6 +717,8 @@ void ws_wrap_def_init(ws_wrap_def *def)
     def->node_mass = 2e-3;
     def->substeps = 2;
 }
+
+WS_DEF_INITS(ws_wrap_def, wrap_defaults, substeps)
 
 static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_load *ld)
 {

@@ -1111,7 +1111,7 @@ def test_load_build_measure_wrap_and_eumos():
     byref = ctypes.byref
     with ws.World(detection_interval=10) as w:
         ld = L.LoadDef()
-        LIB.ws_load_def_init(byref(ld))
+        LIB.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
         ld.layers, ld.count_x, ld.count_y = 1, 2, 1
         load = ctypes.c_void_p()
         assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error()
@@ -1136,11 +1136,11 @@ def test_load_build_measure_wrap_and_eumos():
         assert LIB.ws_load_measure(w.ptr, load, states, 2, byref(n)) == 0
         assert states[0].horizontal == 0.0
         wr = L.WrapDef()
-        LIB.ws_wrap_def_init(byref(wr))
+        LIB.ws_wrap_def_init_sized(byref(wr), ctypes.sizeof(wr))
         web = L.WebId()
         assert LIB.ws_load_wrap_band(w.ptr, load, byref(wr), byref(web)) == 0, w.last_error()
         ed = L.EumosDef()
-        LIB.ws_eumos_def_init(byref(ed))
+        LIB.ws_eumos_def_init_sized(byref(ed), ctypes.sizeof(ed))
         ed.k, ed.rise_time, ed.hold_time, ed.coast_time, ed.rest_after = 0.05, 0.01, 0, 0, 0
         dd, dur = L.DriveDef(), ctypes.c_double()
         assert LIB.ws_eumos_get_drive(byref(ed), byref(dd), byref(dur)) == 0
@@ -1153,11 +1153,11 @@ def test_load_build_measure_wrap_and_eumos():
         assert getattr(res.verdict, "pass") == 1 and res.containment[1].line_load > 0
         LIB.ws_load_destroy(load)
     wd = L.WorldDef()
-    LIB.ws_world_def_init(byref(wd))
+    LIB.ws_world_def_init_sized(byref(wd), ctypes.sizeof(wd))
     wd.detection_interval = 10
     ed.on_sample = L.SampleFn()
     kd = L.KvalueDef()
-    LIB.ws_kvalue_def_init(byref(kd))
+    LIB.ws_kvalue_def_init_sized(byref(kd), ctypes.sizeof(kd))
     kd.k_low, kd.k_high, kd.tolerance, kd.settle_time = 0.05, 0.1, 0.06, 0.05
     kr = L.KvalueResult()
     assert LIB.ws_loadtest_find_k(byref(wd), byref(ld), byref(ed), byref(kd), byref(kr)) == 0, \
