@@ -127,6 +127,13 @@ STRUCTS = {
     "ws_containment_band": L.ContainmentBand,
     "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
     "ws_element_output": L.ElementOutput, "ws_vtk_series_def": L.VtkSeriesDef,
+    "ws_load_interface": L.LoadInterface, "ws_load_def": L.LoadDef, "ws_load_info": L.LoadInfo,
+    "ws_load_carton": L.LoadCarton, "ws_load_carton_state": L.LoadCartonState,
+    "ws_wrap_def": L.WrapDef, "ws_loadtest_interface_state": L.LoadtestInterfaceState,
+    "ws_loadtest_sample": L.LoadtestSample, "ws_eumos_def": L.EumosDef,
+    "ws_loadtest_event": L.LoadtestEvent, "ws_loadtest_criterion": L.LoadtestCriterion,
+    "ws_eumos_verdict": L.EumosVerdict, "ws_eumos_result": L.EumosResult,
+    "ws_kvalue_def": L.KvalueDef, "ws_kvalue_result": L.KvalueResult,
 }
 
 
@@ -1122,6 +1129,65 @@ def test_elements_swap_invariance():
                                    b.angular_velocity])
     assert np.array_equal(run("invariant", False), run("invariant", True))
     assert np.abs(run("attached", False) - run("attached", True)).max() > 1e-3
+
+
+# --- loadtest.h: unit loads and the EUMOS test (the raw calls; no wrapper yet) -------------------
+def test_load_build_measure_wrap_and_eumos():
+    byref = ctypes.byref
+    with ws.World(detection_interval=10) as w:
+        ld = L.LoadDef()
+        LIB.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
+        ld.layers, ld.count_x, ld.count_y = 1, 2, 1
+        load = ctypes.c_void_p()
+        assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error()
+        info = L.LoadInfo()
+        assert LIB.ws_load_get_info(load, byref(info)) == 0
+        assert (info.layers, info.cartons) == (1, 2)
+        assert LIB.ws_load_get_layer_count(load, 0) == 2
+        c = L.LoadCarton()
+        assert LIB.ws_load_get_carton(load, 0, 1, byref(c)) == 0 and c.ix == 1
+        n = ctypes.c_size_t()
+        assert LIB.ws_load_copy_cartons(load, None, 0, byref(n)) == 0 and n.value == 2
+        cartons = (L.LoadCarton * 2)()
+        assert LIB.ws_load_copy_cartons(load, cartons, 2, byref(n)) == 0
+        k, pts = ctypes.c_double(), ctypes.c_int()
+        assert LIB.ws_load_get_point_stiffness(load, 0, byref(k), byref(pts)) == 0
+        assert (k.value, pts.value) == (2e6 / 4, 4)
+        settled, took, drift = ctypes.c_int(), ctypes.c_double(), ctypes.c_double()
+        assert LIB.ws_load_settle(w.ptr, load, 0.05, 0.2, 1e-3, byref(settled), byref(took)) == 0
+        assert LIB.ws_load_get_drift(w.ptr, load, byref(drift)) == 0
+        assert LIB.ws_load_set_reference(w.ptr, load) == 0
+        states = (L.LoadCartonState * 2)()
+        assert LIB.ws_load_measure(w.ptr, load, states, 2, byref(n)) == 0
+        assert states[0].horizontal == 0.0
+        wr = L.WrapDef()
+        LIB.ws_wrap_def_init_sized(byref(wr), ctypes.sizeof(wr))
+        web = L.WebId()
+        assert LIB.ws_load_wrap_band(w.ptr, load, byref(wr), byref(web)) == 0, w.last_error()
+        ed = L.EumosDef()
+        LIB.ws_eumos_def_init_sized(byref(ed), ctypes.sizeof(ed))
+        ed.k, ed.rise_time, ed.hold_time, ed.coast_time, ed.rest_after = 0.05, 0.01, 0, 0, 0
+        dd, dur = L.DriveDef(), ctypes.c_double()
+        assert LIB.ws_eumos_get_drive(byref(ed), byref(dd), byref(dur)) == 0
+        seen = []
+        cb = L.SampleFn(lambda user, smp: seen.append(smp.contents.level) or 0)
+        ed.on_sample = cb
+        res = L.EumosResult()
+        assert LIB.ws_loadtest_run_eumos(w.ptr, load, byref(ed), byref(res)) == 0, w.last_error()
+        assert abs(res.peak_level - 0.05) < 1e-9 and max(seen) == pytest.approx(0.05)
+        assert getattr(res.verdict, "pass") == 1 and res.containment[1].line_load > 0
+        LIB.ws_load_destroy(load)
+    wd = L.WorldDef()
+    LIB.ws_world_def_init_sized(byref(wd), ctypes.sizeof(wd))
+    wd.detection_interval = 10
+    ed.on_sample = L.SampleFn()
+    kd = L.KvalueDef()
+    LIB.ws_kvalue_def_init_sized(byref(kd), ctypes.sizeof(kd))
+    kd.k_low, kd.k_high, kd.tolerance, kd.settle_time = 0.05, 0.1, 0.06, 0.05
+    kr = L.KvalueResult()
+    assert LIB.ws_loadtest_find_k(byref(wd), byref(ld), byref(ed), byref(kd), byref(kr)) == 0, \
+        kr.error
+    assert kr.runs == 2 and kr.k_value == 0.1
 
 
 # --- last: the whole table was exercised ---------------------------------------------------------
