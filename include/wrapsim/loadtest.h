@@ -255,7 +255,9 @@ typedef struct ws_wrap_def {
      *  needs many sub-steps. Default 2e-3: 3.7 kg for the reference load's film, stable at
      *  dt 0.25 ms with 2 sub-steps; its inertia is still small beside the load's. */
     double node_mass;
-    int substeps;         /**< film sub-steps per world step (>= 1); default 2 */
+    /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
+     *  stable-step check accepts (ws_world_get_stable_fraction, ws_web_get_stable_dt) */
+    int substeps;
 } ws_wrap_def;
 
 /** Fill a wrap Def with the defaults above. NULL is ignored.

@@ -184,6 +184,9 @@ WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);
 WS_API ws_status ws_world_get_time(const ws_world *world, double *time);
 /** Time step, s. */
 WS_API ws_status ws_world_get_dt(const ws_world *world, double *dt);
+/** The film's stable-step safety factor (ws_world_def.stable_fraction): a web runs while
+ *  dt / substeps <= it x ws_web_get_stable_dt. */
+WS_API ws_status ws_world_get_stable_fraction(const ws_world *world, double *fraction);
 /** Change the time step (s, > 0) between steps. */
 WS_API ws_status ws_world_set_dt(ws_world *world, double dt);
 /** Gravity, m/s^2. */

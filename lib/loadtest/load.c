@@ -715,7 +715,7 @@ static void wrap_defaults(ws_wrap_def *def)
     def->top_margin = 0.03;
     def->node_pitch = 0.05;
     def->node_mass = 2e-3;
-    def->substeps = 2;
+    def->substeps = 0;
 }
 
 WS_DEF_INITS(ws_wrap_def, wrap_defaults, substeps)
@@ -743,8 +743,8 @@ static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_lo
         bad = "node_pitch must be > 0 m and under a quarter of the load's height";
     else if (!(isfinite(d->node_mass) && d->node_mass >= 0))
         bad = "node_mass must be >= 0 kg";
-    else if (d->substeps < 1)
-        bad = "substeps must be >= 1";
+    else if (d->substeps < 0)
+        bad = "substeps must be >= 1, or 0 for the fewest the stable-step check accepts";
     if (bad)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "wrap: %s", bad);
     if (ld->info.film.bits)
@@ -762,6 +762,24 @@ static ws_status film_law(ws_world *w, double ea, const char *name, ws_law_id *o
     l.damping = 1e-5 * ea; /* a trace of internal damping: its period's worth at 10 us */
     l.name = name;
     return ws_law_create(w, &l, out);
+}
+
+/* The fewest sub-steps with which the world's stable-step check accepts the web: dt / n within
+ * stable_fraction of its stable sub-step. */
+static ws_status fit_substeps(ws_world *w, ws_web_id web)
+{
+    double dt, stable, f;
+    ws_status s;
+    if ((s = ws_world_get_dt(w, &dt)) != WS_OK || (s = ws_web_get_stable_dt(w, web, &stable)) != WS_OK ||
+        (s = ws_world_get_stable_fraction(w, &f)) != WS_OK)
+        return s;
+    double n = ceil(dt / (f * stable));
+    if (!(n <= 100000.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_load_wrap_band: the film's stable sub-step is %.3g s, so dt %.3g s "
+                       "would need %.3g sub-steps: raise node_mass",
+                       stable, dt, n);
+    return ws_web_set_substeps(w, web, n < 1.0 ? 1 : (int)n);
 }
 
 ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws_web_id *out)
@@ -800,7 +818,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     wd.areal_density = d.density * d.gauge * d.layers;
     wd.contact_layer = ld->contact_layer;
     wd.material = ld->info.film_material;
-    wd.substeps = d.substeps;
+    wd.substeps = d.substeps > 0 ? d.substeps : 1;
     wd.name = "film";
     ws_band_def bd;
     ws_band_def_init(&bd);
@@ -817,6 +835,10 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
         wd.law = around;
         wd.law_cross = up;
         s = ws_web_create_band(w, &wd, &bd, &ld->info.film);
+    }
+    if (s == WS_OK && d.substeps == 0 && (s = fit_substeps(w, ld->info.film)) != WS_OK) {
+        ws_web_destroy(w, ld->info.film);
+        ld->info.film = (ws_web_id){0};
     }
     ws_mem_free(&ld->mem, bodies, n * sizeof *bodies);
     if (s == WS_OK)

@@ -275,6 +275,14 @@ ws_status ws_world_get_dt(const ws_world *w, double *dt)
     return WS_OK;
 }
 
+ws_status ws_world_get_stable_fraction(const ws_world *w, double *fraction)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, fraction, "ws_world_get_stable_fraction");
+    *fraction = w->def.stable_fraction;
+    return WS_OK;
+}
+
 ws_status ws_world_set_dt(ws_world *w, double dt)
 {
     NEED_WORLD(w);

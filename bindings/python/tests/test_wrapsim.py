@@ -781,6 +781,7 @@ def test_world_and_body_api(tmp_path):
         assert w.dt == pytest.approx(1e-4)
         w.dt = 2e-4
         assert w.dt == pytest.approx(2e-4)
+        assert w.stable_fraction == 0.5  # the default (world.h)
         w.set_gravity((0, 0, -9.81))
         w.gravity = (0, 0, -9.81)
         assert w.user_data == 1234
@@ -1139,7 +1140,7 @@ def test_load_build_measure_wrap_and_eumos():
         LIB.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
         ld.layers, ld.count_x, ld.count_y = 1, 2, 1
         load = ctypes.c_void_p()
-        assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error()
+        assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
         info = L.LoadInfo()
         assert LIB.ws_load_get_info(load, byref(info)) == 0
         assert (info.layers, info.cartons) == (1, 2)
@@ -1163,7 +1164,7 @@ def test_load_build_measure_wrap_and_eumos():
         wr = L.WrapDef()
         LIB.ws_wrap_def_init_sized(byref(wr), ctypes.sizeof(wr))
         web = L.WebId()
-        assert LIB.ws_load_wrap_band(w.ptr, load, byref(wr), byref(web)) == 0, w.last_error()
+        assert LIB.ws_load_wrap_band(w.ptr, load, byref(wr), byref(web)) == 0, w.last_error
         ed = L.EumosDef()
         LIB.ws_eumos_def_init_sized(byref(ed), ctypes.sizeof(ed))
         ed.k, ed.rise_time, ed.hold_time, ed.coast_time, ed.rest_after = 0.05, 0.01, 0, 0, 0
@@ -1173,7 +1174,7 @@ def test_load_build_measure_wrap_and_eumos():
         cb = L.SampleFn(lambda user, smp: seen.append(smp.contents.level) or 0)
         ed.on_sample = cb
         res = L.EumosResult()
-        assert LIB.ws_loadtest_run_eumos(w.ptr, load, byref(ed), byref(res)) == 0, w.last_error()
+        assert LIB.ws_loadtest_run_eumos(w.ptr, load, byref(ed), byref(res)) == 0, w.last_error
         assert abs(res.peak_level - 0.05) < 1e-9 and max(seen) == pytest.approx(0.05)
         assert getattr(res.verdict, "pass") == 1 and res.containment[1].line_load > 0
         LIB.ws_load_destroy(load)

@@ -432,6 +432,14 @@ class World:
     def dt(self, value):
         self._call("ws_world_set_dt", float(value))
 
+    @property
+    def stable_fraction(self):
+        """The film's stable-step safety factor (a web runs while dt / substeps is at most
+        this times its stable sub-step)."""
+        f = c_double()
+        self._call("ws_world_get_stable_fraction", byref(f))
+        return f.value
+
     def set_gravity(self, g):
         """Gravity, m/s^2."""
         self._call("ws_world_set_gravity", byref(_vec3(g)))

@@ -675,6 +675,7 @@ FUNCTIONS = [
     ("ws_world_get_time", [World_p, P(c_double)], _st),
     ("ws_world_get_dt", [World_p, P(c_double)], _st),
     ("ws_world_set_dt", [World_p, c_double], _st),
+    ("ws_world_get_stable_fraction", [World_p, P(c_double)], _st),
     ("ws_world_set_gravity", [World_p, P(Vec3)], _st),
     ("ws_world_get_stats", [World_p, P(WorldStats)], _st),
     ("ws_world_get_energy", [World_p, P(Energy)], _st),
