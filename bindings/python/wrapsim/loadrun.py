@@ -118,7 +118,10 @@ def _first(t, angle, mask):
 def run(d, progress=False, desc="wrapsim"):
     """Run a checked load file's test. Returns (result, series): result is a JSON-able dict
     with the measured values, the criteria and the verdict; series a dict of numpy columns
-    named by series_columns()."""
+    (for the tilt, named by series_columns())."""
+    if d["test"]["type"] == "eumos":
+        from . import eumos
+        return eumos.run(d, progress, desc)
     sc = build(d)
     w, platform, cartons, film = sc["world"], sc["platform"], sc["cartons"], sc["film"]
     test = d["test"]
