@@ -154,7 +154,7 @@ def run(d, progress=False, desc="wrapsim"):
             dd, duration = L.DriveDef(), ctypes.c_double()
             _check(w, lib.ws_eumos_get_drive(byref(ed), byref(dd), byref(duration)),
                    "ws_eumos_get_drive")
-            total = int(round((duration.value + ed.rest_after) / d["simulation"]["dt_s"]))
+            total = int(round(duration.value / d["simulation"]["dt_s"]))
             bar = _progress(total, desc, progress)
 
             def sample(user, smp):
