@@ -1867,6 +1867,59 @@ START_TEST(test_spring_relaxation)
 }
 END_TEST
 
+START_TEST(test_springs_checked_before_law_histories)
+{
+    /* A film law with history (relaxation) sets up each spring's history from the spring's law,
+     * found by its kind. Shear springs without law_shear, and a mesh spring of an unknown kind,
+     * must be refused before that: they once dereferenced a NULL law (and read past the web's
+     * three laws). Found by the fuzz target. */
+    ws_world *w = world_g(1e-3, NO_G);
+    double k1 = 100.0, tau = 0.05;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_RELAXATION;
+    ld.stiffness = 50.0;
+    ld.prony_stiffness = &k1;
+    ld.prony_time = &tau;
+    ld.prony_count = 1;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law;
+    wd.node_mass = 1e-3;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 3;
+    sd.ny = 3;
+    sd.spacing_x = sd.spacing_y = 0.1;
+    sd.shear = 1;
+    ws_world_stats before, after;
+    ck_ok(w, ws_world_get_stats(w, &before));
+    ws_web_id web;
+    ck_assert_int_eq(ws_web_create_sheet(w, &wd, &sd, &web), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "law_shear"), "%s", ws_world_last_error(w));
+    double xyz[6] = {0, 0, 0, 0.1, 0, 0};
+    uint32_t pair[2] = {0, 1};
+    uint8_t kind = 7;
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = xyz;
+    md.node_count = 2;
+    md.springs = pair;
+    md.spring_count = 1;
+    md.kinds = &kind;
+    ck_assert_int_eq(ws_web_create_mesh(w, &wd, &md, &web), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "unknown kind"), "%s", ws_world_last_error(w));
+    /* Nothing of either web is left behind. */
+    ck_ok(w, ws_world_get_stats(w, &after));
+    ck_assert_uint_eq(after.bytes_in_use, before.bytes_in_use);
+    kind = WS_SPRING_UP;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &web));
+    ws_world_destroy(w);
+}
+END_TEST
+
 static int failing_law(void *user, int dim, const double *u, const double *ud, double t,
                        double *F, double *dFdu, double *dFdud)
 {
@@ -2021,5 +2074,7 @@ int main(void)
     add_case(s, "bulk_copies", test_bulk_copies, 10);
     add_case(s, "spring_relaxation", test_spring_relaxation, 10);
     add_case(s, "spring_user_law_and_failure", test_spring_user_law_and_failure, 10);
+    add_case(s, "springs_checked_before_law_histories", test_springs_checked_before_law_histories,
+             10);
     return run_suite(s);
 }
