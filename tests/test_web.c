@@ -1378,6 +1378,33 @@ START_TEST(test_stable_dt_refusal_counted)
 }
 END_TEST
 
+START_TEST(test_substep_advice_bounded)
+{
+    /* The refusal advises the sub-steps that would do, ceil(dt / S) for the stable sub-step S,
+     * when a web can take them (at most 100000); for 1e-300 kg nodes S is about 1e-152 s and
+     * the quotient does not fit an int (undefined behaviour that printed "substeps >=
+     * -2147483648"): then the advice is the node mass alone. Found by the fuzz target. */
+    const double masses[2] = {1e-5, 1e-300};
+    for (int k = 0; k < 2; k++) {
+        ws_world *w = world_g(1e-4, DOWN_G);
+        ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 100.0, 0.0, 0.0, 0.0);
+        ws_web_id web = pinned_row(w, 11, 0.01, masses[k], law, "light");
+        double S;
+        ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+        ck_assert_int_eq(ws_world_step(w), WS_ERR_NUMERICAL);
+        const char *err = ws_world_last_error(w);
+        const char *at = strstr(err, "substeps >= ");
+        if (k == 0) {
+            ck_assert_msg(at && atoi(at + 12) == (int)ceil(1e-4 / S), "S = %g: %s", S, err);
+        } else {
+            ck_assert_msg(!at && strstr(err, "more than the 100000 sub-steps"), "%s", err);
+            ck_assert_msg(strstr(err, "node mass >= "), "%s", err);
+        }
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 START_TEST(test_step_leaves_no_scratch_in_state)
 {
     /* A sweep keeps the nodes' forces where it writes their new velocities (web.h,
@@ -2065,6 +2092,7 @@ int main(void)
     add_case(s, "sheet_in_blocks_moves_as_its_mesh", test_sheet_in_blocks_moves_as_its_mesh, 10);
     add_case(s, "stable_dt", test_stable_dt, 30);
     add_case(s, "stable_dt_refusal_counted", test_stable_dt_refusal_counted, 10);
+    add_case(s, "substep_advice_bounded", test_substep_advice_bounded, 10);
     add_case(s, "step_leaves_no_scratch_in_state", test_step_leaves_no_scratch_in_state, 10);
     add_case(s, "node_masses_each_their_own", test_node_masses_each_their_own, 10);
     add_case(s, "runaway_without_a_speed_limit", test_runaway_without_a_speed_limit, 10);

@@ -106,18 +106,26 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
     w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
     double r = h / stable;
-    int need = (int)ceil(w->def.dt / stable);
+    /* The sub-steps that would do, when a web may take that many (1..100000, as
+     * ws_web_set_substeps): beyond, the quotient may not even fit an int. */
+    double need = ceil(w->def.dt / stable);
     if (r <= 1.0) /* ran away though stable as its laws state them: sub-steps would not help */
         return ws_fail(w, WS_ERR_NUMERICAL,
                        "web '%s': %s, though dt/substeps = %.3g s is within its stable step "
                        "%.3g s: a spring law stiffer or stronger than it states (a user or "
                        "table law), or a body that hits the film too fast. Try a smaller dt.",
                        web_label(web), what, h, stable);
+    if (!(need <= 100000.0))
+        return ws_fail(w, WS_ERR_NUMERICAL,
+                       "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is "
+                       "%.3g s (smallest node mass %.3g kg), more than the 100000 sub-steps a "
+                       "web takes can reach. Use node mass >= %.3g kg, or a smaller dt.",
+                       web_label(web), what, h, stable, mmin, mmin * fmax(r * r, r));
     return ws_fail(w, WS_ERR_NUMERICAL,
                    "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
                    "(smallest node mass %.3g kg). Use substeps >= %d (ws_web_set_substeps), or "
                    "node mass >= %.3g kg, or a smaller dt.",
-                   web_label(web), what, h, stable, mmin, need, mmin * fmax(r * r, r));
+                   web_label(web), what, h, stable, mmin, (int)need, mmin * fmax(r * r, r));
 }
 
 /* Every web before the step: stable for its sub-step, and room for per-body forces. */
