@@ -6,7 +6,8 @@
  *   - a step returns WS_OK while a body's or a film node's state is not finite;
  *   - a call that failed (a step, or any call that changes the world) changed the state hash;
  *   - a block is freed or resized with another size than it was allocated with;
- *   - bytes are still allocated after ws_world_destroy();
+ *   - the world's statistics count other bytes in use than the allocator has handed out, or
+ *     bytes are still allocated after ws_world_destroy();
  * and AddressSanitizer and UBSan report everything else. tests/fuzz/README.md says how to build
  * and run it. */
 #include <float.h>
@@ -230,6 +231,7 @@ typedef struct fuzz {
     unsigned n_shapes, n_bodies, n_materials, n_laws, n_elements, n_webs;
     long work; /* what steps may still cost, in node sub-steps / 64 */
     int trace; /* FUZZ_API_TRACE set: say each call's status on stderr */
+    long long untracked; /* bytes the hook holds that the world's stats do not count */
 } fuzz;
 
 /* An id from a pool: one made earlier (maybe destroyed since), null, or random bits. */
@@ -323,6 +325,16 @@ static void check_finite(fuzz *f)
         free(xyz);
         free(vel);
     }
+}
+
+/* The world's count of bytes in use moves with the allocator's: what the stats leave out (the
+ * world itself) stays the same from creation to destruction. */
+static long long untracked_bytes(fuzz *f)
+{
+    ws_world_stats st;
+    if (ws_world_get_stats(f->w, &st) != WS_OK)
+        finding("ws_world_get_stats failed on a live world");
+    return (long long)f->alloc.bytes - (long long)st.bytes_in_use;
 }
 
 static uint64_t state_hash(fuzz *f)
@@ -1009,6 +1021,8 @@ static void run(fuzz *f)
             finding("a call that failed changed the state hash");
         if (kind == N_MUTATORS + 1 && state_hash(f) != before)
             finding("a read-out changed the state hash");
+        if (untracked_bytes(f) != f->untracked)
+            finding("the world's bytes in use disagree with the allocator's");
     }
 }
 
@@ -1047,6 +1061,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ws_status s = ws_world_create(&d, &f.w);
     f.alloc.fail_in = -1;
     if (s == WS_OK) {
+        f.untracked = untracked_bytes(&f);
         run(&f);
         ws_world_destroy(f.w);
     } else if (f.w) {
