@@ -1157,11 +1157,19 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
         need = (((need + 7) / 8) | 1) * 8;
         ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
         ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
+        web->act = NULL;
+        web->act_id = NULL;
         web->act_cap = 0;
-        web->act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
-        web->act_id = ws_mem_calloc(mem, need * 4, sizeof(uint32_t));
-        if (!web->act || !web->act_id)
+        double *act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
+        uint32_t *ids = ws_mem_calloc(mem, need * 4, sizeof(uint32_t));
+        if (!act || !ids) {
+            /* Both or neither: the capacity is the size of both. */
+            ws_mem_free(mem, act, need * ACT_ARRAYS * sizeof(double));
+            ws_mem_free(mem, ids, need * 4 * sizeof(uint32_t));
             return -1;
+        }
+        web->act = act;
+        web->act_id = ids;
         web->act_cap = need;
     }
     return 0;

@@ -128,6 +128,32 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
                    web_label(web), what, h, stable, mmin, (int)need, mmin * fmax(r * r, r));
 }
 
+/* Room for the film's loads on `cap` bodies: all four arrays are made anew before any old one
+ * goes, so an allocation that fails leaves every array with the size it is recorded with. */
+static int grow_body_loads(ws_mem *mem, ws_web *web, size_t cap)
+{
+    v3 **arrays[4] = {&web->bforce[0], &web->bmoment[0], &web->bforce[1], &web->bmoment[1]};
+    v3 *fresh[4];
+    for (int a = 0; a < 4; a++) {
+        fresh[a] = ws_mem_alloc(mem, cap * sizeof(v3));
+        if (!fresh[a]) {
+            for (int b = 0; b < a; b++)
+                ws_mem_free(mem, fresh[b], cap * sizeof(v3));
+            return -1;
+        }
+    }
+    for (int a = 0; a < 4; a++) {
+        if (web->bcap)
+            memcpy(fresh[a], *arrays[a], web->bcap * sizeof(v3));
+        for (size_t i = web->bcap; i < cap; i++)
+            fresh[a][i] = v3_make(0, 0, 0);
+        ws_mem_free(mem, *arrays[a], web->bcap * sizeof(v3));
+        *arrays[a] = fresh[a];
+    }
+    web->bcap = cap;
+    return 0;
+}
+
 /* Every web before the step: stable for its sub-step, and room for per-body forces. */
 static ws_status webs_ready(ws_world *w)
 {
@@ -135,29 +161,9 @@ static ws_status webs_ready(ws_world *w)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        if (web->bcap < w->bodies.slots) {
-            size_t cap = w->bodies.capacity;
-            for (int b = 0; b < 2; b++) {
-                v3 *f = ws_mem_realloc(&w->mem, web->bforce[b], web->bcap * sizeof(v3),
-                                       cap * sizeof(v3));
-                if (f)
-                    web->bforce[b] = f;
-                v3 *m = f ? ws_mem_realloc(&w->mem, web->bmoment[b], web->bcap * sizeof(v3),
-                                           cap * sizeof(v3))
-                          : NULL;
-                if (m)
-                    web->bmoment[b] = m;
-                if (!f || !m) {
-                    /* Keep the sizes consistent: shrink what grew back is not possible, so
-                     * record the smaller capacity for both by re-growing next time. */
-                    return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                                   web_label(web));
-                }
-                for (size_t i = web->bcap; i < cap; i++)
-                    web->bforce[b][i] = web->bmoment[b][i] = v3_make(0, 0, 0);
-            }
-            web->bcap = cap;
-        }
+        if (web->bcap < w->bodies.slots && grow_body_loads(&w->mem, web, w->bodies.capacity))
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
         if (w->web_check) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
             if (h > stable)
