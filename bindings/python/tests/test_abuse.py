@@ -28,7 +28,7 @@ def unchanged(w, before):
     assert w.state_hash() == before
 
 
-# --- arrays whose length the C call takes from a count ---------------------------------------------
+# --- arrays whose length the C call takes from a count --------------------------------------------
 @pytest.mark.parametrize("name,dim,given,expected", [
     ("stiffness_matrix", 3, 4, 9), ("stiffness_matrix", 6, 35, 36),
     ("damping_matrix", 3, 8, 9), ("cubic_stiffnesses", 6, 5, 6), ("stiffness_matrix", 1, 2, 1),
@@ -164,7 +164,7 @@ def test_counts_that_the_binding_sets_cannot_be_given(world):
                        node_mass=1e-3)
 
 
-# --- integers that ctypes would truncate ---------------------------------------------------------------
+# --- integers that ctypes would truncate ----------------------------------------------------------
 def test_step_count_is_a_64_bit_integer(world):
     with pytest.raises(OverflowError, match=r"step count: 1180591620717411303424 is outside "
                                             r"-9223372036854775808..9223372036854775807"):
