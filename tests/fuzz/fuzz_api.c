@@ -41,10 +41,10 @@ static unsigned pick(reader *r, unsigned n)
 }
 
 static const double special[] = {
-    0.0,    1.0,      -1.0,      0.5,      2.0,     1e-3,     1e-2,   0.1,      10.0,
-    100.0,  1e3,      1e4,       1e5,      1e6,     1e9,      1e12,   -0.5,     -1e3,
-    1e-6,   1e-9,     1e-300,    1e300,    -1e300,  DBL_MAX,  -DBL_MAX, DBL_MIN, 5e-324,
-    INFINITY, -INFINITY, NAN,    -0.0,     0.25,    2.5e-4,   0.3,    1e20,     -1e20,
+    0.0,      1.0,       -1.0,   0.5,   2.0,    1e-3,    1e-2,     0.1,     10.0,
+    100.0,    1e3,       1e4,    1e5,   1e6,    1e9,     1e12,     -0.5,    -1e3,
+    1e-6,     1e-9,      1e-300, 1e300, -1e300, DBL_MAX, -DBL_MAX, DBL_MIN, 5e-324,
+    INFINITY, -INFINITY, NAN,    -0.0,  0.25,   2.5e-4,  0.3,      1e20,    -1e20,
 };
 #define N_SPECIAL (sizeof special / sizeof special[0])
 
@@ -233,8 +233,8 @@ typedef struct fuzz {
     ws_element_id elements[POOL];
     ws_web_id webs[POOL];
     unsigned n_shapes, n_bodies, n_materials, n_laws, n_elements, n_webs;
-    long work; /* what steps may still cost, in node sub-steps / 64 */
-    int trace; /* FUZZ_API_TRACE set: say each call's status on stderr */
+    long work;           /* what steps may still cost, in node sub-steps / 64 */
+    int trace;           /* FUZZ_API_TRACE set: say each call's status on stderr */
     long long untracked; /* bytes the hook holds that the world's stats do not count */
 } fuzz;
 
@@ -253,10 +253,10 @@ static uint64_t pick_bits(fuzz *f, const uint64_t *bits, unsigned n)
 }
 
 #define PICK(f, pool, n, type) ((type){pick_bits(f, &(pool)[0].bits, (n))})
-#define PUT(pool, n, id)                                                                          \
-    do {                                                                                          \
-        (pool)[(n) % POOL] = (id);                                                                \
-        (n)++;                                                                                    \
+#define PUT(pool, n, id)                                                                           \
+    do {                                                                                           \
+        (pool)[(n) % POOL] = (id);                                                                 \
+        (n)++;                                                                                     \
     } while (0)
 #define COUNT(n) ((n) < POOL ? (n) : POOL)
 
@@ -506,7 +506,7 @@ static ws_status op_drive(fuzz *f)
     d.amplitude = sane(&f->in);
     d.frequency = fabs(sane(&f->in));
     d.phase = sane(&f->in);
-    double *all[] = {&d.start_time, &d.ramp_time, &d.rate,      &d.max_angle,
+    double *all[] = {&d.start_time, &d.ramp_time, &d.rate, &d.max_angle,
                      &d.amplitude,  &d.frequency, &d.phase};
     for (unsigned i = 0; i < sizeof all / sizeof all[0]; i++)
         if (!isfinite(*all[i]) || fabs(*all[i]) > 1e3)
@@ -545,8 +545,8 @@ static ws_status op_material(fuzz *f)
     }
     ws_contact_def c;
     ws_contact_def_init(&c);
-    double *p[] = {&c.stiffness, &c.damping, &c.friction, &c.friction_vlim, &c.stick_stiffness,
-                   &c.stick_damping};
+    double *p[] = {&c.stiffness,     &c.damping,         &c.friction,
+                   &c.friction_vlim, &c.stick_stiffness, &c.stick_damping};
     for (unsigned k = 0, n = pick(&f->in, 4); k < n; k++)
         *p[pick(&f->in, 6)] = num(&f->in);
     c.friction_model = (ws_friction_model)pick(&f->in, 3);
@@ -557,8 +557,7 @@ static ws_status op_material(fuzz *f)
 
 /* Law arrays live in the fuzz input's scratch: the largest is a 6 x 6 matrix. */
 typedef struct law_arrays {
-    double k[36], c[36], k3[6], strain[8], force[8], prony_k[17], prony_t[17], times[4],
-        factors[4];
+    double k[36], c[36], k3[6], strain[8], force[8], prony_k[17], prony_t[17], times[4], factors[4];
     ws_law_id terms[4];
 } law_arrays;
 
@@ -904,8 +903,8 @@ static ws_status op_world(fuzz *f)
     case 0:
         return ws_world_set_dt(f->w, byte(&f->in) & 1 ? num(&f->in) : positive(&f->in) * 1e-4);
     case 1: {
-        ws_vec3 g = byte(&f->in) & 1 ? vec(&f->in)
-                                      : (ws_vec3){num(&f->in), num(&f->in), num(&f->in)};
+        ws_vec3 g =
+            byte(&f->in) & 1 ? vec(&f->in) : (ws_vec3){num(&f->in), num(&f->in), num(&f->in)};
         return ws_world_set_gravity(f->w, &g);
     }
     case 2:
@@ -983,9 +982,9 @@ static void op_read(fuzz *f)
 }
 
 /* Calls that change the world; a failure among them must leave the dynamic state as it was. */
-static ws_status (*const mutators[])(fuzz *) = {op_shape,    op_body,  op_drive, op_body_set,
-                                           op_material, op_law,   op_element, op_web,
-                                           op_world,    op_law_use, op_web_use};
+static ws_status (*const mutators[])(fuzz *) = {op_shape,    op_body,    op_drive,   op_body_set,
+                                                op_material, op_law,     op_element, op_web,
+                                                op_world,    op_law_use, op_web_use};
 #define N_MUTATORS (sizeof mutators / sizeof mutators[0])
 
 static void run(fuzz *f)
