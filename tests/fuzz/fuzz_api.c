@@ -1,8 +1,8 @@
 /* A libFuzzer target: the input bytes decode into a sequence of calls of the public API on one
  * world (shapes, bodies, drives, materials, laws, elements, webs, steps, read-outs), with
- * bounded arguments that include bad ones: stale and foreign ids, NaN, infinities, huge values,
- * destroy-then-use, an allocator that fails on a chosen allocation. The library must refuse bad
- * input with a status; the target aborts (a finding) when
+ * bounded arguments that include bad ones: stale, null and random ids, NaN, infinities, huge
+ * values, destroy-then-use, an allocator that fails on a chosen allocation. The library must refuse
+ * bad input with a status; the target aborts (a finding) when
  *   - a step returns WS_OK while a body's or a film node's state is not finite;
  *   - a call that failed (a step, or any call that changes the world) changed the state hash;
  *   - a block is freed or resized with another size than it was allocated with;
@@ -238,12 +238,16 @@ typedef struct fuzz {
     long long untracked; /* bytes the hook holds that the world's stats do not count */
 } fuzz;
 
-/* An id from a pool: one made earlier (maybe destroyed since), null, or random bits. */
-static uint64_t pick_bits(fuzz *f, const uint64_t *bits, unsigned n)
+/* An id from a pool of n ids (each a struct of one uint64_t): one made earlier (maybe destroyed
+ * since), null, or random bits. */
+static uint64_t pick_bits(fuzz *f, const void *pool, unsigned n)
 {
     unsigned b = byte(&f->in);
-    if (b < 200 && n > 0)
-        return bits[b % n];
+    if (b < 200 && n > 0) {
+        uint64_t bits;
+        memcpy(&bits, (const unsigned char *)pool + (b % n) * sizeof(ws_body_id), sizeof bits);
+        return bits;
+    }
     if (b < 240)
         return 0;
     uint64_t x = 0;
@@ -252,7 +256,10 @@ static uint64_t pick_bits(fuzz *f, const uint64_t *bits, unsigned n)
     return x;
 }
 
-#define PICK(f, pool, n, type) ((type){pick_bits(f, &(pool)[0].bits, (n))})
+#define PICK(f, pool, n, type) ((type){pick_bits(f, (pool), (n))})
+_Static_assert(sizeof(ws_shape_id) == 8 && sizeof(ws_body_id) == 8 && sizeof(ws_material_id) == 8 &&
+                   sizeof(ws_law_id) == 8 && sizeof(ws_element_id) == 8 && sizeof(ws_web_id) == 8,
+               "pick_bits reads the pools as arrays of 64-bit ids");
 #define PUT(pool, n, id)                                                                           \
     do {                                                                                           \
         (pool)[(n) % POOL] = (id);                                                                 \
