@@ -134,8 +134,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
 {
     for (int k = 0; k < 3; k++)
         web->law[k] = c->law[k];
-    if (ws_web_law_state(&w->mem, web) != 0)
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
+    /* Every spring's kind and law are checked before the law histories are set up, which look
+     * up each spring's law by its kind. */
     for (uint32_t s = 0; s < web->ns; s++) {
         if (web->kind[s] > WS_SPRING_SHEAR)
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': spring %u has an unknown kind",
@@ -147,6 +147,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                            "web '%s': spring %u has a rest length that is not > 0", c->label, s);
     }
+    if (ws_web_law_state(&w->mem, web) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     if (c->d.node_mass > 0.0) {
         for (uint32_t i = 0; i < web->n; i++)
             web->m[i] = c->d.node_mass;
