@@ -57,9 +57,11 @@ START_TEST(test_generation_wrap)
 }
 END_TEST
 
-/* Ids of 600 worlds alive at once, each tried in every other world: none is accepted. With
- * 16-bit world tags about 2.7 pairs of these worlds shared a tag (600^2 / 2 / 2^16); with
- * salted 32-bit generations the chance that any of the 718800 look-ups passes is 1.7e-4. */
+/* Ids of 600 worlds alive at once, each tried in every other world: at most one is accepted.
+ * With 16-bit world tags about 2.7 pairs of these worlds shared a tag (600^2 / 2 / 2^16), each
+ * pair accepting both ways' body and material ids: about 11 accepted. With salted 32-bit
+ * generations the expected count over the 718800 look-ups is 1.7e-4, so one accepted id is
+ * allowed (two or more: about 1.4e-8 of runs), and the test cannot fail by chance in practice. */
 START_TEST(test_foreign_ids)
 {
     enum { N = 600 };
@@ -82,7 +84,7 @@ START_TEST(test_foreign_ids)
             tried += 2;
         }
     report("ids: %d worlds alive, %ld foreign look-ups, %ld accepted", N, tried, accepted);
-    ck_assert_int_eq(accepted, 0);
+    ck_assert_int_le(accepted, 1);
     ws_vec3 p;
     ck_assert_int_eq(ws_body_get_position(w[1], b[0], &p), WS_ERR_STALE_HANDLE);
     ck_assert_ptr_nonnull(strstr(ws_world_last_error(w[1]), "another world"));
