@@ -129,6 +129,9 @@ def test_run_pass_and_fail_exit_codes_and_outputs(tmp_path):
     assert all("[" in h for h in header), header
     for name in ("report.html", "slip.png", "drive.png"):
         assert (tmp_path / "b" / name).stat().st_size > 1000, name
+    # The ParaView collection: a frame every 0.05 s of the 1.6 s run, t = 0 included.
+    pvd = (tmp_path / "b" / "paraview" / "run.pvd").read_text()
+    assert pvd.count("<DataSet") == 33, pvd[:400]
 
 
 def test_report_renders_in_a_browser(tmp_path):

@@ -56,13 +56,15 @@ def _run(args):
     except LoadFileError as e:
         return _err(e)
     out = args.output or "wrapsim-out"
-    result, series = loadrun.run(d, progress=not args.quiet, desc=d["name"])
+    import os
+    result, series = loadrun.run(d, progress=not args.quiet, desc=d["name"],
+                                 paraview=os.path.join(out, "paraview"))
     report.write_all(out, d, result, series)
     print(f"{d['name']}: {'PASS' if result['passed'] else 'FAIL'}")
     for c in result["criteria"]:
         m = "none" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}".rstrip()
         print(f"  {'pass' if c['passed'] else 'FAIL'}  {c['criterion']}: measured {m}")
-    print(f"  outputs in {out}/ (report.html, verdict.json, timeseries.csv)")
+    print(f"  outputs in {out}/ (report.html, verdict.json, timeseries.csv, paraview/run.pvd)")
     return 0 if result["passed"] else 1
 
 

@@ -127,7 +127,7 @@ def _result_dict(d, res, state_hash):
                 simulated_s=res.duration)
 
 
-def run(d, progress=False, desc="wrapsim"):
+def run(d, progress=False, desc="wrapsim", paraview=None):
     """Build the unit load, wrap it, let it settle, run the EUMOS test. Returns (result, series)
     like loadrun.run: the verdict as a JSON-able dict and the sampled time series."""
     u = d["unit_load"]
@@ -156,11 +156,15 @@ def run(d, progress=False, desc="wrapsim"):
                    "ws_eumos_get_drive")
             total = int(round(duration.value / d["simulation"]["dt_s"]))
             bar = _progress(total, desc, progress)
+            from .loadrun import paraview_series
+            vtk = paraview_series(w, d, paraview)
 
             def sample(user, smp):
                 s = smp.contents
                 if bar is not None:
                     bar.update(ed.sample_interval)
+                if vtk is not None:
+                    vtk.write_frame()
                 rows.append([s.time, s.level, s.platform_velocity, s.platform_position] +
                             [s.layer_displacement[i] for i in range(s.layers)])
                 return 0
@@ -174,6 +178,8 @@ def run(d, progress=False, desc="wrapsim"):
             finally:
                 if bar is not None:
                     bar.close()
+                if vtk is not None:
+                    vtk.close()
             result = _result_dict(d, res, w.state_hash())
         finally:
             lib.ws_load_destroy(load)

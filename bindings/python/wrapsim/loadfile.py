@@ -163,6 +163,8 @@ SPEC = _section({
     }),
     "output": _section({
         "sample_interval_s": _num("s", 0.01, 0.0, 10.0, True, doc="time series sampling"),
+        "paraview_interval_s": _num("s", 0.05, 0.0, 100.0,
+                                    doc="time between ParaView frames (wrapsim run); 0: none"),
     }),
 })
 

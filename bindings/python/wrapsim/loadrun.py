@@ -115,13 +115,25 @@ def _first(t, angle, mask):
     return dict(t_s=float(t[idx[0]]), angle_deg=float(angle[idx[0]]))
 
 
-def run(d, progress=False, desc="wrapsim"):
+def paraview_series(w, d, folder):
+    """A ParaView collection of the run in `folder` (None, or an interval of 0: none), frames
+    every output.paraview_interval_s."""
+    every = d["output"]["paraview_interval_s"]
+    if folder is None or every <= 0:
+        return None
+    import os
+    os.makedirs(folder, exist_ok=True)
+    return w.vtk_series(folder, "run", time_stride=every)
+
+
+def run(d, progress=False, desc="wrapsim", paraview=None):
     """Run a checked load file's test. Returns (result, series): result is a JSON-able dict
     with the measured values, the criteria and the verdict; series a dict of numpy columns
-    (for the tilt, named by series_columns())."""
+    (for the tilt, named by series_columns()). `paraview`: a folder for a ParaView collection
+    of the run (run.pvd), or None."""
     if d["test"]["type"] == "eumos":
         from . import eumos
-        return eumos.run(d, progress, desc)
+        return eumos.run(d, progress, desc, paraview)
     sc = build(d)
     w, platform, cartons, film = sc["world"], sc["platform"], sc["cartons"], sc["film"]
     test = d["test"]
@@ -135,6 +147,7 @@ def run(d, progress=False, desc="wrapsim"):
     start = None
     tension = np.empty(film.spring_count) if film is not None else None
     px, pz = sc["pivot"]
+    vtk = paraview_series(w, d, paraview)
     bar = _progress(total, desc, progress)
     try:
         for n in range(n_samples):
@@ -165,9 +178,13 @@ def run(d, progress=False, desc="wrapsim"):
             out["cog_beyond_pivot_mm"][n] = 1e3 * beyond
             if film is not None:
                 out["film_peak_tension_N"][n] = film.tensions(out=tension).max()
+            if vtk is not None:
+                vtk.write_frame()
     finally:
         if bar is not None:
             bar.close()
+        if vtk is not None:
+            vtk.close()
     state_hash = w.state_hash()
     w.close()
 
