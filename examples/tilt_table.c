@@ -62,6 +62,7 @@ typedef struct tilt_options {
     double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
     int substeps;         /* film sub-steps per step; 0 = 1 */
     int profile;          /* 1: the library times its phases (ws_world_stats) */
+    int workers;          /* workers of a step; 0 = 1 (the results are the same for any) */
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -194,6 +195,7 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.detection_interval = 5;     /* ... then every 5th step */
     wd.use_ccd = o->use_ccd;
     wd.profile = o->profile;
+    wd.worker_count = o->workers > 0 ? (uint32_t)o->workers : 1u;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
     ws_status s = ws_world_create(&wd, &sc->world);

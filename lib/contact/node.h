@@ -122,15 +122,28 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
                             int from, const uint32_t *nodes, size_t count);
 
+/* A sub-step starts (on the web or a lane of it): the runs' faces are taken afresh, the list of
+ * loads is empty. */
+void ws_node_substep(ws_web *web);
+/* The loads on the bodies listed since ws_node_substep, in node order, added to the per-body
+ * totals bforce and bmoment (global, moment about the CoG), which the step adds to the
+ * bodies. Lanes' lists are added in the order of their nodes, so the totals are those of one
+ * sweep to the bit. */
+void ws_node_loads(ws_web *web, v3 *bforce, v3 *bmoment);
+/* The first stretch whose nodes start at n0 or later (where a lane starting at n0 begins). */
+size_t ws_node_first_segment(const ws_web *web, uint32_t n0);
+/* Room in `lane`, a lane's own scratch (world_step.c), for evaluating ncand candidates of web
+ * `web` with its stretches cut. 0, or -1 when out of memory. */
+int ws_node_lane_scratch(ws_mem *mem, ws_web *lane, const ws_web *web, size_t ncand);
+
 /* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),
  * moving *next past them, at node state (x, v), for a sub-step h: forces into web->f, the node
  * contact forces (`share` = 1 / substeps of them) into fc, and the opposite loads on the bodies
- * (the same share) into the per-body totals bforce and bmoment (global, moment about the CoG),
- * which the step adds to the bodies. cand is the list the stretches were cut from; pp is
- * indexed by body material. The result does not depend on how the candidates are cut. */
+ * (the same share) listed for ws_node_loads (bforce and bmoment are not written here). cand is the
+ * list the stretches were cut from; pp is indexed by body material. The result does not depend on
+ * how the candidates are cut. */
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
-                      v3 *bmoment, uint64_t *checks);
+                      const ws_node_params *pp, double h, double share, v3 *fc, uint64_t *checks);
 
 #endif

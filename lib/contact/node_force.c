@@ -207,7 +207,8 @@ static act_list act_open(ws_web *web)
 {
     const size_t cap = web->act_cap; /* a multiple of 4 (ws_node_scratch) */
     uint32_t *id = web->act_id;
-    act_list L = {(act_group *)web->act, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
+    act_list L = {(act_group *)web->act, id,   id + cap, id + 2 * cap,
+                  id + 3 * cap,          NULL, 0,        web->act_nl};
     L.load = (act_load *)(web->act + ACT_GROUP * cap);
     return L;
 }
@@ -897,13 +898,18 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
          * the window side by side share few groups; the last no further than the depths
          * reach (it may then hold nodes of the one before, not as its own). */
         uint32_t slot = (uint32_t)L->nl;
+        /* No group reaches past the lane's nodes (lane_end), whose forces another lane may be
+         * writing: one that would starts earlier, its first nodes not its own (a lane holds
+         * at least a block of WS_WEB_BLOCK_NODES nodes, so it stays within the lane). */
         const uint32_t last = (uint32_t)(4 * nv - 4);
+        const uint32_t cap = o + 4 * nv > web->lane_end ? web->lane_end - 4 : UINT32_MAX;
         while (in) {
             uint32_t e = ws_lowest_bit(in);
             e = e < last ? e : last;
+            const uint32_t start = o + e < cap ? o + e : cap;
             const uint32_t bits = (uint32_t)(in >> e) & 15u;
             in &= ~((uint64_t)15u << e);
-            B->grp[B->n++] = (run_group){&rf->rc, o + e, slot, bits};
+            B->grp[B->n++] = (run_group){&rf->rc, start, slot, bits << (o + e - start)};
             slot += run_count4[bits];
         }
         L->nl = slot;
@@ -1111,8 +1117,7 @@ static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uin
 
 void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
                       ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
-                      v3 *bmoment, uint64_t *checks)
+                      const ws_node_params *pp, double h, double share, v3 *fc, uint64_t *checks)
 {
     act_list L = act_open(web);
     corner_memo memo = {UINT32_MAX, 0.0};
@@ -1122,8 +1127,6 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
                    tmp + sizeof(run_tmp) / sizeof(double), 0,
                    web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
     size_t k = *next;
-    if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
-        web->rface_gen++;
     /* In locals: the stores of the passes would make the compiler load them again. */
     const ws_nseg *seg = web->seg;
     const size_t nseg = web->nseg;
@@ -1140,8 +1143,54 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     run_flush(&E, &B, h, share, fc);
     act_apply(&E, h, share, fc);
-    loads_apply(&L, bforce, bmoment);
+    web->act_nl = L.nl; /* the loads wait for ws_node_loads */
     node_prefetch(web, cand, k, n1);
+}
+
+void ws_node_substep(ws_web *web)
+{
+    web->rface_gen++; /* the runs' faces are taken afresh */
+    web->act_nl = 0;
+}
+
+void ws_node_loads(ws_web *web, v3 *bforce, v3 *bmoment)
+{
+    act_list L = act_open(web);
+    loads_apply(&L, bforce, bmoment);
+    web->act_nl = 0;
+}
+
+size_t ws_node_first_segment(const ws_web *web, uint32_t n0)
+{
+    size_t lo = 0, hi = web->nseg;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (web->seg[mid].n0 < n0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+int ws_node_lane_scratch(ws_mem *mem, ws_web *lane, const ws_web *web, size_t ncand)
+{
+    if (ws_node_scratch(mem, lane, ncand) != 0)
+        return -1;
+    const size_t need =
+        (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
+    if (lane->rtmp_cap < need &&
+        ws_array_reserve(mem, (void **)&lane->rtmp, &lane->rtmp_cap, need, sizeof(double)) != 0)
+        return -1;
+    const size_t had = lane->rface_cap;
+    if (web->rface_cap > had) {
+        if (ws_array_reserve(mem, (void **)&lane->rface, &lane->rface_cap, web->rface_cap,
+                             sizeof *lane->rface) != 0)
+            return -1;
+        for (size_t f = had; f < lane->rface_cap; f++)
+            lane->rface[f].gen = 0; /* rface_gen is 1 from the first sub-step on */
+    }
+    return 0;
 }
 
 int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)

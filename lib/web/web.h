@@ -143,6 +143,13 @@ typedef struct ws_web {
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
+    size_t act_nl;     /* loads listed in act since the sub-step began (contact/node_force.c) */
+    uint32_t lane_end; /* one past the last node of the lane sweeping this copy (n: one lane) */
+    /* Lanes 1.. of a parallel sweep: each a ws_web holding only its own scratch (tmp, act,
+     * act_id, rtmp, rface and their sizes, fct[0] as its list of touched nodes), nlanes of
+     * them (world_step.c). */
+    struct ws_web *lanes;
+    uint32_t nlanes;
     int runs_off;  /* no short cuts: no runs and no corners, every candidate one by one
                       through its full tests (tests compare the two) */
     uint32_t run_batch;           /* groups of run nodes taken at once; 0: as many as fit
@@ -212,11 +219,27 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * in cache: block k's forces from the springs, node drag and gravity are complete in f once
  * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
  * their contact forces and be integrated. A grid web's blocks are whole rows, enough of them
- * for WS_WEB_BLOCK_NODES nodes; a mesh web is one block. Every sweep starts at block 0, which
- * takes the laws at (t, since) for all of it. */
+ * for WS_WEB_BLOCK_NODES nodes; a mesh web is one block. Every sweep first takes the laws at
+ * (t, since) (ws_web_sweep_laws).
+ *
+ * Lanes: consecutive blocks swept apart, at once, by copies of the web that share its state
+ * and have scratch of their own (world_step.c). The block that starts a lane (edges has
+ * WS_WEB_LANE_FIRST) starts its first row itself, and the block that ends one before the last
+ * (WS_WEB_LANE_LAST) leaves the next row alone; the springs between the two rows are computed
+ * by both, each putting them on its own row, so every node's force gets the same terms in the
+ * same order as in one sweep: the results are the same to the bit for any cut into lanes.
+ * Lanes need a grid web of two blocks or more whose laws are of film form (no law with history
+ * or a user's function, which a lane would call at once with another):
+ * ws_web_sweep_parallel. */
 uint32_t ws_web_block_count(const ws_web *web);
-void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t,
-                         double since, uint32_t k, uint32_t *n0, uint32_t *n1);
+/* The nodes [n0, n1) of block k. */
+void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1);
+#define WS_WEB_LANE_FIRST 1
+#define WS_WEB_LANE_LAST 2
+void ws_web_sweep_laws(ws_web *web, v3 gravity, double t, double since);
+int ws_web_sweep_parallel(const ws_web *web);
+void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, uint32_t k, int edges,
+                         uint32_t *n0, uint32_t *n1);
 /* A sweep that writes the velocities vd keeps the nodes' forces in vd until it integrates
  * them, in place of an array of its own: each node's force is complete before its new
  * velocity is written over it, and the state the sweep streams is smaller by an n-node array

@@ -5,6 +5,7 @@
 #include <wrapsim/wrapsim.h>
 
 #include "base/base.h"
+#include "base/pool.h"
 #include "body/body.h"
 #include "contact/contact.h"
 #include "contact/node.h"
@@ -16,6 +17,19 @@
 #include "web/web.h"
 
 #define WS_ERR_LEN 512
+
+/* Lanes a web's sweep is cut into per worker, at most: more lanes than workers let a worker
+ * that runs while another waits for its core take more of them. */
+#define WS_LANES_PER_WORKER 2
+
+/* A lane of a parallel sweep of a web (world_step.c): a copy of the web sharing its state, with
+ * scratch of its own, the blocks [k0, k1) it sweeps, and what it found. */
+typedef struct ws_lane_job {
+    ws_web view;
+    uint32_t k0, k1;
+    size_t fast;
+    uint64_t checks;
+} ws_lane_job;
 
 struct ws_world {
     ws_mem mem;
@@ -54,6 +68,8 @@ struct ws_world {
     int web_check; /* 1: re-check the webs' stable step before the next step */
     ws_node_params *node_par; /* node contact parameters by body material, scratch */
     ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
+    ws_pool *pool;            /* the world's own threads (worker_count > 1, no host scheduler) */
+    struct ws_lane_job *lane_job; /* a parallel sweep's lanes, WS_LANES_PER_WORKER a worker */
     size_t node_par_cap;
 
     ws_element **elements; /* by id slot (world_element.c) */
@@ -122,6 +138,8 @@ void ws_world_free_laws(ws_world *w);
 /* Take a slot of a table whose objects live in a pointer array, growing the array; the entry is
  * NULL. 0, or -1 when out of memory. */
 int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, uint32_t *slot);
+/* Free the scratch of a web's lanes (world_step.c). */
+void ws_world_web_lanes_free(ws_world *w, ws_web *web);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */

@@ -164,6 +164,176 @@ static ws_status webs_ready(ws_world *w)
     return WS_OK;
 }
 
+/* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
+typedef struct lane_task {
+    ws_world *w;
+    int cur;
+    const ws_ncand *cand;
+    ws_nodes3 xs, vs, xd, vd;
+    double h, share;
+    v3 *fc;
+} lane_task;
+
+/* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
+static void sweep_lane(const lane_task *T, ws_lane_job *J)
+{
+    ws_world *w = T->w;
+    ws_web *web = &J->view;
+    const uint32_t blocks = ws_web_block_count(web);
+    uint32_t n0, n1;
+    ws_web_block_range(web, J->k0, &n0, &n1);
+    size_t next = J->k0 ? ws_node_first_segment(web, n0) : 0;
+    ws_node_substep(web);
+    ws_web_sweep_begin(web, T->vd);
+    for (uint32_t q = J->k0; q < J->k1; q++) {
+        const int edges = (q == J->k0 && q > 0 ? WS_WEB_LANE_FIRST : 0) |
+                          (q + 1 == J->k1 && J->k1 < blocks ? WS_WEB_LANE_LAST : 0);
+        ws_web_forces_block(web, T->xs, T->vs, w->def.gravity, q, edges, &n0, &n1);
+        ws_node_contacts(&w->bodies, T->cur, &w->node_geom, web, T->xs, T->vs, T->cand, n1, &next,
+                         w->node_par, T->h, T->share, T->fc, &J->checks);
+        J->fast +=
+            ws_web_integrate_block(web, T->xs, T->vs, T->xd, T->vd, T->h, n0, n1, w->def.max_speed);
+    }
+    ws_web_sweep_end(web);
+}
+
+/* Items [start, end) of a sub-step's lanes (ws_task_fn). */
+static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker; /* a lane's scratch is its own, whichever worker takes it */
+    const lane_task *T = ctx;
+    for (int32_t i = start; i < end; i++)
+        sweep_lane(T, &T->w->lane_job[i]);
+}
+
+/* The lanes a web's sweep is cut into this step, with the scratch of each ready; 0 when out of
+ * memory. One unless the world has workers and the web can be swept in lanes
+ * (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a block. */
+static uint32_t web_lanes(ws_world *w, ws_web *web, int list)
+{
+    const uint32_t blocks = ws_web_block_count(web),
+                   most = WS_LANES_PER_WORKER * w->def.worker_count;
+    uint32_t lanes = w->def.worker_count > 1 ? most : 1;
+    if (lanes > blocks)
+        lanes = blocks;
+    if (lanes < 2 || !ws_web_sweep_parallel(web))
+        return 1;
+    const size_t ncand = web->ncand[list];
+    if (web->nlanes < most - 1) {
+        const size_t want = most - 1;
+        ws_web *more = ws_mem_calloc(&w->mem, want, sizeof *more);
+        if (!more)
+            return 0;
+        if (web->nlanes)
+            memcpy(more, web->lanes, web->nlanes * sizeof *more);
+        ws_mem_free(&w->mem, web->lanes, web->nlanes * sizeof *more);
+        web->lanes = more;
+        web->nlanes = (uint32_t)want;
+    }
+    for (uint32_t i = 0; i + 1 < lanes; i++) {
+        ws_web *L = &web->lanes[i];
+        if (!L->tmp && !(L->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
+            return 0;
+        if (ws_node_lane_scratch(&w->mem, L, web, ncand) != 0 ||
+            ws_array_reserve(&w->mem, (void **)&L->fct[0], &L->fct_cap[0], ncand + 1,
+                             sizeof(uint32_t)) != 0)
+            return 0;
+    }
+    return lanes;
+}
+
+void ws_world_web_lanes_free(ws_world *w, ws_web *web)
+{
+    for (uint32_t i = 0; i < web->nlanes; i++) {
+        ws_web *L = &web->lanes[i];
+        ws_node_scratch_free(&w->mem, L);
+        ws_mem_free(&w->mem, L->tmp, L->tmp ? WS_WEB_TMP * sizeof(double) : 0);
+        ws_mem_free(&w->mem, L->fct[0], L->fct_cap[0] * sizeof(uint32_t));
+    }
+    ws_mem_free(&w->mem, web->lanes, web->nlanes * sizeof *web->lanes);
+    web->lanes = NULL;
+    web->nlanes = 0;
+}
+
+/* Lane i's copy of the web: its state shared, its scratch its own (lane 0: the web's), the
+ * nodes it ends at. */
+static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
+{
+    ws_lane_job *J = &w->lane_job[i];
+    const uint32_t blocks = ws_web_block_count(web);
+    J->view = *web;
+    J->k0 = (uint32_t)((uint64_t)i * blocks / lanes);
+    J->k1 = (uint32_t)((uint64_t)(i + 1) * blocks / lanes);
+    J->fast = 0;
+    J->checks = 0;
+    ws_web *v = &J->view;
+    uint32_t n0, n1;
+    ws_web_block_range(web, J->k1 - 1, &n0, &n1);
+    v->lane_end = n1;
+    v->run_nodes = v->run_deep = v->corners = 0;
+    v->law_failed = 0;
+    if (i == 0)
+        return;
+    const ws_web *L = &web->lanes[i - 1];
+    v->tmp = L->tmp;
+    v->act = L->act;
+    v->act_id = L->act_id;
+    v->act_cap = L->act_cap;
+    v->rtmp = L->rtmp;
+    v->rtmp_cap = L->rtmp_cap;
+    v->rface = L->rface;
+    v->rface_cap = L->rface_cap;
+    v->rface_gen = L->rface_gen;
+    v->fct[v->fck] = L->fct[0];
+    v->fct_cap[v->fck] = L->fct_cap[0];
+    v->nfct[v->fck] = 0;
+}
+
+/* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
+ * its counts. Returns its nodes too fast. */
+static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *bmoment)
+{
+    ws_lane_job *J = &w->lane_job[i];
+    ws_web *v = &J->view;
+    ws_node_loads(v, bforce, bmoment);
+    web->run_nodes += v->run_nodes;
+    web->run_deep += v->run_deep;
+    web->corners += v->corners;
+    web->law_failed |= v->law_failed;
+    w->stats.narrow_checks += J->checks;
+    const int k = web->fck;
+    if (i == 0) {
+        web->rface_gen = v->rface_gen;
+        web->nfct[k] = v->nfct[k]; /* lane 0 listed into the web's own list */
+    } else {
+        web->lanes[i - 1].rface_gen = v->rface_gen;
+        memcpy(web->fct[k] + web->nfct[k], v->fct[k], v->nfct[k] * sizeof(uint32_t));
+        web->nfct[k] += v->nfct[k];
+    }
+    return J->fast;
+}
+
+/* A sub-step of a web over its lanes: on the host's scheduler, the world's threads or, for one
+ * lane, right here. Returns how many nodes ended too fast. */
+static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
+{
+    for (uint32_t i = 0; i < lanes; i++)
+        lane_open(w, web, lanes, i);
+    if (lanes == 1) {
+        lane_items(0, 1, 0, T);
+    } else if (w->def.enqueue_task) {
+        void *task = w->def.enqueue_task(lane_items, (int32_t)lanes, 1, T, w->def.task_context);
+        if (task)
+            w->def.finish_task(task, w->def.task_context);
+    } else {
+        ws_pool_run(w->pool, lane_items, (int32_t)lanes, T);
+    }
+    size_t fast = 0;
+    for (uint32_t i = 0; i < lanes; i++)
+        fast += lane_close(w, web, i, bforce, bmoment);
+    return fast;
+}
+
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
  * swept block by block (ws_web_forces_block). Forces on the bodies go into their accumulators,
  * averaged over the sub-steps. */
@@ -257,10 +427,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                              (size_t)web->substeps * web->ncand[list] + 1, sizeof(uint32_t)) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
-        const ws_ncand *cand = web->cand[list];
-        const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
+        const uint32_t lanes = web_lanes(w, web, list);
+        if (lanes == 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -268,18 +440,9 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            size_t next = 0, fast = 0;
-            ws_web_sweep_begin(web, vd);
-            for (uint32_t q = 0; q < blocks; q++) {
-                uint32_t n0, n1;
-                ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
-                                    &n1);
-                ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand, n1, &next,
-                                 w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
-                                 web->bmoment[nxt], &w->stats.narrow_checks);
-                fast += ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1, w->def.max_speed);
-            }
-            ws_web_sweep_end(web);
+            ws_web_sweep_laws(web, w->def.gravity, w->time + s * h, s * h);
+            lane_task T = {w, cur, web->cand[list], xs, vs, xd, vd, h, share, web->fc[nxt]};
+            size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
             if (web->law_failed) {

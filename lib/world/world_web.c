@@ -194,6 +194,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
 
 static ws_status fail_web(ws_world *w, ws_web *web, ws_status s)
 {
+    ws_world_web_lanes_free(w, web);
     ws_node_scratch_free(&w->mem, web);
     ws_web_free(&w->mem, web);
     return s;
@@ -381,6 +382,7 @@ ws_status ws_web_destroy(ws_world *w, ws_web_id id)
     if (s != WS_OK)
         return s;
     law_users(w->webs[slot], -1);
+    ws_world_web_lanes_free(w, w->webs[slot]);
     ws_node_scratch_free(&w->mem, w->webs[slot]);
     ws_web_free(&w->mem, w->webs[slot]);
     ws_mem_free(&w->mem, w->webs[slot], sizeof *w->webs[slot]);
@@ -393,6 +395,7 @@ void ws_world_free_webs(ws_world *w)
 {
     for (size_t i = 0; i < w->web_cap && i < w->web_slots.slot_count; i++) {
         if (w->web_slots.dense[i] != UINT32_MAX && w->webs[i]) {
+            ws_world_web_lanes_free(w, w->webs[i]);
             ws_node_scratch_free(&w->mem, w->webs[i]);
             ws_web_free(&w->mem, w->webs[i]);
             ws_mem_free(&w->mem, w->webs[i], sizeof *w->webs[i]);

@@ -134,6 +134,10 @@ class WorldDef(Structure):
         ("log", LogFn),
         ("log_user", c_void_p),
         ("user_data", c_void_p),
+        ("worker_count", c_uint32),
+        ("enqueue_task", c_void_p),
+        ("finish_task", c_void_p),
+        ("task_context", c_void_p),
     ]
 
 
