@@ -5,6 +5,22 @@
 
 #include <string.h>
 
+/* The move test's budget (ws_node_track, ws_node_moved), in sixteenths of the contact margin.
+ * A full detection lists every node-feature pair within the layers and the margin; the list
+ * holds while no node has come half the margin (COVER) closer to any near body, since that is
+ * what it covers on either side. The half is spent as: a node's own move from where it was
+ * found, in the reference body's frame (NODE); what its sub-steps' forces may add beyond the
+ * state the test measures (SUBSTEP: with one sub-step the contacts see only that state, and
+ * the node takes it too); and the deviations of two near bodies from their records at the
+ * lever of their points (BODY each: the reference body's turn carries the node's frame, the
+ * other body's its points), past which a body is re-based. A far body must not close the gap
+ * it had by a node's whole move (NODE + SUBSTEP, a quarter): it is near when it is within it. */
+enum { MOVE_PARTS = 16, MOVE_NODE = 3, MOVE_SUBSTEP = 1, MOVE_BODY = 2, MOVE_COVER = 8 };
+_Static_assert(MOVE_NODE + MOVE_SUBSTEP + 2 * MOVE_BODY == MOVE_COVER,
+               "the move test's parts must add up to the half margin the candidates cover");
+/* Each part as a fraction of the margin (exact: sixteenths are binary fractions). */
+#define MOVE_PART(k) ((double)(k) / MOVE_PARTS)
+
 static int inside_box(v3 p, v3 lo, v3 hi, double e)
 {
     return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
@@ -195,7 +211,7 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
         ws_track *t = &web->track[web->ntrack++];
         t->body = k;
         t->gap = body_gap(b, cur, k, web, x, t);
-        t->near = t->gap <= 0.25 * margin;
+        t->near = t->gap <= MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin;
         /* A point of the body touches a node only within its bounding sphere grown by the
          * layers and the margin, and only in the web's box. */
         t->lever = fmin(sphere_lever(b, k, web, margin),
@@ -485,9 +501,9 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
         double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
-        t->rebase = t->near && d >= margin / 8.0;
+        t->rebase = t->near && d >= MOVE_PART(MOVE_BODY) * margin;
         rebase |= t->rebase;
-        if (!t->near && d + 0.25 * margin >= t->gap)
+        if (!t->near && d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
@@ -499,7 +515,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
      * the margin. Either way a node stays within a quarter margin of where it was found
      * wherever the contacts see it. */
-    const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
+    const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     size_t flagged;
     if (c > 0.0) {
@@ -554,7 +570,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
         if (least - d < t->gap)
             t->gap = least - d;
-        if (d + 0.25 * margin >= t->gap)
+        if (d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Found again now: their moves count from here. */
