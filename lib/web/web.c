@@ -25,7 +25,6 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     memset(web, 0, sizeof *web);
     web->n = n;
     web->ns = ns;
-    web->seg_list = -1;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         ok &= nodes_alloc(mem, &web->x[k], n);
@@ -34,13 +33,8 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     }
     ok &= nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= nodes_alloc(mem, &web->xdet, n);
-    ok &= nodes_alloc(mem, &web->xep, n);
     ok &= nodes_alloc(mem, &web->xsub, n);
     ok &= nodes_alloc(mem, &web->vsub, n);
-    ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
-    ok &= (web->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
-    ok &= (web->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -63,23 +57,13 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
-        ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
 
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
     nodes_free(mem, &web->fmem, web->n);
-    nodes_free(mem, &web->xdet, web->n);
-    nodes_free(mem, &web->xep, web->n);
     nodes_free(mem, &web->xsub, web->n);
     nodes_free(mem, &web->vsub, web->n);
-    ws_mem_free(mem, web->moved, (n ? n : 1) * sizeof(uint32_t));
-    ws_mem_free(mem, web->redo, (n ? n : 1) * sizeof(uint8_t));
-    ws_mem_free(mem, web->cstart, ((size_t)n + 1) * sizeof(size_t));
-    ws_mem_free(mem, web->cbody, web->cbody_cap);
-    ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
-    ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
-    ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
     ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));

@@ -220,6 +220,7 @@ void ws_world_destroy(ws_world *w)
     }
     ws_mem *m = &w->mem;
     ws_pool_destroy(m, w->pool); /* no step runs: its threads wait for work */
+    ws_world_lanes_free(w);
     ws_mem_free(
         m, w->lane_job,
         w->lane_job ? (size_t)WS_LANES_PER_WORKER * w->def.worker_count * sizeof *w->lane_job : 0);

@@ -22,13 +22,21 @@
  * that runs while another waits for its core take more of them. */
 #define WS_LANES_PER_WORKER 2
 
-/* A lane of a parallel sweep of a web (world_step.c): a copy of the web sharing its state, with
- * scratch of its own, the blocks [k0, k1) it sweeps, and what it found. */
+/* A lane of a parallel sweep of a web (world_step.c): copies of the web and its contact that
+ * share their state, with the lane's own scratch (lane 0: the web's); the blocks [k0, k1) it
+ * sweeps and what it found. Lanes 1.. keep their scratch from web to web and step to step:
+ * the spring chunk (tmp, WS_WEB_TMP doubles), the list of touched nodes (fct), the contact
+ * lists, run batch and run faces (own). */
 typedef struct ws_lane_job {
     ws_web view;
+    ws_node_contact cview;
     uint32_t k0, k1;
     size_t fast;
     uint64_t checks;
+    double *tmp;
+    uint32_t *fct;
+    size_t fct_cap;
+    ws_node_contact own;
 } ws_lane_job;
 
 struct ws_world {
@@ -138,8 +146,8 @@ void ws_world_free_laws(ws_world *w);
 /* Take a slot of a table whose objects live in a pointer array, growing the array; the entry is
  * NULL. 0, or -1 when out of memory. */
 int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, uint32_t *slot);
-/* Free the scratch of a web's lanes (world_step.c). */
-void ws_world_web_lanes_free(ws_world *w, ws_web *web);
+/* Free the scratch of the lanes of parallel sweeps (world_step.c). */
+void ws_world_lanes_free(ws_world *w);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */

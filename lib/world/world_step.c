@@ -182,8 +182,8 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     const uint32_t blocks = ws_web_block_count(web);
     uint32_t n0, n1;
     ws_web_block_range(web, J->k0, &n0, &n1);
-    size_t next = J->k0 ? ws_node_first_segment(web, n0) : 0;
-    ws_node_substep(web);
+    size_t next = J->k0 ? ws_node_first_segment(&J->cview, n0) : 0;
+    ws_node_substep(&J->cview);
     ws_web_sweep_begin(web, T->vd);
     for (uint32_t q = J->k0; q < J->k1; q++) {
         const int edges = (q == J->k0 && q > 0 ? WS_WEB_LANE_FIRST : 0) |
@@ -209,7 +209,7 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
 /* The lanes a web's sweep is cut into this step, with the scratch of each ready; 0 when out of
  * memory. One unless the world has workers and the web can be swept in lanes
  * (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a block. */
-static uint32_t web_lanes(ws_world *w, ws_web *web, int list)
+static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
 {
     const uint32_t blocks = ws_web_block_count(web),
                    most = WS_LANES_PER_WORKER * w->def.worker_count;
@@ -218,75 +218,66 @@ static uint32_t web_lanes(ws_world *w, ws_web *web, int list)
         lanes = blocks;
     if (lanes < 2 || !ws_web_sweep_parallel(web))
         return 1;
-    const size_t ncand = web->ncand[list];
-    if (web->nlanes < most - 1) {
-        const size_t want = most - 1;
-        ws_web *more = ws_mem_calloc(&w->mem, want, sizeof *more);
-        if (!more)
+    for (uint32_t i = 1; i < lanes; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
             return 0;
-        if (web->nlanes)
-            memcpy(more, web->lanes, web->nlanes * sizeof *more);
-        ws_mem_free(&w->mem, web->lanes, web->nlanes * sizeof *more);
-        web->lanes = more;
-        web->nlanes = (uint32_t)want;
-    }
-    for (uint32_t i = 0; i + 1 < lanes; i++) {
-        ws_web *L = &web->lanes[i];
-        if (!L->tmp && !(L->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
-            return 0;
-        if (ws_node_lane_scratch(&w->mem, L, web, ncand) != 0 ||
-            ws_array_reserve(&w->mem, (void **)&L->fct[0], &L->fct_cap[0], ncand + 1,
-                             sizeof(uint32_t)) != 0)
+        if (ws_node_lane_scratch(&w->mem, &J->own, web->contact, web->n, ncand) != 0 ||
+            ws_array_reserve(&w->mem, (void **)&J->fct, &J->fct_cap, ncand + 1, sizeof(uint32_t)) !=
+                0)
             return 0;
     }
     return lanes;
 }
 
-void ws_world_web_lanes_free(ws_world *w, ws_web *web)
+void ws_world_lanes_free(ws_world *w)
 {
-    for (uint32_t i = 0; i < web->nlanes; i++) {
-        ws_web *L = &web->lanes[i];
-        ws_node_scratch_free(&w->mem, L);
-        ws_mem_free(&w->mem, L->tmp, L->tmp ? WS_WEB_TMP * sizeof(double) : 0);
-        ws_mem_free(&w->mem, L->fct[0], L->fct_cap[0] * sizeof(uint32_t));
+    const size_t jobs = (size_t)WS_LANES_PER_WORKER * w->def.worker_count;
+    for (size_t i = 0; w->lane_job && i < jobs; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        ws_node_scratch_free(&w->mem, &J->own);
+        ws_mem_free(&w->mem, J->tmp, J->tmp ? WS_WEB_TMP * sizeof(double) : 0);
+        ws_mem_free(&w->mem, J->fct, J->fct_cap * sizeof(uint32_t));
+        J->tmp = NULL;
+        J->fct = NULL;
+        J->fct_cap = 0;
     }
-    ws_mem_free(&w->mem, web->lanes, web->nlanes * sizeof *web->lanes);
-    web->lanes = NULL;
-    web->nlanes = 0;
 }
 
-/* Lane i's copy of the web: its state shared, its scratch its own (lane 0: the web's), the
- * nodes it ends at. */
+/* Lane i's copies of the web and its contact: their state shared, their scratch the lane's own
+ * (lane 0: the web's), the nodes the lane ends at. */
 static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
 {
     ws_lane_job *J = &w->lane_job[i];
     const uint32_t blocks = ws_web_block_count(web);
     J->view = *web;
+    J->cview = *web->contact;
+    J->view.contact = &J->cview;
     J->k0 = (uint32_t)((uint64_t)i * blocks / lanes);
     J->k1 = (uint32_t)((uint64_t)(i + 1) * blocks / lanes);
     J->fast = 0;
     J->checks = 0;
     ws_web *v = &J->view;
+    ws_node_contact *c = &J->cview;
     uint32_t n0, n1;
     ws_web_block_range(web, J->k1 - 1, &n0, &n1);
-    v->lane_end = n1;
-    v->run_nodes = v->run_deep = v->corners = 0;
+    c->lane_end = n1;
+    c->run_nodes = c->run_deep = c->corners = 0;
     v->law_failed = 0;
     if (i == 0)
         return;
-    const ws_web *L = &web->lanes[i - 1];
-    v->tmp = L->tmp;
-    v->act = L->act;
-    v->act_id = L->act_id;
-    v->act_cap = L->act_cap;
-    v->rtmp = L->rtmp;
-    v->rtmp_cap = L->rtmp_cap;
-    v->rface = L->rface;
-    v->rface_cap = L->rface_cap;
-    v->rface_gen = L->rface_gen;
-    v->fct[v->fck] = L->fct[0];
-    v->fct_cap[v->fck] = L->fct_cap[0];
+    v->tmp = J->tmp;
+    v->fct[v->fck] = J->fct;
+    v->fct_cap[v->fck] = J->fct_cap;
     v->nfct[v->fck] = 0;
+    c->act = J->own.act;
+    c->act_id = J->own.act_id;
+    c->act_cap = J->own.act_cap;
+    c->rtmp = J->own.rtmp;
+    c->rtmp_cap = J->own.rtmp_cap;
+    c->rface = J->own.rface;
+    c->rface_cap = J->own.rface_cap;
+    c->rface_gen = J->own.rface_gen;
 }
 
 /* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
@@ -295,18 +286,19 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *b
 {
     ws_lane_job *J = &w->lane_job[i];
     ws_web *v = &J->view;
-    ws_node_loads(v, bforce, bmoment);
-    web->run_nodes += v->run_nodes;
-    web->run_deep += v->run_deep;
-    web->corners += v->corners;
+    ws_node_contact *c = &J->cview, *nc = web->contact;
+    ws_node_loads(c, bforce, bmoment);
+    nc->run_nodes += c->run_nodes;
+    nc->run_deep += c->run_deep;
+    nc->corners += c->corners;
     web->law_failed |= v->law_failed;
     w->stats.narrow_checks += J->checks;
     const int k = web->fck;
     if (i == 0) {
-        web->rface_gen = v->rface_gen;
+        nc->rface_gen = c->rface_gen;
         web->nfct[k] = v->nfct[k]; /* lane 0 listed into the web's own list */
     } else {
-        web->lanes[i - 1].rface_gen = v->rface_gen;
+        J->own.rface_gen = c->rface_gen;
         memcpy(web->fct[k] + web->nfct[k], v->fct[k], v->nfct[k] * sizeof(uint32_t));
         web->nfct[k] += v->nfct[k];
     }
@@ -346,72 +338,20 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        /* Node candidates: all found again when the cache is invalid or when a body may have
-         * come near (ws_node_moved says -1); else those of the nodes that moved far enough
-         * relative to the near bodies, or that a near body past its bound may meet, merged
-         * into the others.
-         * Either way the list holds every node-feature pair that can touch in this step, and
-         * the result is the same as finding them every step (tests/test_detection.c shows it
-         * for body pairs). The world's detection schedule governs the body pairs. */
-        int list = web->list;
-        long moved = 0;
-        size_t changed = 0;
-        int all = web->refresh || !w->cand_valid;
-        if (!all && (moved = ws_node_moved(b, cur, web, web->x[cur], web->v[cur], w->def.dt,
-                                           w->def.contact_margin)) < 0)
-            all = 1;
-        if (all || moved > 0) {
-            double t0 = clock_now(w);
-            int old = list;
-            list ^= 1;
-            /* The record of where nodes were found changes now: should the step fail, the
-             * next one finds every node again (refresh stays set until a step commits). */
-            web->refresh = 1;
-            if (web->seg_list == list) /* cut from what is overwritten now */
-                web->seg_list = -1;
-            int bad;
-            if (all) {
-                bad = ws_node_track(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin) ||
-                      ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
-                                         w->def.contact_margin, NULL, 0, &web->cand[list],
-                                         &web->ncand[list], &web->capcand[list],
-                                         &w->stats.narrow_checks);
-                if (!bad)
-                    ws_node_index(web->cand[list], web->ncand[list], web->n, web->cstart);
-            } else {
-                bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
-                                         w->def.contact_margin, web->moved, (size_t)moved,
-                                         &web->fresh, &web->nfresh, &web->fresh_cap,
-                                         &w->stats.narrow_checks);
-                /* Mostly the nodes found again have the candidates they had: then the
-                 * committed list serves again, uncopied. */
-                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cstart, web->cand[old],
-                                         web->fresh, web->nfresh))
-                    list = old;
-                else /* web->moved keeps the nodes whose candidates changed: their sweep
-                        blocks alone are cut into stretches again */
-                    bad = bad ||
-                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->n, web->cstart,
-                                        web->cand[old], web->ncand[old], web->fresh, web->nfresh,
-                                        &web->cand[list], &web->ncand[list], &web->capcand[list],
-                                        web->moved, &changed) ||
-                          ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
-                                                  list, old, web->moved, changed);
-            }
-            if (bad || ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
-                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                               web_label(web));
-            w->stats.seconds_detection += clock_now(w) - t0;
-            w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
-        }
-        web->next_list = list;
-        ws_node_prepare(b, cur, &w->node_geom, web);
-        /* The list cut into stretches for the evaluation: again whenever it changed (a list
-         * that serves again keeps its stretches). */
-        if (web->seg_list != list &&
-            ws_node_segments(&w->mem, web, web->cand[list], web->ncand[list], list) != 0)
+        /* The node candidates of this step, ready to evaluate (contact/node.c). */
+        ws_node_contact *nc = web->contact;
+        int searched = 0;
+        const double t0 = clock_now(w);
+        if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, w->def.contact_margin,
+                                   w->def.dt, !w->cand_valid, &w->stats.narrow_checks,
+                                   &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
+        if (searched) { /* counted as detection, not film */
+            w->stats.seconds_detection += clock_now(w) - t0;
+            w->stats.seconds_web -= clock_now(w) - t0;
+        }
+        const int list = nc->next_list;
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         for (size_t i = 0; i < web->bcap; i++)
@@ -424,12 +364,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
-                             (size_t)web->substeps * web->ncand[list] + 1, sizeof(uint32_t)) != 0)
+                             (size_t)web->substeps * nc->ncand[list] + 1, sizeof(uint32_t)) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
-        const uint32_t lanes = web_lanes(w, web, list);
+        const uint32_t lanes = web_lanes(w, web, nc->ncand[list]);
         if (lanes == 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
@@ -441,7 +381,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
             ws_web_sweep_laws(web, w->def.gravity, w->time + s * h, s * h);
-            lane_task T = {w, cur, web->cand[list], xs, vs, xd, vd, h, share, web->fc[nxt]};
+            lane_task T = {w, cur, nc->cand[list], xs, vs, xd, vd, h, share, web->fc[nxt]};
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
@@ -622,9 +562,8 @@ static ws_status step_once(ws_world *w)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        web->list = web->next_list;
+        ws_node_contact_commit(web->contact);
         ws_web_commit(web, web->x[w->cur], web->v[w->cur], w->time, w->def.dt);
-        web->refresh = 0;
     }
     w->steps++;
     w->stats.seconds_total += clock_now(w) - t_start;
