@@ -698,9 +698,9 @@ START_TEST(edges_of_faces_a_node_is_well_inside_of_are_dropped)
     probe_web(w, &wd, pos, 2, &web);
     ck_ok(w, ws_world_step(w));
     const ws_web *wb = only_web(w);
-    const ws_ncand *c = wb->contact->cand[wb->contact->next_list];
+    const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
     int faces[2] = {0, 0}, edges[2] = {0, 0}, inside[2] = {0, 0};
-    for (size_t k = 0; k < wb->contact->ncand[wb->contact->next_list]; k++) {
+    for (size_t k = 0; k < wb->contact->cand[wb->contact->next_list].n; k++) {
         ck_assert_uint_lt(c[k].node, 2);
         if (c[k].local & WS_NCAND_EDGE) {
             edges[c[k].node]++;
@@ -884,9 +884,9 @@ START_TEST(corners_are_marked_by_the_detection)
         probe_web(w, &wd, pos, 3, &web);
         ck_ok(w, ws_world_step(w));
         const ws_web *wb = only_web(w);
-        const ws_ncand *c = wb->contact->cand[wb->contact->next_list];
+        const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
         int count[3] = {0, 0, 0}, marked[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
-        for (size_t q = 0; q < wb->contact->ncand[wb->contact->next_list]; q++) {
+        for (size_t q = 0; q < wb->contact->cand[wb->contact->next_list].n; q++) {
             ck_assert_uint_lt(c[q].node, 3);
             count[c[q].node]++;
             marked[c[q].node] += (c[q].local & WS_NCAND_CORNER) != 0;
@@ -1089,9 +1089,9 @@ START_TEST(well_inside_takes_the_projection)
     ws_world *w = edge_film_world(1, off, 0, &id);
     ck_ok(w, ws_world_step(w));
     const ws_web *wb = only_web(w);
-    const ws_ncand *c = wb->contact->cand[wb->contact->next_list];
+    const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
     int faces[3] = {0, 0, 0}, inside[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
-    for (size_t q = 0; q < wb->contact->ncand[wb->contact->next_list]; q++) {
+    for (size_t q = 0; q < wb->contact->cand[wb->contact->next_list].n; q++) {
         ck_assert_uint_lt(c[q].node, 3);
         if (c[q].local & WS_NCAND_EDGE) {
             edges[c[q].node]++;
@@ -1280,10 +1280,14 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
             kept++;
             continue;
         }
-        size_t n = 0;
-        ck_assert_int_eq(ws_node_merge(&mem, nodes, count, N, start, old, nold, fresh, nfresh,
-                                       &out, &n, &cap, changed, &nchanged),
-                         0);
+        const ws_ncand_list lold = {old, nold, nold}, lfresh = {fresh, nfresh, nfresh};
+        ws_ncand_list lout = {out, 0, cap};
+        ck_assert_int_eq(
+            ws_node_merge(&mem, nodes, count, N, start, &lold, &lfresh, &lout, changed, &nchanged),
+            0);
+        out = lout.c;
+        cap = lout.cap;
+        const size_t n = lout.n;
         merges++;
         ck_assert_uint_eq(n, nwant);
         ck_assert(n == 0 || !memcmp(out, want, n * sizeof *out));

@@ -56,7 +56,7 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
         return;
     const size_t m = 3 * (size_t)n + WS_WEB_PAD;
     for (int k = 0; k < 2; k++)
-        ws_mem_free(mem, nc->cand[k], nc->capcand[k] * sizeof(ws_ncand));
+        ws_mem_free(mem, nc->cand[k].c, nc->cand[k].cap * sizeof(ws_ncand));
     ws_mem_free(mem, nc->xdet.x, m * sizeof(double));
     ws_mem_free(mem, nc->xep.x, m * sizeof(double));
     ws_mem_free(mem, nc->moved, (n ? n : 1) * sizeof(uint32_t));
@@ -64,7 +64,7 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
     ws_mem_free(mem, nc->cstart, ((size_t)n + 1) * sizeof(size_t));
     ws_mem_free(mem, nc->cbody, nc->cbody_cap);
     ws_mem_free(mem, nc->track, nc->track_cap * sizeof(ws_track));
-    ws_mem_free(mem, nc->fresh, nc->fresh_cap * sizeof(ws_ncand));
+    ws_mem_free(mem, nc->fresh.c, nc->fresh.cap * sizeof(ws_ncand));
     ws_mem_free(mem, nc->seg, nc->seg_cap * sizeof(ws_nseg));
     ws_node_scratch_free(mem, nc);
     ws_mem_free(mem, nc, sizeof *nc);
@@ -489,7 +489,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
     flag_in_box(nc->redo, x, web->n, &b->A[k], b->st[cur].r[k],
                 v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
                 v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
-    const ws_ncand *c = nc->cand[nc->list];
+    const ws_ncand *c = nc->cand[nc->list].c;
     if (nc->seg_list == nc->list) {
         /* The list's stretches: a run's candidates are of one face, so of one body. */
         for (size_t s = 0; s < nc->nseg; s++) {
@@ -501,7 +501,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
                     nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
         }
     } else {
-        for (size_t q = 0; q < nc->ncand[nc->list]; q++)
+        for (size_t q = 0; q < nc->cand[nc->list].n; q++)
             nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
     }
     t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
@@ -696,9 +696,13 @@ static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
 }
 
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
-                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged)
+                  const ws_ncand_list *old_list, const ws_ncand_list *fresh_list,
+                  ws_ncand_list *out_list, uint32_t *changed, size_t *nchanged)
 {
+    const ws_ncand *old = old_list->c, *fresh = fresh_list->c;
+    const size_t nold = old_list->n, nfresh = fresh_list->n;
+    ws_ncand **out = &out_list->c;
+    size_t *n = &out_list->n, *cap = &out_list->cap;
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
@@ -910,9 +914,10 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
  * order. Only here may a face candidate be marked INSIDE. */
 static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g,
                              const ws_find_body *fb, uint32_t c, uint32_t i, double reach,
-                             double margin, ws_ncand **out, size_t *n, size_t *cap,
-                             uint64_t *checks)
+                             double margin, ws_ncand_list *L, uint64_t *checks)
 {
+    ws_ncand **out = &L->c;
+    size_t *n = &L->n, *cap = &L->cap;
     const uint32_t nf = sh->face_count, k = fb->body;
     const double *v = g->find_val + fb->val + c;
     const uint64_t *mk = g->find_mask + fb->mask + c;
@@ -969,8 +974,10 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
 /* Node i at p (global) against body k of any shape, one by one. */
 static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
                               uint32_t i, uint32_t k, v3 p, double reach, double margin,
-                              ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+                              ws_ncand_list *L, uint64_t *checks)
 {
+    ws_ncand **out = &L->c;
+    size_t *n = &L->n, *cap = &L->cap;
     const ws_shape *sh = b->shape[k];
     v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
     if (!inside_box(s, sh->lo, sh->hi, reach))
@@ -1019,8 +1026,9 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
 
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
                        ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+                       ws_ncand_list *L, uint64_t *checks)
 {
+    size_t *n = &L->n;
     ws_node_contact *nc = web->contact;
     *n = 0;
     if (ws_array_reserve(mem, (void **)&nc->cbody, &nc->cbody_cap, b->slots + 1, 1) != 0)
@@ -1107,12 +1115,12 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 int bad;
                 if (fb->general) {
                     bad = general_candidates(mem, b, cur, g, i, k, v3_make(px[j], py[j], pz[j]),
-                                             reach, margin, out, n, cap, checks);
+                                             reach, margin, L, checks);
                 } else {
                     if (!g->find_mask[fb->mask + M_LOCAL * FIND_CHUNK + c])
                         continue;
-                    bad = convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, out, n,
-                                            cap, checks);
+                    bad =
+                        convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, L, checks);
                 }
                 if (bad)
                     return -1;
@@ -1255,28 +1263,27 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
         if (all) {
             bad = ws_node_track(mem, b, cur, web, x, margin) ||
                   ws_node_candidates(mem, b, cur, g, web, x, margin, NULL, 0, &nc->cand[list],
-                                     &nc->ncand[list], &nc->capcand[list], checks);
+                                     checks);
             if (!bad)
-                ws_node_index(nc->cand[list], nc->ncand[list], web->n, nc->cstart);
+                ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
         } else {
             bad = ws_node_candidates(mem, b, cur, g, web, x, margin, nc->moved, (size_t)moved,
-                                     &nc->fresh, &nc->nfresh, &nc->fresh_cap, checks);
+                                     &nc->fresh, checks);
             /* Mostly the nodes found again have the candidates they had: then the committed
              * list serves again, uncopied. */
-            if (!bad && ws_node_same(nc->moved, (size_t)moved, nc->cstart, nc->cand[old], nc->fresh,
-                                     nc->nfresh))
+            if (!bad && ws_node_same(nc->moved, (size_t)moved, nc->cstart, nc->cand[old].c,
+                                     nc->fresh.c, nc->fresh.n))
                 list = old;
             else /* moved keeps the nodes whose candidates changed: their sweep blocks alone
                     are cut into stretches again */
                 bad =
                     bad ||
-                    ws_node_merge(mem, nc->moved, (size_t)moved, web->n, nc->cstart, nc->cand[old],
-                                  nc->ncand[old], nc->fresh, nc->nfresh, &nc->cand[list],
-                                  &nc->ncand[list], &nc->capcand[list], nc->moved, &changed) ||
-                    ws_node_segments_merged(mem, web, nc->cand[list], nc->ncand[list], list, old,
+                    ws_node_merge(mem, nc->moved, (size_t)moved, web->n, nc->cstart, &nc->cand[old],
+                                  &nc->fresh, &nc->cand[list], nc->moved, &changed) ||
+                    ws_node_segments_merged(mem, web, nc->cand[list].c, nc->cand[list].n, list, old,
                                             nc->moved, changed);
         }
-        if (bad || ws_node_scratch(mem, nc, nc->ncand[list]) != 0)
+        if (bad || ws_node_scratch(mem, nc, nc->cand[list].n) != 0)
             return -1;
     }
     nc->next_list = list;
@@ -1284,7 +1291,7 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
     /* The list cut into stretches for the evaluation: again whenever it changed (a list that
      * serves again keeps its stretches). */
     if (nc->seg_list != list &&
-        ws_node_segments(mem, web, nc->cand[list], nc->ncand[list], list) != 0)
+        ws_node_segments(mem, web, nc->cand[list].c, nc->cand[list].n, list) != 0)
         return -1;
     return 0;
 }

@@ -35,6 +35,12 @@ typedef struct ws_nseg {
     int run;
 } ws_nseg;
 
+/* A growable list of candidates: c[0, n), room for cap. */
+typedef struct ws_ncand_list {
+    ws_ncand *c;
+    size_t n, cap;
+} ws_ncand_list;
+
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
  * reference body (see ws_node_contact): its CoG (rho) and orientation (q) in the reference body's
  * frame (for a near body, as it was when it last moved past its bound, ws_node_moved); its
@@ -57,8 +63,7 @@ typedef struct ws_track {
  * (ws_node_contact_new), freed with it. */
 typedef struct ws_node_contact {
     /* Node-face candidates: changed only by full detection, into the other list. */
-    ws_ncand *cand[2];
-    size_t ncand[2], capcand[2];
+    ws_ncand_list cand[2];
     double *act;      /* the contacts of a sweep block gone one by one (scratch, sized */
     uint32_t *act_id; /* with the candidates; contact/node_force.c) */
     size_t act_cap;
@@ -97,8 +102,7 @@ typedef struct ws_node_contact {
     size_t ntrack, track_cap;
     uint32_t *moved;
     uint8_t *redo;
-    ws_ncand *fresh; /* candidates of the moved nodes (scratch) */
-    size_t nfresh, fresh_cap;
+    ws_ncand_list fresh; /* candidates of the moved nodes (scratch) */
     int refresh;
     /* The same places in the global frame as the reference body stood at an epoch (its pose
      * then: epoch_r, epoch_A, epoch_q): xep = epoch_r + epoch_A xdet, which a node's global
@@ -196,7 +200,7 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
  * when out of memory. */
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
                        ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks);
+                       ws_ncand_list *out, uint64_t *checks);
 
 /* A full detection's record (see ws_node_contact): the web's box from x and the bodies whose boxes come
  * within reach of it, with their pose at state cur; xdet = x. 0, or -1 when out of memory. */
@@ -234,8 +238,8 @@ int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const
  * candidates are not those they had into `changed` (room for count; it may be `nodes`
  * itself), in order, *nchanged of them. 0, or -1 when out of memory (start unchanged). */
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
-                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged);
+                  const ws_ncand_list *old, const ws_ncand_list *fresh, ws_ncand_list *out,
+                  uint32_t *changed, size_t *nchanged);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand);
@@ -267,14 +271,29 @@ size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0);
 int ws_node_lane_scratch(ws_mem *mem, ws_node_contact *lane, const ws_node_contact *nc, uint32_t n,
                          size_t ncand);
 
+/* What every sweep block of a web's sub-step evaluates its node contacts with: the bodies at
+ * state cur (b, with their features in the global frame g), the contact parameters by body
+ * material (pp), the list of candidates the stretches were cut from (cand), the node state
+ * (x, v), the sub-step h, the share 1 / substeps of each contact force the node's record gets
+ * and that record (fc). */
+typedef struct ws_node_pass {
+    ws_body_store *b;
+    int cur;
+    const ws_node_geom *g;
+    const ws_node_params *pp;
+    const ws_ncand *cand;
+    ws_nodes3 x, v;
+    double h, share;
+    v3 *fc;
+} ws_node_pass;
+
 /* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),
- * moving *next past them, at node state (x, v), for a sub-step h: forces into web->f, the node
+ * moving *next past them, with what P gives (ws_node_pass): forces into web->f, the node
  * contact forces (`share` = 1 / substeps of them) into fc, and the opposite loads on the bodies
  * (the same share) listed for ws_node_loads (bforce and bmoment are not written here). cand is the
  * list the stretches were cut from; pp is indexed by body material. The result does not depend on
  * how the candidates are cut. */
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, uint64_t *checks);
+void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
+                      uint64_t *checks);
 
 #endif

@@ -1121,14 +1121,16 @@ static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uin
 }
 #endif
 
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, uint64_t *checks)
+void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
+                      uint64_t *checks)
 {
     ws_node_contact *nc = web->contact;
+    const ws_ncand *cand = P->cand;
+    const double h = P->h, share = P->share;
+    v3 *fc = P->fc;
     act_list L = act_open(web->contact);
     corner_memo memo = {UINT32_MAX, 0.0};
-    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
+    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L, &memo};
     double *tmp = nc->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
     run_batch B = {(run_group *)nc->rtmp, (struct run_tmp *)tmp,
                    tmp + sizeof(run_tmp) / sizeof(double), 0,

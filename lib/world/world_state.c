@@ -487,9 +487,9 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
         else if (named)
             named[i] = (uint8_t)on;
     }
-    size_t nc = C->ncand[C->list];
+    size_t nc = C->cand[C->list].n;
     count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, 4 * 4, "node candidates");
-    room(k, (void **)&C->cand[list], &C->capcand[list], nc + 1, sizeof(ws_ncand));
+    room(k, (void **)&C->cand[list].c, &C->cand[list].cap, nc + 1, sizeof(ws_ncand));
     /* The contacts' room for that many candidates: a step that does not search takes it as
      * it is. */
     if (k->mode == WS_WALK_CHECK && !failed(k) && ws_node_scratch(&w->mem, web->contact, nc) != 0)
@@ -497,7 +497,7 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
     uint32_t prev = 0;
     ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
     for (size_t q = 0; q < nc && !failed(k); q++) {
-        ws_ncand c = reading(k) ? (ws_ncand){0} : C->cand[C->list][q];
+        ws_ncand c = reading(k) ? (ws_ncand){0} : C->cand[C->list].c[q];
         u32v(k, &c.node);
         u32v(k, &c.body);
         u32v(k, &c.feat);
@@ -519,7 +519,7 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
                 fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
                      q);
         } else if (k->mode == WS_WALK_READ) {
-            C->cand[list][q] = c;
+            C->cand[list].c[q] = c;
         }
         prev = c.node;
     }
@@ -554,10 +554,10 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
     C->list = list;
     C->next_list = list;
     C->refresh = refresh;
-    C->ncand[list] = nc;
+    C->cand[list].n = nc;
     C->ref = ref;
     C->ntrack = nt;
-    ws_node_index(C->cand[list], nc, web->n, C->cstart);
+    ws_node_index(C->cand[list].c, nc, web->n, C->cstart);
     C->seg_list = -1; /* the stretches are cut again from the list read */
 }
 

@@ -167,11 +167,8 @@ static ws_status webs_ready(ws_world *w)
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
     ws_world *w;
-    int cur;
-    const ws_ncand *cand;
-    ws_nodes3 xs, vs, xd, vd;
-    double h, share;
-    v3 *fc;
+    ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
+    ws_nodes3 xd, vd;  /* the state written */
 } lane_task;
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
@@ -188,11 +185,10 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     for (uint32_t q = J->k0; q < J->k1; q++) {
         const int edges = (q == J->k0 && q > 0 ? WS_WEB_LANE_FIRST : 0) |
                           (q + 1 == J->k1 && J->k1 < blocks ? WS_WEB_LANE_LAST : 0);
-        ws_web_forces_block(web, T->xs, T->vs, w->def.gravity, q, edges, &n0, &n1);
-        ws_node_contacts(&w->bodies, T->cur, &w->node_geom, web, T->xs, T->vs, T->cand, n1, &next,
-                         w->node_par, T->h, T->share, T->fc, &J->checks);
-        J->fast +=
-            ws_web_integrate_block(web, T->xs, T->vs, T->xd, T->vd, T->h, n0, n1, w->def.max_speed);
+        ws_web_forces_block(web, T->pass.x, T->pass.v, w->def.gravity, q, edges, &n0, &n1);
+        ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
+        J->fast += ws_web_integrate_block(web, T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, n0,
+                                          n1, w->def.max_speed);
     }
     ws_web_sweep_end(web);
 }
@@ -364,12 +360,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
-                             (size_t)web->substeps * nc->ncand[list] + 1, sizeof(uint32_t)) != 0)
+                             (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
-        const uint32_t lanes = web_lanes(w, web, nc->ncand[list]);
+        const uint32_t lanes = web_lanes(w, web, nc->cand[list].n);
         if (lanes == 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
@@ -381,7 +377,11 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
             ws_web_sweep_laws(web, w->def.gravity, w->time + s * h, s * h);
-            lane_task T = {w, cur, nc->cand[list], xs, vs, xd, vd, h, share, web->fc[nxt]};
+            lane_task T = {w,
+                           {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
+                            web->fc[nxt]},
+                           xd,
+                           vd};
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
