@@ -17,9 +17,9 @@ bad=0
 for ((i = 0; i < ${#flags[@]}; i += 2)); do
     name=${flags[i]} args=${flags[i + 1]} dir=build-flags-${flags[i]}
     if [[ -f $dir/meson-private/coredata.dat ]]; then
-        meson setup --reconfigure "$dir" -Dtests=false -Dc_args="$args" >/dev/null
+        meson setup --reconfigure "$dir" -Dtests=false -Dc_args="$args" >/dev/null 2>&1
     else
-        meson setup "$dir" -Dtests=false -Dc_args="$args" >/dev/null
+        meson setup "$dir" -Dtests=false -Dc_args="$args" >/dev/null 2>&1
     fi
     meson compile -C "$dir" bench/bench_wrapped >/dev/null
     hash=$("$dir/bench/bench_wrapped" "$steps" P | sed -n 's/.*state hash \([0-9a-f]*\).*/\1/p')
