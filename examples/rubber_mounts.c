@@ -187,10 +187,12 @@ int main(int argc, char **argv)
         return 1;
     }
     if (csv) {
-        fprintf(csv, "t");
+        /* Each column's unit at the end of its name: s, N, N m (Nm). */
+        fprintf(csv, "t_s");
         for (int m = 0; m < MOUNTS; m++)
             for (int c = 0; c < 6; c++)
-                fprintf(csv, ",m%d_%c%c", m + 1, c < 3 ? 'F' : 'M', "xyz"[c % 3]);
+                fprintf(csv, ",m%d_%c%c_%s", m + 1, c < 3 ? 'F' : 'M', "xyz"[c % 3],
+                        c < 3 ? "N" : "Nm");
         fprintf(csv, "\n");
     }
 

@@ -23,7 +23,8 @@
  *   the world has no floor, and a falling box says nothing more about the load.
  *
  * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
- * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--vtk DIR] [--no-ccd]
+ * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--no-ccd]
+ *                      [--vtk DIR [--vtk-every S] [--vtk-stride N] [--vtk-springs] [--vtk-ascii]]
  *                      [--paper-integrator] [--duration S] [--quiet]
  *                      [--wrapped [--film-mass KG] [--substeps N]]
  *         ./tilt_table --help
@@ -57,10 +58,16 @@ typedef struct tilt_options {
     double duration;      /* s; 0 = 6 s for P, 7 s for R */
     const char *csv;      /* time series file, or NULL */
     const char *vtk_dir;  /* directory for VTK frames, or NULL */
+    double vtk_every;     /* s between VTK frames (the series' time stride); default 0.1 s */
+    int vtk_stride;       /* offer a frame every vtk_stride-th step (frame stride); default 1 */
+    int vtk_springs;      /* 1: add the film's springs as their own block */
+    int vtk_ascii;        /* 1: ASCII files instead of compressed binary */
     int quiet;            /* no progress, no summary */
     int wrapped;          /* 1: stretch film around the stack */
-    double film_mass;     /* kg per node; 0 = 1 g (stable at dt = 0.25 ms without sub-steps) */
-    int substeps;         /* film sub-steps per step; 0 = 1 */
+    double film_mass;     /* kg per node; 0 = 1 g */
+    int substeps;         /* film sub-steps per step; 0 = 2 (1 g nodes then use 0.34 of their
+                             stable sub-step, within the default safety factor 0.5) */
+    double stable_fraction; /* the film check's safety factor (world.h); 0 = the default */
     int profile;          /* 1: the library times its phases (ws_world_stats) */
     int workers;          /* workers of a step; 0 = 1 (the results are the same for any) */
 } tilt_options;
@@ -107,6 +114,8 @@ static void tilt_default_options(tilt_options *o)
     memset(o, 0, sizeof *o);
     o->variant = 'R';
     o->use_ccd = 1;
+    o->vtk_every = 0.1; /* 0.57 deg of tilt a frame: 71 frames of a 7 s run */
+    o->vtk_stride = 1;
 }
 
 /* The film of the reference case: a band from 30 mm above the plane to 20 mm below the top,
@@ -164,7 +173,7 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
     wd.material = film_mat;
     wd.law = around;
     wd.law_cross = up;
-    wd.substeps = o->substeps > 0 ? o->substeps : 1;
+    wd.substeps = o->substeps > 0 ? o->substeps : 2;
     wd.name = "film";
     ws_band_def bd;
     ws_band_def_init(&bd);
@@ -195,6 +204,8 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.detection_interval = 5;     /* ... then every 5th step */
     wd.use_ccd = o->use_ccd;
     wd.profile = o->profile;
+    if (o->stable_fraction > 0)
+        wd.stable_fraction = o->stable_fraction;
     wd.worker_count = o->workers > 0 ? (uint32_t)o->workers : 1u;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
@@ -321,10 +332,11 @@ static double relative_tilt(ws_world *w, ws_body_id a, ws_body_id b)
 }
 
 /* Gross slip of body b on its support: every contact between them slips (tangential speed at
- * or above v_lim under the regularised law, anchor sliding under the stick law), and they slip
- * the same way (|sum of slip velocities| >= half the sum of their sizes): a box turning on its
- * support, as when the platform starts to tilt, slips at every corner but is not sliding. The
- * pair's report gives every slip velocity as b's on its support, whichever owns the face. */
+ * or above v_lim under the regularised law, the anchor at its cap under the stick law), and
+ * they slip the same way (|sum of slip velocities| >= half the sum of their sizes): a box
+ * turning on its support, as when the platform starts to tilt, slips at every corner but is not
+ * sliding. The pair's report gives every slip velocity as b's on its support, whichever owns
+ * the face. */
 static int slides_on(ws_world *w, ws_body_id b, ws_body_id support)
 {
     ws_contact_info buf[64];
@@ -340,7 +352,7 @@ static int slides_on(ws_world *w, ws_body_id b, ws_body_id support)
         sy += v->y;
         sz += v->z;
         size += sqrt(v->x * v->x + v->y * v->y + v->z * v->z);
-        slipping += buf[k].slipping != 0;
+        slipping += buf[k].slipping != 0 || buf[k].at_cap != 0; /* stick: saturated */
     }
     return n > 0 && slipping == n && sqrt(sx * sx + sy * sy + sz * sz) >= 0.5 * size;
 }
@@ -485,15 +497,25 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         return res->status = WS_ERR_IO;
     }
     if (csv)
-        fprintf(csv, "t,plane_angle_deg,"
-                     "bottom_x,bottom_y,bottom_z,bottom_vx,bottom_vy,bottom_vz,bottom_tilt_deg,"
-                     "bottom_slip,top_x,top_y,top_z,top_vx,top_vy,top_vz,top_tilt_deg,top_slip,"
-                     "cog_distance\n");
+        /* Each column's unit at the end of its name: s, deg, m, m/s (m_s). */
+        fprintf(csv, "t_s,plane_angle_deg,"
+                     "bottom_x_m,bottom_y_m,bottom_z_m,bottom_vx_m_s,bottom_vy_m_s,bottom_vz_m_s,"
+                     "bottom_tilt_deg,bottom_slip_m,"
+                     "top_x_m,top_y_m,top_z_m,top_vx_m_s,top_vy_m_s,top_vz_m_s,top_tilt_deg,"
+                     "top_slip_m,cog_distance_m\n");
+    ws_vtk_series_def vd;
+    ws_vtk_series_def_init(&vd);
+    vd.directory = o->vtk_dir;
+    vd.basename = "tilt_table";
+    vd.time_stride = o->vtk_every;
+    vd.frame_stride = o->vtk_stride;
+    vd.springs = o->vtk_springs;
+    vd.format = o->vtk_ascii ? WS_VTK_ASCII : WS_VTK_COMPRESSED;
     if (o->vtk_dir && make_dirs(o->vtk_dir) != 0) {
         snprintf(res->error, sizeof res->error, "cannot create the directory %s: %s",
                  o->vtk_dir, strerror(errno));
         s = WS_ERR_IO;
-    } else if (o->vtk_dir && (s = ws_vtk_series_create(w, o->vtk_dir, "tilt_table", &vtk)) != WS_OK) {
+    } else if (o->vtk_dir && (s = ws_vtk_series_create_def(w, &vd, &vtk)) != WS_OK) {
         snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
     }
     if (s != WS_OK) {
@@ -504,7 +526,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     }
 
     long steps = lround(sc.duration / sc.dt);
-    long csv_every = lround(0.01 / sc.dt), vtk_every = lround(0.05 / sc.dt);
+    long csv_every = lround(0.01 / sc.dt);
     ws_vec3 start[2];
     for (int k = 0; k < 2; k++) {
         ws_vec3 r;
@@ -633,7 +655,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                     t, DEG(theta), r[0].x, r[0].y, r[0].z, v[0].x, v[0].y, v[0].z, DEG(tilt[0]),
                     slip[0], r[1].x, r[1].y, r[1].z, v[1].x, v[1].y, v[1].z, DEG(tilt[1]),
                     slip[1], distance(w, sc.box[0], sc.box[1]));
-        if (vtk && n % vtk_every == 0 && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
+        /* Offered every step: the series' strides choose the frames. */
+        if (vtk && (s = ws_vtk_series_write_frame(vtk)) != WS_OK)
             break;
         /* The end, or a box left the platform: the world has no floor, so it would only fall. */
         if (n == steps || off) {
@@ -685,7 +708,11 @@ static void usage(FILE *f)
             "  --substeps N       film sub-steps per step (1..1000; default 1)\n"
             "  --duration S       simulated time, s (> 0; default 6 for P, 7 for R)\n"
             "  --csv FILE         time series every 10 ms\n"
-            "  --vtk DIR          VTK frames every 50 ms for ParaView (DIR is created)\n"
+            "  --vtk DIR          VTK frames for ParaView (DIR is created)\n"
+            "  --vtk-every S      s between frames (>= 0; default 0.1; 0: every --vtk-stride)\n"
+            "  --vtk-stride N     offer a frame every Nth step (>= 1; default 1)\n"
+            "  --vtk-springs      the film's springs as a block of their own\n"
+            "  --vtk-ascii        ASCII files instead of compressed binary\n"
             "  --no-ccd           without the libccd gate\n"
             "  --paper-integrator the paper's explicit scheme\n"
             "  --quiet            no progress, no summary\n"
@@ -730,7 +757,8 @@ int main(int argc, char **argv)
     tilt_options o;
     tilt_default_options(&o);
     enum { O_VARIANT = 1, O_STICK, O_NO_CCD, O_PAPER, O_CSV, O_VTK, O_DURATION, O_QUIET,
-           O_WRAPPED, O_FILM_MASS, O_SUBSTEPS, O_HELP };
+           O_WRAPPED, O_FILM_MASS, O_SUBSTEPS, O_HELP, O_VTK_EVERY, O_VTK_STRIDE, O_VTK_SPRINGS,
+           O_VTK_ASCII };
     static const struct option longopts[] = {
         {"variant", required_argument, NULL, O_VARIANT},
         {"stick", no_argument, NULL, O_STICK},
@@ -738,6 +766,10 @@ int main(int argc, char **argv)
         {"paper-integrator", no_argument, NULL, O_PAPER},
         {"csv", required_argument, NULL, O_CSV},
         {"vtk", required_argument, NULL, O_VTK},
+        {"vtk-every", required_argument, NULL, O_VTK_EVERY},
+        {"vtk-stride", required_argument, NULL, O_VTK_STRIDE},
+        {"vtk-springs", no_argument, NULL, O_VTK_SPRINGS},
+        {"vtk-ascii", no_argument, NULL, O_VTK_ASCII},
         {"duration", required_argument, NULL, O_DURATION},
         {"quiet", no_argument, NULL, O_QUIET},
         {"wrapped", no_argument, NULL, O_WRAPPED},
@@ -761,6 +793,27 @@ int main(int argc, char **argv)
         case O_PAPER: o.paper_integrator = 1; break;
         case O_CSV: o.csv = optarg; break;
         case O_VTK: o.vtk_dir = optarg; break;
+        case O_VTK_SPRINGS: o.vtk_springs = 1; break;
+        case O_VTK_ASCII: o.vtk_ascii = 1; break;
+        case O_VTK_EVERY: {
+            char *end;
+            errno = 0;
+            o.vtk_every = strtod(optarg, &end);
+            if (end == optarg || *end != '\0' || errno == ERANGE || !isfinite(o.vtk_every) ||
+                o.vtk_every < 0) {
+                fprintf(stderr, "tilt_table: --vtk-every must be a number >= 0, got '%s'\n",
+                        optarg);
+                return 2;
+            }
+            break;
+        }
+        case O_VTK_STRIDE:
+            if (!positive("--vtk-stride", optarg, &x) || x != floor(x) || x > 1e9) {
+                fprintf(stderr, "tilt_table: --vtk-stride must be a whole number >= 1\n");
+                return 2;
+            }
+            o.vtk_stride = (int)x;
+            break;
         case O_QUIET: o.quiet = 1; break;
         case O_WRAPPED: o.wrapped = 1; break;
         case O_DURATION:

@@ -832,6 +832,249 @@ START_TEST(test_impact_comes_to_rest)
 }
 END_TEST
 
+/* ---- bodies against the stable step, and the energy guard ---- */
+
+static const ws_vec3 V0 = {0, 0, 0};
+
+/* A cube of side 0.2 m and mass m on a static slab, its layers overlapping by 0.1 mm (or lifted
+ * by `lift` m), in a world of step dt whose default pair is (k, 10 kg/s). */
+static ws_world *cube_on_slab(double dt, double k, double m, double lift, ws_body_id *cube)
+{
+    ws_contact_def cd = contact_params(k, 10.0, 0.3, WS_FRICTION_REGULARIZED);
+    ws_world *w = contact_world(dt, &cd);
+    make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.1, 0, (ws_vec3){0, 0, -0.05}, Q_ID, V0, "slab");
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &s));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = s;
+    bd.mass = m;
+    bd.position = (ws_vec3){0, 0, 0.1 + 0.0019 + lift}; /* layers 1 mm each */
+    bd.name = "cube";
+    ck_ok(w, ws_body_create(w, &bd, cube));
+    return w;
+}
+
+/* The number after `key` in msg (NaN when absent). */
+static double number_after(const char *msg, const char *key)
+{
+    const char *p = strstr(msg, key);
+    return p ? strtod(p + strlen(key), NULL) : NAN;
+}
+
+START_TEST(test_stiff_contact_refused_with_advice)
+{
+    /* The runaway of a 12 kg box on a slab at 1e12 N/m and the default dt (0.25 ms): it was
+     * launched at 50 m/s with WS_OK. The bound: omega^2 = 8 k / m (8 contacts), damping
+     * negligible: stable step 2 / sqrt(8e12 / 12) = 2.449e-6 s, 100 times below dt. */
+    ws_body_id cube;
+    ws_world *w = cube_on_slab(2.5e-4, 1e12, 12.0, 0.0, &cube);
+    double S, S_exp = 2.0 / sqrt(8e12 / 12.0);
+    ck_ok(w, ws_world_estimate_stable_dt(w, &S));
+    ck_assert_double_eq_tol(S, S_exp, 1e-3 * S_exp); /* the damping's share is 1e-5 */
+    uint64_t h0, h1;
+    ck_ok(w, ws_world_get_state_hash(w, &h0));
+    ck_assert_int_eq(ws_world_step(w), WS_ERR_NUMERICAL);
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", ws_world_last_error(w));
+    report("1e12 N/m on 12 kg: \"%s\"", msg);
+    ck_ok(w, ws_world_get_state_hash(w, &h1));
+    ck_assert(h0 == h1); /* refused before the step: nothing changed */
+    /* The advice names the pair, its stiffness, the masses, the stable step and the fixes. */
+    ck_assert_msg(strstr(msg, "1e+12 N/m") && strstr(msg, "'cube' (12 kg)") &&
+                      strstr(msg, "'slab' (kinematic)") && strstr(msg, "2.45e-06 s"),
+                  "%s", msg);
+    double dt_adv = number_after(msg, "Use dt <= "), k_adv = number_after(msg, "stiffness <= ");
+    ck_assert_msg(dt_adv <= S && dt_adv >= 0.99 * S, "advised dt %g, stable %g", dt_adv, S);
+    /* The stiffness that would do at dt: K = n k with 4 m K >= (dt K + C)^2 - C^2, about
+     * 4 m / (8 dt^2) = 9.6e7 N/m less the damping's share. */
+    ck_assert_msg(k_adv > 0.9 * 4 * 12.0 / (8 * 2.5e-4 * 2.5e-4) && k_adv < 9.6e7, "advised k %g",
+                  k_adv);
+    /* Both pieces of advice work: the named dt runs, and so does the named stiffness. */
+    ck_ok(w, ws_world_set_dt(w, dt_adv));
+    ck_ok(w, ws_world_step_n(w, 100));
+    ck_ok(w, ws_world_set_dt(w, 1.01 * S)); /* just past the bound: refused */
+    ck_assert_int_eq(ws_world_step(w), WS_ERR_NUMERICAL);
+    ck_ok(w, ws_world_set_dt(w, 2.5e-4));
+    ws_contact_def cd = contact_params(k_adv, 10.0, 0.3, WS_FRICTION_REGULARIZED);
+    ck_ok(w, ws_world_set_default_contact(w, &cd));
+    ck_ok(w, ws_world_step_n(w, 100));
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_stiff_but_stable_runs)
+{
+    /* Stiff but stable: the same cube at dt = 0.7 of its bound (k = 0.49 x 4 m / (8 dt^2) =
+     * 4.7e7 N/m at 0.25 ms), dropped from 2 mm above the touching layers, lightly damped (10
+     * kg/s, damping ratio 4e-4). Not refused, the energy guard does not fire on its bounces,
+     * and its energy does not grow: explicit penalty impacts change the energy at each bounce by
+     * up to r / (1 - r) of the impact energy m g h (r = omega dt / 2 <= 0.7 for the stiffest
+     * mode, modified-energy argument, docs/theory.md section 8) but do not pump it up: the
+     * largest excess over the start in the last quarter of 2 s is no more than in the first,
+     * and all of it within 2.5 m g h. (At 0.9 of the bound the same drop gains about 1 J a
+     * second: impacts that close to the limit pump energy; runs belong well inside it.) */
+    const double dt = 2.5e-4, k = 0.49 * 4 * 12.0 / (8 * dt * dt), mgh = 12.0 * G0 * 0.002;
+    ws_body_id cube;
+    ws_world *w = cube_on_slab(dt, k, 12.0, 0.0021, &cube);
+    double S;
+    ck_ok(w, ws_world_estimate_stable_dt(w, &S));
+    report("stiff but stable: k = %.3g N/m, dt / stable step = %.3f", k, dt / S);
+    ck_assert(dt < S && dt > 0.69 * S);
+    ws_energy e0, e;
+    ck_ok(w, ws_world_get_energy(w, &e0));
+    const int n = 8000;
+    double E0 = e0.kinetic + e0.potential + e0.contact, first = -INFINITY, last = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        ck_ok(w, ws_world_step(w));
+        ck_ok(w, ws_world_get_energy(w, &e));
+        double x = e.kinetic + e.potential + e.contact - E0;
+        if (i < n / 4)
+            first = fmax(first, x);
+        if (i >= n - n / 4)
+            last = fmax(last, x);
+    }
+    report("energy excess over the start: first quarter %.4g J, last quarter %.4g J (m g h = "
+           "%.4g J)",
+           first, last, mgh);
+    ck_assert_msg(last <= first + 1e-9 && first <= 2.5 * mgh, "energy excess %g J then %g J", first,
+                  last);
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_energy_guard_without_speed_limit)
+{
+    /* A runaway the mass-based bound cannot see: the cube's inertia given 1e-4 of a solid
+     * cube's (8e-6 kg m^2), so its rocking on the 4 corners (omega^2 ~ k r^2 / J ~ 1e9 / s^2,
+     * omega dt ~ 8) is unstable at dt = 0.25 ms while its bouncing (omega dt = 0.08) is not.
+     * With the speed and spin limits off, only the energy guard can stop it: the step whose
+     * kinetic energy jumps past the allowance fails, names it, and leaves the world as it was,
+     * long before anything overflows (the kinetic energy still below 1 kJ). */
+    ws_world_def wd;
+    ws_world_def_init(&wd);
+    ck_assert(wd.dt == 2.5e-4);
+    ws_mat3 J = {{8e-6, 0, 0, 0, 8e-6, 0, 0, 0, 8e-6}};
+    ws_body_id cube;
+    ws_world *w = NULL;
+    ws_contact_def cd = contact_params(2e5, 10.0, 0.3, WS_FRICTION_REGULARIZED);
+    wd.max_speed = INFINITY;
+    wd.max_angular_speed = INFINITY;
+    ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+    ck_ok(w, ws_world_set_default_contact(w, &cd));
+    make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.1, 0, (ws_vec3){0, 0, -0.05}, Q_ID, V0, "slab");
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &s));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = s;
+    bd.mass = 12.0;
+    bd.inertia = J;
+    bd.position = (ws_vec3){0, 0, 0.1 + 0.0019};
+    bd.angular_velocity = (ws_vec3){0.01, 0, 0};
+    bd.name = "cube";
+    ck_ok(w, ws_body_create(w, &bd, &cube));
+    ws_status st = WS_OK;
+    int k;
+    ws_energy e = {0, 0, 0};
+    for (k = 0; k < 2000 && st == WS_OK; k++) {
+        ck_ok(w, ws_world_get_energy(w, &e));
+        st = ws_world_step(w);
+    }
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", ws_world_last_error(w));
+    uint64_t h0, h1;
+    ck_ok(w, ws_world_get_state_hash(w, &h0));
+    ck_assert_int_eq(ws_world_step(w), WS_ERR_NUMERICAL); /* and again: the world as it was */
+    ck_ok(w, ws_world_get_state_hash(w, &h1));
+    ws_world_stats stats;
+    ck_ok(w, ws_world_get_stats(w, &stats));
+    ws_world_destroy(w);
+    report("small inertia: failed at step %d, kinetic energy then %.3g J: \"%s\"", k, e.kinetic,
+           msg);
+    ck_assert_int_eq(st, WS_ERR_NUMERICAL);
+    ck_assert_msg(strstr(msg, "runaway energy"), "%s", msg);
+    ck_assert_msg(isfinite(e.kinetic) && e.kinetic < 1e3, "kinetic energy %g J", e.kinetic);
+    ck_assert(h0 == h1);
+    ck_assert(stats.numerical_errors == 2);
+}
+END_TEST
+
+/* A stack of two 0.25 m, 5 kg cubes on a plane tilting at 0.1 rad/s from t = 1 s (ramp
+ * 0.05 s), stick friction mu = 0.3 with the given absolute tangential damping (0: the default
+ * ratio), run until theta = 0.9 atan(mu) (15.0 deg). Out: the most contacts flagged slipping in
+ * a step, the contact-steps at the friction cap, and the rocking: the largest difference between
+ * the top box's spin about the tilt axis and the plane's, from 1.5 s after the tilt started
+ * (its start, 2 rad/s^2 for 50 ms, shakes the stack; the normal contacts, 1 % of critical,
+ * take that long to calm it). */
+static void tilting_stack(double stick_damping, int *most_slipping, int *capped, double *rock)
+{
+    const double a = 0.25, m = 5.0, dt = 2.5e-4, rate = 0.1, t0 = 1.0;
+    ws_contact_def cd = contact_params(2e5, 10.0, 0.3, WS_FRICTION_STICK);
+    cd.stick_damping = stick_damping;
+    ws_world *w = contact_world(dt, &cd);
+    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
+                                v3(0, 0, 0), "plane");
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_TILT;
+    dd.axis = v3(0, 1, 0);
+    dd.rate = rate;
+    dd.start_time = t0;
+    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    double gap = 2 * DELTA - m * G0 / (4 * 2e5);
+    make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID, v3(0, 0, 0), "bottom");
+    ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 2 * gap), Q_ID,
+                              v3(0, 0, 0), "top");
+    const double theta_end = 0.9 * atan(0.3);
+    const long steps = lround((t0 + theta_end / rate) / dt);
+    ws_contact_info buf[64];
+    *most_slipping = *capped = 0;
+    *rock = 0.0;
+    for (long k = 1; k <= steps; k++) {
+        ck_ok(w, ws_world_step(w));
+        size_t n;
+        ck_ok(w, ws_world_copy_contacts(w, buf, 64, &n));
+        int sl = 0;
+        for (size_t i = 0; i < n; i++) {
+            sl += buf[i].slipping != 0;
+            *capped += buf[i].at_cap != 0;
+        }
+        *most_slipping = sl > *most_slipping ? sl : *most_slipping;
+        ws_vec3 om;
+        ck_ok(w, ws_body_get_angular_velocity(w, top, &om));
+        if (k * dt > t0 + 1.5)
+            *rock = fmax(*rock, fabs(om.y - rate));
+    }
+    ws_world_destroy(w);
+}
+
+START_TEST(test_stick_stack_settles_on_tilt)
+{
+    /* Below the onset tan(theta) = mu nothing slides: no contact may flag slipping (sliding,
+     * the anchor moving with a slip of v_lim or more), though the friction may touch its cap
+     * for a step (at_cap, counted and reported; before slipping and at_cap were told apart,
+     * every such step flagged slipping). Nor may the stack rock: a stack at rest on the plane
+     * turns with it at 0.1 rad/s; the bound on the top box's spin about that is 5 % of the rate,
+     * 0.005 rad/s. The default anchor damping (critical for a box on its 4 corners) keeps it
+     * to 0.0006; the old default, 10 kg/s (about 1 % of that), rocks at 0.027, which shows the
+     * scene tells them apart. */
+    int most, capped;
+    double rock;
+    tilting_stack(0.0, &most, &capped, &rock);
+    report("stick stack, default damping: most slipping %d, capped %d, rocking %.3g rad/s", most,
+           capped, rock);
+    ck_assert_int_eq(most, 0);
+    ck_assert_msg(rock < 0.005, "the top box rocks: spin %g rad/s off the plane's", rock);
+    int most10, capped10;
+    double rock10;
+    tilting_stack(10.0, &most10, &capped10, &rock10);
+    report("stick stack, 10 kg/s: most slipping %d, capped %d, rocking %.3g rad/s", most10,
+           capped10, rock10);
+    ck_assert_msg(rock10 > 0.01, "the old damping did not rock here (%g rad/s)", rock10);
+}
+END_TEST
+
 /* ======================================================================================== */
 /* Contact geometry: interface stiffness, reports by pair, the layers in the reference stack  */
 /* ======================================================================================== */
@@ -1087,6 +1330,14 @@ static Suite *contact_suite(void)
     tc = tcase_create("impact");
     tcase_set_timeout(tc, 20);
     tcase_add_test(tc, test_impact_comes_to_rest);
+    suite_add_tcase(s, tc);
+
+    tc = tcase_create("stability");
+    tcase_set_timeout(tc, 20);
+    tcase_add_test(tc, test_stiff_contact_refused_with_advice);
+    tcase_add_test(tc, test_stiff_but_stable_runs);
+    tcase_add_test(tc, test_energy_guard_without_speed_limit);
+    tcase_add_test(tc, test_stick_stack_settles_on_tilt);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -311,6 +311,20 @@ static int spin_and_jump(void *user, double t, ws_pose *pose, ws_vec3 *v, ws_vec
 /* A 0.25 m cube wrapped in a band of film (24 x 6 nodes) on a platform that tilts at 1 rad/s
  * from the start: the film snaps on, the platform turns the stack, and from about 0.29 s
  * (tan 16.7 deg = 0.3) box and film slide down it together. */
+
+/* Sub-steps that let a web run at the world's dt within the default safety factor of its
+ * stable step (world.h: stable_fraction). */
+static void fit_substeps(ws_world *w, ws_web_id web)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    double S, dt;
+    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    ck_ok(w, ws_world_get_dt(w, &dt));
+    int n = (int)ceil(dt / (d.stable_fraction * S));
+    ck_ok(w, ws_web_set_substeps(w, web, n < 1 ? 1 : n));
+}
+
 static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
 {
     ws_world_def d;
@@ -413,7 +427,7 @@ static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
         sd.shear = 1;
         wd.law_shear = law;
         ck_ok(w, ws_web_create_sheet(w, &wd, &sd, web));
-        ck_ok(w, ws_web_set_substeps(w, *web, 2)); /* the shear springs need it */
+        fit_substeps(w, *web); /* the shear springs need 2 */
         return w;
     }
     ws_band_def bdf;
@@ -427,6 +441,7 @@ static ws_world *wrapped_world(int kind, ws_web_id *web, ws_body_id *box)
     bdf.prestretch_around = 0.3;
     bdf.prestretch_up = 0.1;
     ck_ok(w, ws_web_create_band(w, &wd, &bdf, web));
+    fit_substeps(w, *web); /* 2 within the default safety factor */
     return w;
 }
 

@@ -29,8 +29,9 @@ typedef struct golden {
 static const golden table[] = {
     {'P', 0, 1, 24000, 0x18046ff93a247f35ull, 4000, 0x3fe9381be67d2471ull},
     {'R', 0, 1, 28000, 0x9a09ce79d7e3ea87ull, 4000, 0xf83061787ded36efull},
-    {'P', 1, 1, 4000, 0x0dea2fe20ef29448ull, 400, 0x035c1cc5f121f232ull},
-    {'R', 1, 1, 4000, 0x68291693c4643dabull, 400, 0xd3b702663551a686ull},
+    /* Wrapped: 2 film sub-steps since the film's safety factor (CHANGELOG). */
+    {'P', 1, 1, 4000, 0x863331870c29437dull, 400, 0x4fc51f0ebd24b40eull},
+    {'R', 1, 1, 4000, 0xa4aa3fdd11cc206eull, 400, 0x168fb9dbde423dffull},
     /* The same without the gate: the same hashes. */
     {'P', 0, 0, 24000, 0x18046ff93a247f35ull, 4000, 0x3fe9381be67d2471ull},
     {'R', 0, 0, 28000, 0x9a09ce79d7e3ea87ull, 4000, 0xf83061787ded36efull},

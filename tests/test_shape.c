@@ -291,6 +291,18 @@ static void expect_rejected(ws_world *w, const double *v, size_t nv, const uint3
     ck_assert_msg(st == want, "expected %s ('%s'), got %s (%s)", ws_status_string(want), word,
                   ws_status_string(st), ws_world_last_error(w));
     ck_err_has(w, word);
+    /* A refused mesh says what to do about it, and the text ends with that hint (or with the
+     * reason), not with stray digits of a format's padding arguments. */
+    const char *e = ws_world_last_error(w);
+    size_t n = strlen(e);
+    if (want == WS_ERR_BAD_MESH && strstr(e, "triangles, got") == NULL &&
+        strstr(e, "does not exist") == NULL) {
+        ck_err_has(w, "repair");
+        ck_assert_msg(e[n - 1] == ')', "error does not end with its hint: '%s'", e);
+    }
+    if (want == WS_ERR_INVALID_ARGUMENT)
+        ck_assert_msg(n > strlen(word) && strcmp(e + n - strlen(word), word) == 0,
+                      "error does not end with '%s': '%s'", word, e);
     ck_assert_int_eq(ws_shape_is_valid(w, s), 0);
     /* Whatever was allocated for the checks was given back. */
     ck_ok(w, ws_world_get_stats(w, &after));
@@ -307,6 +319,15 @@ START_TEST(test_rejected_meshes)
 
     /* Open: the last triangle removed. */
     expect_rejected(w, cube_v, 8, cube_t, 11, WS_ERR_BAD_MESH, "closed");
+
+    /* Open, named by the edge the removed triangle left. */
+    expect_rejected(w, cube_v, 8, cube_t, 11, WS_ERR_BAD_MESH, "edge (");
+
+    /* Non-manifold: a triangle listed twice puts three triangles on each of its edges. */
+    memcpy(t, cube_t, sizeof cube_t);
+    memcpy(t + 36, cube_t, 3 * sizeof *cube_t);
+    expect_rejected(w, cube_v, 8, t, 13, WS_ERR_BAD_MESH, "not manifold");
+    ck_err_has(w, "belongs to 3 triangles");
 
     /* One triangle flipped: its edges run the same way as their neighbours'. */
     memcpy(t, cube_t, sizeof cube_t);

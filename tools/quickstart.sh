@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
-# Build libwrapsim from a fresh Debian machine and run the tilt-table example or every test.
+# Build libwrapsim from a fresh Debian machine and run a load test, the C example or every test.
 #
-#   tools/quickstart.sh example [ARGS...]   install, build, run build/examples/tilt_table ARGS
+#   tools/quickstart.sh example [LOAD] [ARGS...]
+#                                           install, build the Python package into .venv/, and
+#                                           run `wrapsim run LOAD -o wrapsim-out ARGS`: a load
+#                                           file through its test, printing the verdict
+#                                           (default examples/loads/eur_pallet_eumos.json)
+#   tools/quickstart.sh tilt [ARGS...]      install, build, run build/examples/tilt_table ARGS
 #   tools/quickstart.sh test [ARGS...]      install, build, meson test ARGS, then the Python
 #                                           binding's pytest suite; last line
 #                                           "N passed, N failed" over both
@@ -23,7 +28,7 @@ usage() {
 mode=$1
 shift
 case $mode in
-example | test) ;;
+example | tilt | test) ;;
 -h | --help) usage 0 ;;
 *) usage ;;
 esac
@@ -35,17 +40,33 @@ source tools/count_tests.sh
 # shellcheck source=tools/ensure_packages.sh
 source tools/ensure_packages.sh
 
-packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev)
+packages=(gcc libc6-dev meson ninja-build pkg-config check libccd-dev zlib1g-dev)
 python_tests=0
+if [[ $mode == example ]]; then
+    packages+=(python3 python3-venv python3-mesonpy python3-numpy python3-matplotlib python3-tqdm)
+fi
 if [[ $mode == test ]]; then
     packages+=(valgrind)
     if [[ ${WS_PYTHON_TESTS:-1} != 0 ]]; then
         python_tests=1
         packages+=(python3 python3-numpy python3-pytest python3-tqdm python3-matplotlib
-            python3-distributed python3-yaml python3-jsonschema chromium)
+            python3-distributed python3-yaml python3-jsonschema python3-meshio chromium)
     fi
 fi
 ensure_packages "${packages[@]}"
+
+if [[ $mode == example ]]; then
+    load=examples/loads/eur_pallet_eumos.json
+    if (($# >= 1)) && [[ $1 != -* ]]; then
+        load=$1
+        shift
+    fi
+    # The Python package, with the library built inside it, in a venv that sees Debian's
+    # numpy and meson-python (offline: no build isolation).
+    [[ -x .venv/bin/pip ]] || /usr/bin/python3 -m venv --system-site-packages .venv
+    .venv/bin/pip install --quiet --no-build-isolation .
+    exec .venv/bin/wrapsim run "$load" -o wrapsim-out "$@"
+fi
 
 read -r -a extra <<<"${MESON_EXTRA:-}"
 if [[ -f build/meson-private/coredata.dat ]]; then
@@ -55,7 +76,7 @@ else
 fi
 meson compile -C build
 
-if [[ $mode == example ]]; then
+if [[ $mode == tilt ]]; then
     exe=build/examples/tilt_table
     if [[ ! -x $exe ]]; then
         echo "$exe was not built (is examples/tilt_table.c there?)" >&2

@@ -65,7 +65,7 @@ LIFT_HOLD = 0.05  # s: the uphill edge must stay off this long to count as tippi
 STOP_EDGE = (-0.01, 0.0, 0.01)  # the stop's top uphill edge in the 20 x 20 mm bar's frame, m
 
 
-def build(variant, wrapped, film_mass=1e-3, substeps=1):
+def build(variant, wrapped, film_mass=1e-3, substeps=2):
     """The scene of examples/tilt_table.c (tilt_build + tilt_wrap). Returns a dict."""
     w = ws.World(dt=DT, full_detection_until=0.5, detection_interval=5)
     box_mat, plane_mat = w.material("cardboard"), w.material("platform")

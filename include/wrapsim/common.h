@@ -132,7 +132,8 @@ WS_API const char *ws_version_string(void);
 
 /** Optional features built in. */
 enum {
-    WS_FEATURE_CCD = 1 /**< libccd narrow-phase gate available */
+    WS_FEATURE_CCD = 1, /**< libccd narrow-phase gate available */
+    WS_FEATURE_ZLIB = 2 /**< zlib-compressed VTK output (WS_VTK_COMPRESSED) available */
 };
 /** Bit set of WS_FEATURE_* compiled into this library. */
 WS_API unsigned ws_build_features(void);

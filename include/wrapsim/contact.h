@@ -40,7 +40,18 @@ typedef struct ws_contact_info {
     ws_vec3 friction_force; /**< N, tangential */
     ws_vec3 slip_velocity;  /**< tangential velocity of b relative to a, m/s */
     int32_t kind;           /**< ws_contact_kind */
-    int32_t slipping;       /**< 1 if |v_t| >= v_lim (regularised) or the anchor slid (stick) */
+    /** 1 when sliding: |v_t| >= v_lim, under either law (stick: the friction at its cap and
+     *  the anchor moving with the slip, not merely held at the cap for a step). */
+    int32_t slipping;
+    /** 1 when the friction force is at its cap mu N in this step (regularised: |v_t| >= v_lim;
+     *  stick: the anchor spring's force was capped and the anchor moved), whether or not the
+     *  contact is sliding. */
+    int32_t at_cap;
+    int32_t reserved_;      /**< zero */
+    /** Stick model: the anchor spring's tangential deflection, point of b minus its anchor on
+     *  a, m (its force is -stick_stiffness times it, before damping); zero for the regularised
+     *  law. */
+    ws_vec3 anchor_deflection;
 } ws_contact_info;
 
 /** Number of active contacts after the last step. */

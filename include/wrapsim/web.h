@@ -59,7 +59,8 @@ typedef struct ws_sheet_def {
     ws_vec3 axis_y;          /**< direction of the grid's y (normalised); default y */
     double spacing_x;        /**< node spacing along x as placed, m (> 0) */
     double spacing_y;        /**< node spacing along y as placed, m (> 0) */
-    double prestretch_x;     /**< rest length = spacing / (1 + prestretch) (> -1), along x */
+    double prestretch_x;     /**< rest length = spacing / (1 + prestretch), along x; > -1 and
+                                  <= 10 (1000 %) */
     double prestretch_y;     /**< the same along y */
     int shear;               /**< 1: add both diagonals of every cell */
     const uint32_t *pinned;  /**< node indices (i + nx j) held fixed; may be NULL */
@@ -78,8 +79,8 @@ typedef struct ws_band_def {
     double z_top;             /**< highest row, global z, m */
     int n_around;             /**< nodes around (>= 3) */
     int n_up;                 /**< rows (>= 1) */
-    double prestretch_around; /**< e.g. 0.4 */
-    double prestretch_up;     /**< e.g. 0.2 */
+    double prestretch_around; /**< e.g. 0.4: rest length = spacing / (1 + it); > -1, <= 10 */
+    double prestretch_up;     /**< e.g. 0.2; > -1, <= 10 */
     double gap;               /**< extra distance beyond the touching layers, m; default 0 */
     int shear;                /**< 1: add the diagonals */
 } ws_band_def;

@@ -68,6 +68,11 @@ typedef struct ws_world_def {
     ws_log_fn log;          /**< optional log hook; NULL for none */
     void *log_user;         /**< passed to log */
     void *user_data;        /**< yours; see ws_world_get_user_data() */
+    /** Safety factor of the film's stable-step check: a web runs only while dt / substeps <=
+     *  stable_fraction x its stable sub-step (ws_web_get_stable_dt), the bound's margin against
+     *  what it does not see (a film crumpling, nodes sliding off edges, laws stiffer than they
+     *  state). 0 < it <= 1; default 0.5 (docs/theory.md, section 8). */
+    double stable_fraction;
     /** Workers a step may use, 1 (default) to WS_MAX_WORKERS. With more than one the film is
      *  stepped in parallel; the results are the same to the bit for any count. */
     uint32_t worker_count;
@@ -102,7 +107,16 @@ typedef struct ws_contact_def {
     double friction_vlim; /**< regularisation speed v_lim, m/s (> 0); default 0.01 */
     ws_friction_model friction_model; /**< default WS_FRICTION_REGULARIZED */
     double stick_stiffness; /**< tangential spring of the stick model, N/m; default 2e5 */
-    double stick_damping;   /**< tangential damping of the stick model, kg/s; default 10 */
+    /** Tangential damping of the stick model, kg/s per contact point, when > 0 (releases
+     *  up to 0.1.0 defaulted to 10, about 1 % of critical for 5 kg boxes: set 10 to reproduce
+     *  them). Default 0: from stick_damping_ratio. */
+    double stick_damping;
+    /** With stick_damping 0: the tangential damping as a fraction of critical for the pair,
+     *  c = ratio sqrt(stick_stiffness m), m = m_a m_b / (m_a + m_b) of the two bodies (the
+     *  dynamic one's mass against a kinematic body): critical for one of the 4 corner contacts
+     *  of a box face carrying a quarter of m is 2 sqrt(k m / 4). Default 1 (critical for a box
+     *  swaying on its 4 corners); >= 0, <= 10. */
+    double stick_damping_ratio;
 } ws_contact_def;
 
 /** A material: only a name for now; contact parameters belong to pairs of materials. */
@@ -131,7 +145,13 @@ typedef struct ws_world_stats {
     double seconds_contacts;   /**< evaluating body-body contacts */
     double seconds_web;        /**< film: springs, node contacts, node integration */
     double seconds_total;      /**< whole steps */
-    uint64_t reserved[4];      /**< zero; room to grow */
+    /** The largest fraction of a web's stable sub-step that dt / substeps uses (0 without
+     *  webs); a web runs while it is <= ws_world_def.stable_fraction. */
+    double web_step_use;
+    /** dt as a fraction of the bodies' contact stable step (ws_world_estimate_stable_dt without
+     *  the elements; 0 when no two bodies can touch); refused above 1. */
+    double body_step_use;
+    uint64_t reserved[2];      /**< zero; room to grow */
 } ws_world_stats;
 
 /** Mechanical energy of the dynamic bodies, J. */
@@ -176,6 +196,10 @@ WS_API void ws_world_destroy(ws_world *world);
 
 /** Advance one step dt. On WS_ERR_NUMERICAL (or a callback error) the world is left exactly as it
  *  was before the call and ws_world_last_error() says which body and what to change.
+ *  WS_ERR_NUMERICAL: a dt above the bodies' contact stable step (refused before the step), a
+ *  web's sub-step above its stable step, NaN or inf, a speed above max_speed, or runaway energy
+ *  (the bodies' kinetic energy growing in a step by more than the loads' work plus ten times
+ *  the kinetic and contact energy at its start).
  *  Callbacks run inside a step (drives, laws, the log hook) may read the world with any getter;
  *  every call that changes it (create, destroy, set, step) returns WS_ERR_IN_STEP there. */
 WS_API ws_status ws_world_step(ws_world *world);
@@ -186,6 +210,9 @@ WS_API ws_status ws_world_step_n(ws_world *world, int64_t steps);
 WS_API ws_status ws_world_get_time(const ws_world *world, double *time);
 /** Time step, s. */
 WS_API ws_status ws_world_get_dt(const ws_world *world, double *dt);
+/** The film's stable-step safety factor (ws_world_def.stable_fraction): a web runs while
+ *  dt / substeps <= it x ws_web_get_stable_dt. */
+WS_API ws_status ws_world_get_stable_fraction(const ws_world *world, double *fraction);
 /** Change the time step (s, > 0) between steps. */
 WS_API ws_status ws_world_set_dt(ws_world *world, double dt);
 /** Gravity, m/s^2. */
@@ -207,10 +234,11 @@ WS_API const char *ws_world_last_error(const ws_world *world);
 WS_API void *ws_world_get_user_data(const ws_world *world);
 
 /** Estimate the largest stable dt (s) for the bodies and contact pairs now in the world: the
- *  explicit limit 2/omega of the stiffest contact on the lightest body, with a safety factor for
- *  several simultaneous contacts (see docs/theory.md), and of the deformable elements on the
- *  bodies they join (docs/elements.md). Films are not counted here: each web has its own
- *  sub-step limit, ws_web_get_stable_dt(). */
+ *  explicit limit 2/omega of each pair of materials that bodies have, on the lightest such
+ *  pair's effective mass, counting 8 simultaneous contacts (see docs/theory.md), and of the
+ *  deformable elements on the bodies they join (docs/elements.md). ws_world_step refuses a dt
+ *  above the contact part of it (WS_ERR_NUMERICAL, naming the pair and the fix). Films are not
+ *  counted here: each web has its own sub-step limit, ws_web_get_stable_dt(). */
 WS_API ws_status ws_world_estimate_stable_dt(const ws_world *world, double *dt);
 
 /** The material every body has unless its Def names another. */

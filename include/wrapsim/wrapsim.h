@@ -15,5 +15,6 @@
 #include <wrapsim/web.h>
 #include <wrapsim/element.h>
 #include <wrapsim/io.h>
+#include <wrapsim/loadtest.h>
 
 #endif

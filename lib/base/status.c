@@ -33,9 +33,12 @@ const char *ws_version_string(void)
 
 unsigned ws_build_features(void)
 {
+    unsigned features = 0;
 #ifdef WS_HAVE_CCD
-    return WS_FEATURE_CCD;
-#else
-    return 0;
+    features |= WS_FEATURE_CCD;
 #endif
+#ifdef WS_HAVE_ZLIB
+    features |= WS_FEATURE_ZLIB;
+#endif
+    return features;
 }

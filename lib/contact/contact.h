@@ -36,16 +36,26 @@ typedef struct ws_cand {
 
 /* An active contact of the last step. Normal from a to b; forces those on b. */
 typedef struct ws_contact_rec {
-    uint32_t a, b, kind, slipping;
-    v3 x, n, ft, vt;
+    uint32_t a, b, kind, slipping, at_cap;
+    v3 x, n, ft, vt, defl;
     double overlap, fn, energy;
+    double energy_t; /* the stick anchor spring's, J (0 for the regularised law) */
 } ws_contact_rec;
 
 /* Contact parameters resolved for evaluation. */
 typedef struct ws_pair_params {
     double k, c, mu, vlim, kt, ct;
     int model;
+    double zt; /* stick damping ratio, used when ct is 0 */
 } ws_pair_params;
+
+/* The stick model's tangential damping for a pair of bodies of effective mass m_eff (kg; the
+ * dynamic one's mass against a kinematic body): the absolute one when set, else the ratio of
+ * critical, zt sqrt(kt m_eff) (world.h). */
+static inline double ws_stick_damping(const ws_pair_params *p, double m_eff)
+{
+    return p->ct > 0.0 ? p->ct : p->zt * sqrt(p->kt * m_eff);
+}
 
 /* Everything a contact evaluation reads. */
 typedef struct ws_contact_ctx {

@@ -35,7 +35,9 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     v3 vt = v3_madd(vrel, n, -vn);
     double vts = v3_norm(vt);
     v3 ft = v3_make(0, 0, 0);
-    int slipping = 0;
+    int slipping = 0, at_cap = 0;
+    double energy_t = 0.0;
+    v3 defl = v3_make(0, 0, 0);
     if (pp->model == WS_FRICTION_REGULARIZED) {
         /* eq. 13 with p(s) = 2s - s^2: below v_lim, F = -mu N (2 - s) vt / v_lim, which is smooth
          * and needs no division by |vt| at rest. */
@@ -44,7 +46,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
             ft = v3_scale(vt, -pp->mu * fn * (2.0 - s) / pp->vlim);
         } else {
             ft = v3_scale(vt, -pp->mu * fn / vts);
-            slipping = 1;
+            slipping = at_cap = 1;
         }
         c->anchored = 0;
     } else {
@@ -58,7 +60,8 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
         v3 xb = v3_add(st->r[ib], m3_mul_v(&b->A[ib], c->anchor_b));
         v3 dd = v3_sub(xb, xa);
         v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
-        ft = v3_add(v3_scale(dt, -pp->kt), v3_scale(vt, -pp->ct));
+        double m_eff = 1.0 / (b->inv_mass[ia] + b->inv_mass[ib]);
+        ft = v3_add(v3_scale(dt, -pp->kt), v3_scale(vt, -ws_stick_damping(pp, m_eff)));
         double cap = pp->mu * fn, fts = v3_norm(ft);
         if (fts > cap) {
             ft = fts > 0.0 ? v3_scale(ft, cap / fts) : ft;
@@ -66,8 +69,14 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
             v3 dt_new = v3_scale(ft, -1.0 / pp->kt);
             v3 xa_new = v3_sub(xb, dt_new);
             c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
-            slipping = 1;
+            at_cap = 1;
+            /* Sliding, not a step held at the cap: the anchor moves with the slip, at v_lim or
+             * faster (the regularised law's threshold). */
+            slipping = vts >= pp->vlim;
+            dt = dt_new;
         }
+        defl = dt;
+        energy_t = 0.5 * pp->kt * v3_norm2(dt);
     }
     v3 F = v3_add(v3_scale(n, fn), ft);
     apply(b, x->cur, ib, xg, F);
@@ -76,6 +85,8 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     rec->b = ib;
     rec->kind = c->kind;
     rec->slipping = (uint32_t)slipping;
+    rec->at_cap = (uint32_t)at_cap;
+    rec->defl = defl;
     rec->x = xg;
     rec->n = n;
     rec->ft = ft;
@@ -83,6 +94,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     rec->overlap = overlap;
     rec->fn = fn;
     rec->energy = 0.5 * pp->k * overlap * overlap;
+    rec->energy_t = energy_t;
     return 1;
 }
 

@@ -27,6 +27,8 @@ static int cmp_half_edge(const void *pa, const void *pb)
     return 0;
 }
 
+/* The reason a mesh is refused, with what to do about it: a mesh from a file is usually fixed
+ * in a mesh tool, not in code. */
 static void fail(char *why, size_t n, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -189,7 +191,10 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         v3 n = tri_normal_raw(out->vertices, tt);
         if (tt[0] == tt[1] || tt[1] == tt[2] || tt[0] == tt[2] ||
             !(v3_norm(n) > 1e-12 * diag * diag)) {
-            fail(why, why_len, "mesh: triangle %ld is degenerate (zero area)", (long)t);
+            fail(why, why_len,
+                 "mesh: triangle %ld is degenerate (zero area): remove it, or repair the mesh "
+                 "in a mesh tool (merge duplicate vertices, remove degenerate faces)",
+                 (long)t);
             st = WS_ERR_BAD_MESH;
             goto done;
         }
@@ -212,17 +217,28 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
         size_t j = i;
         while (j < nhe && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
             j++;
-        if (j - i != 2) {
+        if (j - i == 1) {
             fail(why, why_len,
-                 j - i == 1 ? "mesh: not closed: edge (%ld, %ld) belongs to one triangle only"
-                            : "mesh: not manifold: edge (%ld, %ld) belongs to more than two triangles",
+                 "mesh: not closed: edge (%ld, %ld) belongs to one triangle only: close the mesh, "
+                 "or repair it in a mesh tool (merge duplicate vertices, fill holes)",
                  (long)he[i].lo, (long)he[i].hi);
+            st = WS_ERR_BAD_MESH;
+            goto done;
+        }
+        if (j - i > 2) {
+            fail(why, why_len,
+                 "mesh: not manifold: edge (%ld, %ld) belongs to %ld triangles, not two: give each "
+                 "solid its own shape, or repair it in a mesh tool (remove duplicate faces, split "
+                 "non-manifold edges)",
+                 (long)he[i].lo, (long)he[i].hi, (long)(j - i));
             st = WS_ERR_BAD_MESH;
             goto done;
         }
         if (he[i].forward == he[i + 1].forward) {
             fail(why, why_len,
-                 "mesh: inconsistent winding: the two triangles at edge (%ld, %ld) run the same way",
+                 "mesh: inconsistent winding: the two triangles at edge (%ld, %ld) run the same "
+                 "way: turn one of them, or repair the mesh in a mesh tool (unify or recalculate "
+                 "the normals)",
                  (long)he[i].lo, (long)he[i].hi);
             st = WS_ERR_BAD_MESH;
             goto done;
@@ -236,8 +252,9 @@ ws_status ws_shape_build(ws_mem *mem, const double *xyz, size_t nv, const uint32
                     &out->inertia_unit);
     if (!(vol > 1e-12 * diag * diag * diag)) {
         fail(why, why_len,
-             "mesh: volume is not positive: triangles must run counter-clockwise seen from "
-             "outside");
+             "mesh: volume is not positive: triangles must run counter-clockwise seen from outside "
+             "(the mesh is inside out): reverse every triangle, or repair it in a mesh tool "
+             "(flip the normals)");
         st = WS_ERR_BAD_MESH;
         goto done;
     }

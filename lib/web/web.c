@@ -774,6 +774,23 @@ double ws_web_stable_dt(const ws_web *web, double kc, double cc)
     return best;
 }
 
+double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h)
+{
+    /* ws_web_stable_dt's bound in closed form: 2/omega (sqrt(1 + z^2) - z) = (sqrt(c^2 + 4 m k)
+     * - c) / k, which is >= h exactly when m >= h^2 k / 4 + h c / 2. A light node is held by
+     * its damping (the h c / 2 term), not by its stiffness. */
+    double most = 0.0;
+    node_bounds(web);
+    for (uint32_t i = 0; i < web->n; i++) {
+        if (web->inv_m[i] == 0.0)
+            continue;
+        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
+        double m = 0.25 * h * h * k + 0.5 * h * c;
+        most = m <= most ? most : m; /* NaN wins */
+    }
+    return most;
+}
+
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k)
 {
     double mm = INFINITY, mk = 0.0;

@@ -10,6 +10,13 @@
 #include "law/law.h"
 #include "math/wmath.h"
 
+/* Input bounds: sub-steps per world step, and pre-stretch of the generators (a rest length no
+ * shorter than 1/11 of the placed spacing: real films stretch by at most a few hundred per
+ * cent; far beyond, the springs' stiffness EA / l0 grows without bound and the stable step
+ * shrinks to nothing). */
+#define WS_WEB_MAX_SUBSTEPS 100000
+#define WS_WEB_MAX_PRESTRETCH 10.0
+
 /* Node vectors as structure of arrays: the x, y and z components apart (one allocation of 3 n
  * doubles), so loops over nodes and over grid springs run on whole vectors. */
 typedef struct ws_nodes3 {
@@ -151,6 +158,10 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v);
 /* Largest stable step for the springs and node drag alone plus a contact of stiffness kc and
  * damping cc on every node (explicit limit with damping, Gershgorin bound on the stiffness). */
 double ws_web_stable_dt(const ws_web *web, double kc, double cc);
+/* The smallest node mass that makes every free node stable at step h with a contact of
+ * stiffness kc and damping cc (the inverse of ws_web_stable_dt's bound, node by node: the
+ * largest over the free nodes of h^2 k / 4 + h c / 2), kg; 0 without free nodes. */
+double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h);
 /* Smallest node mass and largest 2 sum(k) + kc over the free nodes (for error messages). */
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k);
 /* Strain and tension of spring s in state (x, v), with its committed history. */

@@ -62,6 +62,7 @@ static void world_defaults(ws_world_def *def)
     def->max_speed = 1000.0;
     def->max_angular_speed = 1e5;
     def->use_ccd = 1;
+    def->stable_fraction = 0.5;
     def->worker_count = 1;
 }
 WS_DEF_INITS(ws_world_def, world_defaults, user_data)
@@ -75,7 +76,8 @@ static void contact_defaults(ws_contact_def *def)
     def->friction_vlim = 0.01;
     def->friction_model = WS_FRICTION_REGULARIZED;
     def->stick_stiffness = 2e5;
-    def->stick_damping = 10.0;
+    def->stick_damping = 0.0; /* from the ratio */
+    def->stick_damping_ratio = 1.0;
 }
 WS_DEF_INITS(ws_contact_def, contact_defaults, stick_damping)
 
@@ -106,13 +108,18 @@ static ws_status check_contact_def(const ws_world *w, const ws_contact_def *c)
         !(isfinite(c->stick_damping) && c->stick_damping >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "contact: stick_stiffness must be > 0 N/m and stick_damping >= 0 kg/s");
+    if (!(c->stick_damping_ratio >= 0.0 && c->stick_damping_ratio <= 10.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "contact: stick_damping_ratio must be 0..10 (of critical), got %g",
+                       c->stick_damping_ratio);
     return WS_OK;
 }
 
 static ws_pair_params to_params(const ws_contact_def *c)
 {
-    ws_pair_params p = {c->stiffness, c->damping,       c->friction,     c->friction_vlim,
-                        c->stick_stiffness, c->stick_damping, (int)c->friction_model};
+    ws_pair_params p = {c->stiffness,       c->damping,       c->friction,
+                        c->friction_vlim,   c->stick_stiffness, c->stick_damping,
+                        (int)c->friction_model, c->stick_damping_ratio};
     return p;
 }
 
@@ -126,6 +133,7 @@ static ws_contact_def from_params(const ws_pair_params *p)
     c.friction_vlim = p->vlim;
     c.stick_stiffness = p->kt;
     c.stick_damping = p->ct;
+    c.stick_damping_ratio = p->zt;
     c.friction_model = (ws_friction_model)p->model;
     return c;
 }
@@ -149,6 +157,7 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         !(isfinite(d.full_detection_until)) || d.detection_interval < 1 ||
         !(isfinite(d.contact_margin) && d.contact_margin >= 0.0) ||
         !(d.max_speed > 0.0) || !(d.max_angular_speed > 0.0) ||
+        !(d.stable_fraction > 0.0 && d.stable_fraction <= 1.0) ||
         (d.integrator != WS_INTEGRATOR_SYMPLECTIC_EULER &&
          d.integrator != WS_INTEGRATOR_PAPER_EXPLICIT))
         return WS_ERR_INVALID_ARGUMENT;
@@ -245,6 +254,8 @@ void ws_world_destroy(ws_world *w)
     ws_slots_destroy(m, &w->mat_slots);
     ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);
     ws_mem_free(m, w->pair_index, w->pair_dim * w->pair_dim * sizeof *w->pair_index);
+    ws_mem_free(m, w->mat_mass, w->pair_dim * sizeof *w->mat_mass);
+    ws_mem_free(m, w->guard_f, 2 * w->guard_cap * sizeof *w->guard_f); /* guard_m is in it */
     for (int k = 0; k < 2; k++) {
         ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
         ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
@@ -284,6 +295,14 @@ ws_status ws_world_get_dt(const ws_world *w, double *dt)
     return WS_OK;
 }
 
+ws_status ws_world_get_stable_fraction(const ws_world *w, double *fraction)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, fraction, "ws_world_get_stable_fraction");
+    *fraction = w->def.stable_fraction;
+    return WS_OK;
+}
+
 ws_status ws_world_set_dt(ws_world *w, double dt)
 {
     NEED_WORLD(w);
@@ -314,6 +333,18 @@ ws_status ws_world_get_stats(const ws_world *w, ws_world_stats *s)
     s->steps = w->steps;
     s->contacts = w->nrec[w->cur];
     s->candidates = w->ncand[w->cur];
+    /* The margins now (the bounds are asked of scratch, not state: no step is running). */
+    s->web_step_use = 0.0;
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        const ws_web *web = w->webs[k];
+        double use = w->def.dt / web->substeps / ws_world_web_stable_dt((ws_world *)w, web);
+        s->web_step_use = use > s->web_step_use ? use : s->web_step_use;
+    }
+    ws_contact_limit lim;
+    ws_world_contact_limit(w, &lim);
+    s->body_step_use = w->def.dt / lim.dt;
     s->bytes_in_use = w->mem.in_use;
     s->bytes_peak = w->mem.peak;
     s->bodies = w->bodies.alive_count;
@@ -370,10 +401,15 @@ static ws_status create_material(ws_world *w, const char *name, ws_material_id *
         while (dim < slot + 1)
             dim *= 2;
         uint32_t *pi = ws_mem_calloc(&w->mem, dim * dim, sizeof *pi);
-        if (!pi) {
+        ws_mat_mass *mm = pi ? ws_mem_realloc(&w->mem, w->mat_mass, w->pair_dim * sizeof *mm,
+                                              dim * sizeof *mm)
+                             : NULL;
+        if (!mm) {
+            ws_mem_free(&w->mem, pi, dim * dim * sizeof *pi);
             ws_slots_release(&w->mat_slots, slot);
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_material_create: out of memory");
         }
+        w->mat_mass = mm;
         for (size_t a = 0; a < w->pair_dim; a++)
             for (size_t b = 0; b < w->pair_dim; b++)
                 pi[a * dim + b] = w->pair_index[a * w->pair_dim + b];
@@ -502,26 +538,79 @@ ws_status ws_world_set_default_contact(ws_world *w, const ws_contact_def *def)
     return WS_OK;
 }
 
-double ws_world_stable_dt(const ws_world *w)
+double ws_contact_stable_dt(double k, double c, double m_eff)
 {
-    /* Explicit limit 2/omega for a mass on several penalty springs: omega^2 = n k / m with n = 8
-     * simultaneous contacts (a box face on another: 4 corners each way), reduced by damping:
-     * dt < 2/omega (sqrt(1 + z^2) - z), z = n c / (2 m omega). */
+    /* Explicit limit 2/omega for a mass on several penalty springs: omega^2 = n k / m with n
+     * simultaneous contacts, reduced by damping: dt < 2/omega (sqrt(1 + z^2) - z), z = n c /
+     * (2 m omega); in closed form (sqrt(C^2 + 4 m K) - C) / K with K = n k, C = n c. */
+    double K = WS_CONTACTS_PER_BODY * k, C = WS_CONTACTS_PER_BODY * c;
+    if (!(K > 0.0))
+        return INFINITY;
+    return (sqrt(C * C + 4.0 * m_eff * K) - C) / K;
+}
+
+/* Effective mass of a pair of bodies (a kinematic or absent one counts as infinite). */
+static double pair_mass(const ws_body_store *b, uint32_t i, uint32_t j)
+{
+    double inv_i = i == UINT32_MAX ? 0.0 : b->inv_mass[i];
+    double inv_j = j == UINT32_MAX ? 0.0 : b->inv_mass[j];
+    return 1.0 / (inv_i + inv_j);
+}
+
+void ws_world_contact_limit(const ws_world *w, ws_contact_limit *lim)
+{
+    /* Every pair of materials that two bodies now in the world have, at its lightest: the two
+     * lightest dynamic bodies of each material, or a dynamic body against a kinematic one.
+     * The stiffness is the larger of the normal and (stick model) tangential springs, the
+     * damping likewise: either direction can run away. */
     const ws_body_store *b = &w->bodies;
-    double best = INFINITY;
-    for (size_t i = 0; i < b->slots; i++) {
-        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+    ws_mat_mass *mm = ((ws_world *)w)->mat_mass; /* scratch, not state */
+    const uint32_t none = UINT32_MAX;
+    for (size_t a = 0; a < w->pair_dim; a++)
+        mm[a].light[0] = mm[a].light[1] = mm[a].kinematic = none;
+    for (uint32_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
             continue;
-        for (size_t p = 0; p < w->nparams; p++) {
-            const ws_pair_params *pp = &w->params[p];
-            double n = 8.0, om = sqrt(n * pp->k / b->mass[i]);
-            double z = n * pp->c / (2.0 * b->mass[i] * om);
-            double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
-            if (dt < best)
-                best = dt;
+        ws_mat_mass *e = &mm[b->material[i]];
+        if (b->type[i] != WS_BODY_DYNAMIC) {
+            e->kinematic = i;
+        } else if (e->light[0] == none || b->mass[i] < b->mass[e->light[0]]) {
+            e->light[1] = e->light[0];
+            e->light[0] = i;
+        } else if (e->light[1] == none || b->mass[i] < b->mass[e->light[1]]) {
+            e->light[1] = i;
         }
     }
-    return fmin(best, ws_world_element_stable_dt(w)); /* the elements' springs too */
+    *lim = (ws_contact_limit){INFINITY, 0, 0, 0, 0, 0, none, none};
+    for (uint32_t ma = 0; ma < w->pair_dim; ma++) {
+        uint32_t i = mm[ma].light[0];
+        if (i == none)
+            continue; /* a pair needs a dynamic body on one side */
+        for (uint32_t mb = 0; mb < w->pair_dim; mb++) {
+            /* The partner: the lightest dynamic body of mb (the second lightest when it is the
+             * same material), else a kinematic one. */
+            uint32_t j = mb == ma ? mm[mb].light[1] : mm[mb].light[0];
+            if (j == none)
+                j = mm[mb].kinematic;
+            if (j == none)
+                continue;
+            const ws_pair_params *p = &w->params[w->pair_index[ma * w->pair_dim + mb]];
+            int stick = p->model == WS_FRICTION_STICK;
+            double k = stick ? fmax(p->k, p->kt) : p->k;
+            double m = pair_mass(b, i, b->type[j] == WS_BODY_DYNAMIC ? j : none);
+            double c = stick ? fmax(p->c, ws_stick_damping(p, m)) : p->c;
+            double dt = ws_contact_stable_dt(k, c, m);
+            if (dt < lim->dt)
+                *lim = (ws_contact_limit){dt, k, c, m, ma, mb, i, j};
+        }
+    }
+}
+
+double ws_world_stable_dt(const ws_world *w)
+{
+    ws_contact_limit lim;
+    ws_world_contact_limit(w, &lim);
+    return fmin(lim.dt, ws_world_element_stable_dt(w)); /* the elements' springs too */
 }
 
 ws_status ws_world_estimate_stable_dt(const ws_world *w, double *dt)

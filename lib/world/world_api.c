@@ -68,7 +68,7 @@ WS_DEF_INITS(ws_mesh_def, mesh_defaults, triangle_count)
 static ws_status add_shape(ws_world *w, const double *xyz, size_t nv, const uint32_t *tri,
                            size_t nt, const char *fn, ws_shape_id *out)
 {
-    char why[256] = "";
+    char why[400] = ""; /* a refused mesh's reason and repair hint; fits the error text */
     ws_shape *s = ws_mem_alloc(&w->mem, sizeof *s);
     if (!s)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
@@ -829,6 +829,9 @@ ws_status ws_world_copy_contacts(const ws_world *w, ws_contact_info *buf, size_t
         o->slip_velocity = c->vt;
         o->kind = (int32_t)c->kind;
         o->slipping = (int32_t)c->slipping;
+        o->at_cap = (int32_t)c->at_cap;
+        o->reserved_ = 0;
+        o->anchor_deflection = c->defl;
     }
     if (buf && cap < n)
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL,
@@ -885,6 +888,10 @@ ws_status ws_world_copy_contacts_between(const ws_world *w, ws_body_id a, ws_bod
             if (swapped && c->kind == WS_CONTACT_POINT_FACE)
                 o->kind = WS_CONTACT_FACE_POINT;
             o->slipping = (int32_t)c->slipping;
+            o->at_cap = (int32_t)c->at_cap;
+            o->reserved_ = 0;
+            /* The deflection is b's point less its anchor on a: swapped, a's less b's. */
+            o->anchor_deflection = v3_scale(c->defl, sg);
         }
         n++;
     }

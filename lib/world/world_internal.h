@@ -38,6 +38,26 @@ typedef struct ws_lane_job {
     size_t fct_cap;
     ws_node_contact own;
 } ws_lane_job;
+/* Per material, the two lightest dynamic bodies (slots, UINT32_MAX for none) and a kinematic
+ * body of it (scratch of ws_world_contact_limit). */
+typedef struct ws_mat_mass {
+    uint32_t light[2];
+    uint32_t kinematic;
+} ws_mat_mass;
+
+/* The contact pair that sets the bodies' stable step: materials, bodies (b may be kinematic),
+ * the pair's stiffness and damping as the bound counts them, the effective mass and the
+ * stable step (INFINITY when no pair of bodies can touch). */
+typedef struct ws_contact_limit {
+    double dt, k, c, m_eff;
+    uint32_t mat_a, mat_b, body_a, body_b;
+} ws_contact_limit;
+
+/* Simultaneous contacts the bodies' stable-step bound assumes on one body (docs/theory.md). */
+#define WS_CONTACTS_PER_BODY 8.0
+/* The energy guard's allowance: a step's kinetic energy may grow by the known loads' work plus
+ * this multiple of the kinetic and contact energy at its start (docs/theory.md, section 8). */
+#define WS_ENERGY_GROWTH_FACTOR 10.0
 
 struct ws_world {
     ws_mem mem;
@@ -65,6 +85,7 @@ struct ws_world {
     size_t nparams, params_cap;
     uint32_t *pair_index; /* dim x dim, indices into params */
     size_t pair_dim;
+    ws_mat_mass *mat_mass; /* pair_dim entries: scratch of the contact stable step */
 
     ws_law **laws;
     size_t law_cap;
@@ -83,6 +104,11 @@ struct ws_world {
     ws_element **elements; /* by id slot (world_element.c) */
     size_t element_cap;
     ws_slot_table element_slots;
+
+    /* Per body slot: the contacts' force and moment (energy guard); one block of 2 guard_cap,
+     * guard_m = guard_f + guard_cap. */
+    v3 *guard_f, *guard_m;
+    size_t guard_cap;
 
     ws_cand *cand[2];
     size_t ncand[2], capcand[2];
@@ -152,6 +178,8 @@ void ws_world_lanes_free(ws_world *w);
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
+/* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */
+double ws_world_web_mass_for(ws_world *w, const ws_web *web, double h);
 ws_body_id ws_make_body_id(const ws_world *w, uint32_t slot);
 
 /* The two exported inits of a Def type `type` (ws_x_def) whose defaults `defaults` writes:
@@ -178,6 +206,10 @@ void ws_world_refresh_body(ws_world *w, uint32_t slot);
 void ws_world_forget_body(ws_world *w, uint32_t slot);
 /* Largest stable dt for the current bodies and parameters (see ws_world_estimate_stable_dt). */
 double ws_world_stable_dt(const ws_world *w);
+/* The bodies' contact pair with the smallest stable step (world.c). */
+void ws_world_contact_limit(const ws_world *w, ws_contact_limit *lim);
+/* The stable step of a mass m_eff on WS_CONTACTS_PER_BODY contacts of stiffness k, damping c. */
+double ws_contact_stable_dt(double k, double c, double m_eff);
 
 /* Elements (world_element.c). In a step: the loads of every element at state `cur` and time t
  * into the bodies' accumulators, each element's strain kept for the commit (nothing committed

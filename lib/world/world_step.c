@@ -12,6 +12,7 @@
 
 #include <float.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -98,26 +99,63 @@ static const char *web_label(const ws_web *web)
     return web->name ? web->name : "(unnamed)";
 }
 
-/* What would make a web stable at sub-step h: sub-steps for the world's dt, or node mass. */
+/* x rounded up to 4 significant digits so that the number as printed (%.4g) and read back is
+ * still >= x: advice that, taken literally, works. */
+static double round_up_4(double x)
+{
+    if (!(x > 0.0 && x < 1e300))
+        return x;
+    double p = pow(10.0, floor(log10(x)) - 3.0);
+    for (double y = ceil(x / p) * p;; y += p) {
+        char txt[32];
+        snprintf(txt, sizeof txt, "%.4g", y);
+        if (strtod(txt, NULL) >= x)
+            return strtod(txt, NULL);
+    }
+}
+
+/* What would make a web stable at sub-step h: sub-steps for the world's dt, or node mass, both
+ * from the bound the check uses (h <= stable), so that the advice taken as given is accepted
+ * and a little less is not. */
 static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double stable,
                               const char *what)
 {
-    double mmin, kmax;
+    double mmin, kmax, f = w->def.stable_fraction;
     w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
     ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
-    double r = h / stable;
-    int need = (int)ceil(w->def.dt / stable);
-    if (r <= 1.0) /* ran away though stable as its laws state them: sub-steps would not help */
+    double allowed = f * stable; /* what the check lets dt/substeps use */
+    if (h <= allowed) /* ran away though stable as its laws state them: sub-steps would not help */
         return ws_fail(w, WS_ERR_NUMERICAL,
-                       "web '%s': %s, though dt/substeps = %.3g s is within its stable step "
-                       "%.3g s: a spring law stiffer or stronger than it states (a user or "
+                       "web '%s': %s, though dt/substeps = %.3g s is within %g of its stable "
+                       "step %.3g s: a spring law stiffer or stronger than it states (a user or "
                        "table law), or a body that hits the film too fast. Try a smaller dt.",
-                       web_label(web), what, h, stable);
+                       web_label(web), what, h, f, stable);
+    /* Sub-steps: dt / n <= allowed. The quotient is bounded before it becomes an int (a stable
+     * step of about 0 would overflow it). */
+    char sub[192], mass[128];
+    double q = w->def.dt / allowed;
+    if (q <= (double)WS_WEB_MAX_SUBSTEPS) {
+        int n = (int)ceil(q);
+        n += w->def.dt / n > allowed; /* the division rounded the wrong way */
+        snprintf(sub, sizeof sub, "Use substeps >= %d (ws_web_set_substeps), or", n);
+    } else {
+        snprintf(sub, sizeof sub,
+                 "Sub-steps cannot help (it would take more than the limit of %d: dt / stable "
+                 "step = %.3g); use a softer or less pre-stretched film, or",
+                 WS_WEB_MAX_SUBSTEPS, q);
+    }
+    /* Node mass: the check's own bound inverted (ws_web_mass_for_step): a stable sub-step of
+     * h / f. */
+    double m = round_up_4(ws_world_web_mass_for(w, web, h / f) * (1.0 + 1e-9)); /* round-off */
+    if (m > 0.0 && m < 1e300)
+        snprintf(mass, sizeof mass, "node mass >= %.4g kg (every free node)", m);
+    else
+        snprintf(mass, sizeof mass, "a node mass (none is large enough: %.3g kg)", m);
     return ws_fail(w, WS_ERR_NUMERICAL,
-                   "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s "
-                   "(smallest node mass %.3g kg). Use substeps >= %d (ws_web_set_substeps), or "
-                   "node mass >= %.3g kg, or a smaller dt.",
-                   web_label(web), what, h, stable, mmin, need, mmin * fmax(r * r, r));
+                   "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s, "
+                   "of which it may use %g (stable_fraction): %.3g s (smallest node mass %.3g "
+                   "kg). %s %s, or a smaller dt.",
+                   web_label(web), what, h, stable, f, allowed, mmin, sub, mass);
 }
 
 /* Every web before the step: stable for its sub-step, and room for per-body forces. */
@@ -156,7 +194,7 @@ static ws_status webs_ready(ws_world *w)
         }
         if (w->web_check) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
-            if (h > stable)
+            if (!(h <= w->def.stable_fraction * stable)) /* NaN refuses too */
                 return web_unstable(w, web, h, stable, "refused before the step");
         }
     }
@@ -422,6 +460,123 @@ static const char *body_label(const ws_world *w, size_t i)
     return w->bodies.name[i] ? w->bodies.name[i] : "(unnamed)";
 }
 
+static const char *material_label(const ws_world *w, uint32_t m)
+{
+    return w->mat_name[m] ? w->mat_name[m] : m == 0 ? "(default)" : "(unnamed)";
+}
+
+/* x rounded down to 3 significant digits, as printed (%.3g) and read back: a dt to use. */
+static double round_down_3(double x)
+{
+    if (!(x > 0.0 && x < 1e300))
+        return x;
+    double p = pow(10.0, floor(log10(x)) - 2.0);
+    for (double y = floor(x / p) * p;; y -= p) {
+        char txt[32];
+        snprintf(txt, sizeof txt, "%.3g", y);
+        if (strtod(txt, NULL) <= x)
+            return strtod(txt, NULL);
+    }
+}
+
+/* Bodies and their contact pairs against the stable step, before the step (as webs are): the
+ * pair with the smallest stable step, and what would do. */
+static ws_status bodies_ready(ws_world *w)
+{
+    ws_contact_limit L;
+    ws_world_contact_limit(w, &L);
+    double dt = w->def.dt;
+    if (dt <= L.dt)
+        return WS_OK;
+    w->stats.numerical_errors++;
+    const ws_body_store *b = &w->bodies;
+    const double n = WS_CONTACTS_PER_BODY;
+    /* The stiffness that would do at this dt: the bound (sqrt(C^2 + 4 m K) - C) / K >= dt
+     * solved for K = n k (docs/theory.md, section 8); none when the damping alone is too much. */
+    double kmax = 4.0 * (L.m_eff - 0.5 * dt * n * L.c) / (n * dt * dt);
+    char other[96], fix[160];
+    if (b->type[L.body_b] == WS_BODY_DYNAMIC)
+        snprintf(other, sizeof other, "'%s' (%.3g kg)", body_label(w, L.body_b),
+                 b->mass[L.body_b]);
+    else
+        snprintf(other, sizeof other, "'%s' (kinematic)", body_label(w, L.body_b));
+    if (kmax > 0.0)
+        snprintf(fix, sizeof fix, "or stiffness <= %.3g N/m for this pair (ws_world_set_contact)",
+                 kmax);
+    else
+        snprintf(fix, sizeof fix,
+                 "or damping below %.3g kg/s for this pair: its damping alone is too much",
+                 2.0 * L.m_eff / (n * dt));
+    return ws_fail(w, WS_ERR_NUMERICAL,
+                   "step at t = %.6g s refused before the step: contact pair of materials '%s' "
+                   "and '%s' (stiffness %.3g N/m, damping %.3g kg/s) between bodies '%s' (%.3g "
+                   "kg) and %s has a stable step of %.3g s (effective mass %.3g kg on %g "
+                   "contacts), below dt = %.3g s. Use dt <= %.3g s (ws_world_set_dt), %s.",
+                   w->time, material_label(w, L.mat_a), material_label(w, L.mat_b), L.k, L.c,
+                   body_label(w, L.body_a), b->mass[L.body_a], other, L.dt, L.m_eff, n, dt,
+                   round_down_3(L.dt), fix);
+}
+
+static double kinetic(const ws_body_store *b, const ws_body_state *st, size_t i)
+{
+    return 0.5 * b->mass[i] * v3_norm2(st->v[i]) +
+           0.5 * v3_dot(st->w[i], m3_mul_v(&b->J[i], st->w[i]));
+}
+
+/* Energy guard (docs/theory.md, section 8): the bodies' kinetic energy may grow in a step by the
+ * work the known loads did (gravity, film, elements: their force and moment on each body times
+ * its mean velocities; drives: the contact forces of kinematic bodies times their speed) plus
+ * WS_ENERGY_GROWTH_FACTOR times the kinetic and contact energy at its start. Stable penalty
+ * contacts release at most what they store; more is a runaway, whatever max_speed says. */
+static ws_status energy_guard(ws_world *w, int cur, int nxt, size_t nrec)
+{
+    const ws_body_store *b = &w->bodies;
+    const ws_body_state *s0 = &b->st[cur], *s1 = &b->st[nxt];
+    const double dt = w->def.dt;
+    double t0 = 0.0, t1 = 0.0, work = 0.0, stored = 0.0;
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+            continue;
+        t0 += kinetic(b, s0, i);
+        t1 += kinetic(b, s1, i);
+        v3 f = v3_sub(b->f[i], w->guard_f[i]), m = v3_sub(b->m[i], w->guard_m[i]);
+        v3 w1 = m3_mul_v(&b->A[i], s1->w[i]);
+        work += 0.5 * dt *
+                (v3_dot(f, v3_add(s0->v[i], s1->v[i])) + v3_dot(m, v3_add(b->wg[i], w1)));
+    }
+    for (size_t k = 0; k < nrec; k++) {
+        const ws_contact_rec *r = &w->rec[nxt][k];
+        stored += r->energy + r->energy_t;
+        v3 F = v3_add(v3_scale(r->n, r->fn), r->ft); /* on b; a gets -F */
+        uint32_t ends[2] = {r->a, r->b};
+        for (int e = 0; e < 2; e++) {
+            uint32_t j = ends[e];
+            if (b->type[j] == WS_BODY_DYNAMIC)
+                continue;
+            v3 arm = v3_sub(r->x, s0->r[j]);
+            v3 v0 = v3_add(s0->v[j], v3_cross(b->wg[j], arm));
+            v3 v1 = v3_add(s1->v[j], v3_cross(m3_mul_v(&b->A[j], s1->w[j]), arm));
+            work += 0.5 * dt * (fabs(v3_dot(F, v0)) + fabs(v3_dot(F, v1)));
+        }
+    }
+    double allowed = fmax(work, 0.0) + WS_ENERGY_GROWTH_FACTOR * (t0 + stored) +
+                     1e-9 * (t0 + t1) + 1e-300;
+    if (t1 - t0 <= allowed)
+        return WS_OK;
+    w->stats.numerical_errors++;
+    ws_contact_limit L;
+    ws_world_contact_limit(w, &L);
+    return ws_fail(w, WS_ERR_NUMERICAL,
+                   "step at t = %.6g s: runaway energy: the bodies' kinetic energy grew from %.3g "
+                   "J to %.3g J in one step, more than the loads' work (gravity, film, "
+                   "elements, drives: %.3g J) plus %g times the kinetic and contact energy at "
+                   "its start (%.3g J). The step was undone. dt = %.3g s; the bodies' stable "
+                   "step is %.3g s (materials '%s' and '%s'): reduce dt, or the stiffness of "
+                   "the contacts or elements.",
+                   w->time, t0, t1, work, WS_ENERGY_GROWTH_FACTOR, t0 + stored, dt,
+                   ws_world_stable_dt(w), material_label(w, L.mat_a), material_label(w, L.mat_b));
+}
+
 static ws_status health(ws_world *w, int nxt)
 {
     const ws_body_store *b = &w->bodies;
@@ -456,6 +611,21 @@ static ws_status step_once(ws_world *w)
     const int cur = w->cur, nxt = cur ^ 1;
     const double dt = w->def.dt, t = w->time;
     const double t_start = clock_now(w);
+    ws_status s;
+    if ((s = bodies_ready(w)) != WS_OK)
+        return s;
+    /* Room for the energy guard's record of the contacts' loads on each body: one block, the
+     * forces then the moments, so a failed grow leaves one consistent size. */
+    if (w->guard_cap < b->slots) {
+        size_t cap = b->capacity;
+        v3 *f = ws_mem_realloc(&w->mem, w->guard_f, 2 * w->guard_cap * sizeof(v3),
+                               2 * cap * sizeof(v3));
+        if (!f)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        w->guard_f = f;
+        w->guard_m = f + cap;
+        w->guard_cap = cap;
+    }
 
     prepare(w);
 
@@ -467,7 +637,6 @@ static ws_status step_once(ws_world *w)
     int full = !w->cand_valid || t < w->def.full_detection_until ||
                w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval ||
                2.0 * w->travel >= w->def.contact_margin;
-    ws_status s;
     double t_mark = clock_now(w);
     if (full) {
         if ((s = detect_full(w, &x, nxt)) != WS_OK)
@@ -491,6 +660,15 @@ static ws_status step_once(ws_world *w)
     for (size_t k = 0; k < w->ncand[nxt]; k++)
         if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
             nrec++;
+    /* The contacts' share of each body's load, for the energy guard (gravity taken out). */
+    for (size_t i = 0; i < b->slots; i++) {
+        if (!b->alive[i])
+            continue;
+        v3 g = b->type[i] == WS_BODY_DYNAMIC ? v3_scale(w->def.gravity, b->mass[i])
+                                              : v3_make(0, 0, 0);
+        w->guard_f[i] = v3_sub(b->f[i], g);
+        w->guard_m[i] = b->m[i];
+    }
     if ((s = ws_world_element_forces(w, cur, t)) != WS_OK) /* rods, springs, bushings */
         return s;
 
@@ -543,7 +721,7 @@ static ws_status step_once(ws_world *w)
     }
 
     w->stats.narrow_checks += x.narrow_checks;
-    if ((s = health(w, nxt)) != WS_OK)
+    if ((s = health(w, nxt)) != WS_OK || (s = energy_guard(w, cur, nxt, nrec)) != WS_OK)
         return s;
 
     /* Commit. */

@@ -46,6 +46,13 @@ static void web_mesh_defaults(ws_web_mesh_def *def)
 }
 WS_DEF_INITS(ws_web_mesh_def, web_mesh_defaults, pinned_count)
 
+/* A generator's pre-stretch: rest length spacing / (1 + p), so p > -1, and at most
+ * WS_WEB_MAX_PRESTRETCH (web.h says why). */
+static int prestretch_ok(double p)
+{
+    return p > -1.0 && p <= WS_WEB_MAX_PRESTRETCH;
+}
+
 /* What every generator shares: the checked web Def and the laws it names. */
 typedef struct web_common {
     ws_web_def d;
@@ -77,9 +84,9 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
         !(isfinite(d->node_damping) && d->node_damping >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': contact_layer and node_damping must be >= 0", c->label);
-    if (d->substeps < 1 || d->substeps > 100000)
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': substeps must be 1..100000, got %d",
-                       c->label, d->substeps);
+    if (d->substeps < 1 || d->substeps > WS_WEB_MAX_SUBSTEPS)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': substeps must be 1..%d, got %d",
+                       c->label, WS_WEB_MAX_SUBSTEPS, d->substeps);
     c->material = 0;
     if (d->material.bits && (s = ws_lookup_material(w, d->material, &c->material)) != WS_OK)
         return s;
@@ -127,8 +134,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
 {
     for (int k = 0; k < 3; k++)
         web->law[k] = c->law[k];
-    if (ws_web_law_state(&w->mem, web) != 0)
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
+    /* Every spring's kind and law are checked before the law histories are set up, which look
+     * up each spring's law by its kind. */
     for (uint32_t s = 0; s < web->ns; s++) {
         if (web->kind[s] > WS_SPRING_SHEAR)
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': spring %u has an unknown kind",
@@ -140,6 +147,8 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
             return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                            "web '%s': spring %u has a rest length that is not > 0", c->label, s);
     }
+    if (ws_web_law_state(&w->mem, web) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     if (c->d.node_mass > 0.0) {
         for (uint32_t i = 0; i < web->n; i++)
             web->m[i] = c->d.node_mass;
@@ -220,12 +229,12 @@ ws_status ws_web_create_sheet(ws_world *w, const ws_web_def *def, const ws_sheet
     if (g.nx < 1 || g.ny < 1 || (long)g.nx * g.ny < 2 || (long)g.nx * g.ny > 50000000L ||
         !ws_is_finite3(&g.origin) || !(nax > 0.0 && isfinite(nax)) ||
         !(nay > 0.0 && isfinite(nay)) || !(g.spacing_x > 0.0 && isfinite(g.spacing_x)) ||
-        !(g.spacing_y > 0.0 && isfinite(g.spacing_y)) || !(g.prestretch_x > -1.0) ||
-        !(g.prestretch_y > -1.0) || !isfinite(g.prestretch_x) || !isfinite(g.prestretch_y))
+        !(g.spacing_y > 0.0 && isfinite(g.spacing_y)) || !prestretch_ok(g.prestretch_x) ||
+        !prestretch_ok(g.prestretch_y))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': the sheet needs nx, ny >= 1 with at least 2 nodes, non-zero "
-                       "axes, spacings > 0 m and pre-stretches > -1",
-                       c.label);
+                       "axes, spacings > 0 m and pre-stretches > -1 and <= %g (got %g, %g)",
+                       c.label, WS_WEB_MAX_PRESTRETCH, g.prestretch_x, g.prestretch_y);
     ws_web web;
     uint32_t n = (uint32_t)(g.nx * g.ny);
     uint32_t ns = ws_web_sheet_springs(g.nx, g.ny, g.shear && g.nx > 1 && g.ny > 1, 0);
@@ -259,13 +268,12 @@ ws_status ws_web_create_band(ws_world *w, const ws_web_def *def, const ws_band_d
     if (!g.bodies || g.body_count == 0 || g.n_around < 3 || g.n_up < 1 ||
         (long)g.n_around * g.n_up > 50000000L || !isfinite(g.z_bottom) || !isfinite(g.z_top) ||
         g.z_top < g.z_bottom || (g.n_up > 1 && g.z_top == g.z_bottom) ||
-        !(g.prestretch_around > -1.0) || !(g.prestretch_up > -1.0) ||
-        !isfinite(g.prestretch_around) || !isfinite(g.prestretch_up) ||
+        !prestretch_ok(g.prestretch_around) || !prestretch_ok(g.prestretch_up) ||
         !(isfinite(g.gap) && g.gap >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': the band needs bodies, n_around >= 3, n_up >= 1, z_top > "
-                       "z_bottom, pre-stretches > -1 and gap >= 0",
-                       c.label);
+                       "z_bottom, pre-stretches > -1 and <= %g (got %g, %g) and gap >= 0",
+                       c.label, WS_WEB_MAX_PRESTRETCH, g.prestretch_around, g.prestretch_up);
     /* The footprint: every vertex of the bodies, projected along z. */
     size_t np = 0;
     double layer = 0.0;
@@ -450,21 +458,34 @@ int ws_world_node_params(ws_world *w, uint32_t mat)
     return 0;
 }
 
-double ws_world_web_stable_dt(ws_world *w, const ws_web *web)
+/* The stiffest and most damped contact the web can meet: its material against the materials of
+ * the bodies now in the world. */
+static void web_contact_bounds(const ws_world *w, const ws_web *web, double *kc, double *cc)
 {
-    /* The stiffest and most damped contact the web can meet: its material against the
-     * materials of the bodies now in the world. */
-    double kc = 0.0, cc = 0.0;
     const ws_body_store *b = &w->bodies;
+    *kc = *cc = 0.0;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
         const ws_pair_params *p =
             &w->params[w->pair_index[web->material * w->pair_dim + b->material[i]]];
-        kc = fmax(kc, p->k);
-        cc = fmax(cc, p->c);
+        *kc = fmax(*kc, p->k);
+        *cc = fmax(*cc, p->c);
     }
+}
+
+double ws_world_web_stable_dt(ws_world *w, const ws_web *web)
+{
+    double kc, cc;
+    web_contact_bounds(w, web, &kc, &cc);
     return ws_web_stable_dt(web, kc, cc);
+}
+
+double ws_world_web_mass_for(ws_world *w, const ws_web *web, double h)
+{
+    double kc, cc;
+    web_contact_bounds(w, web, &kc, &cc);
+    return ws_web_mass_for_step(web, kc, cc, h);
 }
 
 ws_status ws_web_get_stable_dt(const ws_world *w, ws_web_id id, double *dt)
@@ -487,9 +508,9 @@ ws_status ws_web_set_substeps(ws_world *w, ws_web_id id, int substeps)
     ws_status s = ws_lookup_web(w, id, &slot);
     if (s != WS_OK)
         return s;
-    if (substeps < 1 || substeps > 100000)
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_web_set_substeps: 1..100000, got %d",
-                       substeps);
+    if (substeps < 1 || substeps > WS_WEB_MAX_SUBSTEPS)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_web_set_substeps: 1..%d, got %d",
+                       WS_WEB_MAX_SUBSTEPS, substeps);
     w->webs[slot]->substeps = substeps;
     w->web_check = 1;
     return WS_OK;

@@ -90,7 +90,7 @@ def test_schema_agrees_with_the_checker():
     wrap = s["properties"]["wrap"]["anyOf"][0]["properties"]
     assert wrap["prestretch_around_percent"]["minimum"] == 0.0
     assert "[%]" in wrap["prestretch_around_percent"]["description"]
-    assert s["properties"]["stack"]["properties"]["carton"]["required"] == [
+    assert s["properties"]["stack"]["anyOf"][0]["properties"]["carton"]["required"] == [
         "length_m", "width_m", "height_m", "mass_kg"]
     shipped = json.loads((ROOT / "docs" / "load.schema.json").read_text())
     assert shipped == s, "docs/load.schema.json is stale: regenerate with `wrapsim schema`"
@@ -188,3 +188,73 @@ def test_yaml_load_file(tmp_path):
     (tmp_path / "bad.yaml").write_text("stack: [unclosed")
     with pytest.raises(loadfile.LoadFileError, match="not valid YAML"):
         loadfile.load(tmp_path / "bad.yaml")
+
+
+def small_pallet(**changes):
+    """The shipped EUR pallet load file, unwrapped and cut to 2 layers settling 0.3 s, so a run
+    takes a second or two."""
+    d = json.loads((LOADS / "eur_pallet_eumos.json").read_text())
+    d["unit_load"].update(layers=2, settle_s=0.3, wrap=None)
+    for k, v in changes.items():
+        loadfile.set_path(d, k, v)
+    return d
+
+
+@pytest.mark.parametrize("path,value,message", [
+    ("unit_load.layers", 40, "unit_load.layers: 40 is above 32"),
+    ("unit_load.pattern", "spiral", "unit_load.pattern: 'spiral' is not one of column, brick"),
+    ("unit_load.interfaces.pallet_platform.mu", -1,
+     "unit_load.interfaces.pallet_platform.mu: -1 is below 0"),
+    ("unit_load.carton.mass_kg", 0, "unit_load.carton.mass_kg: 0 is not above 0 kg"),
+    ("test.k_g", 0, "test.k_g: 0 is not above 0 g"),
+    ("test.mode", "reverse", "test.mode: 'reverse' is not one of accelerate, brake"),
+    ("test.type", "tilt", "test.type: 'tilt' needs a stack section"),
+])
+def test_unit_load_bad_values(tmp_path, capsys, path, value, message):
+    d = small_pallet()
+    loadfile.set_path(d, path, value)
+    assert cli.main(["check", str(write(tmp_path, d))]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_stack_and_unit_load_exclude_each_other(tmp_path, capsys):
+    d = small_pallet()
+    d["stack"] = short_tilt()["stack"]
+    assert cli.main(["check", str(write(tmp_path, d))]) == 2
+    assert "give either a stack" in capsys.readouterr().err
+
+
+def test_eumos_run_pass_fail_and_outputs(tmp_path):
+    # Two layers of cartons 0.3 m along the pulse and 0.25 m high: a column tips at a/g = b/h =
+    # 0.15 / 0.25 = 0.6 and the cartons slide on each other from mu = 0.4. At 0.1 g nothing
+    # moves; at 0.8 g the load must fail (the C suite finds the 4-layer load's k-value 0.31 g).
+    a = cli.main(["run", str(write(tmp_path, small_pallet(**{"test.k_g": 0.1}))), "-o",
+                  str(tmp_path / "a"), "-q"])
+    assert a == 0
+    v = json.loads((tmp_path / "a" / "verdict.json").read_text())
+    assert v["test"] == "eumos" and v["passed"] and len(v["criteria"]) == 5
+    # The drive delivered what the standard asks: k g within 50 ms, held 0.3 s.
+    assert v["rise_measured_s"] <= 0.05 and v["time_at_level_s"] >= 0.3
+    assert v["peak_level_g"] == pytest.approx(0.1, rel=1e-6)
+    with open(tmp_path / "a" / "timeseries.csv") as f:
+        header = next(csv.reader(f))
+    assert header[:2] == ["t [s]", "platform_acceleration [g]"] and "layer2_displacement [mm]" in header
+    for name in ("report.html", "displacement.png", "drive.png"):
+        assert (tmp_path / "a" / name).stat().st_size > 1000, name
+    b = cli.main(["run", str(write(tmp_path, small_pallet(**{"test.k_g": 0.8}), "b.json")),
+                  "-o", str(tmp_path / "b"), "-q"])
+    assert b == 1
+    v = json.loads((tmp_path / "b" / "verdict.json").read_text())
+    assert not v["passed"] and not v["criteria"][0]["passed"]
+
+
+def test_kvalue_command(tmp_path, capsys):
+    d = small_pallet()
+    assert cli.main(["kvalue", str(write(tmp_path, d)), "--k-low", "0.1", "--k-high", "0.8",
+                     "--tolerance", "0.1", "-o", str(tmp_path), "-q"]) == 0
+    k = json.loads((tmp_path / "kvalue.json").read_text())
+    # The bracket closes on the k-value: passed at k_value, failed at k_fail, within 0.1 g.
+    assert 0.1 <= k["k_value_g"] < k["k_fail_g"] <= 0.8
+    assert k["k_fail_g"] - k["k_value_g"] <= 0.1 + 1e-9
+    assert "k-value" in capsys.readouterr().out
+    assert cli.main(["kvalue", str(LOADS / "two_cubes_R.json")]) == 2

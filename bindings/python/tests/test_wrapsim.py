@@ -126,7 +126,14 @@ STRUCTS = {
     "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo, "ws_law_info": L.LawInfo,
     "ws_containment_band": L.ContainmentBand,
     "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
-    "ws_element_output": L.ElementOutput,
+    "ws_element_output": L.ElementOutput, "ws_vtk_series_def": L.VtkSeriesDef,
+    "ws_load_interface": L.LoadInterface, "ws_load_def": L.LoadDef, "ws_load_info": L.LoadInfo,
+    "ws_load_carton": L.LoadCarton, "ws_load_carton_state": L.LoadCartonState,
+    "ws_wrap_def": L.WrapDef, "ws_loadtest_interface_state": L.LoadtestInterfaceState,
+    "ws_loadtest_sample": L.LoadtestSample, "ws_eumos_def": L.EumosDef,
+    "ws_loadtest_event": L.LoadtestEvent, "ws_loadtest_criterion": L.LoadtestCriterion,
+    "ws_eumos_verdict": L.EumosVerdict, "ws_eumos_result": L.EumosResult,
+    "ws_kvalue_def": L.KvalueDef, "ws_kvalue_result": L.KvalueResult,
 }
 
 
@@ -172,7 +179,7 @@ def test_struct_fields_match_headers():
 def test_version_and_features():
     assert ws.version_number() >= L.REQUIRED_VERSION
     assert ws.version().count(".") == 2
-    assert ws.build_features() & ~ws.WS_FEATURE_CCD == 0
+    assert ws.build_features() & ~(ws.WS_FEATURE_CCD | ws.WS_FEATURE_ZLIB) == 0
     assert ws.status_string(ws.WS_ERR_STALE_HANDLE).startswith("WS_ERR_STALE_HANDLE")
 
 
@@ -343,6 +350,29 @@ def test_box_rests_at_layer_gap():
         assert f[2] == pytest.approx(m * g, rel=1e-4)
         assert w.energy()["kinetic"] < 1e-9
         assert w.stats()["contacts"] == 4
+        # at rest: nothing slides, nothing at the friction cap, no anchor (regularised law)
+        assert (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        assert (c["anchor_deflection"] == 0).all()
+        # the margin: dt over the pair's bound, 2 / sqrt(8 k / m) for a box on a slab
+        assert w.stats()["body_step_use"] == pytest.approx(
+            w.dt / w.estimate_stable_dt(), rel=1e-12)
+        assert 0 < w.stats()["body_step_use"] < 1
+
+
+def test_stick_contacts_report_their_anchors():
+    # a box on a slab tilted by 10 deg of gravity, stick friction mu = 0.3: it holds, each
+    # anchor spring carrying its share of m g sin(10 deg) (the deflection times stick_stiffness)
+    k, m, g, th = 2e5, 5.0, 9.81, np.radians(10.0)
+    with ws.World(gravity=(g * np.sin(th), 0, -g * np.cos(th))) as w:
+        w.set_default_contact(stiffness=k, damping=50.0, friction=0.3, friction_model="stick")
+        assert w.get_contact(w.default_material, w.default_material)["stick_damping_ratio"] == 1.0
+        w.body(w.box(1.0, 1.0, 0.05), type="kinematic", position=(0, 0, -0.025))
+        w.body(w.box(0.25, 0.25, 0.25), mass=m, position=(0, 0, 0.125 + 2e-3 - m * g / (4 * k)))
+        w.step(4000)
+        c = w.contacts()
+        assert len(c) == 4 and (c["slipping"] == 0).all() and (c["at_cap"] == 0).all()
+        pull = (c["anchor_deflection"][:, 0] * k).sum()  # on the box: -k d, d along +x
+        assert abs(pull) == pytest.approx(m * g * np.sin(th), rel=1e-3)
 
 
 def test_workers_give_the_same_state():
@@ -352,7 +382,7 @@ def test_workers_give_the_same_state():
         with ws.World(worker_count=workers) as w:
             law = w.law("linear_elastic", stiffness=200.0, name="film")
             w.web_sheet(law, nx=40, ny=30, spacing_x=0.01, spacing_y=0.01, prestretch_x=0.02,
-                        prestretch_y=0.02, node_mass=1e-3, substeps=2, name="sheet")
+                        prestretch_y=0.02, node_mass=1e-3, substeps=4, name="sheet")
             w.step(50)
             return w.state_hash()
     one = run(1)
@@ -368,7 +398,7 @@ def test_sheet_tensions_are_ea_times_prestretch():
         edge = [i + nx * j for j in range(ny) for i in range(nx)
                 if i in (0, nx - 1) or j in (0, ny - 1)]
         web = w.web_sheet(law, nx=nx, ny=ny, spacing_x=0.01, spacing_y=0.01, prestretch_x=pre,
-                          prestretch_y=pre, node_mass=1e-3, substeps=4, pinned=edge, name="sheet")
+                          prestretch_y=pre, node_mass=1e-3, substeps=8, pinned=edge, name="sheet")
         info = web.info()
         assert (info["nx"], info["ny"], info["closed"]) == (nx, ny, 0)
         assert web.node_count == nx * ny
@@ -564,7 +594,7 @@ def build_tilt(wrapped=False):
         w.set_contact(film_mat, box_mat, **fc)
         w.set_contact(film_mat, plane_mat, **fc)
         film = w.web_band(around, [bottom, top], law_cross=up, node_mass=1e-3,
-                          contact_layer=layer, material=film_mat, substeps=1, name="film",
+                          contact_layer=layer, material=film_mat, substeps=2, name="film",
                           z_bottom=z0, z_top=z1, n_around=n_around, n_up=n_up,
                           prestretch_around=0.4, prestretch_up=0.2)
     return w, plane, stop, bottom, top, film
@@ -674,8 +704,9 @@ def test_tilt_table_wrapped_matches_c(tilt_exe):
 # --- save and restore ----------------------------------------------------------------------------
 def build_relaxing_sheet(n=8):
     """A box on the ground under a falling sheet whose springs relax (a Prony law: a history in
-    every spring), full detection every 3rd step."""
-    w = ws.World(dt=2.5e-4, detection_interval=3)
+    every spring), full detection every 3rd step; one film sub-step near its bound (the check at
+    the bound itself, as the C suite's twin)."""
+    w = ws.World(dt=2.5e-4, detection_interval=3, stable_fraction=1.0)
     ground = w.body(w.box(2.0, 2.0, 0.05), type="kinematic", position=(0, 0, -0.025))
     box = w.body(w.box(0.25, 0.25, 0.25), mass=5.0, position=(0, 0, 0.126))
     law = w.law("relaxation", stiffness=100.0, prony_stiffness=[300.0, 200.0],
@@ -766,6 +797,7 @@ def test_world_and_body_api(tmp_path):
         assert w.dt == pytest.approx(1e-4)
         w.dt = 2e-4
         assert w.dt == pytest.approx(2e-4)
+        assert w.stable_fraction == 0.5  # the default (world.h)
         w.set_gravity((0, 0, -9.81))
         w.gravity = (0, 0, -9.81)
         assert w.user_data == 1234
@@ -835,14 +867,15 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert law.evaluate(0.0, 2.0)[0] == pytest.approx(0.2)
         assert law.evaluate(0.0, 2.0)[2] == pytest.approx(0.1)
         sheet = w.web_sheet(law, law_shear=shear, nx=4, ny=3, spacing_x=0.05, spacing_y=0.05,
-                            shear=1, node_mass=0.01, pinned=[0, 3])
+                            shear=1, node_mass=0.01, substeps=2, pinned=[0, 3])
         pos = np.array([[0, 0, 1], [0.1, 0, 1], [0.2, 0, 1]], float)
         rope = w.web_mesh(law, pos, [[0, 1], [1, 2]], node_masses=[1e-2] * 3,
-                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3)
+                          rest_lengths=[0.09, 0.09], kinds=[0, 0], pinned=[0], node_mass=1e-3,
+                          substeps=2)
         assert rope.node_count == 3 and rope.info()["nx"] == 0
         assert np.allclose(rope.strains(), 0.1 / 0.09 - 1)
         crate = w.body(w.box(0.2, 0.2, 0.2), mass=1.0, position=(1, 1, 0.1))
-        band = w.web_band(law, [crate], node_mass=1e-3, substeps=8, z_bottom=0.02, z_top=0.18,
+        band = w.web_band(law, [crate], node_mass=1e-3, substeps=12, z_bottom=0.02, z_top=0.18,
                           n_around=12, n_up=4, prestretch_around=0.2, prestretch_up=0.1)
         assert band.info()["closed"] == 1
         assert band.containment(2)["hoop_tension"].min() > 0
@@ -859,6 +892,19 @@ def test_webs_laws_and_vtk_series(tmp_path):
         assert (tmp_path / "run.pvd").exists()
         sheet.write_vtp(tmp_path / "sheet.vtp")
         assert (tmp_path / "sheet.vtp").exists()
+        # Strides: a call every 10 ms from t = 17.5 ms, every 2nd call offered (17.5, 37.5,
+        # 57.5, 77.5, 97.5 ms) and at most one frame per 25 ms slot (slots 0, 1, 2, 3, 3).
+        with w.vtk_series(tmp_path, "strided", format="ascii", frame_stride=2,
+                          time_stride=0.025, springs=1) as strided:
+            for _ in range(10):
+                w.step(40)  # 10 ms at dt 0.25 ms
+                strided.write_frame()
+            assert strided.frame_count == 4
+        assert (tmp_path / "strided_000000_springs1.vtp").exists()
+        with pytest.raises(ws.WrapsimError) as err:
+            w.vtk_series(tmp_path, "bad", frame_stride=0)
+        assert err.value.status == ws.WS_ERR_INVALID_ARGUMENT
+        assert "frame_stride" in err.value.detail
         open_series = w.vtk_series(tmp_path, "left-open")  # closed with the world
         open_series.write_frame()
         with pytest.raises(ws.WrapsimError) as err:
@@ -1100,6 +1146,65 @@ def test_elements_swap_invariance():
                                    b.angular_velocity])
     assert np.array_equal(run("invariant", False), run("invariant", True))
     assert np.abs(run("attached", False) - run("attached", True)).max() > 1e-3
+
+
+# --- loadtest.h: unit loads and the EUMOS test (the raw calls; no wrapper yet) -------------------
+def test_load_build_measure_wrap_and_eumos():
+    byref = ctypes.byref
+    with ws.World(detection_interval=10) as w:
+        ld = L.LoadDef()
+        LIB.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
+        ld.layers, ld.count_x, ld.count_y = 1, 2, 1
+        load = ctypes.c_void_p()
+        assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+        info = L.LoadInfo()
+        assert LIB.ws_load_get_info(load, byref(info)) == 0
+        assert (info.layers, info.cartons) == (1, 2)
+        assert LIB.ws_load_get_layer_count(load, 0) == 2
+        c = L.LoadCarton()
+        assert LIB.ws_load_get_carton(load, 0, 1, byref(c)) == 0 and c.ix == 1
+        n = ctypes.c_size_t()
+        assert LIB.ws_load_copy_cartons(load, None, 0, byref(n)) == 0 and n.value == 2
+        cartons = (L.LoadCarton * 2)()
+        assert LIB.ws_load_copy_cartons(load, cartons, 2, byref(n)) == 0
+        k, pts = ctypes.c_double(), ctypes.c_int()
+        assert LIB.ws_load_get_point_stiffness(load, 0, byref(k), byref(pts)) == 0
+        assert (k.value, pts.value) == (2e6 / 4, 4)
+        settled, took, drift = ctypes.c_int(), ctypes.c_double(), ctypes.c_double()
+        assert LIB.ws_load_settle(w.ptr, load, 0.05, 0.2, 1e-3, byref(settled), byref(took)) == 0
+        assert LIB.ws_load_get_drift(w.ptr, load, byref(drift)) == 0
+        assert LIB.ws_load_set_reference(w.ptr, load) == 0
+        states = (L.LoadCartonState * 2)()
+        assert LIB.ws_load_measure(w.ptr, load, states, 2, byref(n)) == 0
+        assert states[0].horizontal == 0.0
+        wr = L.WrapDef()
+        LIB.ws_wrap_def_init_sized(byref(wr), ctypes.sizeof(wr))
+        web = L.WebId()
+        assert LIB.ws_load_wrap_band(w.ptr, load, byref(wr), byref(web)) == 0, w.last_error
+        ed = L.EumosDef()
+        LIB.ws_eumos_def_init_sized(byref(ed), ctypes.sizeof(ed))
+        ed.k, ed.rise_time, ed.hold_time, ed.coast_time, ed.rest_after = 0.05, 0.01, 0, 0, 0
+        dd, dur = L.DriveDef(), ctypes.c_double()
+        assert LIB.ws_eumos_get_drive(byref(ed), byref(dd), byref(dur)) == 0
+        seen = []
+        cb = L.SampleFn(lambda user, smp: seen.append(smp.contents.level) or 0)
+        ed.on_sample = cb
+        res = L.EumosResult()
+        assert LIB.ws_loadtest_run_eumos(w.ptr, load, byref(ed), byref(res)) == 0, w.last_error
+        assert abs(res.peak_level - 0.05) < 1e-9 and max(seen) == pytest.approx(0.05)
+        assert getattr(res.verdict, "pass") == 1 and res.containment[1].line_load > 0
+        LIB.ws_load_destroy(load)
+    wd = L.WorldDef()
+    LIB.ws_world_def_init_sized(byref(wd), ctypes.sizeof(wd))
+    wd.detection_interval = 10
+    ed.on_sample = L.SampleFn()
+    kd = L.KvalueDef()
+    LIB.ws_kvalue_def_init_sized(byref(kd), ctypes.sizeof(kd))
+    kd.k_low, kd.k_high, kd.tolerance, kd.settle_time = 0.05, 0.1, 0.06, 0.05
+    kr = L.KvalueResult()
+    assert LIB.ws_loadtest_find_k(byref(wd), byref(ld), byref(ed), byref(kd), byref(kr)) == 0, \
+        kr.error
+    assert kr.runs == 2 and kr.k_value == 0.1
 
 
 # --- last: the whole table was exercised ---------------------------------------------------------

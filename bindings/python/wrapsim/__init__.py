@@ -7,6 +7,7 @@ text. See README.md next to this package.
 """
 
 import ctypes
+import operator
 import os
 from ctypes import byref, c_double, c_int, c_size_t, c_uint32, c_uint64, POINTER
 
@@ -34,6 +35,9 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_DRIVE_PULSE, WS_DRIVE_IMPACT, WS_DRIVE_TABLE, WS_DRIVE_RANDOM, WS_DRIVE_SWEEP,
     WS_PULSE_ACCELERATE, WS_PULSE_BRAKE, WS_SWEEP_LOG, WS_SWEEP_LINEAR, WS_TRUCK_LOW,
     WS_TRUCK_MEDIUM, WS_TRUCK_HIGH, WS_STANDARD_GRAVITY)
+from ._lib import (  # noqa: F401  (re-exported constants)
+    WS_FEATURE_ZLIB, WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII, WS_VTK_DEFAULT_BANDS,
+    WS_VTK_MAX_BANDS)
 from ._run import run  # noqa: F401
 
 __all__ = ["World", "Shape", "Material", "Body", "Law", "Web", "VtkSeries", "WrapsimError",
@@ -60,7 +64,7 @@ def _c():
 
 def status_string(status):
     """The library's text for a status, e.g. "WS_ERR_STALE_HANDLE: ..."."""
-    return _c().ws_status_string(int(status)).decode()
+    return _c().ws_status_string(_int(status, c_int, "status")).decode()
 
 
 def version():
@@ -117,6 +121,83 @@ def _mat3(v):
     return m
 
 
+# --- argument checks ----------------------------------------------------------------------------
+# ctypes truncates integers silently (a c_int given 2**32 + 8 gets 8) and a C call reads as many
+# items as the count it is given, whatever the array holds. Every integer and every array that
+# crosses into C goes through one of the two checks below first.
+
+def _c_range(ctype):
+    """(lowest, highest) value of a ctypes integer type."""
+    bits = 8 * ctypes.sizeof(ctype)
+    if ctype is ctypes.c_void_p or ctype(-1).value != -1:
+        return 0, (1 << bits) - 1
+    return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
+
+
+def _int(value, ctype, what):
+    """`value` as a Python int that fits the C type: TypeError when it is not an integer (a
+    float is not taken: it would be truncated), OverflowError when it is out of the type's
+    range; the message names `what`."""
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{what}: expected an integer, got {value!r} "
+                        f"({type(value).__name__})") from None
+    lo, hi = _c_range(ctype)
+    if not lo <= v <= hi:
+        raise OverflowError(f"{what}: {v} is outside {lo}..{hi} (C {ctype.__name__})")
+    return v
+
+
+def _array(value, what, dtype, cols=None, length=None, per=None, bound=None):
+    """`value` as a C-contiguous numpy array of `dtype` for a C call.
+
+    cols: rows of that many values (a flat sequence is cut into rows). length: the number of
+    rows (or values) the C call will read for it, `per` saying of what ("one per spring");
+    ValueError when it has another. Integer dtypes take integers only (TypeError for floats,
+    which would be truncated), each in 0..bound-1 when `bound` is given (ValueError) and in the
+    dtype's range (OverflowError)."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError) as e:  # ragged rows and the like: say which argument
+        raise type(e)(f"{what}: {e}") from None
+    dt = np.dtype(dtype)
+    if dt.kind in "iu":
+        if a.size and a.dtype.kind not in "iuO":
+            raise TypeError(f"{what}: expected integers, got {a.dtype} values")
+        if a.size:
+            if a.dtype.kind == "O":
+                flat = [_int(x, ctypes.c_int64 if dt.kind == "i" else ctypes.c_uint64, what)
+                        for x in a.reshape(-1)]
+                lo, hi = min(flat), max(flat)
+            else:
+                lo, hi = int(a.min()), int(a.max())
+            info = np.iinfo(dt)
+            if bound is not None and (lo < 0 or hi >= bound):
+                bad = lo if lo < 0 else hi
+                raise ValueError(f"{what}: index {bad} is outside 0..{bound - 1}")
+            if lo < info.min or hi > info.max:
+                bad = lo if lo < info.min else hi
+                raise OverflowError(f"{what}: {bad} is outside {info.min}..{info.max} ({dt})")
+        a = np.asarray(a, dtype=dt) if a.dtype.kind != "O" else np.array(a.tolist(), dtype=dt)
+    else:
+        try:
+            a = np.asarray(a, dtype=dt)
+        except (TypeError, ValueError) as e:
+            raise type(e)(f"{what}: {e}") from None
+    if cols is not None:
+        if a.size % cols:
+            raise ValueError(f"{what}: expected rows of {cols} values, got {a.size} values")
+        a = a.reshape(-1, cols)
+    else:
+        a = a.reshape(-1)
+    if length is not None and len(a) != length:
+        unit = "rows" if cols is not None else "values"
+        raise ValueError(f"{what}: expected {length} {unit}"
+                         + (f" ({per})" if per else "") + f", got {len(a)}")
+    return np.ascontiguousarray(a)
+
+
 def _id_of(v, idtype):
     if v is None:
         return idtype(0)
@@ -124,7 +205,7 @@ def _id_of(v, idtype):
         return idtype(v._id.bits)
     if isinstance(v, L._Id):
         return idtype(v.bits)
-    return idtype(int(v))
+    return idtype(_int(v, c_uint64, f"{idtype.__name__}"))
 
 
 def _convert(struct, name, ftype, value):
@@ -148,6 +229,10 @@ def _convert(struct, name, ftype, value):
             raise ValueError(f"{type(struct).__name__}.{name}: unknown value {value!r}"
                              + (f" (one of {', '.join(names)})" if names else ""))
         return names[value.lower()]
+    if ftype is ctypes.c_void_p and value is None:
+        return None
+    if isinstance(ftype, type) and issubclass(ftype, ctypes._SimpleCData):
+        return _int(value, ftype, f"{type(struct).__name__}.{name}")
     return int(value)
 
 
@@ -214,7 +299,8 @@ CONTACT_DTYPE = np.dtype([
     ("body_a", np.uint64), ("body_b", np.uint64), ("point", np.float64, 3),
     ("normal", np.float64, 3), ("overlap", np.float64), ("normal_force", np.float64),
     ("friction_force", np.float64, 3), ("slip_velocity", np.float64, 3), ("kind", np.int32),
-    ("slipping", np.int32)])
+    ("slipping", np.int32), ("at_cap", np.int32), ("reserved_", np.int32),
+    ("anchor_deflection", np.float64, 3)])
 assert CONTACT_DTYPE.itemsize == ctypes.sizeof(L.ContactInfo)
 
 #: numpy layout of ws_containment_band.
@@ -405,10 +491,11 @@ class World:
     # stepping and state
     def step(self, n=1):
         """Take n steps of dt (one ws_world_step for n == 1, else ws_world_step_n)."""
+        n = _int(n, ctypes.c_int64, "step count")
         if n == 1:
             self._call("ws_world_step")
         else:
-            self._call("ws_world_step_n", int(n))
+            self._call("ws_world_step_n", n)
 
     @property
     def time(self):
@@ -427,6 +514,14 @@ class World:
     @dt.setter
     def dt(self, value):
         self._call("ws_world_set_dt", float(value))
+
+    @property
+    def stable_fraction(self):
+        """The film's stable-step safety factor (a web runs while dt / substeps is at most
+        this times its stable sub-step)."""
+        f = c_double()
+        self._call("ws_world_get_stable_fraction", byref(f))
+        return f.value
 
     def set_gravity(self, g):
         """Gravity, m/s^2."""
@@ -501,7 +596,8 @@ class World:
     def set_contact(self, a, b, **params):
         """Contact parameters between materials a and b: ws_contact_def fields (stiffness N/m,
         damping kg/s, friction, friction_vlim m/s, friction_model, stick_stiffness,
-        stick_damping); the others keep ws_contact_def_init's defaults."""
+        stick_damping kg/s, or 0 for stick_damping_ratio of critical); the others keep
+        ws_contact_def_init's defaults."""
         d = _make(L.ContactDef, params)
         self._call("ws_world_set_contact", _id_of(a, L.MaterialId), _id_of(b, L.MaterialId),
                    byref(d))
@@ -530,15 +626,15 @@ class World:
     def cylinder(self, radius, height, segments=32):
         """A prism approximating a cylinder along z (m), `segments` sides."""
         out = L.ShapeId()
-        self._call("ws_shape_create_cylinder", float(radius), float(height), int(segments),
-                   byref(out))
+        self._call("ws_shape_create_cylinder", float(radius), float(height),
+                   _int(segments, c_int, "cylinder segments"), byref(out))
         return Shape(self, out)
 
     def mesh(self, vertices, triangles):
         """A closed mesh shape: vertices (n, 3) in m, triangles (m, 3) indices, counter-
         clockwise seen from outside."""
-        v = np.ascontiguousarray(vertices, dtype=np.float64).reshape(-1, 3)
-        t = np.ascontiguousarray(triangles, dtype=np.uint32).reshape(-1, 3)
+        v = _array(vertices, "mesh vertices", np.float64, cols=3)
+        t = _array(triangles, "mesh triangles", np.uint32, cols=3, bound=len(v))
         d = _make(L.MeshDef, {})
         d.vertices = _ptr(v, c_double)
         d.vertex_count = len(v)
@@ -547,6 +643,25 @@ class World:
         out = L.ShapeId()
         self._call("ws_shape_create_mesh", byref(d), byref(out))
         return Shape(self, out)
+
+    def mesh_from_file(self, path, scale=1.0, weld_tol=1e-6, flip=False, file_format=None):
+        """A closed mesh shape read from an STL (ASCII or binary), OBJ or PLY file (needs
+        meshio). `scale` turns the file's numbers into metres (0.001 for a file in mm);
+        vertices closer than `weld_tol` times the mesh's size are welded into one (STL repeats
+        every vertex in each of its triangles); `flip` reverses an inside-out mesh. Like every
+        mesh, the shape is re-centred on its volume centroid: create its body at
+        `shape.centroid_offset` (identity orientation) to put it where the file had it. Raises
+        wrapsim.meshfile.MeshFileError (a WrapsimError) naming the file, and for a mesh the
+        library refuses, the offending edge's vertex positions in the file's units."""
+        from . import meshfile
+        v, t = meshfile.read_mesh(path, scale=scale, weld_tol=weld_tol, flip=flip,
+                                  file_format=file_format)
+        try:
+            return self.mesh(v, t)
+        except WrapsimError as e:
+            if e.status != WS_ERR_BAD_MESH:
+                raise
+            raise meshfile.refused(str(path), e, v, t, float(scale), float(weld_tol)) from e
 
     # bodies
     def body(self, shape, **kwargs):
@@ -571,7 +686,7 @@ class World:
 
     def body_by_id(self, bits):
         """The Body for a body id's 64 bits (e.g. from contacts()['body_a'])."""
-        bits = int(bits)
+        bits = _int(bits, c_uint64, "body id")
         b = self._bodies.get(bits)
         if b is None:
             b = self._bodies[bits] = Body(self, L.BodyId(bits))
@@ -586,7 +701,8 @@ class World:
     def contacts(self):
         """Active contacts of the last step as a numpy structured array (CONTACT_DTYPE): body_a,
         body_b (id bits; see body_by_id), point, normal, overlap, normal_force, friction_force,
-        slip_velocity, kind, slipping. Forces are those on body_b."""
+        slip_velocity, kind, slipping (sliding), at_cap (friction at mu N this step),
+        anchor_deflection (stick model, m). Forces are those on body_b."""
         n = c_size_t()
         self._call("ws_world_copy_contacts", None, 0, byref(n))
         buf = np.zeros(n.value, dtype=CONTACT_DTYPE)
@@ -628,31 +744,48 @@ class World:
         kwargs["type"] = type
         keep = []  # arrays and callbacks that must live through (or beyond) the create call
 
-        def arr(value, ctype=c_double):
-            a = np.ascontiguousarray(np.asarray(value, dtype=float).reshape(-1))
+        def arr(name, length=None, per=None):
+            a = _array(kwargs[name], f"law {name}", np.float64, length=length, per=per)
             keep.append(a)
-            return a, _ptr(a, ctype)
+            kwargs[name] = _ptr(a, c_double)
+            return len(a)
 
-        for name in ("stiffness_matrix", "damping_matrix", "cubic_stiffnesses"):
+        # The library reads dim x dim matrices and dim stiffnesses; a dim it refuses reads none.
+        dim = _int(kwargs.get("dim", 1), c_int, "law dim")
+        known = dim if dim in (1, 3, 6) else None
+        for name, length, per in (("stiffness_matrix", known and known * known, "dim x dim"),
+                                  ("damping_matrix", known and known * known, "dim x dim"),
+                                  ("cubic_stiffnesses", known, "one per component")):
             if kwargs.get(name) is not None:
-                kwargs[name] = arr(kwargs[name])[1]
+                arr(name, length, per)
+        # Each pair of arrays shares one count, which the binding sets from their length.
         for xs, ys, count in (("table_strain", "table_force", "table_count"),
                               ("prony_stiffness", "prony_time", "prony_count"),
                               ("scale_times", "scale_factors", "scale_count")):
             n = None
             for name in (xs, ys):
                 if kwargs.get(name) is not None:
-                    a, p = arr(kwargs[name])
-                    n = len(a) if n is None else min(n, len(a))
-                    kwargs[name] = p
+                    n = arr(name, n, f"as many as {xs}" if name == ys and n is not None
+                            else None)
+            if count in kwargs:
+                given = _int(kwargs[count], c_size_t, f"law {count}")
+                if given != (n or 0):
+                    raise ValueError(f"law {count}: {given} does not match the arrays "
+                                     f"{xs}, {ys} ({n or 0} values); leave it out")
             if n is not None:
-                kwargs.setdefault(count, n)
+                kwargs[count] = n
         if kwargs.get("terms") is not None:
-            ids = (L.LawId * max(1, len(kwargs["terms"])))(
-                *[_id_of(t, L.LawId) for t in kwargs["terms"]])
+            terms = list(kwargs["terms"])
+            ids = (L.LawId * max(1, len(terms)))(*[_id_of(t, L.LawId) for t in terms])
             keep.append(ids)
-            kwargs.setdefault("term_count", len(kwargs["terms"]))
+            if "term_count" in kwargs and _int(kwargs["term_count"], c_size_t,
+                                               "law term_count") != len(terms):
+                raise ValueError(f"law term_count: {kwargs['term_count']} does not match the "
+                                 f"{len(terms)} terms; leave it out")
+            kwargs["term_count"] = len(terms)
             kwargs["terms"] = ctypes.cast(ids, POINTER(L.LawId))
+        elif kwargs.get("term_count"):
+            raise ValueError("law term_count: given without terms")
         callbacks = []
         scale_fn = kwargs.pop("scale_fn", None)
         user_fn = kwargs.pop("user_fn", None)
@@ -704,12 +837,17 @@ class World:
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
         prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""
         wk, sk = _split(kwargs, L.WebDef, L.SheetDef)
+        if "pinned_count" in sk:
+            raise TypeError("web_sheet: pinned_count is set from `pinned`; leave it out")
         wk["law"] = law
         wd = self._web_def(wk)
         sd = _make(L.SheetDef, sk)
         pins = None
-        if pinned is not None and len(pinned):
-            pins = np.ascontiguousarray(pinned, dtype=np.uint32).reshape(-1)
+        if pinned is not None:
+            # Node indices i + nx j: below nx ny when the grid is one the library takes.
+            nodes = sd.nx * sd.ny if sd.nx >= 1 and sd.ny >= 1 else None
+            pins = _array(pinned, "web_sheet pinned", np.uint32, bound=nodes)
+        if pins is not None and len(pins):
             sd.pinned = _ptr(pins, c_uint32)
             sd.pinned_count = len(pins)
         out = L.WebId()
@@ -721,6 +859,9 @@ class World:
         fields (z_bottom, z_top m, n_around, n_up, prestretch_around, prestretch_up, gap m,
         shear)."""
         wk, bk = _split(kwargs, L.WebDef, L.BandDef)
+        if "body_count" in bk:
+            raise TypeError("web_band: body_count is set from `bodies`; leave it out")
+        bodies = list(bodies)
         wk["law"] = law
         wd = self._web_def(wk)
         bd = _make(L.BandDef, bk)
@@ -741,25 +882,28 @@ class World:
         md = _make(L.WebMeshDef, {})
         keep = []
 
-        def arr(a, dtype, ctype, cols=None):
-            a = np.ascontiguousarray(a, dtype=dtype)
-            a = a.reshape(-1, cols) if cols else a.reshape(-1)
+        def arr(a, what, dtype, ctype, **check):
+            a = _array(a, f"web_mesh {what}", dtype, **check)
             keep.append(a)
             return a, _ptr(a, ctype)
 
-        pos, md.positions = arr(positions, np.float64, c_double, 3)
-        md.node_count = len(pos)
-        spr, md.springs = arr(springs, np.uint32, c_uint32, 2)
-        md.spring_count = len(spr)
+        pos, md.positions = arr(positions, "positions", np.float64, c_double, cols=3)
+        n = md.node_count = len(pos)
+        spr, md.springs = arr(springs, "springs", np.uint32, c_uint32, cols=2, bound=n)
+        m = md.spring_count = len(spr)
         if node_masses is not None:
-            _, md.node_masses = arr(node_masses, np.float64, c_double)
+            _, md.node_masses = arr(node_masses, "node_masses", np.float64, c_double,
+                                    length=n, per="one per node")
         if rest_lengths is not None:
-            _, md.rest_lengths = arr(rest_lengths, np.float64, c_double)
+            _, md.rest_lengths = arr(rest_lengths, "rest_lengths", np.float64, c_double,
+                                     length=m, per="one per spring")
         if kinds is not None:
-            _, md.kinds = arr(kinds, np.uint8, ctypes.c_uint8)
-        if pinned is not None and len(pinned):
-            pins, md.pinned = arr(pinned, np.uint32, c_uint32)
-            md.pinned_count = len(pins)
+            _, md.kinds = arr(kinds, "kinds", np.uint8, ctypes.c_uint8, length=m,
+                              per="one per spring", bound=3)
+        if pinned is not None:
+            pins, ptr = arr(pinned, "pinned", np.uint32, c_uint32, bound=n)
+            if len(pins):
+                md.pinned, md.pinned_count = ptr, len(pins)
         out = L.WebId()
         self._call("ws_web_create_mesh", byref(wd), byref(md), byref(out))
         return Web(self, out)
@@ -813,11 +957,23 @@ class World:
         """Write the bodies as one VTK PolyData file."""
         self._call("ws_world_write_vtp", str(path).encode())
 
-    def vtk_series(self, directory, basename):
-        """Start a .vtp/.pvd time series in `directory` (must exist). A context manager."""
+    def vtk_series(self, directory, basename, **kwargs):
+        """Start a time series for ParaView in `directory` (must exist): a .pvd over per-frame
+        .vtm multiblocks with the blocks bodies, film, contacts (and springs). Keyword arguments
+        are ws_vtk_series_def fields: format (WS_VTK_COMPRESSED, WS_VTK_BINARY, WS_VTK_ASCII or
+        "compressed", "binary", "ascii"), frame_stride, time_stride (s), springs, contacts,
+        containment_bands, double_precision. A context manager."""
+        if isinstance(kwargs.get("format"), str):
+            kwargs["format"] = {"compressed": L.WS_VTK_COMPRESSED, "binary": L.WS_VTK_BINARY,
+                                "ascii": L.WS_VTK_ASCII}[kwargs["format"].lower()]
+        d = _make(L.VtkSeriesDef, kwargs)
+        directory, basename = str(directory).encode(), str(basename).encode()
+        d.directory, d.basename = directory, basename
         p = L.Series_p()
-        self._call("ws_vtk_series_create", str(directory).encode(), str(basename).encode(),
-                   byref(p))
+        if kwargs:
+            self._call("ws_vtk_series_create_def", byref(d), byref(p))
+        else:
+            self._call("ws_vtk_series_create", directory, basename, byref(p))
         s = VtkSeries(self, p)
         self._series.append(s)
         return s
@@ -1245,7 +1401,7 @@ class Web(_Handle):
 
     @substeps.setter
     def substeps(self, n):
-        self._call("ws_web_set_substeps", int(n))
+        self._call("ws_web_set_substeps", _int(n, c_int, "substeps"))
 
     def _bulk(self, fn, n, shape, dtype, ctype, out):
         if out is None:
@@ -1296,8 +1452,13 @@ class Web(_Handle):
     def containment(self, bands):
         """Containment profile in `bands` equal height bands: structured array
         (CONTAINMENT_DTYPE: z_low, z_high m, hoop_tension N, line_load N/m, contact_force N)."""
-        out = np.zeros(int(bands), dtype=CONTAINMENT_DTYPE)
-        self._call("ws_web_get_containment", _ptr(out, L.ContainmentBand), int(bands))
+        n = _int(bands, c_size_t, "containment bands")
+        rows = self.info()["ny"]
+        if rows and not 1 <= n <= rows:
+            raise ValueError(f"containment bands: expected 1..{rows} (the web's rows), got {n}")
+        # A mesh web has no rows: the library refuses it, with room for one band meanwhile.
+        out = np.zeros(n if rows else 1, dtype=CONTAINMENT_DTYPE)
+        self._call("ws_web_get_containment", _ptr(out, L.ContainmentBand), len(out))
         return out
 
     def energy(self):
@@ -1327,7 +1488,7 @@ class VtkSeries:
             raise WrapsimError(s, _c().ws_world_last_error(self.world.ptr).decode())
 
     def write_frame(self):
-        """Write the world now as the next frame."""
+        """Offer the world now as the next frame: written when the series' strides allow it."""
         if not self._ptr:
             raise WrapsimError(WS_ERR_STALE_HANDLE, "the VTK series was closed")
         self._check(_c().ws_vtk_series_write_frame(self._ptr))

@@ -10,7 +10,7 @@ import ctypes.util
 import os
 import pathlib
 import sys
-from ctypes import (CFUNCTYPE, POINTER, Structure, c_char_p, c_double, c_int, c_int32,
+from ctypes import (CFUNCTYPE, POINTER, Structure, c_char, c_char_p, c_double, c_int, c_int32,
                     c_int64, c_size_t, c_uint, c_uint8, c_uint32, c_uint64, c_void_p)
 
 #: The oldest library this binding works with: major * 10000 + minor * 100 + patch.
@@ -36,6 +36,7 @@ WS_ERR_FORMAT = 13
 
 WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR = 0, 1, 2, 3
 WS_FEATURE_CCD = 1
+WS_FEATURE_ZLIB = 2
 WS_INTEGRATOR_SYMPLECTIC_EULER, WS_INTEGRATOR_PAPER_EXPLICIT = 0, 1
 WS_FRICTION_REGULARIZED, WS_FRICTION_STICK = 0, 1
 WS_BODY_DYNAMIC, WS_BODY_KINEMATIC = 0, 1
@@ -134,6 +135,7 @@ class WorldDef(Structure):
         ("log", LogFn),
         ("log_user", c_void_p),
         ("user_data", c_void_p),
+        ("stable_fraction", c_double),
         ("worker_count", c_uint32),
         ("enqueue_task", c_void_p),
         ("finish_task", c_void_p),
@@ -151,6 +153,7 @@ class ContactDef(Structure):
         ("friction_model", c_enum),
         ("stick_stiffness", c_double),
         ("stick_damping", c_double),
+        ("stick_damping_ratio", c_double),
     ]
 
 
@@ -176,7 +179,9 @@ class WorldStats(Structure):
         ("seconds_contacts", c_double),
         ("seconds_web", c_double),
         ("seconds_total", c_double),
-        ("reserved", c_uint64 * 4),
+        ("web_step_use", c_double),
+        ("body_step_use", c_double),
+        ("reserved", c_uint64 * 2),
     ]
 
 
@@ -303,6 +308,9 @@ class ContactInfo(Structure):
         ("slip_velocity", Vec3),
         ("kind", c_int32),
         ("slipping", c_int32),
+        ("at_cap", c_int32),
+        ("reserved_", c_int32),
+        ("anchor_deflection", Vec3),
     ]
 
 
@@ -442,6 +450,29 @@ class ContainmentBand(Structure):
     ]
 
 
+# --- io.h ----------------------------------------------------------------------------------------
+WS_VTK_COMPRESSED = 0
+WS_VTK_BINARY = 1
+WS_VTK_ASCII = 2
+WS_VTK_DEFAULT_BANDS = 10
+WS_VTK_MAX_BANDS = 256
+
+
+class VtkSeriesDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("directory", c_char_p),
+        ("basename", c_char_p),
+        ("format", c_int),
+        ("frame_stride", c_int),
+        ("time_stride", c_double),
+        ("springs", c_int),
+        ("contacts", c_int),
+        ("containment_bands", c_int),
+        ("double_precision", c_int),
+    ]
+
+
 # --- element.h -----------------------------------------------------------------------------------
 class ElementDef(Structure):
     _fields_ = [
@@ -479,9 +510,153 @@ class ElementOutput(Structure):
     ]
 
 
+# --- loadtest.h ----------------------------------------------------------------------------------
+LOAD_MAX_LAYERS = 32
+LOADTEST_MAX_EVENTS = 64
+
+
+class LoadInterface(Structure):
+    _fields_ = [
+        ("stiffness", c_double), ("damping", c_double), ("friction", c_double),
+        ("friction_vlim", c_double), ("friction_model", c_enum),
+        ("stick_stiffness", c_double), ("stick_damping", c_double),
+    ]
+
+
+class LoadDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("pallet_size", Vec3), ("pallet_mass", c_double),
+        ("carton_size", Vec3), ("carton_mass", c_double),
+        ("layers", c_int), ("count_x", c_int), ("count_y", c_int),
+        ("pattern", c_enum), ("gap", c_double), ("contact_layer", c_double),
+        ("stiffness_rule", c_enum),
+        ("carton_carton", LoadInterface), ("carton_pallet", LoadInterface),
+        ("pallet_platform", LoadInterface), ("film_carton", LoadInterface),
+        ("platform", BodyId), ("platform_material", MaterialId), ("origin", Vec3),
+        ("allocator", Allocator),
+    ]
+
+
+class LoadInfo(Structure):
+    _fields_ = [
+        ("platform", BodyId), ("pallet", BodyId),
+        ("carton_material", MaterialId), ("pallet_material", MaterialId),
+        ("platform_material", MaterialId), ("film_material", MaterialId),
+        ("layers", c_int), ("cartons", c_int),
+        ("load_height", c_double), ("pallet_top", c_double), ("total_mass", c_double),
+        ("film", WebId),
+    ]
+
+
+class LoadCarton(Structure):
+    _fields_ = [
+        ("body", BodyId), ("layer", c_int), ("index", c_int), ("ix", c_int), ("iy", c_int),
+        ("turned", c_int), ("size", Vec3),
+    ]
+
+
+class LoadCartonState(Structure):
+    _fields_ = [
+        ("displacement", Vec3), ("horizontal", c_double), ("tilt", c_double),
+        ("velocity", Vec3),
+    ]
+
+
+class WrapDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("gauge", c_double), ("modulus", c_double), ("density", c_double), ("layers", c_int),
+        ("strain_around", c_double), ("strain_up", c_double), ("z_bottom", c_double),
+        ("top_margin", c_double), ("node_pitch", c_double), ("node_mass", c_double),
+        ("substeps", c_int),
+    ]
+
+
+class LoadtestInterfaceState(Structure):
+    _fields_ = [
+        ("normal_force", c_double), ("slip_speed", c_double), ("friction_use", c_double),
+        ("contacts", c_int),
+    ]
+
+
+class LoadtestSample(Structure):
+    _fields_ = [
+        ("time", c_double), ("level", c_double), ("platform_velocity", c_double),
+        ("platform_position", c_double), ("cartons", c_size_t),
+        ("carton", POINTER(LoadCartonState)), ("layers", c_int),
+        ("layer_displacement", POINTER(c_double)), ("interfaces", c_int),
+        ("interface", POINTER(LoadtestInterfaceState)),
+    ]
+
+
+SampleFn = CFUNCTYPE(c_int, c_void_p, POINTER(LoadtestSample))
+
+
+class EumosDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("k", c_double), ("g", c_double), ("rise_time", c_double), ("hold_time", c_double),
+        ("mode", c_enum), ("stop_level", c_double), ("coast_time", c_double),
+        ("rest_before", c_double), ("rest_after", c_double), ("direction", Vec3),
+        ("slip_speed", c_double), ("sample_interval", c_int),
+        ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class LoadtestEvent(Structure):
+    _fields_ = [
+        ("type", c_int), ("layer", c_int), ("index", c_int), ("time", c_double),
+        ("level", c_double), ("value", c_double),
+    ]
+
+
+class LoadtestCriterion(Structure):
+    _fields_ = [("value", c_double), ("limit", c_double), ("pass", c_int)]
+
+
+class EumosVerdict(Structure):
+    _fields_ = [
+        ("load_height", c_double), ("elastic", LoadtestCriterion),
+        ("permanent", LoadtestCriterion), ("bottom", LoadtestCriterion),
+        ("layer_shift", LoadtestCriterion), ("rupture", LoadtestCriterion), ("pass", c_int),
+    ]
+
+
+class EumosResult(Structure):
+    _fields_ = [
+        ("k", c_double), ("duration", c_double), ("peak_level", c_double),
+        ("rise_measured", c_double), ("time_at_level", c_double), ("layers", c_int),
+        ("layer_max", c_double * LOAD_MAX_LAYERS),
+        ("layer_permanent", c_double * LOAD_MAX_LAYERS),
+        ("layer_tilt", c_double * LOAD_MAX_LAYERS),
+        ("interface_slip_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("interface_use_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("cartons_lost", c_int), ("event_count", c_int), ("events_dropped", c_int),
+        ("events", LoadtestEvent * LOADTEST_MAX_EVENTS), ("verdict", EumosVerdict),
+        ("containment", ContainmentBand * 3), ("film_peak_strain", c_double),
+    ]
+
+
+class KvalueDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("k_low", c_double), ("k_high", c_double), ("tolerance", c_double),
+        ("settle_time", c_double), ("wrap", POINTER(WrapDef)),
+    ]
+
+
+class KvalueResult(Structure):
+    _fields_ = [
+        ("k_value", c_double), ("k_fail", c_double), ("runs", c_int),
+        ("last_pass", EumosResult), ("error", c_char * 256),
+    ]
+
+
 # Opaque handles.
 World_p = c_void_p
 Series_p = c_void_p
+Load_p = c_void_p
 
 P = POINTER
 _st = c_enum  # ws_status
@@ -504,6 +679,7 @@ FUNCTIONS = [
     ("ws_world_get_time", [World_p, P(c_double)], _st),
     ("ws_world_get_dt", [World_p, P(c_double)], _st),
     ("ws_world_set_dt", [World_p, c_double], _st),
+    ("ws_world_get_stable_fraction", [World_p, P(c_double)], _st),
     ("ws_world_set_gravity", [World_p, P(Vec3)], _st),
     ("ws_world_get_stats", [World_p, P(WorldStats)], _st),
     ("ws_world_get_energy", [World_p, P(Energy)], _st),
@@ -617,6 +793,8 @@ FUNCTIONS = [
     ("ws_world_write_vtp", [World_p, c_char_p], _st),
     ("ws_web_write_vtp", [World_p, WebId, c_char_p], _st),
     ("ws_vtk_series_create", [World_p, c_char_p, c_char_p, P(Series_p)], _st),
+    ("ws_vtk_series_def_init_sized", [P(VtkSeriesDef), c_size_t], None),
+    ("ws_vtk_series_create_def", [World_p, P(VtkSeriesDef), P(Series_p)], _st),
     ("ws_vtk_series_write_frame", [Series_p], _st),
     ("ws_vtk_series_get_frame_count", [Series_p, P(c_size_t)], _st),
     ("ws_vtk_series_destroy", [Series_p], None),
@@ -624,6 +802,28 @@ FUNCTIONS = [
     ("ws_world_restore", [World_p, c_void_p, c_size_t], _st),
     ("ws_world_save_file", [World_p, c_char_p], _st),
     ("ws_world_restore_file", [World_p, c_char_p], _st),
+    # loadtest.h
+    ("ws_load_def_init_sized", [P(LoadDef), c_size_t], None),
+    ("ws_load_build", [World_p, P(LoadDef), P(Load_p)], _st),
+    ("ws_load_destroy", [Load_p], None),
+    ("ws_load_get_info", [Load_p, P(LoadInfo)], _st),
+    ("ws_load_get_layer_count", [Load_p, c_int], c_int),
+    ("ws_load_get_carton", [Load_p, c_int, c_int, P(LoadCarton)], _st),
+    ("ws_load_copy_cartons", [Load_p, P(LoadCarton), c_size_t, P(c_size_t)], _st),
+    ("ws_load_get_point_stiffness", [Load_p, c_int, P(c_double), P(c_int)], _st),
+    ("ws_load_set_reference", [World_p, Load_p], _st),
+    ("ws_load_measure", [World_p, Load_p, P(LoadCartonState), c_size_t, P(c_size_t)], _st),
+    ("ws_load_get_drift", [World_p, Load_p, P(c_double)], _st),
+    ("ws_load_settle", [World_p, Load_p, c_double, c_double, c_double, P(c_int), P(c_double)],
+     _st),
+    ("ws_wrap_def_init_sized", [P(WrapDef), c_size_t], None),
+    ("ws_load_wrap_band", [World_p, Load_p, P(WrapDef), P(WebId)], _st),
+    ("ws_eumos_def_init_sized", [P(EumosDef), c_size_t], None),
+    ("ws_eumos_get_drive", [P(EumosDef), P(DriveDef), P(c_double)], _st),
+    ("ws_loadtest_run_eumos", [World_p, Load_p, P(EumosDef), P(EumosResult)], _st),
+    ("ws_kvalue_def_init_sized", [P(KvalueDef), c_size_t], None),
+    ("ws_loadtest_find_k", [P(WorldDef), P(LoadDef), P(EumosDef), P(KvalueDef), P(KvalueResult)],
+     _st),
 ]
 
 #: The Defs and their sized inits (ws_*_def_init_sized(def, size)): the binding passes its
@@ -642,6 +842,7 @@ DEF_INITS = [
     ("ws_band_def_init_sized", BandDef),
     ("ws_web_mesh_def_init_sized", WebMeshDef),
     ("ws_element_def_init_sized", ElementDef),
+    ("ws_vtk_series_def_init_sized", VtkSeriesDef),
 ]
 
 

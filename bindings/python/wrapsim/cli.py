@@ -2,6 +2,7 @@
 
   wrapsim run LOAD.json [-o DIR]      run a load file's test; the verdict on stdout, and in DIR
                                       verdict.json, timeseries.csv, PNG plots, report.html
+  wrapsim kvalue LOAD.json [-o DIR]   the EUMOS k-value search of a unit load
   wrapsim check LOAD.json             check a load file without running it
   wrapsim sweep LOAD.json --vary KEY=VALUES [...] [--samples N --seed S]
                 [--scheduler ADDRESS] [--workers N] [-o DIR] [--resume]
@@ -30,7 +31,8 @@ def _info(args):
     except L.LibraryError as e:
         return _err(e)
     features = lib.ws_build_features()
-    names = [name for bit, name in ((L.WS_FEATURE_CCD, "libccd"),) if features & bit]
+    names = [name for bit, name in ((L.WS_FEATURE_CCD, "libccd"), (L.WS_FEATURE_ZLIB, "zlib"))
+             if features & bit]
     print(f"libwrapsim {lib.ws_version_string().decode()}")
     print(f"library:  {lib._wrapsim_path}")
     print(f"binding:  {L.BINDING_VERSION}")
@@ -58,7 +60,7 @@ def _run(args):
     report.write_all(out, d, result, series)
     print(f"{d['name']}: {'PASS' if result['passed'] else 'FAIL'}")
     for c in result["criteria"]:
-        m = "none" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}"
+        m = "none" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}".rstrip()
         print(f"  {'pass' if c['passed'] else 'FAIL'}  {c['criterion']}: measured {m}")
     print(f"  outputs in {out}/ (report.html, verdict.json, timeseries.csv)")
     return 0 if result["passed"] else 1
@@ -81,10 +83,32 @@ def _sweep(args):
             sys.stderr.flush()
 
     path = study.sweep(base, varies, out, args.samples, args.seed, args.scheduler,
-                       args.workers, args.resume, progress)
+                       args.workers, args.resume, progress, kvalue=args.kvalue)
     if not args.quiet:
         sys.stderr.write("\n")
     print(f"sweep: {len(runs)} runs; results in {path}")
+    return 0
+
+
+def _kvalue(args):
+    from . import eumos
+    try:
+        d = load(args.load)
+        if d["test"]["type"] != "eumos":
+            raise LoadFileError("test.type: the k-value search needs 'eumos'")
+    except LoadFileError as e:
+        return _err(e)
+    if not args.quiet:
+        print(f"{d['name']}: EUMOS k-value search from {args.k_low:g} to {args.k_high:g} g "
+              f"(to {args.tolerance:g} g)", file=sys.stderr)
+    k = eumos.find_k(d, args.k_low, args.k_high, args.tolerance)
+    print(f"{d['name']}: k-value {k['k_value_g']:.3f} g (fails at {k['k_fail_g']:.3f} g; "
+          f"{k['runs']} runs)")
+    if args.output:
+        import pathlib
+        out = pathlib.Path(args.output)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "kvalue.json").write_text(json.dumps(k, indent=2) + "\n")
     return 0
 
 
@@ -106,6 +130,14 @@ def build_parser():
     p.add_argument("-o", "--output", help="output folder (default wrapsim-out)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_run)
+    p = sub.add_parser("kvalue", help="the EUMOS k-value: the largest k g the load passes")
+    p.add_argument("load")
+    p.add_argument("--k-low", type=float, default=0.05, help="lowest k tried, g")
+    p.add_argument("--k-high", type=float, default=1.0, help="highest k tried, g")
+    p.add_argument("--tolerance", type=float, default=0.01, help="bracket width, g")
+    p.add_argument("-o", "--output", help="folder for kvalue.json")
+    p.add_argument("-q", "--quiet", action="store_true")
+    p.set_defaults(func=_kvalue)
     p = sub.add_parser("check", help="check a load file without running it")
     p.add_argument("load")
     p.set_defaults(func=_check)
@@ -120,6 +152,8 @@ def build_parser():
     p.add_argument("--workers", type=int, default=2, help="workers of the LocalCluster")
     p.add_argument("-o", "--output", help="output folder (default wrapsim-sweep)")
     p.add_argument("--resume", action="store_true", help="skip the runs already in results.csv")
+    p.add_argument("--kvalue", action="store_true",
+                   help="each run is an EUMOS k-value search (eumos load files)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress")
     p.set_defaults(func=_sweep)
     p = sub.add_parser("schema", help="print the load file's JSON Schema")

@@ -6,9 +6,10 @@ the unit of each key is in SPEC below, from which the JSON Schema (`wrapsim/load
 defaults and checks every value; a bad file raises LoadFileError whose message names the exact
 path and what is wrong, e.g. "wrap.prestretch_around_percent: -20 is below 0 %".
 
-The form of this version: a column of cartons (`stack`) on a platform (`platform`, optionally
-with a stop bar on its downhill side), the materials of each interface (`materials`), an
-optional film band (`wrap`), and the test (`test`, a tilt table) with its criteria.
+Two forms of load: a column of cartons (`stack`) on a tilt table (`platform`, optionally with a
+stop bar on its downhill side; `materials`, an optional film band `wrap`), or a unit load
+(`unit_load`: a pallet with layers of cartons, the interfaces, an optional wrap) for the EUMOS
+40509 test, which the C library's load-test module builds and judges. `test` says which test.
 """
 
 import copy
@@ -41,18 +42,17 @@ def _section(fields, optional=False, doc=""):
     return dict(kind="object", fields=fields, optional=optional, doc=doc)
 
 
-def _interface(mu, stiffness, damping):
+def _interface(mu, stiffness, damping, model="regularized", per="per contact point"):
     return _section({
-        "friction_model": _str(["regularized", "stick"], "regularized",
+        "friction_model": _str(["regularized", "stick"], model,
                                doc="regularized Coulomb (eq. 13; creeps below vlim) or the "
                                    "stick model (a tangential spring anchored at the contact)"),
         "mu": _num("", mu, 0.0, 10.0, doc="Coulomb friction coefficient"),
         "vlim_m_per_s": _num("m/s", 0.01, 0.0, 10.0, True,
                              doc="friction regularisation speed (eq. 13)"),
         "stiffness_N_per_m": _num("N/m", stiffness, 0.0, 1e12, True,
-                                  doc="normal penalty stiffness per contact point"),
-        "damping_kg_per_s": _num("kg/s", damping, 0.0, 1e9,
-                                 doc="normal damping per contact point"),
+                                  doc=f"normal penalty stiffness, {per}"),
+        "damping_kg_per_s": _num("kg/s", damping, 0.0, 1e9, doc=f"normal damping, {per}"),
     })
 
 
@@ -75,6 +75,50 @@ SPEC = _section({
             "thickness_m": _num("m", 0.02, 0.0, 10.0, True, doc="extent along x"),
         }, optional=True, doc="a bar along the downhill face of the bottom carton"),
     }),
+    "unit_load": _section({
+        "pallet": _section({
+            "length_m": _num("m", 1.2, 0.0, 10.0, True, doc="along x, the test's direction"),
+            "width_m": _num("m", 0.8, 0.0, 10.0, True),
+            "height_m": _num("m", 0.144, 0.0, 10.0, True),
+            "mass_kg": _num("kg", 25.0, 0.0, 1e4, True),
+        }, doc="EUR 1200 x 800 x 144 mm by default"),
+        "carton": _section({
+            "length_m": _num("m", 0.3, 0.0, 10.0, True, doc="along the pallet's length"),
+            "width_m": _num("m", 0.4, 0.0, 10.0, True),
+            "height_m": _num("m", 0.25, 0.0, 10.0, True),
+            "mass_kg": _num("kg", 10.0, 0.0, 1e5, True),
+        }),
+        "layers": _int(4, 1, 32),
+        "count_x": _int(4, 1, 256, doc="cartons along the pallet's length in a layer"),
+        "count_y": _int(2, 1, 256, doc="cartons across it"),
+        "pattern": _str(["column", "brick", "turned"], "column",
+                        doc="column stacking, or interlocked: bricks, or every second layer "
+                            "turned"),
+        "gap_m": _num("m", 0.003, 0.0, 1.0, doc="clear gap between neighbouring cartons"),
+        "contact_layer_m": _num("m", 1e-3, 0.0, 0.1, True),
+        "settle_s": _num("s", 1.0, 0.0, 100.0, True,
+                         doc="the load settles this long (and again after wrapping)"),
+        "interfaces": _section({
+            "carton_carton": _interface(0.4, 2e6, 2000.0, "stick", "per interface"),
+            "carton_pallet": _interface(0.45, 2e6, 2000.0, "stick", "per interface"),
+            "pallet_platform": _interface(0.8, 2e7, 2e4, "stick", "per interface"),
+            "film_carton": _interface(0.9, 4000.0, 1.0, "regularized", "per film node"),
+        }, doc="stiffness and damping of a whole face pair, spread over its contact points"),
+        "wrap": _section({
+            "gauge_um": _num("um", 20.0, 0.0, 1000.0, True, doc="film thickness"),
+            "modulus_MPa": _num("MPa", 150.0, 0.0, 1e5, True),
+            "density_kg_per_m3": _num("kg/m^3", 920.0, 0.0, 1e4, True),
+            "layers": _int(3, 1, 100, doc="film layers on top of each other"),
+            "strain_around_percent": _num("%", 10.0, -99.0, 1000.0,
+                                          doc="the strain the film holds on the load around"),
+            "strain_up_percent": _num("%", 2.0, -99.0, 1000.0),
+            "z_bottom_m": _num("m", 0.03, 0.0, 100.0, doc="lowest row above the platform"),
+            "top_margin_m": _num("m", 0.03, 0.0, 100.0),
+            "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
+            "node_mass_kg": _num("kg", 2e-3, 0.0, 10.0,
+                                 doc="per node; 0 for the film's real mass"),
+        }, optional=True, doc="a band of film around the load (absent: unwrapped)"),
+    }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
         "carton": _section({
             "length_m": _num("m", None, 0.0, 10.0, True),
@@ -84,7 +128,7 @@ SPEC = _section({
         }),
         "layers": _int(None, 1, 50, doc="cartons stacked in one column"),
         "contact_layer_m": _num("m", 1e-3, 0.0, 0.1, True, doc="contact layer of every body"),
-    }),
+    }, optional=True, doc="a column of cartons on a tilt table"),
     "materials": _section({
         "carton_carton": _interface(0.3, 2e5, 10.0),
         "carton_platform": _interface(0.3, 2e5, 10.0),
@@ -102,7 +146,13 @@ SPEC = _section({
         "node_mass_kg": _num("kg", 1e-3, 0.0, 10.0, True),
     }, optional=True, doc="a band of film around the stack (absent: unwrapped)"),
     "test": _section({
-        "type": _str(["tilt"], "tilt", doc="tilt table (ISO 10531)"),
+        "type": _str(["tilt", "eumos"], "tilt",
+                     doc="tilt table (ISO 10531; a stack) or EUMOS 40509 (a unit_load)"),
+        "k_g": _num("g", 0.3, 0.0, 10.0, True, doc="eumos: the plateau acceleration"),
+        "mode": _str(["accelerate", "brake"], "accelerate",
+                     doc="eumos: a pulse from rest, or a run-up then braking at k g"),
+        "rise_s": _num("s", 0.04, 0.0, 1.0, True, doc="eumos: the rise to k g (<= 0.05)"),
+        "hold_s": _num("s", 0.35, 0.0, 100.0, doc="eumos: the plateau (>= 0.3)"),
         "start_s": _num("s", 1.0, 0.0, 1e6, doc="the tilt starts (smoothly) at this time"),
         "rate_deg_per_s": _num("deg/s", math.degrees(0.1), 0.0, 90.0, True),
         "duration_s": _num("s", 7.0, 0.0, 1e6, True, doc="simulated time"),
@@ -176,6 +226,16 @@ def _check_section(spec, value, path):
 
 def _cross_checks(d):
     """What one key alone cannot say."""
+    if (d["stack"] is None) == (d["unit_load"] is None):
+        raise LoadFileError("stack: give either a stack (a column on a tilt table) or a "
+                            "unit_load (a pallet with layers of cartons), not both or neither")
+    kind = d["test"]["type"]
+    if kind == "eumos" and d["unit_load"] is None:
+        raise LoadFileError("test.type: 'eumos' needs a unit_load section")
+    if kind == "tilt" and d["stack"] is None:
+        raise LoadFileError("test.type: 'tilt' needs a stack section")
+    if d["stack"] is None:
+        return
     c = d["stack"]["carton"]
     height = d["stack"]["layers"] * c["height_m"]
     w = d["wrap"]

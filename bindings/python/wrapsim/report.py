@@ -10,7 +10,8 @@ import numpy as np
 
 def _unit_header(col):
     """`carton1_slip_mm` -> `carton1_slip [mm]`: the unit in every header."""
-    for suffix, unit in (("_mm", "mm"), ("_deg", "deg"), ("_s", "s"), ("_N", "N")):
+    for suffix, unit in (("_mm", "mm"), ("_deg", "deg"), ("_m_per_s", "m/s"), ("_g", "g"),
+                         ("_s", "s"), ("_N", "N")):
         if col.endswith(suffix):
             return f"{col[:-len(suffix)]} [{unit}]"
     return col
@@ -23,6 +24,61 @@ def write_series(path, series):
     np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
 
 
+def _eumos_plots(plt, folder, d, result, series):
+    t = series["t_s"]
+    H = 1e3 * result["load_height_m"]
+    names = []
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    k = 1
+    while f"layer{k}_displacement_mm" in series:
+        ax.plot(t, series[f"layer{k}_displacement_mm"], label=f"layer {k}")
+        k += 1
+    for sign in (1, -1):
+        ax.axhline(sign * 0.10 * H, color="tab:red", ls="--", lw=1,
+                   label="elastic limit 10 % H" if sign > 0 else None)
+        ax.axhline(sign * 0.05 * H, color="tab:orange", ls=":", lw=1,
+                   label="permanent limit 5 % H" if sign > 0 else None)
+    for e in result["events"]:
+        ax.axvline(e["t_s"], color="0.6", lw=0.6)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("layer displacement relative to the pallet [mm]")
+    ax.set_title(f"EUMOS 40509 at {result['k_g']:g} g: layers against the pallet "
+                 f"(grey: slip, tip and loss events)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(folder / "displacement.png", dpi=110)
+    plt.close(fig)
+    names.append("displacement.png")
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.plot(t, series["platform_acceleration_g"], label="delivered")
+    ax.axhline(result["k_g"], color="0.3", ls=":", lw=1, label=f"k = {result['k_g']:g} g")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("platform acceleration [g]")
+    ax.set_title(f"The drive as delivered: rise {1e3 * result['rise_measured_s']:.1f} ms, "
+                 f"held {result['time_at_level_s']:.3f} s within 1 %")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(folder / "drive.png", dpi=110)
+    plt.close(fig)
+    names.append("drive.png")
+
+    if any(c["line_load_N_per_m"] > 0 for c in result["containment"]):
+        fig, ax = plt.subplots(figsize=(6, 4))
+        bands = [c["band"] for c in result["containment"]]
+        ax.barh(bands, [c["line_load_N_per_m"] for c in result["containment"]])
+        ax.set_xlabel("containment [N/m]")
+        ax.set_title("Film containment by height")
+        ax.grid(alpha=0.3, axis="x")
+        fig.tight_layout()
+        fig.savefig(folder / "containment.png", dpi=110)
+        plt.close(fig)
+        names.append("containment.png")
+    return names
+
+
 def write_plots(folder, d, result, series):
     """The plots as PNG files; returns their names (none without matplotlib)."""
     try:
@@ -31,6 +87,8 @@ def write_plots(folder, d, result, series):
         import matplotlib.pyplot as plt
     except ImportError:
         return []
+    if result["test"] == "eumos":
+        return _eumos_plots(plt, folder, d, result, series)
     t, angle = series["t_s"], series["platform_angle_deg"]
     n = d["stack"]["layers"]
     target = result["target_angle_deg"]
@@ -78,14 +136,15 @@ def write_plots(folder, d, result, series):
 def write_report(folder, d, result, plots):
     rows = []
     for c in result["criteria"]:
-        m = "—" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}"
+        m = "—" if c["measured"] is None else f"{c['measured']:.2f} {c['unit']}".strip()
         verdict = "pass" if c["passed"] else "FAIL"
+        limit = f"{c['limit']:.4g} {c['unit']}".strip()
         rows.append(f"<tr class='{verdict.lower()}'><td>{html.escape(c['criterion'])}</td>"
-                    f"<td>{m}</td><td>{c['limit']:g} {c['unit']}</td><td>{verdict}</td></tr>")
+                    f"<td>{m}</td><td>{limit}</td><td>{verdict}</td></tr>")
     imgs = "".join(f"<figure><img src='{p}' alt='{p}'><figcaption>{p}</figcaption></figure>"
                    for p in plots)
-    load = html.escape(json.dumps({k: d[k] for k in ("platform", "stack", "materials", "wrap")},
-                                  indent=2))
+    keys = ("unit_load",) if d.get("unit_load") else ("platform", "stack", "materials", "wrap")
+    load = html.escape(json.dumps({k: d[k] for k in keys}, indent=2))
     test = html.escape(json.dumps(d["test"], indent=2))
     overall = "PASS" if result["passed"] else "FAIL"
     page = f"""<!DOCTYPE html>

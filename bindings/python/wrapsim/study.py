@@ -20,8 +20,9 @@ import random
 
 from .loadfile import LoadFileError, set_path, validate
 
-RESULT_COLUMNS = ["run_id", "passed", "first_slip_angle_deg", "tip_angle_deg", "state_hash",
-                  "error"]
+RESULT_COLUMNS = ["run_id", "passed", "first_slip_angle_deg", "tip_angle_deg",
+                  "elastic_displacement_mm", "permanent_displacement_mm", "k_value_g",
+                  "state_hash", "error"]
 
 
 def parse_vary(text):
@@ -84,25 +85,37 @@ def plan(base, varies, samples=0, seed=0):
     return runs
 
 
-def run_one(base, params):
-    """One run of a study (executed on a worker): the base load file with `params` set.
-    Returns a row of RESULT_COLUMNS plus the parameters; never raises."""
+def run_one(base, params, kvalue=False):
+    """One run of a study (executed on a worker): the base load file with `params` set; with
+    `kvalue` the EUMOS k-value search instead of one run. Returns a row of RESULT_COLUMNS plus
+    the parameters; never raises."""
     from . import loadrun
-    row = dict(params)
+    row = dict.fromkeys(RESULT_COLUMNS, "")
+    row.update(params)
     try:
         d = copy.deepcopy(base)
         for k, v in params.items():
             set_path(d, k, v)
         d = validate(d)
+        if kvalue:
+            from . import eumos
+            if d["test"]["type"] != "eumos":
+                raise LoadFileError("test.type: a k-value study needs 'eumos'")
+            k = eumos.find_k(d)
+            row.update(k_value_g=k["k_value_g"], passed=k["k_value_g"] >= d["test"]["k_g"])
+            return row
         result, _ = loadrun.run(d)
-        slips = [e["angle_deg"] for e in result["slip_events"].values() if e]
-        row.update(passed=result["passed"],
-                   first_slip_angle_deg=min(slips) if slips else "",
-                   tip_angle_deg=result["tip_event"]["angle_deg"] if result["tip_event"] else "",
-                   state_hash=result["state_hash"], error="")
+        row.update(passed=result["passed"], state_hash=result["state_hash"])
+        if result["test"] == "tilt":
+            slips = [e["angle_deg"] for e in result["slip_events"].values() if e]
+            row.update(first_slip_angle_deg=min(slips) if slips else "",
+                       tip_angle_deg=(result["tip_event"]["angle_deg"]
+                                      if result["tip_event"] else ""))
+        else:
+            c = {x["criterion"].split()[0]: x["measured"] for x in result["criteria"]}
+            row.update(elastic_displacement_mm=c["largest"], permanent_displacement_mm=c["permanent"])
     except Exception as e:  # a failed run is a row, never the end of the study
-        row.update(passed="", first_slip_angle_deg="", tip_angle_deg="", state_hash="",
-                   error=f"{type(e).__name__}: {e}")
+        row.update(error=f"{type(e).__name__}: {e}")
     return row
 
 
@@ -114,7 +127,7 @@ def _done_ids(path):
 
 
 def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resume=False,
-          progress=None, client=None):
+          progress=None, client=None, kvalue=False):
     """Run a study on Dask; append rows to out/results.csv as they finish. Returns the path.
     `progress(done, total)` is called after every run when given. `client`: a Dask client to
     use (and leave open) instead of connecting to `scheduler` or starting a LocalCluster."""
@@ -143,7 +156,8 @@ def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resum
             writer = csv.DictWriter(f, fieldnames=RESULT_COLUMNS + keys)
             if new_file:
                 writer.writeheader()
-            futures = {client.submit(run_one, base, p, pure=False): rid for rid, p in todo}
+            futures = {client.submit(run_one, base, p, kvalue, pure=False): rid
+                       for rid, p in todo}
             for n, fut in enumerate(as_completed(futures), 1):
                 row = fut.result()
                 row["run_id"] = futures[fut]
@@ -156,4 +170,46 @@ def sweep(base, varies, out, samples=0, seed=0, scheduler=None, workers=2, resum
             client.close()
         if cluster is not None:
             cluster.close()
+    plot(path, keys, out / "results.png")
     return path
+
+
+def plot(path, keys, png):
+    """results.png: the k-value (or pass/fail) of every finished run against the first varied
+    key, one marker a run (nothing without matplotlib)."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    with open(path, newline="") as f:
+        rows = [r for r in csv.DictReader(f) if not r["error"]]
+    if not rows or not keys:
+        return
+
+    def num(v):
+        try:
+            return float(v)
+        except ValueError:
+            return v
+
+    x = [num(r[keys[0]]) for r in rows]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    if all(r["k_value_g"] for r in rows):
+        ax.plot(x, [float(r["k_value_g"]) for r in rows], "o")
+        ax.set_ylabel("EUMOS k-value [g]")
+    else:
+        ok = [r["passed"] == "True" for r in rows]
+        ax.plot([a for a, p in zip(x, ok) if p], [1] * sum(ok), "o", color="tab:green",
+                label="pass")
+        ax.plot([a for a, p in zip(x, ok) if not p], [0] * (len(ok) - sum(ok)), "x",
+                color="tab:red", label="fail")
+        ax.set_yticks([0, 1], ["fail", "pass"])
+        ax.legend(fontsize=8)
+    ax.set_xlabel(keys[0])
+    ax.set_title(f"{len(rows)} runs")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)

@@ -1,0 +1,508 @@
+/**
+ * @file loadtest.h
+ * @brief Unit loads (a pallet with layers of cartons) built in one call, and the tests a load
+ *        must pass: the EUMOS 40509 acceleration test with its measurements, events, verdict
+ *        and k-value search.
+ *
+ * A load is built in a world with ws_load_build() from a ws_load_def: the pallet, the cartons
+ * layer by layer, the materials and the contact parameters of every interface. The returned
+ * ws_load (an object outside the world that describes what was built) names the bodies by layer
+ * and place, and carries the reference the measurements are taken from. It uses only the public
+ * calls of the world underneath, so everything it does can be done by hand.
+ *
+ * Interface stiffness (docs/guide.md, chapter 11): by default the stiffness and damping of an
+ * interface are given for the interface as a whole, as a packaging engineer measures them (the
+ * force per metre of compression of one carton bearing on what carries it), and the builder
+ * divides them by the number of contact points a face pair of the load touches with: 4, the
+ * corners of the smaller face lying in the larger (the builder makes every second layer's
+ * cartons 1 mm a side smaller, so that stacked faces are never equal: equal faces put every
+ * corner on the other's edge, where a shift of a nanometre drops half the contacts). With
+ * WS_LOAD_STIFFNESS_PER_POINT they are taken as they are, per contact point, as
+ * ws_contact_def is.
+ *
+ * Frames: the platform's frame is the frame of the platform body (x along the pallet's length
+ * when the platform is created by the builder, z up). Displacements are read relative to the
+ * pallet in that frame, which is what EUMOS 40509 measures.
+ */
+#ifndef WRAPSIM_LOADTEST_H
+#define WRAPSIM_LOADTEST_H
+
+#include <wrapsim/body.h>
+#include <wrapsim/web.h>
+#include <wrapsim/world.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Most layers a load may have. */
+#define WS_LOAD_MAX_LAYERS 32
+/** Most cartons a layer may have. */
+#define WS_LOAD_MAX_PER_LAYER 256
+/** Most events a test run keeps (later ones are counted in events_dropped). */
+#define WS_LOADTEST_MAX_EVENTS 64
+
+/** A load, built in a world. Opaque; destroy with ws_load_destroy(). */
+typedef struct ws_load ws_load;
+
+/** How layers are stacked. */
+typedef enum ws_load_pattern {
+    /** Every layer the same grid: cartons stand on cartons (column stacking). */
+    WS_LOAD_COLUMN = 0,
+    /** Interlocked as bricks: every second layer's rows are shifted by half a carton along x and
+     *  hold one carton fewer, so each of its cartons bridges two below. */
+    WS_LOAD_BRICK = 1,
+    /** Interlocked by turning: every second layer's cartons are turned 90 degrees about the
+     *  vertical, as many along x and y as fit in the footprint of the first layer, centred. */
+    WS_LOAD_TURNED = 2
+} ws_load_pattern;
+
+/** How an interface's stiffness and damping are read. */
+typedef enum ws_load_stiffness_rule {
+    /** For the interface as a whole (N/m, kg/s of one face pair), divided by the number of
+     *  contact points of a face pair of the load (4: the corners of the smaller face). The
+     *  default: no tuning per geometry. */
+    WS_LOAD_STIFFNESS_PER_INTERFACE = 0,
+    /** Per contact point, as ws_contact_def takes them. */
+    WS_LOAD_STIFFNESS_PER_POINT = 1
+} ws_load_stiffness_rule;
+
+/** The contact parameters of one interface. Stiffness, damping and the stick model's spring and
+ *  damper are read by the load's ws_load_stiffness_rule; the film-carton interface is always per
+ *  film node (a node touches at one point). */
+typedef struct ws_load_interface {
+    double stiffness;       /**< normal stiffness, N/m (> 0) */
+    double damping;         /**< normal damping, kg/s (>= 0) */
+    double friction;        /**< Coulomb mu (>= 0) */
+    double friction_vlim;   /**< regularisation speed, m/s (> 0) */
+    ws_friction_model friction_model; /**< default WS_FRICTION_STICK (no creep under a load) */
+    double stick_stiffness; /**< tangential spring of the stick model, N/m (> 0) */
+    double stick_damping;   /**< tangential damping of the stick model, kg/s (>= 0) */
+} ws_load_interface;
+
+/** A unit load: a pallet and layers of equal cartons. Fill with ws_load_def_init(). */
+typedef struct ws_load_def {
+    uint32_t size;  /**< set by ws_load_def_init() */
+    uint32_t magic; /**< set by ws_load_def_init() */
+    ws_vec3 pallet_size;  /**< pallet length (x), width (y), height (z), m; default EUR 1.2, 0.8,
+                               0.144 */
+    double pallet_mass;   /**< kg (> 0); default 25 */
+    ws_vec3 carton_size;  /**< carton along x, along y, height, m; default 0.3, 0.4, 0.25 (a
+                               400 x 300 x 250 mm carton with its long side across the pallet) */
+    double carton_mass;   /**< kg (> 0); default 10 */
+    int layers;           /**< 1 .. WS_LOAD_MAX_LAYERS; default 4 */
+    int count_x;          /**< cartons along x in the first layer (>= 1); default 4 */
+    int count_y;          /**< cartons along y in the first layer (>= 1); default 2 */
+    ws_load_pattern pattern; /**< default WS_LOAD_COLUMN */
+    /** Clear gap between neighbouring cartons' contact layers, m (>= 0). Cartons stand at the
+     *  pitch of their nominal size (a layer of count_x x count_y fills that much of the pallet);
+     *  each carton's mesh is smaller than carton_size by 2 contact_layer + gap in x and y (and
+     *  every second layer's by another 2 mm, see the top of this file). The
+     *  default 0.003 keeps neighbours outside the world's default contact margin (2 mm), so
+     *  they cost no contact checks until they move toward each other. */
+    double gap;
+    double contact_layer; /**< delta of every body of the load, m (>= 0); default 0.001 */
+    ws_load_stiffness_rule stiffness_rule; /**< default WS_LOAD_STIFFNESS_PER_INTERFACE */
+    /** Carton on carton. Default 2e6 N/m, 2000 kg/s, mu 0.4, stick 2e6 N/m, 2000 kg/s. */
+    ws_load_interface carton_carton;
+    /** Carton on pallet (and on the platform, for a carton that falls). Default as
+     *  carton_carton with mu 0.45. */
+    ws_load_interface carton_pallet;
+    /** Pallet on platform. Default 2e7 N/m, 2e4 kg/s, mu 0.8, stick 2e7 N/m, 2e4 kg/s. */
+    ws_load_interface pallet_platform;
+    /** Film on carton and on pallet, per film node. Default 4000 N/m, 1 kg/s, mu 0.9,
+     *  regularised with v_lim 0.01 m/s. */
+    ws_load_interface film_carton;
+    /** The platform to build on, a kinematic body whose top face is level; the null id (default)
+     *  creates one: a kinematic box 4 x 2 x 0.1 m with its top face at z = 0 under the pallet's
+     *  centre. */
+    ws_body_id platform;
+    /** The platform's material when `platform` is given (null: the world's default material). */
+    ws_material_id platform_material;
+    /** Where the pallet's centre of its bottom face goes, m, when the builder creates the
+     *  platform: (x, y, 0) of this; with a given platform, the point of its top face the pallet
+     *  stands on (the builder cannot read a body's shape: say where). Default (0, 0, 0). */
+    ws_vec3 origin;
+    /** Allocator hooks for the ws_load object itself; all NULL (default) means malloc. */
+    ws_allocator allocator;
+} ws_load_def;
+
+/** What a load is, after ws_load_build(). */
+typedef struct ws_load_info {
+    ws_body_id platform;        /**< the platform (created or given) */
+    ws_body_id pallet;          /**< the pallet */
+    ws_material_id carton_material;   /**< the cartons' material */
+    ws_material_id pallet_material;   /**< the pallet's */
+    ws_material_id platform_material; /**< the platform's */
+    ws_material_id film_material;     /**< give this to a web that wraps the load */
+    int layers;                 /**< number of layers */
+    int cartons;                /**< cartons in all */
+    double load_height;         /**< from the platform's top face to the top of the load, m */
+    double pallet_top;          /**< height of the pallet's deck above the platform's top, m */
+    double total_mass;          /**< pallet + cartons, kg */
+    ws_web_id film;             /**< the film of ws_load_wrap_band(); null when unwrapped */
+} ws_load_info;
+
+/** One carton as built. */
+typedef struct ws_load_carton {
+    ws_body_id body;  /**< its id */
+    int layer;        /**< 0 = bottom layer */
+    int index;        /**< place in its layer, row-major: index = iy * nx + ix */
+    int ix;           /**< column in its layer */
+    int iy;           /**< row in its layer */
+    int turned;       /**< 1 if turned 90 degrees about the vertical */
+    ws_vec3 size;     /**< its extent along the platform's x, y, z, m */
+} ws_load_carton;
+
+/** What ws_load_measure() reads of one carton, relative to the reference. */
+typedef struct ws_load_carton_state {
+    /** Displacement relative to the pallet in the platform's frame since the reference, m. */
+    ws_vec3 displacement;
+    double horizontal;  /**< |(dx, dy)| of displacement, m */
+    double tilt;        /**< angle between its vertical axis and the platform's, rad */
+    ws_vec3 velocity;   /**< CoG velocity relative to the pallet, platform frame, m/s */
+} ws_load_carton_state;
+
+/** Fill a load Def with the defaults above. NULL is ignored.
+ *  ws_load_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_load_def_init_sized(ws_load_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_load_def_init)(ws_load_def *def);
+/** Fill with defaults: ws_load_def_init_sized with the caller's sizeof. */
+#define ws_load_def_init(def) ws_load_def_init_sized((def), sizeof *(def))
+
+/** Build a load in a world: materials (carton, pallet, film; platform when created), the
+ *  contact parameters of every pair of them (carton-carton, carton-pallet, carton-platform,
+ *  pallet-platform, film-carton, film-pallet), the platform (unless given), the pallet and the
+ *  cartons, layer by layer from the bottom, each resting on the one below with the contact layers
+ *  just touching. Sets the reference of the measurements (ws_load_set_reference()) to the load
+ *  as built.
+ *  @param world the world to build in
+ *  @param def the load; copied, may be freed after the call
+ *  @param out receives the load; destroy it with ws_load_destroy() (the bodies stay in the
+ *  world). On error *out is NULL and the bodies already created are destroyed.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a size or mass <= 0, NaN, too many layers or
+ *  cartons, a given platform that is not kinematic), WS_ERR_UNINITIALIZED_DEF,
+ *  WS_ERR_STALE_HANDLE (platform or its material), WS_ERR_OUT_OF_MEMORY; the detail is in
+ *  ws_world_last_error(). */
+WS_API ws_status ws_load_build(ws_world *world, const ws_load_def *def, ws_load **out);
+/** Free the load object (not its bodies, which belong to the world). NULL does nothing. May be
+ *  called after the world is destroyed. */
+WS_API void ws_load_destroy(ws_load *load);
+/** Counts, ids and heights. @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL). */
+WS_API ws_status ws_load_get_info(const ws_load *load, ws_load_info *info);
+/** Number of cartons in a layer (0 for a layer out of range). */
+WS_API int ws_load_get_layer_count(const ws_load *load, int layer);
+/** The carton at (layer, index). @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL or out of range,
+ *  with no last error: a load has no world to hold it). */
+WS_API ws_status ws_load_get_carton(const ws_load *load, int layer, int index,
+                                    ws_load_carton *carton);
+/** Copy every carton, bottom layer first, row-major in each layer. buf may be NULL with capacity
+ *  0 to ask for the count; WS_ERR_BUFFER_TOO_SMALL when capacity < count (the first `capacity`
+ *  are copied). */
+WS_API ws_status ws_load_copy_cartons(const ws_load *load, ws_load_carton *buf,
+                                      size_t capacity, size_t *count);
+/** The contact point stiffness (N/m) the builder gave an interface: 0 carton-carton,
+ *  1 carton-pallet, 2 pallet-platform, 3 film-carton; the points per face pair it divided by
+ *  (4, or 1 per point and for the film) in *points (may be NULL). */
+WS_API ws_status ws_load_get_point_stiffness(const ws_load *load, int interface_kind,
+                                             double *stiffness, int *points);
+
+/** Take the load as it stands now as the reference of ws_load_measure(): each carton's position
+ *  and orientation relative to the pallet in the platform's frame.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, or a load of another world), WS_ERR_STALE_HANDLE
+ *  (a body of the load was destroyed). */
+WS_API ws_status ws_load_set_reference(ws_world *world, ws_load *load);
+/** Per carton (in the order of ws_load_copy_cartons()): displacement relative to the pallet in
+ *  the platform's frame since the reference, tilt, velocity relative to the pallet. Same buffer
+ *  rules as ws_load_copy_cartons(). */
+WS_API ws_status ws_load_measure(const ws_world *world, const ws_load *load,
+                                 ws_load_carton_state *buf, size_t capacity, size_t *count);
+/** Largest speed (m/s) of any body of the load (pallet and cartons) relative to the platform's
+ *  point under it: its drift. */
+WS_API ws_status ws_load_get_drift(const ws_world *world, const ws_load *load, double *speed);
+/** Step until the load stands still: at least `min_time` s, then until the drift
+ *  (ws_load_get_drift()) stays below `speed` (m/s, > 0) for 0.1 s, or `max_time` s have passed.
+ *  *settled (may be NULL) is 1 when it stood still, 0 when max_time ran out; *time_taken (may be
+ *  NULL) is the simulated time stepped, s. Errors of the step are returned as they are. */
+WS_API ws_status ws_load_settle(ws_world *world, const ws_load *load, double min_time,
+                                double max_time, double speed, int *settled, double *time_taken);
+
+/** A band of stretch film around the load: `layers` layers of film everywhere on the band,
+ *  laid with an on-load strain, from low on the pallet (the film-to-pallet lock) to near the
+ *  top. A simple wrap, not yet a spiral recipe of a machine (no overlaps, roping or top sheet).
+ *  Fill with ws_wrap_def_init(). */
+typedef struct ws_wrap_def {
+    uint32_t size;  /**< set by ws_wrap_def_init() */
+    uint32_t magic; /**< set by ws_wrap_def_init() */
+    double gauge;         /**< thickness of one film layer, m (> 0); default 20e-6 */
+    double modulus;       /**< Young's modulus of the film, Pa (> 0); default 150e6 */
+    double density;       /**< of the film, kg/m^3 (> 0); default 920 */
+    int layers;           /**< film layers on top of each other (>= 1); default 3 */
+    /** Strain the film holds on the load around it, the tension the pre-stretch leaves (> -1,
+     *  < 10); default 0.1 */
+    double strain_around;
+    double strain_up;     /**< the same up the load; default 0.02 */
+    /** Lowest row, m above the platform's top (>= 0): below the deck's top the film locks the
+     *  load to the pallet. Default 0.03. */
+    double z_bottom;
+    double top_margin;    /**< the highest row this far below the load's top, m (>= 0);
+                               default 0.03 */
+    double node_pitch;    /**< node spacing on the load, m (> 0); default 0.05 */
+    /** kg per node (>= 0); 0 = the film's real mass (density x gauge x layers x area), which
+     *  needs many sub-steps. Default 2e-3: 3.7 kg for the reference load's film, stable at
+     *  dt 0.25 ms with 2 sub-steps; its inertia is still small beside the load's. */
+    double node_mass;
+    /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
+     *  stable-step check accepts (ws_world_get_stable_fraction, ws_web_get_stable_dt) */
+    int substeps;
+} ws_wrap_def;
+
+/** Fill a wrap Def with the defaults above. NULL is ignored.
+ *  ws_wrap_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_wrap_def_init_sized(ws_wrap_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_wrap_def_init)(ws_wrap_def *def);
+/** Fill with defaults: ws_wrap_def_init_sized with the caller's sizeof. */
+#define ws_wrap_def_init(def) ws_wrap_def_init_sized((def), sizeof *(def))
+/** Wrap a band of film around the load as it stands (ws_web_create_band() around the pallet and
+ *  every carton) with the load's film material. The springs follow a tension-compression law
+ *  (1 % stiffness in compression: film buckles) of EA = modulus x gauge x layers x the strip
+ *  a spring stands for, per unit strain. The platform must be level and its frame the global
+ *  one (the band's rows are at global heights).
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world, a load
+ *  already wrapped), WS_ERR_UNINITIALIZED_DEF, WS_ERR_OUT_OF_MEMORY, errors of the web's
+ *  creation. */
+WS_API ws_status ws_load_wrap_band(ws_world *world, ws_load *load, const ws_wrap_def *def,
+                                   ws_web_id *out);
+
+/* ---------------------------------------------------------------------------------------- */
+/* EUMOS 40509 */
+
+/** One interface of the load, between level i - 1 and level i: interface 0 is pallet on
+ *  platform, 1 the bottom layer on the pallet, i layer i - 1 on layer i - 2. */
+typedef struct ws_loadtest_interface_state {
+    double normal_force;  /**< sum of the contacts' normal forces, N */
+    double slip_speed;    /**< normal-force-weighted mean slip speed, m/s */
+    double friction_use;  /**< sum |Ft| / (mu sum Fn): 1 when all of it slides */
+    int contacts;         /**< contacts in it */
+} ws_loadtest_interface_state;
+
+/** A measurement during a run, given to ws_eumos_def.on_sample. Pointers are valid during the
+ *  call only. */
+typedef struct ws_loadtest_sample {
+    double time;          /**< s, from the start of the run */
+    /** the platform's acceleration along the direction, in g, as its drive delivered it
+     *  (ws_body_get_drive_state()); negative while it brakes */
+    double level;
+    double platform_velocity; /**< m/s along the direction */
+    double platform_position; /**< m along the direction, from where it started */
+    size_t cartons;       /**< entries of carton[] */
+    const ws_load_carton_state *carton; /**< per carton, as ws_load_measure() */
+    int layers;           /**< entries of layer_displacement[] */
+    const double *layer_displacement; /**< per layer: mean displacement along the direction, m */
+    int interfaces;       /**< entries of interface[] (layers + 1) */
+    const ws_loadtest_interface_state *interface; /**< per interface */
+} ws_loadtest_sample;
+
+/** The acceleration test of EUMOS 40509 as the platform's WS_DRIVE_PULSE drive: the platform
+ *  accelerates horizontally at k g, reached within 50 ms, held at least 0.3 s, and is then
+ *  stopped gently; or, in the run-up-then-brake variant, it runs up gently and brakes at k g.
+ *  Fill with ws_eumos_def_init(). */
+typedef struct ws_eumos_def {
+    uint32_t size;  /**< set by ws_eumos_def_init() */
+    uint32_t magic; /**< set by ws_eumos_def_init() */
+    double k;                 /**< plateau acceleration in g (> 0, <= 10); default 0.5 */
+    /** The g of k g, m/s^2 (> 0); default 9.81, the world's default gravity, so that k compares
+     *  with the friction coefficients of the load as the world sees them. */
+    double g;
+    /** s, the half-cosine rise 0 -> k g and the fall back (> 0; <= 0.05 for the standard);
+     *  default 0.04 */
+    double rise_time;
+    double hold_time;         /**< s at k g (>= 0; >= 0.3 for the standard); default 0.35 */
+    ws_pulse_mode mode;       /**< default WS_PULSE_ACCELERATE; WS_PULSE_BRAKE: run up, brake */
+    /** The gentle phase (the stop after the pulse, or the run-up before the braking), in g
+     *  (> 0): the peak of its raised-cosine acceleration. The run uses min(stop_level, k / 2),
+     *  so the gentle phase never pushes the load harder than half the pulse. Default 0.2. */
+    double stop_level;
+    double coast_time;        /**< s at constant speed between pulse and gentle phase (>= 0);
+                                   default 0.1 */
+    double rest_before;       /**< s at rest before the drive starts (>= 0); default 0.05 */
+    /** s at rest after the platform stands, before the permanent displacement is read (>= 0);
+     *  default 0.5 */
+    double rest_after;
+    ws_vec3 direction;        /**< of the pulse's acceleration, in the platform's frame;
+                                   horizontal; normalised; default (1, 0, 0) */
+    double slip_speed;        /**< m/s (> 0): an interface whose load-weighted mean slip speed
+                                   passes this is slipping (event); default 0.005 */
+    int sample_interval;      /**< steps between measurements (>= 1); default 4 */
+    /** Called after each measurement with the sample (NULL for none); return non-zero to stop the
+     *  run with WS_ERR_CALLBACK. */
+    int (*on_sample)(void *user, const ws_loadtest_sample *sample);
+    void *sample_user;        /**< passed to on_sample */
+} ws_eumos_def;
+
+/** What happened, when. */
+typedef enum ws_loadtest_event_type {
+    /** An interface began to slip: its mean slip speed passed ws_eumos_def.slip_speed.
+     *  layer = the interface's index. */
+    WS_LOADTEST_SLIP_ONSET = 0,
+    /** A body began to tip: an edge of its base that carried load at the reference carries less
+     *  than 1 % of its support force. layer, index name the carton; layer -1 the pallet. */
+    WS_LOADTEST_TIP_ONSET = 1,
+    /** A carton left the load: its centre left the pallet's footprint or fell by half its
+     *  height. */
+    WS_LOADTEST_CARTON_LOST = 2,
+    /** Film rupture (not produced by unwrapped loads). */
+    WS_LOADTEST_RUPTURE = 3
+} ws_loadtest_event_type;
+
+/** An event of a run. */
+typedef struct ws_loadtest_event {
+    int type;       /**< ws_loadtest_event_type */
+    int layer;      /**< see the type */
+    int index;      /**< carton in its layer, or -1 */
+    double time;    /**< s from the start of the run */
+    double level;   /**< platform acceleration along the direction at that time, in g */
+    double value;   /**< the figure that passed its bound (m/s, N ...) */
+} ws_loadtest_event;
+
+/** One criterion of a verdict. */
+typedef struct ws_loadtest_criterion {
+    double value; /**< measured, in the unit of the criterion */
+    double limit; /**< the bound it must not pass */
+    int pass;     /**< 1 if value <= limit (< for layer shift) */
+} ws_loadtest_criterion;
+
+/** The verdict of EUMOS 40509 (docs/guide.md names each criterion and how it is read). */
+typedef struct ws_eumos_verdict {
+    double load_height; /**< H, m: platform top to the top of the load */
+    /** Largest horizontal displacement of any carton relative to the pallet during the test, m;
+     *  limit 0.10 H. */
+    ws_loadtest_criterion elastic;
+    /** Largest horizontal displacement of any carton after the stop and rest_after, m; limit
+     *  0.05 H. */
+    ws_loadtest_criterion permanent;
+    /** Largest permanent displacement of a carton with part of it in the lowest 0.2 m of the load
+     *  above the pallet, m; limit 0.04 m. */
+    ws_loadtest_criterion bottom;
+    /** Largest permanent displacement of a layer relative to the layer under it (or the pallet),
+     *  layer means, m; limit 0.02 H (strictly less). */
+    ws_loadtest_criterion layer_shift;
+    /** Film ruptures; limit 0. */
+    ws_loadtest_criterion rupture;
+    int pass; /**< 1 if every criterion passes */
+} ws_eumos_verdict;
+
+/** Everything a EUMOS run measured. */
+typedef struct ws_eumos_result {
+    double k;             /**< the level the run used, g */
+    double duration;      /**< s simulated */
+    /** largest |platform acceleration| along the direction the drive delivered, g */
+    double peak_level;
+    /** s from the start of the pulse's rise until the delivered |acceleration| first reached
+     *  0.99 k g (the standard: within 0.05 s) */
+    double rise_measured;
+    /** s the delivered |acceleration| stayed within 1 % of k g (the standard: >= 0.3 s) */
+    double time_at_level;
+    int layers;           /**< entries used in the per-layer arrays */
+    double layer_max[WS_LOAD_MAX_LAYERS];       /**< per layer: largest horizontal displacement
+                                                     of its cartons during the test, m */
+    double layer_permanent[WS_LOAD_MAX_LAYERS]; /**< per layer: largest after the rest, m */
+    double layer_tilt[WS_LOAD_MAX_LAYERS];      /**< per layer: largest tilt of its cartons, rad */
+    /** per interface (layers + 1): largest slip speed (m/s) and friction use during the run */
+    double interface_slip_max[WS_LOAD_MAX_LAYERS + 1];
+    double interface_use_max[WS_LOAD_MAX_LAYERS + 1];     /**< see interface_slip_max */
+    int cartons_lost;     /**< cartons that left the load */
+    int event_count;      /**< events kept in events[] */
+    int events_dropped;   /**< events beyond WS_LOADTEST_MAX_EVENTS */
+    ws_loadtest_event events[WS_LOADTEST_MAX_EVENTS]; /**< in time order */
+    ws_eumos_verdict verdict; /**< the verdict */
+    /** Wrapped loads (ws_load_wrap_band()): the film's containment at the start of the run in
+     *  three equal height bands, bottom, middle, top (ws_web_get_containment(): hoop tension,
+     *  N, line load, N/m, and the bodies' normal force on it, N); zero when unwrapped. */
+    ws_containment_band containment[3];
+    double film_peak_strain; /**< largest spring strain of the film during the run (0: none) */
+} ws_eumos_result;
+
+/** Fill a EUMOS Def with the defaults above. NULL is ignored.
+ *  ws_eumos_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_eumos_def_init_sized(ws_eumos_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_eumos_def_init)(ws_eumos_def *def);
+/** Fill with defaults: ws_eumos_def_init_sized with the caller's sizeof. */
+#define ws_eumos_def_init(def) ws_eumos_def_init_sized((def), sizeof *(def))
+/** The platform drive a EUMOS run sets (a WS_DRIVE_PULSE along `direction`, given in global
+ *  axes for a platform whose frame is the global one, starting at start_time 0: add the world's
+ *  time) and the run's duration in s (rest before, the drive, rest after); either output may
+ *  be NULL.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (a bad Def; no last error: there is no world),
+ *  WS_ERR_UNINITIALIZED_DEF. */
+WS_API ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive,
+                                    double *duration);
+/** Run EUMOS 40509 on a load from the world's present state: the platform's drive is replaced by
+ *  the pulse (ws_eumos_get_drive()) and set back to static at the end, where the platform
+ *  stopped.
+ *  The reference of the measurements is taken at the start (ws_load_set_reference()). Fills
+ *  *result (events, per-layer and per-interface figures, the verdict).
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world),
+ *  WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY, errors of the step
+ *  (WS_ERR_NUMERICAL) and WS_ERR_CALLBACK (on_sample stopped it); the detail is in
+ *  ws_world_last_error(). */
+WS_API ws_status ws_loadtest_run_eumos(ws_world *world, ws_load *load, const ws_eumos_def *def,
+                                       ws_eumos_result *result);
+
+/** The k-value search. Fill with ws_kvalue_def_init(). */
+typedef struct ws_kvalue_def {
+    uint32_t size;  /**< set by ws_kvalue_def_init() */
+    uint32_t magic; /**< set by ws_kvalue_def_init() */
+    double k_low;      /**< lowest k tried, g (> 0); default 0.05 */
+    double k_high;     /**< highest k tried, g (> k_low); default 1.0 */
+    double tolerance;  /**< the search stops when the bracket is narrower, g (> 0); default 0.01 */
+    double settle_time;  /**< s the fresh load settles before the runs (> 0); default 1.0 */
+    /** A wrap to put on the load after it settled (it then settles settle_time again before the
+     *  state is saved); NULL (default) for the load unwrapped. Read during the call only. */
+    const ws_wrap_def *wrap;
+} ws_kvalue_def;
+
+/** What the k-value search found. */
+typedef struct ws_kvalue_result {
+    double k_value;   /**< the largest k the load passed, g (0 if it failed at k_low) */
+    double k_fail;    /**< the smallest k it failed at, g (0 if it passed k_high) */
+    int runs;         /**< EUMOS runs made */
+    ws_eumos_result last_pass; /**< the run at k_value (zero when none passed) */
+    char error[256];  /**< the world's last error when a run failed, else "" */
+} ws_kvalue_result;
+
+/** Fill a k-value Def with the defaults above. NULL is ignored.
+ *  ws_kvalue_def_init(def) calls this with size = sizeof *def as the caller compiled it
+ *  (see "Defs" in common.h). */
+WS_API void ws_kvalue_def_init_sized(ws_kvalue_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). New code reaches the macro
+ *  below. */
+WS_API void(ws_kvalue_def_init)(ws_kvalue_def *def);
+/** Fill with defaults: ws_kvalue_def_init_sized with the caller's sizeof. */
+#define ws_kvalue_def_init(def) ws_kvalue_def_init_sized((def), sizeof *(def))
+/** Find the load's k-value: the largest k at which it passes EUMOS 40509, by bisection between
+ *  k_low and k_high. Every run starts from the same settled load: a world is created from
+ *  `world_def`, the load built from `load_def` and settled for settle_time (then wrapped and
+ *  settled again when def->wrap is given), and its state saved
+ *  (ws_world_save()); each run restores it (ws_world_restore()) and runs EUMOS at its k with the
+ *  rest of `eumos_def`, so each starts from the same state to the bit.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, and any error of a run (its
+ *  text in result->error). */
+WS_API ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *load_def,
+                                    const ws_eumos_def *eumos_def, const ws_kvalue_def *def,
+                                    ws_kvalue_result *result);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
