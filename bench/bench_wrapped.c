@@ -1,7 +1,8 @@
 /* Benchmark (not a test): the wrapped reference case (DESIGN.md), 5856 film nodes, dt 0.25 ms.
  * Prints wall time, steps/s, node-updates/s and where the time goes (contact detection, body
  * contacts, film). Never fails on time.
- * Usage: bench_wrapped [steps] (default 24000: the paper's 6 s, variant P) [R] */
+ * Usage: bench_wrapped [steps] (default 24000: the paper's 6 s, variant P) [P|R] [workers]
+ * (workers: of the step, default 1; the state hash is the same for any count). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -14,6 +15,7 @@ int main(int argc, char **argv)
     o.variant = argc > 2 ? argv[2][0] : 'P';
     o.wrapped = 1;
     o.profile = 1;
+    o.workers = argc > 3 ? atoi(argv[3]) : 1;
     tilt_scene sc;
     if (tilt_build(&o, &sc) != WS_OK) {
         fprintf(stderr, "bench_wrapped: cannot build the scene\n");
@@ -31,8 +33,9 @@ int main(int argc, char **argv)
     ws_world_stats st;
     ws_world_get_stats(sc.world, &st);
     double updates = (double)info.node_count * (double)info.substeps * (double)steps;
-    printf("libwrapsim %s: reference case %c wrapped, %u film nodes x %d sub-step(s), dt 0.25 ms\n",
-           ws_version_string(), o.variant, info.node_count, info.substeps);
+    printf("libwrapsim %s: reference case %c wrapped, %u film nodes x %d sub-step(s), dt 0.25 ms, "
+           "%d worker(s)\n",
+           ws_version_string(), o.variant, info.node_count, info.substeps, o.workers);
     printf("  %ld steps in %.3f s: %.0f steps/s, %.2f M node-updates/s, %.1f us/step\n", steps,
            el, steps / el, updates / el / 1e6, 1e6 * el / steps);
     double tot = st.seconds_total;

@@ -69,6 +69,7 @@ typedef struct tilt_options {
                              stable sub-step, within the default safety factor 0.5) */
     double stable_fraction; /* the film check's safety factor (world.h); 0 = the default */
     int profile;          /* 1: the library times its phases (ws_world_stats) */
+    int workers;          /* workers of a step; 0 = 1 (the results are the same for any) */
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -205,6 +206,7 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.profile = o->profile;
     if (o->stable_fraction > 0)
         wd.stable_fraction = o->stable_fraction;
+    wd.worker_count = o->workers > 0 ? (uint32_t)o->workers : 1u;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
     ws_status s = ws_world_create(&wd, &sc->world);

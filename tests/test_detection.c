@@ -16,7 +16,7 @@ static void force_node_detection(ws_world *w)
 {
     for (size_t k = 0; k < w->web_slots.slot_count; k++)
         if (w->web_slots.dense[k] != UINT32_MAX)
-            w->webs[k]->refresh = 1;
+            w->webs[k]->contact->refresh = 1;
 }
 
 /* The one web of a world. */
@@ -713,9 +713,9 @@ START_TEST(edges_of_faces_a_node_is_well_inside_of_are_dropped)
     probe_web(w, &wd, pos, 2, &web);
     ck_ok(w, ws_world_step(w));
     const ws_web *wb = only_web(w);
-    const ws_ncand *c = wb->cand[wb->next_list];
+    const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
     int faces[2] = {0, 0}, edges[2] = {0, 0}, inside[2] = {0, 0};
-    for (size_t k = 0; k < wb->ncand[wb->next_list]; k++) {
+    for (size_t k = 0; k < wb->contact->cand[wb->contact->next_list].n; k++) {
         ck_assert_uint_lt(c[k].node, 2);
         if (c[k].local & WS_NCAND_EDGE) {
             edges[c[k].node]++;
@@ -750,11 +750,11 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep, ui
     ws_world *b = kind == 4 ? sag_world(&wb, &bb) : wrapped_world(kind, &wb, &bb);
     ws_web *web_a = only_web(a), *web_b = only_web(b);
     ck_assert(web_a && web_b);
-    web_a->runs_off = 1;
+    web_a->contact->runs_off = 1;
     /* Runs take their groups of nodes in batches, each sweep block's at its end; in two of the
      * scenes a batch runs before every chunk of a run instead, as a block with more than a
      * batch holds does. */
-    web_b->run_batch = kind % 2 ? 1u : 0u;
+    web_b->contact->run_batch = kind % 2 ? 1u : 0u;
     const int steps = 2400;
     ws_web_info wi;
     ck_ok(b, ws_web_get_info(b, wb, &wi));
@@ -811,13 +811,15 @@ static void film_runs_case(int kind, uint64_t *run_nodes, uint64_t *run_deep, ui
         max_dev = fmax(max_dev, fabs(xa[i] - xb[i]));
     report("film runs (scene %d): %llu node evaluations in runs (%llu in runs gone one by one), "
            "nodes differ by %.1e m, state hashes %016llx %016llx",
-           kind, (unsigned long long)web_b->run_nodes, (unsigned long long)web_b->run_deep, max_dev,
-           (unsigned long long)ha, (unsigned long long)hb);
-    ck_assert_msg(web_a->run_nodes == 0 && web_a->corners == 0, "short cuts taken with runs off");
+           kind, (unsigned long long)web_b->contact->run_nodes,
+           (unsigned long long)web_b->contact->run_deep, max_dev, (unsigned long long)ha,
+           (unsigned long long)hb);
+    ck_assert_msg(web_a->contact->run_nodes == 0 && web_a->contact->corners == 0,
+                  "short cuts taken with runs off");
     ck_assert_msg(ha == hb && max_dev == 0.0, "runs differ from one by one: %.3e m", max_dev);
-    *run_nodes += web_b->run_nodes;
-    *run_deep += web_b->run_deep;
-    *corners += web_b->corners;
+    *run_nodes += web_b->contact->run_nodes;
+    *run_deep += web_b->contact->run_deep;
+    *corners += web_b->contact->corners;
     free(xa);
     ws_world_destroy(a);
     ws_world_destroy(b);
@@ -897,9 +899,9 @@ START_TEST(corners_are_marked_by_the_detection)
         probe_web(w, &wd, pos, 3, &web);
         ck_ok(w, ws_world_step(w));
         const ws_web *wb = only_web(w);
-        const ws_ncand *c = wb->cand[wb->next_list];
+        const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
         int count[3] = {0, 0, 0}, marked[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
-        for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+        for (size_t q = 0; q < wb->contact->cand[wb->contact->next_list].n; q++) {
             ck_assert_uint_lt(c[q].node, 3);
             count[c[q].node]++;
             marked[c[q].node] += (c[q].local & WS_NCAND_CORNER) != 0;
@@ -974,7 +976,7 @@ static ws_world *edge_film_world(int prism, const double *off, int runs_off, ws_
     }
     pos[9] = pos[10] = pos[11] = 3.0;
     probe_web(w, &wd, pos, 3, web);
-    only_web(w)->runs_off = runs_off;
+    only_web(w)->contact->runs_off = runs_off;
     return w;
 }
 
@@ -999,8 +1001,8 @@ START_TEST(corner_edge_tests_spared_only_in_its_region)
         ws_world *a = edge_film_world(prism, off, 1, &wa), *b = edge_film_world(prism, off, 0, &wb);
         ck_ok(a, ws_world_step(a));
         ck_ok(b, ws_world_step(b));
-        ck_assert_uint_eq(only_web(a)->corners, 0);
-        ck_assert_uint_eq(only_web(b)->corners, 3);
+        ck_assert_uint_eq(only_web(a)->contact->corners, 0);
+        ck_assert_uint_eq(only_web(b)->contact->corners, 3);
         double fa[12], fb[12];
         size_t n;
         ck_ok(a, ws_web_copy_contact_forces(a, wa, fa, 4, &n));
@@ -1102,9 +1104,9 @@ START_TEST(well_inside_takes_the_projection)
     ws_world *w = edge_film_world(1, off, 0, &id);
     ck_ok(w, ws_world_step(w));
     const ws_web *wb = only_web(w);
-    const ws_ncand *c = wb->cand[wb->next_list];
+    const ws_ncand *c = wb->contact->cand[wb->contact->next_list].c;
     int faces[3] = {0, 0, 0}, inside[3] = {0, 0, 0}, edges[3] = {0, 0, 0};
-    for (size_t q = 0; q < wb->ncand[wb->next_list]; q++) {
+    for (size_t q = 0; q < wb->contact->cand[wb->contact->next_list].n; q++) {
         ck_assert_uint_lt(c[q].node, 3);
         if (c[q].local & WS_NCAND_EDGE) {
             edges[c[q].node]++;
@@ -1172,7 +1174,7 @@ START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
     ck_assert_uint_eq(web->n, N);
     ws_body_store *b = &w->bodies;
     const int cur = w->cur;
-    const uint32_t k = web->ref;
+    const uint32_t k = web->contact->ref;
     ck_assert_uint_ne(k, UINT32_MAX);
     const double margin = w->def.contact_margin, lim = 0.25 * margin;
     uint64_t seed = 12345;
@@ -1202,18 +1204,19 @@ START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
             x.z[i] += 8e-4 * rnd[6 + 3 * j];
         }
         for (uint32_t q = 0; q < N; q++) {
-            s0[3 * q] = web->xdet.x[q];
-            s0[3 * q + 1] = web->xdet.y[q];
-            s0[3 * q + 2] = web->xdet.z[q];
+            s0[3 * q] = web->contact->xdet.x[q];
+            s0[3 * q + 1] = web->contact->xdet.y[q];
+            s0[3 * q + 2] = web->contact->xdet.z[q];
         }
-        const v3 e0 = web->epoch_r;
+        const v3 e0 = web->contact->epoch_r;
         long moved = ws_node_moved(b, cur, web, x, web->v[cur], w->def.dt, margin);
         if (moved < 0)
             ck_abort_msg("step %d: every node to be found again", step);
-        epochs += e0.x != web->epoch_r.x || e0.y != web->epoch_r.y || e0.z != web->epoch_r.z;
+        epochs += e0.x != web->contact->epoch_r.x || e0.y != web->contact->epoch_r.y ||
+                  e0.z != web->contact->epoch_r.z;
         memset(hit, 0, N);
         for (long m = 0; m < moved; m++)
-            hit[web->moved[m]] = 1;
+            hit[web->contact->moved[m]] = 1;
         for (uint32_t q = 0; q < N; q++) {
             /* Asserted only when it fails: the checks are many. */
             v3 u = v3_sub(m3_tmul_v(&b->A[k], v3_sub(nodes_get(x, q), b->st[cur].r[k])),
@@ -1292,10 +1295,14 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
             kept++;
             continue;
         }
-        size_t n = 0;
-        ck_assert_int_eq(ws_node_merge(&mem, nodes, count, N, start, old, nold, fresh, nfresh,
-                                       &out, &n, &cap, changed, &nchanged),
-                         0);
+        const ws_ncand_list lold = {old, nold, nold}, lfresh = {fresh, nfresh, nfresh};
+        ws_ncand_list lout = {out, 0, cap};
+        ck_assert_int_eq(
+            ws_node_merge(&mem, nodes, count, N, start, &lold, &lfresh, &lout, changed, &nchanged),
+            0);
+        out = lout.c;
+        cap = lout.cap;
+        const size_t n = lout.n;
         merges++;
         ck_assert_uint_eq(n, nwant);
         ck_assert(n == 0 || !memcmp(out, want, n * sizeof *out));

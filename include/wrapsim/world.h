@@ -26,6 +26,20 @@ typedef enum ws_integrator {
     WS_INTEGRATOR_PAPER_EXPLICIT = 1
 } ws_integrator;
 
+/** A piece of a step's work given to the host's scheduler: items [start, end) of it, on worker
+ *  `worker` (< ws_world_def.worker_count, distinct among pieces that run at once), with the
+ *  task's own context. */
+typedef void ws_task_fn(int32_t start, int32_t end, uint32_t worker, void *task_context);
+/** The host's scheduler takes a task of `item_count` items (0 .. item_count - 1), to be cut
+ *  into ranges of at least `min_range` items and run, each range once, on its workers, in any
+ *  order, at once or one after another. Returns a handle that ws_finish_task_fn receives, or
+ *  NULL when it ran the whole task before returning (then it is not finished). `user_context`
+ *  is ws_world_def.task_context. */
+typedef void *ws_enqueue_task_fn(ws_task_fn *task, int32_t item_count, int32_t min_range,
+                                 void *task_context, void *user_context);
+/** Wait until every range of the task `user_task` (an ws_enqueue_task_fn's handle) has run. */
+typedef void ws_finish_task_fn(void *user_task, void *user_context);
+
 /** World parameters. Fill with ws_world_def_init(), then change what you need. */
 typedef struct ws_world_def {
     uint32_t size;  /**< set by ws_world_def_init(); do not change */
@@ -59,7 +73,19 @@ typedef struct ws_world_def {
      *  what it does not see (a film crumpling, nodes sliding off edges, laws stiffer than they
      *  state). 0 < it <= 1; default 0.5 (docs/theory.md, section 8). */
     double stable_fraction;
+    /** Workers a step may use, 1 (default) to WS_MAX_WORKERS. With more than one the film is
+     *  stepped in parallel; the results are the same to the bit for any count. */
+    uint32_t worker_count;
+    /** The host's scheduler (both, or neither: NULL, the default). Without them and with
+     *  worker_count > 1 the world runs its own worker_count - 1 threads, made with it and
+     *  joined when it is destroyed. With them, the world makes no thread. */
+    ws_enqueue_task_fn *enqueue_task;
+    ws_finish_task_fn *finish_task; /**< see enqueue_task */
+    void *task_context;             /**< passed to enqueue_task and finish_task */
 } ws_world_def;
+
+/** The most workers a world takes. */
+#define WS_MAX_WORKERS 64
 
 /** Friction laws for a pair of materials. */
 typedef enum ws_friction_model {

@@ -5,6 +5,71 @@
 
 #include <string.h>
 
+/* The move test's budget (ws_node_track, ws_node_moved), in sixteenths of the contact margin.
+ * A full detection lists every node-feature pair within the layers and the margin; the list
+ * holds while no node has come half the margin (COVER) closer to any near body, since that is
+ * what it covers on either side. The half is spent as: a node's own move from where it was
+ * found, in the reference body's frame (NODE); what its sub-steps' forces may add beyond the
+ * state the test measures (SUBSTEP: with one sub-step the contacts see only that state, and
+ * the node takes it too); and the deviations of two near bodies from their records at the
+ * lever of their points (BODY each: the reference body's turn carries the node's frame, the
+ * other body's its points), past which a body is re-based. A far body must not close the gap
+ * it had by a node's whole move (NODE + SUBSTEP, a quarter): it is near when it is within it. */
+enum { MOVE_PARTS = 16, MOVE_NODE = 3, MOVE_SUBSTEP = 1, MOVE_BODY = 2, MOVE_COVER = 8 };
+_Static_assert(MOVE_NODE + MOVE_SUBSTEP + 2 * MOVE_BODY == MOVE_COVER,
+               "the move test's parts must add up to the half margin the candidates cover");
+/* Each part as a fraction of the margin (exact: sixteenths are binary fractions). */
+#define MOVE_PART(k) ((double)(k) / MOVE_PARTS)
+
+/* Node vectors laid out as the web's (web.c): x, y and z of 3 n doubles in one block, then
+ * WS_WEB_PAD more (the state walk takes the 3 n at once). */
+static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+{
+    double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
+    a->x = p;
+    a->y = p ? p + n : NULL;
+    a->z = p ? p + 2 * (size_t)n : NULL;
+    return p != NULL;
+}
+
+ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
+{
+    ws_node_contact *nc = ws_mem_calloc(mem, 1, sizeof *nc);
+    if (!nc)
+        return NULL;
+    nc->seg_list = -1;
+    int ok = nodes_alloc(mem, &nc->xdet, n);
+    ok &= nodes_alloc(mem, &nc->xep, n);
+    ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
+    ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
+    ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
+    if (!ok) {
+        ws_node_contact_free(mem, nc, n);
+        return NULL;
+    }
+    return nc;
+}
+
+void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
+{
+    if (!nc)
+        return;
+    const size_t m = 3 * (size_t)n + WS_WEB_PAD;
+    for (int k = 0; k < 2; k++)
+        ws_mem_free(mem, nc->cand[k].c, nc->cand[k].cap * sizeof(ws_ncand));
+    ws_mem_free(mem, nc->xdet.x, m * sizeof(double));
+    ws_mem_free(mem, nc->xep.x, m * sizeof(double));
+    ws_mem_free(mem, nc->moved, (n ? n : 1) * sizeof(uint32_t));
+    ws_mem_free(mem, nc->redo, (n ? n : 1) * sizeof(uint8_t));
+    ws_mem_free(mem, nc->cstart, ((size_t)n + 1) * sizeof(size_t));
+    ws_mem_free(mem, nc->cbody, nc->cbody_cap);
+    ws_mem_free(mem, nc->track, nc->track_cap * sizeof(ws_track));
+    ws_mem_free(mem, nc->fresh.c, nc->fresh.cap * sizeof(ws_ncand));
+    ws_mem_free(mem, nc->seg, nc->seg_cap * sizeof(ws_nseg));
+    ws_node_scratch_free(mem, nc);
+    ws_mem_free(mem, nc, sizeof *nc);
+}
+
 static int inside_box(v3 p, v3 lo, v3 hi, double e)
 {
     return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
@@ -86,13 +151,14 @@ static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web
 static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, v3 *r, v3 *v,
                      v3 *w, qt *p)
 {
-    if (web->ref == UINT32_MAX) {
+    ws_node_contact *nc = web->contact;
+    if (nc->ref == UINT32_MAX) {
         *A = m3_identity();
         *r = *v = *w = v3_make(0, 0, 0);
         *p = qt_identity();
         return;
     }
-    uint32_t k = web->ref;
+    uint32_t k = nc->ref;
     *A = b->A[k];
     *r = b->st[cur].r[k];
     *v = b->st[cur].v[k];
@@ -141,15 +207,16 @@ static void ref_chunk(size_t m, const double *restrict px, const double *restric
 static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *only,
                    size_t count)
 {
+    ws_node_contact *nc = web->contact;
     double t[10][REF_CHUNK];
-    double lever2 = web->lever2;
+    double lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
         const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
         if (!only) {
-            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &web->epoch_A, web->epoch_r,
-                      web->xdet.x + q0, web->xdet.y + q0, web->xdet.z + q0, web->xep.x + q0,
-                      web->xep.y + q0, web->xep.z + q0, t[9]);
+            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &nc->epoch_A, nc->epoch_r,
+                      nc->xdet.x + q0, nc->xdet.y + q0, nc->xdet.z + q0, nc->xep.x + q0,
+                      nc->xep.y + q0, nc->xep.z + q0, t[9]);
         } else {
             const uint32_t *nd = only + q0;
             for (size_t j = 0; j < m; j++) {
@@ -157,55 +224,56 @@ static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *
                 t[1][j] = x.y[nd[j]];
                 t[2][j] = x.z[nd[j]];
             }
-            ref_chunk(m, t[0], t[1], t[2], A, r, &web->epoch_A, web->epoch_r, t[3], t[4], t[5],
-                      t[6], t[7], t[8], t[9]);
+            ref_chunk(m, t[0], t[1], t[2], A, r, &nc->epoch_A, nc->epoch_r, t[3], t[4], t[5], t[6],
+                      t[7], t[8], t[9]);
             for (size_t j = 0; j < m; j++) {
                 const uint32_t i = nd[j];
-                web->xdet.x[i] = t[3][j];
-                web->xdet.y[i] = t[4][j];
-                web->xdet.z[i] = t[5][j];
-                web->xep.x[i] = t[6][j];
-                web->xep.y[i] = t[7][j];
-                web->xep.z[i] = t[8][j];
+                nc->xdet.x[i] = t[3][j];
+                nc->xdet.y[i] = t[4][j];
+                nc->xdet.z[i] = t[5][j];
+                nc->xep.x[i] = t[6][j];
+                nc->xep.y[i] = t[7][j];
+                nc->xep.z[i] = t[8][j];
             }
         }
         for (size_t j = 0; j < m; j++)
             lever2 = t[9][j] > lever2 ? t[9][j] : lever2;
     }
-    web->lever2 = lever2;
+    nc->lever2 = lever2;
 }
 
 int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
                   double margin)
 {
-    web->ntrack = 0;
-    web->ref = UINT32_MAX;
+    ws_node_contact *nc = web->contact;
+    nc->ntrack = 0;
+    nc->ref = UINT32_MAX;
     if (web->n == 0)
         return 0;
-    if (ws_array_reserve(mem, (void **)&web->track, &web->track_cap, b->slots + 1,
-                         sizeof *web->track) != 0)
+    if (ws_array_reserve(mem, (void **)&nc->track, &nc->track_cap, b->slots + 1,
+                         sizeof *nc->track) != 0)
         return -1;
-    web_box(web, x, &web->box_lo, &web->box_hi);
+    web_box(web, x, &nc->box_lo, &nc->box_hi);
     /* Near: a body that comes within the distance a node may still go before it is found
      * again (a quarter of the margin, ws_node_moved) with the layers. */
     double heaviest = -1.0;
     for (uint32_t k = 0; k < b->slots; k++) {
         if (!b->alive[k])
             continue;
-        ws_track *t = &web->track[web->ntrack++];
+        ws_track *t = &nc->track[nc->ntrack++];
         t->body = k;
         t->gap = body_gap(b, cur, k, web, x, t);
-        t->near = t->gap <= 0.25 * margin;
+        t->near = t->gap <= MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin;
         /* A point of the body touches a node only within its bounding sphere grown by the
          * layers and the margin, and only in the web's box. */
         t->lever = fmin(sphere_lever(b, k, web, margin),
-                        far_corner(b->st[cur].r[k], web->box_lo, web->box_hi));
+                        far_corner(b->st[cur].r[k], nc->box_lo, nc->box_hi));
         /* The reference: the heaviest dynamic body near the web (the load the film rides
          * on), else a kinematic one. */
         double m = b->type[k] == WS_BODY_DYNAMIC ? b->mass[k] : 0.0;
         if (t->near && m > heaviest) {
             heaviest = m;
-            web->ref = k;
+            nc->ref = k;
         }
     }
     m3 A;
@@ -213,16 +281,16 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
     qt p;
     ref_pose(b, cur, web, &A, &r, &v, &w, &p);
     qt pc = qt_conj(p);
-    for (size_t q = 0; q < web->ntrack; q++) {
-        ws_track *t = &web->track[q];
+    for (size_t q = 0; q < nc->ntrack; q++) {
+        ws_track *t = &nc->track[q];
         uint32_t k = t->body;
         t->rho = m3_tmul_v(&A, v3_sub(b->st[cur].r[k], r));
         t->q = qt_mul(pc, b->st[cur].p[k]);
     }
-    web->epoch_A = A;
-    web->epoch_r = r;
-    web->epoch_q = p;
-    web->lever2 = 0.0;
+    nc->epoch_A = A;
+    nc->epoch_r = r;
+    nc->epoch_q = p;
+    nc->lever2 = 0.0;
     to_ref(web, x, &A, r, NULL, 0);
     return 0;
 }
@@ -241,7 +309,7 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
         redo[i] = (uint8_t)flag[i];
 }
 
-/* The per-node test of ws_node_moved: 1 in web->redo for a node whose measure reaches the
+/* The per-node test of ws_node_moved: 1 in nc->redo for a node whose measure reaches the
  * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
  * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
  * have none flagged: their bytes are cleared, not narrowed. */
@@ -249,6 +317,7 @@ WS_VECTOR_LOOP
 static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
                          double c, double lim)
 {
+    ws_node_contact *nc = web->contact;
     const double *a = A->m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
@@ -258,8 +327,8 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
     size_t count = 0;
     for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
         const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
-        const double *restrict ox = web->xdet.x + i0, *restrict oy = web->xdet.y + i0,
-                               *restrict oz = web->xdet.z + i0;
+        const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
+                               *restrict oz = nc->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
         const size_t before = count;
@@ -289,18 +358,19 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
                 count += f;
             }
         }
-        put_flags(web->redo + i0, flag, e, count != before);
+        put_flags(nc->redo + i0, flag, e, count != before);
     }
     return count;
 }
 
-/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in web->redo for a
+/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in nc->redo for a
  * node whose distance from its place at the epoch (xep) reaches lim (or is NaN), else 0; how
  * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
  * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
 WS_VECTOR_LOOP
 static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim, int renew)
 {
+    ws_node_contact *nc = web->contact;
     const double *a = A->m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
@@ -310,13 +380,13 @@ static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim
     size_t count = 0;
     for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
         const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
-        double *restrict ox = web->xep.x + i0, *restrict oy = web->xep.y + i0,
-                         *restrict oz = web->xep.z + i0;
+        double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
+                         *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         const size_t before = count;
         if (renew) {
-            const double *restrict sx = web->xdet.x + i0, *restrict sy = web->xdet.y + i0,
-                                   *restrict sz = web->xdet.z + i0;
+            const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
+                                   *restrict sz = nc->xdet.z + i0;
             for (size_t i = 0; i < e; i++) {
                 double gx = r.x + (a0 * sx[i] + a1 * sy[i] + a2 * sz[i]);
                 double gy = r.y + (a3 * sx[i] + a4 * sy[i] + a5 * sz[i]);
@@ -337,7 +407,7 @@ static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim
                 count += f;
             }
         }
-        put_flags(web->redo + i0, flag, e, count != before);
+        put_flags(nc->redo + i0, flag, e, count != before);
     }
     return count;
 }
@@ -407,31 +477,32 @@ static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r,
 
 /* Re-base near body k (see ws_node_moved) at state cur: its record (rho, q) in the reference
  * frame (A, r, conjugate orientation pc) and its lever from now, and the nodes it may meet
- * flagged in web->redo: those in its box grown by the reach (layers + margin), in its frame
+ * flagged in nc->redo: those in its box grown by the reach (layers + margin), in its frame
  * now, and those that hold a candidate of it in the committed list. */
 static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
                         double margin, const m3 *A, v3 r, qt pc)
 {
+    ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
     const ws_shape *sh = b->shape[k];
     const double e = b->layer[k] + web->layer + margin;
-    flag_in_box(web->redo, x, web->n, &b->A[k], b->st[cur].r[k],
+    flag_in_box(nc->redo, x, web->n, &b->A[k], b->st[cur].r[k],
                 v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
                 v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
-    const ws_ncand *c = web->cand[web->list];
-    if (web->seg_list == web->list) {
+    const ws_ncand *c = nc->cand[nc->list].c;
+    if (nc->seg_list == nc->list) {
         /* The list's stretches: a run's candidates are of one face, so of one body. */
-        for (size_t s = 0; s < web->nseg; s++) {
-            const ws_nseg *sg = &web->seg[s];
+        for (size_t s = 0; s < nc->nseg; s++) {
+            const ws_nseg *sg = &nc->seg[s];
             if (sg->run && c[sg->c0].body == k)
-                memset(web->redo + sg->n0, 1, sg->n1 - sg->n0);
+                memset(nc->redo + sg->n0, 1, sg->n1 - sg->n0);
             else if (!sg->run)
                 for (size_t q = sg->c0; q < sg->c1; q++)
-                    web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+                    nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
         }
     } else {
-        for (size_t q = 0; q < web->ncand[web->list]; q++)
-            web->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+        for (size_t q = 0; q < nc->cand[nc->list].n; q++)
+            nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
     }
     t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
     t->q = qt_mul(pc, b->st[cur].p[k]);
@@ -441,10 +512,11 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
 long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                    double dt, double margin)
 {
+    ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
     /* A body made since the full detection: find every node again. */
     for (uint32_t k = 0, q = 0; k < b->slots; k++) {
-        if (q < web->ntrack && web->track[q].body == k) {
+        if (q < nc->ntrack && nc->track[q].body == k) {
             q++;
             continue;
         }
@@ -456,7 +528,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     qt p;
     ref_pose(b, cur, web, &A, &r, &vr, &wr, &p);
     qt pc = qt_conj(p);
-    double reach = far_corner(r, web->box_lo, web->box_hi) + margin;
+    double reach = far_corner(r, nc->box_lo, nc->box_hi) + margin;
     /* The contacts of this step are evaluated with the bodies as they are now (state cur),
      * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
      * move relative to the reference counts as it stands: its CoG's move and its turn times
@@ -479,15 +551,15 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * candidates are found again too: the body may have jumped, so that they are out of its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
     int rebase = 0;
-    for (size_t q = 0; q < web->ntrack; q++) {
-        ws_track *t = &web->track[q];
+    for (size_t q = 0; q < nc->ntrack; q++) {
+        ws_track *t = &nc->track[q];
         uint32_t k = t->body;
         v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
         double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
-        t->rebase = t->near && d >= margin / 8.0;
+        t->rebase = t->near && d >= MOVE_PART(MOVE_BODY) * margin;
         rebase |= t->rebase;
-        if (!t->near && d + 0.25 * margin >= t->gap)
+        if (!t->near && d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
@@ -499,7 +571,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
      * the margin. Either way a node stays within a quarter margin of where it was found
      * wherever the contacts see it. */
-    const double lim = (web->substeps > 1 ? 0.1875 : 0.25) * margin,
+    const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     size_t flagged;
     if (c > 0.0) {
@@ -516,26 +588,26 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
          * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
          * node is flagged before it has moved 7/8 of the bound; it costs about what turning
          * every node costs, and a load that rocks on its film needs one every few steps. */
-        const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(web->epoch_q), p)));
-        double drift = v3_norm(v3_sub(r, web->epoch_r)) + turn * sqrt(web->lever2);
+        const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
+        double drift = v3_norm(v3_sub(r, nc->epoch_r)) + turn * sqrt(nc->lever2);
         const int renew = !(drift < 0.125 * lim);
         if (renew) {
-            web->epoch_A = A;
-            web->epoch_r = r;
-            web->epoch_q = p;
+            nc->epoch_A = A;
+            nc->epoch_r = r;
+            nc->epoch_q = p;
             drift = 0.0;
         }
         flagged = flag_epoch(web, x, &A, r, lim - drift, renew);
     }
-    for (size_t q = 0; rebase && q < web->ntrack; q++)
-        if (web->track[q].rebase)
-            rebase_body(b, cur, &web->track[q], web, x, margin, &A, r, pc);
+    for (size_t q = 0; rebase && q < nc->ntrack; q++)
+        if (nc->track[q].rebase)
+            rebase_body(b, cur, &nc->track[q], web, x, margin, &A, r, pc);
     /* Most steps flag no node. */
-    long count = flagged || rebase ? (long)collect_flagged(web->redo, web->n, web->moved) : 0;
+    long count = flagged || rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
-    for (size_t q = 0; count && q < web->ntrack; q++) {
-        ws_track *t = &web->track[q];
+    for (size_t q = 0; count && q < nc->ntrack; q++) {
+        ws_track *t = &nc->track[q];
         if (t->near)
             continue;
         uint32_t k = t->body;
@@ -544,7 +616,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         body_span(b, k, web, t->axis, &ax, &blo, &bhi);
         double o = v3_dot(ax, st->r[k]), least = INFINITY;
         for (long m = 0; m < count; m++) {
-            uint32_t i = web->moved[m];
+            uint32_t i = nc->moved[m];
             double cc = ax.x * x.x[i] + ax.y * x.y[i] + ax.z * x.z[i] - o;
             double g = fmax(cc - bhi, blo - cc);
             least = g < least ? g : least;
@@ -554,11 +626,11 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
         double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
         if (least - d < t->gap)
             t->gap = least - d;
-        if (d + 0.25 * margin >= t->gap)
+        if (d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Found again now: their moves count from here. */
-    to_ref(web, x, &A, r, web->moved, (size_t)count);
+    to_ref(web, x, &A, r, nc->moved, (size_t)count);
     return count;
 }
 
@@ -624,9 +696,13 @@ static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
 }
 
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
-                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged)
+                  const ws_ncand_list *old_list, const ws_ncand_list *fresh_list,
+                  ws_ncand_list *out_list, uint32_t *changed, size_t *nchanged)
 {
+    const ws_ncand *old = old_list->c, *fresh = fresh_list->c;
+    const size_t nold = old_list->n, nfresh = fresh_list->n;
+    ws_ncand **out = &out_list->c;
+    size_t *n = &out_list->n, *cap = &out_list->cap;
     if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
         return -1;
     ws_ncand *o = *out;
@@ -838,9 +914,10 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
  * order. Only here may a face candidate be marked INSIDE. */
 static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g,
                              const ws_find_body *fb, uint32_t c, uint32_t i, double reach,
-                             double margin, ws_ncand **out, size_t *n, size_t *cap,
-                             uint64_t *checks)
+                             double margin, ws_ncand_list *L, uint64_t *checks)
 {
+    ws_ncand **out = &L->c;
+    size_t *n = &L->n, *cap = &L->cap;
     const uint32_t nf = sh->face_count, k = fb->body;
     const double *v = g->find_val + fb->val + c;
     const uint64_t *mk = g->find_mask + fb->mask + c;
@@ -897,8 +974,10 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
 /* Node i at p (global) against body k of any shape, one by one. */
 static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
                               uint32_t i, uint32_t k, v3 p, double reach, double margin,
-                              ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+                              ws_ncand_list *L, uint64_t *checks)
 {
+    ws_ncand **out = &L->c;
+    size_t *n = &L->n, *cap = &L->cap;
     const ws_shape *sh = b->shape[k];
     v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
     if (!inside_box(s, sh->lo, sh->hi, reach))
@@ -947,13 +1026,15 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
 
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
                        ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks)
+                       ws_ncand_list *L, uint64_t *checks)
 {
+    size_t *n = &L->n;
+    ws_node_contact *nc = web->contact;
     *n = 0;
-    if (ws_array_reserve(mem, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1) != 0)
+    if (ws_array_reserve(mem, (void **)&nc->cbody, &nc->cbody_cap, b->slots + 1, 1) != 0)
         return -1;
     if (!nodes) /* a full search: the list holds no other candidates */
-        memset(web->cbody, 0, web->cbody_cap);
+        memset(nc->cbody, 0, nc->cbody_cap);
     if (web->n == 0)
         return 0;
     const double pad = web->layer + 0.5 * margin;
@@ -981,7 +1062,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
             if (!c)
                 continue;
-            web->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
+            nc->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
             if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
                                  sizeof *g->find_node) != 0)
                 return -1;
@@ -1034,12 +1115,12 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 int bad;
                 if (fb->general) {
                     bad = general_candidates(mem, b, cur, g, i, k, v3_make(px[j], py[j], pz[j]),
-                                             reach, margin, out, n, cap, checks);
+                                             reach, margin, L, checks);
                 } else {
                     if (!g->find_mask[fb->mask + M_LOCAL * FIND_CHUNK + c])
                         continue;
-                    bad = convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, out, n,
-                                            cap, checks);
+                    bad =
+                        convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, L, checks);
                 }
                 if (bad)
                     return -1;
@@ -1127,9 +1208,10 @@ static void prepare_body(const ws_body_store *b, int cur, ws_node_geom *g, uint3
 
 void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
 {
-    const size_t m = web->cbody_cap < b->slots ? web->cbody_cap : b->slots;
+    ws_node_contact *nc = web->contact;
+    const size_t m = nc->cbody_cap < b->slots ? nc->cbody_cap : b->slots;
     for (uint32_t k = 0; k < m; k++)
-        if (web->cbody[k] && !g->ready[k] && b->alive[k]) {
+        if (nc->cbody[k] && !g->ready[k] && b->alive[k]) {
             prepare_body(b, cur, g, k);
             g->ready[k] = 1;
         }
@@ -1148,4 +1230,74 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->find_mask, g->find_mask_cap * sizeof *g->find_mask);
     ws_mem_free(mem, g->find_node, g->find_node_cap * sizeof *g->find_node);
     ws_mem_free(mem, g->ready, g->ready_cap);
+}
+
+int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
+                           ws_web *web, double margin, double dt, int all, uint64_t *checks,
+                           int *searched)
+{
+    ws_node_contact *nc = web->contact;
+    const ws_nodes3 x = web->x[cur];
+    /* Node candidates: all found again when asked, when the record is invalid or when a body
+     * may have come near (ws_node_moved says -1); else those of the nodes that moved far
+     * enough relative to the near bodies, or that a near body past its bound may meet, merged
+     * into the others. Either way the list holds every node-feature pair that can touch in
+     * this step, and the result is the same as finding them every step (tests/test_detection.c
+     * shows it). */
+    int list = nc->list;
+    long moved = 0;
+    size_t changed = 0;
+    all |= nc->refresh;
+    if (!all && (moved = ws_node_moved(b, cur, web, x, web->v[cur], dt, margin)) < 0)
+        all = 1;
+    *searched = all || moved > 0;
+    if (*searched) {
+        const int old = list;
+        list ^= 1;
+        /* The record of where nodes were found changes now: should the step fail, the next
+         * one finds every node again (refresh stays set until a step commits). */
+        nc->refresh = 1;
+        if (nc->seg_list == list) /* cut from what is overwritten now */
+            nc->seg_list = -1;
+        int bad;
+        if (all) {
+            bad = ws_node_track(mem, b, cur, web, x, margin) ||
+                  ws_node_candidates(mem, b, cur, g, web, x, margin, NULL, 0, &nc->cand[list],
+                                     checks);
+            if (!bad)
+                ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
+        } else {
+            bad = ws_node_candidates(mem, b, cur, g, web, x, margin, nc->moved, (size_t)moved,
+                                     &nc->fresh, checks);
+            /* Mostly the nodes found again have the candidates they had: then the committed
+             * list serves again, uncopied. */
+            if (!bad && ws_node_same(nc->moved, (size_t)moved, nc->cstart, nc->cand[old].c,
+                                     nc->fresh.c, nc->fresh.n))
+                list = old;
+            else /* moved keeps the nodes whose candidates changed: their sweep blocks alone
+                    are cut into stretches again */
+                bad =
+                    bad ||
+                    ws_node_merge(mem, nc->moved, (size_t)moved, web->n, nc->cstart, &nc->cand[old],
+                                  &nc->fresh, &nc->cand[list], nc->moved, &changed) ||
+                    ws_node_segments_merged(mem, web, nc->cand[list].c, nc->cand[list].n, list, old,
+                                            nc->moved, changed);
+        }
+        if (bad || ws_node_scratch(mem, nc, nc->cand[list].n) != 0)
+            return -1;
+    }
+    nc->next_list = list;
+    ws_node_prepare(b, cur, g, web);
+    /* The list cut into stretches for the evaluation: again whenever it changed (a list that
+     * serves again keeps its stretches). */
+    if (nc->seg_list != list &&
+        ws_node_segments(mem, web, nc->cand[list].c, nc->cand[list].n, list) != 0)
+        return -1;
+    return 0;
+}
+
+void ws_node_contact_commit(ws_node_contact *nc)
+{
+    nc->list = nc->next_list;
+    nc->refresh = 0;
 }

@@ -6,6 +6,127 @@
 #include "web/web.h"
 
 /* Contact parameters of the web's material against each body material. */
+/* A node candidate: node `node` of the web against a feature of body `body`: a face, or
+ * (local has WS_NCAND_EDGE set) a convex edge. feat indexes the feature prepared in the global
+ * frame, local (without the flags) the feature in the body's shape. Candidates are sorted by
+ * node, so a sub-step can take them block by block with the nodes. */
+typedef struct ws_ncand {
+    uint32_t node, body, feat, local;
+} ws_ncand;
+#define WS_NCAND_EDGE 0x80000000u   /* local names an edge */
+#define WS_NCAND_INSIDE 0x40000000u /* the node was found well inside the face's outline */
+/* On the first of a node's candidates of a body: they are a corner, two faces of a flat convex
+ * shape and then the edge between them (the contacts tell the three apart by the planes). */
+#define WS_NCAND_CORNER 0x20000000u
+#define WS_NCAND_FLAGS (WS_NCAND_EDGE | WS_NCAND_INSIDE | WS_NCAND_CORNER)
+/* A shape's faces and edges (at most its triangles and 3/2 of them, under WS_MESH_MAX_ITEMS)
+ * are numbered below the flags. */
+_Static_assert(3ull * WS_MESH_MAX_ITEMS / 2 < WS_NCAND_CORNER, "feature numbers reach the flags");
+#define WS_NCAND_FACES 64 /* the most faces of a body whose candidates get INSIDE */
+
+/* The candidates of a web cut into stretches of nodes, in node order, within one row of a grid
+ * web (a sweep block holds whole rows, ws_web_block_count), within the web otherwise. A run:
+ * nodes [n0, n1), each with exactly one candidate, all of the same face and found well inside it
+ * (WS_NCAND_INSIDE); node n0 + k has candidate c0 + k. Runs are evaluated on vectors
+ * (contact/node_force.c). Otherwise: candidates [c0, c1), of nodes in [n0, n1), evaluated one by
+ * one. */
+typedef struct ws_nseg {
+    uint32_t n0, n1, c0, c1;
+    int run;
+} ws_nseg;
+
+/* A growable list of candidates: c[0, n), room for cap. */
+typedef struct ws_ncand_list {
+    ws_ncand *c;
+    size_t n, cap;
+} ws_ncand_list;
+
+/* A body as a full detection of a web's node candidates saw it, relative to the web's
+ * reference body (see ws_node_contact): its CoG (rho) and orientation (q) in the reference body's
+ * frame (for a near body, as it was when it last moved past its bound, ws_node_moved); its
+ * lever: how far from its CoG a point of it can touch a node. Near the web, or far from it:
+ * then every node lies beyond its box (grown by the layers) along its own axis `axis` (0, 1,
+ * 2), whose interval is (lo, hi), and `gap` is the least distance beyond it that a node had
+ * when last found, less how far the body had moved by then (ws_node_moved). rebase: scratch
+ * of ws_node_moved. */
+typedef struct ws_track {
+    uint32_t body;
+    int near, axis, rebase;
+    v3 rho;
+    qt q;
+    double lo, hi, gap, lever;
+} ws_track;
+
+/* A web's contact with the bodies (web->contact): its node candidates, the record of where the
+ * nodes were found and how the bodies stood (tracks, epochs), the stretches and runs the
+ * candidates are cut into, and the scratch their evaluation uses. Made with the web
+ * (ws_node_contact_new), freed with it. */
+typedef struct ws_node_contact {
+    /* Node-face candidates: changed only by full detection, into the other list. */
+    ws_ncand_list cand[2];
+    double *act;      /* the contacts of a sweep block gone one by one (scratch, sized */
+    uint32_t *act_id; /* with the candidates; contact/node_force.c) */
+    size_t act_cap;
+    ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
+    size_t nseg, seg_cap;
+    int seg_list;
+    size_t act_nl;      /* loads listed in act since the sub-step began (contact/node_force.c) */
+    uint32_t lane_end;  /* one past the last node of the lane sweeping this copy (n: one lane) */
+    int runs_off;       /* no short cuts: no runs and no corners, every candidate one by one
+                           through its full tests (tests compare the two) */
+    uint32_t run_batch; /* groups of run nodes taken at once; 0: as many as fit
+                           (tests make it small to run the batches often) */
+    uint64_t run_nodes, run_deep; /* nodes evaluated in runs; of them, in runs that went one
+                                     by one because a node lay below the face (diagnostics) */
+    uint64_t corners;             /* corners told apart by their planes (diagnostics) */
+    double *rtmp; /* the runs' batch, its kernel's values, the nodes' depths (scratch, */
+                  /* contact/node_force.c) */
+    size_t rtmp_cap;
+    struct ws_run_face *rface; /* per face that runs lie on, what they need of it and its */
+    size_t rface_cap;          /* body, filled in sub-step rface_gen (scratch, node_force.c) */
+    uint64_t rface_gen;
+    int list;      /* the committed list */
+    int next_list; /* the list this step used, committed with it */
+    /* Node candidates stay valid while no node has moved half the contact margin relative to
+     * any body near the web since they were found (ws_node_moved). Moves are
+     * measured in the frame of a reference body, the heaviest dynamic body near the web (none:
+     * the global frame), so a stack that slides or turns with its film costs nothing. At a full
+     * detection: the web's box (lo, hi) and every body (track: near the web or how far from
+     * it, with its pose then); per node, where it was, in the reference frame, when its
+     * candidates were found (xdet). moved: the nodes to find again (scratch, n). refresh says
+     * every node must be found again before the next step. */
+    ws_nodes3 xdet;
+    v3 box_lo, box_hi;
+    uint32_t ref;    /* the reference body's slot, UINT32_MAX for none */
+    ws_track *track; /* every body at the full detection, in slot order */
+    size_t ntrack, track_cap;
+    uint32_t *moved;
+    uint8_t *redo;
+    ws_ncand_list fresh; /* candidates of the moved nodes (scratch) */
+    int refresh;
+    /* The same places in the global frame as the reference body stood at an epoch (its pose
+     * then: epoch_r, epoch_A, epoch_q): xep = epoch_r + epoch_A xdet, which a node's global
+     * position is compared with (ws_node_moved); lever2: the largest |xdet|^2 since the full
+     * detection. */
+    ws_nodes3 xep;
+    m3 epoch_A;
+    v3 epoch_r;
+    qt epoch_q;
+    double lever2;
+    /* Where each node's candidates start in the list last found or merged (n + 1, see
+     * ws_node_index). */
+    size_t *cstart;
+    /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
+     * some node searched since the full detection, ws_node_candidates). */
+    uint8_t *cbody;
+    size_t cbody_cap;
+} ws_node_contact;
+
+/* A web's contact object for n nodes (zeroed, lists empty); NULL when out of memory. */
+ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n);
+/* Free it and all it holds (NULL: nothing); n as made. */
+void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n);
+
 typedef struct ws_node_params {
     double k, c, mu, vlim;
 } ws_node_params;
@@ -54,6 +175,19 @@ typedef struct ws_node_geom {
  * body prepared yet: a step prepares only the bodies some web's candidates may name
  * (ws_node_prepare). 0, or -1 when out of memory (only when bodies were added since the last
  * call). */
+/* The one call of a step before a web's sub-steps: its candidates brought up to date at state
+ * cur (all found again when `all`, the record of the last search is invalid or a body may
+ * have come near; else those of the nodes that moved, ws_node_moved, merged in), the bodies'
+ * features prepared (g) and the list cut into stretches, with the room its evaluation needs.
+ * The list to evaluate is nc->next_list, nc->cand[next_list]; *searched says whether nodes
+ * were searched. Feature checks are counted in *checks. 0, or -1 when out of memory (nothing
+ * committed changed; the next step searches every node). */
+int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
+                           ws_web *web, double margin, double dt, int all, uint64_t *checks,
+                           int *searched);
+/* After an accepted step: its list becomes the committed one. */
+void ws_node_contact_commit(ws_node_contact *nc);
+
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
 
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
@@ -66,9 +200,9 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
  * when out of memory. */
 int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
                        ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand **out, size_t *n, size_t *cap, uint64_t *checks);
+                       ws_ncand_list *out, uint64_t *checks);
 
-/* A full detection's record (see ws_web): the web's box from x and the bodies whose boxes come
+/* A full detection's record (see ws_node_contact): the web's box from x and the bodies whose boxes come
  * within reach of it, with their pose at state cur; xdet = x. 0, or -1 when out of memory. */
 int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
                   double margin);
@@ -104,12 +238,12 @@ int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const
  * candidates are not those they had into `changed` (room for count; it may be `nodes`
  * itself), in order, *nchanged of them. 0, or -1 when out of memory (start unchanged). */
 int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand *old, size_t nold, const ws_ncand *fresh, size_t nfresh,
-                  ws_ncand **out, size_t *n, size_t *cap, uint32_t *changed, size_t *nchanged);
+                  const ws_ncand_list *old, const ws_ncand_list *fresh, ws_ncand_list *out,
+                  uint32_t *changed, size_t *nchanged);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
-int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand);
-void ws_node_scratch_free(ws_mem *mem, ws_web *web);
+int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand);
+void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc);
 
 /* Cut the candidates (sorted by node) of list `list` of a web into its stretches (web->seg,
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
@@ -122,15 +256,44 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
                             int from, const uint32_t *nodes, size_t count);
 
+/* A sub-step starts (on the web or a lane of it): the runs' faces are taken afresh, the list of
+ * loads is empty. */
+void ws_node_substep(ws_node_contact *nc);
+/* The loads on the bodies listed since ws_node_substep, in node order, added to the per-body
+ * totals bforce and bmoment (global, moment about the CoG), which the step adds to the
+ * bodies. Lanes' lists are added in the order of their nodes, so the totals are those of one
+ * sweep to the bit. */
+void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment);
+/* The first stretch whose nodes start at n0 or later (where a lane starting at n0 begins). */
+size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0);
+/* Room in `lane`, a lane's own scratch (world_step.c), for evaluating ncand candidates of a
+ * web of n nodes whose contact is nc, with its stretches cut. 0, or -1 when out of memory. */
+int ws_node_lane_scratch(ws_mem *mem, ws_node_contact *lane, const ws_node_contact *nc, uint32_t n,
+                         size_t ncand);
+
+/* What every sweep block of a web's sub-step evaluates its node contacts with: the bodies at
+ * state cur (b, with their features in the global frame g), the contact parameters by body
+ * material (pp), the list of candidates the stretches were cut from (cand), the node state
+ * (x, v), the sub-step h, the share 1 / substeps of each contact force the node's record gets
+ * and that record (fc). */
+typedef struct ws_node_pass {
+    ws_body_store *b;
+    int cur;
+    const ws_node_geom *g;
+    const ws_node_params *pp;
+    const ws_ncand *cand;
+    ws_nodes3 x, v;
+    double h, share;
+    v3 *fc;
+} ws_node_pass;
+
 /* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),
- * moving *next past them, at node state (x, v), for a sub-step h: forces into web->f, the node
+ * moving *next past them, with what P gives (ws_node_pass): forces into web->f, the node
  * contact forces (`share` = 1 / substeps of them) into fc, and the opposite loads on the bodies
- * (the same share) into the per-body totals bforce and bmoment (global, moment about the CoG),
- * which the step adds to the bodies. cand is the list the stretches were cut from; pp is
- * indexed by body material. The result does not depend on how the candidates are cut. */
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
-                      v3 *bmoment, uint64_t *checks);
+ * (the same share) listed for ws_node_loads (bforce and bmoment are not written here). cand is the
+ * list the stretches were cut from; pp is indexed by body material. The result does not depend on
+ * how the candidates are cut. */
+void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
+                      uint64_t *checks);
 
 #endif

@@ -160,7 +160,7 @@ static inline void friction_of(double nx, double ny, double nz, double tx, doubl
 /* ---- the contacts of a sweep block gone one by one
  *
  * The one-by-one pass lists the contacts whose tests it passed, in node order, in groups of
- * four (web->act). At the block's end their normal forces go on vectors and into f, and once
+ * four (nc->act). At the block's end their normal forces go on vectors and into f, and once
  * every normal force of the block is in, their frictions go on vectors and they are applied
  * to the nodes. Runs apply theirs in batches (run_flush), into the places in the list of loads
  * they took. The loads on the bodies of both go to one list of loads in node order, which is
@@ -183,7 +183,7 @@ typedef struct act_group {
     double kx[4], ky[4], kz[4], ax[4], ay[4], az[4], bx[4], by[4], bz[4], mx[4], my[4], mz[4];
 } act_group;
 
-/* The doubles of web->act per contact of its room (act_cap): its group's share, then its load. */
+/* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
 enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS = ACT_GROUP + 6 };
 
 /* A load on a body: force and moment about the CoG; the list's loads come after its groups. */
@@ -203,12 +203,13 @@ typedef struct act_list {
     size_t n, nl;
 } act_list;
 
-static act_list act_open(ws_web *web)
+static act_list act_open(ws_node_contact *nc)
 {
-    const size_t cap = web->act_cap; /* a multiple of 4 (ws_node_scratch) */
-    uint32_t *id = web->act_id;
-    act_list L = {(act_group *)web->act, id, id + cap, id + 2 * cap, id + 3 * cap, NULL, 0, 0};
-    L.load = (act_load *)(web->act + ACT_GROUP * cap);
+    const size_t cap = nc->act_cap; /* a multiple of 4 (ws_node_scratch) */
+    uint32_t *id = nc->act_id;
+    act_list L = {(act_group *)nc->act, id,   id + cap, id + 2 * cap,
+                  id + 3 * cap,         NULL, 0,        nc->act_nl};
+    L.load = (act_load *)(nc->act + ACT_GROUP * cap);
     return L;
 }
 
@@ -546,9 +547,9 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
          * their tests: a corner's three (marked by the detection) as its planes leave them. */
         uint32_t left;
         int sure = 0;
-        if ((c0->local & WS_NCAND_CORNER) && !E->web->runs_off) {
+        if ((c0->local & WS_NCAND_CORNER) && !E->web->contact->runs_off) {
             left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo, &sure);
-            E->web->corners++;
+            E->web->contact->corners++;
             k += 3;
         } else {
             size_t e = k + 1;
@@ -641,7 +642,7 @@ typedef struct run_const {
 } run_const;
 
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
- * filled by the first of them (gen: the sub-step, web->rface_gen). */
+ * filled by the first of them (gen: the sub-step, nc->rface_gen). */
 typedef struct ws_run_face {
     run_face q;
     run_const rc;
@@ -838,8 +839,9 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
 static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
 {
     ws_web *web = E->web;
-    ws_run_face *e = &web->rface[c->feat];
-    if (e->gen == web->rface_gen)
+    ws_node_contact *nc = web->contact;
+    ws_run_face *e = &nc->rface[c->feat];
+    if (e->gen == nc->rface_gen)
         return e;
     const ws_body_store *b = E->b;
     const ws_body_state *st = E->st;
@@ -851,7 +853,7 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
     e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
     e->rc = (run_const){n.x,  n.y,  n.z,  hi,   r.x,  r.y,  r.z,   vb.x,    vb.y,
                         vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim, bi};
-    e->gen = web->rface_gen;
+    e->gen = nc->rface_gen;
     return e;
 }
 
@@ -868,6 +870,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
                          double h, double share, v3 *fc)
 {
     ws_web *web = E->web;
+    ws_node_contact *nc = web->contact;
     const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
@@ -883,9 +886,9 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
             in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
-        web->run_nodes += m;
+        nc->run_nodes += m;
         if (!whole || (in & below)) { /* one by one */
-            web->run_deep += whole ? m : 0;
+            nc->run_deep += whole ? m : 0;
             contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
@@ -897,13 +900,18 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
          * the window side by side share few groups; the last no further than the depths
          * reach (it may then hold nodes of the one before, not as its own). */
         uint32_t slot = (uint32_t)L->nl;
+        /* No group reaches past the lane's nodes (lane_end), whose forces another lane may be
+         * writing: one that would starts earlier, its first nodes not its own (a lane holds
+         * at least a block of WS_WEB_BLOCK_NODES nodes, so it stays within the lane). */
         const uint32_t last = (uint32_t)(4 * nv - 4);
+        const uint32_t cap = o + 4 * nv > nc->lane_end ? nc->lane_end - 4 : UINT32_MAX;
         while (in) {
             uint32_t e = ws_lowest_bit(in);
             e = e < last ? e : last;
+            const uint32_t start = o + e < cap ? o + e : cap;
             const uint32_t bits = (uint32_t)(in >> e) & 15u;
             in &= ~((uint64_t)15u << e);
-            B->grp[B->n++] = (run_group){&rf->rc, o + e, slot, bits};
+            B->grp[B->n++] = (run_group){&rf->rc, start, slot, bits << (o + e - start)};
             slot += run_count4[bits];
         }
         L->nl = slot;
@@ -948,6 +956,7 @@ static void seg_close_run(seg_cut *sc)
 static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t k, size_t n,
                             uint64_t stop)
 {
+    ws_node_contact *nc = web->contact;
     const ws_ncand *cand = sc->cand;
     uint64_t end = 0; /* the end of the block of the current node, at most stop */
     sc->g0 = sc->r0 = sc->r1 = k;
@@ -963,8 +972,8 @@ static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t 
             end = (uint64_t)(node / bl + 1) * bl;
             end = end < stop ? end : stop;
         }
-        int single = !web->runs_off && e == k + 1 &&
-                     (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
+        int single =
+            !nc->runs_off && e == k + 1 && (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
         if (single && sc->r1 > sc->r0 && sc->r1 == k && cand[k].feat == cand[sc->r0].feat &&
             node == cand[k - 1].node + 1) {
             sc->r1 = e; /* the run goes on */
@@ -1005,31 +1014,33 @@ static uint32_t seg_block(const ws_web *web)
 /* The stretches cut (sc) are list `list`'s: room for the faces their runs lie on. */
 static int seg_done(ws_mem *mem, ws_web *web, const seg_cut *sc, int list)
 {
-    web->nseg = sc->nseg;
-    const size_t had = web->rface_cap;
-    if (ws_array_reserve(mem, (void **)&web->rface, &web->rface_cap, sc->faces,
-                         sizeof *web->rface) != 0)
+    ws_node_contact *nc = web->contact;
+    nc->nseg = sc->nseg;
+    const size_t had = nc->rface_cap;
+    if (ws_array_reserve(mem, (void **)&nc->rface, &nc->rface_cap, sc->faces, sizeof *nc->rface) !=
+        0)
         return -1;
-    for (size_t f = had; f < web->rface_cap; f++)
-        web->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
-    web->seg_list = list;
+    for (size_t f = had; f < nc->rface_cap; f++)
+        nc->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
+    nc->seg_list = list;
     return 0;
 }
 
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list)
 {
-    web->seg_list = -1;
-    web->nseg = 0;
-    if (web->rtmp_cap == 0) {
+    ws_node_contact *nc = web->contact;
+    nc->seg_list = -1;
+    nc->nseg = 0;
+    if (nc->rtmp_cap == 0) {
         /* A run batch: its groups, run_kernel's scratch, the nodes' depths. */
         const size_t need =
             (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
-        if (ws_array_reserve(mem, (void **)&web->rtmp, &web->rtmp_cap, need, sizeof(double)) != 0)
+        if (ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double)) != 0)
             return -1;
     }
-    if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, n + 1, sizeof *web->seg) != 0)
+    if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
         return -1;
-    seg_cut sc = {cand, web->seg, 0, 0, 0, 0, 0};
+    seg_cut sc = {cand, nc->seg, 0, 0, 0, 0, 0};
     seg_cut_range(&sc, web, seg_block(web), 0, n, UINT64_MAX);
     return seg_done(mem, web, &sc, list);
 }
@@ -1037,17 +1048,17 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
 int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
                             int from, const uint32_t *nodes, size_t count)
 {
-    if (web->seg_list != from)
+    ws_node_contact *nc = web->contact;
+    if (nc->seg_list != from)
         return ws_node_segments(mem, web, cand, n, list);
     const uint32_t bl = seg_block(web);
-    const size_t nold = web->nseg;
-    web->seg_list = -1;
+    const size_t nold = nc->nseg;
+    nc->seg_list = -1;
     /* The new stretches go after the old ones, then down in their place. */
-    if (ws_array_reserve(mem, (void **)&web->seg, &web->seg_cap, nold + n + 1, sizeof *web->seg) !=
-        0)
+    if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, nold + n + 1, sizeof *nc->seg) != 0)
         return -1;
-    const ws_nseg *old = web->seg;
-    seg_cut sc = {cand, web->seg + nold, 0, 0, 0, 0, 0};
+    const ws_nseg *old = nc->seg;
+    seg_cut sc = {cand, nc->seg + nold, 0, 0, 0, 0, 0};
     size_t p = 0, k = 0; /* the next old stretch; where the next candidates lie in cand */
     for (size_t q = 0; q <= count;) {
         const uint64_t b0 = q < count ? (uint64_t)(nodes[q] / bl) * bl : UINT64_MAX,
@@ -1072,7 +1083,7 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
         while (q < count && nodes[q] < b1)
             q++;
     }
-    memmove(web->seg, sc.seg, sc.nseg * sizeof *web->seg);
+    memmove(nc->seg, sc.seg, sc.nseg * sizeof *nc->seg);
     return seg_done(mem, web, &sc, list);
 }
 
@@ -1088,9 +1099,10 @@ __attribute__((always_inline)) static inline void node_prefetch(const ws_web *we
                                                                 const ws_ncand *cand, size_t k,
                                                                 uint32_t n1)
 {
+    ws_node_contact *nc = web->contact;
     const uint64_t end = (uint64_t)n1 + seg_block(web);
-    const ws_nseg *seg = web->seg;
-    const size_t nseg = web->nseg;
+    const ws_nseg *seg = nc->seg;
+    const size_t nseg = nc->nseg;
     size_t s = k;
     for (; s < nseg && seg[s].n0 < end; s++) {
         __builtin_prefetch(cand + seg[s].c0);
@@ -1109,24 +1121,24 @@ static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uin
 }
 #endif
 
-void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *web, ws_nodes3 x,
-                      ws_nodes3 v, const ws_ncand *cand, uint32_t n1, size_t *next,
-                      const ws_node_params *pp, double h, double share, v3 *fc, v3 *bforce,
-                      v3 *bmoment, uint64_t *checks)
+void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
+                      uint64_t *checks)
 {
-    act_list L = act_open(web);
+    ws_node_contact *nc = web->contact;
+    const ws_ncand *cand = P->cand;
+    const double h = P->h, share = P->share;
+    v3 *fc = P->fc;
+    act_list L = act_open(web->contact);
     corner_memo memo = {UINT32_MAX, 0.0};
-    const node_env E = {b, &b->st[cur], g, web, x, v, pp, &L, &memo};
-    double *tmp = web->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
-    run_batch B = {(run_group *)web->rtmp, (struct run_tmp *)tmp,
+    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L, &memo};
+    double *tmp = nc->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
+    run_batch B = {(run_group *)nc->rtmp, (struct run_tmp *)tmp,
                    tmp + sizeof(run_tmp) / sizeof(double), 0,
-                   web->run_batch > 0 && web->run_batch < RUN_GROUPS ? web->run_batch : RUN_GROUPS};
+                   nc->run_batch > 0 && nc->run_batch < RUN_GROUPS ? nc->run_batch : RUN_GROUPS};
     size_t k = *next;
-    if (k == 0) /* a sub-step starts: the runs' faces are taken afresh */
-        web->rface_gen++;
     /* In locals: the stores of the passes would make the compiler load them again. */
-    const ws_nseg *seg = web->seg;
-    const size_t nseg = web->nseg;
+    const ws_nseg *seg = nc->seg;
+    const size_t nseg = nc->nseg;
     uint64_t tried = 0;
     for (; k < nseg && seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &seg[k];
@@ -1140,20 +1152,65 @@ void ws_node_contacts(ws_body_store *b, int cur, const ws_node_geom *g, ws_web *
     *next = k;
     run_flush(&E, &B, h, share, fc);
     act_apply(&E, h, share, fc);
-    loads_apply(&L, bforce, bmoment);
+    nc->act_nl = L.nl; /* the loads wait for ws_node_loads */
     node_prefetch(web, cand, k, n1);
 }
 
-int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
+void ws_node_substep(ws_node_contact *nc)
+{
+    nc->rface_gen++; /* the runs' faces are taken afresh */
+    nc->act_nl = 0;
+}
+
+void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
+{
+    act_list L = act_open(nc);
+    loads_apply(&L, bforce, bmoment);
+    nc->act_nl = 0;
+}
+
+size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0)
+{
+    size_t lo = 0, hi = nc->nseg;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (nc->seg[mid].n0 < n0)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+int ws_node_lane_scratch(ws_mem *mem, ws_node_contact *lane, const ws_node_contact *nc, uint32_t n,
+                         size_t ncand)
+{
+    if (ws_node_scratch(mem, lane, ncand) != 0)
+        return -1;
+    const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + n;
+    if (lane->rtmp_cap < need &&
+        ws_array_reserve(mem, (void **)&lane->rtmp, &lane->rtmp_cap, need, sizeof(double)) != 0)
+        return -1;
+    const size_t had = lane->rface_cap;
+    if (nc->rface_cap > had) {
+        if (ws_array_reserve(mem, (void **)&lane->rface, &lane->rface_cap, nc->rface_cap,
+                             sizeof *lane->rface) != 0)
+            return -1;
+        for (size_t f = had; f < lane->rface_cap; f++)
+            lane->rface[f].gen = 0; /* rface_gen is 1 from the first sub-step on */
+    }
+    return 0;
+}
+
+int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
 {
     /* Four more than every candidate, a multiple of four (act_apply's passes run on whole
      * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
      * different sets of the first-level cache. Grown by half at least: the candidates of a
      * web being wrapped grow step by step, and each new room is cleared. */
-    if (ncand + 4 > web->act_cap) {
-        size_t need = ncand + 4 > web->act_cap + web->act_cap / 2
-                          ? ncand + 4
-                          : web->act_cap + web->act_cap / 2;
+    if (ncand + 4 > nc->act_cap) {
+        size_t need =
+            ncand + 4 > nc->act_cap + nc->act_cap / 2 ? ncand + 4 : nc->act_cap + nc->act_cap / 2;
         need = (((need + 7) / 8) | 1) * 8;
         /* The new room is taken before the old is let go: out of memory, the web keeps the
          * room it had, of the size it had (a restore that fails leaves the world as it was). */
@@ -1163,24 +1220,24 @@ int ws_node_scratch(ws_mem *mem, ws_web *web, size_t ncand)
             ws_mem_free(mem, act, act ? need * ACT_ARRAYS * sizeof(double) : 0);
             return -1;
         }
-        ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
-        ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
-        web->act = act;
-        web->act_id = act_id;
-        web->act_cap = need;
+        ws_mem_free(mem, nc->act, nc->act_cap * ACT_ARRAYS * sizeof(double));
+        ws_mem_free(mem, nc->act_id, nc->act_cap * 4 * sizeof(uint32_t));
+        nc->act = act;
+        nc->act_id = act_id;
+        nc->act_cap = need;
     }
     return 0;
 }
 
-void ws_node_scratch_free(ws_mem *mem, ws_web *web)
+void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
 {
-    ws_mem_free(mem, web->act, web->act_cap * ACT_ARRAYS * sizeof(double));
-    ws_mem_free(mem, web->act_id, web->act_cap * 4 * sizeof(uint32_t));
-    ws_mem_free(mem, web->rtmp, web->rtmp_cap * sizeof(double));
-    ws_mem_free(mem, web->rface, web->rface_cap * sizeof *web->rface);
-    web->rface = NULL;
-    web->act = NULL;
-    web->act_id = NULL;
-    web->rtmp = NULL;
-    web->act_cap = web->rtmp_cap = web->rface_cap = 0;
+    ws_mem_free(mem, nc->act, nc->act_cap * ACT_ARRAYS * sizeof(double));
+    ws_mem_free(mem, nc->act_id, nc->act_cap * 4 * sizeof(uint32_t));
+    ws_mem_free(mem, nc->rtmp, nc->rtmp_cap * sizeof(double));
+    ws_mem_free(mem, nc->rface, nc->rface_cap * sizeof *nc->rface);
+    nc->rface = NULL;
+    nc->act = NULL;
+    nc->act_id = NULL;
+    nc->rtmp = NULL;
+    nc->act_cap = nc->rtmp_cap = nc->rface_cap = 0;
 }

@@ -25,7 +25,6 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     memset(web, 0, sizeof *web);
     web->n = n;
     web->ns = ns;
-    web->seg_list = -1;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         ok &= nodes_alloc(mem, &web->x[k], n);
@@ -34,13 +33,8 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     }
     ok &= nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= nodes_alloc(mem, &web->xdet, n);
-    ok &= nodes_alloc(mem, &web->xep, n);
     ok &= nodes_alloc(mem, &web->xsub, n);
     ok &= nodes_alloc(mem, &web->vsub, n);
-    ok &= (web->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
-    ok &= (web->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
-    ok &= (web->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -63,23 +57,13 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
-        ws_mem_free(mem, web->cand[k], web->capcand[k] * sizeof(ws_ncand));
 
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
     nodes_free(mem, &web->fmem, web->n);
-    nodes_free(mem, &web->xdet, web->n);
-    nodes_free(mem, &web->xep, web->n);
     nodes_free(mem, &web->xsub, web->n);
     nodes_free(mem, &web->vsub, web->n);
-    ws_mem_free(mem, web->moved, (n ? n : 1) * sizeof(uint32_t));
-    ws_mem_free(mem, web->redo, (n ? n : 1) * sizeof(uint8_t));
-    ws_mem_free(mem, web->cstart, ((size_t)n + 1) * sizeof(size_t));
-    ws_mem_free(mem, web->cbody, web->cbody_cap);
-    ws_mem_free(mem, web->track, web->track_cap * sizeof(ws_track));
-    ws_mem_free(mem, web->fresh, web->fresh_cap * sizeof(ws_ncand));
-    ws_mem_free(mem, web->seg, web->seg_cap * sizeof(ws_nseg));
     ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
@@ -253,7 +237,8 @@ static void spring_run_apply(const double *restrict x, const double *restrict y,
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
  * spring of a general law, which is evaluated with the spring's history as committed, at
  * (t, since). A law that fails (a user callback) marks the web; the step reports it. */
-static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p)
+static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p,
+                          uint32_t lo, uint32_t hi)
 {
     v3 d;
     double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
@@ -268,8 +253,17 @@ static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spr
         return;
     }
     v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
-    nodes_add(web->f, web->sa[s], fu);
-    nodes_add(web->f, web->sb[s], v3_scale(fu, -1.0));
+    const uint32_t a = web->sa[s], b = web->sb[s];
+    if (a >= lo && a < hi)
+        nodes_add(web->f, a, fu);
+    if (b >= lo && b < hi)
+        nodes_add(web->f, b, v3_scale(fu, -1.0));
+}
+
+/* The same onto both ends. */
+static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p)
+{
+    spring_one_in(web, x, v, s, p, 0, UINT32_MAX);
 }
 
 /* Gravity and node drag on nodes [n0, n1): the start of their force. */
@@ -500,6 +494,41 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, cons
     }
 }
 
+/* The up-springs and shear pairs from row j to row j + 1 onto the ends in rows [r0, r1) alone
+ * (j and j + 1 both for all of them), in the order grid_step puts them: at the edge of a lane
+ * (ws_web_forces_block) each of the two lanes computes the springs and takes its own row's
+ * side, which gets the values and the order it gets in one sweep. The other side's forces go
+ * to the scratch. */
+static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1,
+                         const ws_spring_form *P)
+{
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const size_t cols = web->closed ? nx : nx - 1, a = nx * j;
+    const uint32_t lo = (uint32_t)(nx * r0), hi = (uint32_t)(nx * r1);
+    const size_t s0 = cols * ny + nx * j;
+    const ws_spring_form *p = &P[WS_SPRING_UP];
+    if (web->law[WS_SPRING_UP] && p->gen) {
+        for (size_t i = 0; i < nx; i++)
+            spring_one_in(web, x, v, (uint32_t)(s0 + i), *p, lo, hi);
+    } else if (web->law[WS_SPRING_UP]) {
+        const ws_nodes3 f = web->f;
+        const int up = j >= r0 && j < r1, down = j + 1 >= r0 && j + 1 < r1;
+        double *dx = web->tmp, *dy = dx + WS_WEB_CHUNK, *dz = dy + WS_WEB_CHUNK;
+        for (size_t o = 0; o < nx; o += WS_WEB_CHUNK) {
+            const size_t q = a + o, m = nx - o < WS_WEB_CHUNK ? nx - o : WS_WEB_CHUNK;
+            spring_run_apply(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, nx, m,
+                             web->inv_l0 + s0 + o, p->kc, p->dk, p->w, p->qw, p->c,
+                             up ? f.x + q : dx, up ? f.y + q : dy, up ? f.z + q : dz,
+                             down ? f.x + q + nx : dx, down ? f.y + q + nx : dy,
+                             down ? f.z + q + nx : dz);
+        }
+    }
+    size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
+    if (shear0 < web->ns)
+        for (size_t s = shear0; s < shear0 + 2 * cols; s++)
+            spring_one_in(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR], lo, hi);
+}
+
 /* The rows of a grid web's sweep block: at least WS_WEB_BLOCK_NODES nodes (all of them in a
  * smaller web). */
 static size_t block_rows(const ws_web *web)
@@ -517,6 +546,19 @@ uint32_t ws_web_block_count(const ws_web *web)
         return 0u;
     const size_t r = block_rows(web);
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
+}
+
+void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1)
+{
+    if (web->nx <= 0) {
+        *n0 = 0;
+        *n1 = web->n;
+        return;
+    }
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
+    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
+    *n0 = (uint32_t)(nx * j0);
+    *n1 = (uint32_t)(nx * j1);
 }
 
 /* Row j of a grid web complete: row j + 1 started (base forces, its around-springs), then the
@@ -537,21 +579,33 @@ static void grid_step(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t j,
             spring_one(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR]);
 }
 
-void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, double since,
-                         uint32_t k, uint32_t *n0, uint32_t *n1)
+void ws_web_sweep_laws(ws_web *web, v3 g, double t, double since)
 {
-    /* The laws' parameters by spring kind, taken once a sweep and hoisted out of the loops. */
+    for (int q = 0; q < 3; q++)
+        web->form[q] = form_of(web->law[q], t, since);
+    /* Without drag, gravity and drag m g - c v is m g to the bit: c v is a zero (the
+     * velocities are finite, or the step fails on them), which leaves any m g but -0 as
+     * it is. */
+    web->no_drag = web->damping == 0.0 && !signbit(web->damping) && !(g.x == 0.0 && signbit(g.x)) &&
+                   !(g.y == 0.0 && signbit(g.y)) && !(g.z == 0.0 && signbit(g.z));
+}
+
+int ws_web_sweep_parallel(const ws_web *web)
+{
+    if (web->nx <= 0 || ws_web_block_count(web) < 2)
+        return 0;
+    double kc, dk, w, c;
+    for (int q = 0; q < 3; q++)
+        if (web->law[q] && !ws_law_film_form(web->law[q], &kc, &dk, &w, &c))
+            return 0;
+    return 1;
+}
+
+void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t k, int edges,
+                         uint32_t *n0, uint32_t *n1)
+{
+    /* The laws' parameters by spring kind, taken once a sweep (ws_web_sweep_laws). */
     const ws_spring_form *P = web->form;
-    if (k == 0) {
-        for (int q = 0; q < 3; q++)
-            web->form[q] = form_of(web->law[q], t, since);
-        /* Without drag, gravity and drag m g - c v is m g to the bit: c v is a zero (the
-         * velocities are finite, or the step fails on them), which leaves any m g but -0 as
-         * it is. */
-        web->no_drag = web->damping == 0.0 && !signbit(web->damping) &&
-                       !(g.x == 0.0 && signbit(g.x)) && !(g.y == 0.0 && signbit(g.y)) &&
-                       !(g.z == 0.0 && signbit(g.z));
-    }
     if (web->nx == 0) {
         base_forces(web, v, g, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
@@ -563,10 +617,24 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, double t, 
     /* Row j is complete once the springs to row j + 1 are in (grid_step). */
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
     const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
-    if (j0 == 0)
+    if (j0 == 0) {
         grid_row(web, x, v, g, 0, P);
-    for (size_t j = j0; j < j1; j++)
-        grid_step(web, x, v, g, j, P);
+    } else if (edges & WS_WEB_LANE_FIRST) {
+        /* The lane's first row as the lane before would have started it: its wraps (computed
+         * a group of rows at once, as the rows from 0 find them), the row, the springs from
+         * the row before onto it. */
+        if (web->closed && !P[WS_SPRING_AROUND].gen && web->law[WS_SPRING_AROUND] && nx >= 2 &&
+            j0 % WS_WEB_WRAPS != 0)
+            wrap_rows(web, x, v, j0 - j0 % WS_WEB_WRAPS, &P[WS_SPRING_AROUND]);
+        grid_row(web, x, v, g, j0, P);
+        pair_springs(web, x, v, j0 - 1, j0, j1, P);
+    }
+    for (size_t j = j0; j < j1; j++) {
+        if (j + 1 == j1 && j1 < ny && (edges & WS_WEB_LANE_LAST))
+            pair_springs(web, x, v, j, j0, j1, P); /* the next lane starts row j1 */
+        else
+            grid_step(web, x, v, g, j, P);
+    }
     *n0 = (uint32_t)(nx * j0);
     *n1 = (uint32_t)(nx * j1);
 }

@@ -63,6 +63,7 @@ static void world_defaults(ws_world_def *def)
     def->max_angular_speed = 1e5;
     def->use_ccd = 1;
     def->stable_fraction = 0.5;
+    def->worker_count = 1;
 }
 WS_DEF_INITS(ws_world_def, world_defaults, user_data)
 
@@ -164,6 +165,10 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
                 (d.allocator.free != NULL);
     if (hooks != 0 && hooks != 3)
         return WS_ERR_INVALID_ARGUMENT;
+    /* Workers: 1 to WS_MAX_WORKERS; the host's scheduler is both of its calls or neither. */
+    if (d.worker_count < 1 || d.worker_count > WS_MAX_WORKERS ||
+        (d.enqueue_task == NULL) != (d.finish_task == NULL))
+        return WS_ERR_INVALID_ARGUMENT;
 
     ws_mem mem;
     ws_mem_init(&mem, &d.allocator);
@@ -188,6 +193,16 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         return WS_ERR_OUT_OF_MEMORY;
     }
     w->params_cap = 4;
+    if (d.worker_count > 1 && !d.enqueue_task &&
+        !(w->pool = ws_pool_create(&w->mem, d.worker_count - 1))) {
+        ws_world_destroy(w);
+        return WS_ERR_OUT_OF_MEMORY;
+    }
+    if (!(w->lane_job = ws_mem_calloc(&w->mem, (size_t)WS_LANES_PER_WORKER * d.worker_count,
+                                      sizeof *w->lane_job))) {
+        ws_world_destroy(w);
+        return WS_ERR_OUT_OF_MEMORY;
+    }
     ws_contact_def c;
     ws_contact_def_init(&c);
     w->params[0] = to_params(&c);
@@ -213,6 +228,11 @@ void ws_world_destroy(ws_world *w)
         return;
     }
     ws_mem *m = &w->mem;
+    ws_pool_destroy(m, w->pool); /* no step runs: its threads wait for work */
+    ws_world_lanes_free(w);
+    ws_mem_free(
+        m, w->lane_job,
+        w->lane_job ? (size_t)WS_LANES_PER_WORKER * w->def.worker_count * sizeof *w->lane_job : 0);
     ws_world_free_elements(w); /* before the laws and bodies they use */
     ws_world_free_webs(w);
     ws_world_free_laws(w);

@@ -5,6 +5,7 @@
 #include <wrapsim/wrapsim.h>
 
 #include "base/base.h"
+#include "base/pool.h"
 #include "body/body.h"
 #include "contact/contact.h"
 #include "contact/node.h"
@@ -17,6 +18,26 @@
 
 #define WS_ERR_LEN 512
 
+/* Lanes a web's sweep is cut into per worker, at most: more lanes than workers let a worker
+ * that runs while another waits for its core take more of them. */
+#define WS_LANES_PER_WORKER 2
+
+/* A lane of a parallel sweep of a web (world_step.c): copies of the web and its contact that
+ * share their state, with the lane's own scratch (lane 0: the web's); the blocks [k0, k1) it
+ * sweeps and what it found. Lanes 1.. keep their scratch from web to web and step to step:
+ * the spring chunk (tmp, WS_WEB_TMP doubles), the list of touched nodes (fct), the contact
+ * lists, run batch and run faces (own). */
+typedef struct ws_lane_job {
+    ws_web view;
+    ws_node_contact cview;
+    uint32_t k0, k1;
+    size_t fast;
+    uint64_t checks;
+    double *tmp;
+    uint32_t *fct;
+    size_t fct_cap;
+    ws_node_contact own;
+} ws_lane_job;
 /* Per material, the two lightest dynamic bodies (slots, UINT32_MAX for none) and a kinematic
  * body of it (scratch of ws_world_contact_limit). */
 typedef struct ws_mat_mass {
@@ -76,6 +97,8 @@ struct ws_world {
     int web_check; /* 1: re-check the webs' stable step before the next step */
     ws_node_params *node_par; /* node contact parameters by body material, scratch */
     ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
+    ws_pool *pool;            /* the world's own threads (worker_count > 1, no host scheduler) */
+    struct ws_lane_job *lane_job; /* a parallel sweep's lanes, WS_LANES_PER_WORKER a worker */
     size_t node_par_cap;
 
     ws_element **elements; /* by id slot (world_element.c) */
@@ -149,6 +172,8 @@ void ws_world_free_laws(ws_world *w);
 /* Take a slot of a table whose objects live in a pointer array, growing the array; the entry is
  * NULL. 0, or -1 when out of memory. */
 int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, uint32_t *slot);
+/* Free the scratch of the lanes of parallel sweeps (world_step.c). */
+void ws_world_lanes_free(ws_world *w);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
 /* The stable sub-step of a web with the stiffest contact its material can have. */

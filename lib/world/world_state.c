@@ -444,6 +444,123 @@ static void web_body_room(ws_walk *k, ws_web *web)
     web->bcap = cap;
 }
 
+/* A web's contact with the bodies (contact/node.h, web->contact): its committed candidates,
+ * the bodies they may name, the record of where the nodes were found (tracks, epochs). */
+static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
+{
+    ws_world *w = k->w;
+    const ws_body_store *b = &w->bodies;
+    ws_node_contact *C = web->contact;
+    int list = C->list, refresh = C->refresh;
+    intv(k, &list, 2, "a web's committed candidate list");
+    intv(k, &refresh, 2, "a web's refresh flag");
+    /* Which bodies the candidates may name, by body slot: the step prepares the features of
+     * those alone, so a candidate of another would read features never prepared. A check
+     * keeps them to test the candidates with. */
+    size_t had = C->cbody_cap;
+    room(k, (void **)&C->cbody, &C->cbody_cap, b->slots + 1, 1);
+    if (k->mode == WS_WALK_CHECK && C->cbody_cap > had) /* a new body flag is clear */
+        memset(C->cbody + had, 0, C->cbody_cap - had);
+    /* A check's scratch: the flags as read, then where each body's features start. */
+    uint8_t *named = NULL;
+    const size_t scratch = (b->slots + 1) * (1 + 2 * sizeof(uint32_t)) + 4;
+    if (k->mode == WS_WALK_CHECK && !failed(k) &&
+        !(named = ws_mem_calloc(&w->mem, scratch, 1)))
+        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory checking a web's candidates");
+    uint32_t base[2] = {0, 0}, *bases = NULL;
+    if (named) {
+        bases = (uint32_t *)(void *)(named + ((b->slots + 1 + 3) & ~(size_t)3));
+        for (size_t i = 0; i < b->slots; i++) {
+            bases[2 * i] = base[0];
+            bases[2 * i + 1] = base[1];
+            if (b->alive[i]) {
+                base[0] += b->shape[i]->face_count;
+                base[1] += b->shape[i]->edge_count;
+            }
+        }
+    }
+    for (size_t i = 0; i < b->slots && !failed(k); i++) {
+        int on = !reading(k) && i < C->cbody_cap && C->cbody[i];
+        intv(k, &on, 2, "a web's body flag");
+        if (k->mode == WS_WALK_READ)
+            C->cbody[i] = (uint8_t)on;
+        else if (named)
+            named[i] = (uint8_t)on;
+    }
+    size_t nc = C->cand[C->list].n;
+    count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, 4 * 4, "node candidates");
+    room(k, (void **)&C->cand[list].c, &C->cand[list].cap, nc + 1, sizeof(ws_ncand));
+    /* The contacts' room for that many candidates: a step that does not search takes it as
+     * it is. */
+    if (k->mode == WS_WALK_CHECK && !failed(k) && ws_node_scratch(&w->mem, web->contact, nc) != 0)
+        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory for %zu node candidates", nc);
+    uint32_t prev = 0;
+    ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
+    for (size_t q = 0; q < nc && !failed(k); q++) {
+        ws_ncand c = reading(k) ? (ws_ncand){0} : C->cand[C->list].c[q];
+        u32v(k, &c.node);
+        u32v(k, &c.body);
+        u32v(k, &c.feat);
+        u32v(k, &c.local);
+        if (k->mode == WS_WALK_CHECK) {
+            check_ncand(k, web, &c, prev, q, bases);
+            /* After a failed step the list may name bodies the flags no longer do; the next
+             * step then finds every candidate again (refresh) and reads none of them. */
+            if (!failed(k) && !refresh && !named[c.body])
+                fail(k, WS_ERR_FORMAT, "node candidate %zu names body %u, which the web's "
+                     "flags say it has no candidate of", q, c.body);
+            last[0] = last[1];
+            last[1] = last[2];
+            last[2] = c;
+            if (!failed(k) && q >= 2 && (last[0].local & WS_NCAND_CORNER) && !corner_ok(w, last))
+                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
+                     q - 2);
+            if (!failed(k) && q + 2 >= nc && (c.local & WS_NCAND_CORNER))
+                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
+                     q);
+        } else if (k->mode == WS_WALK_READ) {
+            C->cand[list].c[q] = c;
+        }
+        prev = c.node;
+    }
+    f64s(k, C->xdet.x, 3 * (size_t)web->n, 0);
+    f64s(k, C->xep.x, 3 * (size_t)web->n, 0);
+    v3s(k, &C->box_lo, 0);
+    v3s(k, &C->box_hi, 0);
+    uint32_t ref = C->ref;
+    u32v(k, &ref);
+    if (k->mode == WS_WALK_CHECK && ref != UINT32_MAX && !body_ok(w, ref))
+        fail(k, WS_ERR_FORMAT, "web %u's reference body %u is not of this world", slot, ref);
+    size_t nt = C->ntrack;
+    count(k, &nt, b->slots, 3 * 4 + 11 * 8, "a web's tracked bodies");
+    room(k, (void **)&C->track, &C->track_cap, nt + 1, sizeof(ws_track));
+    for (size_t q = 0; q < nt && !failed(k); q++) {
+        ws_track t = reading(k) ? (ws_track){0} : C->track[q];
+        walk_track(k, &t);
+        if (k->mode == WS_WALK_READ)
+            C->track[q] = t;
+    }
+    f64s(k, C->epoch_A.m, 9, 0);
+    v3s(k, &C->epoch_r, 0);
+    qts(k, &C->epoch_q, 0);
+    f64s(k, &C->lever2, 1, 0);
+    if (named)
+        ws_mem_free(&w->mem, named, scratch);
+    if (k->mode != WS_WALK_READ || failed(k))
+        return;
+    /* Read: what follows from the above. */
+    for (size_t i = b->slots; i < C->cbody_cap; i++)
+        C->cbody[i] = 0;
+    C->list = list;
+    C->next_list = list;
+    C->refresh = refresh;
+    C->cand[list].n = nc;
+    C->ref = ref;
+    C->ntrack = nt;
+    ws_node_index(C->cand[list].c, nc, web->n, C->cstart);
+    C->seg_list = -1; /* the stretches are cut again from the list read */
+}
+
 static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
 {
     ws_world *w = k->w;
@@ -473,119 +590,14 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
             web->bmoment[cur][i] = m;
         }
     }
-    /* The node candidates and the record of where the nodes were found (contact/node.h). */
-    int list = web->list, refresh = web->refresh;
-    intv(k, &list, 2, "a web's committed candidate list");
-    intv(k, &refresh, 2, "a web's refresh flag");
-    /* Which bodies the candidates may name, by body slot: the step prepares the features of
-     * those alone, so a candidate of another would read features never prepared. A check
-     * keeps them to test the candidates with. */
-    size_t had = web->cbody_cap;
-    room(k, (void **)&web->cbody, &web->cbody_cap, b->slots + 1, 1);
-    if (k->mode == WS_WALK_CHECK && web->cbody_cap > had) /* a new body flag is clear */
-        memset(web->cbody + had, 0, web->cbody_cap - had);
-    /* A check's scratch: the flags as read, then where each body's features start. */
-    uint8_t *named = NULL;
-    const size_t scratch = (b->slots + 1) * (1 + 2 * sizeof(uint32_t)) + 4;
-    if (k->mode == WS_WALK_CHECK && !failed(k) &&
-        !(named = ws_mem_calloc(&w->mem, scratch, 1)))
-        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory checking a web's candidates");
-    uint32_t base[2] = {0, 0}, *bases = NULL;
-    if (named) {
-        bases = (uint32_t *)(void *)(named + ((b->slots + 1 + 3) & ~(size_t)3));
-        for (size_t i = 0; i < b->slots; i++) {
-            bases[2 * i] = base[0];
-            bases[2 * i + 1] = base[1];
-            if (b->alive[i]) {
-                base[0] += b->shape[i]->face_count;
-                base[1] += b->shape[i]->edge_count;
-            }
-        }
-    }
-    for (size_t i = 0; i < b->slots && !failed(k); i++) {
-        int on = !reading(k) && i < web->cbody_cap && web->cbody[i];
-        intv(k, &on, 2, "a web's body flag");
-        if (k->mode == WS_WALK_READ)
-            web->cbody[i] = (uint8_t)on;
-        else if (named)
-            named[i] = (uint8_t)on;
-    }
-    size_t nc = web->ncand[web->list];
-    count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, 4 * 4, "node candidates");
-    room(k, (void **)&web->cand[list], &web->capcand[list], nc + 1, sizeof(ws_ncand));
-    /* The contacts' room for that many candidates: a step that does not search takes it as
-     * it is. */
-    if (k->mode == WS_WALK_CHECK && !failed(k) && ws_node_scratch(&w->mem, web, nc) != 0)
-        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory for %zu node candidates", nc);
-    uint32_t prev = 0;
-    ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
-    for (size_t q = 0; q < nc && !failed(k); q++) {
-        ws_ncand c = reading(k) ? (ws_ncand){0} : web->cand[web->list][q];
-        u32v(k, &c.node);
-        u32v(k, &c.body);
-        u32v(k, &c.feat);
-        u32v(k, &c.local);
-        if (k->mode == WS_WALK_CHECK) {
-            check_ncand(k, web, &c, prev, q, bases);
-            /* After a failed step the list may name bodies the flags no longer do; the next
-             * step then finds every candidate again (refresh) and reads none of them. */
-            if (!failed(k) && !refresh && !named[c.body])
-                fail(k, WS_ERR_FORMAT, "node candidate %zu names body %u, which the web's "
-                     "flags say it has no candidate of", q, c.body);
-            last[0] = last[1];
-            last[1] = last[2];
-            last[2] = c;
-            if (!failed(k) && q >= 2 && (last[0].local & WS_NCAND_CORNER) && !corner_ok(w, last))
-                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
-                     q - 2);
-            if (!failed(k) && q + 2 >= nc && (c.local & WS_NCAND_CORNER))
-                fail(k, WS_ERR_FORMAT, "node candidate %zu is marked a corner but is not one",
-                     q);
-        } else if (k->mode == WS_WALK_READ) {
-            web->cand[list][q] = c;
-        }
-        prev = c.node;
-    }
-    f64s(k, web->xdet.x, 3 * (size_t)web->n, 0);
-    f64s(k, web->xep.x, 3 * (size_t)web->n, 0);
-    v3s(k, &web->box_lo, 0);
-    v3s(k, &web->box_hi, 0);
-    uint32_t ref = web->ref;
-    u32v(k, &ref);
-    if (k->mode == WS_WALK_CHECK && ref != UINT32_MAX && !body_ok(w, ref))
-        fail(k, WS_ERR_FORMAT, "web %u's reference body %u is not of this world", slot, ref);
-    size_t nt = web->ntrack;
-    count(k, &nt, b->slots, 3 * 4 + 11 * 8, "a web's tracked bodies");
-    room(k, (void **)&web->track, &web->track_cap, nt + 1, sizeof(ws_track));
-    for (size_t q = 0; q < nt && !failed(k); q++) {
-        ws_track t = reading(k) ? (ws_track){0} : web->track[q];
-        walk_track(k, &t);
-        if (k->mode == WS_WALK_READ)
-            web->track[q] = t;
-    }
-    f64s(k, web->epoch_A.m, 9, 0);
-    v3s(k, &web->epoch_r, 0);
-    qts(k, &web->epoch_q, 0);
-    f64s(k, &web->lever2, 1, 0);
-    if (named)
-        ws_mem_free(&w->mem, named, scratch);
+    walk_node_contact(k, web, slot);
     if (k->mode != WS_WALK_READ || failed(k))
         return;
-    /* Read: what follows from the above. */
-    for (size_t i = b->slots; i < web->cbody_cap; i++)
-        web->cbody[i] = 0;
+    /* Read: the nodes whose contact force may be non-zero, from the forces read. */
     web->nfct[cur] = 0;
     for (uint32_t i = 0; i < web->n; i++)
         if (web->fc[cur][i].x != 0.0 || web->fc[cur][i].y != 0.0 || web->fc[cur][i].z != 0.0)
             web->fct[cur][web->nfct[cur]++] = i;
-    web->list = list;
-    web->next_list = list;
-    web->refresh = refresh;
-    web->ncand[list] = nc;
-    web->ref = ref;
-    web->ntrack = nt;
-    ws_node_index(web->cand[list], nc, web->n, web->cstart);
-    web->seg_list = -1; /* the stretches are cut again from the list read */
 }
 
 static void walk_webs(ws_walk *k)

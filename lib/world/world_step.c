@@ -202,6 +202,164 @@ static ws_status webs_ready(ws_world *w)
     return WS_OK;
 }
 
+/* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
+typedef struct lane_task {
+    ws_world *w;
+    ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
+    ws_nodes3 xd, vd;  /* the state written */
+} lane_task;
+
+/* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
+static void sweep_lane(const lane_task *T, ws_lane_job *J)
+{
+    ws_world *w = T->w;
+    ws_web *web = &J->view;
+    const uint32_t blocks = ws_web_block_count(web);
+    uint32_t n0, n1;
+    ws_web_block_range(web, J->k0, &n0, &n1);
+    size_t next = J->k0 ? ws_node_first_segment(&J->cview, n0) : 0;
+    ws_node_substep(&J->cview);
+    ws_web_sweep_begin(web, T->vd);
+    for (uint32_t q = J->k0; q < J->k1; q++) {
+        const int edges = (q == J->k0 && q > 0 ? WS_WEB_LANE_FIRST : 0) |
+                          (q + 1 == J->k1 && J->k1 < blocks ? WS_WEB_LANE_LAST : 0);
+        ws_web_forces_block(web, T->pass.x, T->pass.v, w->def.gravity, q, edges, &n0, &n1);
+        ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
+        J->fast += ws_web_integrate_block(web, T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, n0,
+                                          n1, w->def.max_speed);
+    }
+    ws_web_sweep_end(web);
+}
+
+/* Items [start, end) of a sub-step's lanes (ws_task_fn). */
+static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker; /* a lane's scratch is its own, whichever worker takes it */
+    const lane_task *T = ctx;
+    for (int32_t i = start; i < end; i++)
+        sweep_lane(T, &T->w->lane_job[i]);
+}
+
+/* The lanes a web's sweep is cut into this step, with the scratch of each ready; 0 when out of
+ * memory. One unless the world has workers and the web can be swept in lanes
+ * (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a block. */
+static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
+{
+    const uint32_t blocks = ws_web_block_count(web),
+                   most = WS_LANES_PER_WORKER * w->def.worker_count;
+    uint32_t lanes = w->def.worker_count > 1 ? most : 1;
+    if (lanes > blocks)
+        lanes = blocks;
+    if (lanes < 2 || !ws_web_sweep_parallel(web))
+        return 1;
+    for (uint32_t i = 1; i < lanes; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
+            return 0;
+        if (ws_node_lane_scratch(&w->mem, &J->own, web->contact, web->n, ncand) != 0 ||
+            ws_array_reserve(&w->mem, (void **)&J->fct, &J->fct_cap, ncand + 1, sizeof(uint32_t)) !=
+                0)
+            return 0;
+    }
+    return lanes;
+}
+
+void ws_world_lanes_free(ws_world *w)
+{
+    const size_t jobs = (size_t)WS_LANES_PER_WORKER * w->def.worker_count;
+    for (size_t i = 0; w->lane_job && i < jobs; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        ws_node_scratch_free(&w->mem, &J->own);
+        ws_mem_free(&w->mem, J->tmp, J->tmp ? WS_WEB_TMP * sizeof(double) : 0);
+        ws_mem_free(&w->mem, J->fct, J->fct_cap * sizeof(uint32_t));
+        J->tmp = NULL;
+        J->fct = NULL;
+        J->fct_cap = 0;
+    }
+}
+
+/* Lane i's copies of the web and its contact: their state shared, their scratch the lane's own
+ * (lane 0: the web's), the nodes the lane ends at. */
+static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
+{
+    ws_lane_job *J = &w->lane_job[i];
+    const uint32_t blocks = ws_web_block_count(web);
+    J->view = *web;
+    J->cview = *web->contact;
+    J->view.contact = &J->cview;
+    J->k0 = (uint32_t)((uint64_t)i * blocks / lanes);
+    J->k1 = (uint32_t)((uint64_t)(i + 1) * blocks / lanes);
+    J->fast = 0;
+    J->checks = 0;
+    ws_web *v = &J->view;
+    ws_node_contact *c = &J->cview;
+    uint32_t n0, n1;
+    ws_web_block_range(web, J->k1 - 1, &n0, &n1);
+    c->lane_end = n1;
+    c->run_nodes = c->run_deep = c->corners = 0;
+    v->law_failed = 0;
+    if (i == 0)
+        return;
+    v->tmp = J->tmp;
+    v->fct[v->fck] = J->fct;
+    v->fct_cap[v->fck] = J->fct_cap;
+    v->nfct[v->fck] = 0;
+    c->act = J->own.act;
+    c->act_id = J->own.act_id;
+    c->act_cap = J->own.act_cap;
+    c->rtmp = J->own.rtmp;
+    c->rtmp_cap = J->own.rtmp_cap;
+    c->rface = J->own.rface;
+    c->rface_cap = J->own.rface_cap;
+    c->rface_gen = J->own.rface_gen;
+}
+
+/* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
+ * its counts. Returns its nodes too fast. */
+static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *bmoment)
+{
+    ws_lane_job *J = &w->lane_job[i];
+    ws_web *v = &J->view;
+    ws_node_contact *c = &J->cview, *nc = web->contact;
+    ws_node_loads(c, bforce, bmoment);
+    nc->run_nodes += c->run_nodes;
+    nc->run_deep += c->run_deep;
+    nc->corners += c->corners;
+    web->law_failed |= v->law_failed;
+    w->stats.narrow_checks += J->checks;
+    const int k = web->fck;
+    if (i == 0) {
+        nc->rface_gen = c->rface_gen;
+        web->nfct[k] = v->nfct[k]; /* lane 0 listed into the web's own list */
+    } else {
+        J->own.rface_gen = c->rface_gen;
+        memcpy(web->fct[k] + web->nfct[k], v->fct[k], v->nfct[k] * sizeof(uint32_t));
+        web->nfct[k] += v->nfct[k];
+    }
+    return J->fast;
+}
+
+/* A sub-step of a web over its lanes: on the host's scheduler, the world's threads or, for one
+ * lane, right here. Returns how many nodes ended too fast. */
+static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
+{
+    for (uint32_t i = 0; i < lanes; i++)
+        lane_open(w, web, lanes, i);
+    if (lanes == 1) {
+        lane_items(0, 1, 0, T);
+    } else if (w->def.enqueue_task) {
+        void *task = w->def.enqueue_task(lane_items, (int32_t)lanes, 1, T, w->def.task_context);
+        if (task)
+            w->def.finish_task(task, w->def.task_context);
+    } else {
+        ws_pool_run(w->pool, lane_items, (int32_t)lanes, T);
+    }
+    size_t fast = 0;
+    for (uint32_t i = 0; i < lanes; i++)
+        fast += lane_close(w, web, i, bforce, bmoment);
+    return fast;
+}
+
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
  * swept block by block (ws_web_forces_block). Forces on the bodies go into their accumulators,
  * averaged over the sub-steps. */
@@ -214,72 +372,20 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        /* Node candidates: all found again when the cache is invalid or when a body may have
-         * come near (ws_node_moved says -1); else those of the nodes that moved far enough
-         * relative to the near bodies, or that a near body past its bound may meet, merged
-         * into the others.
-         * Either way the list holds every node-feature pair that can touch in this step, and
-         * the result is the same as finding them every step (tests/test_detection.c shows it
-         * for body pairs). The world's detection schedule governs the body pairs. */
-        int list = web->list;
-        long moved = 0;
-        size_t changed = 0;
-        int all = web->refresh || !w->cand_valid;
-        if (!all && (moved = ws_node_moved(b, cur, web, web->x[cur], web->v[cur], w->def.dt,
-                                           w->def.contact_margin)) < 0)
-            all = 1;
-        if (all || moved > 0) {
-            double t0 = clock_now(w);
-            int old = list;
-            list ^= 1;
-            /* The record of where nodes were found changes now: should the step fail, the
-             * next one finds every node again (refresh stays set until a step commits). */
-            web->refresh = 1;
-            if (web->seg_list == list) /* cut from what is overwritten now */
-                web->seg_list = -1;
-            int bad;
-            if (all) {
-                bad = ws_node_track(&w->mem, b, cur, web, web->x[cur], w->def.contact_margin) ||
-                      ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
-                                         w->def.contact_margin, NULL, 0, &web->cand[list],
-                                         &web->ncand[list], &web->capcand[list],
-                                         &w->stats.narrow_checks);
-                if (!bad)
-                    ws_node_index(web->cand[list], web->ncand[list], web->n, web->cstart);
-            } else {
-                bad = ws_node_candidates(&w->mem, b, cur, &w->node_geom, web, web->x[cur],
-                                         w->def.contact_margin, web->moved, (size_t)moved,
-                                         &web->fresh, &web->nfresh, &web->fresh_cap,
-                                         &w->stats.narrow_checks);
-                /* Mostly the nodes found again have the candidates they had: then the
-                 * committed list serves again, uncopied. */
-                if (!bad && ws_node_same(web->moved, (size_t)moved, web->cstart, web->cand[old],
-                                         web->fresh, web->nfresh))
-                    list = old;
-                else /* web->moved keeps the nodes whose candidates changed: their sweep
-                        blocks alone are cut into stretches again */
-                    bad = bad ||
-                          ws_node_merge(&w->mem, web->moved, (size_t)moved, web->n, web->cstart,
-                                        web->cand[old], web->ncand[old], web->fresh, web->nfresh,
-                                        &web->cand[list], &web->ncand[list], &web->capcand[list],
-                                        web->moved, &changed) ||
-                          ws_node_segments_merged(&w->mem, web, web->cand[list], web->ncand[list],
-                                                  list, old, web->moved, changed);
-            }
-            if (bad || ws_node_scratch(&w->mem, web, web->ncand[list]) != 0)
-                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                               web_label(web));
-            w->stats.seconds_detection += clock_now(w) - t0;
-            w->stats.seconds_web -= clock_now(w) - t0; /* counted as detection, not film */
-        }
-        web->next_list = list;
-        ws_node_prepare(b, cur, &w->node_geom, web);
-        /* The list cut into stretches for the evaluation: again whenever it changed (a list
-         * that serves again keeps its stretches). */
-        if (web->seg_list != list &&
-            ws_node_segments(&w->mem, web, web->cand[list], web->ncand[list], list) != 0)
+        /* The node candidates of this step, ready to evaluate (contact/node.c). */
+        ws_node_contact *nc = web->contact;
+        int searched = 0;
+        const double t0 = clock_now(w);
+        if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, w->def.contact_margin,
+                                   w->def.dt, !w->cand_valid, &w->stats.narrow_checks,
+                                   &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
+        if (searched) { /* counted as detection, not film */
+            w->stats.seconds_detection += clock_now(w) - t0;
+            w->stats.seconds_web -= clock_now(w) - t0;
+        }
+        const int list = nc->next_list;
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         for (size_t i = 0; i < web->bcap; i++)
@@ -292,13 +398,15 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
-                             (size_t)web->substeps * web->ncand[list] + 1, sizeof(uint32_t)) != 0)
+                             (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
-        const ws_ncand *cand = web->cand[list];
-        const uint32_t blocks = ws_web_block_count(web);
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
+        const uint32_t lanes = web_lanes(w, web, nc->cand[list].n);
+        if (lanes == 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -306,18 +414,13 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            size_t next = 0, fast = 0;
-            ws_web_sweep_begin(web, vd);
-            for (uint32_t q = 0; q < blocks; q++) {
-                uint32_t n0, n1;
-                ws_web_forces_block(web, xs, vs, w->def.gravity, w->time + s * h, s * h, q, &n0,
-                                    &n1);
-                ws_node_contacts(b, cur, &w->node_geom, web, xs, vs, cand, n1, &next,
-                                 w->node_par, h, share, web->fc[nxt], web->bforce[nxt],
-                                 web->bmoment[nxt], &w->stats.narrow_checks);
-                fast += ws_web_integrate_block(web, xs, vs, xd, vd, h, n0, n1, w->def.max_speed);
-            }
-            ws_web_sweep_end(web);
+            ws_web_sweep_laws(web, w->def.gravity, w->time + s * h, s * h);
+            lane_task T = {w,
+                           {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
+                            web->fc[nxt]},
+                           xd,
+                           vd};
+            size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
             if (web->law_failed) {
@@ -637,9 +740,8 @@ static ws_status step_once(ws_world *w)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         ws_web *web = w->webs[k];
-        web->list = web->next_list;
+        ws_node_contact_commit(web->contact);
         ws_web_commit(web, web->x[w->cur], web->v[w->cur], w->time, w->def.dt);
-        web->refresh = 0;
     }
     w->steps++;
     w->stats.seconds_total += clock_now(w) - t_start;

@@ -178,8 +178,10 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->material = c->material;
     web->damping = c->d.node_damping;
     web->substeps = c->d.substeps;
-    web->list = 0;
-    web->refresh = 1;
+    if (!(web->contact = ws_node_contact_new(&w->mem, web->n)))
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
+    web->contact->list = 0;
+    web->contact->refresh = 1;
     /* Both buffers start equal, so the world's committed index (0 or 1) finds the web. */
     memcpy(web->x[1].x, web->x[0].x, 3 * (size_t)web->n * sizeof(double));
     if (c->d.name && !(web->name = ws_mem_strdup(&w->mem, c->d.name)))
@@ -203,7 +205,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
 
 static ws_status fail_web(ws_world *w, ws_web *web, ws_status s)
 {
-    ws_node_scratch_free(&w->mem, web);
+    ws_node_contact_free(&w->mem, web->contact, web->n);
     ws_web_free(&w->mem, web);
     return s;
 }
@@ -389,7 +391,7 @@ ws_status ws_web_destroy(ws_world *w, ws_web_id id)
     if (s != WS_OK)
         return s;
     law_users(w->webs[slot], -1);
-    ws_node_scratch_free(&w->mem, w->webs[slot]);
+    ws_node_contact_free(&w->mem, w->webs[slot]->contact, w->webs[slot]->n);
     ws_web_free(&w->mem, w->webs[slot]);
     ws_mem_free(&w->mem, w->webs[slot], sizeof *w->webs[slot]);
     w->webs[slot] = NULL;
@@ -401,7 +403,7 @@ void ws_world_free_webs(ws_world *w)
 {
     for (size_t i = 0; i < w->web_cap && i < w->web_slots.slot_count; i++) {
         if (w->web_slots.dense[i] != UINT32_MAX && w->webs[i]) {
-            ws_node_scratch_free(&w->mem, w->webs[i]);
+            ws_node_contact_free(&w->mem, w->webs[i]->contact, w->webs[i]->n);
             ws_web_free(&w->mem, w->webs[i]);
             ws_mem_free(&w->mem, w->webs[i], sizeof *w->webs[i]);
         }

@@ -136,6 +136,10 @@ class WorldDef(Structure):
         ("log_user", c_void_p),
         ("user_data", c_void_p),
         ("stable_fraction", c_double),
+        ("worker_count", c_uint32),
+        ("enqueue_task", c_void_p),
+        ("finish_task", c_void_p),
+        ("task_context", c_void_p),
     ]
 
 

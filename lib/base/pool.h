@@ -1,0 +1,22 @@
+/* A small pool of threads of one world, for a step's parallel work when the host gives no
+ * scheduler of its own (ws_world_def.enqueue_task). Made with the world, joined when it is
+ * destroyed; no state outside it. */
+#ifndef WS_POOL_H
+#define WS_POOL_H
+
+#include <wrapsim/world.h>
+
+#include "base/base.h"
+
+typedef struct ws_pool ws_pool;
+
+/* A pool of `threads` threads (>= 1) beside the caller's. NULL when out of memory or when the
+ * system gives no thread (what was made is undone). */
+ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads);
+/* Stop and join the threads, free the pool (NULL: nothing). */
+void ws_pool_destroy(ws_mem *mem, ws_pool *pool);
+/* Run items [0, count) of `task`, one item a call, on the threads and the caller (worker 0),
+ * each item on whichever takes it first, and return when all have run. */
+void ws_pool_run(ws_pool *pool, ws_task_fn *task, int32_t count, void *ctx);
+
+#endif

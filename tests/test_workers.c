@@ -1,0 +1,341 @@
+/* Workers: a step on several workers (the world's own threads, or a host's scheduler) must give
+ * the state a step on one gives, to the bit. The film is swept in lanes of rows whose edges are
+ * computed by both neighbours and whose loads on the bodies are added in node order, so the
+ * sums are the same sums in the same order: the state hash (every double by its bits) is the
+ * test, with no tolerance. A scheduler that runs the pieces in reverse order, or each on a
+ * thread of its own, shows that the result does not depend on who runs them when. */
+#define TILT_TABLE_NO_MAIN
+#include "../examples/tilt_table.c"
+
+#include <pthread.h>
+
+#include "helpers.h"
+
+static int short_run(void)
+{
+    const char *e = getenv("WS_TEST_SHORT");
+    return e && *e && strcmp(e, "0") != 0;
+}
+
+/* ---- schedulers of a host ---- */
+
+/* Runs every item, the last first, before returning (no handle). */
+static void *enqueue_reverse(ws_task_fn *task, int32_t count, int32_t min_range, void *ctx,
+                             void *user)
+{
+    (void)min_range;
+    int *calls = user;
+    (*calls)++;
+    for (int32_t i = count; i-- > 0;)
+        task(i, i + 1, 0, ctx);
+    return NULL;
+}
+
+static void finish_never(void *task, void *user)
+{
+    (void)task, (void)user;
+    ck_abort_msg("finish called for a task run before enqueue returned");
+}
+
+/* Each item on a thread of its own, the threads started last first; finish joins them. */
+#define MAX_ITEMS 64
+typedef struct thread_task {
+    pthread_t id[MAX_ITEMS];
+    struct item {
+        ws_task_fn *task;
+        void *ctx;
+        int32_t i;
+    } item[MAX_ITEMS];
+    int32_t count;
+} thread_task;
+
+static void *item_main(void *arg)
+{
+    struct item *it = arg;
+    it->task(it->i, it->i + 1, (uint32_t)it->i, it->ctx);
+    return NULL;
+}
+
+static void *enqueue_threads(ws_task_fn *task, int32_t count, int32_t min_range, void *ctx,
+                             void *user)
+{
+    (void)min_range;
+    thread_task *t = user;
+    ck_assert_int_le(count, MAX_ITEMS);
+    t->count = count;
+    for (int32_t i = count; i-- > 0;) {
+        t->item[i] = (struct item){task, ctx, i};
+        ck_assert_int_eq(pthread_create(&t->id[i], NULL, item_main, &t->item[i]), 0);
+    }
+    return t;
+}
+
+static void finish_threads(void *task, void *user)
+{
+    thread_task *t = task;
+    ck_assert_ptr_eq(task, user);
+    for (int32_t i = 0; i < t->count; i++)
+        pthread_join(t->id[i], NULL);
+}
+
+/* ---- the wrapped reference case ---- */
+
+/* The wrapped case P (a closed band of 5856 nodes around the stack) for `steps` steps on
+ * `workers` of the world's threads; its state hash. */
+static uint64_t wrapped_hash(long steps, int workers)
+{
+    tilt_options o;
+    tilt_default_options(&o);
+    o.variant = 'P';
+    o.wrapped = 1;
+    o.quiet = 1;
+    o.workers = workers;
+    tilt_scene sc;
+    ck_assert_int_eq(tilt_build(&o, &sc), WS_OK);
+    ck_ok(sc.world, ws_world_step_n(sc.world, steps));
+    uint64_t h = 0;
+    ck_ok(sc.world, ws_world_get_state_hash(sc.world, &h));
+    ws_world_destroy(sc.world);
+    return h;
+}
+
+START_TEST(test_wrapped_same_for_any_workers)
+{
+    /* 0.1 s: the band falls onto the stack and its contacts (runs and one by one) form; 7.5 ms
+     * and 2 workers under WS_TEST_SHORT (sanitizers, valgrind), past the first contacts. */
+    const long steps = short_run() ? 30 : 400;
+    const int most = short_run() ? 2 : 4;
+    const uint64_t one = wrapped_hash(steps, 1);
+    for (int k = 2; k <= most; k++) {
+        uint64_t h = wrapped_hash(steps, k);
+        report("workers: wrapped case, %ld steps, %d workers: 0x%016llx (1 worker 0x%016llx)",
+               steps, k, (unsigned long long)h, (unsigned long long)one);
+        ck_assert_msg(h == one, "%d workers: state hash 0x%016llx, 1 worker 0x%016llx", k,
+                      (unsigned long long)h, (unsigned long long)one);
+    }
+}
+END_TEST
+
+/* ---- a sheet dropped onto a box ---- */
+
+typedef struct sheet_run {
+    int workers;
+    int host; /* 0: the world's threads (or none), 1: reverse order, 2: a thread an item */
+    int law_type;
+} sheet_run;
+
+/* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, dropped from
+ * 3 mm onto a box on the ground so that it drapes over the edges: contacts on faces, edges and
+ * corners, runs and one by one, with friction. Its state hash after `steps` steps. */
+static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 2.5e-4;
+    d.worker_count = (uint32_t)r->workers;
+    int calls = 0;
+    thread_task tt;
+    if (r->host == 1) {
+        d.enqueue_task = enqueue_reverse;
+        d.finish_task = finish_never;
+        d.task_context = &calls;
+    } else if (r->host == 2) {
+        d.enqueue_task = enqueue_threads;
+        d.finish_task = finish_threads;
+        d.task_context = &tt;
+    }
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    add_ground(w, 2.0, no_material());
+    ws_body_id box =
+        add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = (ws_law_type)r->law_type;
+    ld.stiffness = 200.0;
+    ld.damping = r->law_type == WS_LAW_LINEAR_VISCOELASTIC ? 0.05 : 0.0;
+    if (r->law_type == WS_LAW_CUBIC_ELASTIC)
+        ld.cubic_stiffness = 2e3;
+    ws_law_id law;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = wd.law_cross = wd.law_shear = law;
+    wd.node_damping = 1e-3;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 48;
+    sd.ny = 40;
+    sd.spacing_x = sd.spacing_y = 0.0125;
+    sd.origin = (ws_vec3){-0.2975, -0.24375, 0.303};
+    sd.prestretch_x = sd.prestretch_y = 0.02;
+    sd.shear = 1;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    double S;
+    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    /* Sub-steps for half the stable sub-step, with 5 % to spare (the world's default
+     * stable_fraction is 0.5). */
+    int n = (int)ceil(2.1 * d.dt / S);
+    ck_ok(w, ws_web_set_substeps(w, web, n < 1 ? 1 : n));
+    /* The film touches the box: a sheet in free fall would test no contact. */
+    double press = 0.0;
+    for (long k = 0; k < steps; k += 20) {
+        ck_ok(w, ws_world_step_n(w, steps - k < 20 ? steps - k : 20));
+        ws_vec3 f;
+        ck_ok(w, ws_web_get_body_force(w, web, box, &f, NULL));
+        press = fmax(press, -f.z);
+    }
+    ck_assert_msg(press > 0.0, "the sheet never pressed on the box");
+    uint64_t h = 0;
+    ck_ok(w, ws_world_get_state_hash(w, &h));
+    ws_world_destroy(w);
+    if (enqueued)
+        *enqueued = calls;
+    return h;
+}
+
+static long sheet_steps(void)
+{
+    /* The sheet lands after 25 ms (3 mm at g) and drapes for 0.18 s; under WS_TEST_SHORT
+     * (sanitizers, valgrind) for 5 ms after it lands. */
+    return short_run() ? 120 : 800;
+}
+
+START_TEST(test_sheet_same_for_any_workers)
+{
+    const long steps = sheet_steps();
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC};
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
+        r.workers = k;
+        uint64_t h = sheet_hash(&r, steps, NULL);
+        ck_assert_msg(h == one, "%d workers: state hash 0x%016llx, 1 worker 0x%016llx", k,
+                      (unsigned long long)h, (unsigned long long)one);
+    }
+    /* A host's scheduler: the pieces last first, then each on a thread of its own. */
+    int calls = 0;
+    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC};
+    uint64_t h = sheet_hash(&r, steps, &calls);
+    ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    ck_assert_msg(calls > 0, "the host's scheduler was never called");
+    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC};
+    h = sheet_hash(&r, steps, NULL);
+    ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers and both schedulers", steps,
+           (unsigned long long)one, short_run() ? 2 : 4);
+}
+END_TEST
+
+START_TEST(test_sheet_law_with_history)
+{
+    /* A law that is not of the film form (cubic: evaluated spring by spring, as a law with
+     * history or a user's function would be) sweeps in one lane whatever the workers: the
+     * same hash, and the host's scheduler never called. */
+    const long steps = short_run() ? 120 : 500;
+    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC};
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    int calls = 0;
+    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC};
+    ck_assert(sheet_hash(&r, steps, &calls) == one);
+    ck_assert_int_eq(calls, 0);
+    if (!short_run()) {
+        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC};
+        ck_assert(sheet_hash(&r, steps, NULL) == one);
+    }
+}
+END_TEST
+
+START_TEST(test_oom_in_a_parallel_step)
+{
+    /* Every allocation of the first steps of a sheet on 2 workers fails in turn (the lanes'
+     * scratch among them): each failure is WS_ERR_OUT_OF_MEMORY and undoes the step, and
+     * after the world is gone every block was freed with the size it was allocated with. */
+    test_alloc a = {0};
+    a.allocs_left = -1;
+    a.track = 1;
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 2.5e-4;
+    d.worker_count = 2;
+    test_alloc_install(&d, &a);
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    add_ground(w, 2.0, no_material());
+    add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
+    ws_law_id law;
+    ws_law_def ld;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_LINEAR_ELASTIC;
+    ld.stiffness = 200.0;
+    ck_ok(w, ws_law_create(w, &ld, &law));
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = wd.law_cross = law;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 48;
+    sd.ny = 40;
+    sd.spacing_x = sd.spacing_y = 0.0125;
+    sd.origin = (ws_vec3){-0.2975, -0.24375, 0.30};
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    ck_ok(w, ws_web_set_substeps(w, web, 8)); /* half the stable sub-step: 6 would do */
+    long failures = 0, n = 0;
+    for (; n < 2000; n++) {
+        a.allocs_left = n;
+        ws_status st = ws_world_step(w);
+        if (st == WS_OK)
+            break;
+        ck_assert_msg(st == WS_ERR_OUT_OF_MEMORY, "allocation %ld failed: status %d, %s", n,
+                      (int)st, ws_world_last_error(w));
+        failures++;
+    }
+    a.allocs_left = -1;
+    ck_assert_msg(n < 2000, "the step never had enough memory");
+    ck_assert_msg(failures > 0, "no allocation failed: the test tested nothing");
+    ck_ok(w, ws_world_step_n(w, 20)); /* and steps on */
+    ws_world_destroy(w);
+    ck_assert_msg(a.size_errors == 0, "%ld frees with the wrong size, first: %s", a.size_errors,
+                  a.size_error);
+    ck_assert_msg(a.live == 0 && a.bytes == 0, "%ld blocks and %lld bytes left", a.live, a.bytes);
+    test_alloc_done(&a);
+}
+END_TEST
+
+START_TEST(test_bad_worker_defs)
+{
+    ws_world_def d;
+    ws_world *w = NULL;
+    ws_world_def_init(&d);
+    ck_assert_uint_eq(d.worker_count, 1);
+    d.worker_count = 0;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_ERR_INVALID_ARGUMENT);
+    d.worker_count = WS_MAX_WORKERS + 1;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_ERR_INVALID_ARGUMENT);
+    d.worker_count = 2;
+    d.enqueue_task = enqueue_reverse; /* without its finish */
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_ptr_null(w);
+    d.enqueue_task = NULL;
+    d.worker_count = WS_MAX_WORKERS;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_world_destroy(w); /* its threads joined */
+}
+END_TEST
+
+int main(void)
+{
+    (void)tilt_run;
+    Suite *s = suite_create("workers");
+    add_case(s, "wrapped_same_for_any_workers", test_wrapped_same_for_any_workers, 300);
+    add_case(s, "sheet_same_for_any_workers", test_sheet_same_for_any_workers, 300);
+    add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
+    add_case(s, "oom_in_a_parallel_step", test_oom_in_a_parallel_step, 300);
+    add_case(s, "bad_worker_defs", test_bad_worker_defs, 60);
+    return run_suite(s);
+}
