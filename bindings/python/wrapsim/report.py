@@ -24,6 +24,21 @@ def write_series(path, series):
     np.savetxt(path, data, delimiter=",", header=header, comments="", fmt="%.9g")
 
 
+def _finish(plt, fig, ax, path, labels, legend=True):
+    """Label, grid, legend, save and close one plot; `labels` = (x, y, title)."""
+    ax.set_xlabel(labels[0])
+    if labels[1]:
+        ax.set_ylabel(labels[1])
+    ax.set_title(labels[2])
+    ax.grid(alpha=0.3)
+    if legend:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path.name
+
+
 def _eumos_plots(plt, folder, d, result, series):
     t = series["t_s"]
     H = 1e3 * result["load_height_m"]
@@ -40,42 +55,26 @@ def _eumos_plots(plt, folder, d, result, series):
                    label="permanent limit 5 % H" if sign > 0 else None)
     for e in result["events"]:
         ax.axvline(e["t_s"], color="0.6", lw=0.6)
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("layer displacement relative to the pallet [mm]")
-    ax.set_title(f"EUMOS 40509 at {result['k_g']:g} g: layers against the pallet "
-                 f"(grey: slip, tip and loss events)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(folder / "displacement.png", dpi=110)
-    plt.close(fig)
-    names.append("displacement.png")
+    names.append(_finish(plt, fig, ax, folder / "displacement.png", (
+        "time [s]", "layer displacement relative to the pallet [mm]",
+        f"EUMOS 40509 at {result['k_g']:g} g: layers against the pallet "
+        f"(grey: slip, tip and loss events)")))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.plot(t, series["platform_acceleration_g"], label="delivered")
     ax.axhline(result["k_g"], color="0.3", ls=":", lw=1, label=f"k = {result['k_g']:g} g")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("platform acceleration [g]")
-    ax.set_title(f"The drive as delivered: rise {1e3 * result['rise_measured_s']:.1f} ms, "
-                 f"held {result['time_at_level_s']:.3f} s within 1 %")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(folder / "drive.png", dpi=110)
-    plt.close(fig)
-    names.append("drive.png")
+    names.append(_finish(plt, fig, ax, folder / "drive.png", (
+        "time [s]", "platform acceleration [g]",
+        f"The drive as delivered: rise {1e3 * result['rise_measured_s']:.1f} ms, "
+        f"held {result['time_at_level_s']:.3f} s within 1 %")))
 
     if any(c["line_load_N_per_m"] > 0 for c in result["containment"]):
         fig, ax = plt.subplots(figsize=(6, 4))
         bands = [c["band"] for c in result["containment"]]
         ax.barh(bands, [c["line_load_N_per_m"] for c in result["containment"]])
-        ax.set_xlabel("containment [N/m]")
-        ax.set_title("Film containment by height")
-        ax.grid(alpha=0.3, axis="x")
-        fig.tight_layout()
-        fig.savefig(folder / "containment.png", dpi=110)
-        plt.close(fig)
-        names.append("containment.png")
+        names.append(_finish(plt, fig, ax, folder / "containment.png",
+                             ("containment [N/m]", "", "Film containment by height"),
+                             legend=False))
     return names
 
 
@@ -105,15 +104,9 @@ def write_plots(folder, d, result, series):
         if ev:
             ax.axvline(ev["angle_deg"], color="tab:orange", lw=0.8)
     ax.set_ylim(min(-1.0, ax.get_ylim()[0]), max(3 * lim, 1.0))
-    ax.set_xlabel("platform angle [deg]")
-    ax.set_ylabel("slip along the platform [mm]")
-    ax.set_title("Slip of each carton against the platform angle")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
-    fig.tight_layout()
-    fig.savefig(folder / "slip.png", dpi=110)
-    plt.close(fig)
-    names.append("slip.png")
+    names.append(_finish(plt, fig, ax, folder / "slip.png", (
+        "platform angle [deg]", "slip along the platform [mm]",
+        "Slip of each carton against the platform angle")))
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.plot(t, angle, label="platform angle")
@@ -121,15 +114,8 @@ def write_plots(folder, d, result, series):
         ax.axvline(result["tip_event"]["t_s"], color="tab:red", ls="--", lw=1,
                    label=f"tip at {result['tip_event']['angle_deg']:.2f}°")
     ax.axhline(target, color="0.3", ls=":", lw=1, label=f"target {target:g}°")
-    ax.set_xlabel("time [s]")
-    ax.set_ylabel("platform angle [deg]")
-    ax.set_title("The drive as delivered")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(folder / "drive.png", dpi=110)
-    plt.close(fig)
-    names.append("drive.png")
+    names.append(_finish(plt, fig, ax, folder / "drive.png",
+                         ("time [s]", "platform angle [deg]", "The drive as delivered")))
     return names
 
 
