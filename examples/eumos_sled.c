@@ -13,11 +13,24 @@
  *
  * Copy it as the start of your own test: change the load Def, the EUMOS Def, read the result.
  */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <wrapsim/wrapsim.h>
+
+/* A number in [lo, hi], or an error: "--k abc" must not run the default. */
+static int number(const char *text, double lo, double hi, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (errno || end == text || *end || !(v >= lo && v <= hi))
+        return -1;
+    *out = v;
+    return 0;
+}
 
 static const char *event_name(int type)
 {
@@ -70,12 +83,14 @@ int main(int argc, char **argv)
     double k = 0.3, settle = 1.0, rest = 0.5;
     int brake = 0, find_k = 0, wrapped = 0;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--k") && i + 1 < argc)
-            k = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--settle") && i + 1 < argc)
-            settle = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--rest") && i + 1 < argc)
-            rest = atof(argv[++i]);
+        if (!strcmp(argv[i], "--k") && i + 1 < argc && number(argv[i + 1], 1e-3, 10, &k) == 0)
+            i++;
+        else if (!strcmp(argv[i], "--settle") && i + 1 < argc &&
+                 number(argv[i + 1], 0.2, 100, &settle) == 0)
+            i++;
+        else if (!strcmp(argv[i], "--rest") && i + 1 < argc &&
+                 number(argv[i + 1], 0, 100, &rest) == 0)
+            i++;
         else if (!strcmp(argv[i], "--brake"))
             brake = 1;
         else if (!strcmp(argv[i], "--find-k"))
