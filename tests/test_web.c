@@ -1875,13 +1875,10 @@ static ws_web_id held_spring(ws_world *w, ws_law_id law)
     return spring_pair(w, law, 0.11, &l0, 2);
 }
 
-START_TEST(test_spring_relaxation)
+/* A standard linear solid, the film's relaxing law: k_inf = 50 N, k1 = 100 N, tau = 0.05 s
+ * (the law copies its Prony terms). */
+static ws_law_id solid_law(ws_world *w)
 {
-    /* Film loses tension after wrapping. A spring of a standard linear solid (k_inf = 50 N,
-     * k1 = 100 N, tau = 0.05 s) stretched by 0.1 and held: T(t) = (k_inf + k1 e^(-t/tau)) 0.1,
-     * from 15 N at once down to 5 N. The history is committed once per step with an update
-     * exact for a held strain, so the only error is round-off: 1e-12 relative. */
-    ws_world *w = world_g(1e-3, NO_G);
     double k1 = 100.0, tau = 0.05;
     ws_law_def ld;
     ws_law_def_init(&ld);
@@ -1892,6 +1889,18 @@ START_TEST(test_spring_relaxation)
     ld.prony_count = 1;
     ws_law_id law;
     ck_ok(w, ws_law_create(w, &ld, &law));
+    return law;
+}
+
+START_TEST(test_spring_relaxation)
+{
+    /* Film loses tension after wrapping. A spring of a standard linear solid (k_inf = 50 N,
+     * k1 = 100 N, tau = 0.05 s) stretched by 0.1 and held: T(t) = (k_inf + k1 e^(-t/tau)) 0.1,
+     * from 15 N at once down to 5 N. The history is committed once per step with an update
+     * exact for a held strain, so the only error is round-off: 1e-12 relative. */
+    ws_world *w = world_g(1e-3, NO_G);
+    const double k1 = 100.0, tau = 0.05; /* solid_law's */
+    ws_law_id law = solid_law(w);
     ws_web_id web = held_spring(w, law);
     double worst = 0.0, T = 0.0;
     size_t n;
