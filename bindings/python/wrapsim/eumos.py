@@ -14,6 +14,7 @@ import numpy as np
 from . import World, WrapsimError, _c
 from . import _lib as L
 from ._run import _progress
+from .loadrun import paraview_series, world_params
 
 _PATTERNS = {"column": 0, "brick": 1, "turned": 2}
 _MODELS = {"regularized": L.WS_FRICTION_REGULARIZED, "stick": L.WS_FRICTION_STICK}
@@ -83,12 +84,6 @@ def eumos_def(d, k=None):
     return ed
 
 
-def _world(d):
-    s = d["simulation"]
-    return World(dt=s["dt_s"], full_detection_until=s["full_detection_until_s"],
-                 detection_interval=s["detection_interval"])
-
-
 def _check(w, status, what):
     if status != L.WS_OK:
         raise WrapsimError(status, f"{what}: {w.last_error}")
@@ -132,7 +127,7 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
     like loadrun.run: the verdict as a JSON-able dict and the sampled time series."""
     u = d["unit_load"]
     lib = _c()
-    with _world(d) as w:
+    with World(**world_params(d)) as w:
         ld = load_def(d)
         load = ctypes.c_void_p()
         _check(w, lib.ws_load_build(w.ptr, byref(ld), byref(load)), "ws_load_build")
@@ -156,7 +151,6 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
                    "ws_eumos_get_drive")
             total = int(round(duration.value / d["simulation"]["dt_s"]))
             bar = _progress(total, desc, progress)
-            from .loadrun import paraview_series
             vtk = paraview_series(w, d, paraview)
 
             def sample(user, smp):
@@ -195,11 +189,9 @@ def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01):
     """The EUMOS k-value of the load file's load (ws_loadtest_find_k): every run starts from
     one settled (and wrapped) state. Returns a dict: k_value, k_fail (g), runs."""
     lib = _c()
-    s = d["simulation"]
     wdef = _init(L.WorldDef, "ws_world_def_init_sized")
-    wdef.dt = s["dt_s"]
-    wdef.full_detection_until = s["full_detection_until_s"]
-    wdef.detection_interval = s["detection_interval"]
+    for field, value in world_params(d).items():
+        setattr(wdef, field, value)
     ld = load_def(d)
     ed = eumos_def(d)
     kd = _init(L.KvalueDef, "ws_kvalue_def_init_sized")

@@ -20,16 +20,22 @@ from . import _lib as L
 from ._run import _progress
 
 
+def world_params(d):
+    """The ws_world_def fields a load file's `simulation` section sets."""
+    s = d["simulation"]
+    return dict(dt=s["dt_s"], full_detection_until=s["full_detection_until_s"],
+                detection_interval=s["detection_interval"])
+
+
 def build(d):
     """A world with the platform, the stack and the film of a checked load file. Returns
     a dict: world, platform, stop (or None), cartons (bottom first), film (or None),
     pivot (x, z) of the tip edge in the platform's frame."""
-    sim, plat, stack, mats = d["simulation"], d["platform"], d["stack"], d["materials"]
+    plat, stack, mats = d["platform"], d["stack"], d["materials"]
     c = stack["carton"]
     layer = stack["contact_layer_m"]
     gap = 2 * layer
-    w = World(dt=sim["dt_s"], full_detection_until=sim["full_detection_until_s"],
-              detection_interval=sim["detection_interval"])
+    w = World(**world_params(d))
     carton_mat, plat_mat = w.material("carton"), w.material("platform")
 
     def pair(m):
