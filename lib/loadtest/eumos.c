@@ -144,8 +144,9 @@ typedef struct run_state {
     double layer_disp[WS_LOAD_MAX_LAYERS];
     ws_loadtest_interface_state ifs[WS_LOAD_MAX_LAYERS + 1];
     double ifs_use[WS_LOAD_MAX_LAYERS + 1];
-    double *strain; /* the film's spring strains (wrapped loads) */
-    size_t springs;
+    double t0;        /* world time at the start of the run */
+    uint32_t broken;  /* the film's broken springs at the last sample */
+    int ruptured;     /* 1 once a spring of the film broke in the run (its event is out) */
 } run_state;
 
 static void add_event(ws_eumos_result *r, int type, int layer, int index, double t, double level,
@@ -287,15 +288,26 @@ static ws_status sample(ws_world *w, run_state *rs, double t, double a, double v
     ws_status s = ws_load_measure(w, ld, rs->cs, (size_t)ld->info.cartons, &n);
     if (s != WS_OK || (s = read_contacts(w, rs)) != WS_OK)
         return s;
-    if (rs->strain) {
-        size_t ns;
-        if ((s = ws_web_copy_spring_strains(w, ld->info.film, rs->strain, rs->springs, &ns)) !=
-            WS_OK)
-            return s;
-        for (size_t i = 0; i < ns; i++)
-            r->film_peak_strain = fmax(r->film_peak_strain, rs->strain[i]);
-    }
     double level = a / rs->d.g;
+    if (ld->info.film.bits) {
+        ws_web_peak pk;
+        ws_web_rupture ru;
+        if ((s = ws_web_get_peak_strain(w, ld->info.film, &pk)) != WS_OK ||
+            (s = ws_web_get_rupture(w, ld->info.film, &ru)) != WS_OK)
+            return s;
+        if (pk.found)
+            r->film_peak_strain = fmax(r->film_peak_strain, pk.strain);
+        /* The first break in the run, at its own time when it is in the run (the event comes
+         * before this sample's others, which are at t). */
+        if (!rs->ruptured && ru.broken_count > rs->broken) {
+            rs->ruptured = 1;
+            int in_run = ru.first_time > rs->t0;
+            add_event(r, WS_LOADTEST_RUPTURE, -1, in_run ? (int)ru.first_spring : -1,
+                      in_run ? ru.first_time - rs->t0 : t, level,
+                      in_run ? ru.first_strain : (double)ru.broken_count);
+        }
+        rs->broken = ru.broken_count;
+    }
     if (fabs(level) > r->peak_level)
         r->peak_level = fabs(level);
     find_tips(rs, t, level);
@@ -388,7 +400,7 @@ static void judge(run_state *rs)
     criterion(&vd->permanent, permanent, 0.05 * H, 0);
     criterion(&vd->bottom, bottom, 0.04, 0);
     criterion(&vd->layer_shift, shift, 0.02 * H, 1);
-    criterion(&vd->rupture, 0, 0, 0);
+    criterion(&vd->rupture, rs->broken, 0, 0);
     vd->pass = vd->elastic.pass && vd->permanent.pass && vd->bottom.pass &&
                vd->layer_shift.pass && vd->rupture.pass;
 }
@@ -403,7 +415,6 @@ static void run_free(run_state *rs)
     ws_mem_free(&ld->mem, rs->ref_bins, nb * sizeof *rs->ref_bins);
     ws_mem_free(&ld->mem, rs->tipped, nb);
     ws_mem_free(&ld->mem, rs->lost, nb);
-    ws_mem_free(&ld->mem, rs->strain, rs->springs * sizeof *rs->strain);
 }
 
 static ws_status run_alloc(ws_world *w, run_state *rs)
@@ -415,13 +426,7 @@ static ws_status run_alloc(ws_world *w, run_state *rs)
     rs->ref_bins = ws_mem_calloc(&ld->mem, nb, sizeof *rs->ref_bins);
     rs->tipped = ws_mem_calloc(&ld->mem, nb, 1);
     rs->lost = ws_mem_calloc(&ld->mem, nb, 1);
-    ws_web_info wi;
-    if (ld->info.film.bits && ws_web_get_info(w, ld->info.film, &wi) == WS_OK) {
-        rs->springs = wi.spring_count;
-        rs->strain = ws_mem_calloc(&ld->mem, rs->springs, sizeof *rs->strain);
-    }
-    if (!rs->cs || !rs->bins || !rs->ref_bins || !rs->tipped || !rs->lost ||
-        (rs->springs && !rs->strain)) {
+    if (!rs->cs || !rs->bins || !rs->ref_bins || !rs->tipped || !rs->lost) {
         run_free(rs);
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "EUMOS run: out of memory for %zu bodies", nb);
     }
@@ -516,11 +521,16 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
                                                dd.gentle_acceleration;
     if ((s = run_alloc(w, &rs)) != WS_OK)
         return s;
+    rs.t0 = sl.t0;
+    ws_web_rupture ru;
+    memset(&ru, 0, sizeof ru);
     if (ld->info.film.bits &&
-        (s = ws_web_get_containment(w, ld->info.film, result->containment, 3)) != WS_OK) {
+        ((s = ws_web_get_containment(w, ld->info.film, result->containment, 3)) != WS_OK ||
+         (s = ws_web_get_rupture(w, ld->info.film, &ru)) != WS_OK)) {
         run_free(&rs);
         return s;
     }
+    rs.broken = ld->info.film.bits ? ru.broken_count : 0; /* a break in the run is news */
     if ((s = ws_body_set_drive(w, ld->info.platform, &dd)) == WS_OK) {
         s = run_steps(w, &rs, &sl, dt);
         /* The platform stays where it stopped. */

@@ -125,6 +125,7 @@ STRUCTS = {
     "ws_web_def": L.WebDef, "ws_sheet_def": L.SheetDef, "ws_band_def": L.BandDef,
     "ws_web_mesh_def": L.WebMeshDef, "ws_web_info": L.WebInfo, "ws_law_info": L.LawInfo,
     "ws_containment_band": L.ContainmentBand,
+    "ws_web_rupture": L.WebRupture, "ws_web_peak": L.WebPeak,
     "ws_element_id": L.ElementId, "ws_element_def": L.ElementDef,
     "ws_element_output": L.ElementOutput, "ws_vtk_series_def": L.VtkSeriesDef,
     "ws_load_interface": L.LoadInterface, "ws_load_def": L.LoadDef, "ws_load_info": L.LoadInfo,

@@ -597,6 +597,8 @@ class WrapDef(Structure):
         ("strain_around", c_double), ("strain_up", c_double), ("z_bottom", c_double),
         ("top_margin", c_double), ("node_pitch", c_double), ("node_mass", c_double),
         ("substeps", c_int),
+        ("elongation_at_break", c_double), ("powered_prestretch", c_double),
+        ("rupture_strain", c_double),
     ]
 
 
