@@ -713,18 +713,26 @@ START_TEST(the_wrapped_pallet_load_holds_together)
     /* The 0.3 g run again with the film's rupture strain between its peak at rest and its peak
      * in the run: until a spring breaks it is the same run to the bit (a limit changes
      * nothing before a break), so the film must break in it, be reported when it does, and
-     * fail the verdict's "no rupture". */
-    if (!short_run()) {
+     * fail the verdict's "no rupture". Under WS_TEST_SHORT the brief pulse with a limit just
+     * below the peak at rest: the film breaks in the run's first step. */
+    {
         ck_ok(w, ws_world_restore(w, state, len));
         ws_web_peak pk;
         ck_ok(w, ws_web_get_peak_strain(w, film, &pk));
-        ck_assert(peak0 > pk.strain + 1e-3);
-        const double lim = 0.5 * (pk.strain + peak0);
+        ck_assert(short_run() || peak0 > pk.strain + 1e-3);
+        const double lim = short_run() ? 0.99 * pk.strain : 0.5 * (pk.strain + peak0);
         ck_ok(w, ws_web_set_rupture_strain(w, film, lim));
         ws_eumos_def e;
         ws_eumos_def_init(&e);
         e.k = ks[0];
         e.rest_after = 0.3;
+        if (short_run()) {
+            e.k = 0.05;
+            e.rise_time = 0.01;
+            e.hold_time = 0;
+            e.coast_time = 0;
+            e.rest_after = 0;
+        }
         ws_eumos_result r;
         ck_ok(w, ws_loadtest_run_eumos(w, ld, &e, &r));
         const ws_loadtest_event *ev = NULL;
