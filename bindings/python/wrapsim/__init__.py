@@ -856,9 +856,9 @@ class World:
         return Web(self, out)
 
     def web_band(self, law, bodies, **kwargs):
-        """A band wrapped around `bodies` (as they are now): ws_web_def fields and ws_band_def
-        fields (z_bottom, z_top m, n_around, n_up, prestretch_around, prestretch_up, gap m,
-        shear)."""
+        """A band wrapped around `bodies` (as they are now): ws_web_def fields (as web_sheet,
+        rupture_strain among them) and ws_band_def fields (z_bottom, z_top m, n_around, n_up,
+        prestretch_around, prestretch_up, gap m, shear)."""
         wk, bk = _split(kwargs, L.WebDef, L.BandDef)
         if "body_count" in bk:
             raise TypeError("web_band: body_count is set from `bodies`; leave it out")
