@@ -261,3 +261,63 @@ def test_kvalue_command(tmp_path, capsys):
     assert k["k_fail_g"] - k["k_value_g"] <= 0.1 + 1e-9
     assert "k-value" in capsys.readouterr().out
     assert cli.main(["kvalue", str(LOADS / "two_cubes_R.json")]) == 2
+
+
+def test_sweep_on_a_scheduler_given_by_address(tmp_path):
+    """`--scheduler ADDRESS`: a scheduler and a worker started as their own processes (as on a
+    cluster), the command connecting to them; its rows equal those of a LocalCluster."""
+    pytest.importorskip("dask.distributed")
+    import os
+    import socket
+    import time
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(os.path.abspath(p) for p in sys.path if p)
+    if env.get("WRAPSIM_LIBRARY"):  # the worker runs in another folder
+        env["WRAPSIM_LIBRARY"] = os.path.abspath(env["WRAPSIM_LIBRARY"])
+    py = [sys.executable, "-m", "distributed.cli"]
+    sched = subprocess.Popen(py[:2] + ["distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                                       "--port", str(port), "--dashboard-address", ":0",
+                                       "--no-show"],
+                             env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    worker = subprocess.Popen(py[:2] + ["distributed.cli.dask_worker", address, "--nworkers",
+                                        "1", "--nthreads", "1", "--no-dashboard"],
+                              env=env, cwd=tmp_path, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
+    try:
+        from dask.distributed import Client
+        deadline = time.time() + 60
+        while True:  # until the worker has joined the scheduler
+            try:
+                with Client(address, timeout=5) as c:
+                    if c.scheduler_info()["workers"]:
+                        break
+            except OSError:
+                pass
+            assert time.time() < deadline, "the scheduler or its worker did not start"
+            time.sleep(0.5)
+        base = short_tilt()
+        base["test"]["duration_s"] = 0.4
+        load = write(tmp_path, base)
+        out = tmp_path / "remote"
+        r = subprocess.run([sys.executable, "-m", "wrapsim", "sweep", str(load), "--vary",
+                            "stack.layers=1:2", "--scheduler", address, "-o", str(out), "-q"],
+                           env=env, capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr[-2000:]
+        remote = {row["stack.layers"]: row for row in csv.DictReader(open(out / "results.csv"))}
+        assert sorted(remote) == ["1", "2"]
+        assert all(row["error"] == "" for row in remote.values()), remote
+        local = study.sweep(base, [study.parse_vary("stack.layers=1:2")], tmp_path / "local",
+                            workers=1)
+        for row in csv.DictReader(open(local)):
+            assert remote[row["stack.layers"]]["state_hash"] == row["state_hash"]
+    finally:
+        for p in (worker, sched):
+            p.terminate()
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
