@@ -307,6 +307,11 @@ typedef struct ws_loadtest_sample {
     const double *layer_displacement; /**< per layer: mean displacement along the direction, m */
     int interfaces;       /**< entries of interface[] (layers + 1) */
     const ws_loadtest_interface_state *interface; /**< per interface */
+    /** Tilt runs: the platform's angle, rad (level is then tan of it); 0 for the others */
+    double angle;
+    /** Per carton (entries: cartons), the interface under it alone: the normal force, slip
+     *  speed and friction use of the contacts that carry it, as interface[] for a layer */
+    const ws_loadtest_interface_state *carton_base;
 } ws_loadtest_sample;
 
 /** The acceleration test of EUMOS 40509 as the platform's WS_DRIVE_PULSE drive: the platform
