@@ -281,6 +281,8 @@ def test_vibration_run_random_and_sweep(tmp_path):
         header = next(csv.reader(f))
     assert header[:2] == ["t [s]", "platform_acceleration [g]"]
     assert "interface1_friction_use [1]" in header and "interface0_slip [mm/s]" in header
+    assert {"carton_l1_1_base_friction_use [1]", "carton_l2_8_tilt [deg]",
+            "carton_l2_8_base_slip [mm/s]", "carton_l1_3_horizontal [mm]"} <= set(header)
     assert all("[" in h for h in header), header
     for name in ("report.html", "displacement.png", "drive.png", "friction_use.png"):
         assert (tmp_path / "a" / name).stat().st_size > 1000, name

@@ -141,7 +141,7 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
         try:
             td, fn, duration, keep = make(d)
             td.sample_interval = _sample_interval(d)
-            rows = []
+            rows, cartons = [], []
             bar = _progress(int(round(duration / d["simulation"]["dt_s"])), desc, progress)
             vtk = paraview_series(w, d, paraview)
 
@@ -156,6 +156,8 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
                             [s.layer_displacement[i] for i in range(s.layers)] +
                             [s.interface[i].slip_speed for i in range(s.interfaces)] +
                             [s.interface[i].friction_use for i in range(s.interfaces)])
+                cartons.append([(c.horizontal, c.tilt, b.slip_speed, b.friction_use)
+                                for c, b in zip(s.carton[:s.cartons], s.carton_base[:s.cartons])])
                 return 0
 
             cb = L.SampleFn(sample)
@@ -170,6 +172,11 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
                     vtk.close()
             del keep
             result = _result_dict(d, res, w.state_hash())
+            n = ctypes.c_size_t()
+            lib.ws_load_copy_cartons(load, None, 0, byref(n))
+            places = (L.LoadCarton * n.value)()
+            _check(w, lib.ws_load_copy_cartons(load, places, n.value, byref(n)),
+                   "ws_load_copy_cartons")
         finally:
             lib.ws_load_destroy(load)
     layers = d["unit_load"]["layers"]
@@ -188,4 +195,14 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
         series[f"interface{i}_slip_mm_per_s"] = 1e3 * data[:, 5 + layers + i]
     for i in range(layers + 1):
         series[f"interface{i}_friction_use"] = data[:, 6 + 2 * layers + i]
+    # Per carton (layer l, place i): horizontal displacement against the pallet, tilt, and the
+    # slip speed and friction use of the contacts under it.
+    per = np.array(cartons).reshape(len(cartons), -1, 4)
+    names = [(c.layer + 1, c.index + 1) for c in places]
+    for k, (layer, index) in enumerate(names):
+        stem = f"carton_l{layer}_{index}"
+        series[f"{stem}_horizontal_mm"] = 1e3 * per[:, k, 0]
+        series[f"{stem}_tilt_deg"] = np.degrees(per[:, k, 1])
+        series[f"{stem}_base_slip_mm_per_s"] = 1e3 * per[:, k, 2]
+        series[f"{stem}_base_friction_use"] = per[:, k, 3]
     return result, series
