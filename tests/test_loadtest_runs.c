@@ -370,10 +370,71 @@ START_TEST(bad_defs_and_a_stopped_run)
     im.on_sample = stop_at_third;
     im.sample_user = &n;
     ck_assert_int_eq(ws_loadtest_run_impact(w, ld, &im, &r), WS_ERR_CALLBACK);
+    ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "on_sample stopped"));
     ck_assert_int_eq(n, 3);
     ck_ok(w, ws_world_get_state_hash(w, &h1));
     ck_assert_uint_eq(h0, h1);
     ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* Allocation failures inside a run (the saved state, the measurement buffers, the contact
+ * buffer's growth, the random drive's breakpoints: the load's allocator), at each allocation in
+ * turn: WS_ERR_OUT_OF_MEMORY, the world restored (its hash as before), every block of the run
+ * given back with its size (the tracking allocator checks each free), and a run that gets all
+ * its blocks passes as usual. */
+START_TEST(allocation_failures_in_a_run_leave_the_world_as_it_was)
+{
+    test_alloc ta = {.allocs_left = -1, .track = 1};
+    ws_world *w = load_world();
+    ws_load_def d;
+    ws_load_def_init(&d);
+    d.layers = 1;
+    d.count_x = 2;
+    d.count_y = 1;
+    d.allocator.alloc = ta_alloc;
+    d.allocator.realloc = ta_realloc;
+    d.allocator.free = ta_free;
+    d.allocator.user = &ta;
+    ws_load *ld;
+    ck_ok(w, ws_load_build(w, &d, &ld));
+    ck_ok(w, ws_world_step_n(w, 1000));
+    uint64_t h0, h1;
+    ck_ok(w, ws_world_get_state_hash(w, &h0));
+    long live0 = ta.live;
+    long long bytes0 = ta.bytes;
+    ws_vibration_test_def v;
+    ws_vibration_test_def_init(&v);
+    v.duration = 0.2;
+    v.ramp_time = 0.05;
+    v.rest_after = 0;
+    int ok = 0, oom = 0;
+    for (long n = 0; n < 16 && !ok; n++) {
+        ws_loadtest_result r;
+        ta.allocs_left = n;
+        ws_status st = ws_loadtest_run_vibration(w, ld, &v, &r);
+        ta.allocs_left = -1;
+        if (st == WS_OK) {
+            ok = 1;
+        } else {
+            ck_assert_int_eq(st, WS_ERR_OUT_OF_MEMORY);
+            ck_assert_ptr_nonnull(strstr(ws_world_last_error(w), "vibration"));
+            oom++;
+        }
+        ck_ok(w, ws_world_get_state_hash(w, &h1));
+        ck_assert_uint_eq(h0, h1);
+        ck_assert_int_eq(ta.live, live0);
+        ck_assert(ta.bytes == bytes0);
+        ck_assert_int_eq(ta.size_errors, 0);
+    }
+    report("vibration run: %d allocation failures refused before a run got all it needed", oom);
+    ck_assert_int_eq(ok, 1);
+    ck_assert_int_ge(oom, 3);
+    ws_load_destroy(ld);
+    ck_assert_int_eq(ta.live, 0);
+    ck_assert(ta.bytes == 0);
+    test_alloc_done(&ta);
     ws_world_destroy(w);
 }
 END_TEST
@@ -388,5 +449,6 @@ int main(void)
     add_case(s, "sweep", sweep_finds_the_resonance_of_a_box_on_its_contact, 300);
     add_case(s, "random", random_vibration_restores_the_world_and_repeats, 300);
     add_case(s, "bad_defs", bad_defs_and_a_stopped_run, 60);
+    add_case(s, "allocation", allocation_failures_in_a_run_leave_the_world_as_it_was, 120);
     return run_suite(s);
 }
