@@ -750,6 +750,34 @@ START_TEST(the_wrapped_pallet_load_holds_together)
         ck_assert(r.verdict.rupture.value >= 1 && !r.verdict.rupture.pass && !r.verdict.pass);
         ck_assert(r.verdict.rupture.value == (double)ru.broken_count);
     }
+    /* The other runs share the measurements: an impact on the wrapped load whose film breaks
+     * at once (its limit just below its peak at rest) reports the break and fails its
+     * rupture check. */
+    {
+        ck_ok(w, ws_world_restore(w, state, len));
+        ws_web_peak pk;
+        ck_ok(w, ws_web_get_peak_strain(w, film, &pk));
+        ck_ok(w, ws_web_set_rupture_strain(w, film, 0.99 * pk.strain));
+        ws_impact_test_def im;
+        ws_impact_test_def_init(&im);
+        im.speed = 0.3;
+        im.pulse_duration = 0.05;
+        im.gentle_acceleration = 2.0;
+        im.coast_time = 0;
+        im.rest_after = 0;
+        ws_loadtest_result lr;
+        ck_ok(w, ws_loadtest_run_impact(w, ld, &im, &lr));
+        int events = 0;
+        for (int k = 0; k < lr.event_count; k++)
+            events += lr.events[k].type == WS_LOADTEST_RUPTURE;
+        const ws_loadtest_check *rc = NULL;
+        for (int k = 0; k < lr.verdict.count; k++)
+            if (lr.verdict.check[k].id == WS_CHECK_RUPTURE)
+                rc = &lr.verdict.check[k];
+        ck_assert_int_eq(events, 1);
+        ck_assert_ptr_nonnull(rc);
+        ck_assert(rc->value >= 1 && rc->limit == 0 && !rc->pass && !lr.verdict.pass);
+    }
     free(state);
     ws_load_destroy(ld);
     ws_world_destroy(w);
