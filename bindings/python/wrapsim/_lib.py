@@ -426,6 +426,7 @@ class WebMeshDef(Structure):
         ("kinds", POINTER(c_uint8)),
         ("pinned", POINTER(c_uint32)),
         ("pinned_count", c_size_t),
+        ("stiffness_scales", POINTER(c_double)),
     ]
 
 
