@@ -359,7 +359,7 @@ WS_API ws_status ws_load_wrap_spiral(ws_world *world, ws_load *load,
 /** The film layers the spiral of `def` lays on a load `height` m high (from the platform's top)
  *  whose deck is at `deck` m, at height z (m above the platform's top) and a place `s` m round
  *  the load's outline of perimeter `perimeter` m from where the film starts (the middle of the
- *  load's face towards -y); roping not counted. Fractional never: whole layers.
+ *  load's face towards -y); roping not counted. A whole number: the revolutions covering it.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def or geometry), WS_ERR_UNINITIALIZED_DEF. */
 WS_API ws_status ws_spiral_wrap_layers(const ws_spiral_wrap_def *def, double height, double deck,
                                        double perimeter, double s, double z, int *layers);
