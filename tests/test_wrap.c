@@ -330,7 +330,7 @@ START_TEST(the_wrapped_cubes_stand_still)
     }
     ws_load_containment b[3];
     ck_ok(w, ws_load_get_containment(w, ld, b, 3));
-    report("wrapped two cubes: in %.1f s from creation the bodies moved up to %.3f mm and turned "
+    report("wrapped two cubes: in %.2f s from creation the bodies moved up to %.3f mm and turned "
            "up to %.5f deg; containment bottom/middle/top %.1f / %.1f / %.1f N (hoop %.1f / "
            "%.1f / %.1f N)",
            short_run() ? 0.05 : 1.0, most * 1e3, turn * 180 / WS_TEST_PI, b[0].force,
@@ -392,7 +392,7 @@ START_TEST(the_wrapped_pallet_load_does_not_walk)
     double peak, h;
     uint32_t spring;
     ck_ok(w, ws_load_get_film_peak(w, ld, &peak, &spring, &h));
-    report("wrapped EUR pallet load (%u film nodes, %d sub-steps): in %.1f s from creation the "
+    report("wrapped EUR pallet load (%u film nodes, %d sub-steps): in %.2f s from creation the "
            "cartons turned up to %.4f deg, closed gaps by up to %.2f mm, moved outwards up to "
            "%.3f mm; the load walked %.3f mm",
            wi.node_count, wi.substeps, short_run() ? 0.05 : 1.0, turn * 180 / WS_TEST_PI,
