@@ -368,11 +368,13 @@ WS_API ws_status ws_spiral_wrap_layers(const ws_spiral_wrap_def *def, double hei
 typedef struct ws_load_containment {
     double z_low;  /**< m above the platform's top, the band's lower bound */
     double z_high; /**< its upper bound */
-    /** Containment force, N: the film's horizontal contact forces on the load in the band,
-     *  sum of |F_x| + |F_y| over its nodes, divided by 8. A closed band of hoop tension T
-     *  round any convex outline turns its tangent once round, so its contact forces sum to
-     *  4 T along x and 4 T along y: the force is the band's hoop tension, read from what the
-     *  load feels (the pull-plate quantity, for the whole band). */
+    /** Containment force, N: how hard the film in the band squeezes the load across its two
+     *  vertical mid-planes (through the pallet's centre, along x and along y), from the bodies'
+     *  contact forces on the film's nodes: sum over the nodes of (s_x F_x + s_y F_y) / 8, s = +1
+     *  on the low side of a plane and -1 on the high side. The film in equilibrium crosses each
+     *  plane twice at its hoop tension T, so each plane's squeeze is 2 T from either side and
+     *  the force is T: the band's hoop tension, read from what the load feels (the pull-plate
+     *  quantity, for the whole band). */
     double force;
     /** The film's own hoop tension across the band, N: the sum over the film's rows in the band
      *  of each row's mean around-spring tension. Equal to `force` when the film is at rest. */

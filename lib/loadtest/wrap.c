@@ -668,14 +668,25 @@ ws_status ws_load_get_containment(const ws_world *w, const ws_load *cld,
         bands[b].z_low = H * (double)b / (double)count;
         bands[b].z_high = H * (double)(b + 1) / (double)count;
     }
-    /* A height's band; heights off the load go to the nearest. */
+    /* A height's band; heights off the load go to the nearest. The squeeze across the load's
+     * two vertical mid-planes through the pallet's centre: each node's force counts inwards,
+     * towards the plane, from whichever side it is on (friction along a face, pointing away,
+     * counts against), so in equilibrium each plane's squeeze is the tension of the film's
+     * crossings of it, twice the hoop tension. */
+    ws_vec3 centre;
+    if ((s = ws_body_get_position(w, ld->info.pallet, &centre)) != WS_OK) {
+        film_free(ld, &fs);
+        return s;
+    }
     const double per_band = H / (double)count;
     for (size_t i = 0; i < fs.n; i++) {
         double h = fs.x[3 * i + 2] - zp;
         double q = floor(h / per_band);
         size_t b = q < 0 ? 0 : q >= (double)count ? count - 1 : (size_t)q;
         const double *f = fs.f + 3 * i;
-        bands[b].force += (fabs(f[0]) + fabs(f[1])) / 8.0;
+        double sx = fs.x[3 * i] < centre.x ? 1.0 : -1.0;
+        double sy = fs.x[3 * i + 1] < centre.y ? 1.0 : -1.0;
+        bands[b].force -= (sx * f[0] + sy * f[1]) / 8.0; /* f is on the node: the load's is -f */
         bands[b].contact_force += sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
     }
     /* Rows by their mean height; a row's around-springs are nx j .. nx j + nx - 1. */
