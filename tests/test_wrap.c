@@ -532,6 +532,63 @@ START_TEST(bad_spiral_defs_are_refused_with_the_field_named)
 }
 END_TEST
 
+/* Out of memory at each allocation in turn, of the load's allocator (the recipe's buffers and
+ * the read-outs') and of the world's (the web): a clear WS_ERR_OUT_OF_MEMORY, no film left
+ * behind, the load still unwrapped, and every byte back when all is destroyed. */
+START_TEST(out_of_memory_leaves_the_load_unwrapped)
+{
+    for (int which = 0; which < 2; which++) {
+        int failed = 0, ok = 0;
+        for (long n = 0; n < 60 && !ok; n++) {
+            ws_world_def wd;
+            ws_world_def_init(&wd);
+            test_alloc tw = {.allocs_left = -1}, tl = {.allocs_left = -1};
+            test_alloc_install(&wd, &tw);
+            ws_world *w = NULL;
+            ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+            ws_load_def d;
+            ws_load_def_init(&d);
+            d.layers = 1;
+            d.allocator.alloc = ta_alloc;
+            d.allocator.realloc = ta_realloc;
+            d.allocator.free = ta_free;
+            d.allocator.user = &tl;
+            ws_load *ld = NULL;
+            ck_ok(w, ws_load_build(w, &d, &ld));
+            ws_spiral_wrap_def sd;
+            ws_spiral_wrap_def_init(&sd);
+            sd.node_mass_min = 1e-3;
+            (which ? &tw : &tl)->allocs_left = which ? 3 * n : n;
+            ws_web_id film = {0};
+            ws_status s = ws_load_wrap_spiral(w, ld, &sd, &film);
+            ws_load_containment b[3];
+            ws_status s2 = s == WS_OK ? ws_load_get_containment(w, ld, b, 3) : WS_OK;
+            tw.allocs_left = tl.allocs_left = -1;
+            ws_load_info in;
+            ck_assert_int_eq(ws_load_get_info(ld, &in), WS_OK);
+            if (s != WS_OK) {
+                failed++;
+                ck_assert_int_eq(s, WS_ERR_OUT_OF_MEMORY);
+                ck_assert_uint_eq(in.film.bits, 0);
+                ck_assert_uint_eq(film.bits, 0);
+            } else if (s2 != WS_OK) {
+                ck_assert_int_eq(s2, WS_ERR_OUT_OF_MEMORY);
+            } else {
+                ok = 1;
+            }
+            ws_load_destroy(ld);
+            ws_world_destroy(w);
+            ck_assert_int_eq(tl.live, 0);
+            ck_assert_int_eq(tl.bytes, 0);
+            ck_assert_int_eq(tw.live, 0);
+            ck_assert_int_eq(tw.bytes, 0);
+        }
+        ck_assert_int_gt(failed, 0);
+        ck_assert_int_eq(ok, 1);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("wrap");
@@ -543,5 +600,6 @@ int main(void)
     add_case(s, "cubes_stand_still", the_wrapped_cubes_stand_still, 300);
     add_case(s, "pallet_does_not_walk", the_wrapped_pallet_load_does_not_walk, 600);
     add_case(s, "bad_defs", bad_spiral_defs_are_refused_with_the_field_named, 60);
+    add_case(s, "out_of_memory", out_of_memory_leaves_the_load_unwrapped, 120);
     return run_suite(s);
 }
