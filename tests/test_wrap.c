@@ -231,7 +231,7 @@ START_TEST(a_single_band_contains_with_its_hoop_tension)
     double hl = sd.gauge / ((1 + sd.prestretch) * (1 - sd.neck_in));
     double zlo = in.pallet_top + sd.lock_height, zhi = in.load_height - sd.top_margin;
     double T = sd.modulus * hl * sd.load_strain * (zhi - zlo);
-    ck_ok(w, ws_world_step_n(w, 800));
+    ck_ok(w, ws_world_step_n(w, short_run() ? 100 : 800));
     ws_load_containment b[1];
     ck_ok(w, ws_load_get_containment(w, ld, b, 1));
     report("single band round a 0.6 x 0.4 m box: containment force %.3f N, hoop tension %.3f N, "
@@ -290,7 +290,7 @@ START_TEST(roping_adds_its_cross_section)
     double wl = sd.width * (1 - sd.neck_in);
     double zlo = in.pallet_top + sd.lock_height, zhi = in.load_height - sd.top_margin;
     double T = sd.modulus * hl * sd.load_strain * (zhi - zlo + sd.rope_revolutions * wl);
-    ck_ok(w, ws_world_step_n(w, 800));
+    ck_ok(w, ws_world_step_n(w, short_run() ? 100 : 800));
     ws_load_containment b[1];
     ck_ok(w, ws_load_get_containment(w, ld, b, 1));
     report("band with half a revolution of rope: containment force %.2f N, hoop tension %.2f N, "
