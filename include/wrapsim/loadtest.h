@@ -324,6 +324,12 @@ typedef struct ws_spiral_wrap_def {
      *  default 0: no roping */
     double rope_revolutions;
     double rope_height; /**< m above the platform's top (> 0 when roping); default 0.2 */
+    /** 1: a top sheet, a loose sheet of film over the top face laid before the top
+     *  revolutions, which hold its edges (it joins the film's highest row over the load's top
+     *  edges); 0 (default): none */
+    int top_sheet;
+    /** thickness of the top sheet, m (> 0; it is not pre-stretched); default 50e-6 */
+    double top_sheet_gauge;
     double node_pitch;  /**< node spacing on the load, m (> 0); default 0.05 */
     /** Smallest node mass, kg (>= 0): nodes lighter than this (the film's real mass from its
      *  layers) are made this heavy, so fewer sub-steps are stable. Default 0: the real mass. */

@@ -39,6 +39,8 @@ static void spiral_defaults(ws_spiral_wrap_def *d)
     d->top_margin = 0.02;
     d->rope_revolutions = 0.0;
     d->rope_height = 0.2;
+    d->top_sheet = 0;
+    d->top_sheet_gauge = 50e-6;
     d->node_pitch = 0.05;
     d->node_mass_min = 0.0;
     d->substeps = 0;
@@ -79,6 +81,10 @@ static const char *spiral_bad(const ws_spiral_wrap_def *d)
         return "rope_revolutions must be 0 .. 1000";
     if (d->rope_revolutions > 0 && !(isfinite(d->rope_height) && d->rope_height > 0))
         return "rope_height must be > 0 m when there is roping";
+    if (d->top_sheet != 0 && d->top_sheet != 1)
+        return "top_sheet must be 0 or 1";
+    if (!(isfinite(d->top_sheet_gauge) && d->top_sheet_gauge > 0 && d->top_sheet_gauge < 0.01))
+        return "top_sheet_gauge must be > 0 and < 0.01 m";
     if (!(isfinite(d->node_pitch) && d->node_pitch > 0))
         return "node_pitch must be > 0 m";
     if (!in_range(d->node_mass_min, 0, 1e3))
@@ -256,6 +262,7 @@ static int outline_at(const wbox *b, int n, double z, double tol, outline *o)
 /* Everything the web is made of, in the load's memory. */
 typedef struct wrap_mesh {
     int nx, ny, sx, sy; /* nodes a row, rows; segments along x and along y of a row */
+    int sheet;          /* 1 with a top sheet: (sx + 1) (sy + 1) nodes after the rows' */
     size_t n, ns;
     double *pos, *mass, *rest, *scale, *phase;
     uint32_t *spr;
@@ -275,8 +282,15 @@ static void mesh_free(ws_load *ld, wrap_mesh *m)
 
 static int mesh_alloc(ws_load *ld, wrap_mesh *m)
 {
-    m->n = (size_t)m->nx * (size_t)m->ny;
-    m->ns = 2 * m->n - (size_t)m->nx; /* around: nx a row; up: nx between rows */
+    const size_t rows = (size_t)m->nx * (size_t)m->ny;
+    m->n = rows;
+    m->ns = 2 * rows - (size_t)m->nx; /* around: nx a row; up: nx between rows */
+    if (m->sheet) {
+        /* Its grid's springs along x and y, and one from each edge node to the highest row. */
+        const size_t gx = (size_t)m->sx + 1, gy = (size_t)m->sy + 1;
+        m->n += gx * gy;
+        m->ns += (gx - 1) * gy + gx * (gy - 1) + (size_t)m->nx;
+    }
     m->pos = ws_mem_calloc(&ld->mem, 3 * m->n, sizeof(double));
     m->mass = ws_mem_calloc(&ld->mem, m->n, sizeof(double));
     m->phase = ws_mem_calloc(&ld->mem, m->n, sizeof(double));
@@ -347,6 +361,90 @@ static double corner_place(double T, double kc, double off)
     if (r2 * T / kc < off)
         return (off - r2 * T / kc) / r2; /* the edge's contact */
     return fmin(off - T / kc, 0.0);      /* the two faces' contacts */
+}
+
+/* The highest row's node that edge node (ix, iy) of the top sheet's grid joins. */
+static size_t sheet_edge_row_node(const wrap_mesh *m, int ix, int iy)
+{
+    const int sx = m->sx, sy = m->sy;
+    int i;
+    if (iy == 0)
+        i = ix;
+    else if (ix == sx)
+        i = sx + iy;
+    else if (iy == sy)
+        i = sx + sy + (sx - ix);
+    else
+        i = (2 * sx + sy + (sy - iy)) % m->nx;
+    return (size_t)(m->ny - 1) * (size_t)m->nx + (size_t)i;
+}
+
+static void put_spring(wrap_mesh *m, size_t k, size_t a, size_t b, uint8_t kind, double scale)
+{
+    const double *pa = m->pos + 3 * a, *pb = m->pos + 3 * b;
+    m->spr[2 * k] = (uint32_t)a;
+    m->spr[2 * k + 1] = (uint32_t)b;
+    m->kind[k] = kind;
+    m->scale[k] = scale;
+    m->rest[k] = sqrt((pb[0] - pa[0]) * (pb[0] - pa[0]) + (pb[1] - pa[1]) * (pb[1] - pa[1]) +
+                      (pb[2] - pa[2]) * (pb[2] - pa[2]));
+}
+
+/* The top sheet: a grid over the top face `o` at height z (global), laid loose (its springs as
+ * placed), its edge nodes joined to the highest row's nodes over the load's top edges. Its
+ * springs take the around law (E h_l dz) for x and the up law (E h_l ds) for y, scaled by its
+ * thickness q = gauge / h_l and by the strip each stands for; its nodes the mass of their
+ * share of the face (at least mass_min). k0: its first spring. */
+static void top_sheet(wrap_mesh *m, const outline *o, double z, double q, double dz,
+                      double ds, double rho_h, double mass_min, size_t k0)
+{
+    const int gx = m->sx + 1, gy = m->sy + 1;
+    const size_t n0 = (size_t)m->nx * (size_t)m->ny;
+    const double hx = (o->x1 - o->x0) / m->sx, hy = (o->y1 - o->y0) / m->sy;
+    for (int iy = 0; iy < gy; iy++)
+        for (int ix = 0; ix < gx; ix++) {
+            size_t a = n0 + (size_t)iy * gx + ix;
+            m->pos[3 * a] = o->x0 + ix * hx;
+            m->pos[3 * a + 1] = o->y0 + iy * hy;
+            m->pos[3 * a + 2] = z;
+            double wx = (ix == 0 || ix == m->sx) ? 0.5 * hx : hx;
+            double wy = (iy == 0 || iy == m->sy) ? 0.5 * hy : hy;
+            m->mass[a] = fmax(mass_min, rho_h * wx * wy);
+        }
+    size_t k = k0;
+    for (int iy = 0; iy < gy; iy++)
+        for (int ix = 0; ix + 1 < gx; ix++, k++) {
+            size_t a = n0 + (size_t)iy * gx + ix;
+            double wy = (iy == 0 || iy == m->sy) ? 0.5 * hy : hy;
+            put_spring(m, k, a, a + 1, WS_SPRING_AROUND, q * wy / dz);
+        }
+    for (int iy = 0; iy + 1 < gy; iy++)
+        for (int ix = 0; ix < gx; ix++, k++) {
+            size_t a = n0 + (size_t)iy * gx + ix;
+            double wx = (ix == 0 || ix == m->sx) ? 0.5 * hx : hx;
+            put_spring(m, k, a, a + (size_t)gx, WS_SPRING_UP, q * wx / ds);
+        }
+    /* Over the top edges: each edge node of the grid to its node of the highest row. */
+    for (int i = 0; i < m->nx; i++, k++) {
+        int ix, iy;
+        if (i <= m->sx) {
+            ix = i;
+            iy = 0;
+        } else if (i <= m->sx + m->sy) {
+            ix = m->sx;
+            iy = i - m->sx;
+        } else if (i <= 2 * m->sx + m->sy) {
+            ix = m->sx - (i - m->sx - m->sy);
+            iy = m->sy;
+        } else {
+            ix = 0;
+            iy = m->sy - (i - 2 * m->sx - m->sy);
+        }
+        size_t a = n0 + (size_t)iy * gx + ix;
+        size_t b = sheet_edge_row_node(m, ix, iy);
+        double w = 0.5 * (i <= m->sx || (i > m->sx + m->sy && i <= 2 * m->sx + m->sy) ? hx : hy);
+        put_spring(m, k, b, a, WS_SPRING_UP, q * 2 * w / ds);
+    }
 }
 
 ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def *def,
@@ -425,6 +523,7 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
     m.sx = (int)ceil(lx / d.node_pitch);
     m.sy = (int)ceil(ly / d.node_pitch);
     m.nx = 2 * (m.sx + m.sy);
+    m.sheet = d.top_sheet;
     if (mesh_alloc(ld, &m) != 0) {
         s = ws_fail(w, WS_ERR_OUT_OF_MEMORY, "spiral wrap: out of memory for %d x %d nodes", m.nx,
                     m.ny);
@@ -515,7 +614,7 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
     for (int j = 0; j + 1 < m.ny; j++)
         for (int i = 0; i < nx; i++) {
             size_t a = (size_t)j * nx + i, b = a + (size_t)nx;
-            size_t k = m.n + (size_t)j * nx + i;
+            size_t k = (size_t)nx * (size_t)m.ny + (size_t)j * nx + i;
             const double *pa = m.pos + 3 * a, *pb = m.pos + 3 * b;
             const double *pl = m.pos + 3 * ((size_t)j * nx + (i + nx - 1) % nx);
             const double *pr = m.pos + 3 * ((size_t)j * nx + (i + 1) % nx);
@@ -533,6 +632,10 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
             m.spr[2 * k + 1] = (uint32_t)b;
             m.kind[k] = WS_SPRING_UP;
         }
+    if (m.sheet)
+        top_sheet(&m, &rows[m.ny - 1], zp + H + off, d.top_sheet_gauge / sp.hl, dz, ds_ref,
+                  d.density * d.top_sheet_gauge, d.node_mass_min,
+                  2 * (size_t)nx * (size_t)m.ny - (size_t)nx);
     {
         /* The film may reach the platform (a low pallet lock, a sagging edge): there it meets
          * the platform as it meets the pallet. The pair's damping also sets the light film's

@@ -582,6 +582,7 @@ class SpiralWrapDef(Structure):
         ("revolutions_bottom", c_double), ("revolutions_top", c_double), ("overlap", c_double),
         ("passes", c_int), ("pallet_lock", c_int), ("lock_height", c_double),
         ("top_margin", c_double), ("rope_revolutions", c_double), ("rope_height", c_double),
+        ("top_sheet", c_int), ("top_sheet_gauge", c_double),
         ("node_pitch", c_double), ("node_mass_min", c_double), ("substeps", c_int),
     ]
 

@@ -95,6 +95,8 @@ def spiral_def(d):
     sd.top_margin = w["top_margin_m"]
     sd.rope_revolutions = w["rope_revolutions"]
     sd.rope_height = w["rope_height_m"]
+    sd.top_sheet = 1 if w["top_sheet"] else 0
+    sd.top_sheet_gauge = w["top_sheet_gauge_um"] * 1e-6
     sd.node_pitch = w["node_pitch_m"]
     sd.node_mass_min = w["node_mass_min_kg"]
     return sd

@@ -150,6 +150,10 @@ SPEC = _section({
                                      doc="revolutions of film rolled into a cable (0: none)"),
             "rope_height_m": _num("m", 0.2, 0.0, 100.0, True,
                                   doc="height of the rope above the platform"),
+            "top_sheet": _bool(False, doc="a loose sheet of film over the top face, held by "
+                                          "the top revolutions"),
+            "top_sheet_gauge_um": _num("um", 50.0, 0.0, 10000.0, True,
+                                       doc="thickness of the top sheet"),
             "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
             "node_mass_min_kg": _num("kg", 0.0, 0.0, 10.0,
                                      doc="smallest node mass (0: the film's real mass)"),
