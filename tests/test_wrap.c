@@ -613,6 +613,41 @@ START_TEST(bad_spiral_defs_are_refused_with_the_field_named)
 }
 END_TEST
 
+/* The spiral's film breaks at the film's elongation at break, counted from the film off the
+ * roll: the springs' rest length is the film the powered pre-stretch p left, so a break at
+ * elongation e_b off the roll is a strain (1 + e_b) / (1 + p) - 1 on the load, 2/3 with the
+ * defaults (e_b = 4, p = 2). A limit the laid film already passes is refused. */
+START_TEST(the_spiral_film_breaks_at_its_elongation)
+{
+    ws_world *w = wrap_world();
+    ws_load_def d;
+    ws_load_def_init(&d);
+    d.layers = 1;
+    ws_load *ld;
+    ck_ok(w, ws_load_build(w, &d, &ld));
+    ws_spiral_wrap_def sd;
+    ws_web_id film;
+    ws_spiral_wrap_def_init(&sd);
+    sd.prestretch = 4.5; /* past the elongation at break: no elongation left */
+    ck_assert_int_eq(ws_load_wrap_spiral(w, ld, &sd, &film), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "prestretch"), "%s", ws_world_last_error(w));
+    ws_spiral_wrap_def_init(&sd);
+    sd.rupture_strain = 0.05; /* below the 0.1 the film is laid with */
+    ck_assert_int_eq(ws_load_wrap_spiral(w, ld, &sd, &film), WS_ERR_INVALID_ARGUMENT);
+    ck_assert_msg(strstr(ws_world_last_error(w), "rupture strain"), "%s",
+                  ws_world_last_error(w));
+    ws_spiral_wrap_def_init(&sd);
+    sd.node_mass_min = 1e-3;
+    ck_ok(w, ws_load_wrap_spiral(w, ld, &sd, &film));
+    ws_web_rupture r;
+    ck_ok(w, ws_web_get_rupture(w, film, &r));
+    ck_assert_double_eq(r.rupture_strain, (1 + 4.0) / (1 + 2.0) - 1);
+    ck_assert_int_eq(r.broken_count, 0);
+    ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* Out of memory at each allocation in turn, of the load's allocator (the recipe's buffers and
  * the read-outs') and of the world's (the web): a clear WS_ERR_OUT_OF_MEMORY, no film left
  * behind, the load still unwrapped, and every byte back when all is destroyed. */
@@ -682,6 +717,7 @@ int main(void)
     add_case(s, "top_sheet", a_top_sheet_lies_on_the_top, 300);
     add_case(s, "pallet_does_not_walk", the_wrapped_pallet_load_does_not_walk, 600);
     add_case(s, "bad_defs", bad_spiral_defs_are_refused_with_the_field_named, 60);
+    add_case(s, "rupture", the_spiral_film_breaks_at_its_elongation, 60);
     add_case(s, "out_of_memory", out_of_memory_leaves_the_load_unwrapped, 120);
     return run_suite(s);
 }

@@ -351,6 +351,17 @@ typedef struct ws_spiral_wrap_def {
     /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
      *  stable-step check accepts */
     int substeps;
+    /* ---- film rupture (trailing fields: older callers get the defaults) ---- */
+    /** The film's elongation at break, from its length off the roll (>= 0; 0: the film never
+     *  breaks, unless rupture_strain is given). Default 4.0 (400 %, LLDPE stretch film breaks
+     *  at 300-500 %). Must be above `prestretch`. */
+    double elongation_at_break;
+    /** The web's rupture strain (ws_web_def.rupture_strain) when > 0; 0 (the default): from the
+     *  elongation at break and the pre-stretch, (1 + elongation_at_break) / (1 + prestretch) - 1,
+     *  0.667 with the defaults; either way above `load_strain` (the film would break as it is
+     *  laid). The top sheet, not pre-stretched, takes the same limit: it breaks early, if
+     *  ever. */
+    double rupture_strain;
 } ws_spiral_wrap_def;
 
 /** Fill a spiral wrap Def with the defaults above. NULL is ignored. */

@@ -44,6 +44,19 @@ static void spiral_defaults(ws_spiral_wrap_def *d)
     d->node_pitch = 0.05;
     d->node_mass_min = 0.0;
     d->substeps = 0;
+    d->elongation_at_break = 4.0;
+    d->rupture_strain = 0.0;
+}
+
+/* The film's rupture strain from its rest length on the load (0: none): the given one, or the
+ * elongation at break turned from the film off the roll to the film the pre-stretch left. */
+static double spiral_rupture(const ws_spiral_wrap_def *d)
+{
+    if (d->rupture_strain > 0)
+        return d->rupture_strain;
+    if (d->elongation_at_break == 0)
+        return 0;
+    return (1 + d->elongation_at_break) / (1 + d->prestretch) - 1;
 }
 
 WS_DEF_INITS(ws_spiral_wrap_def, spiral_defaults, substeps)
@@ -91,6 +104,15 @@ static const char *spiral_bad(const ws_spiral_wrap_def *d)
         return "node_mass_min must be >= 0 kg";
     if (d->substeps < 0 || d->substeps > 100000)
         return "substeps must be 1 .. 100000, or 0 for the fewest the stable-step check accepts";
+    if (!in_range(d->elongation_at_break, 0, 100) || !in_range(d->rupture_strain, 0, 100))
+        return "elongation_at_break and rupture_strain must be 0 .. 100";
+    if (d->rupture_strain == 0 && d->elongation_at_break > 0 &&
+        !(d->prestretch < d->elongation_at_break))
+        return "prestretch must be below elongation_at_break: a film stretched that far has no "
+               "elongation left";
+    if (spiral_rupture(d) != 0 && !(spiral_rupture(d) > d->load_strain))
+        return "the film would break as it is laid: its rupture strain (rupture_strain, or from "
+               "elongation_at_break and prestretch) must be above load_strain";
     return NULL;
 }
 
@@ -658,6 +680,7 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
         wd.law_cross = up;
         wd.substeps = d.substeps > 0 ? d.substeps : 1;
         wd.name = "spiral film";
+        wd.rupture_strain = spiral_rupture(&d);
         ws_web_mesh_def md;
         ws_web_mesh_def_init(&md);
         md.positions = m.pos;

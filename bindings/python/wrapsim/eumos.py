@@ -102,6 +102,8 @@ def spiral_def(d):
     sd.top_sheet_gauge = w["top_sheet_gauge_um"] * 1e-6
     sd.node_pitch = w["node_pitch_m"]
     sd.node_mass_min = w["node_mass_min_kg"]
+    sd.elongation_at_break = w["elongation_at_break_percent"] / 100
+    sd.rupture_strain = w["rupture_strain_percent"] / 100
     return sd
 
 

@@ -171,6 +171,13 @@ SPEC = _section({
             "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
             "node_mass_min_kg": _num("kg", 0.0, 0.0, 10.0,
                                      doc="smallest node mass (0: the film's real mass)"),
+            "elongation_at_break_percent": _num("%", 400.0, 0.0, 10000.0,
+                                                doc="from the film off the roll; 0: the film "
+                                                    "never breaks"),
+            "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
+                                           doc="the film's rupture strain from its rest length "
+                                               "on the load; 0: from the elongation at break "
+                                               "and the pre-stretch"),
         }, optional=True, doc="the spiral wrap of a stretch-wrapping machine (absent: none)"),
     }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
