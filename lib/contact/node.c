@@ -314,19 +314,19 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
  * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
  * have none flagged: their bytes are cleared, not narrowed. */
 WS_VECTOR_LOOP
-static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
-                         double c, double lim)
+static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
-    ws_node_contact *nc = web->contact;
-    const double *a = A->m;
+    const ws_move_test *M = &nc->move;
+    const v3 r = M->r, vr = M->vr, wr = M->wr;
+    const double c = M->c, lim = M->lim;
+    const double *a = M->A.m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
-    const size_t n = web->n;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
-    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
         const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
                                *restrict oz = nc->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
@@ -368,18 +368,20 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
  * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
  * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
 WS_VECTOR_LOOP
-static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim, int renew)
+static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
 {
-    ws_node_contact *nc = web->contact;
-    const double *a = A->m;
+    const ws_move_test *M = &nc->move;
+    const v3 r = M->r;
+    const double lim = M->lim;
+    const int renew = M->renew;
+    const double *a = M->A.m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
-    const size_t n = web->n;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
-    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
         double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
                          *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
@@ -509,8 +511,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
     t->lever = sphere_lever(b, k, web, margin);
 }
 
-long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                   double dt, double margin)
+int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin)
 {
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
@@ -551,6 +552,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * candidates are found again too: the body may have jumped, so that they are out of its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
     int rebase = 0;
+    ws_move_test *M = &nc->move;
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         uint32_t k = t->body;
@@ -573,10 +575,17 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    size_t flagged;
-    if (c > 0.0) {
-        flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
-    } else {
+    M->A = A;
+    M->r = r;
+    M->vr = vr;
+    M->wr = wr;
+    M->pc = pc;
+    M->c = c;
+    M->lim = lim;
+    M->reach = reach;
+    M->renew = 0;
+    M->rebase = rebase;
+    if (c <= 0.0) {
         /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
          * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
          * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
@@ -590,15 +599,35 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
          * every node costs, and a load that rocks on its film needs one every few steps. */
         const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
         double drift = v3_norm(v3_sub(r, nc->epoch_r)) + turn * sqrt(nc->lever2);
-        const int renew = !(drift < 0.125 * lim);
-        if (renew) {
+        M->renew = !(drift < 0.125 * lim);
+        if (M->renew) {
             nc->epoch_A = A;
             nc->epoch_r = r;
             nc->epoch_q = p;
             drift = 0.0;
         }
-        flagged = flag_epoch(web, x, &A, r, lim - drift, renew);
+        M->lim = lim - drift;
     }
+    return 0;
+}
+
+size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1)
+{
+    ws_node_contact *nc = web->contact;
+    return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
+}
+
+long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
+                       size_t flagged)
+{
+    ws_node_contact *nc = web->contact;
+    const ws_body_state *st = &b->st[cur];
+    const ws_move_test *M = &nc->move;
+    const m3 A = M->A;
+    const v3 r = M->r;
+    const qt pc = M->pc;
+    const double reach = M->reach;
+    const int rebase = M->rebase;
     for (size_t q = 0; rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_body(b, cur, &nc->track[q], web, x, margin, &A, r, pc);
@@ -632,6 +661,14 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
     /* Found again now: their moves count from here. */
     to_ref(web, x, &A, r, nc->moved, (size_t)count);
     return count;
+}
+
+long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                   double dt, double margin)
+{
+    if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
+        return -1;
+    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
 }
 
 void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
@@ -1232,8 +1269,16 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->ready, g->ready_cap);
 }
 
+int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
+                          int all)
+{
+    ws_node_contact *nc = web->contact;
+    nc->search_all = all || nc->refresh || ws_node_moved_begin(b, cur, web, dt, margin) < 0;
+    return !nc->search_all;
+}
+
 int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
-                           ws_web *web, double margin, double dt, int all, uint64_t *checks,
+                           ws_web *web, double margin, size_t flagged, uint64_t *checks,
                            int *searched)
 {
     ws_node_contact *nc = web->contact;
@@ -1244,11 +1289,10 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
      * into the others. Either way the list holds every node-feature pair that can touch in
      * this step, and the result is the same as finding them every step (tests/test_detection.c
      * shows it). */
-    int list = nc->list;
+    int list = nc->list, all = nc->search_all;
     long moved = 0;
     size_t changed = 0;
-    all |= nc->refresh;
-    if (!all && (moved = ws_node_moved(b, cur, web, x, web->v[cur], dt, margin)) < 0)
+    if (!all && (moved = ws_node_moved_end(b, cur, web, x, margin, flagged)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {

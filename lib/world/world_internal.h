@@ -31,7 +31,7 @@ typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
     uint32_t k0, k1;
-    size_t fast;
+    size_t fast, flagged; /* nodes too fast; nodes the move test flagged */
     uint64_t checks;
     double *tmp;
     uint32_t *fct;

@@ -240,18 +240,23 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         sweep_lane(T, &T->w->lane_job[i]);
 }
 
-/* The lanes a web's sweep is cut into this step, with the scratch of each ready; 0 when out of
- * memory. One unless the world has workers and the web can be swept in lanes
- * (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a block. */
-static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
+/* The lanes a web's sweep is cut into: one unless the world has workers and the web can be
+ * swept in lanes (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a
+ * block. The same lanes, on the same workers, run the move test and every sub-step, so a
+ * lane's nodes stay in the cache of the core that runs it. */
+static uint32_t web_lanes(const ws_world *w, const ws_web *web)
 {
     const uint32_t blocks = ws_web_block_count(web),
                    most = WS_LANES_PER_WORKER * w->def.worker_count;
     uint32_t lanes = w->def.worker_count > 1 ? most : 1;
     if (lanes > blocks)
         lanes = blocks;
-    if (lanes < 2 || !ws_web_sweep_parallel(web))
-        return 1;
+    return lanes < 2 || !ws_web_sweep_parallel(web) ? 1 : lanes;
+}
+
+/* The scratch of each of the lanes ready for ncand candidates; 0 when out of memory. */
+static int lanes_ready(ws_world *w, ws_web *web, uint32_t lanes, size_t ncand)
+{
     for (uint32_t i = 1; i < lanes; i++) {
         ws_lane_job *J = &w->lane_job[i];
         if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
@@ -261,7 +266,57 @@ static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
                 0)
             return 0;
     }
-    return lanes;
+    return 1;
+}
+
+/* Run items [0, count) of task on the host's scheduler, the world's threads or, for one item,
+ * right here. */
+static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, void *ctx)
+{
+    if (count == 1) {
+        task(0, 1, 0, ctx);
+    } else if (w->def.enqueue_task) {
+        void *h = w->def.enqueue_task(task, (int32_t)count, 1, ctx, w->def.task_context);
+        if (h)
+            w->def.finish_task(h, w->def.task_context);
+    } else {
+        ws_pool_run(w->pool, task, (int32_t)count, ctx);
+    }
+}
+
+/* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
+ * them): the count flagged in each lane's job. */
+typedef struct flag_task {
+    ws_world *w;
+    ws_web *web;
+    uint32_t lanes;
+    ws_nodes3 x, v;
+} flag_task;
+
+static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker;
+    const flag_task *T = ctx;
+    const uint32_t blocks = ws_web_block_count(T->web);
+    for (int32_t i = start; i < end; i++) {
+        uint32_t n0 = 0, n1 = T->web->n, m0, m1; /* one lane: the whole web */
+        if (T->lanes > 1) {
+            ws_web_block_range(T->web, (uint32_t)((uint64_t)i * blocks / T->lanes), &n0, &m1);
+            ws_web_block_range(T->web, (uint32_t)((uint64_t)(i + 1) * blocks / T->lanes) - 1,
+                               &m0, &n1);
+        }
+        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, n0, n1);
+    }
+}
+
+static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
+{
+    flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
+    run_task(w, flag_items, lanes, &T);
+    size_t flagged = 0;
+    for (uint32_t i = 0; i < lanes; i++)
+        flagged += w->lane_job[i].flagged;
+    return flagged;
 }
 
 void ws_world_lanes_free(ws_world *w)
@@ -345,15 +400,7 @@ static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *
 {
     for (uint32_t i = 0; i < lanes; i++)
         lane_open(w, web, lanes, i);
-    if (lanes == 1) {
-        lane_items(0, 1, 0, T);
-    } else if (w->def.enqueue_task) {
-        void *task = w->def.enqueue_task(lane_items, (int32_t)lanes, 1, T, w->def.task_context);
-        if (task)
-            w->def.finish_task(task, w->def.task_context);
-    } else {
-        ws_pool_run(w->pool, lane_items, (int32_t)lanes, T);
-    }
+    run_task(w, lane_items, lanes, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
         fast += lane_close(w, web, i, bforce, bmoment);
@@ -375,10 +422,13 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         /* The node candidates of this step, ready to evaluate (contact/node.c). */
         ws_node_contact *nc = web->contact;
         int searched = 0;
+        const uint32_t lanes = web_lanes(w, web);
+        size_t flagged = 0;
+        if (ws_node_contact_begin(b, cur, web, w->def.dt, w->def.contact_margin, !w->cand_valid))
+            flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
         if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, w->def.contact_margin,
-                                   w->def.dt, !w->cand_valid, &w->stats.narrow_checks,
-                                   &searched) != 0)
+                                   flagged, &w->stats.narrow_checks, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
@@ -403,8 +453,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                            web_label(web));
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
-        const uint32_t lanes = web_lanes(w, web, nc->cand[list].n);
-        if (lanes == 0)
+        if (!lanes_ready(w, web, lanes, nc->cand[list].n))
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         /* Sub-steps alternate between the next state and the web's scratch state so that
