@@ -207,11 +207,10 @@ typedef struct lane_task {
     ws_world *w;
     ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
     ws_nodes3 xd, vd;  /* the state written */
-    /* In the first sub-step of a step swept in lanes: the nodes whose contact forces of the
-     * next state were last written (zero, zn of them), which each lane zeroes in its own rows
-     * before it adds to them, so that those rows stay in its core's cache. */
-    const uint32_t *zero;
-    size_t zn;
+    /* The first sub-step of a step swept in lanes: each lane zeroes the contact forces of
+     * the next state in its own rows before it adds to them, so that those rows stay in its
+     * core's cache. */
+    int zero;
 } lane_task;
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
@@ -226,9 +225,7 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     if (T->zero) {
         uint32_t m0, end;
         ws_web_block_range(web, J->k1 - 1, &m0, &end);
-        for (size_t q = 0; q < T->zn; q++)
-            if (T->zero[q] >= n0 && T->zero[q] < end)
-                T->pass.fc[T->zero[q]] = v3_make(0, 0, 0);
+        memset(T->pass.fc + n0, 0, (end - n0) * sizeof(v3));
     }
     ws_node_substep(&J->cview);
     ws_web_sweep_begin(web, T->vd);
@@ -269,16 +266,13 @@ static uint32_t web_lanes(const ws_world *w, const ws_web *web)
 /* The scratch of each of the lanes ready for ncand candidates; 0 when out of memory. */
 static int lanes_ready(ws_world *w, ws_web *web, uint32_t lanes, size_t ncand)
 {
-    for (uint32_t i = 0; i < lanes && lanes > 1; i++) {
+    for (uint32_t i = 1; i < lanes; i++) {
         ws_lane_job *J = &w->lane_job[i];
-        /* Every lane lists its touched nodes apart: the web's list is read while they run. */
-        if (ws_array_reserve(&w->mem, (void **)&J->fct, &J->fct_cap, ncand + 1, sizeof(uint32_t)))
-            return 0;
-        if (i == 0) /* the rest of lane 0's scratch is the web's */
-            continue;
         if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
             return 0;
-        if (ws_node_lane_scratch(&w->mem, &J->own, web->contact, web->n, ncand) != 0)
+        if (ws_node_lane_scratch(&w->mem, &J->own, web->contact, web->n, ncand) != 0 ||
+            ws_array_reserve(&w->mem, (void **)&J->fct, &J->fct_cap, ncand + 1, sizeof(uint32_t)) !=
+                0)
             return 0;
     }
     return 1;
@@ -368,14 +362,12 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
     c->lane_end = n1;
     c->run_nodes = c->run_deep = c->corners = 0;
     v->law_failed = 0;
-    if (lanes > 1) {
-        v->fct[v->fck] = J->fct;
-        v->fct_cap[v->fck] = J->fct_cap;
-        v->nfct[v->fck] = 0;
-    }
     if (i == 0)
         return;
     v->tmp = J->tmp;
+    v->fct[v->fck] = J->fct;
+    v->fct_cap[v->fck] = J->fct_cap;
+    v->nfct[v->fck] = 0;
     c->act = J->own.act;
     c->act_id = J->own.act_id;
     c->act_cap = J->own.act_cap;
@@ -388,8 +380,7 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
 
 /* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
  * its counts. Returns its nodes too fast. */
-static size_t lane_close(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i, v3 *bforce,
-                         v3 *bmoment)
+static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *bmoment)
 {
     ws_lane_job *J = &w->lane_job[i];
     ws_web *v = &J->view;
@@ -401,13 +392,11 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i, v
     web->law_failed |= v->law_failed;
     w->stats.narrow_checks += J->checks;
     const int k = web->fck;
-    if (i == 0)
+    if (i == 0) {
         nc->rface_gen = c->rface_gen;
-    else
-        J->own.rface_gen = c->rface_gen;
-    if (lanes == 1) {
-        web->nfct[k] = v->nfct[k]; /* one lane listed into the web's own list */
+        web->nfct[k] = v->nfct[k]; /* lane 0 listed into the web's own list */
     } else {
+        J->own.rface_gen = c->rface_gen;
         memcpy(web->fct[k] + web->nfct[k], v->fct[k], v->nfct[k] * sizeof(uint32_t));
         web->nfct[k] += v->nfct[k];
     }
@@ -423,7 +412,7 @@ static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *
     run_task(w, lane_items, lanes, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
-        fast += lane_close(w, web, lanes, i, bforce, bmoment);
+        fast += lane_close(w, web, i, bforce, bmoment);
     return fast;
 }
 
@@ -467,10 +456,9 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
         /* The node contact forces this step writes: zero where they were not (the nodes that
-         * had contacts when fc[nxt] was last written): here, or by the lanes in their rows. */
-        const uint32_t *zero = lanes > 1 ? web->fct[nxt] : NULL;
-        const size_t zn = web->nfct[nxt];
-        for (size_t q = 0; !zero && q < zn; q++)
+         * had contacts when fc[nxt] was last written), or, in lanes, every one by the lane of
+         * its row (the others are zero already). */
+        for (size_t q = 0; lanes == 1 && q < web->nfct[nxt]; q++)
             web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
         web->nfct[nxt] = 0;
         web->fck = nxt;
@@ -489,8 +477,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                             web->fc[nxt]},
                            xd,
                            vd,
-                           s == 0 ? zero : NULL,
-                           zn};
+                           s == 0 && lanes > 1};
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
