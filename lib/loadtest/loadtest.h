@@ -50,6 +50,72 @@ struct ws_load {
     ws_vec3 carton_shape; /* the carton's size in its own frame */
 };
 
+/* ---- the measurements of a test run (record.c), shared by every test ---------------------- */
+
+/* Where a run's figures go: the fields of the caller's result. */
+typedef struct ws_lt_sink {
+    double *peak_level;
+    double *layer_max, *layer_tilt;                  /* [layers] */
+    double *interface_slip_max, *interface_use_max;  /* [layers + 1] */
+    int *cartons_lost, *event_count, *events_dropped;
+    ws_loadtest_event *events;                       /* [WS_LOADTEST_MAX_EVENTS] */
+    double *film_peak_strain;
+} ws_lt_sink;
+
+/* Four quarters of a base: a contact more than a quarter of the half-size off the centre along
+ * x or y counts for that edge. */
+enum { WS_LT_BIN_XP, WS_LT_BIN_XN, WS_LT_BIN_YP, WS_LT_BIN_YN, WS_LT_BINS };
+
+/* A run's measuring state: buffers, the events found so far, the latest sample. */
+typedef struct ws_lt_run {
+    ws_load *ld;
+    ws_lt_sink sink;
+    const char *name;     /* of the test, for error messages */
+    ws_vec3 dir;          /* the drive's direction in the platform's frame (layer means) */
+    double slip_speed;    /* m/s: slip onset */
+    double tip_fraction;  /* an edge below this share of its body's support has unloaded */
+    int (*on_sample)(void *user, const ws_loadtest_sample *sample);
+    void *sample_user;
+    ws_contact_info *contacts;
+    size_t contacts_cap;
+    ws_load_carton_state *cs;
+    double (*bins)[WS_LT_BINS];     /* per body (pallet = 0, carton c = c + 1): support by edge */
+    double (*ref_bins)[WS_LT_BINS]; /* the same at the first sample */
+    unsigned char *tipped, *lost;
+    int have_ref_bins;
+    int slipped[WS_LOAD_MAX_LAYERS + 1];
+    double layer_disp[WS_LOAD_MAX_LAYERS];
+    ws_loadtest_interface_state ifs[WS_LOAD_MAX_LAYERS + 1];
+    double ifs_use[WS_LOAD_MAX_LAYERS + 1];
+    ws_loadtest_interface_state *base; /* per carton: the contacts under it */
+    double *base_use;
+    double *strain; /* the film's spring strains (wrapped loads) */
+    size_t springs;
+} ws_lt_run;
+
+/* Set up a run's measurements (buffers from the load's allocator); `sink` says where the maxima
+ * and events go (zeroed by the caller). WS_ERR_OUT_OF_MEMORY with the message set. */
+ws_status ws_lt_begin(ws_world *w, ws_lt_run *run, ws_load *ld, const ws_lt_sink *sink,
+                      const char *name);
+/* Free what ws_lt_begin took. */
+void ws_lt_end(ws_lt_run *run);
+/* One measurement at run time t (s): cartons, layers, interfaces, events, running maxima, the
+ * sample callback. `level` is the drive's level (a / g, or tan theta on a tilt), v and x the
+ * platform's velocity and position along the drive, angle the tilt's (0 for the others). */
+ws_status ws_lt_sample(ws_world *w, ws_lt_run *run, double t, double level, double v, double x,
+                       double angle);
+/* Append an event (counted as dropped past WS_LOADTEST_MAX_EVENTS). */
+void ws_lt_event(const ws_lt_sink *sink, int type, int layer, int index, double t, double level,
+                 double value);
+/* A criterion: pass when value <= limit (value < limit when strict). */
+void ws_lt_criterion(ws_loadtest_criterion *c, double value, double limit, int strict);
+/* From the latest sample (the permanent state after a rest): per layer the largest horizontal
+ * carton displacement (fmax into layer_permanent[], may be NULL), the largest of a carton whose
+ * base is within 0.2 m above the deck (*bottom) and the largest shift of a layer's mean relative
+ * to the layer under it (*shift). */
+void ws_lt_permanent(const ws_lt_run *run, double *layer_permanent, double *bottom,
+                     double *shift);
+
 /* The key of a body id, or NULL when it is not part of the load. */
 const ws_load_key *ws_load_find(const ws_load *load, ws_body_id id);
 /* Platform rotation (body to global) and the pallet's CoG and velocity. */

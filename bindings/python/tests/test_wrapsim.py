@@ -1207,6 +1207,50 @@ def test_load_build_measure_wrap_and_eumos():
     assert kr.runs == 2 and kr.k_value == 0.1
 
 
+def test_load_tilt_impact_and_vibration_runs():
+    """The other platform tests through the table: each gives its verdict of named criteria and
+    leaves the world's state as it was (the hash before and after)."""
+    byref = ctypes.byref
+    with ws.World(detection_interval=10) as w:
+        ld = L.LoadDef()
+        LIB.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
+        ld.layers, ld.count_x, ld.count_y = 1, 1, 1
+        load = ctypes.c_void_p()
+        assert LIB.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+        assert LIB.ws_world_step_n(w.ptr, 1200) == 0  # settle 0.3 s
+        h0, h1 = ctypes.c_uint64(), ctypes.c_uint64()
+        assert LIB.ws_world_get_state_hash(w.ptr, byref(h0)) == 0
+        res = L.LoadtestResult()
+        td = L.TiltTestDef()
+        LIB.ws_tilt_test_def_init_sized(byref(td), ctypes.sizeof(td))
+        td.target_angle, td.stop_time, td.hold_time = 0.1, 0.5, 0.0  # the default 0.05 rad/s
+        angles = []
+        td.on_sample = L.SampleFn(lambda user, smp: angles.append(smp.contents.angle) or 0)
+        assert LIB.ws_loadtest_run_tilt(w.ptr, load, byref(td), byref(res)) == 0, w.last_error
+        assert res.kind == L.LOADTEST_TILT
+        assert getattr(res.verdict, "pass") == 1, [(e.type, e.layer, e.time, e.level)
+                                                   for e in res.events[:res.event_count]]
+        assert max(angles) == pytest.approx(0.1) and res.failure_event == -1
+        names = [LIB.ws_loadtest_check_name(res.verdict.check[i].id)
+                 for i in range(res.verdict.count)]
+        assert names == [b"stable_angle", b"cartons_lost"]
+        im = L.ImpactTestDef()
+        LIB.ws_impact_test_def_init_sized(byref(im), ctypes.sizeof(im))
+        im.speed, im.pulse_duration, im.gentle_acceleration = 0.3, 0.05, 2.0
+        im.coast_time, im.rest_after = 0.0, 0.0
+        assert LIB.ws_loadtest_run_impact(w.ptr, load, byref(im), byref(res)) == 0, w.last_error
+        assert res.velocity_change == pytest.approx(0.3, rel=1e-3)
+        vd = L.VibrationTestDef()
+        LIB.ws_vibration_test_def_init_sized(byref(vd), ctypes.sizeof(vd))
+        vd.sweep, vd.sweep_level, vd.frequency_start, vd.frequency_end = 1, 0.02, 5.0, 20.0
+        vd.duration, vd.ramp_time, vd.rest_after = 1.0, 0.1, 0.0
+        assert LIB.ws_loadtest_run_vibration(w.ptr, load, byref(vd), byref(res)) == 0, \
+            w.last_error
+        assert res.kind == L.LOADTEST_SWEEP and res.response_bins == L.LOADTEST_RESPONSE_BINS
+        assert LIB.ws_world_get_state_hash(w.ptr, byref(h1)) == 0 and h0.value == h1.value
+        LIB.ws_load_destroy(load)
+
+
 # --- last: the whole table was exercised ---------------------------------------------------------
 def test_zz_every_function_was_called():
     others = {n for n in globals() if n.startswith("test_") and n != "test_zz_every_function_was_called"}

@@ -587,6 +587,7 @@ class LoadtestSample(Structure):
         ("carton", POINTER(LoadCartonState)), ("layers", c_int),
         ("layer_displacement", POINTER(c_double)), ("interfaces", c_int),
         ("interface", POINTER(LoadtestInterfaceState)),
+        ("angle", c_double), ("carton_base", POINTER(LoadtestInterfaceState)),
     ]
 
 
@@ -650,6 +651,84 @@ class KvalueResult(Structure):
     _fields_ = [
         ("k_value", c_double), ("k_fail", c_double), ("runs", c_int),
         ("last_pass", EumosResult), ("error", c_char * 256),
+    ]
+
+
+LOADTEST_MAX_CHECKS = 8
+LOADTEST_RESPONSE_BINS = 48
+LOADTEST_TILT, LOADTEST_IMPACT, LOADTEST_RANDOM, LOADTEST_SWEEP = 1, 2, 3, 4
+
+
+class TiltTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("rate", c_double), ("target_angle", c_double), ("max_angle", c_double),
+        ("ramp_time", c_double), ("stop_time", c_double), ("hold_time", c_double),
+        ("stop_at_failure", c_int), ("after_failure", c_double), ("direction", Vec3),
+        ("rest_before", c_double), ("slip_speed", c_double), ("tip_fraction", c_double),
+        ("sample_interval", c_int), ("keep_state", c_int),
+        ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class ImpactTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("speed", c_double), ("pulse_duration", c_double), ("gentle_acceleration", c_double),
+        ("coast_time", c_double), ("rest_before", c_double), ("rest_after", c_double),
+        ("direction", Vec3), ("slip_speed", c_double), ("tip_fraction", c_double),
+        ("sample_interval", c_int), ("keep_state", c_int),
+        ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class VibrationTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("sweep", c_int), ("psd_frequency", POINTER(c_double)),
+        ("psd_level", POINTER(c_double)), ("psd_count", c_size_t), ("grms", c_double),
+        ("seed", c_uint64), ("sample_rate", c_double), ("sweep_level", c_double),
+        ("frequency_start", c_double), ("frequency_end", c_double), ("sweep_law", c_enum),
+        ("resonance_min", c_double), ("duration", c_double), ("ramp_time", c_double),
+        ("direction", Vec3), ("rest_before", c_double), ("rest_after", c_double),
+        ("slip_speed", c_double), ("tip_fraction", c_double), ("sample_interval", c_int),
+        ("keep_state", c_int), ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class LoadtestCheck(Structure):
+    _fields_ = [
+        ("id", c_int), ("at_least", c_int), ("value", c_double), ("limit", c_double),
+        ("pass", c_int),
+    ]
+
+
+class LoadtestVerdict(Structure):
+    _fields_ = [
+        ("load_height", c_double), ("count", c_int),
+        ("check", LoadtestCheck * LOADTEST_MAX_CHECKS), ("pass", c_int),
+    ]
+
+
+class LoadtestResult(Structure):
+    _fields_ = [
+        ("kind", c_int), ("duration", c_double), ("peak_level", c_double),
+        ("angle_reached", c_double), ("failure_angle", c_double), ("failure_event", c_int),
+        ("impact_speed", c_double), ("velocity_change", c_double),
+        ("peak_deceleration", c_double), ("grms_delivered", c_double),
+        ("grms_target", c_double), ("resonance_frequency", c_double),
+        ("resonance_transmissibility", c_double), ("response_bins", c_int),
+        ("response_frequency", c_double * LOADTEST_RESPONSE_BINS),
+        ("response_transmissibility", c_double * LOADTEST_RESPONSE_BINS),
+        ("layers", c_int),
+        ("layer_max", c_double * LOAD_MAX_LAYERS),
+        ("layer_permanent", c_double * LOAD_MAX_LAYERS),
+        ("layer_tilt", c_double * LOAD_MAX_LAYERS),
+        ("interface_slip_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("interface_use_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("cartons_lost", c_int), ("event_count", c_int), ("events_dropped", c_int),
+        ("events", LoadtestEvent * LOADTEST_MAX_EVENTS), ("film_peak_strain", c_double),
+        ("verdict", LoadtestVerdict),
     ]
 
 
@@ -822,6 +901,14 @@ FUNCTIONS = [
     ("ws_eumos_get_drive", [P(EumosDef), P(DriveDef), P(c_double)], _st),
     ("ws_loadtest_run_eumos", [World_p, Load_p, P(EumosDef), P(EumosResult)], _st),
     ("ws_kvalue_def_init_sized", [P(KvalueDef), c_size_t], None),
+    ("ws_tilt_test_def_init_sized", [P(TiltTestDef), c_size_t], None),
+    ("ws_impact_test_def_init_sized", [P(ImpactTestDef), c_size_t], None),
+    ("ws_vibration_test_def_init_sized", [P(VibrationTestDef), c_size_t], None),
+    ("ws_loadtest_run_tilt", [World_p, Load_p, P(TiltTestDef), P(LoadtestResult)], _st),
+    ("ws_loadtest_run_impact", [World_p, Load_p, P(ImpactTestDef), P(LoadtestResult)], _st),
+    ("ws_loadtest_run_vibration", [World_p, Load_p, P(VibrationTestDef), P(LoadtestResult)],
+     _st),
+    ("ws_loadtest_check_name", [c_int], c_char_p),
     ("ws_loadtest_find_k", [P(WorldDef), P(LoadDef), P(EumosDef), P(KvalueDef), P(KvalueResult)],
      _st),
 ]
@@ -843,6 +930,9 @@ DEF_INITS = [
     ("ws_web_mesh_def_init_sized", WebMeshDef),
     ("ws_element_def_init_sized", ElementDef),
     ("ws_vtk_series_def_init_sized", VtkSeriesDef),
+    ("ws_tilt_test_def_init_sized", TiltTestDef),
+    ("ws_impact_test_def_init_sized", ImpactTestDef),
+    ("ws_vibration_test_def_init_sized", VibrationTestDef),
 ]
 
 

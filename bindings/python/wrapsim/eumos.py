@@ -122,26 +122,38 @@ def _result_dict(d, res, state_hash):
                 simulated_s=res.duration)
 
 
+def prepare(w, d):
+    """Build the load file's unit load in world `w`, let it settle, wrap it (then settle again)
+    when the file has a wrap. Returns the ws_load pointer; destroy it with ws_load_destroy."""
+    u = d["unit_load"]
+    lib = _c()
+    ld = load_def(d)
+    load = ctypes.c_void_p()
+    _check(w, lib.ws_load_build(w.ptr, byref(ld), byref(load)), "ws_load_build")
+    try:
+        settled, taken = ctypes.c_int(), ctypes.c_double()
+        wd = wrap_def(d)
+        if wd is not None:
+            _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
+                                         byref(settled), byref(taken)), "ws_load_settle")
+            web = L.WebId()
+            _check(w, lib.ws_load_wrap_band(w.ptr, load, byref(wd), byref(web)),
+                   "ws_load_wrap_band")
+        _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
+                                     byref(settled), byref(taken)), "ws_load_settle")
+    except BaseException:
+        lib.ws_load_destroy(load)
+        raise
+    return load
+
+
 def run(d, progress=False, desc="wrapsim", paraview=None):
     """Build the unit load, wrap it, let it settle, run the EUMOS test. Returns (result, series)
     like loadrun.run: the verdict as a JSON-able dict and the sampled time series."""
-    u = d["unit_load"]
     lib = _c()
     with World(**world_params(d)) as w:
-        ld = load_def(d)
-        load = ctypes.c_void_p()
-        _check(w, lib.ws_load_build(w.ptr, byref(ld), byref(load)), "ws_load_build")
+        load = prepare(w, d)
         try:
-            settled, taken = ctypes.c_int(), ctypes.c_double()
-            wd = wrap_def(d)
-            if wd is not None:
-                _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                             byref(settled), byref(taken)), "ws_load_settle")
-                web = L.WebId()
-                _check(w, lib.ws_load_wrap_band(w.ptr, load, byref(wd), byref(web)),
-                       "ws_load_wrap_band")
-            _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                         byref(settled), byref(taken)), "ws_load_settle")
             info = L.LoadInfo()
             _check(w, lib.ws_load_get_info(load, byref(info)), "ws_load_get_info")
             rows = []

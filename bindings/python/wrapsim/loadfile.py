@@ -9,7 +9,8 @@ path and what is wrong, e.g. "wrap.prestretch_around_percent: -20 is below 0 %".
 Two forms of load: a column of cartons (`stack`) on a tilt table (`platform`, optionally with a
 stop bar on its downhill side; `materials`, an optional film band `wrap`), or a unit load
 (`unit_load`: a pallet with layers of cartons, the interfaces, an optional wrap) for the EUMOS
-40509 test, which the C library's load-test module builds and judges. `test` says which test.
+40509 test, the tilt, the horizontal impact or vibration, which the C library's load-test
+module builds and judges. `test` says which test.
 """
 
 import copy
@@ -36,6 +37,12 @@ def _int(default=None, minimum=None, maximum=None, doc=""):
 
 def _str(choices, default=None, doc=""):
     return dict(kind="string", choices=choices, default=default, doc=doc)
+
+
+def _pairs(doc=""):
+    """A list of [x, y] pairs of positive numbers, x increasing (PSD breakpoints); [] for
+    none."""
+    return dict(kind="pairs", default=[], doc=doc)
 
 
 def _section(fields, optional=False, doc=""):
@@ -146,18 +153,42 @@ SPEC = _section({
         "node_mass_kg": _num("kg", 1e-3, 0.0, 10.0, True),
     }, optional=True, doc="a band of film around the stack (absent: unwrapped)"),
     "test": _section({
-        "type": _str(["tilt", "eumos"], "tilt",
-                     doc="tilt table (ISO 10531; a stack) or EUMOS 40509 (a unit_load)"),
+        "type": _str(["tilt", "eumos", "impact", "vibration"], "tilt",
+                     doc="tilt table (ISO 10531; a stack or a unit_load), EUMOS 40509, "
+                         "horizontal impact (ASTM D4003 / D5414, ISTA 3E) or vibration (ASTM "
+                         "D4169 truck random, or a sine sweep); the last three need a unit_load"),
         "k_g": _num("g", 0.3, 0.0, 10.0, True, doc="eumos: the plateau acceleration"),
         "mode": _str(["accelerate", "brake"], "accelerate",
                      doc="eumos: a pulse from rest, or a run-up then braking at k g"),
         "rise_s": _num("s", 0.04, 0.0, 1.0, True, doc="eumos: the rise to k g (<= 0.05)"),
         "hold_s": _num("s", 0.35, 0.0, 100.0, doc="eumos: the plateau (>= 0.3)"),
+        "speed_m_per_s": _num("m/s", 1.2, 0.0, 20.0, True,
+                              doc="impact: the platform's speed at the impact (1.2, 1.75)"),
+        "pulse_ms": _num("ms", 10.0, 0.0, 1000.0, True,
+                         doc="impact: the programmer's half-sine deceleration"),
+        "coast_s": _num("s", 0.2, 0.0, 100.0, doc="impact: at speed before the impact"),
+        "rest_s": _num("s", 0.5, 0.0, 100.0,
+                       doc="impact, vibration: at rest after, before the permanent state"),
+        "vibration": _str(["random", "sweep"], "random",
+                          doc="vibration: random from a PSD, or a sine sweep (resonance)"),
+        "grms_g": _num("g", 0.54, 0.0, 20.0,
+                       doc="vibration, random: the PSD scaled to this Grms (D4169 truck: 0.40, "
+                           "0.54, 0.70); 0 plays the PSD as given"),
+        "psd": _pairs(doc="vibration, random: breakpoints [Hz, g^2/Hz], log-log between; "
+                          "[] (default): the library's truck spectrum"),
+        "seed": _int(1, 0, 2 ** 53, doc="vibration, random: the same seed, the same history"),
+        "sweep_g": _num("g", 0.25, 0.0, 10.0, True, doc="vibration, sweep: amplitude"),
+        "sweep_from_hz": _num("Hz", 2.0, 0.0, 1e4, True, doc="vibration, sweep: start"),
+        "sweep_to_hz": _num("Hz", 40.0, 0.0, 1e4, True, doc="vibration, sweep: end (log law)"),
+        "resonance_min_hz": _num("Hz", 0.0, 0.0, 1e4,
+                                 doc="vibration, sweep: the resonance must be at least this"),
         "start_s": _num("s", 1.0, 0.0, 1e6, doc="the tilt starts (smoothly) at this time"),
         "rate_deg_per_s": _num("deg/s", math.degrees(0.1), 0.0, 90.0, True),
-        "duration_s": _num("s", 7.0, 0.0, 1e6, True, doc="simulated time"),
+        "duration_s": _num("s", 7.0, 0.0, 1e6, True,
+                           doc="tilt of a stack: simulated time; vibration: the shaking"),
         "target_angle_deg": _num("deg", 20.0, 0.0, 89.0, True,
-                                 doc="the load passes when nothing slips or tips below it"),
+                                 doc="tilt: the load passes when nothing slips or tips below "
+                                     "it"),
         "slip_limit_mm": _num("mm", 5.0, 0.0, 1e4, True,
                               doc="relative slip that counts as slipping"),
     }),
@@ -189,6 +220,22 @@ def _check_value(spec, value, path):
         if hi is not None and value > hi:
             raise LoadFileError(f"{path}: {value:g} is above {hi:g}{unit}")
         return int(value) if kind == "integer" else float(value)
+    if kind == "pairs":
+        if not isinstance(value, list):
+            raise LoadFileError(f"{path}: {value!r} is not a list of [x, y] pairs")
+        out = []
+        for i, pair in enumerate(value):
+            if (not isinstance(pair, list) or len(pair) != 2 or
+                    any(isinstance(x, bool) or not isinstance(x, (int, float)) or
+                        not math.isfinite(x) or x <= 0 for x in pair)):
+                raise LoadFileError(f"{path}[{i}]: {pair!r} is not a pair of numbers > 0")
+            if out and pair[0] <= out[-1][0]:
+                raise LoadFileError(f"{path}[{i}]: {pair[0]:g} does not increase on "
+                                    f"{out[-1][0]:g}")
+            out.append([float(pair[0]), float(pair[1])])
+        if len(out) == 1:
+            raise LoadFileError(f"{path}: one breakpoint; give at least two, or none")
+        return out
     if kind == "string":
         if not isinstance(value, str):
             raise LoadFileError(f"{path}: {value!r} is not a string")
@@ -220,7 +267,7 @@ def _check_section(spec, value, path):
                 raise LoadFileError(f"{sub_path}: missing (a required value"
                                     f"{', in ' + sub['unit'] if sub.get('unit') else ''})")
             else:
-                out[key] = sub["default"]
+                out[key] = copy.deepcopy(sub["default"])
         else:
             out[key] = _check_value(sub, value[key], sub_path)
     return out
@@ -231,11 +278,13 @@ def _cross_checks(d):
     if (d["stack"] is None) == (d["unit_load"] is None):
         raise LoadFileError("stack: give either a stack (a column on a tilt table) or a "
                             "unit_load (a pallet with layers of cartons), not both or neither")
-    kind = d["test"]["type"]
-    if kind == "eumos" and d["unit_load"] is None:
-        raise LoadFileError("test.type: 'eumos' needs a unit_load section")
-    if kind == "tilt" and d["stack"] is None:
-        raise LoadFileError("test.type: 'tilt' needs a stack section")
+    t = d["test"]
+    kind = t["type"]
+    if kind in ("eumos", "impact", "vibration") and d["unit_load"] is None:
+        raise LoadFileError(f"test.type: '{kind}' needs a unit_load section")
+    if t["sweep_to_hz"] <= t["sweep_from_hz"]:
+        raise LoadFileError(f"test.sweep_to_hz: {t['sweep_to_hz']:g} Hz is not above "
+                            f"sweep_from_hz ({t['sweep_from_hz']:g} Hz)")
     if d["stack"] is None:
         return
     c = d["stack"]["carton"]
@@ -313,7 +362,10 @@ def _schema_of(spec):
         if spec.get("doc"):
             out["description"] = spec["doc"]
         return out
-    if kind == "string":
+    if kind == "pairs":
+        out = {"type": "array", "items": {"type": "array", "minItems": 2, "maxItems": 2,
+                                          "items": {"type": "number", "exclusiveMinimum": 0}}}
+    elif kind == "string":
         out = {"type": "string"}
         if spec["choices"]:
             out["enum"] = list(spec["choices"])
