@@ -21,25 +21,14 @@ _Static_assert(MOVE_NODE + MOVE_SUBSTEP + 2 * MOVE_BODY == MOVE_COVER,
 /* Each part as a fraction of the margin (exact: sixteenths are binary fractions). */
 #define MOVE_PART(k) ((double)(k) / MOVE_PARTS)
 
-/* Node vectors laid out as the web's (web.c): x, y and z of 3 n doubles in one block, then
- * WS_WEB_PAD more (the state walk takes the 3 n at once). */
-static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
-{
-    double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
-    a->x = p;
-    a->y = p ? p + n : NULL;
-    a->z = p ? p + 2 * (size_t)n : NULL;
-    return p != NULL;
-}
-
 ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
 {
     ws_node_contact *nc = ws_mem_calloc(mem, 1, sizeof *nc);
     if (!nc)
         return NULL;
     nc->seg_list = -1;
-    int ok = nodes_alloc(mem, &nc->xdet, n);
-    ok &= nodes_alloc(mem, &nc->xep, n);
+    int ok = ws_nodes_alloc(mem, &nc->xdet, n);
+    ok &= ws_nodes_alloc(mem, &nc->xep, n);
     ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
     ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
@@ -54,11 +43,10 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
 {
     if (!nc)
         return;
-    const size_t m = 3 * (size_t)n + WS_WEB_PAD;
     for (int k = 0; k < 2; k++)
         ws_mem_free(mem, nc->cand[k].c, nc->cand[k].cap * sizeof(ws_ncand));
-    ws_mem_free(mem, nc->xdet.x, m * sizeof(double));
-    ws_mem_free(mem, nc->xep.x, m * sizeof(double));
+    ws_nodes_free(mem, &nc->xdet, n);
+    ws_nodes_free(mem, &nc->xep, n);
     ws_mem_free(mem, nc->moved, (n ? n : 1) * sizeof(uint32_t));
     ws_mem_free(mem, nc->redo, (n ? n : 1) * sizeof(uint8_t));
     ws_mem_free(mem, nc->cstart, ((size_t)n + 1) * sizeof(size_t));
@@ -318,8 +306,7 @@ static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n
 {
     const ws_move_test *M = &nc->move;
     const v3 r = M->r, vr = M->vr, wr = M->wr;
-    const double c = M->c, lim = M->lim;
-    const double *a = M->A.m;
+    const double c = M->c, lim = M->lim, *a = M->A.m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
@@ -370,11 +357,9 @@ static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n
 WS_VECTOR_LOOP
 static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
 {
-    const ws_move_test *M = &nc->move;
-    const v3 r = M->r;
-    const double lim = M->lim;
-    const int renew = M->renew;
-    const double *a = M->A.m;
+    const v3 r = nc->move.r;
+    const double lim = nc->move.lim, *a = nc->move.A.m;
+    const int renew = nc->move.renew;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
@@ -575,16 +560,7 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
      * wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    M->A = A;
-    M->r = r;
-    M->vr = vr;
-    M->wr = wr;
-    M->pc = pc;
-    M->c = c;
-    M->lim = lim;
-    M->reach = reach;
-    M->renew = 0;
-    M->rebase = rebase;
+    *M = (ws_move_test){A, r, vr, wr, pc, c, lim, reach, 0, rebase};
     if (c <= 0.0) {
         /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
          * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
@@ -627,12 +603,11 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     const v3 r = M->r;
     const qt pc = M->pc;
     const double reach = M->reach;
-    const int rebase = M->rebase;
-    for (size_t q = 0; rebase && q < nc->ntrack; q++)
+    for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_body(b, cur, &nc->track[q], web, x, margin, &A, r, pc);
     /* Most steps flag no node. */
-    long count = flagged || rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
+    long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
     for (size_t q = 0; count && q < nc->ntrack; q++) {
@@ -661,14 +636,6 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     /* Found again now: their moves count from here. */
     to_ref(web, x, &A, r, nc->moved, (size_t)count);
     return count;
-}
-
-long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                   double dt, double margin)
-{
-    if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
-        return -1;
-    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
 }
 
 void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)

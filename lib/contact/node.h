@@ -239,8 +239,7 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
  * is found again its move relative to a near body stays under half the margin, the distance a
  * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
  * node.c. */
-long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                   double dt, double margin);
+
 /* ws_node_moved in three parts, so that the per-node test runs in pieces (a lane's nodes):
  * the bodies' part, -1 when every node must be found again, else 0 with the test set up in
  * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
@@ -249,6 +248,13 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
 size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
                        size_t flagged);
+static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
+                                 ws_nodes3 v, double dt, double margin)
+{
+    if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
+        return -1;
+    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
+}
 
 /* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]
  * is the first of node i or of a later node, start[n] = nc. */

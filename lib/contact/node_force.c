@@ -103,9 +103,10 @@ typedef struct act_load {
 
 /* A contact's load on its body: the opposite of the contact force on the node (friction a plus
  * the normal force fn along n) times share, and its moment about the CoG at lever l; zero for
- * a contact that does not push (push: all bits or none). Adding it leaves every sum as it was then: the bodies' sums start at +0 and never
- * reach -0, and the moment's zero, of either sign, changes no sum. Both paths (act_friction,
- * run_kernel) take it from here, so their loads agree to the bit. */
+ * a contact that does not push (push: all bits or none). Adding that zero leaves every sum as it
+ * was: the bodies' sums start at +0 and never reach -0, and the moment's zero, of either sign,
+ * changes no sum. Both paths (act_friction, run_kernel) take it from here, so their loads agree
+ * to the bit. */
 static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double share, v3 l)
 {
     const double Bx = pick(push, (a.x + n.x * fn) * -share, 0.0),
@@ -296,14 +297,14 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
             const v3 a = friction_of(n, v3_make(e->tx[l], e->ty[l], e->tz[l]),
                                      v3_make(e->kx[l], e->ky[l], e->kz[l]), e->im[l], e->m[l],
                                      fn, e->mu[l], e->vl[l], h);
-            const double fx = a.x, fy = a.y, fz = a.z;
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
              * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = 0 - (uint64_t)(fn > 0.0);
-            e->ax[l] = pick(push, fx, -0.0);
-            e->ay[l] = pick(push, fy, -0.0);
-            e->az[l] = pick(push, fz, -0.0);
-            const act_load B = body_load(push, a, n, fn, share, v3_make(e->lx[l], e->ly[l], e->lz[l]));
+            e->ax[l] = pick(push, a.x, -0.0);
+            e->ay[l] = pick(push, a.y, -0.0);
+            e->az[l] = pick(push, a.z, -0.0);
+            const act_load B =
+                body_load(push, a, n, fn, share, v3_make(e->lx[l], e->ly[l], e->lz[l]));
             e->bx[l] = B.f.x;
             e->by[l] = B.f.y;
             e->bz[l] = B.f.z;

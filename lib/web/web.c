@@ -3,9 +3,7 @@
 #include <float.h>
 #include <string.h>
 
-/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
- * read past a grid's last node). */
-static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+int ws_nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
     double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
     a->x = p;
@@ -14,7 +12,7 @@ static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
     return p != NULL;
 }
 
-static void nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+void ws_nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
     ws_mem_free(mem, a->x, (3 * (size_t)n + WS_WEB_PAD) * sizeof(double));
     a->x = a->y = a->z = NULL;
@@ -27,14 +25,14 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     web->ns = ns;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
-        ok &= nodes_alloc(mem, &web->x[k], n);
-        ok &= nodes_alloc(mem, &web->v[k], n);
+        ok &= ws_nodes_alloc(mem, &web->x[k], n);
+        ok &= ws_nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
-    ok &= nodes_alloc(mem, &web->fmem, n);
+    ok &= ws_nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= nodes_alloc(mem, &web->xsub, n);
-    ok &= nodes_alloc(mem, &web->vsub, n);
+    ok &= ws_nodes_alloc(mem, &web->xsub, n);
+    ok &= ws_nodes_alloc(mem, &web->vsub, n);
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -53,17 +51,17 @@ void ws_web_free(ws_mem *mem, ws_web *web)
 {
     size_t n = web->n, ns = web->ns ? web->ns : 1;
     for (int k = 0; k < 2; k++) {
-        nodes_free(mem, &web->x[k], web->n);
-        nodes_free(mem, &web->v[k], web->n);
+        ws_nodes_free(mem, &web->x[k], web->n);
+        ws_nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
 
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
-    nodes_free(mem, &web->fmem, web->n);
-    nodes_free(mem, &web->xsub, web->n);
-    nodes_free(mem, &web->vsub, web->n);
+    ws_nodes_free(mem, &web->fmem, web->n);
+    ws_nodes_free(mem, &web->xsub, web->n);
+    ws_nodes_free(mem, &web->vsub, web->n);
     ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));

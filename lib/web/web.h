@@ -108,6 +108,11 @@ typedef struct ws_web {
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */
 void ws_web_note_masses(ws_web *web);
 /* Allocate a web of n nodes and ns springs (zeroed). */
+/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
+ * read past a grid's last node; the state walk takes the 3 n at once). 1, or 0 when out of
+ * memory (a->x NULL). Freed with the same n. */
+int ws_nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n);
+void ws_nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n);
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns);
 void ws_web_free(ws_mem *mem, ws_web *web);
 /* Room for the springs' law histories, initialised as just stretched to the strains the nodes
