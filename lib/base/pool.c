@@ -231,7 +231,8 @@ void ws_pool_destroy(ws_mem *mem, ws_pool *p)
 void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, void *ctx)
 {
     if (count > p->claim_cap) { /* more items than the pool was made for: run them here */
-        task(0, count, 0, ctx);
+        for (int32_t i = 0; i < count; i++)
+            task(i, i + 1, 0, ctx);
         return;
     }
     pthread_mutex_lock(&p->lock);
