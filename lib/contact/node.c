@@ -160,16 +160,22 @@ static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, 
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* m nodes at (px, py, pz) to the reference frame (A, r): s = A^T (x - r) into (sx, sy, sz), and
- * their place at the epoch (E, e), e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
+/* The reference frame (A, r) and the epoch's (E, e). */
+typedef struct ref_frames {
+    const m3 *A, *E;
+    v3 r, e;
+} ref_frames;
+
+/* m nodes at (px, py, pz) to the reference frame: s = A^T (x - r) into (sx, sy, sz), and their
+ * place at the epoch, e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
 WS_VECTOR_LOOP
 static void ref_chunk(size_t m, const double *restrict px, const double *restrict py,
-                      const double *restrict pz, const m3 *A, v3 r, const m3 *E, v3 e,
-                      double *restrict sx, double *restrict sy, double *restrict sz,
-                      double *restrict gx, double *restrict gy, double *restrict gz,
-                      double *restrict l2)
+                      const double *restrict pz, const ref_frames *F, double *restrict sx,
+                      double *restrict sy, double *restrict sz, double *restrict gx,
+                      double *restrict gy, double *restrict gz, double *restrict l2)
 {
-    const double *a = A->m, *c = E->m;
+    const double *a = F->A->m, *c = F->E->m;
+    const v3 r = F->r, e = F->e;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
@@ -196,15 +202,14 @@ static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *
                    size_t count)
 {
     ws_node_contact *nc = web->contact;
-    double t[10][REF_CHUNK];
-    double lever2 = nc->lever2;
+    const ref_frames F = {A, &nc->epoch_A, r, nc->epoch_r};
+    double t[10][REF_CHUNK], lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
         const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
         if (!only) {
-            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &nc->epoch_A, nc->epoch_r,
-                      nc->xdet.x + q0, nc->xdet.y + q0, nc->xdet.z + q0, nc->xep.x + q0,
-                      nc->xep.y + q0, nc->xep.z + q0, t[9]);
+            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, &F, nc->xdet.x + q0, nc->xdet.y + q0,
+                      nc->xdet.z + q0, nc->xep.x + q0, nc->xep.y + q0, nc->xep.z + q0, t[9]);
         } else {
             const uint32_t *nd = only + q0;
             for (size_t j = 0; j < m; j++) {
@@ -212,8 +217,7 @@ static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *
                 t[1][j] = x.y[nd[j]];
                 t[2][j] = x.z[nd[j]];
             }
-            ref_chunk(m, t[0], t[1], t[2], A, r, &nc->epoch_A, nc->epoch_r, t[3], t[4], t[5], t[6],
-                      t[7], t[8], t[9]);
+            ref_chunk(m, t[0], t[1], t[2], &F, t[3], t[4], t[5], t[6], t[7], t[8], t[9]);
             for (size_t j = 0; j < m; j++) {
                 const uint32_t i = nd[j];
                 nc->xdet.x[i] = t[3][j];
@@ -599,13 +603,9 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
     const ws_move_test *M = &nc->move;
-    const m3 A = M->A;
-    const v3 r = M->r;
-    const qt pc = M->pc;
-    const double reach = M->reach;
     for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
-            rebase_body(b, cur, &nc->track[q], web, x, margin, &A, r, pc);
+            rebase_body(b, cur, &nc->track[q], web, x, margin, &M->A, M->r, M->pc);
     /* Most steps flag no node. */
     long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
@@ -625,16 +625,16 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
             double g = fmax(cc - bhi, blo - cc);
             least = g < least ? g : least;
         }
-        v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
-        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
-        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
+        v3 rho = m3_tmul_v(&M->A, v3_sub(st->r[k], M->r));
+        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(M->pc, st->p[k]))));
+        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + M->reach);
         if (least - d < t->gap)
             t->gap = least - d;
         if (d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Found again now: their moves count from here. */
-    to_ref(web, x, &A, r, nc->moved, (size_t)count);
+    to_ref(web, x, &M->A, M->r, nc->moved, (size_t)count);
     return count;
 }
 
