@@ -258,6 +258,20 @@ typedef struct ws_wrap_def {
     /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
      *  stable-step check accepts (ws_world_get_stable_fraction, ws_web_get_stable_dt) */
     int substeps;
+    /* ---- film rupture (trailing fields: older callers get the defaults) ---- */
+    /** The film's elongation at break, from its unstretched length (>= 0; 0: the film never
+     *  breaks, unless rupture_strain is given). Default 4.0: 400 %, in the middle of LLDPE
+     *  stretch film's 300-500 %. */
+    double elongation_at_break;
+    /** The powered pre-stretch the film got before it was laid, from its unstretched length
+     *  (>= 0, below elongation_at_break): the springs' rest length is the film after it.
+     *  Default 2.5 (250 %, a machine's pre-stretch carriage); 0 for a hand wrap. */
+    double powered_prestretch;
+    /** The web's rupture strain (ws_web_def.rupture_strain) when > 0; 0 (the default): from
+     *  the two above, (1 + elongation_at_break) / (1 + powered_prestretch) - 1, 0.43 with the
+     *  defaults. Must be above strain_around and strain_up (the film would break as it is
+     *  laid). */
+    double rupture_strain;
 } ws_wrap_def;
 
 /** Fill a wrap Def with the defaults above. NULL is ignored.
@@ -362,7 +376,8 @@ typedef enum ws_loadtest_event_type {
     /** A carton left the load: its centre left the pallet's footprint or fell by half its
      *  height. */
     WS_LOADTEST_CARTON_LOST = 2,
-    /** Film rupture (not produced by unwrapped loads). */
+    /** Film rupture: the first spring of the film broke in the run (ws_web_get_rupture).
+     *  layer -1, index the spring, value its strain. Wrapped loads only. */
     WS_LOADTEST_RUPTURE = 3
 } ws_loadtest_event_type;
 
@@ -398,7 +413,8 @@ typedef struct ws_eumos_verdict {
     /** Largest permanent displacement of a layer relative to the layer under it (or the pallet),
      *  layer means, m; limit 0.02 H (strictly less). */
     ws_loadtest_criterion layer_shift;
-    /** Film ruptures; limit 0. */
+    /** Film rupture: springs of the film broken by the end of the run (ws_web_get_rupture);
+     *  limit 0. */
     ws_loadtest_criterion rupture;
     int pass; /**< 1 if every criterion passes */
 } ws_eumos_verdict;
@@ -431,7 +447,9 @@ typedef struct ws_eumos_result {
      *  three equal height bands, bottom, middle, top (ws_web_get_containment(): hoop tension,
      *  N, line load, N/m, and the bodies' normal force on it, N); zero when unwrapped. */
     ws_containment_band containment[3];
-    double film_peak_strain; /**< largest spring strain of the film during the run (0: none) */
+    /** largest strain of an intact spring of the film during the run (0: none); where it is
+     *  now: ws_web_get_peak_strain() */
+    double film_peak_strain;
 } ws_eumos_result;
 
 /** Fill a EUMOS Def with the defaults above. NULL is ignored.
@@ -543,7 +561,8 @@ typedef enum ws_loadtest_check_id {
     WS_CHECK_GRMS = 6,
     /** Sweep: the resonance found, Hz; at least the Def's resonance_min. */
     WS_CHECK_RESONANCE = 7,
-    /** Film ruptures; at most 0 (none are produced yet). */
+    /** Wrapped loads: springs of the film broken by the end of the run (ws_web_get_rupture);
+     *  at most 0. */
     WS_CHECK_RUPTURE = 8
 } ws_loadtest_check_id;
 
@@ -610,7 +629,8 @@ typedef struct ws_loadtest_result {
     int event_count;       /**< events kept in events[] */
     int events_dropped;    /**< events beyond WS_LOADTEST_MAX_EVENTS */
     ws_loadtest_event events[WS_LOADTEST_MAX_EVENTS]; /**< in time order */
-    double film_peak_strain; /**< largest spring strain of the film (0: unwrapped) */
+    /** largest strain of an intact spring of the film (0: unwrapped) */
+    double film_peak_strain;
     ws_loadtest_verdict verdict; /**< the verdict */
 } ws_loadtest_result;
 

@@ -149,7 +149,7 @@ static void judge(run_state *rs)
     ws_lt_criterion(&vd->permanent, permanent, 0.05 * H, 0);
     ws_lt_criterion(&vd->bottom, bottom, 0.04, 0);
     ws_lt_criterion(&vd->layer_shift, shift, 0.02 * H, 1);
-    ws_lt_criterion(&vd->rupture, 0, 0, 0);
+    ws_lt_criterion(&vd->rupture, rs->m.broken, 0, 0);
     vd->pass = vd->elastic.pass && vd->permanent.pass && vd->bottom.pass &&
                vd->layer_shift.pass && vd->rupture.pass;
 }

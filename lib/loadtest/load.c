@@ -716,6 +716,19 @@ static void wrap_defaults(ws_wrap_def *def)
     def->node_pitch = 0.05;
     def->node_mass = 2e-3;
     def->substeps = 0;
+    def->elongation_at_break = 4.0;
+    def->powered_prestretch = 2.5;
+}
+
+/* The film's rupture strain from a wrap Def (0: none): the given one, or the elongation at break
+ * turned from the unstretched film to the rest length the powered pre-stretch left. */
+static double wrap_rupture(const ws_wrap_def *d)
+{
+    if (d->rupture_strain > 0)
+        return d->rupture_strain;
+    if (d->elongation_at_break == 0)
+        return 0;
+    return (1 + d->elongation_at_break) / (1 + d->powered_prestretch) - 1;
 }
 
 WS_DEF_INITS(ws_wrap_def, wrap_defaults, substeps)
@@ -745,6 +758,23 @@ static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_lo
         bad = "node_mass must be >= 0 kg";
     else if (d->substeps < 0)
         bad = "substeps must be >= 1, or 0 for the fewest the stable-step check accepts";
+    else if (!(isfinite(d->elongation_at_break) && d->elongation_at_break >= 0) ||
+             !(isfinite(d->powered_prestretch) && d->powered_prestretch >= 0) ||
+             !(isfinite(d->rupture_strain) && d->rupture_strain >= 0))
+        bad = "elongation_at_break, powered_prestretch and rupture_strain must be >= 0";
+    else if (d->rupture_strain == 0 && d->elongation_at_break > 0 &&
+             !(d->powered_prestretch < d->elongation_at_break))
+        bad = "powered_prestretch must be below elongation_at_break: a film stretched that far "
+              "has no elongation left";
+    if (!bad && wrap_rupture(d) != 0 &&
+        !(wrap_rupture(d) > d->strain_around && wrap_rupture(d) > d->strain_up))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "wrap: the film would break as it is laid: its rupture strain %g (%s) is "
+                       "not above strain_around %g and strain_up %g",
+                       wrap_rupture(d),
+                       d->rupture_strain > 0 ? "rupture_strain"
+                                             : "from elongation_at_break and powered_prestretch",
+                       d->strain_around, d->strain_up);
     if (bad)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "wrap: %s", bad);
     if (ld->info.film.bits)
@@ -820,6 +850,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     wd.material = ld->info.film_material;
     wd.substeps = d.substeps > 0 ? d.substeps : 1;
     wd.name = "film";
+    wd.rupture_strain = wrap_rupture(&d);
     ws_band_def bd;
     ws_band_def_init(&bd);
     bd.bodies = bodies;

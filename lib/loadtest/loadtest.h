@@ -89,8 +89,11 @@ typedef struct ws_lt_run {
     double ifs_use[WS_LOAD_MAX_LAYERS + 1];
     ws_loadtest_interface_state *base; /* per carton: the contacts under it */
     double *base_use;
-    double *strain; /* the film's spring strains (wrapped loads) */
-    size_t springs;
+    /* The film (wrapped loads): its broken springs at the last sample, and whether the event
+     * of its first break in the run is out; a film broken before the run (broken at the start)
+     * reports the next break at the sample that sees it. */
+    uint32_t broken, broken_at_start;
+    int ruptured;
 } ws_lt_run;
 
 /* Set up a run's measurements (buffers from the load's allocator); `sink` says where the maxima

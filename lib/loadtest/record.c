@@ -171,6 +171,34 @@ static void find_tips(ws_lt_run *rs, double t, double level)
     }
 }
 
+/* The film: its peak strain over the intact springs, and the event of its first break in the
+ * run, at the time it broke (the world's time then, counted back from this sample's t; the
+ * event goes before this sample's others, which are at t). */
+static ws_status film_sample(ws_world *w, ws_lt_run *rs, double t, double level)
+{
+    const ws_lt_sink *sk = &rs->sink;
+    const ws_web_id film = rs->ld->info.film;
+    ws_web_peak pk;
+    ws_web_rupture ru;
+    double now;
+    ws_status s;
+    if ((s = ws_web_get_peak_strain(w, film, &pk)) != WS_OK ||
+        (s = ws_web_get_rupture(w, film, &ru)) != WS_OK || (s = ws_world_get_time(w, &now)) != WS_OK)
+        return s;
+    if (pk.found)
+        *sk->film_peak_strain = fmax(*sk->film_peak_strain, pk.strain);
+    if (!rs->ruptured && ru.broken_count > rs->broken) {
+        rs->ruptured = 1;
+        if (rs->broken_at_start == 0)
+            ws_lt_event(sk, WS_LOADTEST_RUPTURE, -1, (int)ru.first_spring,
+                        t - (now - ru.first_time), level, ru.first_strain);
+        else
+            ws_lt_event(sk, WS_LOADTEST_RUPTURE, -1, -1, t, level, (double)ru.broken_count);
+    }
+    rs->broken = ru.broken_count;
+    return WS_OK;
+}
+
 ws_status ws_lt_sample(ws_world *w, ws_lt_run *rs, double t, double level, double v, double x,
                        double angle)
 {
@@ -180,14 +208,8 @@ ws_status ws_lt_sample(ws_world *w, ws_lt_run *rs, double t, double level, doubl
     ws_status s = ws_load_measure(w, ld, rs->cs, (size_t)ld->info.cartons, &n);
     if (s != WS_OK || (s = read_contacts(w, rs)) != WS_OK)
         return s;
-    if (rs->strain) {
-        size_t ns;
-        if ((s = ws_web_copy_spring_strains(w, ld->info.film, rs->strain, rs->springs, &ns)) !=
-            WS_OK)
-            return s;
-        for (size_t i = 0; i < ns; i++)
-            *sk->film_peak_strain = fmax(*sk->film_peak_strain, rs->strain[i]);
-    }
+    if (ld->info.film.bits && (s = film_sample(w, rs, t, level)) != WS_OK)
+        return s;
     if (fabs(level) > *sk->peak_level)
         *sk->peak_level = fabs(level);
     find_tips(rs, t, level);
@@ -286,15 +308,13 @@ void ws_lt_end(ws_lt_run *rs)
     ws_mem_free(&ld->mem, rs->ref_bins, nb * sizeof *rs->ref_bins);
     ws_mem_free(&ld->mem, rs->tipped, nb);
     ws_mem_free(&ld->mem, rs->lost, nb);
-    ws_mem_free(&ld->mem, rs->strain, rs->springs * sizeof *rs->strain);
     rs->contacts = NULL;
     rs->cs = NULL;
     rs->base = NULL;
     rs->base_use = NULL;
     rs->bins = rs->ref_bins = NULL;
     rs->tipped = rs->lost = NULL;
-    rs->strain = NULL;
-    rs->contacts_cap = rs->springs = 0;
+    rs->contacts_cap = 0;
 }
 
 ws_status ws_lt_begin(ws_world *w, ws_lt_run *rs, ws_load *ld, const ws_lt_sink *sink,
@@ -311,13 +331,11 @@ ws_status ws_lt_begin(ws_world *w, ws_lt_run *rs, ws_load *ld, const ws_lt_sink 
     rs->ref_bins = ws_mem_calloc(&ld->mem, nb, sizeof *rs->ref_bins);
     rs->tipped = ws_mem_calloc(&ld->mem, nb, 1);
     rs->lost = ws_mem_calloc(&ld->mem, nb, 1);
-    ws_web_info wi;
-    if (ld->info.film.bits && ws_web_get_info(w, ld->info.film, &wi) == WS_OK) {
-        rs->springs = wi.spring_count;
-        rs->strain = ws_mem_calloc(&ld->mem, rs->springs, sizeof *rs->strain);
-    }
+    ws_web_rupture ru;
+    if (ld->info.film.bits && ws_web_get_rupture(w, ld->info.film, &ru) == WS_OK)
+        rs->broken = rs->broken_at_start = ru.broken_count; /* a break in the run is news */
     if (!rs->cs || !rs->base || !rs->base_use || !rs->bins || !rs->ref_bins || !rs->tipped ||
-        !rs->lost || (rs->springs && !rs->strain)) {
+        !rs->lost) {
         ws_lt_end(rs);
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "%s run: out of memory for %zu bodies", name,
                        nb);

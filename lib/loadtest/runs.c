@@ -320,6 +320,13 @@ static void check(ws_loadtest_verdict *vd, int id, double value, double limit, i
     c->pass = at_least ? value >= limit : (strict ? value < limit : value <= limit);
 }
 
+/* A wrapped load's film: no spring of it broken by the end of the run. */
+static void judge_rupture(lt_test *lt)
+{
+    if (lt->m.ld->info.film.bits)
+        check(&lt->res->verdict, WS_CHECK_RUPTURE, lt->m.broken, 0, 0, 0);
+}
+
 static void verdict_pass(ws_loadtest_verdict *vd)
 {
     vd->pass = 1;
@@ -443,6 +450,7 @@ ws_status ws_loadtest_run_tilt(ws_world *w, ws_load *ld, const ws_tilt_test_def 
                     result->events[i].level <= tan(d->target_angle);
         check(vd, WS_CHECK_STABLE_ANGLE, stable, d->target_angle, 1, 0);
         check(vd, WS_CHECK_CARTONS_LOST, lost, 0, 0, 0);
+        judge_rupture(&lt);
         ws_lt_permanent(&lt.m, result->layer_permanent, NULL, NULL);
         verdict_pass(vd);
     }
@@ -531,6 +539,7 @@ ws_status ws_loadtest_run_impact(ws_world *w, ws_load *ld, const ws_impact_test_
               0.01, 0, 0);
         judge_permanent(&lt, 1);
         check(vd, WS_CHECK_CARTONS_LOST, result->cartons_lost, 0, 0, 0);
+        judge_rupture(&lt);
         verdict_pass(vd);
     }
     return test_close(w, &lt, s);
@@ -747,6 +756,7 @@ ws_status ws_loadtest_run_vibration(ws_world *w, ws_load *ld, const ws_vibration
         }
         judge_permanent(&lt, 0);
         check(vd, WS_CHECK_CARTONS_LOST, result->cartons_lost, 0, 0, 0);
+        judge_rupture(&lt);
         verdict_pass(vd);
     }
     return test_close(w, &lt, s);

@@ -231,6 +231,19 @@ def test_stack_and_unit_load_exclude_each_other(tmp_path, capsys):
     assert "give either a stack" in capsys.readouterr().err
 
 
+def test_wrap_rupture_fields_reach_the_wrap_def():
+    # The load file's film figures in percent become the ws_wrap_def's fractions; the shipped
+    # EUR load's wrap takes the defaults (400 % elongation at break, 250 % powered pre-stretch).
+    from wrapsim import eumos
+    d = loadfile.validate(json.loads((LOADS / "eur_pallet_eumos.json").read_text()))
+    wd = eumos.wrap_def(d)
+    assert (wd.elongation_at_break, wd.powered_prestretch, wd.rupture_strain) == (4.0, 2.5, 0.0)
+    loadfile.set_path(d, "unit_load.wrap.rupture_strain_percent", 30.0)
+    loadfile.set_path(d, "unit_load.wrap.elongation_at_break_percent", 0.0)
+    wd = eumos.wrap_def(loadfile.validate(d))
+    assert wd.rupture_strain == pytest.approx(0.3) and wd.elongation_at_break == 0.0
+
+
 def test_eumos_run_pass_fail_and_outputs(tmp_path):
     # Two layers of cartons 0.3 m along the pulse and 0.25 m high: a column tips at a/g = b/h =
     # 0.15 / 0.25 = 0.6 and the cartons slide on each other from mu = 0.4. At 0.1 g nothing

@@ -383,6 +383,7 @@ class WebDef(Structure):
         ("law_shear", LawId),
         ("substeps", c_int),
         ("name", c_char_p),
+        ("rupture_strain", c_double),
     ]
 
 
@@ -438,6 +439,32 @@ class WebInfo(Structure):
         ("substeps", c_int),
         ("mass", c_double),
         ("min_node_mass", c_double),
+    ]
+
+
+class WebRupture(Structure):
+    _fields_ = [
+        ("rupture_strain", c_double),
+        ("broken_count", c_uint32),
+        ("broken_last_step", c_uint32),
+        ("ruptured", c_int),
+        ("first_spring", c_uint32),
+        ("first_time", c_double),
+        ("first_strain", c_double),
+        ("first_position", Vec3),
+    ]
+
+
+class WebPeak(Structure):
+    _fields_ = [
+        ("found", c_int),
+        ("spring", c_uint32),
+        ("strain", c_double),
+        ("tension", c_double),
+        ("node_a", c_uint32),
+        ("node_b", c_uint32),
+        ("position_a", Vec3),
+        ("position_b", Vec3),
     ]
 
 
@@ -570,6 +597,8 @@ class WrapDef(Structure):
         ("strain_around", c_double), ("strain_up", c_double), ("z_bottom", c_double),
         ("top_margin", c_double), ("node_pitch", c_double), ("node_mass", c_double),
         ("substeps", c_int),
+        ("elongation_at_break", c_double), ("powered_prestretch", c_double),
+        ("rupture_strain", c_double),
     ]
 
 
@@ -857,6 +886,10 @@ FUNCTIONS = [
     ("ws_web_get_body_force", [World_p, WebId, BodyId, P(Vec3), P(Vec3)], _st),
     ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
     ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
+    ("ws_web_set_rupture_strain", [World_p, WebId, c_double], _st),
+    ("ws_web_get_rupture", [World_p, WebId, P(WebRupture)], _st),
+    ("ws_web_copy_broken_springs", [World_p, WebId, P(c_uint32), c_size_t, P(c_size_t)], _st),
+    ("ws_web_get_peak_strain", [World_p, WebId, P(WebPeak)], _st),
     # element.h
     ("ws_element_def_init_sized", [P(ElementDef), c_size_t], None),
     ("ws_element_create", [World_p, P(ElementDef), P(ElementId)], _st),

@@ -70,6 +70,9 @@ def wrap_def(d):
     wd.top_margin = w["top_margin_m"]
     wd.node_pitch = w["node_pitch_m"]
     wd.node_mass = w["node_mass_kg"]
+    wd.elongation_at_break = w["elongation_at_break_percent"] / 100
+    wd.powered_prestretch = w["powered_prestretch_percent"] / 100
+    wd.rupture_strain = w["rupture_strain_percent"] / 100
     return wd
 
 

@@ -124,6 +124,13 @@ SPEC = _section({
             "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
             "node_mass_kg": _num("kg", 2e-3, 0.0, 10.0,
                                  doc="per node; 0 for the film's real mass"),
+            "elongation_at_break_percent": _num("%", 400.0, 0.0, 10000.0,
+                                                doc="from unstretched; 0: the film never breaks"),
+            "powered_prestretch_percent": _num("%", 250.0, 0.0, 10000.0,
+                                               doc="the pre-stretch before the film is laid"),
+            "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
+                                           doc="the film's rupture strain from its rest length; "
+                                               "0: from the two above"),
         }, optional=True, doc="a band of film around the load (absent: unwrapped)"),
     }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
