@@ -538,7 +538,7 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, cons
 
 /* The up-springs and shear pairs from row j to row j + 1 onto the ends in rows [r0, r1) alone
  * (j and j + 1 both for all of them), in the order grid_step puts them: at the edge of a lane
- * (ws_web_forces_block) each of the two lanes computes the springs and takes its own row's
+ * (ws_web_forces_rows) each of the two lanes computes the springs and takes its own row's
  * side, which gets the values and the order it gets in one sweep. The other side's forces go
  * to the scratch. */
 static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1,
@@ -571,13 +571,13 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
             spring_one_in(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR], lo, hi);
 }
 
-/* The rows of a grid web's sweep block: at least WS_WEB_BLOCK_NODES nodes (all of them in a
- * smaller web). */
-static size_t block_rows(const ws_web *web)
+uint32_t ws_web_block_rows(const ws_web *web)
 {
+    if (web->nx <= 0 || web->ny <= 0)
+        return 1u;
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     const size_t r = (WS_WEB_BLOCK_NODES + nx - 1) / nx;
-    return r < ny ? r : ny;
+    return (uint32_t)(r < ny ? r : ny);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
@@ -586,7 +586,7 @@ uint32_t ws_web_block_count(const ws_web *web)
         return 1u; /* a mesh web */
     if (web->ny <= 0)
         return 0u;
-    const size_t r = block_rows(web);
+    const size_t r = ws_web_block_rows(web);
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
 }
 
@@ -597,7 +597,7 @@ void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n
         *n1 = web->n;
         return;
     }
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = ws_web_block_rows(web);
     const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
     *n0 = (uint32_t)(nx * j0);
     *n1 = (uint32_t)(nx * j1);
@@ -643,8 +643,8 @@ int ws_web_sweep_parallel(const ws_web *web)
     return 1;
 }
 
-void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t k, int edges,
-                         uint32_t *n0, uint32_t *n1)
+void ws_web_forces_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t j0, uint32_t j1,
+                        int edges, uint32_t *n0, uint32_t *n1)
 {
     /* The laws' parameters by spring kind, taken once a sweep (ws_web_sweep_laws). */
     const ws_spring_form *P = web->form;
@@ -657,8 +657,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t k
         return;
     }
     /* Row j is complete once the springs to row j + 1 are in (grid_step). */
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
-    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     if (j0 == 0) {
         grid_row(web, x, v, g, 0, P);
     } else if (edges & WS_WEB_LANE_FIRST) {
