@@ -140,7 +140,8 @@ typedef struct ws_load_info {
     double load_height;         /**< from the platform's top face to the top of the load, m */
     double pallet_top;          /**< height of the pallet's deck above the platform's top, m */
     double total_mass;          /**< pallet + cartons, kg */
-    ws_web_id film;             /**< the film of ws_load_wrap_band(); null when unwrapped */
+    ws_web_id film;             /**< the film of ws_load_wrap_band() or ws_load_wrap_spiral();
+                                     null when unwrapped */
 } ws_load_info;
 
 /** One carton as built. */
@@ -293,6 +294,141 @@ WS_API void(ws_wrap_def_init)(ws_wrap_def *def);
  *  creation. */
 WS_API ws_status ws_load_wrap_band(ws_world *world, ws_load *load, const ws_wrap_def *def,
                                    ws_web_id *out);
+
+/** A spiral wrap as a stretch-wrapping machine lays it (docs/guide.md, chapter 11, and
+ *  docs/theory.md, "The spiral wrap"): a film of `width` and `gauge` off the roll, stretched on
+ *  the carriage by the powered `prestretch`, which thins it and narrows it by `neck_in`, laid
+ *  round the turning load holding the elastic `load_strain`; `revolutions_bottom` at the
+ *  bottom, then a spiral up whose revolutions overlap by `overlap` of the laid width,
+ *  `revolutions_top` at the top and, with `passes` = 2, the spiral down again. Where revolutions
+ *  overlap the film has the stiffness and mass of every layer there. Fill with
+ *  ws_spiral_wrap_def_init(). */
+typedef struct ws_spiral_wrap_def {
+    uint32_t size;  /**< set by ws_spiral_wrap_def_init() */
+    uint32_t magic; /**< set by ws_spiral_wrap_def_init() */
+    double width;   /**< film width off the roll, m (> 0); default 0.5 */
+    double gauge;   /**< film thickness off the roll, m (> 0); default 20e-6 */
+    /** Young's modulus of the film as it lies on the load (after the pre-stretch), Pa (> 0);
+     *  default 150e6 */
+    double modulus;
+    double density;    /**< kg/m^3 (> 0); default 920 */
+    /** Powered pre-stretch, as a fraction: 2.0 is 200 %, a metre off the roll becomes three on
+     *  the load (0 .. 10); default 2.0. Plastic: it thins the film (volume kept), it is not the
+     *  strain the film holds on the load. */
+    double prestretch;
+    /** Fraction of the width the pre-stretch takes away (the film necks between the rollers;
+     *  0 .. 0.9); default 0.15: a 500 mm film lies 425 mm wide. */
+    double neck_in;
+    /** The elastic strain the film holds on the load, measured from its pre-stretched length:
+     *  the stretch between the carriage's last roller and the load (> 0, < 1); default 0.1. */
+    double load_strain;
+    double revolutions_bottom; /**< revolutions at the lowest height (>= 0); default 2 */
+    double revolutions_top;    /**< revolutions at the highest height (>= 0); default 2 */
+    /** Fraction of the laid width by which a revolution of the spiral overlaps the one before
+     *  (0 .. 0.95); default 0.5 (every spiral pass lays two layers) */
+    double overlap;
+    int passes;        /**< 1: spiral up; 2: up and down again; default 2 */
+    /** 1 (default): the film's lower edge goes down onto the pallet, `lock_height` above the
+     *  platform's top, and locks the load to it; 0: it starts `lock_height` above the deck. */
+    int pallet_lock;
+    double lock_height; /**< m (>= 0); default 0.05 */
+    /** The film's upper edge this far below the top of the load, m (>= 0); default 0.02 */
+    double top_margin;
+    /** Revolutions of roped film (the width rolled into a cable) at `rope_height` (>= 0);
+     *  default 0: no roping */
+    double rope_revolutions;
+    double rope_height; /**< m above the platform's top (> 0 when roping); default 0.2 */
+    /** 1: a top sheet, a loose sheet of film over the top face laid before the top
+     *  revolutions, which hold its edges (it joins the film's highest row over the load's top
+     *  edges); 0 (default): none */
+    int top_sheet;
+    /** thickness of the top sheet, m (> 0; it is not pre-stretched); default 50e-6 */
+    double top_sheet_gauge;
+    double node_pitch;  /**< node spacing on the load, m (> 0); default 0.05 */
+    /** Smallest node mass, kg (>= 0): nodes lighter than this (the film's real mass from its
+     *  layers) are made this heavy, so fewer sub-steps are stable. Default 0: the real mass. */
+    double node_mass_min;
+    /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
+     *  stable-step check accepts */
+    int substeps;
+    /* ---- film rupture (trailing fields: older callers get the defaults) ---- */
+    /** The film's elongation at break, from its length off the roll (>= 0; 0: the film never
+     *  breaks, unless rupture_strain is given). Default 4.0 (400 %, LLDPE stretch film breaks
+     *  at 300-500 %). Must be above `prestretch`. */
+    double elongation_at_break;
+    /** The web's rupture strain (ws_web_def.rupture_strain) when > 0; 0 (the default): from the
+     *  elongation at break and the pre-stretch, (1 + elongation_at_break) / (1 + prestretch) - 1,
+     *  0.667 with the defaults; either way above `load_strain` (the film would break as it is
+     *  laid). The top sheet, not pre-stretched, takes the same limit: it breaks early, if
+     *  ever. */
+    double rupture_strain;
+} ws_spiral_wrap_def;
+
+/** Fill a spiral wrap Def with the defaults above. NULL is ignored. */
+WS_API void ws_spiral_wrap_def_init_sized(ws_spiral_wrap_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). */
+WS_API void(ws_spiral_wrap_def_init)(ws_spiral_wrap_def *def);
+/** Fill with defaults: ws_spiral_wrap_def_init_sized with the caller's sizeof. */
+#define ws_spiral_wrap_def_init(def) ws_spiral_wrap_def_init_sized((def), sizeof *(def))
+
+/** Wrap the load as it stands in a spiral of film (the load's film material): one web, a grid
+ *  of nodes round the load (rows node_pitch apart or less, following the load's outline at
+ *  their height, a node on every vertical corner), each node's mass and each spring's stiffness
+ *  the sum over the film layers the spiral lays there (ws_web_mesh_def.stiffness_scales). The
+ *  film is laid in equilibrium: each row's around-springs share one tension (the row's mean
+ *  layers x E h_l x load_strain a unit height, h_l the laid thickness), the corners' nodes sit
+ *  as deep in their contact as that tension presses them, nothing is stretched up the load, so
+ *  a load that stood still stands still wrapped. The platform must be level, its frame the
+ *  global one; the load's outline at each height is taken as the rectangle of its bodies there
+ *  (as ws_load_build makes them).
+ *  @param out receives the web (also in ws_load_info.film)
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def: the message names the field, a
+ *  load of another world, a load already wrapped), WS_ERR_UNINITIALIZED_DEF,
+ *  WS_ERR_OUT_OF_MEMORY, errors of the web's creation. */
+WS_API ws_status ws_load_wrap_spiral(ws_world *world, ws_load *load,
+                                     const ws_spiral_wrap_def *def, ws_web_id *out);
+/** The film layers the spiral of `def` lays on a load `height` m high (from the platform's top)
+ *  whose deck is at `deck` m, at height z (m above the platform's top) and a place `s` m round
+ *  the load's outline of perimeter `perimeter` m from where the film starts (the middle of the
+ *  load's face towards -y); roping not counted. A whole number: the revolutions covering it.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def or geometry), WS_ERR_UNINITIALIZED_DEF. */
+WS_API ws_status ws_spiral_wrap_layers(const ws_spiral_wrap_def *def, double height, double deck,
+                                       double perimeter, double s, double z, int *layers);
+
+/** The containment of one height band of a wrapped load. */
+typedef struct ws_load_containment {
+    double z_low;  /**< m above the platform's top, the band's lower bound */
+    double z_high; /**< its upper bound */
+    /** Containment force, N: how hard the film in the band squeezes the load across its two
+     *  vertical mid-planes (through the pallet's centre, along x and along y), from the bodies'
+     *  contact forces on the film's nodes: sum over the nodes of (s_x F_x + s_y F_y) / 8, s = +1
+     *  on the low side of a plane and -1 on the high side. The film in equilibrium crosses each
+     *  plane twice at its hoop tension T, so each plane's squeeze is 2 T from either side and
+     *  the force is T: the band's hoop tension, read from what the load feels (the pull-plate
+     *  quantity, for the whole band). */
+    double force;
+    /** The film's own hoop tension across the band, N: the sum over the film's rows in the band
+     *  of each row's mean around-spring tension. Equal to `force` when the film is at rest. */
+    double hoop_tension;
+    double line_load;     /**< force per metre of the band's height, N/m */
+    double contact_force; /**< sum of |contact force| on the band's nodes, N */
+    int rows;             /**< film rows in the band */
+} ws_load_containment;
+
+/** Containment of a wrapped load (ws_load_wrap_band or ws_load_wrap_spiral) in `count` equal
+ *  height bands of the load, bottom first (3: bottom, middle, top thirds from the platform's
+ *  top to the load's top), from the last step's contact forces and the film's present state.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, count 0 or above 64, a load that is not
+ *  wrapped, a load of another world), WS_ERR_STALE_HANDLE (the film destroyed). */
+WS_API ws_status ws_load_get_containment(const ws_world *world, const ws_load *load,
+                                         ws_load_containment *bands, size_t count);
+/** The film's largest spring strain now (l/l0 - 1), the spring's index (ws_web_copy_springs
+ *  order) and its height (mean of its ends' z, m above the platform's top). Any output but
+ *  `strain` may be NULL.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a load that is not wrapped),
+ *  WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY. */
+WS_API ws_status ws_load_get_film_peak(const ws_world *world, const ws_load *load,
+                                       double *strain, uint32_t *spring, double *height);
 
 /* ---------------------------------------------------------------------------------------- */
 /* EUMOS 40509 */
@@ -492,6 +628,9 @@ typedef struct ws_kvalue_def {
     /** A wrap to put on the load after it settled (it then settles settle_time again before the
      *  state is saved); NULL (default) for the load unwrapped. Read during the call only. */
     const ws_wrap_def *wrap;
+    /** A spiral wrap (ws_load_wrap_spiral()) to put on the load after it settled, when `wrap`
+     *  is NULL; NULL (default) for none. Read during the call only. */
+    const ws_spiral_wrap_def *spiral;
 } ws_kvalue_def;
 
 /** What the k-value search found. */

@@ -108,6 +108,11 @@ typedef struct ws_web_mesh_def {
     const uint8_t *kinds;        /**< ws_spring_kind per spring; NULL: all WS_SPRING_AROUND */
     const uint32_t *pinned;      /**< node indices held fixed; may be NULL */
     size_t pinned_count;         /**< entries in pinned */
+    /** Per spring, its force as a multiple of its law's (finite, > 0): e.g. the number of film
+     *  layers the spring stands for, so one law serves a film whose layers vary from place to
+     *  place. Tensions, energy and the stable step read it too. NULL (default): 1 for every
+     *  spring. */
+    const double *stiffness_scales;
 } ws_web_mesh_def;
 
 /** Facts of a web. */

@@ -251,7 +251,7 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
     if ((s = ws_lt_begin(w, &rs.m, ld, &sink, "EUMOS")) != WS_OK)
         return s;
     if (ld->info.film.bits &&
-        (s = ws_web_get_containment(w, ld->info.film, result->containment, 3)) != WS_OK) {
+        (s = ws_load_film_containment(w, ld, result->containment)) != WS_OK) {
         ws_lt_end(&rs.m);
         return s;
     }
@@ -296,6 +296,10 @@ static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_d
     ws_web_id film;
     if (kd->wrap && ((s = ws_load_wrap_band(kw->w, kw->ld, kd->wrap, &film)) != WS_OK ||
                      (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
+        return s;
+    if (!kd->wrap && kd->spiral &&
+        ((s = ws_load_wrap_spiral(kw->w, kw->ld, kd->spiral, &film)) != WS_OK ||
+         (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
         return s;
     if ((s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
         return s;

@@ -48,6 +48,12 @@ struct ws_load {
     double carton_mass;
     double contact_layer;
     ws_vec3 carton_shape; /* the carton's size in its own frame */
+    double carton_cut;    /* its mesh is smaller by this along its own x and y (build_bodies),
+                             and every second layer's by 2 WS_LOAD_INSET more */
+    /* The film's rows when it is wrapped: nodes i + film_nx j, row j's around-springs
+     * film_nx j .. film_nx j + film_nx - 1 (a closed band's numbering); 0 when unwrapped. */
+    int film_nx, film_ny;
+    int film_spiral; /* 1 when the film is ws_load_wrap_spiral's (a mesh web) */
 };
 
 /* ---- the measurements of a test run (record.c), shared by every test ---------------------- */
@@ -124,5 +130,18 @@ const ws_load_key *ws_load_find(const ws_load *load, ws_body_id id);
 /* Platform rotation (body to global) and the pallet's CoG and velocity. */
 ws_status ws_load_frame(const ws_world *w, const ws_load *load, ws_mat3 *a_platform,
                         ws_vec3 *r_pallet, ws_vec3 *v_pallet);
+
+/* WS_OK, or WS_ERR_INVALID_ARGUMENT (no world, no load, a load of another world) naming fn. */
+ws_status ws_load_check_world(const ws_world *w, const ws_load *ld, const char *fn);
+/* The film's spring law: tension-compression, EA `ea` N per unit strain in tension, 1 % of it
+ * in compression (film buckles), a trace of internal damping. */
+ws_status ws_load_film_law(ws_world *w, double ea, const char *name, ws_law_id *out);
+/* The fewest sub-steps with which the world's stable-step check accepts the web: dt / n within
+ * stable_fraction of its stable sub-step; fn names the caller in the error. */
+ws_status ws_load_fit_substeps(ws_world *w, ws_web_id web, const char *fn);
+/* The containment a EUMOS result reports, three bands bottom up: the band generator's grid
+ * read-out (ws_web_get_containment) for ws_load_wrap_band's film, the load's read-out
+ * (ws_load_get_containment: hoop tension a row, force a metre of height) for a spiral's. */
+ws_status ws_load_film_containment(const ws_world *w, const ws_load *ld, ws_containment_band *b);
 
 #endif

@@ -70,6 +70,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->sb, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->inv_l0, ((size_t)web->ns + WS_WEB_PAD) * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
+    ws_mem_free(mem, web->kscale, web->kscale ? (size_t)web->ns * sizeof(double) : 0);
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free(mem, web->broken, web->broken ? (size_t)web->ns + WS_WEB_PAD : 0);
     ws_mem_free_str(mem, web->name);
@@ -257,6 +258,8 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_
         web->law_failed = 1;
         return;
     }
+    if (web->kscale)
+        F *= web->kscale[s];
     v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
     const uint32_t a = web->sa[s], b = web->sb[s];
     if (a >= lo && a < hi)
@@ -785,8 +788,9 @@ static void node_bounds(const ws_web *web)
         acc.x[i] = acc.y[i] = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_law *L = web->law[web->kind[s]];
-        double k = 2.0 * ws_law_max_stiffness(L) * web->inv_l0[s];
-        double c = 2.0 * ws_law_max_damping(L) * web->inv_l0[s];
+        const double q = web->kscale ? web->kscale[s] : 1.0;
+        double k = 2.0 * ws_law_max_stiffness(L) * q * web->inv_l0[s];
+        double c = 2.0 * ws_law_max_damping(L) * q * web->inv_l0[s];
         acc.x[web->sa[s]] += k;
         acc.x[web->sb[s]] += k;
         acc.y[web->sa[s]] += c;
@@ -863,7 +867,7 @@ double ws_web_spring_tension(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32
     double F = 0.0;
     if (ws_law_eval(web->law[web->kind[s]], h, &eps, &epsd, 0.0, 0.0, &F, NULL, NULL) != 0)
         return NAN;
-    return F;
+    return web->kscale ? F * web->kscale[s] : F;
 }
 
 double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x)
@@ -874,7 +878,8 @@ double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x)
             continue; /* holds nothing */
         double eps = ws_web_spring_strain(web, x, s);
         const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-        e += ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
+        double q = web->kscale ? web->kscale[s] : 1.0;
+        e += q * ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
     }
     return e;
 }

@@ -86,6 +86,10 @@ typedef struct ws_web {
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
+    /* Each spring's force as a multiple of its law's (the film layers a spring stands for), or
+     * NULL when every spring takes its law as it is. Mesh webs only: their springs run one by
+     * one (spring_one_in), so the grid's vector loops never read it. */
+    double *kscale;
     ws_law *law[3];          /* by kind; NULL when no spring of that kind */
     /* Laws with history (relaxation...): each spring's own, nstate doubles a spring, spring s
      * at hist + s nstate; committed after an accepted step (ws_web_commit), read during it. */

@@ -384,6 +384,23 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
                                                     nodes_get(web.x[0], a)));
         web.inv_l0[k] = 1.0 / l0;
     }
+    if (g.stiffness_scales && web.ns) {
+        if (!(web.kscale = ws_mem_alloc(&w->mem, (size_t)web.ns * sizeof(double)))) {
+            s = ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c.label);
+            return fail_web(w, &web, s);
+        }
+        for (uint32_t k = 0; k < web.ns; k++) {
+            double q = g.stiffness_scales[k];
+            if (!(isfinite(q) && q > 0.0 && q <= 1e6)) {
+                s = ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                            "web '%s': spring %u has stiffness scale %g: need a finite value > 0 "
+                            "and <= 1e6",
+                            c.label, k, q);
+                return fail_web(w, &web, s);
+            }
+            web.kscale[k] = q;
+        }
+    }
     if (c.d.node_mass > 0.0 && g.node_masses)
         c.d.node_mass = 0.0; /* the per-node masses win */
     s = finish_web(w, &c, &web, g.pinned, g.pinned ? g.pinned_count : 0, 0, out);

@@ -874,10 +874,11 @@ class World:
         return Web(self, out)
 
     def web_mesh(self, law, positions, springs, node_masses=None, rest_lengths=None,
-                 kinds=None, pinned=None, **kwargs):
+                 kinds=None, pinned=None, stiffness_scales=None, **kwargs):
         """A web of raw nodes (positions (n, 3) m) and springs ((m, 2) node indices), with
-        optional node_masses (kg), rest_lengths (m), kinds (ws_spring_kind) and pinned nodes;
-        other keywords are ws_web_def fields."""
+        optional node_masses (kg), rest_lengths (m), kinds (ws_spring_kind), pinned nodes and
+        stiffness_scales (each spring's force as a multiple of its law's, e.g. its film
+        layers); other keywords are ws_web_def fields."""
         kwargs["law"] = law
         wd = self._web_def(kwargs)
         md = _make(L.WebMeshDef, {})
@@ -901,6 +902,9 @@ class World:
         if kinds is not None:
             _, md.kinds = arr(kinds, "kinds", np.uint8, ctypes.c_uint8, length=m,
                               per="one per spring", bound=3)
+        if stiffness_scales is not None:
+            _, md.stiffness_scales = arr(stiffness_scales, "stiffness_scales", np.float64,
+                                         c_double, length=m, per="one per spring")
         if pinned is not None:
             pins, ptr = arr(pinned, "pinned", np.uint32, c_uint32, bound=n)
             if len(pins):

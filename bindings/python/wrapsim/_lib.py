@@ -427,6 +427,7 @@ class WebMeshDef(Structure):
         ("kinds", POINTER(c_uint8)),
         ("pinned", POINTER(c_uint32)),
         ("pinned_count", c_size_t),
+        ("stiffness_scales", POINTER(c_double)),
     ]
 
 
@@ -602,6 +603,28 @@ class WrapDef(Structure):
     ]
 
 
+class SpiralWrapDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("width", c_double), ("gauge", c_double), ("modulus", c_double), ("density", c_double),
+        ("prestretch", c_double), ("neck_in", c_double), ("load_strain", c_double),
+        ("revolutions_bottom", c_double), ("revolutions_top", c_double), ("overlap", c_double),
+        ("passes", c_int), ("pallet_lock", c_int), ("lock_height", c_double),
+        ("top_margin", c_double), ("rope_revolutions", c_double), ("rope_height", c_double),
+        ("top_sheet", c_int), ("top_sheet_gauge", c_double),
+        ("node_pitch", c_double), ("node_mass_min", c_double), ("substeps", c_int),
+        ("elongation_at_break", c_double), ("rupture_strain", c_double),
+    ]
+
+
+class LoadContainment(Structure):
+    _fields_ = [
+        ("z_low", c_double), ("z_high", c_double), ("force", c_double),
+        ("hoop_tension", c_double), ("line_load", c_double), ("contact_force", c_double),
+        ("rows", c_int),
+    ]
+
+
 class LoadtestInterfaceState(Structure):
     _fields_ = [
         ("normal_force", c_double), ("slip_speed", c_double), ("friction_use", c_double),
@@ -673,6 +696,7 @@ class KvalueDef(Structure):
         ("size", c_uint32), ("magic", c_uint32),
         ("k_low", c_double), ("k_high", c_double), ("tolerance", c_double),
         ("settle_time", c_double), ("wrap", POINTER(WrapDef)),
+        ("spiral", POINTER(SpiralWrapDef)),
     ]
 
 
@@ -930,6 +954,12 @@ FUNCTIONS = [
      _st),
     ("ws_wrap_def_init_sized", [P(WrapDef), c_size_t], None),
     ("ws_load_wrap_band", [World_p, Load_p, P(WrapDef), P(WebId)], _st),
+    ("ws_spiral_wrap_def_init_sized", [P(SpiralWrapDef), c_size_t], None),
+    ("ws_load_wrap_spiral", [World_p, Load_p, P(SpiralWrapDef), P(WebId)], _st),
+    ("ws_spiral_wrap_layers", [P(SpiralWrapDef), c_double, c_double, c_double, c_double,
+                               c_double, P(c_int)], _st),
+    ("ws_load_get_containment", [World_p, Load_p, P(LoadContainment), c_size_t], _st),
+    ("ws_load_get_film_peak", [World_p, Load_p, P(c_double), P(c_uint32), P(c_double)], _st),
     ("ws_eumos_def_init_sized", [P(EumosDef), c_size_t], None),
     ("ws_eumos_get_drive", [P(EumosDef), P(DriveDef), P(c_double)], _st),
     ("ws_loadtest_run_eumos", [World_p, Load_p, P(EumosDef), P(EumosResult)], _st),

@@ -39,6 +39,11 @@ def _str(choices, default=None, doc=""):
     return dict(kind="string", choices=choices, default=default, doc=doc)
 
 
+def _bool(default, doc=""):
+    return dict(kind="boolean", unit="", default=default, minimum=None, maximum=None,
+                exclusive_min=False, doc=doc)
+
+
 def _pairs(doc=""):
     """A list of [x, y] pairs of positive numbers, x increasing (PSD breakpoints); [] for
     none."""
@@ -132,6 +137,48 @@ SPEC = _section({
                                            doc="the film's rupture strain from its rest length; "
                                                "0: from the two above"),
         }, optional=True, doc="a band of film around the load (absent: unwrapped)"),
+        "spiral_wrap": _section({
+            "width_m": _num("m", 0.5, 0.0, 10.0, True, doc="film width off the roll"),
+            "gauge_um": _num("um", 20.0, 0.0, 1000.0, True, doc="film thickness off the roll"),
+            "modulus_MPa": _num("MPa", 150.0, 0.0, 1e5, True,
+                                doc="Young's modulus of the film as it lies on the load"),
+            "density_kg_per_m3": _num("kg/m^3", 920.0, 0.0, 1e4, True),
+            "prestretch_percent": _num("%", 200.0, 0.0, 1000.0,
+                                       doc="powered pre-stretch (plastic: thins the film)"),
+            "neck_in_percent": _num("%", 15.0, 0.0, 90.0,
+                                    doc="width the pre-stretch takes away"),
+            "load_strain_percent": _num("%", 10.0, 0.0, 99.0, True,
+                                        doc="elastic strain the film holds on the load"),
+            "revolutions_bottom": _num("", 2.0, 0.0, 1000.0, doc="revolutions at the bottom"),
+            "revolutions_top": _num("", 2.0, 0.0, 1000.0, doc="revolutions at the top"),
+            "overlap_percent": _num("%", 50.0, 0.0, 95.0,
+                                    doc="of the laid width, between spiral revolutions"),
+            "passes": _int(2, 1, 2, doc="1: spiral up; 2: up and down"),
+            "pallet_lock": _bool(True, doc="the film's lower edge goes down onto the pallet"),
+            "lock_height_m": _num("m", 0.05, 0.0, 100.0,
+                                  doc="the film's lower edge above the platform (with the "
+                                      "lock) or above the deck (without)"),
+            "top_margin_m": _num("m", 0.02, 0.0, 100.0,
+                                 doc="the film's upper edge below the load's top"),
+            "rope_revolutions": _num("", 0.0, 0.0, 1000.0,
+                                     doc="revolutions of film rolled into a cable (0: none)"),
+            "rope_height_m": _num("m", 0.2, 0.0, 100.0, True,
+                                  doc="height of the rope above the platform"),
+            "top_sheet": _bool(False, doc="a loose sheet of film over the top face, held by "
+                                          "the top revolutions"),
+            "top_sheet_gauge_um": _num("um", 50.0, 0.0, 10000.0, True,
+                                       doc="thickness of the top sheet"),
+            "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
+            "node_mass_min_kg": _num("kg", 0.0, 0.0, 10.0,
+                                     doc="smallest node mass (0: the film's real mass)"),
+            "elongation_at_break_percent": _num("%", 400.0, 0.0, 10000.0,
+                                                doc="from the film off the roll; 0: the film "
+                                                    "never breaks"),
+            "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
+                                           doc="the film's rupture strain from its rest length "
+                                               "on the load; 0: from the elongation at break "
+                                               "and the pre-stretch"),
+        }, optional=True, doc="the spiral wrap of a stretch-wrapping machine (absent: none)"),
     }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
         "carton": _section({
@@ -213,6 +260,10 @@ def _unit_text(unit):
 
 def _check_value(spec, value, path):
     kind = spec["kind"]
+    if kind == "boolean":
+        if not isinstance(value, bool):
+            raise LoadFileError(f"{path}: {value!r} is not true or false")
+        return value
     if kind in ("number", "integer"):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise LoadFileError(f"{path}: {value!r} is not a number")
@@ -292,6 +343,18 @@ def _cross_checks(d):
     if t["sweep_to_hz"] <= t["sweep_from_hz"]:
         raise LoadFileError(f"test.sweep_to_hz: {t['sweep_to_hz']:g} Hz is not above "
                             f"sweep_from_hz ({t['sweep_from_hz']:g} Hz)")
+    u = d["unit_load"]
+    if u is not None and u["wrap"] is not None and u["spiral_wrap"] is not None:
+        raise LoadFileError("unit_load.spiral_wrap: give a band (unit_load.wrap) or a spiral "
+                            "(unit_load.spiral_wrap), not both")
+    sp = u["spiral_wrap"] if u is not None else None
+    if sp is not None:
+        height = (u["pallet"]["height_m"] + u["layers"] * u["carton"]["height_m"])
+        low = sp["lock_height_m"] + (0.0 if sp["pallet_lock"] else u["pallet"]["height_m"])
+        if low + sp["top_margin_m"] >= height:
+            raise LoadFileError(f"unit_load.spiral_wrap.lock_height_m: the film ({low:g} m "
+                                f"above the platform to {sp['top_margin_m']:g} m below the "
+                                f"top) has no height on a load {height:g} m high")
     if d["stack"] is None:
         return
     c = d["stack"]["carton"]
