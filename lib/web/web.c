@@ -593,19 +593,6 @@ uint32_t ws_web_block_count(const ws_web *web)
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
 }
 
-void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1)
-{
-    if (web->nx <= 0) {
-        *n0 = 0;
-        *n1 = web->n;
-        return;
-    }
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = ws_web_block_rows(web);
-    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
-    *n0 = (uint32_t)(nx * j0);
-    *n1 = (uint32_t)(nx * j1);
-}
-
 /* Row j of a grid web complete: row j + 1 started (base forces, its around-springs), then the
  * up-springs and shear pairs between the two (row 0 is started by the sweep's first block). */
 static void grid_step(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t j,

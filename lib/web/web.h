@@ -158,8 +158,6 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * ws_web_sweep_parallel. */
 uint32_t ws_web_block_count(const ws_web *web);
 uint32_t ws_web_block_rows(const ws_web *web); /* rows of a grid web's block; 1 for a mesh */
-/* The nodes [n0, n1) of block k. */
-void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1);
 #define WS_WEB_LANE_FIRST 1
 #define WS_WEB_LANE_LAST 2
 void ws_web_sweep_laws(ws_web *web, v3 gravity, double t, double since);

@@ -340,20 +340,27 @@ static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
 {
     (void)worker;
     const flag_task *T = ctx;
-    const uint32_t blocks = ws_web_block_count(T->web);
     for (int32_t i = start; i < end; i++) {
-        uint32_t n0 = 0, n1 = T->web->n, m0, m1; /* one lane: the whole web */
-        if (T->lanes > 1) {
-            ws_web_block_range(T->web, (uint32_t)((uint64_t)i * blocks / T->lanes), &n0, &m1);
-            ws_web_block_range(T->web, (uint32_t)((uint64_t)(i + 1) * blocks / T->lanes) - 1,
-                               &m0, &n1);
-        }
-        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, n0, n1);
+        const ws_lane_job *J = &T->w->lane_job[i];
+        const uint32_t nx = T->lanes > 1 ? (uint32_t)T->web->nx : 0; /* 0: the whole web */
+        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, nx ? nx * J->r0 : 0,
+                                                 nx ? nx * J->r1 : T->web->n);
     }
 }
 
+/* The flags in the lanes of the last cut when it cuts this web's rows (the nodes stay on
+ * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. */
 static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
 {
+    ws_lane_job *J = w->lane_job;
+    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
+    int cut = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
+    for (uint32_t i = 0; i < lanes; i++)
+        cut &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1);
+    for (uint32_t i = 0; i < lanes && !cut; i++) {
+        J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
+        J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
+    }
     flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
     run_task(w, flag_items, lanes, &T);
     size_t flagged = 0;
