@@ -2,7 +2,8 @@
 # Workers: the wrapped reference case at 1, 2 and 4 workers and the plain loop (bench_plain, one
 # core), run one after another in interleaved rounds, so that a machine whose speed drifts
 # drifts across all of them alike. Prints each round's wall times, the ratios 1→2 (speed-up)
-# and 2-workers / plain, and their medians. A figure, not a test: it never fails on time. The
+# and 2-workers / plain, and their medians; the last also per node-update (the wrapped case
+# takes its film's sub-steps a step, the plain loop one). A figure, not a test: it never fails on time. The
 # runs take the whole machine in turn (a run at 2 workers needs 2 free cores): say how loaded
 # it was (uptime) next to the figures.
 #
@@ -21,7 +22,8 @@ done
 [ -x /usr/bin/time ] || { echo "workers.sh: needs GNU time at /usr/bin/time" >&2; exit 2; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-echo "load before: $(uptime)"
+subs=$("$w" 1 P 1 | sed -n 's/.* x \([0-9]*\) sub-step.*/\1/p')
+echo "load before: $(uptime); the wrapped case's film takes ${subs:=1} sub-step(s) a step"
 r=1
 while [ "$r" -le "$rounds" ]; do
     /usr/bin/time -f %e -o "$tmp/1" "$w" "$steps" P 1 >/dev/null
@@ -30,7 +32,7 @@ while [ "$r" -le "$rounds" ]; do
     /usr/bin/time -f %e -o "$tmp/p" "$p" "$steps" >/dev/null
     echo "$(cat "$tmp/1") $(cat "$tmp/2") $(cat "$tmp/4") $(cat "$tmp/p")"
     r=$((r + 1))
-done | awk '{ printf "round %d: 1 worker %.2f s, 2 workers %.2f s, 4 workers %.2f s, plain %.2f s;" \
+done | awk -v subs="$subs" '{ printf "round %d: 1 worker %.2f s, 2 workers %.2f s, 4 workers %.2f s, plain %.2f s;" \
                      " 1->2 %.2fx, 1->4 %.2fx, 2 workers / plain %.3f\n",
                      NR, $1, $2, $3, $4, $1 / $2, $1 / $3, $2 / $4;
               s[NR] = $1 / $2; f[NR] = $1 / $3; q[NR] = $2 / $4; o[NR] = $1 / $4; n = NR }
@@ -39,5 +41,7 @@ done | awk '{ printf "round %d: 1 worker %.2f s, 2 workers %.2f s, 4 workers %.2
                     if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
                 return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2 }
             END { printf "median: 1->2 speed-up %.2fx, 1->4 %.2fx, 2 workers / plain %.3f, " \
-                         "1 worker / plain %.3f (%d rounds)\n", med(s), med(f), med(q), med(o), n }'
+                         "1 worker / plain %.3f (%d rounds)\n", med(s), med(f), med(q), med(o), n;
+                  printf "per node-update: 2 workers / plain %.3f, 1 worker / plain %.3f\n",
+                         med(q) / subs, med(o) / subs }'
 echo "load after: $(uptime)"

@@ -8,7 +8,9 @@
 #include "../examples/tilt_table.c"
 
 #include <pthread.h>
+#include <stdatomic.h>
 
+#include "base/pool.h"
 #include "helpers.h"
 
 static int short_run(void)
@@ -328,6 +330,67 @@ START_TEST(test_bad_worker_defs)
 }
 END_TEST
 
+/* ---- the world's own threads, directly ---- */
+
+/* What a task's items recorded: how often each ran, and on which worker. */
+typedef struct pool_probe {
+    atomic_int runs[64];
+    atomic_uint worker[64];
+    atomic_int bad_range;
+    uint32_t workers;
+} pool_probe;
+
+static void probe_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    pool_probe *P = ctx;
+    if (end != start + 1 || worker >= P->workers)
+        atomic_fetch_add(&P->bad_range, 1);
+    for (int32_t i = start; i < end; i++) {
+        atomic_fetch_add(&P->runs[i], 1);
+        atomic_store(&P->worker[i], worker);
+    }
+}
+
+/* Every item of every task runs exactly once, on a worker below the pool's count, one item a
+ * call, whatever the task's size: 20000 tasks back to back (a thread that wakes late for one
+ * must not take an item of the next), of 1 to 48 items (more than the pool was made for: then
+ * all on the caller). The bookkeeping of each task is exact, so any miss is a failure. And the
+ * pool is made and joined with its bytes back to zero. */
+START_TEST(test_pool_runs_each_item_once)
+{
+    ws_mem mem;
+    ws_mem_init(&mem, NULL);
+    const uint32_t threads = 3, cap = 32;
+    ws_pool *pool = ws_pool_create(&mem, threads, (int32_t)cap);
+    ck_assert_ptr_nonnull(pool);
+    pool_probe *P = calloc(1, sizeof *P);
+    ck_assert_ptr_nonnull(P);
+    P->workers = threads + 1;
+    const int tasks = short_run() ? 2000 : 20000;
+    long on_threads = 0;
+    for (int t = 0; t < tasks; t++) {
+        const int32_t count = 1 + (int32_t)((t * 7919u) % 48u);
+        for (int32_t i = 0; i < count; i++)
+            atomic_store(&P->runs[i], 0);
+        ws_pool_run(pool, probe_items, count, P);
+        for (int32_t i = 0; i < count; i++) {
+            if (atomic_load(&P->runs[i]) != 1)
+                ck_abort_msg("task %d of %d items: item %d ran %d times", t, count, i,
+                             atomic_load(&P->runs[i]));
+            on_threads += atomic_load(&P->worker[i]) != 0;
+            if (count > (int32_t)cap && atomic_load(&P->worker[i]) != 0)
+                ck_abort_msg("task %d of %d items, more than %u: item %d on worker %u", t, count,
+                             cap, i, atomic_load(&P->worker[i]));
+        }
+    }
+    ck_assert_int_eq(atomic_load(&P->bad_range), 0);
+    report("pool: %d tasks, %ld items on the threads", tasks, on_threads);
+    ws_pool_destroy(&mem, pool);
+    ck_assert_uint_eq(mem.in_use, 0);
+    free(P);
+}
+END_TEST
+
 int main(void)
 {
     (void)tilt_run;
@@ -337,5 +400,6 @@ int main(void)
     add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
     add_case(s, "oom_in_a_parallel_step", test_oom_in_a_parallel_step, 300);
     add_case(s, "bad_worker_defs", test_bad_worker_defs, 60);
+    add_case(s, "pool_runs_each_item_once", test_pool_runs_each_item_once, 120);
     return run_suite(s);
 }

@@ -10,13 +10,15 @@
 
 typedef struct ws_pool ws_pool;
 
-/* A pool of `threads` threads (>= 1) beside the caller's. NULL when out of memory or when the
- * system gives no thread (what was made is undone). */
-ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads);
+/* A pool of `threads` threads (>= 1) beside the caller's, for tasks of at most `items` items
+ * (a larger task runs on the caller alone). NULL when out of memory or when the system gives
+ * no thread (what was made is undone). */
+ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads, int32_t items);
 /* Stop and join the threads, free the pool (NULL: nothing). */
 void ws_pool_destroy(ws_mem *mem, ws_pool *pool);
 /* Run items [0, count) of `task`, one item a call, on the threads and the caller (worker 0),
- * each item on whichever takes it first, and return when all have run. */
+ * and return when all have run. Worker k of n runs its share, items [k count / n, (k + 1)
+ * count / n), first, then takes what is left of the others'. */
 void ws_pool_run(ws_pool *pool, ws_task_fn *task, int32_t count, void *ctx);
 
 #endif

@@ -21,25 +21,14 @@ _Static_assert(MOVE_NODE + MOVE_SUBSTEP + 2 * MOVE_BODY == MOVE_COVER,
 /* Each part as a fraction of the margin (exact: sixteenths are binary fractions). */
 #define MOVE_PART(k) ((double)(k) / MOVE_PARTS)
 
-/* Node vectors laid out as the web's (web.c): x, y and z of 3 n doubles in one block, then
- * WS_WEB_PAD more (the state walk takes the 3 n at once). */
-static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
-{
-    double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
-    a->x = p;
-    a->y = p ? p + n : NULL;
-    a->z = p ? p + 2 * (size_t)n : NULL;
-    return p != NULL;
-}
-
 ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
 {
     ws_node_contact *nc = ws_mem_calloc(mem, 1, sizeof *nc);
     if (!nc)
         return NULL;
     nc->seg_list = -1;
-    int ok = nodes_alloc(mem, &nc->xdet, n);
-    ok &= nodes_alloc(mem, &nc->xep, n);
+    int ok = ws_nodes_alloc(mem, &nc->xdet, n);
+    ok &= ws_nodes_alloc(mem, &nc->xep, n);
     ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
     ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
@@ -54,11 +43,10 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
 {
     if (!nc)
         return;
-    const size_t m = 3 * (size_t)n + WS_WEB_PAD;
     for (int k = 0; k < 2; k++)
         ws_mem_free(mem, nc->cand[k].c, nc->cand[k].cap * sizeof(ws_ncand));
-    ws_mem_free(mem, nc->xdet.x, m * sizeof(double));
-    ws_mem_free(mem, nc->xep.x, m * sizeof(double));
+    ws_nodes_free(mem, &nc->xdet, n);
+    ws_nodes_free(mem, &nc->xep, n);
     ws_mem_free(mem, nc->moved, (n ? n : 1) * sizeof(uint32_t));
     ws_mem_free(mem, nc->redo, (n ? n : 1) * sizeof(uint8_t));
     ws_mem_free(mem, nc->cstart, ((size_t)n + 1) * sizeof(size_t));
@@ -172,16 +160,22 @@ static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, 
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* m nodes at (px, py, pz) to the reference frame (A, r): s = A^T (x - r) into (sx, sy, sz), and
- * their place at the epoch (E, e), e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
+/* The reference frame (A, r) and the epoch's (E, e). */
+typedef struct ref_frames {
+    const m3 *A, *E;
+    v3 r, e;
+} ref_frames;
+
+/* m nodes at (px, py, pz) to the reference frame: s = A^T (x - r) into (sx, sy, sz), and their
+ * place at the epoch, e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
 WS_VECTOR_LOOP
 static void ref_chunk(size_t m, const double *restrict px, const double *restrict py,
-                      const double *restrict pz, const m3 *A, v3 r, const m3 *E, v3 e,
-                      double *restrict sx, double *restrict sy, double *restrict sz,
-                      double *restrict gx, double *restrict gy, double *restrict gz,
-                      double *restrict l2)
+                      const double *restrict pz, const ref_frames *F, double *restrict sx,
+                      double *restrict sy, double *restrict sz, double *restrict gx,
+                      double *restrict gy, double *restrict gz, double *restrict l2)
 {
-    const double *a = A->m, *c = E->m;
+    const double *a = F->A->m, *c = F->E->m;
+    const v3 r = F->r, e = F->e;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
@@ -208,15 +202,14 @@ static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *
                    size_t count)
 {
     ws_node_contact *nc = web->contact;
-    double t[10][REF_CHUNK];
-    double lever2 = nc->lever2;
+    const ref_frames F = {A, &nc->epoch_A, r, nc->epoch_r};
+    double t[10][REF_CHUNK], lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
         const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
         if (!only) {
-            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, A, r, &nc->epoch_A, nc->epoch_r,
-                      nc->xdet.x + q0, nc->xdet.y + q0, nc->xdet.z + q0, nc->xep.x + q0,
-                      nc->xep.y + q0, nc->xep.z + q0, t[9]);
+            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, &F, nc->xdet.x + q0, nc->xdet.y + q0,
+                      nc->xdet.z + q0, nc->xep.x + q0, nc->xep.y + q0, nc->xep.z + q0, t[9]);
         } else {
             const uint32_t *nd = only + q0;
             for (size_t j = 0; j < m; j++) {
@@ -224,8 +217,7 @@ static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *
                 t[1][j] = x.y[nd[j]];
                 t[2][j] = x.z[nd[j]];
             }
-            ref_chunk(m, t[0], t[1], t[2], A, r, &nc->epoch_A, nc->epoch_r, t[3], t[4], t[5], t[6],
-                      t[7], t[8], t[9]);
+            ref_chunk(m, t[0], t[1], t[2], &F, t[3], t[4], t[5], t[6], t[7], t[8], t[9]);
             for (size_t j = 0; j < m; j++) {
                 const uint32_t i = nd[j];
                 nc->xdet.x[i] = t[3][j];
@@ -314,19 +306,18 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
  * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
  * have none flagged: their bytes are cleared, not narrowed. */
 WS_VECTOR_LOOP
-static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 r, v3 vr, v3 wr,
-                         double c, double lim)
+static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
-    ws_node_contact *nc = web->contact;
-    const double *a = A->m;
+    const ws_move_test *M = &nc->move;
+    const v3 r = M->r, vr = M->vr, wr = M->wr;
+    const double c = M->c, lim = M->lim, *a = M->A.m;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
-    const size_t n = web->n;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
-    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
         const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
                                *restrict oz = nc->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
@@ -368,18 +359,18 @@ static size_t flag_moved(ws_web *web, ws_nodes3 x, ws_nodes3 v, const m3 *A, v3 
  * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
  * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
 WS_VECTOR_LOOP
-static size_t flag_epoch(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, double lim, int renew)
+static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
 {
-    ws_node_contact *nc = web->contact;
-    const double *a = A->m;
+    const v3 r = nc->move.r;
+    const double lim = nc->move.lim, *a = nc->move.A.m;
+    const int renew = nc->move.renew;
     const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
                  a7 = a[7], a8 = a[8];
     const double lim2 = lim * lim;
-    const size_t n = web->n;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
-    for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
         double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
                          *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
@@ -509,8 +500,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
     t->lever = sphere_lever(b, k, web, margin);
 }
 
-long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                   double dt, double margin)
+int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin)
 {
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
@@ -551,6 +541,7 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * candidates are found again too: the body may have jumped, so that they are out of its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
     int rebase = 0;
+    ws_move_test *M = &nc->move;
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         uint32_t k = t->body;
@@ -573,10 +564,8 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
      * wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
                  c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    size_t flagged;
-    if (c > 0.0) {
-        flagged = flag_moved(web, x, v, &A, r, vr, wr, c, lim);
-    } else {
+    *M = (ws_move_test){A, r, vr, wr, pc, c, lim, reach, 0, rebase};
+    if (c <= 0.0) {
         /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
          * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
          * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
@@ -590,20 +579,35 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
          * every node costs, and a load that rocks on its film needs one every few steps. */
         const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
         double drift = v3_norm(v3_sub(r, nc->epoch_r)) + turn * sqrt(nc->lever2);
-        const int renew = !(drift < 0.125 * lim);
-        if (renew) {
+        M->renew = !(drift < 0.125 * lim);
+        if (M->renew) {
             nc->epoch_A = A;
             nc->epoch_r = r;
             nc->epoch_q = p;
             drift = 0.0;
         }
-        flagged = flag_epoch(web, x, &A, r, lim - drift, renew);
+        M->lim = lim - drift;
     }
-    for (size_t q = 0; rebase && q < nc->ntrack; q++)
+    return 0;
+}
+
+size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1)
+{
+    ws_node_contact *nc = web->contact;
+    return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
+}
+
+long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
+                       size_t flagged)
+{
+    ws_node_contact *nc = web->contact;
+    const ws_body_state *st = &b->st[cur];
+    const ws_move_test *M = &nc->move;
+    for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
-            rebase_body(b, cur, &nc->track[q], web, x, margin, &A, r, pc);
+            rebase_body(b, cur, &nc->track[q], web, x, margin, &M->A, M->r, M->pc);
     /* Most steps flag no node. */
-    long count = flagged || rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
+    long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
      * the least of what it was and their distances beyond its box now, less its move so far. */
     for (size_t q = 0; count && q < nc->ntrack; q++) {
@@ -621,16 +625,16 @@ long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws
             double g = fmax(cc - bhi, blo - cc);
             least = g < least ? g : least;
         }
-        v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
-        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
-        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + reach);
+        v3 rho = m3_tmul_v(&M->A, v3_sub(st->r[k], M->r));
+        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(M->pc, st->p[k]))));
+        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + M->reach);
         if (least - d < t->gap)
             t->gap = least - d;
         if (d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
             return -1;
     }
     /* Found again now: their moves count from here. */
-    to_ref(web, x, &A, r, nc->moved, (size_t)count);
+    to_ref(web, x, &M->A, M->r, nc->moved, (size_t)count);
     return count;
 }
 
@@ -1232,8 +1236,16 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
     ws_mem_free(mem, g->ready, g->ready_cap);
 }
 
+int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
+                          int all)
+{
+    ws_node_contact *nc = web->contact;
+    nc->search_all = all || nc->refresh || ws_node_moved_begin(b, cur, web, dt, margin) < 0;
+    return !nc->search_all;
+}
+
 int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
-                           ws_web *web, double margin, double dt, int all, uint64_t *checks,
+                           ws_web *web, double margin, size_t flagged, uint64_t *checks,
                            int *searched)
 {
     ws_node_contact *nc = web->contact;
@@ -1244,11 +1256,10 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
      * into the others. Either way the list holds every node-feature pair that can touch in
      * this step, and the result is the same as finding them every step (tests/test_detection.c
      * shows it). */
-    int list = nc->list;
+    int list = nc->list, all = nc->search_all;
     long moved = 0;
     size_t changed = 0;
-    all |= nc->refresh;
-    if (!all && (moved = ws_node_moved(b, cur, web, x, web->v[cur], dt, margin)) < 0)
+    if (!all && (moved = ws_node_moved_end(b, cur, web, x, margin, flagged)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {

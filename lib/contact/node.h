@@ -57,6 +57,19 @@ typedef struct ws_track {
     double lo, hi, gap, lever;
 } ws_track;
 
+/* The move test of a step between its parts (ws_node_moved_begin, ws_node_flag,
+ * ws_node_moved_end): the reference body's pose (A, r, conjugate orientation pc) and velocity
+ * (vr, global turn rate wr) now, the per-node bound lim with the share c of a node's
+ * velocity that counts (0: one sub-step, measured from the epoch, which renew starts anew),
+ * the reach of a far body, and whether a near body is re-based. */
+typedef struct ws_move_test {
+    m3 A;
+    v3 r, vr, wr;
+    qt pc;
+    double c, lim, reach;
+    int renew, rebase;
+} ws_move_test;
+
 /* A web's contact with the bodies (web->contact): its node candidates, the record of where the
  * nodes were found and how the bodies stood (tracks, epochs), the stretches and runs the
  * candidates are cut into, and the scratch their evaluation uses. Made with the web
@@ -109,6 +122,8 @@ typedef struct ws_node_contact {
      * position is compared with (ws_node_moved); lever2: the largest |xdet|^2 since the full
      * detection. */
     ws_nodes3 xep;
+    ws_move_test move; /* this step's (scratch) */
+    int search_all;    /* this step finds every node again (ws_node_contact_begin) */
     m3 epoch_A;
     v3 epoch_r;
     qt epoch_q;
@@ -175,15 +190,20 @@ typedef struct ws_node_geom {
  * body prepared yet: a step prepares only the bodies some web's candidates may name
  * (ws_node_prepare). 0, or -1 when out of memory (only when bodies were added since the last
  * call). */
-/* The one call of a step before a web's sub-steps: its candidates brought up to date at state
- * cur (all found again when `all`, the record of the last search is invalid or a body may
- * have come near; else those of the nodes that moved, ws_node_moved, merged in), the bodies'
+/* The first of the two calls of a step before a web's sub-steps: whether every node is to be
+ * found again at state cur (when `all`, the record of the last search is invalid, or a body
+ * may have come near: 0 returned), or the per-node move test is to run (1 returned: over every
+ * node, in any pieces, ws_node_flag, then ws_node_contact_update). */
+int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
+                          int all);
+/* The second: the candidates brought up to date at state cur (all found again, or those of
+ * the nodes that moved merged in; `flagged`: the sum of ws_node_flag's counts), the bodies'
  * features prepared (g) and the list cut into stretches, with the room its evaluation needs.
  * The list to evaluate is nc->next_list, nc->cand[next_list]; *searched says whether nodes
  * were searched. Feature checks are counted in *checks. 0, or -1 when out of memory (nothing
  * committed changed; the next step searches every node). */
 int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
-                           ws_web *web, double margin, double dt, int all, uint64_t *checks,
+                           ws_web *web, double margin, size_t flagged, uint64_t *checks,
                            int *searched);
 /* After an accepted step: its list becomes the committed one. */
 void ws_node_contact_commit(ws_node_contact *nc);
@@ -219,8 +239,22 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
  * is found again its move relative to a near body stays under half the margin, the distance a
  * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
  * node.c. */
-long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                   double dt, double margin);
+
+/* ws_node_moved in three parts, so that the per-node test runs in pieces (a lane's nodes):
+ * the bodies' part, -1 when every node must be found again, else 0 with the test set up in
+ * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
+ * distinct nodes); the rest, given the pieces' total, as ws_node_moved returns. */
+int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin);
+size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
+long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
+                       size_t flagged);
+static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
+                                 ws_nodes3 v, double dt, double margin)
+{
+    if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
+        return -1;
+    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
+}
 
 /* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]
  * is the first of node i or of a later node, start[n] = nc. */

@@ -78,16 +78,12 @@ static inline double pick(uint64_t mask, double a, double b)
 
 /* friction_of in parts, which run_kernel takes in different passes. The slip velocity
  * predicted at the end of the sub-step, from t, the other forces k and 1 / mass im. */
-static inline void friction_pred(double nx, double ny, double nz, double tx, double ty, double tz,
-                                 double kx, double ky, double kz, double im, double h, double *px,
-                                 double *py, double *pz)
+static inline v3 friction_pred(v3 n, v3 t, v3 k, double im, double h)
 {
-    double dot = kx * nx + ky * ny + kz * nz;
-    double ox = kx + nx * (-dot), oy = ky + ny * (-dot), oz = kz + nz * (-dot);
+    double dot = k.x * n.x + k.y * n.y + k.z * n.z;
+    double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
     double hm = h * im;
-    *px = tx + ox * hm;
-    *py = ty + oy * hm;
-    *pz = tz + oz * hm;
+    return v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
 }
 
 /* The friction over the predicted slip velocity, of speed vps (for a node that slips). */
@@ -100,26 +96,24 @@ static inline double friction_scale(double vps, double mass, double fn, double m
     return -(law < stop ? law : stop) / vps;
 }
 
+/* A load on a body: force and moment about the CoG. */
+typedef struct act_load {
+    v3 f, m;
+} act_load;
+
 /* A contact's load on its body: the opposite of the contact force on the node (friction a plus
- * the normal force fn along n) times share, and its moment about the CoG at lever l, into
- * b[0..2] (force) and b[3..5] (moment); zero for a contact that does not push (push: all bits
- * or none). Adding it leaves every sum as it was then: the bodies' sums start at +0 and never
- * reach -0, and the moment's zero, of either sign, changes no sum. Both paths (act_friction,
- * run_kernel) take it from here, so their loads agree to the bit. */
-static inline void body_load(uint64_t push, double ax, double ay, double az, double nx,
-                             double ny, double nz, double fn, double share, double lx, double ly,
-                             double lz, double *bx, double *by, double *bz, double *mx,
-                             double *my, double *mz)
+ * the normal force fn along n) times share, and its moment about the CoG at lever l; zero for
+ * a contact that does not push (push: all bits or none). Adding that zero leaves every sum as it
+ * was: the bodies' sums start at +0 and never reach -0, and the moment's zero, of either sign,
+ * changes no sum. Both paths (act_friction, run_kernel) take it from here, so their loads agree
+ * to the bit. */
+static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double share, v3 l)
 {
-    const double Bx = pick(push, (ax + nx * fn) * -share, 0.0),
-                 By = pick(push, (ay + ny * fn) * -share, 0.0),
-                 Bz = pick(push, (az + nz * fn) * -share, 0.0);
-    *bx = Bx;
-    *by = By;
-    *bz = Bz;
-    *mx = ly * Bz - lz * By;
-    *my = lz * Bx - lx * Bz;
-    *mz = lx * By - ly * Bx;
+    const double Bx = pick(push, (a.x + n.x * fn) * -share, 0.0),
+                 By = pick(push, (a.y + n.y * fn) * -share, 0.0),
+                 Bz = pick(push, (a.z + n.z * fn) * -share, 0.0);
+    return (act_load){v3_make(Bx, By, Bz),
+                      v3_make(l.y * Bz - l.z * By, l.z * Bx - l.x * Bz, l.x * By - l.y * Bx)};
 }
 
 /* Whether a node slips (at the predicted speed vps): all bits or none, for pick. */
@@ -143,18 +137,14 @@ static inline uint64_t friction_slips(double vps, double im)
  * force comes before any friction: a node at a corner touches two faces, and this makes the
  * result independent of the order of the faces (which differs from corner to corner and would
  * twist a symmetric load). */
-static inline void friction_of(double nx, double ny, double nz, double tx, double ty, double tz,
-                               double kx, double ky, double kz, double im, double mass, double fn,
-                               double mu, double vlim, double h, double *ax, double *ay, double *az)
+static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double fn, double mu,
+                             double vlim, double h)
 {
-    double px, py, pz;
-    friction_pred(nx, ny, nz, tx, ty, tz, kx, ky, kz, im, h, &px, &py, &pz);
-    const double vps = sqrt(px * px + py * py + pz * pz);
+    const v3 p = friction_pred(n, t, k, im, h);
+    const double vps = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
     const double s = friction_scale(vps, mass, fn, mu, vlim, h);
     const uint64_t slips = friction_slips(vps, im);
-    *ax = pick(slips, px * s, 0.0);
-    *ay = pick(slips, py * s, 0.0);
-    *az = pick(slips, pz * s, 0.0);
+    return v3_make(pick(slips, p.x * s, 0.0), pick(slips, p.y * s, 0.0), pick(slips, p.z * s, 0.0));
 }
 
 /* ---- the contacts of a sweep block gone one by one
@@ -186,10 +176,7 @@ typedef struct act_group {
 /* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
 enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS = ACT_GROUP + 6 };
 
-/* A load on a body: force and moment about the CoG; the list's loads come after its groups. */
-typedef struct act_load {
-    v3 f, m;
-} act_load;
+/* The list's loads (act_load) come after its groups. */
 _Static_assert(sizeof(act_load) == 6 * sizeof(double) && sizeof(act_group) % 32 == 0,
                "a list's loads take 6 doubles each, its groups whole vectors");
 
@@ -242,31 +229,30 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
  * the overlap, against the body's velocity there. A contact never pulls: its vector is the
  * force times whether it pushes (0 or 1), without a branch. Straight-line code, so loops of
  * it run on vectors; run_kernel has the same arithmetic for a run's nodes. */
-static inline void normal_of(double nx, double ny, double nz, double d, double hi, double xx,
-                             double xy, double xz, double ux, double uy, double uz, double rx,
-                             double ry, double rz, double vx, double vy, double vz, double wx,
-                             double wy, double wz, double k, double c, double *px, double *py,
-                             double *pz, double *lx, double *ly, double *lz, double *tx,
-                             double *ty, double *tz, double *fn)
+typedef struct node_normal {
+    v3 p, l, t;
+    double fn;
+} node_normal;
+
+/* A body's motion as a contact sees it: its CoG, velocity and global spin. */
+typedef struct body_motion {
+    v3 r, v, w;
+} body_motion;
+
+static inline node_normal normal_of(v3 n, double d, double hi, v3 x, v3 u, body_motion b,
+                                    double k, double c)
 {
-    const double s = -0.5 * d;
-    const double ax = (xx + nx * s) - rx, ay = (xy + ny * s) - ry, az = (xz + nz * s) - rz;
-    const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
-                 bz = vz + (wx * ay - wy * ax);
-    const double vrx = ux - bx, vry = uy - by, vrz = uz - bz;
+    const double nx = n.x, ny = n.y, nz = n.z, s = -0.5 * d;
+    const double ax = (x.x + nx * s) - b.r.x, ay = (x.y + ny * s) - b.r.y,
+                 az = (x.z + nz * s) - b.r.z;
+    const double bx = b.v.x + (b.w.y * az - b.w.z * ay), by = b.v.y + (b.w.z * ax - b.w.x * az),
+                 bz = b.v.z + (b.w.x * ay - b.w.y * ax);
+    const double vrx = u.x - bx, vry = u.y - by, vrz = u.z - bz;
     const double vn = vrx * nx + vry * ny + vrz * nz;
     const double f = k * (hi - d) - c * vn;
     const double push = f > 0.0, fp = f * push;
-    *px = nx * fp;
-    *py = ny * fp;
-    *pz = nz * fp;
-    *lx = ax;
-    *ly = ay;
-    *lz = az;
-    *tx = vrx + nx * (-vn);
-    *ty = vry + ny * (-vn);
-    *tz = vrz + nz * (-vn);
-    *fn = f;
+    return (node_normal){v3_make(nx * fp, ny * fp, nz * fp), v3_make(ax, ay, az),
+                         v3_make(vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn)), f};
 }
 
 /* The normal forces of the contacts of groups [0, ng) (normal_of). */
@@ -275,12 +261,25 @@ static void act_normal(size_t ng, act_group *restrict G)
 {
     for (size_t g = 0; g < ng; g++) {
         act_group *e = &G[g];
-        for (size_t l = 0; l < 4; l++)
-            normal_of(e->nx[l], e->ny[l], e->nz[l], e->d[l], e->hi[l], e->xx[l], e->xy[l],
-                      e->xz[l], e->ux[l], e->uy[l], e->uz[l], e->rx[l], e->ry[l], e->rz[l],
-                      e->vx[l], e->vy[l], e->vz[l], e->wx[l], e->wy[l], e->wz[l], e->kp[l],
-                      e->cp[l], &e->px[l], &e->py[l], &e->pz[l], &e->lx[l], &e->ly[l],
-                      &e->lz[l], &e->tx[l], &e->ty[l], &e->tz[l], &e->fn[l]);
+        for (size_t l = 0; l < 4; l++) {
+            const body_motion b = {v3_make(e->rx[l], e->ry[l], e->rz[l]),
+                                   v3_make(e->vx[l], e->vy[l], e->vz[l]),
+                                   v3_make(e->wx[l], e->wy[l], e->wz[l])};
+            const node_normal o =
+                normal_of(v3_make(e->nx[l], e->ny[l], e->nz[l]), e->d[l], e->hi[l],
+                          v3_make(e->xx[l], e->xy[l], e->xz[l]),
+                          v3_make(e->ux[l], e->uy[l], e->uz[l]), b, e->kp[l], e->cp[l]);
+            e->px[l] = o.p.x;
+            e->py[l] = o.p.y;
+            e->pz[l] = o.p.z;
+            e->lx[l] = o.l.x;
+            e->ly[l] = o.l.y;
+            e->lz[l] = o.l.z;
+            e->tx[l] = o.t.x;
+            e->ty[l] = o.t.y;
+            e->tz[l] = o.t.z;
+            e->fn[l] = o.fn;
+        }
     }
 }
 
@@ -293,18 +292,25 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
     for (size_t g = 0; g < ng; g++) {
         act_group *e = &G[g];
         for (size_t l = 0; l < 4; l++) {
-            const double nx = e->nx[l], ny = e->ny[l], nz = e->nz[l], fn = e->fn[l];
-            double fx, fy, fz;
-            friction_of(nx, ny, nz, e->tx[l], e->ty[l], e->tz[l], e->kx[l], e->ky[l], e->kz[l],
-                        e->im[l], e->m[l], fn, e->mu[l], e->vl[l], h, &fx, &fy, &fz);
+            const v3 n = v3_make(e->nx[l], e->ny[l], e->nz[l]);
+            const double fn = e->fn[l];
+            const v3 a = friction_of(n, v3_make(e->tx[l], e->ty[l], e->tz[l]),
+                                     v3_make(e->kx[l], e->ky[l], e->kz[l]), e->im[l], e->m[l],
+                                     fn, e->mu[l], e->vl[l], h);
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
              * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = 0 - (uint64_t)(fn > 0.0);
-            e->ax[l] = pick(push, fx, -0.0);
-            e->ay[l] = pick(push, fy, -0.0);
-            e->az[l] = pick(push, fz, -0.0);
-            body_load(push, fx, fy, fz, nx, ny, nz, fn, share, e->lx[l], e->ly[l], e->lz[l],
-                      &e->bx[l], &e->by[l], &e->bz[l], &e->mx[l], &e->my[l], &e->mz[l]);
+            e->ax[l] = pick(push, a.x, -0.0);
+            e->ay[l] = pick(push, a.y, -0.0);
+            e->az[l] = pick(push, a.z, -0.0);
+            const act_load B =
+                body_load(push, a, n, fn, share, v3_make(e->lx[l], e->ly[l], e->lz[l]));
+            e->bx[l] = B.f.x;
+            e->by[l] = B.f.y;
+            e->bz[l] = B.f.z;
+            e->mx[l] = B.m.x;
+            e->my[l] = B.m.y;
+            e->mz[l] = B.m.z;
         }
     }
 }
@@ -714,6 +720,8 @@ static inline double double_of(uint64_t u)
     return a;
 }
 
+/* The restrict arrays stay parameters (17 of them: over the house's 12), since in a struct GCC
+ * 12 no longer takes them as apart and runs the kernel with 11 % more instructions. */
 WS_VECTOR_LOOP
 static void run_kernel(size_t ng, const run_group *restrict grp, const double *restrict px,
                        const double *restrict py, const double *restrict pz,
@@ -728,31 +736,25 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const double nx = q->nx, ny = q->ny, nz = q->nz, hi = q->hi, rx = q->rx, ry = q->ry,
-                     rz = q->rz, vx = q->vx, vy = q->vy, vz = q->vz, wx = q->wx, wy = q->wy,
-                     wz = q->wz, k = q->k, c = q->c;
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const body_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
+                               v3_make(q->wx, q->wy, q->wz)};
+        const double hi = q->hi, k = q->k, c = q->c;
         for (size_t l = 0; l < 4; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            const double d = depth[t], s = -0.5 * d; /* the depth run_depth took */
             T->keep[e] = double_of(0 - ((bits >> l) & 1u));
-            const double ax = (px[t] + nx * s) - rx, ay = (py[t] + ny * s) - ry,
-                         az = (pz[t] + nz * s) - rz;
-            const double bx = vx + (wy * az - wz * ay), by = vy + (wz * ax - wx * az),
-                         bz = vz + (wx * ay - wy * ax);
-            const double vrx = ux[t] - bx, vry = uy[t] - by, vrz = uz[t] - bz;
-            const double vn = vrx * nx + vry * ny + vrz * nz;
-            const double fn = k * (hi - d) - c * vn;
-            const double push = fn > 0.0, fp = fn * push;
-            T->kx[e] = gx[t] + nx * fp;
-            T->ky[e] = gy[t] + ny * fp;
-            T->kz[e] = gz[t] + nz * fp;
-            T->tx[e] = vrx + nx * (-vn);
-            T->ty[e] = vry + ny * (-vn);
-            T->tz[e] = vrz + nz * (-vn);
-            T->fn[e] = fn;
-            T->lx[e] = ax;
-            T->ly[e] = ay;
-            T->lz[e] = az;
+            const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
+                                            v3_make(ux[t], uy[t], uz[t]), b, k, c);
+            T->kx[e] = gx[t] + nf.p.x;
+            T->ky[e] = gy[t] + nf.p.y;
+            T->kz[e] = gz[t] + nf.p.z;
+            T->tx[e] = nf.t.x;
+            T->ty[e] = nf.t.y;
+            T->tz[e] = nf.t.z;
+            T->fn[e] = nf.fn;
+            T->lx[e] = nf.l.x;
+            T->ly[e] = nf.l.y;
+            T->lz[e] = nf.l.z;
         }
     }
     /* act_apply's friction: the slip predicted, and its size */
@@ -762,9 +764,9 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
         const double nx = q->nx, ny = q->ny, nz = q->nz, mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < 4; l++) {
             const size_t e = 4 * g + l;
-            double ax, ay, az;
-            friction_pred(nx, ny, nz, T->tx[e], T->ty[e], T->tz[e], T->kx[e], T->ky[e], T->kz[e],
-                          im[o + l], h, &ax, &ay, &az);
+            const v3 p = friction_pred(v3_make(nx, ny, nz), v3_make(T->tx[e], T->ty[e], T->tz[e]),
+                                       v3_make(T->kx[e], T->ky[e], T->kz[e]), im[o + l], h);
+            const double ax = p.x, ay = p.y, az = p.z;
             T->px[e] = ax;
             T->py[e] = ay;
             T->pz[e] = az;
@@ -792,8 +794,14 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             gx[t] = pick(keep, T->kx[e] + ax, gx[t]);
             gy[t] = pick(keep, T->ky[e] + ay, gy[t]);
             gz[t] = pick(keep, T->kz[e] + az, gz[t]);
-            body_load(push, ax, ay, az, nx, ny, nz, fn, share, T->lx[e], T->ly[e], T->lz[e],
-                      &T->bx[e], &T->by[e], &T->bz[e], &T->mx[e], &T->my[e], &T->mz[e]);
+            const act_load B = body_load(push, v3_make(ax, ay, az), v3_make(nx, ny, nz), fn,
+                                         share, v3_make(T->lx[e], T->ly[e], T->lz[e]));
+            T->bx[e] = B.f.x;
+            T->by[e] = B.f.y;
+            T->bz[e] = B.f.z;
+            T->mx[e] = B.m.x;
+            T->my[e] = B.m.y;
+            T->mz[e] = B.m.z;
         }
     }
 }

@@ -3,9 +3,7 @@
 #include <float.h>
 #include <string.h>
 
-/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
- * read past a grid's last node). */
-static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+int ws_nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
     double *p = ws_mem_calloc(mem, 3 * (size_t)n + WS_WEB_PAD, sizeof(double));
     a->x = p;
@@ -14,7 +12,7 @@ static int nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n)
     return p != NULL;
 }
 
-static void nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
+void ws_nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n)
 {
     ws_mem_free(mem, a->x, (3 * (size_t)n + WS_WEB_PAD) * sizeof(double));
     a->x = a->y = a->z = NULL;
@@ -28,14 +26,14 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     web->first_spring = UINT32_MAX;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
-        ok &= nodes_alloc(mem, &web->x[k], n);
-        ok &= nodes_alloc(mem, &web->v[k], n);
+        ok &= ws_nodes_alloc(mem, &web->x[k], n);
+        ok &= ws_nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
-    ok &= nodes_alloc(mem, &web->fmem, n);
+    ok &= ws_nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= nodes_alloc(mem, &web->xsub, n);
-    ok &= nodes_alloc(mem, &web->vsub, n);
+    ok &= ws_nodes_alloc(mem, &web->xsub, n);
+    ok &= ws_nodes_alloc(mem, &web->vsub, n);
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -54,17 +52,17 @@ void ws_web_free(ws_mem *mem, ws_web *web)
 {
     size_t n = web->n, ns = web->ns ? web->ns : 1;
     for (int k = 0; k < 2; k++) {
-        nodes_free(mem, &web->x[k], web->n);
-        nodes_free(mem, &web->v[k], web->n);
+        ws_nodes_free(mem, &web->x[k], web->n);
+        ws_nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
 
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
-    nodes_free(mem, &web->fmem, web->n);
-    nodes_free(mem, &web->xsub, web->n);
-    nodes_free(mem, &web->vsub, web->n);
+    ws_nodes_free(mem, &web->fmem, web->n);
+    ws_nodes_free(mem, &web->xsub, web->n);
+    ws_nodes_free(mem, &web->vsub, web->n);
     ws_mem_free(mem, web->tmp, WS_WEB_TMP * sizeof(double));
     ws_mem_free(mem, web->m, n * sizeof(double));
     ws_mem_free(mem, web->inv_m, n * sizeof(double));
@@ -543,7 +541,7 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, cons
 
 /* The up-springs and shear pairs from row j to row j + 1 onto the ends in rows [r0, r1) alone
  * (j and j + 1 both for all of them), in the order grid_step puts them: at the edge of a lane
- * (ws_web_forces_block) each of the two lanes computes the springs and takes its own row's
+ * (ws_web_forces_rows) each of the two lanes computes the springs and takes its own row's
  * side, which gets the values and the order it gets in one sweep. The other side's forces go
  * to the scratch. */
 static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1,
@@ -576,13 +574,13 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
             spring_one_in(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR], lo, hi);
 }
 
-/* The rows of a grid web's sweep block: at least WS_WEB_BLOCK_NODES nodes (all of them in a
- * smaller web). */
-static size_t block_rows(const ws_web *web)
+uint32_t ws_web_block_rows(const ws_web *web)
 {
+    if (web->nx <= 0 || web->ny <= 0)
+        return 1u;
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     const size_t r = (WS_WEB_BLOCK_NODES + nx - 1) / nx;
-    return r < ny ? r : ny;
+    return (uint32_t)(r < ny ? r : ny);
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
@@ -591,21 +589,8 @@ uint32_t ws_web_block_count(const ws_web *web)
         return 1u; /* a mesh web */
     if (web->ny <= 0)
         return 0u;
-    const size_t r = block_rows(web);
+    const size_t r = ws_web_block_rows(web);
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
-}
-
-void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1)
-{
-    if (web->nx <= 0) {
-        *n0 = 0;
-        *n1 = web->n;
-        return;
-    }
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
-    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
-    *n0 = (uint32_t)(nx * j0);
-    *n1 = (uint32_t)(nx * j1);
 }
 
 /* Row j of a grid web complete: row j + 1 started (base forces, its around-springs), then the
@@ -648,8 +633,8 @@ int ws_web_sweep_parallel(const ws_web *web)
     return 1;
 }
 
-void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t k, int edges,
-                         uint32_t *n0, uint32_t *n1)
+void ws_web_forces_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t j0, uint32_t j1,
+                        int edges, uint32_t *n0, uint32_t *n1)
 {
     /* The laws' parameters by spring kind, taken once a sweep (ws_web_sweep_laws). */
     const ws_spring_form *P = web->form;
@@ -662,8 +647,7 @@ void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t k
         return;
     }
     /* Row j is complete once the springs to row j + 1 are in (grid_step). */
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny, r = block_rows(web);
-    const size_t j0 = (size_t)k * r, j1 = j0 + r < ny ? j0 + r : ny;
+    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     if (j0 == 0) {
         grid_row(web, x, v, g, 0, P);
     } else if (edges & WS_WEB_LANE_FIRST) {

@@ -125,6 +125,11 @@ typedef struct ws_web {
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */
 void ws_web_note_masses(ws_web *web);
 /* Allocate a web of n nodes and ns springs (zeroed). */
+/* Node vectors: x, y and z apart in one allocation, WS_WEB_PAD zeros after z (spring_run may
+ * read past a grid's last node; the state walk takes the 3 n at once). 1, or 0 when out of
+ * memory (a->x NULL). Freed with the same n. */
+int ws_nodes_alloc(ws_mem *mem, ws_nodes3 *a, uint32_t n);
+void ws_nodes_free(ws_mem *mem, ws_nodes3 *a, uint32_t n);
 ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns);
 void ws_web_free(ws_mem *mem, ws_web *web);
 /* Room for the springs' law histories, initialised as just stretched to the strains the nodes
@@ -135,10 +140,11 @@ int ws_web_law_state(ws_mem *mem, ws_web *web);
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 
 /* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays
- * in cache: block k's forces from the springs, node drag and gravity are complete in f once
- * ws_web_forces_block(k) has run (later blocks' partly), and its nodes [n0, n1) may then get
- * their contact forces and be integrated. A grid web's blocks are whole rows, enough of them
- * for WS_WEB_BLOCK_NODES nodes; a mesh web is one block. Every sweep first takes the laws at
+ * in cache: the forces from the springs, node drag and gravity of a block's rows [j0, j1) are
+ * complete in f once ws_web_forces_rows(j0, j1) has run (later rows' partly), and its nodes
+ * [n0, n1) may then get their contact forces and be integrated. A grid web's blocks are whole
+ * rows, ws_web_block_rows of them (enough for WS_WEB_BLOCK_NODES nodes; a lane may end with
+ * fewer); a mesh web is one block, whatever the rows asked. Every sweep first takes the laws at
  * (t, since) (ws_web_sweep_laws).
  *
  * Lanes: consecutive blocks swept apart, at once, by copies of the web that share its state
@@ -151,14 +157,13 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * or a user's function, which a lane would call at once with another):
  * ws_web_sweep_parallel. */
 uint32_t ws_web_block_count(const ws_web *web);
-/* The nodes [n0, n1) of block k. */
-void ws_web_block_range(const ws_web *web, uint32_t k, uint32_t *n0, uint32_t *n1);
+uint32_t ws_web_block_rows(const ws_web *web); /* rows of a grid web's block; 1 for a mesh */
 #define WS_WEB_LANE_FIRST 1
 #define WS_WEB_LANE_LAST 2
 void ws_web_sweep_laws(ws_web *web, v3 gravity, double t, double since);
 int ws_web_sweep_parallel(const ws_web *web);
-void ws_web_forces_block(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, uint32_t k, int edges,
-                         uint32_t *n0, uint32_t *n1);
+void ws_web_forces_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, uint32_t j0, uint32_t j1,
+                        int edges, uint32_t *n0, uint32_t *n1);
 /* A sweep that writes the velocities vd keeps the nodes' forces in vd until it integrates
  * them, in place of an array of its own: each node's force is complete before its new
  * velocity is written over it, and the state the sweep streams is smaller by an n-node array

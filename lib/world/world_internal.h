@@ -23,15 +23,15 @@
 #define WS_LANES_PER_WORKER 2
 
 /* A lane of a parallel sweep of a web (world_step.c): copies of the web and its contact that
- * share their state, with the lane's own scratch (lane 0: the web's); the blocks [k0, k1) it
+ * share their state, with the lane's own scratch (lane 0: the web's); the rows [r0, r1) it
  * sweeps and what it found. Lanes 1.. keep their scratch from web to web and step to step:
  * the spring chunk (tmp, WS_WEB_TMP doubles), the list of touched nodes (fct), the contact
  * lists, run batch and run faces (own). */
 typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
-    uint32_t k0, k1;
-    size_t fast;
+    uint32_t r0, r1;
+    size_t fast, flagged; /* nodes too fast; nodes the move test flagged */
     uint64_t checks;
     double *tmp;
     uint32_t *fct;

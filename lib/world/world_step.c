@@ -207,6 +207,10 @@ typedef struct lane_task {
     ws_world *w;
     ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
     ws_nodes3 xd, vd;  /* the state written */
+    /* The first sub-step of a step swept in lanes: each lane zeroes the contact forces of
+     * the next state in its own rows before it adds to them, so that those rows stay in its
+     * core's cache. */
+    int zero;
 } lane_task;
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
@@ -214,16 +218,19 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
 {
     ws_world *w = T->w;
     ws_web *web = &J->view;
-    const uint32_t blocks = ws_web_block_count(web);
-    uint32_t n0, n1;
-    ws_web_block_range(web, J->k0, &n0, &n1);
-    size_t next = J->k0 ? ws_node_first_segment(&J->cview, n0) : 0;
+    const uint32_t rows = web->nx > 0 ? (uint32_t)web->ny : 1, r = ws_web_block_rows(web);
+    uint32_t n0 = web->nx > 0 ? (uint32_t)web->nx * J->r0 : 0, n1;
+    size_t next = J->r0 ? ws_node_first_segment(&J->cview, n0) : 0;
+    if (T->zero)
+        memset(T->pass.fc + n0, 0, (J->cview.lane_end - n0) * sizeof(v3));
     ws_node_substep(&J->cview);
     ws_web_sweep_begin(web, T->vd);
-    for (uint32_t q = J->k0; q < J->k1; q++) {
-        const int edges = (q == J->k0 && q > 0 ? WS_WEB_LANE_FIRST : 0) |
-                          (q + 1 == J->k1 && J->k1 < blocks ? WS_WEB_LANE_LAST : 0);
-        ws_web_forces_block(web, T->pass.x, T->pass.v, w->def.gravity, q, edges, &n0, &n1);
+    /* Blocks of r rows from the lane's first row (the last may be shorter). */
+    for (uint32_t j = J->r0; j < J->r1; j += r) {
+        const uint32_t j1 = J->r1 - j > r ? j + r : J->r1;
+        const int edges = (j == J->r0 && j > 0 ? WS_WEB_LANE_FIRST : 0) |
+                          (j1 == J->r1 && j1 < rows ? WS_WEB_LANE_LAST : 0);
+        ws_web_forces_rows(web, T->pass.x, T->pass.v, w->def.gravity, j, j1, edges, &n0, &n1);
         ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
         J->fast += ws_web_integrate_block(web, T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, n0,
                                           n1, w->def.max_speed);
@@ -240,18 +247,59 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         sweep_lane(T, &T->w->lane_job[i]);
 }
 
-/* The lanes a web's sweep is cut into this step, with the scratch of each ready; 0 when out of
- * memory. One unless the world has workers and the web can be swept in lanes
- * (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a block. */
-static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
+/* The lanes a web's sweep is cut into: one unless the world has workers and the web can be
+ * swept in lanes (ws_web_sweep_parallel); else WS_LANES_PER_WORKER a worker, at most one a
+ * block. The same lanes, on the same workers, run the move test and every sub-step, so a
+ * lane's nodes stay in the cache of the core that runs it. */
+static uint32_t web_lanes(const ws_world *w, const ws_web *web)
 {
     const uint32_t blocks = ws_web_block_count(web),
                    most = WS_LANES_PER_WORKER * w->def.worker_count;
     uint32_t lanes = w->def.worker_count > 1 ? most : 1;
     if (lanes > blocks)
         lanes = blocks;
-    if (lanes < 2 || !ws_web_sweep_parallel(web))
-        return 1;
+    return lanes < 2 || !ws_web_sweep_parallel(web) ? 1 : lanes;
+}
+
+/* The rows of each of the lanes (r0, r1), cut so that their work is about equal: a row costs
+ * its nodes (springs, integration, a contact each in a run) and 0.6 of a node for each
+ * candidate it takes one by one (a fit of the lanes' times on the wrapped reference case).
+ * Every lane but the last holds a block's rows at least, the last a row: the run kernel's
+ * groups, which may start up to three nodes before a node of the lane's end, stay within it.
+ * The results do not depend on the cut. */
+static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
+{
+    ws_lane_job *J = w->lane_job;
+    if (lanes == 1 || web->nx <= 0) {
+        J[0].r0 = 0;
+        J[0].r1 = web->nx > 0 ? (uint32_t)web->ny : 1;
+        return;
+    }
+    const ws_node_contact *nc = web->contact;
+    const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny, r = ws_web_block_rows(web);
+    const int segs = nc->seg_list == nc->next_list;
+    uint64_t total = 5ull * nx * ny, acc = 0;
+    for (size_t s = 0; segs && s < nc->nseg; s++)
+        total += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
+    uint32_t i = 1;
+    J[0].r0 = 0;
+    for (uint32_t j = 0, s = 0; j < ny && i < lanes; j++) {
+        acc += 5ull * nx; /* row j, with its stretches */
+        for (; segs && s < nc->nseg && nc->seg[s].n0 < nx * (j + 1); s++)
+            acc += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
+        /* Lane i starts after row j once the lanes before have their share, within room. */
+        const uint32_t lo = J[i - 1].r0 + r, hi = ny - (lanes - i - 1) * r - 1;
+        if ((acc * lanes >= total * i && j + 1 >= lo) || j + 1 == hi) {
+            J[i - 1].r1 = J[i].r0 = j + 1;
+            i++;
+        }
+    }
+    J[lanes - 1].r1 = ny;
+}
+
+/* The scratch of each of the lanes ready for ncand candidates; 0 when out of memory. */
+static int lanes_ready(ws_world *w, ws_web *web, uint32_t lanes, size_t ncand)
+{
     for (uint32_t i = 1; i < lanes; i++) {
         ws_lane_job *J = &w->lane_job[i];
         if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
@@ -261,7 +309,64 @@ static uint32_t web_lanes(ws_world *w, ws_web *web, size_t ncand)
                 0)
             return 0;
     }
-    return lanes;
+    return 1;
+}
+
+/* Run items [0, count) of task on the host's scheduler, the world's threads or, for one item,
+ * right here. */
+static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, void *ctx)
+{
+    if (count == 1) {
+        task(0, 1, 0, ctx);
+    } else if (w->def.enqueue_task) {
+        void *h = w->def.enqueue_task(task, (int32_t)count, 1, ctx, w->def.task_context);
+        if (h)
+            w->def.finish_task(h, w->def.task_context);
+    } else {
+        ws_pool_run(w->pool, task, (int32_t)count, ctx);
+    }
+}
+
+/* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
+ * them): the count flagged in each lane's job. */
+typedef struct flag_task {
+    ws_world *w;
+    ws_web *web;
+    uint32_t lanes;
+    ws_nodes3 x, v;
+} flag_task;
+
+static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker;
+    const flag_task *T = ctx;
+    for (int32_t i = start; i < end; i++) {
+        const ws_lane_job *J = &T->w->lane_job[i];
+        const uint32_t nx = T->lanes > 1 ? (uint32_t)T->web->nx : 0; /* 0: the whole web */
+        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, nx ? nx * J->r0 : 0,
+                                                 nx ? nx * J->r1 : T->web->n);
+    }
+}
+
+/* The flags in the lanes of the last cut when it cuts this web's rows (the nodes stay on
+ * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. */
+static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
+{
+    ws_lane_job *J = w->lane_job;
+    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
+    int cut = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
+    for (uint32_t i = 0; i < lanes; i++)
+        cut &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1);
+    for (uint32_t i = 0; i < lanes && !cut; i++) {
+        J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
+        J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
+    }
+    flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
+    run_task(w, flag_items, lanes, &T);
+    size_t flagged = 0;
+    for (uint32_t i = 0; i < lanes; i++)
+        flagged += w->lane_job[i].flagged;
+    return flagged;
 }
 
 void ws_world_lanes_free(ws_world *w)
@@ -283,19 +388,15 @@ void ws_world_lanes_free(ws_world *w)
 static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
 {
     ws_lane_job *J = &w->lane_job[i];
-    const uint32_t blocks = ws_web_block_count(web);
+    (void)lanes;
     J->view = *web;
     J->cview = *web->contact;
     J->view.contact = &J->cview;
-    J->k0 = (uint32_t)((uint64_t)i * blocks / lanes);
-    J->k1 = (uint32_t)((uint64_t)(i + 1) * blocks / lanes);
     J->fast = 0;
     J->checks = 0;
     ws_web *v = &J->view;
     ws_node_contact *c = &J->cview;
-    uint32_t n0, n1;
-    ws_web_block_range(web, J->k1 - 1, &n0, &n1);
-    c->lane_end = n1;
+    c->lane_end = web->nx > 0 ? (uint32_t)web->nx * J->r1 : web->n;
     c->run_nodes = c->run_deep = c->corners = 0;
     v->law_failed = 0;
     if (i == 0)
@@ -345,15 +446,7 @@ static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *
 {
     for (uint32_t i = 0; i < lanes; i++)
         lane_open(w, web, lanes, i);
-    if (lanes == 1) {
-        lane_items(0, 1, 0, T);
-    } else if (w->def.enqueue_task) {
-        void *task = w->def.enqueue_task(lane_items, (int32_t)lanes, 1, T, w->def.task_context);
-        if (task)
-            w->def.finish_task(task, w->def.task_context);
-    } else {
-        ws_pool_run(w->pool, lane_items, (int32_t)lanes, T);
-    }
+    run_task(w, lane_items, lanes, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
         fast += lane_close(w, web, i, bforce, bmoment);
@@ -375,10 +468,13 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         /* The node candidates of this step, ready to evaluate (contact/node.c). */
         ws_node_contact *nc = web->contact;
         int searched = 0;
+        const uint32_t lanes = web_lanes(w, web);
+        size_t flagged = 0;
+        if (ws_node_contact_begin(b, cur, web, w->def.dt, w->def.contact_margin, !w->cand_valid))
+            flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
         if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, w->def.contact_margin,
-                                   w->def.dt, !w->cand_valid, &w->stats.narrow_checks,
-                                   &searched) != 0)
+                                   flagged, &w->stats.narrow_checks, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
@@ -388,25 +484,24 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         const int list = nc->next_list;
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        /* Room to list every contact of every sub-step, before anything changes. */
+        if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
+                             (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0 ||
+            !lanes_ready(w, web, lanes, nc->cand[list].n))
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           web_label(web));
+        lanes_cut(w, web, lanes);
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
         /* The node contact forces this step writes: zero where they were not (the nodes that
-         * had contacts when fc[nxt] was last written), room to list every contact of every
-         * sub-step. */
-        for (size_t q = 0; q < web->nfct[nxt]; q++)
+         * had contacts when fc[nxt] was last written), or, in lanes, every one by the lane of
+         * its row (the others are zero already). */
+        for (size_t q = 0; lanes == 1 && q < web->nfct[nxt]; q++)
             web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
         web->nfct[nxt] = 0;
         web->fck = nxt;
-        if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
-                             (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                           web_label(web));
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
-        const uint32_t lanes = web_lanes(w, web, nc->cand[list].n);
-        if (lanes == 0)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
-                           web_label(web));
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -419,7 +514,8 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
                             web->fc[nxt]},
                            xd,
-                           vd};
+                           vd,
+                           s == 0 && lanes > 1};
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
