@@ -412,7 +412,7 @@ ws_status ws_loadtest_run_tilt(ws_world *w, ws_load *ld, const ws_tilt_test_def 
     tilt_ctx c;
     memset(&c, 0, sizeof c);
     ws_tilt_test_def_init(&c.d);
-    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "tilt test")) != WS_OK)
+    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "tilt_test")) != WS_OK)
         return s;
     char why[160];
     if (tilt_check(&c.d, why, sizeof why) != 0)
@@ -514,7 +514,7 @@ ws_status ws_loadtest_run_impact(ws_world *w, ws_load *ld, const ws_impact_test_
         return s;
     ws_impact_test_def d;
     ws_impact_test_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, "impact test")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "impact_test")) != WS_OK)
         return s;
     char why[160];
     if (impact_check(&d, why, sizeof why) != 0)
@@ -709,7 +709,7 @@ ws_status ws_loadtest_run_vibration(ws_world *w, ws_load *ld, const ws_vibration
     vib_ctx c;
     memset(&c, 0, sizeof c);
     ws_vibration_test_def_init(&c.d);
-    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "vibration test")) != WS_OK)
+    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "vibration_test")) != WS_OK)
         return s;
     char why[160];
     if (vibration_check(&c.d, why, sizeof why) != 0)
