@@ -388,6 +388,28 @@ START_TEST(runs_refuse_bad_input)
     bad_vibration(w, ld, "sweep_law", v_law);
     bad_vibration(w, ld, "resonance_min", v_res_nan);
 
+    /* A platform with a drive of the caller's: the run would replace it (and its static drive at
+     * the end would hold that drive's start, not the restored pose): refused, unchanged. */
+    ws_tilt_test_def_init(&td);
+    ws_impact_test_def_init(&id);
+    ws_vibration_test_def_init(&vd);
+    ws_load_info info;
+    ck_ok(w, ws_load_get_info(ld, &info));
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_SINE;
+    dd.amplitude = 0.01;
+    dd.frequency = 2;
+    dd.direction = (ws_vec3){1, 0, 0};
+    ck_ok(w, ws_body_set_drive(w, info.platform, &dd));
+    ck_ok(w, ws_world_step_n(w, 40));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "platform has a drive",
+            ws_loadtest_run_tilt(w, ld, &td, &r));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "platform has a drive",
+            ws_loadtest_run_impact(w, ld, &id, &r));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "platform has a drive",
+            ws_loadtest_run_vibration(w, ld, &vd, &r));
+
     /* The criteria's names: every id has one, anything else is "unknown". */
     for (int k = WS_CHECK_STABLE_ANGLE; k <= WS_CHECK_RUPTURE; k++)
         ck_assert_str_ne(ws_loadtest_check_name(k), "unknown");

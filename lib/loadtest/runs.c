@@ -236,6 +236,17 @@ static ws_status test_open(ws_world *w, ws_load *ld, ws_loadtest_result *res, lt
     res->failure_angle = -1;
     res->failure_event = -1;
     res->verdict.load_height = ld->info.load_height;
+    /* The run drives the platform and leaves it static: a drive of the caller's would be lost
+     * (and the static drive set at the end would hold that drive's start, not the restored
+     * pose), so the platform must stand still on its own. */
+    ws_drive_state ds0;
+    if ((s = ws_body_get_drive_state(w, ld->info.platform, &ds0)) != WS_OK)
+        return s;
+    if (ds0.type != WS_DRIVE_STATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "%s run: the platform has a drive (type %d); the run drives it itself: "
+                       "give it a static drive first",
+                       name, (int)ds0.type);
     if ((s = ws_world_get_dt(w, &lt->dt)) != WS_OK ||
         (s = ws_world_get_time(w, &lt->t0)) != WS_OK ||
         (s = ws_body_get_position(w, ld->info.platform, &lt->r0)) != WS_OK ||
