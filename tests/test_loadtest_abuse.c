@@ -6,9 +6,10 @@
  *  2. the tilt, impact and vibration runs;
  *  3. the spiral wrap, its layers and the wrapped load's read-outs;
  *  4. the calls that change the world, from inside a step: WS_ERR_IN_STEP, nothing changed.
+ *  5. a torn film's peak strain: of its intact springs, not of the broken ones' drifting ends.
  *
- * Nothing here runs a test to its end: every case is a refusal, and the whole suite takes well
- * under a second. */
+ * Nothing here runs a test to its end: every case but 5 is a refusal, and the whole suite takes
+ * well under a second. */
 #include "helpers.h"
 
 #include <stdint.h>
@@ -574,6 +575,41 @@ START_TEST(spiral_refuses_bad_input)
 }
 END_TEST
 
+/* A torn film's peak: the check at the end of every step breaks each spring past the limit,
+ * so after a step no intact spring is above it, and the film's peak (ws_load_get_film_peak)
+ * is the web's intact peak (ws_web_get_peak_strain), to the bit. The broken springs' ends
+ * drift apart (strains of 10 and more a second later); they are no peak of the film. */
+START_TEST(a_torn_film_peaks_in_its_intact_springs)
+{
+    ws_world *w = abuse_world();
+    ws_load *ld = small_load(w);
+    ws_spiral_wrap_def sd;
+    ws_spiral_wrap_def_init(&sd);
+    sd.node_mass_min = 1e-3;
+    ws_web_id film;
+    ck_ok(w, ws_load_wrap_spiral(w, ld, &sd, &film));
+    ck_ok(w, ws_web_set_rupture_strain(w, film, 0.105)); /* about the laid film's 0.1 */
+    ck_ok(w, ws_world_step_n(w, 200));
+    ws_web_rupture r;
+    ck_ok(w, ws_web_get_rupture(w, film, &r));
+    ck_assert_uint_gt(r.broken_count, 0);
+    double strain, height;
+    uint32_t spring;
+    ws_web_peak pk;
+    ck_ok(w, ws_load_get_film_peak(w, ld, &strain, &spring, &height));
+    ck_ok(w, ws_web_get_peak_strain(w, film, &pk));
+    report("torn spiral film: %u springs broken, film peak %.4f at spring %u, %.3f m up",
+           r.broken_count, strain, spring, height);
+    ck_assert(pk.found);
+    ck_assert_double_eq(strain, pk.strain);
+    ck_assert_uint_eq(spring, pk.spring);
+    ck_assert_double_le(strain, 0.105);
+    ck_assert(height > 0.0 && height < 0.5);
+    ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* A k-value search with a bad spiral Def is refused before it runs anything. */
 START_TEST(kvalue_refuses_a_bad_spiral)
 {
@@ -711,6 +747,7 @@ int main(void)
     add_case(s, "runs", runs_refuse_bad_input, 30);
     add_case(s, "spiral", spiral_refuses_bad_input, 30);
     add_case(s, "kvalue_spiral", kvalue_refuses_a_bad_spiral, 30);
+    add_case(s, "torn_film_peak", a_torn_film_peaks_in_its_intact_springs, 60);
     add_case(s, "in_step", calls_inside_a_step_are_refused, 30);
     return run_suite(s);
 }

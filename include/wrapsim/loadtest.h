@@ -425,11 +425,11 @@ typedef struct ws_load_containment {
  *  wrapped, a load of another world), WS_ERR_STALE_HANDLE (the film destroyed). */
 WS_API ws_status ws_load_get_containment(const ws_world *world, const ws_load *load,
                                          ws_load_containment *bands, size_t count);
-/** The film's largest spring strain now (l/l0 - 1), the spring's index (ws_web_copy_springs
- *  order) and its height (mean of its ends' z, m above the platform's top). Any output but
- *  `strain` may be NULL.
+/** The film's largest strain of an intact spring now (l/l0 - 1; ws_web_get_peak_strain), the
+ *  spring's index (ws_web_copy_springs order) and its height (mean of its ends' z, m above the
+ *  platform's top); all 0 when no spring is intact. Any output but `strain` may be NULL.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a load that is not wrapped),
- *  WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY. */
+ *  WS_ERR_STALE_HANDLE. */
 WS_API ws_status ws_load_get_film_peak(const ws_world *world, const ws_load *load,
                                        double *strain, uint32_t *spring, double *height);
 

@@ -855,44 +855,28 @@ ws_status ws_load_get_containment(const ws_world *w, const ws_load *cld,
     return WS_OK;
 }
 
-ws_status ws_load_get_film_peak(const ws_world *w, const ws_load *cld, double *strain,
+ws_status ws_load_get_film_peak(const ws_world *w, const ws_load *ld, double *strain,
                                 uint32_t *spring, double *height)
 {
-    ws_load *ld = (ws_load *)(uintptr_t)cld;
     ws_status s = ws_load_check_world(w, ld, "ws_load_get_film_peak");
     if (s != WS_OK)
         return s;
     NEED_OUT(w, strain, "ws_load_get_film_peak");
-    film_state fs;
+    if (!ld->info.film.bits || ld->film_nx <= 0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_load_get_film_peak: the load is not wrapped");
+    /* Intact springs only: a broken one carries nothing and its two ends drift apart, so its
+     * strain (tens once the film has torn) says nothing of the film that holds the load. */
+    ws_web_peak pk;
     double zp;
-    if ((s = film_read(w, ld, &fs, 0, "ws_load_get_film_peak")) != WS_OK)
+    if ((s = ws_web_get_peak_strain(w, ld->info.film, &pk)) != WS_OK ||
+        (s = platform_top(w, ld, &zp)) != WS_OK)
         return s;
-    if ((s = platform_top(w, ld, &zp)) != WS_OK) {
-        film_free(ld, &fs);
-        return s;
-    }
-    uint32_t *pairs = ws_mem_calloc(&ld->mem, 2 * (fs.ns ? fs.ns : 1), sizeof *pairs);
-    size_t c;
-    if (!pairs) {
-        film_free(ld, &fs);
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_load_get_film_peak: out of memory");
-    }
-    if ((s = ws_web_copy_springs(w, ld->info.film, pairs, fs.ns, &c)) == WS_OK) {
-        size_t best = 0;
-        for (size_t k = 1; k < fs.ns; k++)
-            if (fs.t[k] > fs.t[best])
-                best = k;
-        *strain = fs.ns ? fs.t[best] : 0.0;
-        if (spring)
-            *spring = (uint32_t)best;
-        if (height)
-            *height = fs.ns ? 0.5 * (fs.x[3 * pairs[2 * best] + 2] +
-                                     fs.x[3 * pairs[2 * best + 1] + 2]) - zp
-                            : 0.0;
-    }
-    ws_mem_free(&ld->mem, pairs, 2 * (fs.ns ? fs.ns : 1) * sizeof *pairs);
-    film_free(ld, &fs);
-    return s;
+    *strain = pk.found ? pk.strain : 0.0;
+    if (spring)
+        *spring = pk.found ? pk.spring : 0;
+    if (height)
+        *height = pk.found ? 0.5 * (pk.position_a.z + pk.position_b.z) - zp : 0.0;
+    return WS_OK;
 }
 
 ws_status ws_load_film_containment(const ws_world *w, const ws_load *ld, ws_containment_band *out)
