@@ -30,18 +30,18 @@ static uint64_t world_bytes(ws_world *w)
 }
 
 /* The call returns `want`, its message holds `field`, and the world's state is unchanged. */
-#define REFUSED(w, want, field, call)                                                             \
-    do {                                                                                          \
-        uint64_t h0_ = state_hash(w);                                                             \
-        uint64_t n0_ = world_bytes(w);                                                              \
-        ws_status s_ = (call);                                                                    \
-        ck_assert_msg(s_ == (want), "%s: %s, want %s (%s)", #call, ws_status_string(s_),          \
-                      ws_status_string(want), ws_world_last_error(w));                            \
-        ck_assert_msg(strstr(ws_world_last_error(w), (field)) != NULL,                            \
-                      "%s: the message does not name '%s': %s", #call, (field),                   \
-                      ws_world_last_error(w));                                                    \
-        ck_assert_msg(state_hash(w) == h0_, "%s changed the world's state", #call);               \
-        ck_assert_msg(world_bytes(w) == n0_, "%s kept memory of the world", #call);                 \
+#define REFUSED(w, want, field, call)                                                              \
+    do {                                                                                           \
+        uint64_t h0_ = state_hash(w);                                                              \
+        uint64_t n0_ = world_bytes(w);                                                             \
+        ws_status s_ = (call);                                                                     \
+        ck_assert_msg(s_ == (want), "%s: %s, want %s (%s)", #call, ws_status_string(s_),           \
+                      ws_status_string(want), ws_world_last_error(w));                             \
+        ck_assert_msg(strstr(ws_world_last_error(w), (field)) != NULL,                             \
+                      "%s: the message does not name '%s': %s", #call, (field),                    \
+                      ws_world_last_error(w));                                                     \
+        ck_assert_msg(state_hash(w) == h0_, "%s changed the world's state", #call);                \
+        ck_assert_msg(world_bytes(w) == n0_, "%s kept memory of the world", #call);                \
     } while (0)
 
 static ws_world *abuse_world(void)
@@ -220,8 +220,11 @@ static void bad_vibration(ws_world *w, ws_load *ld, const char *field,
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, field, ws_loadtest_run_vibration(w, ld, &d, &r));
 }
 
-#define SETTER(name, type, ...)                                                                   \
-    static void name(type *d) { __VA_ARGS__; }
+#define SETTER(name, type, ...)                                                                    \
+    static void name(type *d)                                                                      \
+    {                                                                                              \
+        __VA_ARGS__;                                                                               \
+    }
 
 SETTER(t_rate_nan, ws_tilt_test_def, d->rate = NAN)
 SETTER(t_rate_neg, ws_tilt_test_def, d->rate = -0.05)
@@ -322,8 +325,7 @@ START_TEST(runs_refuse_bad_input)
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load", ws_loadtest_run_tilt(w, NULL, &td, &r));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load", ws_loadtest_run_impact(w, NULL, &id, &r));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load", ws_loadtest_run_vibration(w, NULL, &vd, &r));
-    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world",
-            ws_loadtest_run_tilt(w, foreign, &td, &r));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world", ws_loadtest_run_tilt(w, foreign, &td, &r));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world",
             ws_loadtest_run_impact(w, foreign, &id, &r));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world",
@@ -434,7 +436,9 @@ typedef struct spiral_case {
     double value;
 } spiral_case;
 
+/* clang-format off */
 #define SD(f, v) {#f, offsetof(ws_spiral_wrap_def, f), (v)}
+/* clang-format on */
 
 START_TEST(spiral_refuses_bad_input)
 {
@@ -445,21 +449,23 @@ START_TEST(spiral_refuses_bad_input)
     ws_web_id film;
 
     /* Every double field: NaN, infinite, negative, absurdly large or small. */
+    /* clang-format off */
     const spiral_case cases[] = {
-        SD(width, NAN),          SD(width, -0.5),          SD(width, INFINITY),
-        SD(width, 1e-9),         SD(width, 1e300),         SD(gauge, 0),
-        SD(gauge, NAN),          SD(gauge, 1e300),         SD(modulus, -1),
-        SD(modulus, INFINITY),   SD(modulus, 1e300),       SD(density, 0),
-        SD(density, 1e300),      SD(prestretch, -0.1),     SD(prestretch, 11),
-        SD(neck_in, 0.95),       SD(neck_in, NAN),         SD(load_strain, 0),
-        SD(load_strain, 1),      SD(revolutions_bottom, -1), SD(revolutions_top, 1e9),
-        SD(overlap, 0.99),       SD(overlap, -0.1),        SD(lock_height, NAN),
-        SD(lock_height, 50),     SD(top_margin, -1),       SD(rope_revolutions, -1),
-        SD(top_sheet_gauge, 0),  SD(node_pitch, 0),        SD(node_pitch, 1e-12),
-        SD(node_pitch, NAN),     SD(node_mass_min, -1),    SD(node_mass_min, INFINITY),
+        SD(width, NAN), SD(width, -0.5), SD(width, INFINITY),
+        SD(width, 1e-9), SD(width, 1e300), SD(gauge, 0),
+        SD(gauge, NAN), SD(gauge, 1e300), SD(modulus, -1),
+        SD(modulus, INFINITY), SD(modulus, 1e300), SD(density, 0),
+        SD(density, 1e300), SD(prestretch, -0.1), SD(prestretch, 11),
+        SD(neck_in, 0.95), SD(neck_in, NAN), SD(load_strain, 0),
+        SD(load_strain, 1), SD(revolutions_bottom, -1), SD(revolutions_top, 1e9),
+        SD(overlap, 0.99), SD(overlap, -0.1), SD(lock_height, NAN),
+        SD(lock_height, 50), SD(top_margin, -1), SD(rope_revolutions, -1),
+        SD(top_sheet_gauge, 0), SD(node_pitch, 0), SD(node_pitch, 1e-12),
+        SD(node_pitch, NAN), SD(node_mass_min, -1), SD(node_mass_min, INFINITY),
         SD(elongation_at_break, -1), SD(elongation_at_break, 1.5), SD(rupture_strain, NAN),
         SD(rupture_strain, 0.05),
     };
+    /* clang-format on */
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         ws_spiral_wrap_def_init(&sd);
         memcpy((char *)&sd + cases[k].offset, &cases[k].value, sizeof(double));
@@ -515,10 +521,10 @@ START_TEST(spiral_refuses_bad_input)
                      WS_ERR_INVALID_ARGUMENT);
     ck_assert_int_eq(ws_spiral_wrap_layers(&sd, 1.5, 0.15, 4, 0, 0.8, NULL),
                      WS_ERR_INVALID_ARGUMENT);
-    const double geo[][5] = {{NAN, 0.15, 4, 0, 0.8},     {1e300, 0.15, 4, 0, 0.8},
-                             {1.5, -1, 4, 0, 0.8},        {1.5, 0.15, 0, 0, 0.8},
+    const double geo[][5] = {{NAN, 0.15, 4, 0, 0.8},        {1e300, 0.15, 4, 0, 0.8},
+                             {1.5, -1, 4, 0, 0.8},          {1.5, 0.15, 0, 0, 0.8},
                              {1.5, 0.15, INFINITY, 0, 0.8}, {1.5, 0.15, 4, NAN, 0.8},
-                             {1.5, 0.15, 4, 0, NAN},      {-1.5, 0.15, 4, 0, 0.8}};
+                             {1.5, 0.15, 4, 0, NAN},        {-1.5, 0.15, 4, 0, 0.8}};
     for (size_t k = 0; k < sizeof geo / sizeof geo[0]; k++)
         ck_assert_int_eq(ws_spiral_wrap_layers(&sd, geo[k][0], geo[k][1], geo[k][2], geo[k][3],
                                                geo[k][4], &layers),
@@ -537,15 +543,14 @@ START_TEST(spiral_refuses_bad_input)
     uint32_t spring;
     double height;
     ck_assert_int_eq(ws_load_get_containment(NULL, ld, b, 3), WS_ERR_INVALID_ARGUMENT);
-    ck_assert_int_eq(ws_load_get_film_peak(NULL, ld, &strain, NULL, NULL),
-                     WS_ERR_INVALID_ARGUMENT);
+    ck_assert_int_eq(ws_load_get_film_peak(NULL, ld, &strain, NULL, NULL), WS_ERR_INVALID_ARGUMENT);
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load", ws_load_get_containment(w, NULL, b, 3));
-    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load", ws_load_get_film_peak(w, NULL, &strain, NULL, NULL));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "load",
+            ws_load_get_film_peak(w, NULL, &strain, NULL, NULL));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "not wrapped", ws_load_get_containment(w, ld, b, 3));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "not wrapped",
             ws_load_get_film_peak(w, ld, &strain, &spring, &height));
-    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world",
-            ws_load_get_containment(w, foreign, b, 3));
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world", ws_load_get_containment(w, foreign, b, 3));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "another world",
             ws_load_get_film_peak(w, foreign, &strain, NULL, NULL));
 
@@ -633,7 +638,8 @@ START_TEST(kvalue_refuses_a_bad_spiral)
 }
 END_TEST
 
-/* ---- 4. from inside a step --------------------------------------------------------------------- */
+/* ---- 4. from inside a step ---------------------------------------------------------------------
+ */
 
 typedef struct in_step {
     ws_world *w;
@@ -659,8 +665,8 @@ static void try_in_step(in_step *c)
     ws_loadtest_result r;
     ws_web_id film;
     static const char *names[6] = {"ws_web_set_rupture_strain", "ws_loadtest_run_tilt",
-                                   "ws_loadtest_run_impact", "ws_loadtest_run_vibration",
-                                   "ws_load_wrap_spiral", "ws_web_set_rupture_strain"};
+                                   "ws_loadtest_run_impact",    "ws_loadtest_run_vibration",
+                                   "ws_load_wrap_spiral",       "ws_web_set_rupture_strain"};
     c->got[0] = ws_web_set_rupture_strain(w, c->web, 0.5);
     c->named[0] = strstr(ws_world_last_error(w), names[0]) != NULL;
     c->got[1] = ws_loadtest_run_tilt(w, c->ld, &td, &r);

@@ -514,10 +514,11 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
      * them is counted in an int. */
     const double perimeter = 2 * (ld->pallet_size.x + ld->pallet_size.y);
     if (!((sp.hi - sp.lo) / d.node_pitch * perimeter / d.node_pitch <= SPIRAL_MAX_NODES))
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "spiral wrap: node_pitch %.3g m makes about %.3g nodes on the load: at most %g",
-                       d.node_pitch, (sp.hi - sp.lo) * perimeter / (d.node_pitch * d.node_pitch),
-                       SPIRAL_MAX_NODES);
+        return ws_fail(
+            w, WS_ERR_INVALID_ARGUMENT,
+            "spiral wrap: node_pitch %.3g m makes about %.3g nodes on the load: at most %g",
+            d.node_pitch, (sp.hi - sp.lo) * perimeter / (d.node_pitch * d.node_pitch),
+            SPIRAL_MAX_NODES);
     if (!(d.node_pitch < 0.25 * (sp.hi - sp.lo)))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "spiral wrap: node_pitch must be under a quarter of the film's height "
@@ -863,7 +864,8 @@ ws_status ws_load_get_film_peak(const ws_world *w, const ws_load *ld, double *st
         return s;
     NEED_OUT(w, strain, "ws_load_get_film_peak");
     if (!ld->info.film.bits || ld->film_nx <= 0)
-        return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_load_get_film_peak: the load is not wrapped");
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_load_get_film_peak: the load is not wrapped");
     /* Intact springs only: a broken one carries nothing and its two ends drift apart, so its
      * strain (tens once the film has torn) says nothing of the film that holds the load. */
     ws_web_peak pk;

@@ -233,11 +233,11 @@ typedef struct fuzz {
     ws_element_id elements[POOL];
     ws_web_id webs[POOL];
     unsigned n_shapes, n_bodies, n_materials, n_laws, n_elements, n_webs;
-    long work;           /* what steps may still cost, in node sub-steps / 64 */
-    int trace;           /* FUZZ_API_TRACE set: say each call's status on stderr */
-    long long untracked; /* bytes the hook holds that the world's stats do not count */
-    ws_load *load;       /* op_load's load, or NULL */
-    fuzz_alloc load_alloc; /* the load's own allocator */
+    long work;                 /* what steps may still cost, in node sub-steps / 64 */
+    int trace;                 /* FUZZ_API_TRACE set: say each call's status on stderr */
+    long long untracked;       /* bytes the hook holds that the world's stats do not count */
+    ws_load *load;             /* op_load's load, or NULL */
+    fuzz_alloc load_alloc;     /* the load's own allocator */
     ws_loadtest_result result; /* a run's result (large for the stack) */
 } fuzz;
 
@@ -1016,8 +1016,8 @@ static ws_status op_load(fuzz *f, unsigned what)
         d.count_x = 1 + (int)pick(&f->in, 2);
         d.count_y = 1;
         if (byte(&f->in) & 1)
-            d.carton_size = (ws_vec3){positive(&f->in) / 8, positive(&f->in) / 8,
-                                      positive(&f->in) / 8};
+            d.carton_size =
+                (ws_vec3){positive(&f->in) / 8, positive(&f->in) / 8, positive(&f->in) / 8};
         if (byte(&f->in) & 1)
             d.carton_mass = num(&f->in);
         d.allocator = (ws_allocator){fa_alloc, fa_realloc, fa_free, &f->load_alloc};
