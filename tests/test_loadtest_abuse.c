@@ -615,6 +615,42 @@ START_TEST(a_torn_film_peaks_in_its_intact_springs)
 }
 END_TEST
 
+/* The band wrap's rupture fields: NaN, infinite, negative; a pre-stretch that leaves no
+ * elongation; a rupture strain the film passes as it is laid. */
+START_TEST(band_rupture_fields_are_checked)
+{
+    ws_world *w = abuse_world();
+    ws_load *ld = small_load(w);
+    ck_ok(w, ws_world_step(w));
+    ws_wrap_def d;
+    ws_web_id film;
+    const double bad[] = {NAN, INFINITY, -1.0};
+    for (int k = 0; k < 3; k++) {
+        ws_wrap_def_init(&d);
+        d.elongation_at_break = bad[k];
+        REFUSED(w, WS_ERR_INVALID_ARGUMENT, "elongation_at_break",
+                ws_load_wrap_band(w, ld, &d, &film));
+        ws_wrap_def_init(&d);
+        d.powered_prestretch = bad[k];
+        REFUSED(w, WS_ERR_INVALID_ARGUMENT, "powered_prestretch",
+                ws_load_wrap_band(w, ld, &d, &film));
+        ws_wrap_def_init(&d);
+        d.rupture_strain = bad[k];
+        REFUSED(w, WS_ERR_INVALID_ARGUMENT, "rupture_strain", ws_load_wrap_band(w, ld, &d, &film));
+    }
+    ws_wrap_def_init(&d);
+    d.powered_prestretch = 4.0; /* = elongation_at_break */
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "powered_prestretch must be below elongation_at_break",
+            ws_load_wrap_band(w, ld, &d, &film));
+    ws_wrap_def_init(&d);
+    d.rupture_strain = 0.05; /* the band is laid at strain_around 0.1 */
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "would break as it is laid",
+            ws_load_wrap_band(w, ld, &d, &film));
+    ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
 /* A k-value search with a bad spiral Def is refused before it runs anything. */
 START_TEST(kvalue_refuses_a_bad_spiral)
 {
@@ -752,6 +788,7 @@ int main(void)
     add_case(s, "rupture", rupture_calls_refuse_bad_input, 30);
     add_case(s, "runs", runs_refuse_bad_input, 30);
     add_case(s, "spiral", spiral_refuses_bad_input, 30);
+    add_case(s, "band_rupture", band_rupture_fields_are_checked, 30);
     add_case(s, "kvalue_spiral", kvalue_refuses_a_bad_spiral, 30);
     add_case(s, "torn_film_peak", a_torn_film_peaks_in_its_intact_springs, 60);
     add_case(s, "in_step", calls_inside_a_step_are_refused, 30);
