@@ -306,12 +306,12 @@ WS_API ws_status ws_load_wrap_band(ws_world *world, ws_load *load, const ws_wrap
 typedef struct ws_spiral_wrap_def {
     uint32_t size;  /**< set by ws_spiral_wrap_def_init() */
     uint32_t magic; /**< set by ws_spiral_wrap_def_init() */
-    double width;   /**< film width off the roll, m (> 0); default 0.5 */
-    double gauge;   /**< film thickness off the roll, m (> 0); default 20e-6 */
-    /** Young's modulus of the film as it lies on the load (after the pre-stretch), Pa (> 0);
-     *  default 150e6 */
+    double width;   /**< film width off the roll, m (> 0, <= 10); default 0.5 */
+    double gauge;   /**< film thickness off the roll, m (> 0, <= 0.01); default 20e-6 */
+    /** Young's modulus of the film as it lies on the load (after the pre-stretch), Pa (> 0,
+     *  <= 1e12); default 150e6 */
     double modulus;
-    double density;    /**< kg/m^3 (> 0); default 920 */
+    double density;    /**< kg/m^3 (> 0, <= 1e5); default 920 */
     /** Powered pre-stretch, as a fraction: 2.0 is 200 %, a metre off the roll becomes three on
      *  the load (0 .. 10); default 2.0. Plastic: it thins the film (volume kept), it is not the
      *  strain the film holds on the load. */
@@ -344,7 +344,9 @@ typedef struct ws_spiral_wrap_def {
     int top_sheet;
     /** thickness of the top sheet, m (> 0; it is not pre-stretched); default 50e-6 */
     double top_sheet_gauge;
-    double node_pitch;  /**< node spacing on the load, m (> 0); default 0.05 */
+    /** node spacing on the load, m (> 0, under a quarter of the film's height on the load, and
+     *  at most about 1e6 nodes round the pallet); default 0.05 */
+    double node_pitch;
     /** Smallest node mass, kg (>= 0): nodes lighter than this (the film's real mass from its
      *  layers) are made this heavy, so fewer sub-steps are stable. Default 0: the real mass. */
     double node_mass_min;
@@ -382,8 +384,9 @@ WS_API void(ws_spiral_wrap_def_init)(ws_spiral_wrap_def *def);
  *  global one; the load's outline at each height is taken as the rectangle of its bodies there
  *  (as ws_load_build makes them).
  *  @param out receives the web (also in ws_load_info.film)
+ *  A spiral lays at most 1e4 revolutions (a film narrow for the load's height is refused).
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def: the message names the field, a
- *  load of another world, a load already wrapped), WS_ERR_UNINITIALIZED_DEF,
+ *  load of another world, a load already wrapped), WS_ERR_UNINITIALIZED_DEF, WS_ERR_IN_STEP,
  *  WS_ERR_OUT_OF_MEMORY, errors of the web's creation. */
 WS_API ws_status ws_load_wrap_spiral(ws_world *world, ws_load *load,
                                      const ws_spiral_wrap_def *def, ws_web_id *out);
@@ -422,11 +425,11 @@ typedef struct ws_load_containment {
  *  wrapped, a load of another world), WS_ERR_STALE_HANDLE (the film destroyed). */
 WS_API ws_status ws_load_get_containment(const ws_world *world, const ws_load *load,
                                          ws_load_containment *bands, size_t count);
-/** The film's largest spring strain now (l/l0 - 1), the spring's index (ws_web_copy_springs
- *  order) and its height (mean of its ends' z, m above the platform's top). Any output but
- *  `strain` may be NULL.
+/** The film's largest strain of an intact spring now (l/l0 - 1; ws_web_get_peak_strain), the
+ *  spring's index (ws_web_copy_springs order) and its height (mean of its ends' z, m above the
+ *  platform's top); all 0 when no spring is intact. Any output but `strain` may be NULL.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a load that is not wrapped),
- *  WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY. */
+ *  WS_ERR_STALE_HANDLE. */
 WS_API ws_status ws_load_get_film_peak(const ws_world *world, const ws_load *load,
                                        double *strain, uint32_t *spring, double *height);
 
@@ -784,7 +787,9 @@ WS_API const char *ws_loadtest_check_name(int id);
 typedef struct ws_tilt_test_def {
     uint32_t size;  /**< set by ws_tilt_test_def_init() */
     uint32_t magic; /**< set by ws_tilt_test_def_init() */
-    double rate;         /**< rad/s (> 0, <= 1); default 0.05 (2.9 degrees a second) */
+    /** rad/s (> 0, <= 1, and at most 1e4 s to max_angle); default 0.05 (2.9 degrees a
+     *  second) */
+    double rate;
     /** rad (> 0, < pi/2): the load must stand to this angle; default atan(0.5), 26.6 degrees,
      *  where tan theta equals EUMOS 40509's 0.5 g */
     double target_angle;
@@ -825,8 +830,8 @@ typedef struct ws_impact_test_def {
     uint32_t magic; /**< set by ws_impact_test_def_init() */
     double speed;          /**< m/s at impact (> 0, <= 20); default 1.2 (e.g. 1.2 or 1.75) */
     double pulse_duration; /**< s of the half-sine (> 0, <= 1); default 0.01 */
-    /** Peak of the gentle run-up's acceleration, m/s^2 (> 0); default 2 (0.2 g): the run-up
-     *  takes 2 speed / this */
+    /** Peak of the gentle run-up's acceleration, m/s^2 (> 0, <= 100, and a run-up of at most
+     *  1e4 s); default 2 (0.2 g): the run-up takes 2 speed / this */
     double gentle_acceleration;
     double coast_time;     /**< s at speed before the impact (>= 0); default 0.2 */
     double rest_before;    /**< s (>= 0); default 0.05 */
@@ -852,7 +857,7 @@ typedef struct ws_vibration_test_def {
      *  spectrum (ws_vibration_truck_psd) */
     const double *psd_frequency;
     const double *psd_level;  /**< random: g^2/Hz, with psd_frequency */
-    size_t psd_count;         /**< random: breakpoints (>= 2) */
+    size_t psd_count;         /**< random: breakpoints (2 .. 10000) */
     /** Random: the Grms to play, g (>= 0): the PSD is scaled to it; 0 plays the PSD as given.
      *  Default 0.54 (the D4169 truck's medium level; 0.40 and 0.70 are the others) */
     double grms;
@@ -903,10 +908,11 @@ WS_API void(ws_vibration_test_def_init)(ws_vibration_test_def *def);
  *  events of EUMOS (the level is tan theta) and the verdict: WS_CHECK_STABLE_ANGLE (the angle
  *  at the first failure event, at least target_angle), WS_CHECK_CARTONS_LOST. The world is
  *  restored at the end unless keep_state (the platform's drive is then static either way).
- *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world),
- *  WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY, errors of the step and
- *  WS_ERR_CALLBACK; the detail is in ws_world_last_error(). On an error the world is restored
- *  too when it can be. */
+ *  The platform must have no drive, or a static one: the run drives it.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world, a driven
+ *  platform), WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE, WS_ERR_IN_STEP,
+ *  WS_ERR_OUT_OF_MEMORY, errors of the step and WS_ERR_CALLBACK; the detail is in
+ *  ws_world_last_error(). On an error the world is restored too when it can be. */
 WS_API ws_status ws_loadtest_run_tilt(ws_world *world, ws_load *load, const ws_tilt_test_def *def,
                                       ws_loadtest_result *result);
 /** Run a horizontal impact on a load from the world's present state: the velocity change the

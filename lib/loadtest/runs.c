@@ -100,6 +100,12 @@ const char *ws_loadtest_check_name(int id)
         }                                                                                         \
     } while (0)
 
+/* The longest stretch of a run a rate or an acceleration may ask for, s: as long as the
+ * longest of its phases given as times. */
+#define LT_MAX_RUN 1e4
+/* Most PSD breakpoints a random run copies (a spectrum has tens). */
+#define LT_MAX_BREAKPOINTS 10000
+
 /* A time in s: finite, in [0, 1e4]. */
 static int time_ok(double t) { return isfinite(t) && t >= 0 && t <= 1e4; }
 
@@ -137,6 +143,10 @@ static int tilt_check(ws_tilt_test_def *d, char *why, size_t len)
     NEED(time_ok(d->ramp_time) && time_ok(d->stop_time) && time_ok(d->hold_time) &&
              time_ok(d->after_failure) && time_ok(d->rest_before),
          "ramp_time, stop_time, hold_time, after_failure and rest_before must be in [0, 1e4] s");
+    double max_angle = d->max_angle > 0 ? d->max_angle : d->target_angle;
+    NEED(max_angle / d->rate <= LT_MAX_RUN,
+         "rate %g rad/s takes %g s to reach %g rad: at most %g s (rate >= %g rad/s)", d->rate,
+         max_angle / d->rate, max_angle, LT_MAX_RUN, max_angle / LT_MAX_RUN);
     if (direction_ok(d->direction, 1, &d->direction, why, len) != 0)
         return -1;
     return common_check(d->slip_speed, d->tip_fraction, d->sample_interval, why, len);
@@ -151,6 +161,9 @@ static int impact_check(ws_impact_test_def *d, char *why, size_t len)
     NEED(isfinite(d->gentle_acceleration) && d->gentle_acceleration > 0 &&
              d->gentle_acceleration <= 100,
          "gentle_acceleration must be in (0, 100] m/s^2, got %g", d->gentle_acceleration);
+    NEED(2 * d->speed / d->gentle_acceleration <= LT_MAX_RUN,
+         "gentle_acceleration %g m/s^2 takes %g s to run up to %g m/s: at most %g s",
+         d->gentle_acceleration, 2 * d->speed / d->gentle_acceleration, d->speed, LT_MAX_RUN);
     NEED(time_ok(d->coast_time) && time_ok(d->rest_before) && time_ok(d->rest_after),
          "coast_time, rest_before and rest_after must be in [0, 1e4] s");
     if (direction_ok(d->direction, 1, &d->direction, why, len) != 0)
@@ -184,8 +197,9 @@ static int vibration_check(ws_vibration_test_def *d, char *why, size_t len)
              "grms must be in [0, 20] g, got %g", d->grms);
         NEED(!d->psd_frequency == !d->psd_level,
              "psd_frequency and psd_level must be given together");
-        NEED(!d->psd_frequency || d->psd_count >= 2,
-             "psd_count must be >= 2 with breakpoints, got %zu", d->psd_count);
+        NEED(!d->psd_frequency || (d->psd_count >= 2 && d->psd_count <= LT_MAX_BREAKPOINTS),
+             "psd_count must be 2 .. %d with breakpoints, got %zu", LT_MAX_BREAKPOINTS,
+             d->psd_count);
     }
     if (direction_ok(d->direction, 0, &d->direction, why, len) != 0)
         return -1;
@@ -222,6 +236,17 @@ static ws_status test_open(ws_world *w, ws_load *ld, ws_loadtest_result *res, lt
     res->failure_angle = -1;
     res->failure_event = -1;
     res->verdict.load_height = ld->info.load_height;
+    /* The run drives the platform and leaves it static: a drive of the caller's would be lost
+     * (and the static drive set at the end would hold that drive's start, not the restored
+     * pose), so the platform must stand still on its own. */
+    ws_drive_state ds0;
+    if ((s = ws_body_get_drive_state(w, ld->info.platform, &ds0)) != WS_OK)
+        return s;
+    if (ds0.type != WS_DRIVE_STATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "%s run: the platform has a drive (type %d); the run drives it itself: "
+                       "give it a static drive first",
+                       name, (int)ds0.type);
     if ((s = ws_world_get_dt(w, &lt->dt)) != WS_OK ||
         (s = ws_world_get_time(w, &lt->t0)) != WS_OK ||
         (s = ws_body_get_position(w, ld->info.platform, &lt->r0)) != WS_OK ||
@@ -391,13 +416,14 @@ ws_status ws_loadtest_run_tilt(ws_world *w, ws_load *ld, const ws_tilt_test_def 
                                ws_loadtest_result *result)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_loadtest_run_tilt");
     ws_status s = load_check(w, ld, result, "ws_loadtest_run_tilt");
     if (s != WS_OK)
         return s;
     tilt_ctx c;
     memset(&c, 0, sizeof c);
     ws_tilt_test_def_init(&c.d);
-    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "tilt test")) != WS_OK)
+    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "tilt_test")) != WS_OK)
         return s;
     char why[160];
     if (tilt_check(&c.d, why, sizeof why) != 0)
@@ -493,12 +519,13 @@ ws_status ws_loadtest_run_impact(ws_world *w, ws_load *ld, const ws_impact_test_
                                  ws_loadtest_result *result)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_loadtest_run_impact");
     ws_status s = load_check(w, ld, result, "ws_loadtest_run_impact");
     if (s != WS_OK)
         return s;
     ws_impact_test_def d;
     ws_impact_test_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, "impact test")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "impact_test")) != WS_OK)
         return s;
     char why[160];
     if (impact_check(&d, why, sizeof why) != 0)
@@ -686,13 +713,14 @@ ws_status ws_loadtest_run_vibration(ws_world *w, ws_load *ld, const ws_vibration
                                     ws_loadtest_result *result)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_loadtest_run_vibration");
     ws_status s = load_check(w, ld, result, "ws_loadtest_run_vibration");
     if (s != WS_OK)
         return s;
     vib_ctx c;
     memset(&c, 0, sizeof c);
     ws_vibration_test_def_init(&c.d);
-    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "vibration test")) != WS_OK)
+    if ((s = ws_def_take(w, &c.d, sizeof c.d, def, "vibration_test")) != WS_OK)
         return s;
     char why[160];
     if (vibration_check(&c.d, why, sizeof why) != 0)

@@ -66,14 +66,14 @@ static int in_range(double v, double lo, double hi) { return isfinite(v) && v >=
 /* The field a Def gets wrong and why, or NULL. */
 static const char *spiral_bad(const ws_spiral_wrap_def *d)
 {
-    if (!(isfinite(d->width) && d->width > 0))
-        return "width must be > 0 m";
-    if (!(isfinite(d->gauge) && d->gauge > 0))
-        return "gauge must be > 0 m";
-    if (!(isfinite(d->modulus) && d->modulus > 0))
-        return "modulus must be > 0 Pa";
-    if (!(isfinite(d->density) && d->density > 0))
-        return "density must be > 0 kg/m^3";
+    if (!(isfinite(d->width) && d->width > 0 && d->width <= 10))
+        return "width must be > 0 and <= 10 m";
+    if (!(isfinite(d->gauge) && d->gauge > 0 && d->gauge <= 0.01))
+        return "gauge must be > 0 and <= 0.01 m";
+    if (!(isfinite(d->modulus) && d->modulus > 0 && d->modulus <= 1e12))
+        return "modulus must be > 0 and <= 1e12 Pa";
+    if (!(isfinite(d->density) && d->density > 0 && d->density <= 1e5))
+        return "density must be > 0 and <= 1e5 kg/m^3";
     if (!in_range(d->prestretch, 0, 10))
         return "prestretch must be 0 .. 10 (0 .. 1000 %)";
     if (!in_range(d->neck_in, 0, 0.9))
@@ -128,8 +128,14 @@ typedef struct spiral {
     double rb, rup, rt, total; /* revolutions at the bottom, up, at the top; in all */
 } spiral;
 
-/* The spiral of d on a load `height` high with its deck at `deck`: 0, or -1 when the film's
- * band has no height on the load. */
+/* Most revolutions a spiral may lay: the layer count walks them all at every sample. */
+#define SPIRAL_MAX_REVOLUTIONS 1e4
+/* Most nodes of a spiral's film (about 100 bytes each in the world). */
+#define SPIRAL_MAX_NODES 1e6
+
+/* The spiral of d on a load `height` high with its deck at `deck`: 0, -1 when the film's band
+ * has no height on the load, -2 when it lays more than SPIRAL_MAX_REVOLUTIONS (a film narrow
+ * for the load's height). */
 static int spiral_of(const ws_spiral_wrap_def *d, double height, double deck, spiral *sp)
 {
     /* Volume kept through the pre-stretch: width W (1 - neck_in), length (1 + prestretch). */
@@ -148,7 +154,7 @@ static int spiral_of(const ws_spiral_wrap_def *d, double height, double deck, sp
     sp->rt = d->revolutions_top;
     sp->rup = sp->zt > sp->zb ? (sp->zt - sp->zb) / sp->pitch : 0.0;
     sp->total = sp->rb + sp->rup + sp->rt + (d->passes == 2 ? sp->rup : 0.0);
-    return 0;
+    return sp->total <= SPIRAL_MAX_REVOLUTIONS ? 0 : -2;
 }
 
 /* Height of the film's centre after r revolutions. */
@@ -475,10 +481,11 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
     ws_status s = ws_load_check_world(w, ld, "ws_load_wrap_spiral");
     if (s != WS_OK)
         return s;
+    NOT_IN_STEP(w, "ws_load_wrap_spiral");
     NEED_OUT(w, out, "ws_load_wrap_spiral");
     ws_spiral_wrap_def d;
     ws_spiral_wrap_def_init(&d);
-    if ((s = ws_def_take(w, &d, sizeof d, def, "spiral wrap")) != WS_OK)
+    if ((s = ws_def_take(w, &d, sizeof d, def, "spiral_wrap")) != WS_OK)
         return s;
     const char *bad = spiral_bad(&d);
     if (bad)
@@ -492,11 +499,26 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
     const double zp = pc.z - 0.5 * ld->pallet_size.z - 2 * ld->contact_layer;
     const double H = ld->info.load_height;
     spiral sp;
-    if (spiral_of(&d, H, ld->info.pallet_top, &sp) != 0)
+    int geometry = spiral_of(&d, H, ld->info.pallet_top, &sp);
+    if (geometry == -1)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "spiral wrap: lock_height and top_margin leave no film on a load %.3g m "
                        "high (deck at %.3g m)",
                        H, ld->info.pallet_top);
+    if (geometry != 0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "spiral wrap: width %.3g m, neck_in and overlap climb %.3g m a revolution: "
+                       "%.3g revolutions on a load %.3g m high, at most %g",
+                       d.width, sp.pitch, sp.total, H, SPIRAL_MAX_REVOLUTIONS);
+    /* Rows and nodes round the load's widest outline (its pallet's) bounded before any of
+     * them is counted in an int. */
+    const double perimeter = 2 * (ld->pallet_size.x + ld->pallet_size.y);
+    if (!((sp.hi - sp.lo) / d.node_pitch * perimeter / d.node_pitch <= SPIRAL_MAX_NODES))
+        return ws_fail(
+            w, WS_ERR_INVALID_ARGUMENT,
+            "spiral wrap: node_pitch %.3g m makes about %.3g nodes on the load: at most %g",
+            d.node_pitch, (sp.hi - sp.lo) * perimeter / (d.node_pitch * d.node_pitch),
+            SPIRAL_MAX_NODES);
     if (!(d.node_pitch < 0.25 * (sp.hi - sp.lo)))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "spiral wrap: node_pitch must be under a quarter of the film's height "
@@ -834,44 +856,29 @@ ws_status ws_load_get_containment(const ws_world *w, const ws_load *cld,
     return WS_OK;
 }
 
-ws_status ws_load_get_film_peak(const ws_world *w, const ws_load *cld, double *strain,
+ws_status ws_load_get_film_peak(const ws_world *w, const ws_load *ld, double *strain,
                                 uint32_t *spring, double *height)
 {
-    ws_load *ld = (ws_load *)(uintptr_t)cld;
     ws_status s = ws_load_check_world(w, ld, "ws_load_get_film_peak");
     if (s != WS_OK)
         return s;
     NEED_OUT(w, strain, "ws_load_get_film_peak");
-    film_state fs;
+    if (!ld->info.film.bits || ld->film_nx <= 0)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_load_get_film_peak: the load is not wrapped");
+    /* Intact springs only: a broken one carries nothing and its two ends drift apart, so its
+     * strain (tens once the film has torn) says nothing of the film that holds the load. */
+    ws_web_peak pk;
     double zp;
-    if ((s = film_read(w, ld, &fs, 0, "ws_load_get_film_peak")) != WS_OK)
+    if ((s = ws_web_get_peak_strain(w, ld->info.film, &pk)) != WS_OK ||
+        (s = platform_top(w, ld, &zp)) != WS_OK)
         return s;
-    if ((s = platform_top(w, ld, &zp)) != WS_OK) {
-        film_free(ld, &fs);
-        return s;
-    }
-    uint32_t *pairs = ws_mem_calloc(&ld->mem, 2 * (fs.ns ? fs.ns : 1), sizeof *pairs);
-    size_t c;
-    if (!pairs) {
-        film_free(ld, &fs);
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_load_get_film_peak: out of memory");
-    }
-    if ((s = ws_web_copy_springs(w, ld->info.film, pairs, fs.ns, &c)) == WS_OK) {
-        size_t best = 0;
-        for (size_t k = 1; k < fs.ns; k++)
-            if (fs.t[k] > fs.t[best])
-                best = k;
-        *strain = fs.ns ? fs.t[best] : 0.0;
-        if (spring)
-            *spring = (uint32_t)best;
-        if (height)
-            *height = fs.ns ? 0.5 * (fs.x[3 * pairs[2 * best] + 2] +
-                                     fs.x[3 * pairs[2 * best + 1] + 2]) - zp
-                            : 0.0;
-    }
-    ws_mem_free(&ld->mem, pairs, 2 * (fs.ns ? fs.ns : 1) * sizeof *pairs);
-    film_free(ld, &fs);
-    return s;
+    *strain = pk.found ? pk.strain : 0.0;
+    if (spring)
+        *spring = pk.found ? pk.spring : 0;
+    if (height)
+        *height = pk.found ? 0.5 * (pk.position_a.z + pk.position_b.z) - zp : 0.0;
+    return WS_OK;
 }
 
 ws_status ws_load_film_containment(const ws_world *w, const ws_load *ld, ws_containment_band *out)

@@ -233,9 +233,12 @@ typedef struct fuzz {
     ws_element_id elements[POOL];
     ws_web_id webs[POOL];
     unsigned n_shapes, n_bodies, n_materials, n_laws, n_elements, n_webs;
-    long work;           /* what steps may still cost, in node sub-steps / 64 */
-    int trace;           /* FUZZ_API_TRACE set: say each call's status on stderr */
-    long long untracked; /* bytes the hook holds that the world's stats do not count */
+    long work;                 /* what steps may still cost, in node sub-steps / 64 */
+    int trace;                 /* FUZZ_API_TRACE set: say each call's status on stderr */
+    long long untracked;       /* bytes the hook holds that the world's stats do not count */
+    ws_load *load;             /* op_load's load, or NULL */
+    fuzz_alloc load_alloc;     /* the load's own allocator */
+    ws_loadtest_result result; /* a run's result (large for the stack) */
 } fuzz;
 
 /* An id from a pool of n ids (each a struct of one uint64_t): one made earlier (maybe destroyed
@@ -811,7 +814,7 @@ static ws_status op_web(fuzz *f)
     }
     default: {
         web_common(f, &d);
-        double pos[3 * 12], masses[12], rest[16];
+        double pos[3 * 12], masses[12], rest[16], scales[16];
         uint32_t springs[2 * 16];
         uint8_t kinds[16];
         ws_web_mesh_def m;
@@ -829,6 +832,13 @@ static ws_status op_web(fuzz *f)
             kinds[i] = (uint8_t)pick(&f->in, 4);
         }
         unsigned flags = byte(&f->in);
+        if (flags & 64) {
+            for (size_t i = 0; i < m.spring_count; i++)
+                scales[i] = byte(&f->in) & 1 ? num(&f->in) : positive(&f->in);
+            m.stiffness_scales = scales;
+        }
+        if (flags & 128)
+            d.rupture_strain = byte(&f->in) & 1 ? num(&f->in) : positive(&f->in) / 16.0;
         m.positions = flags & 1 ? pos : NULL;
         m.node_masses = flags & 2 ? masses : NULL;
         m.springs = flags & 4 ? springs : NULL;
@@ -979,6 +989,193 @@ static void op_read(fuzz *f)
     }
 }
 
+/* A platform test's sample callback: stops the run at its first sample (WS_ERR_CALLBACK), so
+ * a run costs a few steps, and the world must be restored after it. */
+static int stop_run(void *user, const ws_loadtest_sample *sample)
+{
+    (void)user;
+    (void)sample;
+    return 1;
+}
+
+/* The load: built small (one layer of one or two cartons), wrapped in a spiral of fuzzed
+ * figures, read, run for a few steps, destroyed. Its own allocator is the fuzz allocator too
+ * (its own counts: the world's statistics leave the load's object out). */
+static ws_status op_load(fuzz *f, unsigned what)
+{
+    ws_load *ld = f->load;
+    if (!ld || what == 0) {
+        if (ld) {
+            ws_load_destroy(ld);
+            f->load = NULL;
+            return WS_OK;
+        }
+        ws_load_def d;
+        ws_load_def_init(&d);
+        d.layers = integer(&f->in, 1, 2);
+        d.count_x = 1 + (int)pick(&f->in, 2);
+        d.count_y = 1;
+        if (byte(&f->in) & 1)
+            d.carton_size =
+                (ws_vec3){positive(&f->in) / 8, positive(&f->in) / 8, positive(&f->in) / 8};
+        if (byte(&f->in) & 1)
+            d.carton_mass = num(&f->in);
+        d.allocator = (ws_allocator){fa_alloc, fa_realloc, fa_free, &f->load_alloc};
+        ws_status s = ws_load_build(f->w, &d, &ld);
+        if (s == WS_OK) {
+            ws_load_info info;
+            f->load = ld;
+            if (ws_load_get_info(ld, &info) == WS_OK) {
+                PUT(f->bodies, f->n_bodies, info.pallet);
+                PUT(f->bodies, f->n_bodies, info.platform);
+            }
+        }
+        return s;
+    }
+    ws_loadtest_result *res = &f->result;
+    switch (what) {
+    case 1: {
+        ws_spiral_wrap_def d;
+        ws_spiral_wrap_def_init(&d);
+        unsigned flags = byte(&f->in);
+        if (flags & 1) {
+            d.width = positive(&f->in) / 8;
+            d.gauge = positive(&f->in) * 1e-5;
+            d.modulus = positive(&f->in) * 1e8;
+        }
+        if (flags & 2) {
+            d.prestretch = sane(&f->in);
+            d.neck_in = sane(&f->in) / 8;
+            d.load_strain = sane(&f->in) / 8;
+            d.overlap = sane(&f->in) / 4;
+        }
+        if (flags & 4) {
+            d.revolutions_bottom = sane(&f->in);
+            d.revolutions_top = sane(&f->in);
+            d.passes = integer(&f->in, 1, 2);
+            d.pallet_lock = integer(&f->in, 0, 1);
+            d.lock_height = sane(&f->in) / 16;
+            d.top_margin = sane(&f->in) / 16;
+        }
+        if (flags & 8) {
+            d.rope_revolutions = sane(&f->in);
+            d.rope_height = sane(&f->in) / 4;
+        }
+        if (flags & 16) {
+            d.top_sheet = integer(&f->in, 0, 1);
+            d.top_sheet_gauge = positive(&f->in) * 1e-5;
+        }
+        if (flags & 32) {
+            d.elongation_at_break = sane(&f->in);
+            d.rupture_strain = sane(&f->in) / 4;
+        }
+        d.node_pitch = flags & 64 ? positive(&f->in) / 32 : 0.1;
+        d.node_mass_min = flags & 128 ? num(&f->in) : 1e-3;
+        d.substeps = integer(&f->in, 0, 8);
+        ws_web_id film;
+        ws_status s = ws_load_wrap_spiral(f->w, ld, byte(&f->in) ? &d : NULL, &film);
+        if (s == WS_OK)
+            PUT(f->webs, f->n_webs, film);
+        return s;
+    }
+    case 2: {
+        ws_load_containment b[8];
+        double strain, height;
+        uint32_t spring;
+        ws_load_get_containment(f->w, ld, byte(&f->in) ? b : NULL, pick(&f->in, 9));
+        ws_load_get_film_peak(f->w, ld, &strain, byte(&f->in) ? &spring : NULL,
+                              byte(&f->in) ? &height : NULL);
+        return WS_OK;
+    }
+    case 3: {
+        ws_tilt_test_def d;
+        ws_tilt_test_def_init(&d);
+        d.rate = byte(&f->in) & 1 ? num(&f->in) : positive(&f->in) / 8;
+        d.target_angle = sane(&f->in) / 4;
+        d.direction = vec(&f->in);
+        d.sample_interval = 1 + (int)pick(&f->in, 8); /* the callback stops the run there */
+        d.on_sample = stop_run;
+        return ws_loadtest_run_tilt(f->w, ld, &d, res);
+    }
+    case 4: {
+        ws_impact_test_def d;
+        ws_impact_test_def_init(&d);
+        d.speed = byte(&f->in) & 1 ? num(&f->in) : positive(&f->in);
+        d.gentle_acceleration = byte(&f->in) & 1 ? num(&f->in) : positive(&f->in);
+        d.pulse_duration = positive(&f->in) / 64;
+        d.direction = vec(&f->in);
+        d.sample_interval = 1 + (int)pick(&f->in, 8); /* the callback stops the run there */
+        d.on_sample = stop_run;
+        return ws_loadtest_run_impact(f->w, ld, &d, res);
+    }
+    case 5: {
+        ws_vibration_test_def d;
+        ws_vibration_test_def_init(&d);
+        double fr[4], lv[4];
+        d.sweep = integer(&f->in, 0, 1);
+        if (byte(&f->in) & 1) {
+            d.psd_count = pick(&f->in, 5);
+            for (size_t i = 0; i < d.psd_count; i++) {
+                fr[i] = (double)(i + 1) * positive(&f->in) * 10;
+                lv[i] = positive(&f->in) / 256;
+            }
+            d.psd_frequency = fr;
+            d.psd_level = lv;
+        }
+        d.grms = sane(&f->in);
+        d.sample_rate = byte(&f->in) & 1 ? num(&f->in) : 1024;
+        d.frequency_start = positive(&f->in);
+        d.frequency_end = d.frequency_start + sane(&f->in) * 10;
+        d.duration = positive(&f->in);
+        d.ramp_time = positive(&f->in) / 16;
+        d.direction = vec(&f->in);
+        d.sample_interval = 1 + (int)pick(&f->in, 8); /* the callback stops the run there */
+        d.on_sample = stop_run;
+        return ws_loadtest_run_vibration(f->w, ld, &d, res);
+    }
+    default: {
+        /* An uninitialised Def, a NULL result. */
+        ws_tilt_test_def d;
+        memset(&d, 0, sizeof d);
+        if (byte(&f->in) & 1)
+            return ws_loadtest_run_tilt(f->w, ld, &d, res);
+        ws_tilt_test_def_init(&d);
+        return ws_loadtest_run_tilt(f->w, ld, &d, NULL);
+    }
+    }
+}
+
+/* The film's rupture: set a web's limit, read its rupture, its broken springs, its peak. */
+static ws_status op_rupture(fuzz *f, unsigned what)
+{
+    ws_web_id id = pick_web(f);
+    uint32_t springs[64];
+    size_t n = 0, cap = pick(&f->in, 65);
+    ws_web_rupture r;
+    ws_web_peak p;
+    switch (what) {
+    case 0:
+        return ws_web_set_rupture_strain(f->w, id,
+                                         byte(&f->in) & 1 ? num(&f->in) : positive(&f->in) / 16.0);
+    case 1:
+        ws_web_get_rupture(f->w, id, byte(&f->in) ? &r : NULL);
+        ws_web_get_peak_strain(f->w, id, byte(&f->in) ? &p : NULL);
+        break;
+    default:
+        ws_web_copy_broken_springs(f->w, id, byte(&f->in) ? springs : NULL, cap,
+                                   byte(&f->in) ? &n : NULL);
+        break;
+    }
+    return WS_OK;
+}
+
+/* The op codes 0xE0 .. 0xEF, added after the corpus was made (the others decode as before):
+ * the load (0 .. 7) and the rupture calls (8 ..). */
+static ws_status op_extra(fuzz *f, unsigned code)
+{
+    return code < 8 ? op_load(f, code) : op_rupture(f, (code - 8) % 3);
+}
+
 /* Calls that change the world; a failure among them must leave the dynamic state as it was. */
 static ws_status (*const mutators[])(fuzz *) = {op_shape,    op_body,    op_drive,   op_body_set,
                                                 op_material, op_law,     op_element, op_web,
@@ -992,12 +1189,16 @@ static void run(fuzz *f)
         if (op >= 0xF0) {
             /* Fail the allocation `k` allocations from now, during the next call. */
             f->alloc.fail_in = byte(&f->in) % 32;
+            f->load_alloc.fail_in = f->alloc.fail_in;
             op = byte(&f->in);
         }
         unsigned kind = op % (N_MUTATORS + 3);
         uint64_t before = state_hash(f);
         ws_status s = WS_OK;
-        if (kind < N_MUTATORS) {
+        if (op >= 0xE0 && op < 0xF0) {
+            kind = N_MUTATORS + 3; /* a mutator: failures are checked as theirs */
+            s = op_extra(f, op - 0xE0);
+        } else if (kind < N_MUTATORS) {
             s = mutators[kind](f);
         } else if (kind == N_MUTATORS) {
             for (int i = 0, n = 1 + (int)(byte(&f->in) % 16); i < n; i++)
@@ -1015,6 +1216,7 @@ static void run(fuzz *f)
             }
         }
         f->alloc.fail_in = -1;
+        f->load_alloc.fail_in = -1;
         if (f->trace)
             fprintf(stderr, "op %u: %s %s\n", kind, ws_status_string(s),
                     s != WS_OK ? ws_world_last_error(f->w) : "");
@@ -1035,6 +1237,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memset(&f, 0, sizeof f);
     f.in = (reader){data, size};
     f.alloc.fail_in = -1;
+    f.load_alloc.fail_in = -1;
     f.work = 4000;
     f.trace = getenv("FUZZ_API_TRACE") != NULL;
     ws_world_def d;
@@ -1064,11 +1267,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (s == WS_OK) {
         f.untracked = untracked_bytes(&f);
         run(&f);
+        ws_load_destroy(f.load);
         ws_world_destroy(f.w);
     } else if (f.w) {
         finding("ws_world_create failed but gave a world");
     }
     if (f.alloc.blocks != 0 || f.alloc.bytes != 0)
         finding("bytes still allocated after ws_world_destroy");
+    if (f.load_alloc.blocks != 0 || f.load_alloc.bytes != 0)
+        finding("bytes of the load still allocated after ws_load_destroy");
     return 0;
 }

@@ -12,6 +12,7 @@ import sys
 SHAPE, BODY, DRIVE, BODY_SET, MATERIAL, LAW, ELEMENT, WEB, WORLD, LAW_USE, WEB_USE, STEP, READ, \
     STEP_N = range(14)
 NAN, INF, HUGE = 29, 27, 21  # indices into special[] of fuzz_api.c
+EXTRA = 0xE0  # op codes 0xE0 .. 0xEF: the load (+0 .. +7) and the rupture calls (+8 .. +10)
 
 
 def sane(x):
@@ -143,6 +144,21 @@ def seeds():
     s['set_dt_gravity'] = world() + ground_and_box() + [WORLD, 0, 0, 3] + \
         [WORLD, 1, 1, sane(1), sane(0), sane(-9)] + steps(32) + [STEP_N, 7]
     s['vtp'] = world() + ground_and_box() + steps(4) + [READ, 0, 7]
+    # A load of one carton, spiral-wrapped (node pitch 0.05 m), read, its film given a low
+    # rupture strain and stepped; then each platform test, stopped at its first sample.
+    load = [EXTRA + 0, 0, 0, 0, 0]
+    spiral = [EXTRA + 1, 64, 50, 0, 1]
+    s['load_spiral'] = world() + load + spiral + steps(8) + [EXTRA + 2, 1, 3, 1, 1] + \
+        [EXTRA + 8, 0, 0, 0, 39] + steps(16) + [EXTRA + 9, 0, 0, 1, 1] + \
+        [EXTRA + 10, 0, 16, 1, 1] + [EXTRA + 10, 0, 1, 1, 1]
+    s['load_spiral_alloc_fail'] = world() + load + [0xF0, 5] + spiral + [0xF0, 20] + spiral
+    s['load_runs'] = world() + load + steps(8) + \
+        [EXTRA + 3, 0, 12, 187, 160, 128, 128, 3] + \
+        [EXTRA + 4, 0, 37, 0, 63, 19, 160, 128, 128, 3] + \
+        [EXTRA + 5, 1, 0, 145, 0, 63, 250, 31, 50, 128, 128, 160, 3] + \
+        [EXTRA + 7, 1] + [EXTRA + 7, 0] + spiral + [EXTRA + 3, 0, 12, 187, 160, 128, 128, 0]
+    s['load_destroyed_pallet'] = world() + load + [WORLD, 3, 0] + spiral + \
+        [EXTRA + 3, 0, 12, 187, 160, 128, 128, 3] + [EXTRA + 0]
     return s
 
 

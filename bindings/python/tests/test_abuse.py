@@ -240,3 +240,88 @@ def test_status_codes_are_a_c_int():
     assert ws.status_string(ws.WS_ERR_IO).startswith("WS_ERR_IO")
     with pytest.raises(OverflowError, match=r"status: 4294967306 is outside"):
         ws.status_string(2 ** 32 + ws.WS_ERR_IO)
+
+
+# --- the film's rupture, stiffness scales and a wrapped load's bands -------------------------------
+@pytest.mark.parametrize("value,error", [
+    ("abc", ValueError), (None, TypeError), ([0.5], TypeError), (1j, TypeError),
+    (2 ** 1100, OverflowError),
+])
+def test_rupture_strain_is_a_real_number(world, value, error):
+    web = world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3)
+    before = world.state_hash()
+    with pytest.raises(error, match=r"^rupture_strain: expected a real number"):
+        web.rupture_strain = value
+    with pytest.raises(error, match=r"^WebDef.rupture_strain: expected a real number"):
+        world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3, rupture_strain=value)
+    assert web.rupture_strain == 0.0
+    unchanged(world, before)
+
+
+@pytest.mark.parametrize("value", [-1.0, float("nan"), float("inf"), -1e-300])
+def test_rupture_strain_out_of_range_is_refused_by_the_library(world, value):
+    web = world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3, rupture_strain=0.2)
+    before = world.state_hash()
+    with pytest.raises(ws.WrapsimError, match=r"ws_web_set_rupture_strain: .*finite and >= 0"):
+        web.rupture_strain = value
+    with pytest.raises(ws.WrapsimError, match=r"rupture_strain must be finite and >= 0"):
+        world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3, rupture_strain=value)
+    assert web.rupture_strain == 0.2
+    unchanged(world, before)
+
+
+def test_rupture_read_outs_of_a_destroyed_web_are_refused(world):
+    web = world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3, rupture_strain=0.2)
+    web.destroy()
+    for call in (web.rupture, web.broken_springs, web.peak_strain):
+        with pytest.raises(ws.WrapsimError, match=r"WS_ERR_STALE_HANDLE"):
+            call()
+    with pytest.raises(ws.WrapsimError, match=r"WS_ERR_STALE_HANDLE"):
+        web.rupture_strain = 0.1
+
+
+@pytest.mark.parametrize("scales,error,message", [
+    ([1.0] * 3, ValueError, r"stiffness_scales: expected 4 values \(one per spring\), got 3"),
+    ([1.0] * 5, ValueError, r"stiffness_scales: expected 4 values \(one per spring\), got 5"),
+    (2.0, ValueError, r"stiffness_scales: expected 4 values \(one per spring\), got 1"),
+    (["a"] * 4, ValueError, r"stiffness_scales: could not convert string to float"),
+    ([1.0, 1.0, [1.0, 2.0], 1.0], ValueError, r"stiffness_scales: "),
+    ([1.0, 2.0, float("nan"), 1.0], ws.WrapsimError, r"spring 2 has stiffness scale nan"),
+    ([1.0, 0.0, 1.0, 1.0], ws.WrapsimError, r"spring 1 has stiffness scale 0"),
+    ([1.0, 1.0, 1.0, 1e7], ws.WrapsimError, r"spring 3 has stiffness scale 1e\+07: need a "
+                                            r"finite value > 0 and <= 1e6"),
+])
+def test_stiffness_scales_are_one_real_per_spring(world, scales, error, message):
+    before = world.state_hash()
+    with pytest.raises(error, match=message):
+        world.web_mesh(web_law(world), SQUARE, EDGES, node_mass=1e-3, stiffness_scales=scales)
+    unchanged(world, before)
+
+
+def test_containment_bands_of_a_load_are_checked():
+    import ctypes
+    from ctypes import byref
+
+    from wrapsim import _lib as L
+    from wrapsim import eumos
+    lib = ws._c()
+    with ws.World(detection_interval=10) as w:
+        ld = L.LoadDef()
+        lib.ws_load_def_init_sized(byref(ld), ctypes.sizeof(ld))
+        ld.layers = 1
+        load = ctypes.c_void_p()
+        assert lib.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+        try:
+            for bands, error, message in [
+                    (-1, OverflowError, r"containment bands: -1 is outside 0.."),
+                    (2.0, TypeError, r"containment bands: expected an integer"),
+                    (0, ValueError, r"containment bands: expected 1..64, got 0"),
+                    (65, ValueError, r"containment bands: expected 1..64, got 65"),
+                    (2 ** 70, OverflowError, r"containment bands: 1180591620717411303424")]:
+                with pytest.raises(error, match=message):
+                    eumos.containment_bands(w, load, bands)
+            # In range but unwrapped: the library says so.
+            with pytest.raises(ws.WrapsimError, match=r"the load is not wrapped"):
+                eumos.containment_bands(w, load, np.uint8(3))
+        finally:
+            lib.ws_load_destroy(load)

@@ -216,9 +216,33 @@ def small_pallet(**changes):
     ("test.psd", [[10, -1], [20, 0.01]], "test.psd[0]: [10, -1] is not a pair of numbers > 0"),
     ("test.sweep_to_hz", 1.0, "test.sweep_to_hz: 1 Hz is not above sweep_from_hz"),
     ("test.vibration", "shock", "test.vibration: 'shock' is not one of random, sweep"),
+    # The library's limits of the runs and of the band's rupture, named by the file's path.
+    ("test.type", "drop", "test.type: 'drop' is not one of tilt, eumos, impact, vibration"),
+    ("test.speed_m_per_s", 25, "test.speed_m_per_s: 25 is above 20 m/s"),
+    ("test.pulse_ms", 0, "test.pulse_ms: 0 is not above 0 ms"),
+    ("test.grms_g", -0.1, "test.grms_g: -0.1 is below 0 g"),
+    ("test.seed", 1.5, "test.seed: 1.5 is not a whole number"),
+    ("test.psd", [[10, 0.01], [1000, 0.01]], "test.psd[1]: 1000 Hz is not below 512 Hz"),
+    ("test.psd", [[10, 1e13], [20, 0.01]], "test.psd[0]: 1e+13 g^2/Hz is not below 1e12"),
+    ("test.psd", [[10, 0.01], [20, True]], "test.psd[1]: [20, True] is not a pair of numbers"),
+    ("test.psd", [[10, 0.01], [20, 0.01, 3]], "test.psd[1]: [20, 0.01, 3] is not a pair"),
+    ("test.psd", {"10": 0.01}, "test.psd: {'10': 0.01} is not a list of [x, y] pairs"),
+    ("unit_load.wrap.elongation_at_break_percent", 100,
+     "unit_load.wrap.elongation_at_break_percent: 100 % is not above "
+     "powered_prestretch_percent (250 %)"),
+    ("unit_load.wrap.rupture_strain_percent", 1,
+     "unit_load.wrap.rupture_strain_percent: the film's rupture strain (1 %) is not above "
+     "strain_around_percent and strain_up_percent"),
+    ("unit_load.wrap.rupture_strain_percent", -1,
+     "unit_load.wrap.rupture_strain_percent: -1 is below 0 %"),
+    ("unit_load.wrap.powered_prestretch_percent", "lots",
+     "unit_load.wrap.powered_prestretch_percent: 'lots' is not a number"),
 ])
 def test_unit_load_bad_values(tmp_path, capsys, path, value, message):
     d = small_pallet()
+    d["unit_load"]["wrap"] = json.loads((LOADS / "eur_pallet_eumos.json").read_text())[
+        "unit_load"]["wrap"]
+    loadfile.set_path(d, "test.type", "vibration")
     loadfile.set_path(d, path, value)
     assert cli.main(["check", str(write(tmp_path, d))]) == 2
     assert message in capsys.readouterr().err
@@ -420,12 +444,52 @@ def spiral_pallet(**changes):
      "unit_load.spiral_wrap.pallet_lock: 'yes' is not true or false"),
     ("unit_load.spiral_wrap.top_margin_m", 2.0,
      "unit_load.spiral_wrap.lock_height_m: the film"),
+    # Checked against each other and the load as the library checks them.
+    ("unit_load.spiral_wrap.elongation_at_break_percent", 100,
+     "unit_load.spiral_wrap.elongation_at_break_percent: 100 % is not above prestretch_percent"),
+    ("unit_load.spiral_wrap.rupture_strain_percent", 5,
+     "unit_load.spiral_wrap.rupture_strain_percent: the film's rupture strain (5 %) is not "
+     "above load_strain_percent (10 %)"),
+    ("unit_load.spiral_wrap.node_pitch_m", 0.5,
+     "unit_load.spiral_wrap.node_pitch_m: 0.5 m is not under a quarter of the film's height"),
+    ("unit_load.spiral_wrap.node_pitch_m", 1e-5,
+     "unit_load.spiral_wrap.node_pitch_m: 1e-05 m makes about"),
+    ("unit_load.spiral_wrap.width_m", 1e-6,
+     "unit_load.spiral_wrap.width_m: 1e-06 m climbs 4.25e-07 m a revolution"),
+    ("unit_load.spiral_wrap.width_m", "wide", "unit_load.spiral_wrap.width_m: 'wide' is not a"),
+    ("unit_load.spiral_wrap.top_sheet_gauge_um", 10000,
+     "unit_load.spiral_wrap.top_sheet_gauge_um: 10000 is above 5000 um"),
+    ("unit_load.spiral_wrap.passes", 1.5, "unit_load.spiral_wrap.passes: 1.5 is not a whole"),
+    ("unit_load.spiral_wrap.top_sheet", 1,
+     "unit_load.spiral_wrap.top_sheet: 1 is not true or false"),
+    ("unit_load.spiral_wrap.neck_in_percent", -5,
+     "unit_load.spiral_wrap.neck_in_percent: -5 is below 0 %"),
+    ("unit_load.spiral_wrap.film_colour", "blue", "unit_load.spiral_wrap.film_colour: unknown"),
 ])
 def test_spiral_wrap_bad_values(tmp_path, capsys, path, value, message):
     d = spiral_pallet()
     loadfile.set_path(d, path, value)
     assert cli.main(["check", str(write(tmp_path, d))]) == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("path,value,message", [
+    ("test.rate_deg_per_s", 80, "test.rate_deg_per_s: 80 deg/s is above 57.3 (1 rad/s)"),
+    ("test.rate_deg_per_s", 1e-6, "test.rate_deg_per_s: 1e-06 deg/s takes more than 1e4 s"),
+    ("test.duration_s", 1e5, None),  # a tilt's duration is its own: not the vibration's limit
+])
+def test_unit_load_tilt_bad_values(tmp_path, capsys, path, value, message):
+    d = spiral_pallet(**{"test.type": "tilt"})
+    loadfile.set_path(d, path, value)
+    assert cli.main(["check", str(write(tmp_path, d))]) == (0 if message is None else 2)
+    if message is not None:
+        assert message in capsys.readouterr().err
+
+
+def test_vibration_duration_is_the_library_s(tmp_path, capsys):
+    d = spiral_pallet(**{"test.type": "vibration", "test.duration_s": 1e5})
+    assert cli.main(["check", str(write(tmp_path, d))]) == 2
+    assert "test.duration_s: 100000 s is above 1e4 s for a vibration" in capsys.readouterr().err
 
 
 def test_band_and_spiral_exclude_each_other(tmp_path, capsys):

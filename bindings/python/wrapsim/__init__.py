@@ -149,6 +149,17 @@ def _int(value, ctype, what):
     return v
 
 
+def _real(value, what):
+    """`value` as a Python float for a C double, the message naming `what`: TypeError when it is
+    not a number (None, a sequence, a complex), ValueError for a string that is not one,
+    OverflowError for an integer too large for a double."""
+    try:
+        return float(value)
+    except (TypeError, ValueError, OverflowError) as e:
+        raise type(e)(f"{what}: expected a real number, got {value!r} "
+                      f"({type(value).__name__})") from None
+
+
 def _array(value, what, dtype, cols=None, length=None, per=None, bound=None):
     """`value` as a C-contiguous numpy array of `dtype` for a C call.
 
@@ -222,7 +233,7 @@ def _convert(struct, name, ftype, value):
     if isinstance(ftype, type) and issubclass(ftype, ctypes._Pointer):
         return value  # a pointer the caller made (arrays kept alive by it), or None
     if ftype is c_double:
-        return float(value)
+        return _real(value, f"{type(struct).__name__}.{name}")
     if isinstance(value, str):
         names = _ENUMS.get((type(struct), name))
         if not names or value.lower() not in names:
@@ -1455,7 +1466,7 @@ class Web(_Handle):
 
     @rupture_strain.setter
     def rupture_strain(self, strain):
-        self._call("ws_web_set_rupture_strain", float(strain))
+        self._call("ws_web_set_rupture_strain", _real(strain, "rupture_strain"))
 
     def rupture(self):
         """dict: rupture_strain, broken_count, broken_last_step (> 0: springs broke in the

@@ -11,7 +11,7 @@ from ctypes import byref
 
 import numpy as np
 
-from . import World, WrapsimError, _c
+from . import World, WrapsimError, _c, _int
 from . import _lib as L
 from ._run import _progress
 from .loadrun import paraview_series, world_params
@@ -109,7 +109,10 @@ def spiral_def(d):
 
 def containment_bands(w, load, bands=3):
     """The containment of a wrapped load by height band, bottom first
-    (ws_load_get_containment): a list of dicts in N, N/m and m."""
+    (ws_load_get_containment): a list of dicts in N, N/m and m. `bands`: 1 .. 64."""
+    bands = _int(bands, ctypes.c_size_t, "containment bands")
+    if not 1 <= bands <= 64:
+        raise ValueError(f"containment bands: expected 1..64, got {bands}")
     out = (L.LoadContainment * bands)()
     _check(w, _c().ws_load_get_containment(w.ptr, load, out, bands), "ws_load_get_containment")
     return [dict(z_low_m=b.z_low, z_high_m=b.z_high, force_N=b.force,

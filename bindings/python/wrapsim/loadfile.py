@@ -166,7 +166,7 @@ SPEC = _section({
                                   doc="height of the rope above the platform"),
             "top_sheet": _bool(False, doc="a loose sheet of film over the top face, held by "
                                           "the top revolutions"),
-            "top_sheet_gauge_um": _num("um", 50.0, 0.0, 10000.0, True,
+            "top_sheet_gauge_um": _num("um", 50.0, 0.0, 5000.0, True,
                                        doc="thickness of the top sheet"),
             "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
             "node_mass_min_kg": _num("kg", 0.0, 0.0, 10.0,
@@ -331,6 +331,76 @@ def _check_section(spec, value, path):
     return out
 
 
+def _film_breaks(path, elongation, prestretch, prestretch_key, rupture, laid, laid_key):
+    """The library's rule for a film's rupture (ws_wrap_def, ws_spiral_wrap_def), in percent:
+    the pre-stretch below the elongation at break, and the rupture strain above the strain the
+    film is laid with (it would break as it is laid)."""
+    if rupture == 0 and elongation > 0 and not prestretch < elongation:
+        raise LoadFileError(f"{path}.elongation_at_break_percent: {elongation:g} % is not above "
+                            f"{prestretch_key} ({prestretch:g} %): the film has no elongation "
+                            f"left")
+    strain = rupture if rupture > 0 else (
+        0.0 if elongation == 0 else 100 * ((1 + elongation / 100) / (1 + prestretch / 100) - 1))
+    if strain != 0 and not strain > laid:
+        key = "rupture_strain_percent" if rupture > 0 else "elongation_at_break_percent"
+        raise LoadFileError(f"{path}.{key}: the film's rupture strain ({strain:g} %) is not above "
+                            f"{laid_key} ({laid:g} %): it would break as it is laid")
+
+
+def _spiral_checks(sp, low, high, perimeter):
+    """The spiral's figures the library checks against each other and the film's height on the
+    load (low .. high, m above the platform; the pallet's perimeter, m)."""
+    path = "unit_load.spiral_wrap"
+    _film_breaks(path, sp["elongation_at_break_percent"], sp["prestretch_percent"],
+                 "prestretch_percent", sp["rupture_strain_percent"], sp["load_strain_percent"],
+                 "load_strain_percent")
+    if not sp["node_pitch_m"] < 0.25 * (high - low):
+        raise LoadFileError(f"{path}.node_pitch_m: {sp['node_pitch_m']:g} m is not under a "
+                            f"quarter of the film's height on the load ({high - low:g} m)")
+    nodes = (high - low) * perimeter / sp["node_pitch_m"] ** 2
+    if nodes > 1e6:
+        raise LoadFileError(f"{path}.node_pitch_m: {sp['node_pitch_m']:g} m makes about "
+                            f"{nodes:.3g} film nodes, at most 1e6")
+    if sp["rope_revolutions"] > 0 and not low <= sp["rope_height_m"] <= high:
+        raise LoadFileError(f"{path}.rope_height_m: {sp['rope_height_m']:g} m is not on the film "
+                            f"({low:g} .. {high:g} m above the platform)")
+    # The spiral climbs its laid width less the overlap a revolution; the library lays at most
+    # 1e4 revolutions.
+    pitch = sp["width_m"] * (1 - sp["neck_in_percent"] / 100) * (1 - sp["overlap_percent"] / 100)
+    revolutions = (sp["revolutions_bottom"] + sp["revolutions_top"] + sp["rope_revolutions"] +
+                   sp["passes"] * (high - low) / pitch)
+    if revolutions > 1e4:
+        raise LoadFileError(f"{path}.width_m: {sp['width_m']:g} m climbs {pitch:g} m a "
+                            f"revolution: about {revolutions:.3g} revolutions, at most 10000")
+
+
+def _unit_load_test_checks(t):
+    """The limits of the library's runs (ws_loadtest_run_tilt, _impact, _vibration) that the
+    keys, shared with the stack's tilt, do not hold."""
+    kind = t["type"]
+    if kind == "tilt":
+        rate = math.radians(t["rate_deg_per_s"])
+        if rate > 1:
+            raise LoadFileError(f"test.rate_deg_per_s: {t['rate_deg_per_s']:g} deg/s is above "
+                                f"{math.degrees(1):.4g} (1 rad/s) for a unit load")
+        if math.radians(t["target_angle_deg"]) / rate > 1e4:
+            raise LoadFileError(f"test.rate_deg_per_s: {t['rate_deg_per_s']:g} deg/s takes more "
+                                f"than 1e4 s to reach the target angle")
+    if kind == "vibration":
+        if t["duration_s"] > 1e4:
+            raise LoadFileError(f"test.duration_s: {t['duration_s']:g} s is above 1e4 s for a "
+                                f"vibration")
+        if len(t["psd"]) > 10000:
+            raise LoadFileError(f"test.psd: {len(t['psd'])} breakpoints, at most 10000")
+        for i, (f, g) in enumerate(t["psd"]):
+            # The history is sampled at 1024 Hz (ws_vibration_test_def.sample_rate).
+            if f >= 512:
+                raise LoadFileError(f"test.psd[{i}]: {f:g} Hz is not below 512 Hz (half the "
+                                    f"1024 Hz the history is sampled at)")
+            if g >= 1e12:
+                raise LoadFileError(f"test.psd[{i}]: {g:g} g^2/Hz is not below 1e12")
+
+
 def _cross_checks(d):
     """What one key alone cannot say."""
     if (d["stack"] is None) == (d["unit_load"] is None):
@@ -355,6 +425,17 @@ def _cross_checks(d):
             raise LoadFileError(f"unit_load.spiral_wrap.lock_height_m: the film ({low:g} m "
                                 f"above the platform to {sp['top_margin_m']:g} m below the "
                                 f"top) has no height on a load {height:g} m high")
+        _spiral_checks(sp, low, height - sp["top_margin_m"],
+                       2 * (u["pallet"]["length_m"] + u["pallet"]["width_m"]))
+    if u is not None and u["wrap"] is not None:
+        w = u["wrap"]
+        _film_breaks("unit_load.wrap", w["elongation_at_break_percent"],
+                     w["powered_prestretch_percent"], "powered_prestretch_percent",
+                     w["rupture_strain_percent"],
+                     max(w["strain_around_percent"], w["strain_up_percent"]),
+                     "strain_around_percent and strain_up_percent")
+    if u is not None:
+        _unit_load_test_checks(t)
     if d["stack"] is None:
         return
     c = d["stack"]["carton"]
