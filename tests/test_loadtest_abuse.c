@@ -412,6 +412,11 @@ START_TEST(runs_refuse_bad_input)
             ws_loadtest_run_impact(w, ld, &id, &r));
     REFUSED(w, WS_ERR_INVALID_ARGUMENT, "platform has a drive",
             ws_loadtest_run_vibration(w, ld, &vd, &r));
+    ws_eumos_def ed;
+    ws_eumos_def_init(&ed);
+    ws_eumos_result er;
+    REFUSED(w, WS_ERR_INVALID_ARGUMENT, "platform has a drive",
+            ws_loadtest_run_eumos(w, ld, &ed, &er));
 
     /* The criteria's names: every id has one, anything else is "unknown". */
     for (int k = WS_CHECK_STABLE_ANGLE; k <= WS_CHECK_RUPTURE; k++)
@@ -682,8 +687,8 @@ typedef struct in_step {
     ws_load *ld;
     ws_web_id web;
     int calls;
-    ws_status got[6];
-    int named[6];
+    ws_status got[7];
+    int named[7];
     int reads_ok;
 } in_step;
 
@@ -700,9 +705,10 @@ static void try_in_step(in_step *c)
     ws_spiral_wrap_def_init(&sd);
     ws_loadtest_result r;
     ws_web_id film;
-    static const char *names[6] = {"ws_web_set_rupture_strain", "ws_loadtest_run_tilt",
+    static const char *names[7] = {"ws_web_set_rupture_strain", "ws_loadtest_run_tilt",
                                    "ws_loadtest_run_impact",    "ws_loadtest_run_vibration",
-                                   "ws_load_wrap_spiral",       "ws_web_set_rupture_strain"};
+                                   "ws_load_wrap_spiral",       "ws_web_set_rupture_strain",
+                                   "ws_loadtest_run_eumos"};
     c->got[0] = ws_web_set_rupture_strain(w, c->web, 0.5);
     c->named[0] = strstr(ws_world_last_error(w), names[0]) != NULL;
     c->got[1] = ws_loadtest_run_tilt(w, c->ld, &td, &r);
@@ -715,6 +721,11 @@ static void try_in_step(in_step *c)
     c->named[4] = strstr(ws_world_last_error(w), names[4]) != NULL;
     c->got[5] = ws_web_set_rupture_strain(w, c->web, 0.0);
     c->named[5] = strstr(ws_world_last_error(w), names[5]) != NULL;
+    ws_eumos_def ed;
+    ws_eumos_def_init(&ed);
+    ws_eumos_result er;
+    c->got[6] = ws_loadtest_run_eumos(w, c->ld, &ed, &er);
+    c->named[6] = strstr(ws_world_last_error(w), names[6]) != NULL;
     /* The readers work inside a step. */
     ws_web_rupture ru;
     ws_web_peak pk;
@@ -763,7 +774,7 @@ START_TEST(calls_inside_a_step_are_refused)
     ck_ok(w, ws_body_set_drive(w, kin, &dd));
     ck_ok(w, ws_world_step(w));
     ck_assert_int_ge(c.calls, 2);
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < 7; k++) {
         ck_assert_msg(c.got[k] == WS_ERR_IN_STEP, "call %d returned %s", k,
                       ws_status_string(c.got[k]));
         ck_assert_msg(c.named[k], "call %d: the message does not name the call", k);

@@ -197,12 +197,24 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
                                 ws_eumos_result *result)
 {
     NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_loadtest_run_eumos");
     NEED_OUT(w, result, "ws_loadtest_run_eumos");
     if (!ld)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "ws_loadtest_run_eumos: load is NULL");
     if (ld->world != w)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_loadtest_run_eumos: the load was built in another world");
+    /* The run drives the platform and leaves it static where it stopped: a drive of the
+     * caller's would be lost, so the platform must stand on its own. */
+    ws_drive_state ds0;
+    ws_status s0 = ws_body_get_drive_state(w, ld->info.platform, &ds0);
+    if (s0 != WS_OK)
+        return s0;
+    if (ds0.type != WS_DRIVE_STATIC)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_loadtest_run_eumos: the platform has a drive (type %d); the run "
+                       "drives it itself: give it a static drive first",
+                       (int)ds0.type);
     run_state rs;
     memset(&rs, 0, sizeof rs);
     ws_eumos_def_init(&rs.d);
