@@ -192,7 +192,8 @@ static ws_status webs_ready(ws_world *w)
             }
             web->bcap = cap;
         }
-        if (w->web_check) {
+        /* An implicit web is stable at any step for its stiffness: no refusal. */
+        if (w->web_check && web->integrator == WS_WEB_EXPLICIT) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
             if (!(h <= w->def.stable_fraction * stable)) /* NaN refuses too */
                 return web_unstable(w, web, h, stable, "refused before the step");
@@ -401,6 +402,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
                              (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
+        if (web->integrator == WS_WEB_IMPLICIT) {
+            ws_status st = ws_world_web_implicit(w, web, cur, nxt, list);
+            if (st != WS_OK)
+                return st;
+            continue;
+        }
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
         const uint32_t lanes = web_lanes(w, web, nc->cand[list].n);
