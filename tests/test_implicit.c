@@ -206,7 +206,7 @@ static v3 contact_force(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_no
                         ws_nodes3 v, ws_node_link *L, uint32_t i, int *count)
 {
     size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c, cl->n,
-                             x, v, 0.0, 0.0, L);
+                             x, v, 0.0, NULL, 0.0, L);
     v3 f = v3_make(0, 0, 0);
     *count = 0;
     for (size_t k = 0; k < n; k++)
@@ -313,7 +313,7 @@ START_TEST(test_contact_jacobian)
             ck_assert_int_eq(cnt, 1);
             ws_node_link link;
             size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c,
-                                     cl->n, x, v, 0.0, 0.0, L);
+                                     cl->n, x, v, 0.0, NULL, 0.0, L);
             for (size_t k = 0; k < n; k++)
                 if (L[k].node == i && L[k].active)
                     link = L[k];

@@ -32,13 +32,14 @@ typedef struct ws_node_link {
  * the bodies at state cur (features prepared in g), parameters pp by body material, the
  * window raised by reach: each into out (room for count), their number returned. A contact
  * that pushes at the start starts active, with its friction, and so does one that the node
- * reaches within the step h at its present velocity (with the normal force it would end with);
+ * reaches within the step h at its present velocity plus `guess` (xyz per node; NULL: none)
+ * (with the normal force it would end with);
  * any other (beyond the window, or leaving it) starts inactive with its normal force's linear
  * model alone (f = fn n, K, D along n), which ws_node_link_update may bring in. */
 size_t ws_node_links(const ws_body_store *b, int cur, const ws_node_geom *g,
                      const ws_node_params *pp, const ws_web *web, const ws_ncand *cand,
-                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, double reach,
-                     ws_node_link *out);
+                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, const double *guess,
+                     double reach, ws_node_link *out);
 
 /* After a solve over step h (dv; new velocities v1): each contact's normal force at the end of
  * the step by its linear model, fn - k h n.v1 - c n.dv; an inactive contact becomes active

@@ -11,7 +11,7 @@
 
 static size_t scratch_doubles(uint32_t n)
 {
-    return 8 * VEC(n) + 3 * SYMS(n); /* f fs b dv r z p q, kc dc pinv */
+    return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
 }
 
 int ws_implicit_reserve(ws_mem *mem, ws_web *web)
@@ -44,7 +44,8 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->fs = q, q += VEC(n);
     im->kc = q, q += SYMS(n);
     im->dc = q, q += SYMS(n);
-    im->pinv = q;
+    im->pinv = q, q += SYMS(n);
+    im->nd = q;
     web->imp = im;
     return 0;
 }
@@ -112,7 +113,7 @@ int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double 
         v3 e, dvel;
         double l, eps, rate, F, Fu, Fud;
         if (!spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
-            *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             continue;
         }
         if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud) || !isfinite(F))
@@ -216,6 +217,72 @@ void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y)
     combine(web, 1.0, h, h * h, p, y);
 }
 
+/* A's parts for step h: each spring's block (a, b) and each node's own block (nd). */
+static void operator_for(const ws_web *web, double h)
+{
+    ws_implicit *im = web->imp;
+    const double h2 = h * h;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        ws_ispring *q = &im->sp[s];
+        q->a = h2 * q->ka + h * q->cs;
+        q->b = h2 * q->kb;
+    }
+    for (uint32_t i = 0; i < web->n; i++) {
+        double *S = im->nd + WS_SYM * (size_t)i;
+        const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
+        const double d = web->m[i] + h * web->damping;
+        for (int k = 0; k < WS_SYM; k++)
+            S[k] = h2 * kc[k] + h * dc[k];
+        S[WS_SYM_XX] += d;
+        S[WS_SYM_YY] += d;
+        S[WS_SYM_ZZ] += d;
+    }
+}
+
+/* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
+ * preconditioner is), so its y is not needed: it is set to zero. */
+static double apply_fast(const ws_web *web, const double *restrict p, double *restrict y)
+{
+    const ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
+        double *Y = y + 3 * (size_t)i;
+        Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
+        Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
+        Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
+    }
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_ispring *q = &im->sp[s];
+        const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double ed = q->a * (q->ex * dx + q->ey * dy + q->ez * dz);
+        const double tx = ed * q->ex + q->b * dx, ty = ed * q->ey + q->b * dy,
+                     tz = ed * q->ez + q->b * dz;
+        double *YA = y + 3 * (size_t)sa[s], *YB = y + 3 * (size_t)sb[s];
+        YA[0] += tx;
+        YA[1] += ty;
+        YA[2] += tz;
+        YB[0] -= tx;
+        YB[1] -= ty;
+        YB[2] -= tz;
+    }
+    double py = 0.0;
+    if (web->same_inv_m) { /* no pinned node */
+        for (size_t j = 0; j < VEC(n); j++)
+            py += p[j] * y[j];
+        return py;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        double *Y = y + 3 * (size_t)i;
+        if (web->inv_m[i] == 0.0)
+            Y[0] = Y[1] = Y[2] = 0.0;
+        py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
+    }
+    return py;
+}
+
 /* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
  * its dv stays zero. 0, or -1 when a block is not positive definite (NaN, or a matrix broken
  * by its inputs). */
@@ -279,14 +346,20 @@ static double dot(const double *a, const double *b, size_t m)
     return s;
 }
 
-static void precondition(const ws_implicit *im, uint32_t n, const double *r, double *z)
+/* z = P r, P the block-Jacobi preconditioner; returns r . z. */
+static double precondition(const ws_implicit *im, uint32_t n, const double *restrict r,
+                           double *restrict z)
 {
+    double rz = 0.0;
     for (uint32_t i = 0; i < n; i++) {
-        const double *R = r + 3 * (size_t)i;
+        const double *R = r + 3 * (size_t)i, *S = im->pinv + WS_SYM * (size_t)i;
         double *Z = z + 3 * (size_t)i;
-        Z[0] = Z[1] = Z[2] = 0.0;
-        ws_sym_madd(im->pinv + WS_SYM * (size_t)i, R[0], R[1], R[2], Z);
+        Z[0] = S[WS_SYM_XX] * R[0] + S[WS_SYM_XY] * R[1] + S[WS_SYM_XZ] * R[2];
+        Z[1] = S[WS_SYM_XY] * R[0] + S[WS_SYM_YY] * R[1] + S[WS_SYM_YZ] * R[2];
+        Z[2] = S[WS_SYM_XZ] * R[0] + S[WS_SYM_YZ] * R[1] + S[WS_SYM_ZZ] * R[2];
+        rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
     }
+    return rz;
 }
 
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
@@ -322,30 +395,32 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         im->last_residual = NAN;
         return -1;
     }
+    operator_for(web, h);
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
-    ws_implicit_apply(web, h, x, q);
+    for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
+        if (web->inv_m[i] == 0.0)
+            x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
+    (void)apply_fast(web, x, q);
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
     double rr = dot(r, r, m);
-    precondition(im, n, r, z);
+    double rz = precondition(im, n, r, z);
     memcpy(p, z, m * sizeof(double));
-    double rz = dot(r, z, m);
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
-        ws_implicit_apply(web, h, p, q);
-        const double pq = dot(p, q, m);
+        const double pq = apply_fast(web, p, q);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
         const double alpha = rz / pq;
+        rr = 0.0;
         for (size_t j = 0; j < m; j++) {
             x[j] += alpha * p[j];
             r[j] -= alpha * q[j];
+            rr += r[j] * r[j];
         }
         it++;
-        rr = dot(r, r, m);
-        precondition(im, n, r, z);
-        const double rz1 = dot(r, z, m), beta = rz1 / rz;
+        const double rz1 = precondition(im, n, r, z), beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)
             p[j] = z[j] + beta * p[j];

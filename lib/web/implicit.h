@@ -26,6 +26,8 @@ enum { WS_SYM_XX, WS_SYM_YY, WS_SYM_ZZ, WS_SYM_XY, WS_SYM_XZ, WS_SYM_YZ, WS_SYM 
  * -df_a/dx_a = ka e e^T + kb I and damping -df_a/dv_a = cs e e^T. */
 typedef struct ws_ispring {
     double ex, ey, ez, ka, kb, cs;
+    double a, b; /* the solve's: A's block of the spring, a e e^T + b I (a = h^2 ka + h cs,
+                    b = h^2 kb), set by ws_implicit_solve */
 } ws_ispring;
 
 typedef struct ws_implicit {
@@ -36,6 +38,8 @@ typedef struct ws_implicit {
     ws_ispring *sp;  /* per spring */
     double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
     double *pinv;    /* per node: the inverse of A's diagonal block (symmetric) */
+    double *nd;      /* per node: A's own part of the node, M + h (drag + dc) + h^2 kc (the
+                        solve's, symmetric) */
     int warm;        /* dv holds the last converged solution */
     /* Counts (ws_web_get_solver_stats). */
     uint64_t solves, iterations;

@@ -41,7 +41,8 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
         /* The contacts the step may reach: those of nodes within a step's travel of the
          * window's top, bounded by the margin the candidates cover. */
         const size_t nl = ws_node_links(b, cur, &w->node_geom, w->node_par, web, cl->c, cl->n, xs,
-                                        vs, h, w->def.contact_margin, w->links);
+                                        vs, h, im->warm ? im->dv : NULL,
+                                        w->def.contact_margin, w->links);
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
