@@ -539,6 +539,105 @@ START_TEST(test_converges_to_explicit)
 }
 END_TEST
 
+static void band_case(double mu)
+{
+    /* The band of tests/test_web.c (band_pressure) on the implicit film: a cylinder R = 0.1 m of
+     * 128 sides, kinematic at rest, a band of 64 x 3 nodes pre-stretched 0.2 around, no
+     * gravity, EA = 100 N (T ~ 20 N), 1 g nodes with drag 0.5 kg/s, film-cylinder pair k =
+     * 4000 N/m, c = 1 kg/s, mu as given; here at dt = 1 ms in one step, 5 times the
+     * explicit stable step (the explicit film would need 10 sub-steps at the check's 0.5). After 0.3 s the band is at rest to e^-75 (backward
+     * Euler damps every mode at least as the drag does), and at rest a step's contact force is
+     * its penalty at the start (the linear terms vanish with v and dv). Each row's contact
+     * forces sum to 2 N T sin(pi / N) for the regular 64-gon of nodes (1e-6: settling and
+     * round-off), and frictionless each is k times its overlap along the face normal (1e-6). */
+    const double R = 0.1, dt = 1e-3, EA = 100.0, kc = 4000.0, reach = 2e-3;
+    const int seg = 128, na = 64, nu = 3;
+    ws_world *w = world_g(dt, NO_G);
+    ws_shape_id cs;
+    ck_ok(w, ws_shape_create_cylinder(w, R, 0.3, seg, &cs));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = cs;
+    ws_body_id cyl;
+    ck_ok(w, ws_body_create(w, &bd, &cyl));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film, dflt;
+    ck_ok(w, ws_material_create(w, &md, &film));
+    ck_ok(w, ws_world_get_default_material(w, &dflt));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = kc;
+    cd.damping = 1.0;
+    cd.friction = mu;
+    ck_ok(w, ws_world_set_contact(w, film, dflt, &cd));
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.005, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.node_damping = 0.5;
+    wd.law = law;
+    wd.material = film;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-10;
+    ws_band_def bdf;
+    ws_band_def_init(&bdf);
+    bdf.bodies = &cyl;
+    bdf.body_count = 1;
+    bdf.z_bottom = -0.05;
+    bdf.z_top = 0.05;
+    bdf.n_around = na;
+    bdf.n_up = nu;
+    bdf.prestretch_around = 0.2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_band(w, &wd, &bdf, &web));
+    double S;
+    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    ck_ok(w, ws_world_step_n(w, 300));
+    const size_t nn = (size_t)na * nu;
+    double *x = malloc(3 * nn * sizeof *x), *fc = malloc(3 * nn * sizeof *fc);
+    double *T = malloc(nn * 2 * sizeof *T);
+    ck_assert(x && fc && T);
+    size_t cnt;
+    ck_ok(w, ws_web_copy_positions(w, web, x, nn, &cnt));
+    ck_ok(w, ws_web_copy_contact_forces(w, web, fc, nn, &cnt));
+    ck_ok(w, ws_web_copy_spring_tensions(w, web, T, nn * 2, &cnt));
+    const double a = R * cos(PI / seg);
+    for (int j = 0; j < nu; j++) {
+        double Tm = 0.0, F = 0.0, worst_law = 0.0;
+        for (int i = 0; i < na; i++) {
+            Tm += T[j * na + i] / na;
+            const double *p = x + 3 * (j * na + i), *f = fc + 3 * (j * na + i);
+            const double fn = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+            F += fn;
+            const double ang = atan2(f[1], f[0]);
+            const double fidx = floor((ang < 0 ? ang + 2 * PI : ang) / (2 * PI / seg));
+            const double thf = (fidx + 0.5) * 2 * PI / seg;
+            const double d = p[0] * cos(thf) + p[1] * sin(thf) - a, want = kc * (reach - d);
+            if (mu == 0.0)
+                worst_law = fmax(worst_law, fabs(fn - want) / want);
+        }
+        const double pred = 2 * na * Tm * sin(PI / na);
+        report("implicit band mu %.1f row %d at dt %.0f ms (%.0f x the explicit stable step): "
+               "sum |f| %.6f N, 2 N T sin(pi/N) %.6f N (rel %.2g); contact law %.2g",
+               mu, j, 1e3 * dt, dt / S, F, pred, (F - pred) / pred, worst_law);
+        ck_assert_msg(fabs(F - pred) <= 1e-6 * pred, "row %d: %.9f vs %.9f", j, F, pred);
+        ck_assert_msg(worst_law <= 1e-6, "row %d: contact law off by %g", j, worst_law);
+    }
+    free(x);
+    free(fc);
+    free(T);
+    ws_world_destroy(w);
+}
+
+START_TEST(test_band_pressure)
+{
+    band_case(0.0);
+    band_case(0.3);
+}
+END_TEST
+
 /* ---- 4. a failed solve ---- */
 
 START_TEST(test_failed_solve_leaves_world)
@@ -633,6 +732,7 @@ int main(void)
     add_case(s, "string_mode_amplification", test_string_mode_amplification, 10);
     add_case(s, "row_tension", test_row_tension, 20);
     add_case(s, "converges_to_explicit", test_converges_to_explicit, 60);
+    add_case(s, "band_pressure", test_band_pressure, 60);
     add_case(s, "failed_solve_leaves_world", test_failed_solve_leaves_world, 10);
     add_case(s, "bad_solver_defs", test_bad_solver_defs, 10);
     return run_suite(s);
