@@ -154,7 +154,8 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
     return ws_fail(w, WS_ERR_NUMERICAL,
                    "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s, "
                    "of which it may use %g (stable_fraction): %.3g s (smallest node mass %.3g "
-                   "kg). %s %s, or a smaller dt.",
+                   "kg). %s %s, or a smaller dt; or make it implicit (ws_web_def.integrator = "
+                   "WS_WEB_IMPLICIT), which has no such limit.",
                    web_label(web), what, h, stable, f, allowed, mmin, sub, mass);
 }
 
