@@ -3,7 +3,10 @@
  * each timed as the best of `repeats`: settling (1 s from the load as built), a EUMOS 40509 run
  * at 0.25 g (the pulse, the gentle stop, 0.5 s of rest) with its measurements every 4 steps,
  * and, with the load wrapped in the default band (ws_load_wrap_band), 1 s of stepping. Prints
- * steps/s, node-updates/s for the film, and the wall and CPU time. Never fails on time.
+ * steps/s, node-updates/s for the film, and the wall and CPU time; and, as a yardstick for the
+ * machine's speed at the time (see bench_plain.c), the plain scalar explicit loop over the same
+ * film (the same nodes, springs, laws and sub-steps, no contacts and no bodies) and the wrapped
+ * load's CPU time as a ratio to it. Never fails on time.
  * Usage: bench_pallet [repeats] */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
@@ -12,6 +15,8 @@
 #include <time.h>
 
 #include <wrapsim/wrapsim.h>
+
+#include "plain_film.h"
 
 static double now(void)
 {
@@ -42,6 +47,7 @@ int main(int argc, char **argv)
         repeats = 1;
     double best_settle = INFINITY, best_run = INFINITY, run_time = 0;
     double cpu_settle = INFINITY, cpu_run = INFINITY, best_wrap = INFINITY, cpu_wrap = INFINITY;
+    double cpu_plain = INFINITY;
     uint32_t nodes = 0;
     int substeps = 1;
     long settle_steps = 4000, run_steps = 0;
@@ -90,6 +96,23 @@ int main(int argc, char **argv)
         if ((s = ws_load_wrap_band(w, ld, &wr, &film)) != WS_OK ||
             (s = ws_web_get_info(w, film, &wi)) != WS_OK)
             die(w, s);
+        /* The plain loop over the film as it is laid on (every spring at its on-load strain), for
+         * as many sub-steps as the wrapped load's phase takes. */
+        plain_film pf;
+        if (plain_film_load(w, film, 1e-5, &pf) != 0) {
+            fprintf(stderr, "bench_pallet: cannot read the film\n");
+            return 1;
+        }
+        double h = 2.5e-4 / wi.substeps;
+        c0 = cpu();
+        for (long i = 0; i < settle_steps * wi.substeps; i++)
+            plain_step(pf.nd, pf.n, pf.sp, pf.ns, h, -9.81);
+        cpu_plain = fmin(cpu_plain, cpu() - c0);
+        if (!isfinite(plain_film_check(&pf))) {
+            fprintf(stderr, "bench_pallet: the plain loop ran away\n");
+            return 1;
+        }
+        plain_film_free(&pf);
         t0 = now();
         c0 = cpu();
         if ((s = ws_world_step_n(w, settle_steps)) != WS_OK)
@@ -116,6 +139,11 @@ int main(int argc, char **argv)
            1e6 * best_wrap / settle_steps,
            (double)nodes * substeps * settle_steps / best_wrap / 1e6, nodes, substeps,
            settle_steps, repeats, best_wrap, cpu_wrap);
+    printf("plain loop %8.0f steps/s  %6.1f us/step  %.1f M node-updates/s  (the same film, "
+           "no contacts or bodies; figures of CPU time, %.3f s): wrapped / plain = %.2f (CPU)\n",
+           settle_steps / cpu_plain, 1e6 * cpu_plain / settle_steps,
+           (double)nodes * substeps * settle_steps / cpu_plain / 1e6, cpu_plain,
+           cpu_wrap / cpu_plain);
     printf("  %llu contacts after the run, %llu full detections; state hash %016llx\n",
            (unsigned long long)st.contacts, (unsigned long long)st.full_detections,
            (unsigned long long)hash);

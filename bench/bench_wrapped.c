@@ -2,7 +2,9 @@
  * Prints wall time, steps/s, node-updates/s and where the time goes (contact detection, body
  * contacts, film). Never fails on time.
  * Usage: bench_wrapped [steps] (default 24000: the paper's 6 s, variant P) [P|R] [workers]
- * (workers: of the step, default 1; the state hash is the same for any count). */
+ * [rupture] (workers: of the step, default 1; the state hash is the same for any count;
+ * rupture: the film's rupture strain, default 0: none, as in the reference case; with one the
+ * peak strain and the springs broken are printed too). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -19,6 +21,11 @@ int main(int argc, char **argv)
     tilt_scene sc;
     if (tilt_build(&o, &sc) != WS_OK) {
         fprintf(stderr, "bench_wrapped: cannot build the scene\n");
+        return 1;
+    }
+    const double rupture = argc > 4 ? atof(argv[4]) : 0.0;
+    if (rupture != 0.0 && ws_web_set_rupture_strain(sc.world, sc.film, rupture) != WS_OK) {
+        fprintf(stderr, "bench_wrapped: %s\n", ws_world_last_error(sc.world));
         return 1;
     }
     ws_web_info info;
@@ -45,6 +52,18 @@ int main(int argc, char **argv)
            100 * st.seconds_web / tot);
     printf("  %llu full body detections, %llu feature checks\n",
            (unsigned long long)st.full_detections, (unsigned long long)st.narrow_checks);
+    if (rupture != 0.0) {
+        ws_web_rupture r;
+        ws_web_peak pk;
+        ws_web_get_rupture(sc.world, sc.film, &r);
+        ws_web_get_peak_strain(sc.world, sc.film, &pk);
+        printf("  rupture strain %g: %u of %u springs broken", rupture, r.broken_count,
+               info.spring_count);
+        if (r.ruptured)
+            printf(", the first at t = %.4f s (spring %u, z = %.3f m)", r.first_time,
+                   r.first_spring, r.first_position.z);
+        printf("; peak strain now %.4f (spring %u)\n", pk.strain, pk.spring);
+    }
     uint64_t hash = 0;
     ws_world_get_state_hash(sc.world, &hash);
     ws_vec3 p0, p1;

@@ -638,6 +638,91 @@ START_TEST(test_band_pressure)
 }
 END_TEST
 
+START_TEST(test_scales_and_rupture)
+{
+    /* A mesh web's stiffness scales and broken springs on the implicit film. A row of 5 nodes,
+     * ends pinned, pre-stretch 0.1, EA = 50 N, every spring scaled by 3: settled with drag, each
+     * spring pulls 3 EA 0.1 = 15 N (1e-9). Then a rupture strain of 0.05 breaks them all at the
+     * end of the next step, and from then on the free nodes fall with nothing but gravity and
+     * their drag: the middle node follows backward Euler's recurrence for a free particle
+     * (below) to round-off (1e-12 of its drop). */
+    const double dt = 1e-3, sp = 0.05, l0 = sp / 1.1, EA = 50.0;
+    ws_world *w = world_g(dt, NO_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.1, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.node_damping = 0.05;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-10;
+    double pos[15] = {0};
+    uint32_t pairs[8];
+    double rest[4], scale[4];
+    for (int i = 0; i < 5; i++)
+        pos[3 * i] = i * sp;
+    for (int i = 0; i < 4; i++) {
+        pairs[2 * i] = (uint32_t)i;
+        pairs[2 * i + 1] = (uint32_t)i + 1;
+        rest[i] = l0;
+        scale[i] = 3.0;
+    }
+    const uint32_t pins[2] = {0, 4};
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = pos;
+    md.node_count = 5;
+    md.springs = pairs;
+    md.spring_count = 4;
+    md.rest_lengths = rest;
+    md.pinned = pins;
+    md.pinned_count = 2;
+    md.stiffness_scales = scale;
+    ws_web_id id;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &id));
+    const ws_vec3 down = {0, 0, -G0};
+    ck_ok(w, ws_world_set_gravity(w, &down));
+    ck_ok(w, ws_world_step_n(w, 20));
+    ck_ok(w, ws_world_set_gravity(w, &NO_G));
+    ck_ok(w, ws_world_step_n(w, 3000));
+    double T[4];
+    size_t cnt;
+    ck_ok(w, ws_web_copy_spring_tensions(w, id, T, 4, &cnt));
+    for (int i = 0; i < 4; i++)
+        ck_assert_msg(fabs(T[i] - 3 * EA * 0.1) <= 1e-9 * 3 * EA * 0.1, "spring %d: %.12g", i,
+                      T[i]);
+    ck_ok(w, ws_web_set_rupture_strain(w, id, 0.05));
+    ck_ok(w, ws_world_set_gravity(w, &down));
+    ck_ok(w, ws_world_step(w));
+    ws_web_rupture rp;
+    ck_ok(w, ws_web_get_rupture(w, id, &rp));
+    ck_assert_uint_eq(rp.broken_count, 4);
+    double x0[15], v0[15], x1[15];
+    ck_ok(w, ws_web_copy_positions(w, id, x0, 5, &cnt));
+    ck_ok(w, ws_web_copy_velocities(w, id, v0, 5, &cnt));
+    const int K = 50;
+    ck_ok(w, ws_world_step_n(w, K));
+    ck_ok(w, ws_web_copy_positions(w, id, x1, 5, &cnt));
+    /* The middle node alone under gravity and its drag d: backward Euler's step is
+     * v' = (m v + h m g) / (m + h d), z' = z + h v'. */
+    const double m = 1e-3, d = 0.05;
+    double v = v0[3 * 2 + 2], z = x0[3 * 2 + 2];
+    for (int k = 0; k < K; k++) {
+        v = (m * v + dt * m * -G0) / (m + dt * d);
+        z += dt * v;
+    }
+    const double drop = x0[3 * 2 + 2] - z;
+    report("after the break: middle node dropped %.9g m in %d steps, backward Euler's free "
+           "fall %.9g m",
+           x0[3 * 2 + 2] - x1[3 * 2 + 2], K, drop);
+    ck_assert(drop > 1e-3);
+    ck_assert_msg(fabs(x1[3 * 2 + 2] - z) <= 1e-12 * drop, "z %.15g vs %.15g", x1[3 * 2 + 2], z);
+    ws_world_destroy(w);
+    report("scales and rupture on the implicit film: tensions 3 EA p, %u springs broken",
+           rp.broken_count);
+}
+END_TEST
+
 /* ---- 4. a failed solve ---- */
 
 START_TEST(test_failed_solve_leaves_world)
@@ -733,6 +818,7 @@ int main(void)
     add_case(s, "row_tension", test_row_tension, 20);
     add_case(s, "converges_to_explicit", test_converges_to_explicit, 60);
     add_case(s, "band_pressure", test_band_pressure, 60);
+    add_case(s, "scales_and_rupture", test_scales_and_rupture, 10);
     add_case(s, "failed_solve_leaves_world", test_failed_solve_leaves_world, 10);
     add_case(s, "bad_solver_defs", test_bad_solver_defs, 10);
     return run_suite(s);

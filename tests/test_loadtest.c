@@ -627,7 +627,24 @@ START_TEST(the_wrapped_pallet_load_holds_together)
     ws_wrap_def wr;
     ws_wrap_def_init(&wr);
     ws_web_id film;
+    /* A film that would break as it is laid, or a bad figure of its elongation, is refused. */
+    wr.rupture_strain = 0.05; /* below the 10 % laid on */
+    ck_assert_int_eq(ws_load_wrap_band(w, ld, &wr, &film), WS_ERR_INVALID_ARGUMENT);
+    ck_assert(strstr(ws_world_last_error(w), "would break as it is laid"));
+    wr.rupture_strain = 0;
+    wr.powered_prestretch = 4.0; /* as much as the film's elongation at break */
+    ck_assert_int_eq(ws_load_wrap_band(w, ld, &wr, &film), WS_ERR_INVALID_ARGUMENT);
+    wr.powered_prestretch = 2.5;
+    wr.elongation_at_break = NAN;
+    ck_assert_int_eq(ws_load_wrap_band(w, ld, &wr, &film), WS_ERR_INVALID_ARGUMENT);
+    ck_assert(strstr(ws_world_last_error(w), "elongation_at_break"));
+    ws_wrap_def_init(&wr);
     ck_ok(w, ws_load_wrap_band(w, ld, &wr, &film));
+    /* The default rupture strain: 400 % elongation at break from unstretched, 250 % powered
+     * pre-stretch: 5 / 3.5 - 1 of the rest length. */
+    ws_web_rupture ru;
+    ck_ok(w, ws_web_get_rupture(w, film, &ru));
+    ck_assert(fabs(ru.rupture_strain - (5.0 / 3.5 - 1.0)) < 1e-15);
     ws_load_info in;
     ck_assert_int_eq(ws_load_get_info(ld, &in), WS_OK);
     ck_assert_uint_eq(in.film.bits, film.bits);
@@ -649,6 +666,7 @@ START_TEST(the_wrapped_pallet_load_holds_together)
     ck_assert_ptr_nonnull(state);
     ck_ok(w, ws_world_save(w, state, len, &len));
     const double ks[2] = {0.3, 0.5};
+    double peak0 = 0;
     /* Under WS_TEST_SHORT (sanitizers, valgrind) one brief pulse of 0.05 g runs the code of a
      * wrapped run; the physics is checked in the full run. */
     for (int i = 0; i < (short_run() ? 1 : 2); i++) {
@@ -685,8 +703,80 @@ START_TEST(the_wrapped_pallet_load_holds_together)
         for (int b = 0; b < 3; b++)
             ck_assert(r.containment[b].line_load > 100);
         ck_assert(r.film_peak_strain > 0.02 && r.film_peak_strain < 0.3);
+        /* No rupture: the film's peak stays far below its 0.43. */
+        ck_assert(v->rupture.pass && v->rupture.value == 0 && v->rupture.limit == 0);
         if (i == 0)
             ck_assert_int_eq(v->pass, 1);
+        if (i == 0)
+            peak0 = r.film_peak_strain;
+    }
+    /* The 0.3 g run again with the film's rupture strain between its peak at rest and its peak
+     * in the run: until a spring breaks it is the same run to the bit (a limit changes
+     * nothing before a break), so the film must break in it, be reported when it does, and
+     * fail the verdict's "no rupture". Under WS_TEST_SHORT the brief pulse with a limit just
+     * below the peak at rest: the film breaks in the run's first step. */
+    {
+        ck_ok(w, ws_world_restore(w, state, len));
+        ws_web_peak pk;
+        ck_ok(w, ws_web_get_peak_strain(w, film, &pk));
+        ck_assert(short_run() || peak0 > pk.strain + 1e-3);
+        const double lim = short_run() ? 0.99 * pk.strain : 0.5 * (pk.strain + peak0);
+        ck_ok(w, ws_web_set_rupture_strain(w, film, lim));
+        ws_eumos_def e;
+        ws_eumos_def_init(&e);
+        e.k = ks[0];
+        e.rest_after = 0.3;
+        if (short_run()) {
+            e.k = 0.05;
+            e.rise_time = 0.01;
+            e.hold_time = 0;
+            e.coast_time = 0;
+            e.rest_after = 0;
+        }
+        ws_eumos_result r;
+        ck_ok(w, ws_loadtest_run_eumos(w, ld, &e, &r));
+        const ws_loadtest_event *ev = NULL;
+        for (int k = 0; k < r.event_count; k++)
+            if (r.events[k].type == WS_LOADTEST_RUPTURE)
+                ev = &r.events[k];
+        ck_assert_msg(ev != NULL, "no rupture event");
+        ck_ok(w, ws_web_get_rupture(w, film, &ru));
+        report("wrapped pallet load at %.1f g, film rupture strain %.4f (peak %.4f at rest, %.4f "
+               "in the run): the film broke at t = %.3f s (%.2f g), spring %d at strain %.4f, "
+               "z = %.3f m; %u springs broken by the end: %s",
+               e.k, lim, pk.strain, peak0, ev->time, ev->level, ev->index, ev->value,
+               ru.first_position.z, ru.broken_count, r.verdict.pass ? "pass" : "fail");
+        ck_assert(ev->value > lim && ev->index >= 0 && ev->time > 0 && ev->time < r.duration);
+        ck_assert(r.verdict.rupture.value >= 1 && !r.verdict.rupture.pass && !r.verdict.pass);
+        ck_assert(r.verdict.rupture.value == (double)ru.broken_count);
+    }
+    /* The other runs share the measurements: an impact on the wrapped load whose film breaks
+     * at once (its limit just below its peak at rest) reports the break and fails its
+     * rupture check. */
+    {
+        ck_ok(w, ws_world_restore(w, state, len));
+        ws_web_peak pk;
+        ck_ok(w, ws_web_get_peak_strain(w, film, &pk));
+        ck_ok(w, ws_web_set_rupture_strain(w, film, 0.99 * pk.strain));
+        ws_impact_test_def im;
+        ws_impact_test_def_init(&im);
+        im.speed = 0.3;
+        im.pulse_duration = 0.05;
+        im.gentle_acceleration = 2.0;
+        im.coast_time = 0;
+        im.rest_after = 0;
+        ws_loadtest_result lr;
+        ck_ok(w, ws_loadtest_run_impact(w, ld, &im, &lr));
+        int events = 0;
+        for (int k = 0; k < lr.event_count; k++)
+            events += lr.events[k].type == WS_LOADTEST_RUPTURE;
+        const ws_loadtest_check *rc = NULL;
+        for (int k = 0; k < lr.verdict.count; k++)
+            if (lr.verdict.check[k].id == WS_CHECK_RUPTURE)
+                rc = &lr.verdict.check[k];
+        ck_assert_int_eq(events, 1);
+        ck_assert_ptr_nonnull(rc);
+        ck_assert(rc->value >= 1 && rc->limit == 0 && !rc->pass && !lr.verdict.pass);
     }
     free(state);
     ws_load_destroy(ld);

@@ -473,7 +473,7 @@ START_TEST(refuses_bad_saves)
     expect_refused(b.world, c, n, WS_ERR_FORMAT, "not a saved");
     memcpy(c, buf, n);
     c[8] = 3; /* format version 3 */
-    expect_refused(b.world, c, n, WS_ERR_FORMAT, "version 3 is newer than this library's 1");
+    expect_refused(b.world, c, n, WS_ERR_FORMAT, "version 3 is newer than this library's 2");
     memcpy(c, buf, n);
     for (int i = 0; i < 4; i++) /* the byte-order mark written big-endian */
         c[12 + i] = (unsigned char)(i + 1);
@@ -575,9 +575,9 @@ START_TEST(save_sizes)
     ck_assert_int_eq(ws_world_save(a.world, b, n, NULL), WS_ERR_INVALID_ARGUMENT);
     ck_assert_int_eq(ws_world_save(NULL, b, n, &m), WS_ERR_INVALID_ARGUMENT);
     ck_ok(a.world, ws_world_save(a.world, b, n, &m));
-    /* The header as documented: magic, version 1, the byte-order mark, the state's length. */
+    /* The header as documented: magic, version 2, the byte-order mark, the state's length. */
     ck_assert(memcmp(b, "WSSTATE", 8) == 0);
-    ck_assert(b[8] == 1 && b[9] == 0 && b[10] == 0 && b[11] == 0);
+    ck_assert(b[8] == 2 && b[9] == 0 && b[10] == 0 && b[11] == 0);
     ck_assert(b[12] == 4 && b[13] == 3 && b[14] == 2 && b[15] == 1);
     uint64_t len = 0;
     for (int i = 7; i >= 0; i--)

@@ -5,7 +5,7 @@
 #                                           install, build the Python package into .venv/, and
 #                                           run `wrapsim run LOAD -o wrapsim-out ARGS`: a load
 #                                           file through its test, printing the verdict
-#                                           (default examples/loads/eur_pallet_eumos.json)
+#                                           (default examples/loads/eur_pallet_spiral.json)
 #   tools/quickstart.sh tilt [ARGS...]      install, build, run build/examples/tilt_table ARGS
 #   tools/quickstart.sh test [ARGS...]      install, build, meson test ARGS, then the Python
 #                                           binding's pytest suite; last line
@@ -56,7 +56,7 @@ fi
 ensure_packages "${packages[@]}"
 
 if [[ $mode == example ]]; then
-    load=examples/loads/eur_pallet_eumos.json
+    load=examples/loads/eur_pallet_spiral.json
     if (($# >= 1)) && [[ $1 != -* ]]; then
         load=$1
         shift

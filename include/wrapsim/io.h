@@ -150,8 +150,9 @@ WS_API ws_status ws_vtk_series_get_frame_count(const ws_vtk_series *series, size
 /** Close the series (the files stay). NULL is allowed. Destroy it before its world. */
 WS_API void ws_vtk_series_destroy(ws_vtk_series *series);
 
-/** The save format this library writes; it reads this one and the older ones. */
-#define WS_SAVE_FORMAT_VERSION 1
+/** The save format this library writes; it reads this one and the older ones. Version 2 adds
+ *  the webs' rupture (broken springs); a version 1 save restores with none broken. */
+#define WS_SAVE_FORMAT_VERSION 2
 
 /** Save the world's state into `buf` (`cap` bytes): the time and step count, every body's
  *  position, orientation and velocities, every web's node positions and velocities and its

@@ -140,7 +140,8 @@ typedef struct ws_load_info {
     double load_height;         /**< from the platform's top face to the top of the load, m */
     double pallet_top;          /**< height of the pallet's deck above the platform's top, m */
     double total_mass;          /**< pallet + cartons, kg */
-    ws_web_id film;             /**< the film of ws_load_wrap_band(); null when unwrapped */
+    ws_web_id film;             /**< the film of ws_load_wrap_band() or ws_load_wrap_spiral();
+                                     null when unwrapped */
 } ws_load_info;
 
 /** One carton as built. */
@@ -258,6 +259,20 @@ typedef struct ws_wrap_def {
     /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
      *  stable-step check accepts (ws_world_get_stable_fraction, ws_web_get_stable_dt) */
     int substeps;
+    /* ---- film rupture (trailing fields: older callers get the defaults) ---- */
+    /** The film's elongation at break, from its unstretched length (>= 0; 0: the film never
+     *  breaks, unless rupture_strain is given). Default 4.0: 400 %, in the middle of LLDPE
+     *  stretch film's 300-500 %. */
+    double elongation_at_break;
+    /** The powered pre-stretch the film got before it was laid, from its unstretched length
+     *  (>= 0, below elongation_at_break): the springs' rest length is the film after it.
+     *  Default 2.5 (250 %, a machine's pre-stretch carriage); 0 for a hand wrap. */
+    double powered_prestretch;
+    /** The web's rupture strain (ws_web_def.rupture_strain) when > 0; 0 (the default): from
+     *  the two above, (1 + elongation_at_break) / (1 + powered_prestretch) - 1, 0.43 with the
+     *  defaults. Must be above strain_around and strain_up (the film would break as it is
+     *  laid). */
+    double rupture_strain;
 } ws_wrap_def;
 
 /** Fill a wrap Def with the defaults above. NULL is ignored.
@@ -279,6 +294,141 @@ WS_API void(ws_wrap_def_init)(ws_wrap_def *def);
  *  creation. */
 WS_API ws_status ws_load_wrap_band(ws_world *world, ws_load *load, const ws_wrap_def *def,
                                    ws_web_id *out);
+
+/** A spiral wrap as a stretch-wrapping machine lays it (docs/guide.md, chapter 11, and
+ *  docs/theory.md, "The spiral wrap"): a film of `width` and `gauge` off the roll, stretched on
+ *  the carriage by the powered `prestretch`, which thins it and narrows it by `neck_in`, laid
+ *  round the turning load holding the elastic `load_strain`; `revolutions_bottom` at the
+ *  bottom, then a spiral up whose revolutions overlap by `overlap` of the laid width,
+ *  `revolutions_top` at the top and, with `passes` = 2, the spiral down again. Where revolutions
+ *  overlap the film has the stiffness and mass of every layer there. Fill with
+ *  ws_spiral_wrap_def_init(). */
+typedef struct ws_spiral_wrap_def {
+    uint32_t size;  /**< set by ws_spiral_wrap_def_init() */
+    uint32_t magic; /**< set by ws_spiral_wrap_def_init() */
+    double width;   /**< film width off the roll, m (> 0); default 0.5 */
+    double gauge;   /**< film thickness off the roll, m (> 0); default 20e-6 */
+    /** Young's modulus of the film as it lies on the load (after the pre-stretch), Pa (> 0);
+     *  default 150e6 */
+    double modulus;
+    double density;    /**< kg/m^3 (> 0); default 920 */
+    /** Powered pre-stretch, as a fraction: 2.0 is 200 %, a metre off the roll becomes three on
+     *  the load (0 .. 10); default 2.0. Plastic: it thins the film (volume kept), it is not the
+     *  strain the film holds on the load. */
+    double prestretch;
+    /** Fraction of the width the pre-stretch takes away (the film necks between the rollers;
+     *  0 .. 0.9); default 0.15: a 500 mm film lies 425 mm wide. */
+    double neck_in;
+    /** The elastic strain the film holds on the load, measured from its pre-stretched length:
+     *  the stretch between the carriage's last roller and the load (> 0, < 1); default 0.1. */
+    double load_strain;
+    double revolutions_bottom; /**< revolutions at the lowest height (>= 0); default 2 */
+    double revolutions_top;    /**< revolutions at the highest height (>= 0); default 2 */
+    /** Fraction of the laid width by which a revolution of the spiral overlaps the one before
+     *  (0 .. 0.95); default 0.5 (every spiral pass lays two layers) */
+    double overlap;
+    int passes;        /**< 1: spiral up; 2: up and down again; default 2 */
+    /** 1 (default): the film's lower edge goes down onto the pallet, `lock_height` above the
+     *  platform's top, and locks the load to it; 0: it starts `lock_height` above the deck. */
+    int pallet_lock;
+    double lock_height; /**< m (>= 0); default 0.05 */
+    /** The film's upper edge this far below the top of the load, m (>= 0); default 0.02 */
+    double top_margin;
+    /** Revolutions of roped film (the width rolled into a cable) at `rope_height` (>= 0);
+     *  default 0: no roping */
+    double rope_revolutions;
+    double rope_height; /**< m above the platform's top (> 0 when roping); default 0.2 */
+    /** 1: a top sheet, a loose sheet of film over the top face laid before the top
+     *  revolutions, which hold its edges (it joins the film's highest row over the load's top
+     *  edges); 0 (default): none */
+    int top_sheet;
+    /** thickness of the top sheet, m (> 0; it is not pre-stretched); default 50e-6 */
+    double top_sheet_gauge;
+    double node_pitch;  /**< node spacing on the load, m (> 0); default 0.05 */
+    /** Smallest node mass, kg (>= 0): nodes lighter than this (the film's real mass from its
+     *  layers) are made this heavy, so fewer sub-steps are stable. Default 0: the real mass. */
+    double node_mass_min;
+    /** film sub-steps per world step (>= 1), or 0 (the default): the fewest that the world's
+     *  stable-step check accepts */
+    int substeps;
+    /* ---- film rupture (trailing fields: older callers get the defaults) ---- */
+    /** The film's elongation at break, from its length off the roll (>= 0; 0: the film never
+     *  breaks, unless rupture_strain is given). Default 4.0 (400 %, LLDPE stretch film breaks
+     *  at 300-500 %). Must be above `prestretch`. */
+    double elongation_at_break;
+    /** The web's rupture strain (ws_web_def.rupture_strain) when > 0; 0 (the default): from the
+     *  elongation at break and the pre-stretch, (1 + elongation_at_break) / (1 + prestretch) - 1,
+     *  0.667 with the defaults; either way above `load_strain` (the film would break as it is
+     *  laid). The top sheet, not pre-stretched, takes the same limit: it breaks early, if
+     *  ever. */
+    double rupture_strain;
+} ws_spiral_wrap_def;
+
+/** Fill a spiral wrap Def with the defaults above. NULL is ignored. */
+WS_API void ws_spiral_wrap_def_init_sized(ws_spiral_wrap_def *def, size_t size);
+/** The plain form of the init (the whole Def of these headers). */
+WS_API void(ws_spiral_wrap_def_init)(ws_spiral_wrap_def *def);
+/** Fill with defaults: ws_spiral_wrap_def_init_sized with the caller's sizeof. */
+#define ws_spiral_wrap_def_init(def) ws_spiral_wrap_def_init_sized((def), sizeof *(def))
+
+/** Wrap the load as it stands in a spiral of film (the load's film material): one web, a grid
+ *  of nodes round the load (rows node_pitch apart or less, following the load's outline at
+ *  their height, a node on every vertical corner), each node's mass and each spring's stiffness
+ *  the sum over the film layers the spiral lays there (ws_web_mesh_def.stiffness_scales). The
+ *  film is laid in equilibrium: each row's around-springs share one tension (the row's mean
+ *  layers x E h_l x load_strain a unit height, h_l the laid thickness), the corners' nodes sit
+ *  as deep in their contact as that tension presses them, nothing is stretched up the load, so
+ *  a load that stood still stands still wrapped. The platform must be level, its frame the
+ *  global one; the load's outline at each height is taken as the rectangle of its bodies there
+ *  (as ws_load_build makes them).
+ *  @param out receives the web (also in ws_load_info.film)
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def: the message names the field, a
+ *  load of another world, a load already wrapped), WS_ERR_UNINITIALIZED_DEF,
+ *  WS_ERR_OUT_OF_MEMORY, errors of the web's creation. */
+WS_API ws_status ws_load_wrap_spiral(ws_world *world, ws_load *load,
+                                     const ws_spiral_wrap_def *def, ws_web_id *out);
+/** The film layers the spiral of `def` lays on a load `height` m high (from the platform's top)
+ *  whose deck is at `deck` m, at height z (m above the platform's top) and a place `s` m round
+ *  the load's outline of perimeter `perimeter` m from where the film starts (the middle of the
+ *  load's face towards -y); roping not counted. A whole number: the revolutions covering it.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def or geometry), WS_ERR_UNINITIALIZED_DEF. */
+WS_API ws_status ws_spiral_wrap_layers(const ws_spiral_wrap_def *def, double height, double deck,
+                                       double perimeter, double s, double z, int *layers);
+
+/** The containment of one height band of a wrapped load. */
+typedef struct ws_load_containment {
+    double z_low;  /**< m above the platform's top, the band's lower bound */
+    double z_high; /**< its upper bound */
+    /** Containment force, N: how hard the film in the band squeezes the load across its two
+     *  vertical mid-planes (through the pallet's centre, along x and along y), from the bodies'
+     *  contact forces on the film's nodes: sum over the nodes of (s_x F_x + s_y F_y) / 8, s = +1
+     *  on the low side of a plane and -1 on the high side. The film in equilibrium crosses each
+     *  plane twice at its hoop tension T, so each plane's squeeze is 2 T from either side and
+     *  the force is T: the band's hoop tension, read from what the load feels (the pull-plate
+     *  quantity, for the whole band). */
+    double force;
+    /** The film's own hoop tension across the band, N: the sum over the film's rows in the band
+     *  of each row's mean around-spring tension. Equal to `force` when the film is at rest. */
+    double hoop_tension;
+    double line_load;     /**< force per metre of the band's height, N/m */
+    double contact_force; /**< sum of |contact force| on the band's nodes, N */
+    int rows;             /**< film rows in the band */
+} ws_load_containment;
+
+/** Containment of a wrapped load (ws_load_wrap_band or ws_load_wrap_spiral) in `count` equal
+ *  height bands of the load, bottom first (3: bottom, middle, top thirds from the platform's
+ *  top to the load's top), from the last step's contact forces and the film's present state.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, count 0 or above 64, a load that is not
+ *  wrapped, a load of another world), WS_ERR_STALE_HANDLE (the film destroyed). */
+WS_API ws_status ws_load_get_containment(const ws_world *world, const ws_load *load,
+                                         ws_load_containment *bands, size_t count);
+/** The film's largest spring strain now (l/l0 - 1), the spring's index (ws_web_copy_springs
+ *  order) and its height (mean of its ends' z, m above the platform's top). Any output but
+ *  `strain` may be NULL.
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a load that is not wrapped),
+ *  WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY. */
+WS_API ws_status ws_load_get_film_peak(const ws_world *world, const ws_load *load,
+                                       double *strain, uint32_t *spring, double *height);
 
 /* ---------------------------------------------------------------------------------------- */
 /* EUMOS 40509 */
@@ -307,6 +457,11 @@ typedef struct ws_loadtest_sample {
     const double *layer_displacement; /**< per layer: mean displacement along the direction, m */
     int interfaces;       /**< entries of interface[] (layers + 1) */
     const ws_loadtest_interface_state *interface; /**< per interface */
+    /** Tilt runs: the platform's angle, rad (level is then tan of it); 0 for the others */
+    double angle;
+    /** Per carton (entries: cartons), the interface under it alone: the normal force, slip
+     *  speed and friction use of the contacts that carry it, as interface[] for a layer */
+    const ws_loadtest_interface_state *carton_base;
 } ws_loadtest_sample;
 
 /** The acceleration test of EUMOS 40509 as the platform's WS_DRIVE_PULSE drive: the platform
@@ -357,7 +512,8 @@ typedef enum ws_loadtest_event_type {
     /** A carton left the load: its centre left the pallet's footprint or fell by half its
      *  height. */
     WS_LOADTEST_CARTON_LOST = 2,
-    /** Film rupture (not produced by unwrapped loads). */
+    /** Film rupture: the first spring of the film broke in the run (ws_web_get_rupture).
+     *  layer -1, index the spring, value its strain. Wrapped loads only. */
     WS_LOADTEST_RUPTURE = 3
 } ws_loadtest_event_type;
 
@@ -393,7 +549,8 @@ typedef struct ws_eumos_verdict {
     /** Largest permanent displacement of a layer relative to the layer under it (or the pallet),
      *  layer means, m; limit 0.02 H (strictly less). */
     ws_loadtest_criterion layer_shift;
-    /** Film ruptures; limit 0. */
+    /** Film rupture: springs of the film broken by the end of the run (ws_web_get_rupture);
+     *  limit 0. */
     ws_loadtest_criterion rupture;
     int pass; /**< 1 if every criterion passes */
 } ws_eumos_verdict;
@@ -426,7 +583,9 @@ typedef struct ws_eumos_result {
      *  three equal height bands, bottom, middle, top (ws_web_get_containment(): hoop tension,
      *  N, line load, N/m, and the bodies' normal force on it, N); zero when unwrapped. */
     ws_containment_band containment[3];
-    double film_peak_strain; /**< largest spring strain of the film during the run (0: none) */
+    /** largest strain of an intact spring of the film during the run (0: none); where it is
+     *  now: ws_web_get_peak_strain() */
+    double film_peak_strain;
 } ws_eumos_result;
 
 /** Fill a EUMOS Def with the defaults above. NULL is ignored.
@@ -469,6 +628,9 @@ typedef struct ws_kvalue_def {
     /** A wrap to put on the load after it settled (it then settles settle_time again before the
      *  state is saved); NULL (default) for the load unwrapped. Read during the call only. */
     const ws_wrap_def *wrap;
+    /** A spiral wrap (ws_load_wrap_spiral()) to put on the load after it settled, when `wrap`
+     *  is NULL; NULL (default) for none. Read during the call only. */
+    const ws_spiral_wrap_def *spiral;
 } ws_kvalue_def;
 
 /** What the k-value search found. */
@@ -500,6 +662,268 @@ WS_API void(ws_kvalue_def_init)(ws_kvalue_def *def);
 WS_API ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *load_def,
                                     const ws_eumos_def *eumos_def, const ws_kvalue_def *def,
                                     ws_kvalue_result *result);
+
+/* ---------------------------------------------------------------------------------------- */
+/* Tilt, horizontal impact, random vibration and sine sweep */
+
+/** Most criteria a verdict of ws_loadtest_result holds. */
+#define WS_LOADTEST_MAX_CHECKS 8
+/** Frequency bins of a sweep's response (ws_loadtest_result.response_*). */
+#define WS_LOADTEST_RESPONSE_BINS 48
+
+/** Which test a ws_loadtest_result is of. */
+typedef enum ws_loadtest_kind {
+    WS_LOADTEST_TILT = 1,    /**< ISO 10531 tilt (ws_loadtest_run_tilt) */
+    WS_LOADTEST_IMPACT = 2,  /**< horizontal impact (ws_loadtest_run_impact) */
+    WS_LOADTEST_RANDOM = 3,  /**< random vibration (ws_loadtest_run_vibration) */
+    WS_LOADTEST_SWEEP = 4    /**< sine sweep (ws_loadtest_run_vibration) */
+} ws_loadtest_kind;
+
+/** What a criterion of a ws_loadtest_verdict measures (ws_loadtest_check_name() gives its name;
+ *  docs/guide.md, chapter 11, its basis). */
+typedef enum ws_loadtest_check_id {
+    /** Tilt: the angle (rad) at the first failure event (a slip onset, a tip onset, a carton
+     *  leaving the load), or the largest angle reached when none came; at least the target. */
+    WS_CHECK_STABLE_ANGLE = 1,
+    /** Cartons that left the load; at most 0. */
+    WS_CHECK_CARTONS_LOST = 2,
+    /** Largest horizontal displacement of any carton relative to the pallet after the run and
+     *  its rest, m; at most 0.05 H (EUMOS 40509's permanent limit). */
+    WS_CHECK_PERMANENT = 3,
+    /** Largest shift of a layer's mean relative to the layer under it after the run, m; less
+     *  than 0.02 H (EUMOS 40509's layer limit). */
+    WS_CHECK_LAYER_SHIFT = 4,
+    /** Impact: |delivered velocity change - speed| / speed; at most 0.01. */
+    WS_CHECK_VELOCITY_CHANGE = 5,
+    /** Random: |delivered Grms - target| / target over the untapered part; at most 0.10 (a
+     *  run of seconds samples its history's Grms with a scatter of a few percent) */
+    WS_CHECK_GRMS = 6,
+    /** Sweep: the resonance found, Hz; at least the Def's resonance_min. */
+    WS_CHECK_RESONANCE = 7,
+    /** Wrapped loads: springs of the film broken by the end of the run (ws_web_get_rupture);
+     *  at most 0. */
+    WS_CHECK_RUPTURE = 8
+} ws_loadtest_check_id;
+
+/** One criterion of a verdict: what it measures, the measured value, the limit and pass. */
+typedef struct ws_loadtest_check {
+    int id;         /**< ws_loadtest_check_id */
+    /** 1: the value must be at least the limit; 0: at most the limit (less than it for
+     *  WS_CHECK_LAYER_SHIFT) */
+    int at_least;
+    double value;   /**< measured, in the unit of the criterion */
+    double limit;   /**< its bound */
+    int pass;       /**< 1 if it passes */
+} ws_loadtest_check;
+
+/** The verdict of a tilt, impact or vibration run. */
+typedef struct ws_loadtest_verdict {
+    double load_height;  /**< H, m: platform top to the top of the load */
+    int count;           /**< criteria in check[] */
+    ws_loadtest_check check[WS_LOADTEST_MAX_CHECKS]; /**< in the order of the test's table */
+    int pass;            /**< 1 if every criterion passes */
+} ws_loadtest_verdict;
+
+/** Everything a tilt, impact or vibration run measured. Levels are the drive's: the platform's
+ *  acceleration along the drive's direction in g, or on the tilt tan theta (the along-platform
+ *  share of gravity over the normal one, which takes the place of a/g). */
+typedef struct ws_loadtest_result {
+    int kind;              /**< ws_loadtest_kind */
+    double duration;       /**< s simulated */
+    double peak_level;     /**< largest |level| at the samples */
+    /** Tilt: the largest angle reached, rad */
+    double angle_reached;
+    /** Tilt: the angle (rad) at the first failure event, or -1 when none came */
+    double failure_angle;
+    /** Tilt: index in events[] of the first failure event, or -1 */
+    int failure_event;
+    /** Impact: the platform's speed as the programmer's pulse began, m/s */
+    double impact_speed;
+    /** Impact: the velocity change the pulse delivered, m/s: the integral of the delivered
+     *  acceleration over the pulse (trapezoids at every step) */
+    double velocity_change;
+    /** Impact: the largest deceleration delivered at the steps, g */
+    double peak_deceleration;
+    /** Random: the Grms the platform delivered over the untapered part (every step), g */
+    double grms_delivered;
+    double grms_target;    /**< random: the Grms asked, g */
+    /** Sweep: the load's resonance, Hz: where the top layer's transmissibility peaks (0 when
+     *  the sweep found no peak inside its band) */
+    double resonance_frequency;
+    /** Sweep: the top layer's transmissibility there (its vertical velocity amplitude over the
+     *  platform's, as the acceleration ratio for a steady sine) */
+    double resonance_transmissibility;
+    /** Sweep: bins of the response, equal ratios from f1 to f2 (entries used) */
+    int response_bins;
+    double response_frequency[WS_LOADTEST_RESPONSE_BINS];        /**< bin centres, Hz */
+    double response_transmissibility[WS_LOADTEST_RESPONSE_BINS]; /**< top layer, per bin */
+    int layers;            /**< entries used in the per-layer arrays */
+    double layer_max[WS_LOAD_MAX_LAYERS];       /**< per layer: largest horizontal displacement of
+                                                     its cartons during the run, m */
+    double layer_permanent[WS_LOAD_MAX_LAYERS]; /**< per layer: largest at the end, m */
+    double layer_tilt[WS_LOAD_MAX_LAYERS];      /**< per layer: largest tilt, rad */
+    double interface_slip_max[WS_LOAD_MAX_LAYERS + 1]; /**< per interface: largest slip speed */
+    double interface_use_max[WS_LOAD_MAX_LAYERS + 1];  /**< per interface: largest friction use */
+    int cartons_lost;      /**< cartons that left the load */
+    int event_count;       /**< events kept in events[] */
+    int events_dropped;    /**< events beyond WS_LOADTEST_MAX_EVENTS */
+    ws_loadtest_event events[WS_LOADTEST_MAX_EVENTS]; /**< in time order */
+    /** largest strain of an intact spring of the film (0: unwrapped) */
+    double film_peak_strain;
+    ws_loadtest_verdict verdict; /**< the verdict */
+} ws_loadtest_result;
+
+/** The name of a criterion ("stable_angle", "cartons_lost" ...; "unknown" for another id):
+ *  static text. */
+WS_API const char *ws_loadtest_check_name(int id);
+
+/** ISO 10531 tilt: the platform turns about a horizontal axis in its top face at `rate` from
+ *  level, smoothly (the rate ramped in over ramp_time), to max_angle, where it stops smoothly
+ *  and holds; the run ends hold_time after it stands, or after_failure after the first failure
+ *  event when stop_at_failure is set. Fill with ws_tilt_test_def_init(). */
+typedef struct ws_tilt_test_def {
+    uint32_t size;  /**< set by ws_tilt_test_def_init() */
+    uint32_t magic; /**< set by ws_tilt_test_def_init() */
+    double rate;         /**< rad/s (> 0, <= 1); default 0.05 (2.9 degrees a second) */
+    /** rad (> 0, < pi/2): the load must stand to this angle; default atan(0.5), 26.6 degrees,
+     *  where tan theta equals EUMOS 40509's 0.5 g */
+    double target_angle;
+    /** rad (>= target_angle, < pi/2), where the platform stops; 0 (default): target_angle */
+    double max_angle;
+    double ramp_time;    /**< s (>= 0) of the smooth start; default 0.5 */
+    double stop_time;    /**< s (>= 0) of the smooth stop at max_angle; default 1.0 */
+    double hold_time;    /**< s (>= 0) at max_angle; default 0.5 */
+    int stop_at_failure; /**< 1 (default): end after_failure s after the first failure event */
+    double after_failure; /**< s (>= 0); default 0.5 */
+    /** Downhill, in the platform's frame, horizontal; normalised; default (1, 0, 0). The axis
+     *  runs along the top face of the platform under the pallet's centre, across it. */
+    ws_vec3 direction;
+    double rest_before;   /**< s at rest before the tilt starts (>= 0); default 0.05 */
+    /** m/s (> 0): an interface whose load-weighted mean slip speed passes this is slipping;
+     *  default 0.0002: past tan theta = mu a box gains slip speed as g rate t^2 / (2 cos
+     *  theta), so at the default rate the event falls 0.5 % of tan theta after the onset; the
+     *  stick springs' stretch before it moves a load at about 1e-5 m/s */
+    double slip_speed;
+    /** Tip onset: an edge of a base that carried load now carries less than this share of its
+     *  body's support (> 0, < 0.5); default 0.001 */
+    double tip_fraction;
+    int sample_interval;  /**< steps between measurements (>= 1); default 4 */
+    /** 0 (default): the world is restored to the state it had before the run (ws_world_save /
+     *  ws_world_restore), the platform static; 1: it is left as the run ended */
+    int keep_state;
+    /** Called after each measurement (NULL for none); non-zero stops the run (WS_ERR_CALLBACK) */
+    int (*on_sample)(void *user, const ws_loadtest_sample *sample);
+    void *sample_user;    /**< passed to on_sample */
+} ws_tilt_test_def;
+
+/** Horizontal impact (ASTM D4003 / D5414, ISTA 3E): the platform runs up gently to `speed`,
+ *  coasts, and is stopped by a programmer: a half-sine deceleration of pulse_duration whose
+ *  velocity change is `speed` (WS_DRIVE_IMPACT); then rest. Fill with
+ *  ws_impact_test_def_init(). */
+typedef struct ws_impact_test_def {
+    uint32_t size;  /**< set by ws_impact_test_def_init() */
+    uint32_t magic; /**< set by ws_impact_test_def_init() */
+    double speed;          /**< m/s at impact (> 0, <= 20); default 1.2 (e.g. 1.2 or 1.75) */
+    double pulse_duration; /**< s of the half-sine (> 0, <= 1); default 0.01 */
+    /** Peak of the gentle run-up's acceleration, m/s^2 (> 0); default 2 (0.2 g): the run-up
+     *  takes 2 speed / this */
+    double gentle_acceleration;
+    double coast_time;     /**< s at speed before the impact (>= 0); default 0.2 */
+    double rest_before;    /**< s (>= 0); default 0.05 */
+    double rest_after;     /**< s after the impact before the permanent state (>= 0); 0.5 */
+    /** The platform's travel, in its frame, horizontal; normalised; default (1, 0, 0): the
+     *  load is thrown towards +direction when the platform stops */
+    ws_vec3 direction;
+    double slip_speed;     /**< m/s (> 0), slip onset; default 0.005 */
+    double tip_fraction;   /**< tip onset share (> 0, < 0.5); default 0.01 */
+    int sample_interval;   /**< steps (>= 1); default 4 */
+    int keep_state;        /**< as ws_tilt_test_def; default 0 (restored) */
+    int (*on_sample)(void *user, const ws_loadtest_sample *sample); /**< as the tilt's */
+    void *sample_user;     /**< passed to on_sample */
+} ws_impact_test_def;
+
+/** Random vibration (ASTM D4169 truck, ISTA) or a sine sweep on the platform, vertical by
+ *  default. Fill with ws_vibration_test_def_init(). */
+typedef struct ws_vibration_test_def {
+    uint32_t size;  /**< set by ws_vibration_test_def_init() */
+    uint32_t magic; /**< set by ws_vibration_test_def_init() */
+    int sweep;      /**< 0 (default): random vibration; 1: sine sweep */
+    /** Random: PSD breakpoints (Hz, g^2/Hz), copied; NULL (default): the library's truck
+     *  spectrum (ws_vibration_truck_psd) */
+    const double *psd_frequency;
+    const double *psd_level;  /**< random: g^2/Hz, with psd_frequency */
+    size_t psd_count;         /**< random: breakpoints (>= 2) */
+    /** Random: the Grms to play, g (>= 0): the PSD is scaled to it; 0 plays the PSD as given.
+     *  Default 0.54 (the D4169 truck's medium level; 0.40 and 0.70 are the others) */
+    double grms;
+    uint64_t seed;            /**< random: the same seed, the same history; default 1 */
+    double sample_rate;       /**< random: Hz (> 2 x the top breakpoint); default 1024 */
+    /** Sweep: acceleration amplitude, g (> 0); default 0.25 */
+    double sweep_level;
+    double frequency_start;   /**< sweep: Hz (> 0); default 2 */
+    double frequency_end;     /**< sweep: Hz (> frequency_start); default 40 */
+    ws_sweep_law sweep_law;   /**< sweep: default WS_SWEEP_LOG */
+    /** Sweep: the resonance must be at least this, Hz (>= 0); default 0 (reported only). Set it
+     *  to keep the load's resonance above a vehicle's strong band. */
+    double resonance_min;
+    double duration;          /**< s played (> 0); default 10 */
+    double ramp_time;         /**< s of the taper or fade at both ends (>= 0); default 0.5 */
+    /** Of the shaking, in the platform's frame; normalised; default (0, 0, 1), vertical */
+    ws_vec3 direction;
+    double rest_before;       /**< s (>= 0); default 0.05 */
+    double rest_after;        /**< s (>= 0); default 0.5 */
+    double slip_speed;        /**< m/s (> 0), slip onset; default 0.005 */
+    double tip_fraction;      /**< tip onset share (> 0, < 0.5); default 0.01 */
+    int sample_interval;      /**< steps (>= 1); default 4 */
+    int keep_state;           /**< as ws_tilt_test_def; default 0 (restored) */
+    int (*on_sample)(void *user, const ws_loadtest_sample *sample); /**< as the tilt's */
+    void *sample_user;        /**< passed to on_sample */
+} ws_vibration_test_def;
+
+/** Fill a tilt test Def with the defaults above (NULL is ignored). */
+WS_API void ws_tilt_test_def_init_sized(ws_tilt_test_def *def, size_t size);
+/** The plain form of the init. */
+WS_API void(ws_tilt_test_def_init)(ws_tilt_test_def *def);
+/** Fill with defaults: ws_tilt_test_def_init_sized with the caller's sizeof. */
+#define ws_tilt_test_def_init(def) ws_tilt_test_def_init_sized((def), sizeof *(def))
+/** Fill an impact test Def with the defaults above (NULL is ignored). */
+WS_API void ws_impact_test_def_init_sized(ws_impact_test_def *def, size_t size);
+/** The plain form of the init. */
+WS_API void(ws_impact_test_def_init)(ws_impact_test_def *def);
+/** Fill with defaults: ws_impact_test_def_init_sized with the caller's sizeof. */
+#define ws_impact_test_def_init(def) ws_impact_test_def_init_sized((def), sizeof *(def))
+/** Fill a vibration test Def with the defaults above (NULL is ignored). */
+WS_API void ws_vibration_test_def_init_sized(ws_vibration_test_def *def, size_t size);
+/** The plain form of the init. */
+WS_API void(ws_vibration_test_def_init)(ws_vibration_test_def *def);
+/** Fill with defaults: ws_vibration_test_def_init_sized with the caller's sizeof. */
+#define ws_vibration_test_def_init(def) ws_vibration_test_def_init_sized((def), sizeof *(def))
+
+/** Run the ISO 10531 tilt on a load from the world's present state, with the measurements and
+ *  events of EUMOS (the level is tan theta) and the verdict: WS_CHECK_STABLE_ANGLE (the angle
+ *  at the first failure event, at least target_angle), WS_CHECK_CARTONS_LOST. The world is
+ *  restored at the end unless keep_state (the platform's drive is then static either way).
+ *  @return WS_OK, WS_ERR_INVALID_ARGUMENT (NULL, a bad Def, a load of another world),
+ *  WS_ERR_UNINITIALIZED_DEF, WS_ERR_STALE_HANDLE, WS_ERR_OUT_OF_MEMORY, errors of the step and
+ *  WS_ERR_CALLBACK; the detail is in ws_world_last_error(). On an error the world is restored
+ *  too when it can be. */
+WS_API ws_status ws_loadtest_run_tilt(ws_world *world, ws_load *load, const ws_tilt_test_def *def,
+                                      ws_loadtest_result *result);
+/** Run a horizontal impact on a load from the world's present state: the velocity change the
+ *  programmer delivered (velocity_change, peak_deceleration) and the verdict:
+ *  WS_CHECK_VELOCITY_CHANGE, WS_CHECK_PERMANENT, WS_CHECK_LAYER_SHIFT, WS_CHECK_CARTONS_LOST.
+ *  The world is restored at the end unless keep_state. Errors as ws_loadtest_run_tilt(). */
+WS_API ws_status ws_loadtest_run_impact(ws_world *world, ws_load *load,
+                                        const ws_impact_test_def *def,
+                                        ws_loadtest_result *result);
+/** Run random vibration (the Grms delivered) or a sine sweep (the top layer's transmissibility
+ *  by frequency and the resonance) on a load from the world's present state, and the verdict:
+ *  random WS_CHECK_GRMS, WS_CHECK_LAYER_SHIFT, WS_CHECK_CARTONS_LOST; sweep WS_CHECK_RESONANCE,
+ *  WS_CHECK_LAYER_SHIFT, WS_CHECK_CARTONS_LOST. The world is restored at the end unless
+ *  keep_state. Errors as ws_loadtest_run_tilt(). */
+WS_API ws_status ws_loadtest_run_vibration(ws_world *world, ws_load *load,
+                                           const ws_vibration_test_def *def,
+                                           ws_loadtest_result *result);
 
 #ifdef __cplusplus
 }

@@ -58,6 +58,16 @@ typedef struct ws_web_def {
     ws_law_id law_shear;    /**< law of WS_SPRING_SHEAR springs; required when there are any */
     int substeps;           /**< web sub-steps per world step (>= 1); default 1 */
     const char *name;       /**< optional, copied; used in error messages */
+    /** Rupture: the strain l/l0 - 1 past which a spring breaks (>= 0, finite; 0, the default:
+     *  none), checked at the end of every step. A broken spring carries no force (neither
+     *  spring nor damper) from then on, for good (ws_web_get_rupture). From a film's
+     *  elongation at break e_b, measured from its unstretched length (LLDPE stretch film: 3 to
+     *  5, i.e. 300-500 %), and the powered pre-stretch P that made the film the rest length l0
+     *  is (l0 = (1 + P) x its unstretched length): (1 + e_b) / (1 + P) - 1, e.g. 0.43 for
+     *  e_b = 4, P = 2.5; e_b itself when l0 is the unstretched film (P = 0). The strain the film
+     *  is laid with on the load (a generator's pre-stretch) counts from l0 and so uses part
+     *  of it. A trailing field: older callers get 0. */
+    double rupture_strain;
     int integrator;         /**< ws_web_integrator; default WS_WEB_EXPLICIT */
     double solver_tolerance; /**< implicit webs: the linear solve stops when its residual is
                                   at most this times the larger of the right-hand side's norm
@@ -118,6 +128,11 @@ typedef struct ws_web_mesh_def {
     const uint8_t *kinds;        /**< ws_spring_kind per spring; NULL: all WS_SPRING_AROUND */
     const uint32_t *pinned;      /**< node indices held fixed; may be NULL */
     size_t pinned_count;         /**< entries in pinned */
+    /** Per spring, its force as a multiple of its law's (finite, > 0): e.g. the number of film
+     *  layers the spring stands for, so one law serves a film whose layers vary from place to
+     *  place. Tensions, energy and the stable step read it too. NULL (default): 1 for every
+     *  spring. */
+    const double *stiffness_scales;
 } ws_web_mesh_def;
 
 /** Facts of a web. */
@@ -140,6 +155,31 @@ typedef struct ws_containment_band {
     double line_load;      /**< hoop tension per unit height, N/m */
     double contact_force;  /**< total normal force of the bodies on its nodes, N */
 } ws_containment_band;
+
+/** Rupture of a web (ws_web_get_rupture). */
+typedef struct ws_web_rupture {
+    double rupture_strain;     /**< the limit now; 0: none */
+    uint32_t broken_count;     /**< springs broken so far */
+    uint32_t broken_last_step; /**< of them, broken by the last step: an event when > 0 */
+    int ruptured;              /**< 1 once a spring has broken; the first_ fields are then set */
+    uint32_t first_spring;     /**< the first break: the most strained spring of the first step
+                                    that broke any (UINT32_MAX before) */
+    double first_time;         /**< s, world time at the end of that step */
+    double first_strain;       /**< its strain then */
+    ws_vec3 first_position;    /**< m, the midpoint of its two nodes then */
+} ws_web_rupture;
+
+/** The most strained intact spring of a web now (ws_web_get_peak_strain). */
+typedef struct ws_web_peak {
+    int found;         /**< 0 when the web has no intact spring (then the rest is zero) */
+    uint32_t spring;   /**< its index (as ws_web_copy_springs numbers them) */
+    double strain;     /**< l/l0 - 1 */
+    double tension;    /**< N, the law's force now */
+    uint32_t node_a;   /**< its first node */
+    uint32_t node_b;   /**< its second node */
+    ws_vec3 position_a; /**< m, node_a now */
+    ws_vec3 position_b; /**< m, node_b now */
+} ws_web_peak;
 
 /** Fill a web Def with defaults (layer 1 mm, 1 sub-step; the law and a mass must be set).
  *  ws_web_def_init(def) calls this with size = sizeof *def as the caller compiled it
@@ -232,7 +272,7 @@ WS_API ws_status ws_web_copy_springs(const ws_world *world, ws_web_id id, uint32
 /** Spring strains l/l0 - 1 now. */
 WS_API ws_status ws_web_copy_spring_strains(const ws_world *world, ws_web_id id, double *strain,
                                             size_t capacity, size_t *count);
-/** Spring tensions now (the law's force, N; negative in compression). */
+/** Spring tensions now (the law's force, N; negative in compression; 0 when broken). */
 WS_API ws_status ws_web_copy_spring_tensions(const ws_world *world, ws_web_id id,
                                              double *tension, size_t capacity, size_t *count);
 /** Total force (N, global) and moment about the CoG (N m) the web put on a body in the last
@@ -243,6 +283,23 @@ WS_API ws_status ws_web_get_body_force(const ws_world *world, ws_web_id web, ws_
  *  top. WS_ERR_INVALID_ARGUMENT for a mesh web or count outside 1..rows. */
 WS_API ws_status ws_web_get_containment(const ws_world *world, ws_web_id id,
                                         ws_containment_band *bands, size_t count);
+/** Set the rupture strain of a web (see ws_web_def.rupture_strain; >= 0, 0: no more breaks).
+ *  Springs broken stay broken. A web given a limit (here or in its Def) has its springs'
+ *  broken flags in its saved state and state hash from then on.
+ *  @return WS_OK, WS_ERR_STALE_HANDLE, WS_ERR_INVALID_ARGUMENT (negative, NaN or infinite),
+ *  WS_ERR_OUT_OF_MEMORY, WS_ERR_IN_STEP. */
+WS_API ws_status ws_web_set_rupture_strain(ws_world *world, ws_web_id id, double strain);
+/** The web's rupture: its limit, how many springs broke (in all and in the last step: poll
+ *  this after each step for the event) and the first break (time, spring, strain, place).
+ *  @return WS_OK, WS_ERR_STALE_HANDLE, WS_ERR_INVALID_ARGUMENT (out NULL). */
+WS_API ws_status ws_web_get_rupture(const ws_world *world, ws_web_id id, ws_web_rupture *out);
+/** Indices of the broken springs, ascending (a bulk copy, as above; count = broken_count). */
+WS_API ws_status ws_web_copy_broken_springs(const ws_world *world, ws_web_id id,
+                                            uint32_t *springs, size_t capacity, size_t *count);
+/** The most strained intact spring now (peak film strain and where): its index, strain,
+ *  tension and its nodes' positions. Ties go to the lower index.
+ *  @return WS_OK, WS_ERR_STALE_HANDLE, WS_ERR_INVALID_ARGUMENT (out NULL). */
+WS_API ws_status ws_web_get_peak_strain(const ws_world *world, ws_web_id id, ws_web_peak *out);
 /** Energy of the web, J: kinetic, elastic (springs), and gravitational (-m g . x summed). */
 WS_API ws_status ws_web_get_energy(const ws_world *world, ws_web_id id, double *kinetic,
                                    double *elastic, double *gravity);

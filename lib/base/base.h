@@ -9,12 +9,13 @@
 
 #include <wrapsim/common.h>
 
-/* A hot loop compiled twice, for the baseline x86-64 and for AVX2, the one for the machine
- * chosen when the library loads. The arithmetic is the same (no FMA: AVX2 alone does not enable
- * it, and -ffp-contract=off), so the results are too, to the bit. */
+/* A hot loop compiled three times, for the baseline x86-64, for AVX2 and for AVX-512, the one for
+ * the machine chosen when the library loads. The arithmetic is the same (no FMA: neither target
+ * enables it, and -ffp-contract=off; the no_fused_ops test counts them in the library), so the
+ * results are too, to the bit. */
 #if defined(__x86_64__) && defined(__GNUC__) && defined(__has_attribute) && !defined(__clang__)
 #if __has_attribute(target_clones)
-#define WS_VECTOR_LOOP __attribute__((target_clones("avx2", "default")))
+#define WS_VECTOR_LOOP __attribute__((target_clones("avx512f", "avx2", "default")))
 #endif
 #endif
 #ifndef WS_VECTOR_LOOP

@@ -41,7 +41,7 @@ ws_status ws_world_save(const ws_world *world, void *buf, size_t cap, size_t *ne
     if (!buf && cap)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "ws_world_save: buffer is NULL but capacity is %zu", cap);
-    ws_walk k = {WS_WALK_WRITE, 0, NULL, NULL, 0, 0, WS_OK, NULL};
+    ws_walk k = {WS_WALK_WRITE, 0, NULL, NULL, 0, 0, WS_OK, NULL, 0};
     ws_world_walk(w, &k);
     *needed = HEADER + k.pos;
     if (!buf)
@@ -50,7 +50,7 @@ ws_status ws_world_save(const ws_world *world, void *buf, size_t cap, size_t *ne
         return ws_fail(w, WS_ERR_BUFFER_TOO_SMALL, "ws_world_save: room for %zu bytes, it needs %zu",
                        cap, *needed);
     unsigned char *b = buf;
-    k = (ws_walk){WS_WALK_WRITE, 0, b + HEADER, NULL, 0, 0, WS_OK, NULL};
+    k = (ws_walk){WS_WALK_WRITE, 0, b + HEADER, NULL, 0, 0, WS_OK, NULL, 0};
     ws_world_walk(w, &k);
     memcpy(b, magic, sizeof magic);
     put32(b + 8, WS_SAVE_FORMAT_VERSION);
@@ -100,11 +100,11 @@ ws_status ws_world_restore(ws_world *w, const void *buf, size_t len)
                        "save is corrupted",
                        (unsigned long long)sum, (unsigned long long)have);
     /* Check all of it against the world, then write it: nothing changes unless all is good. */
-    ws_walk k = {WS_WALK_CHECK, 0, NULL, b + HEADER, 0, (size_t)plen, WS_OK, NULL};
+    ws_walk k = {WS_WALK_CHECK, 0, NULL, b + HEADER, 0, (size_t)plen, WS_OK, NULL, version};
     ws_status s = ws_world_walk(w, &k);
     if (s != WS_OK)
         return s;
-    k = (ws_walk){WS_WALK_READ, 0, NULL, b + HEADER, 0, (size_t)plen, WS_OK, NULL};
+    k = (ws_walk){WS_WALK_READ, 0, NULL, b + HEADER, 0, (size_t)plen, WS_OK, NULL, version};
     return ws_world_walk(w, &k);
 }
 

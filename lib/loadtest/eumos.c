@@ -125,307 +125,33 @@ ws_status ws_eumos_get_drive(const ws_eumos_def *def, ws_drive_def *drive, doubl
 
 /* ---- the run ------------------------------------------------------------------------------ */
 
-/* Four quarters of a base: a contact more than a quarter of the half-size off the centre along
- * x or y counts for that edge. */
-enum { BIN_XP, BIN_XN, BIN_YP, BIN_YN, BINS };
-
 typedef struct run_state {
-    ws_load *ld;
+    ws_lt_run m; /* the measurements (record.c) */
     ws_eumos_def d;
     ws_eumos_result *res;
-    ws_contact_info *contacts;
-    size_t contacts_cap;
-    ws_load_carton_state *cs;
-    double (*bins)[BINS];     /* per body (pallet = 0, carton c = c + 1): support force by edge */
-    double (*ref_bins)[BINS]; /* the same at the first sample */
-    unsigned char *tipped, *lost;
-    int have_ref_bins;
-    int slipped[WS_LOAD_MAX_LAYERS + 1];
-    double layer_disp[WS_LOAD_MAX_LAYERS];
-    ws_loadtest_interface_state ifs[WS_LOAD_MAX_LAYERS + 1];
-    double ifs_use[WS_LOAD_MAX_LAYERS + 1];
-    double *strain; /* the film's spring strains (wrapped loads) */
-    size_t springs;
 } run_state;
 
-static void add_event(ws_eumos_result *r, int type, int layer, int index, double t, double level,
-                      double value)
-{
-    if (r->event_count >= WS_LOADTEST_MAX_EVENTS) {
-        r->events_dropped++;
-        return;
-    }
-    ws_loadtest_event *e = &r->events[r->event_count++];
-    e->type = type;
-    e->layer = layer;
-    e->index = index;
-    e->time = t;
-    e->level = level;
-    e->value = value;
-}
-
-static double interface_mu(const ws_load *ld, int i)
-{
-    return ld->friction[i == 0 ? WS_IF_PALLET_PLATFORM
-                               : (i == 1 ? WS_IF_CARTON_PALLET : WS_IF_CARTON_CARTON)];
-}
-
-/* The support force under each edge of a body from a contact at `point`. */
-static ws_status bin_contact(const ws_world *w, const ws_load *ld, const ws_load_key *upper,
-                             ws_vec3 point, double fn, double (*bins)[BINS])
-{
-    ws_body_id id = upper->body < 0 ? ld->info.pallet : ld->carton[upper->body].body;
-    ws_vec3 r;
-    ws_mat3 a;
-    ws_status s;
-    if ((s = ws_body_get_position(w, id, &r)) != WS_OK ||
-        (s = ws_body_get_rotation(w, id, &a)) != WS_OK)
-        return s;
-    v3 o = m3_tmul_v(&a, v3_sub(point, r));
-    v3 half = upper->body < 0 ? v3_scale(ld->pallet_size, 0.5) : v3_scale(ld->carton_shape, 0.5);
-    double *b = bins[upper->body + 1];
-    if (o.x > 0.25 * half.x)
-        b[BIN_XP] += fn;
-    if (o.x < -0.25 * half.x)
-        b[BIN_XN] += fn;
-    if (o.y > 0.25 * half.y)
-        b[BIN_YP] += fn;
-    if (o.y < -0.25 * half.y)
-        b[BIN_YN] += fn;
-    return WS_OK;
-}
-
-/* Sort the contacts into interfaces (neighbouring levels) and the bases' edges. */
-static ws_status read_contacts(ws_world *w, run_state *rs)
-{
-    ws_load *ld = rs->ld;
-    size_t n;
-    ws_status s = ws_world_get_contact_count(w, &n);
-    if (s != WS_OK)
-        return s;
-    if (n > rs->contacts_cap) {
-        size_t cap = n + n / 2 + 16;
-        void *p = ws_mem_realloc(&ld->mem, rs->contacts, rs->contacts_cap * sizeof *rs->contacts,
-                                 cap * sizeof *rs->contacts);
-        if (!p)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "EUMOS run: no room for %zu contacts", n);
-        rs->contacts = p;
-        rs->contacts_cap = cap;
-    }
-    if ((s = ws_world_copy_contacts(w, rs->contacts, rs->contacts_cap, &n)) != WS_OK)
-        return s;
-    int ni = ld->info.layers + 1;
-    for (int i = 0; i < ni; i++) {
-        memset(&rs->ifs[i], 0, sizeof rs->ifs[i]);
-        rs->ifs_use[i] = 0;
-    }
-    memset(rs->bins, 0, (size_t)(ld->info.cartons + 1) * sizeof *rs->bins);
-    for (size_t k = 0; k < n; k++) {
-        const ws_contact_info *c = &rs->contacts[k];
-        const ws_load_key *ka = ws_load_find(ld, c->body_a), *kb = ws_load_find(ld, c->body_b);
-        if (!ka || !kb || abs(ka->level - kb->level) != 1)
-            continue;
-        const ws_load_key *lower = ka->level < kb->level ? ka : kb;
-        const ws_load_key *upper = ka->level < kb->level ? kb : ka;
-        ws_loadtest_interface_state *f = &rs->ifs[lower->level];
-        double fn = c->normal_force;
-        f->normal_force += fn;
-        f->slip_speed += fn * v3_norm(c->slip_velocity);
-        rs->ifs_use[lower->level] += v3_norm(c->friction_force);
-        f->contacts++;
-        if ((s = bin_contact(w, ld, upper, c->point, fn, rs->bins)) != WS_OK)
-            return s;
-    }
-    for (int i = 0; i < ni; i++) {
-        ws_loadtest_interface_state *f = &rs->ifs[i];
-        double mu = interface_mu(ld, i);
-        f->friction_use = f->normal_force > 0 && mu > 0 ? rs->ifs_use[i] / (mu * f->normal_force)
-                                                        : 0;
-        f->slip_speed = f->normal_force > 0 ? f->slip_speed / f->normal_force : 0;
-    }
-    return WS_OK;
-}
-
-/* Tip onset: an edge that carried more than 5 % of the body's support at the first sample now
- * carries less than 1 % of it while the body still rests on something. */
-static void find_tips(run_state *rs, double t, double level)
-{
-    ws_load *ld = rs->ld;
-    int nb = ld->info.cartons + 1;
-    if (!rs->have_ref_bins) {
-        memcpy(rs->ref_bins, rs->bins, (size_t)nb * sizeof *rs->bins);
-        rs->have_ref_bins = 1;
-        return;
-    }
-    for (int b = 0; b < nb; b++) {
-        if (rs->tipped[b])
-            continue;
-        const double *now = rs->bins[b], *ref = rs->ref_bins[b];
-        double tot_now = now[BIN_XP] + now[BIN_XN], tot_ref = ref[BIN_XP] + ref[BIN_XN];
-        double tot_y_now = now[BIN_YP] + now[BIN_YN], tot_y_ref = ref[BIN_YP] + ref[BIN_YN];
-        int tip = 0;
-        for (int e = 0; e < BINS; e++) {
-            double tn = e < 2 ? tot_now : tot_y_now, tr = e < 2 ? tot_ref : tot_y_ref;
-            if (tr > 0 && ref[e] > 0.05 * tr && tn > 0.25 * tr && now[e] < 0.01 * tn)
-                tip = 1;
-        }
-        if (tip) {
-            rs->tipped[b] = 1;
-            int layer = b == 0 ? -1 : ld->carton[b - 1].layer;
-            int index = b == 0 ? -1 : ld->carton[b - 1].index;
-            add_event(rs->res, WS_LOADTEST_TIP_ONSET, layer, index, t, level, 0);
-        }
-    }
-}
-
-/* One measurement: cartons, layers, interfaces, events, running maxima. */
-static ws_status sample(ws_world *w, run_state *rs, double t, double a, double v, double x)
-{
-    ws_load *ld = rs->ld;
-    ws_eumos_result *r = rs->res;
-    size_t n;
-    ws_status s = ws_load_measure(w, ld, rs->cs, (size_t)ld->info.cartons, &n);
-    if (s != WS_OK || (s = read_contacts(w, rs)) != WS_OK)
-        return s;
-    if (rs->strain) {
-        size_t ns;
-        if ((s = ws_web_copy_spring_strains(w, ld->info.film, rs->strain, rs->springs, &ns)) !=
-            WS_OK)
-            return s;
-        for (size_t i = 0; i < ns; i++)
-            r->film_peak_strain = fmax(r->film_peak_strain, rs->strain[i]);
-    }
-    double level = a / rs->d.g;
-    if (fabs(level) > r->peak_level)
-        r->peak_level = fabs(level);
-    find_tips(rs, t, level);
-    v3 dir = rs->d.direction;
-    for (int l = 0; l < ld->info.layers; l++) {
-        double sum = 0;
-        int c0 = ld->layer_start[l], c1 = ld->layer_start[l + 1];
-        for (int c = c0; c < c1; c++) {
-            const ws_load_carton_state *cs = &rs->cs[c];
-            sum += cs->displacement.x * dir.x + cs->displacement.y * dir.y;
-            r->layer_max[l] = fmax(r->layer_max[l], cs->horizontal);
-            r->layer_tilt[l] = fmax(r->layer_tilt[l], cs->tilt);
-            v3 rel = v3_add(ld->reference[c], cs->displacement);
-            int off = fabs(rel.x) > 0.5 * ld->pallet_size.x ||
-                      fabs(rel.y) > 0.5 * ld->pallet_size.y ||
-                      cs->displacement.z < -0.5 * ld->carton[c].size.z;
-            if (off && !rs->lost[c]) {
-                rs->lost[c] = 1;
-                r->cartons_lost++;
-                add_event(r, WS_LOADTEST_CARTON_LOST, l, ld->carton[c].index, t, level,
-                          cs->horizontal);
-            }
-        }
-        rs->layer_disp[l] = sum / (c1 - c0);
-    }
-    for (int i = 0; i <= ld->info.layers; i++) {
-        const ws_loadtest_interface_state *f = &rs->ifs[i];
-        r->interface_slip_max[i] = fmax(r->interface_slip_max[i], f->slip_speed);
-        r->interface_use_max[i] = fmax(r->interface_use_max[i], f->friction_use);
-        if (!rs->slipped[i] && f->slip_speed > rs->d.slip_speed) {
-            rs->slipped[i] = 1;
-            add_event(r, WS_LOADTEST_SLIP_ONSET, i, -1, t, level, f->slip_speed);
-        }
-    }
-    if (rs->d.on_sample) {
-        ws_loadtest_sample sm;
-        sm.time = t;
-        sm.level = level;
-        sm.platform_velocity = v;
-        sm.platform_position = x;
-        sm.cartons = n;
-        sm.carton = rs->cs;
-        sm.layers = ld->info.layers;
-        sm.layer_displacement = rs->layer_disp;
-        sm.interfaces = ld->info.layers + 1;
-        sm.interface = rs->ifs;
-        if (rs->d.on_sample(rs->d.sample_user, &sm) != 0)
-            return ws_fail(w, WS_ERR_CALLBACK, "EUMOS run: on_sample stopped the run at t = %g s",
-                           t);
-    }
-    return WS_OK;
-}
-
-static void criterion(ws_loadtest_criterion *c, double value, double limit, int strict)
-{
-    c->value = value;
-    c->limit = limit;
-    c->pass = strict ? value < limit : value <= limit;
-}
-
-/* The verdict from the permanent displacements (rs->cs after the rest) and the maxima. */
+/* The verdict from the permanent displacements (the last sample, after the rest) and the
+ * maxima. */
 static void judge(run_state *rs)
 {
-    ws_load *ld = rs->ld;
+    ws_load *ld = rs->m.ld;
     ws_eumos_result *r = rs->res;
     ws_eumos_verdict *vd = &r->verdict;
-    double H = ld->info.load_height, elastic = 0, permanent = 0, bottom = 0, shift = 0;
-    double prev_x = 0, prev_y = 0; /* the pallet's own displacement is zero by definition */
+    double H = ld->info.load_height, elastic = 0, permanent = 0, bottom, shift;
+    ws_lt_permanent(&rs->m, r->layer_permanent, &bottom, &shift);
     for (int l = 0; l < ld->info.layers; l++) {
-        double mx = 0, my = 0;
-        int c0 = ld->layer_start[l], c1 = ld->layer_start[l + 1];
-        for (int c = c0; c < c1; c++) {
-            const ws_load_carton_state *cs = &rs->cs[c];
-            r->layer_permanent[l] = fmax(r->layer_permanent[l], cs->horizontal);
-            if (ld->carton_bottom[c] < 0.2)
-                bottom = fmax(bottom, cs->horizontal);
-            mx += cs->displacement.x;
-            my += cs->displacement.y;
-        }
-        mx /= c1 - c0;
-        my /= c1 - c0;
-        shift = fmax(shift, hypot(mx - prev_x, my - prev_y));
-        prev_x = mx;
-        prev_y = my;
         elastic = fmax(elastic, r->layer_max[l]);
         permanent = fmax(permanent, r->layer_permanent[l]);
     }
     vd->load_height = H;
-    criterion(&vd->elastic, elastic, 0.10 * H, 0);
-    criterion(&vd->permanent, permanent, 0.05 * H, 0);
-    criterion(&vd->bottom, bottom, 0.04, 0);
-    criterion(&vd->layer_shift, shift, 0.02 * H, 1);
-    criterion(&vd->rupture, 0, 0, 0);
+    ws_lt_criterion(&vd->elastic, elastic, 0.10 * H, 0);
+    ws_lt_criterion(&vd->permanent, permanent, 0.05 * H, 0);
+    ws_lt_criterion(&vd->bottom, bottom, 0.04, 0);
+    ws_lt_criterion(&vd->layer_shift, shift, 0.02 * H, 1);
+    ws_lt_criterion(&vd->rupture, rs->m.broken, 0, 0);
     vd->pass = vd->elastic.pass && vd->permanent.pass && vd->bottom.pass &&
                vd->layer_shift.pass && vd->rupture.pass;
-}
-
-static void run_free(run_state *rs)
-{
-    ws_load *ld = rs->ld;
-    size_t nb = (size_t)ld->info.cartons + 1;
-    ws_mem_free(&ld->mem, rs->contacts, rs->contacts_cap * sizeof *rs->contacts);
-    ws_mem_free(&ld->mem, rs->cs, (nb - 1) * sizeof *rs->cs);
-    ws_mem_free(&ld->mem, rs->bins, nb * sizeof *rs->bins);
-    ws_mem_free(&ld->mem, rs->ref_bins, nb * sizeof *rs->ref_bins);
-    ws_mem_free(&ld->mem, rs->tipped, nb);
-    ws_mem_free(&ld->mem, rs->lost, nb);
-    ws_mem_free(&ld->mem, rs->strain, rs->springs * sizeof *rs->strain);
-}
-
-static ws_status run_alloc(ws_world *w, run_state *rs)
-{
-    ws_load *ld = rs->ld;
-    size_t nb = (size_t)ld->info.cartons + 1;
-    rs->cs = ws_mem_calloc(&ld->mem, nb - 1, sizeof *rs->cs);
-    rs->bins = ws_mem_calloc(&ld->mem, nb, sizeof *rs->bins);
-    rs->ref_bins = ws_mem_calloc(&ld->mem, nb, sizeof *rs->ref_bins);
-    rs->tipped = ws_mem_calloc(&ld->mem, nb, 1);
-    rs->lost = ws_mem_calloc(&ld->mem, nb, 1);
-    ws_web_info wi;
-    if (ld->info.film.bits && ws_web_get_info(w, ld->info.film, &wi) == WS_OK) {
-        rs->springs = wi.spring_count;
-        rs->strain = ws_mem_calloc(&ld->mem, rs->springs, sizeof *rs->strain);
-    }
-    if (!rs->cs || !rs->bins || !rs->ref_bins || !rs->tipped || !rs->lost ||
-        (rs->springs && !rs->strain)) {
-        run_free(rs);
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "EUMOS run: out of memory for %zu bodies", nb);
-    }
-    return WS_OK;
 }
 
 /* The platform's drive during a run and where the run stands. */
@@ -451,7 +177,7 @@ static ws_status run_steps(ws_world *w, run_state *rs, const sled *sl, double dt
             return s;
         done += chunk;
         ws_drive_state ds;
-        if ((s = ws_body_get_drive_state(w, rs->ld->info.platform, &ds)) != WS_OK)
+        if ((s = ws_body_get_drive_state(w, rs->m.ld->info.platform, &ds)) != WS_OK)
             return s;
         double t = ds.time - sl->t0;
         double a = v3_dot(ds.acceleration, sl->dir), v = v3_dot(ds.velocity, sl->dir);
@@ -460,7 +186,7 @@ static ws_status run_steps(ws_world *w, run_state *rs, const sled *sl, double dt
             r->time_at_level += (double)chunk * dt;
         if (r->rise_measured < 0 && fabs(a) >= 0.99 * kg)
             r->rise_measured = t - sl->rise_start;
-        if ((s = sample(w, rs, t, a, v, x)) != WS_OK)
+        if ((s = ws_lt_sample(w, &rs->m, t, a / rs->d.g, v, x, 0)) != WS_OK)
             return s;
         r->duration = t;
     }
@@ -491,8 +217,16 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
     memset(result, 0, sizeof *result);
     result->k = rs.d.k;
     result->layers = ld->info.layers;
-    rs.ld = ld;
     rs.res = result;
+    rs.m.dir = rs.d.direction;
+    rs.m.slip_speed = rs.d.slip_speed;
+    rs.m.tip_fraction = 0.01;
+    rs.m.on_sample = rs.d.on_sample;
+    rs.m.sample_user = rs.d.sample_user;
+    ws_lt_sink sink = {&result->peak_level, result->layer_max, result->layer_tilt,
+                       result->interface_slip_max, result->interface_use_max,
+                       &result->cartons_lost, &result->event_count, &result->events_dropped,
+                       result->events, &result->film_peak_strain};
 
     sled sl;
     double dt;
@@ -514,11 +248,11 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
         sl.rise_start += rs.d.coast_time + 2 * dd.acceleration *
                                                (rs.d.rise_time + rs.d.hold_time) /
                                                dd.gentle_acceleration;
-    if ((s = run_alloc(w, &rs)) != WS_OK)
+    if ((s = ws_lt_begin(w, &rs.m, ld, &sink, "EUMOS")) != WS_OK)
         return s;
     if (ld->info.film.bits &&
-        (s = ws_web_get_containment(w, ld->info.film, result->containment, 3)) != WS_OK) {
-        run_free(&rs);
+        (s = ws_load_film_containment(w, ld, result->containment)) != WS_OK) {
+        ws_lt_end(&rs.m);
         return s;
     }
     if ((s = ws_body_set_drive(w, ld->info.platform, &dd)) == WS_OK) {
@@ -531,7 +265,7 @@ ws_status ws_loadtest_run_eumos(ws_world *w, ws_load *ld, const ws_eumos_def *de
     }
     if (s == WS_OK)
         judge(&rs);
-    run_free(&rs);
+    ws_lt_end(&rs.m);
     return s;
 }
 
@@ -562,6 +296,10 @@ static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_d
     ws_web_id film;
     if (kd->wrap && ((s = ws_load_wrap_band(kw->w, kw->ld, kd->wrap, &film)) != WS_OK ||
                      (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
+        return s;
+    if (!kd->wrap && kd->spiral &&
+        ((s = ws_load_wrap_spiral(kw->w, kw->ld, kd->spiral, &film)) != WS_OK ||
+         (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
         return s;
     if ((s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
         return s;

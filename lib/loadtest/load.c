@@ -371,6 +371,7 @@ static ws_status build_bodies(ws_world *w, const ws_load_def *d, ws_load *ld, ws
      * the gap), so a layer of count x size fills that much of the pallet and no carton's edge
      * lies on the deck's edge, where coinciding edges would make contacts come and go. */
     double cut = clear + d->gap;
+    ld->carton_cut = cut;
     /* Every second layer's cartons are smaller by WS_LOAD_INSET a side, so two stacked faces
      * are never equal: the smaller face's four corners lie inside the larger, and a shift of a
      * nanometre does not halve the contacts of a pair, as it does when equal faces put every
@@ -560,7 +561,7 @@ ws_status ws_load_frame(const ws_world *w, const ws_load *ld, ws_mat3 *a_pf, ws_
     return v_pal ? ws_body_get_velocity(w, ld->info.pallet, v_pal) : WS_OK;
 }
 
-static ws_status check_world(const ws_world *w, const ws_load *ld, const char *fn)
+ws_status ws_load_check_world(const ws_world *w, const ws_load *ld, const char *fn)
 {
     if (!w)
         return WS_ERR_INVALID_ARGUMENT;
@@ -573,7 +574,7 @@ static ws_status check_world(const ws_world *w, const ws_load *ld, const char *f
 
 ws_status ws_load_set_reference(ws_world *w, ws_load *ld)
 {
-    ws_status s = check_world(w, ld, "ws_load_set_reference");
+    ws_status s = ws_load_check_world(w, ld, "ws_load_set_reference");
     if (s != WS_OK)
         return s;
     ws_mat3 a_pf;
@@ -592,7 +593,7 @@ ws_status ws_load_set_reference(ws_world *w, ws_load *ld)
 ws_status ws_load_measure(const ws_world *w, const ws_load *ld, ws_load_carton_state *buf,
                           size_t capacity, size_t *count)
 {
-    ws_status s = check_world(w, ld, "ws_load_measure");
+    ws_status s = ws_load_check_world(w, ld, "ws_load_measure");
     if (s != WS_OK)
         return s;
     NEED_OUT(w, count, "ws_load_measure");
@@ -644,7 +645,7 @@ static ws_status body_drift(const ws_world *w, ws_body_id platform, ws_body_id i
 
 ws_status ws_load_get_drift(const ws_world *w, const ws_load *ld, double *speed)
 {
-    ws_status s = check_world(w, ld, "ws_load_get_drift");
+    ws_status s = ws_load_check_world(w, ld, "ws_load_get_drift");
     if (s != WS_OK)
         return s;
     NEED_OUT(w, speed, "ws_load_get_drift");
@@ -661,7 +662,7 @@ ws_status ws_load_get_drift(const ws_world *w, const ws_load *ld, double *speed)
 ws_status ws_load_settle(ws_world *w, const ws_load *ld, double min_time, double max_time,
                          double speed, int *settled, double *time_taken)
 {
-    ws_status s = check_world(w, ld, "ws_load_settle");
+    ws_status s = ws_load_check_world(w, ld, "ws_load_settle");
     if (s != WS_OK)
         return s;
     if (!(isfinite(min_time) && min_time >= 0 && isfinite(max_time) && max_time >= min_time))
@@ -716,6 +717,19 @@ static void wrap_defaults(ws_wrap_def *def)
     def->node_pitch = 0.05;
     def->node_mass = 2e-3;
     def->substeps = 0;
+    def->elongation_at_break = 4.0;
+    def->powered_prestretch = 2.5;
+}
+
+/* The film's rupture strain from a wrap Def (0: none): the given one, or the elongation at break
+ * turned from the unstretched film to the rest length the powered pre-stretch left. */
+static double wrap_rupture(const ws_wrap_def *d)
+{
+    if (d->rupture_strain > 0)
+        return d->rupture_strain;
+    if (d->elongation_at_break == 0)
+        return 0;
+    return (1 + d->elongation_at_break) / (1 + d->powered_prestretch) - 1;
 }
 
 WS_DEF_INITS(ws_wrap_def, wrap_defaults, substeps)
@@ -745,6 +759,23 @@ static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_lo
         bad = "node_mass must be >= 0 kg";
     else if (d->substeps < 0)
         bad = "substeps must be >= 1, or 0 for the fewest the stable-step check accepts";
+    else if (!(isfinite(d->elongation_at_break) && d->elongation_at_break >= 0) ||
+             !(isfinite(d->powered_prestretch) && d->powered_prestretch >= 0) ||
+             !(isfinite(d->rupture_strain) && d->rupture_strain >= 0))
+        bad = "elongation_at_break, powered_prestretch and rupture_strain must be >= 0";
+    else if (d->rupture_strain == 0 && d->elongation_at_break > 0 &&
+             !(d->powered_prestretch < d->elongation_at_break))
+        bad = "powered_prestretch must be below elongation_at_break: a film stretched that far "
+              "has no elongation left";
+    if (!bad && wrap_rupture(d) != 0 &&
+        !(wrap_rupture(d) > d->strain_around && wrap_rupture(d) > d->strain_up))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "wrap: the film would break as it is laid: its rupture strain %g (%s) is "
+                       "not above strain_around %g and strain_up %g",
+                       wrap_rupture(d),
+                       d->rupture_strain > 0 ? "rupture_strain"
+                                             : "from elongation_at_break and powered_prestretch",
+                       d->strain_around, d->strain_up);
     if (bad)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "wrap: %s", bad);
     if (ld->info.film.bits)
@@ -752,7 +783,7 @@ static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_lo
     return WS_OK;
 }
 
-static ws_status film_law(ws_world *w, double ea, const char *name, ws_law_id *out)
+ws_status ws_load_film_law(ws_world *w, double ea, const char *name, ws_law_id *out)
 {
     ws_law_def l;
     ws_law_def_init(&l);
@@ -764,9 +795,7 @@ static ws_status film_law(ws_world *w, double ea, const char *name, ws_law_id *o
     return ws_law_create(w, &l, out);
 }
 
-/* The fewest sub-steps with which the world's stable-step check accepts the web: dt / n within
- * stable_fraction of its stable sub-step. */
-static ws_status fit_substeps(ws_world *w, ws_web_id web)
+ws_status ws_load_fit_substeps(ws_world *w, ws_web_id web, const char *fn)
 {
     double dt, stable, f;
     ws_status s;
@@ -776,15 +805,15 @@ static ws_status fit_substeps(ws_world *w, ws_web_id web)
     double n = ceil(dt / (f * stable));
     if (!(n <= 100000.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
-                       "ws_load_wrap_band: the film's stable sub-step is %.3g s, so dt %.3g s "
+                       "%s: the film's stable sub-step is %.3g s, so dt %.3g s "
                        "would need %.3g sub-steps: raise node_mass",
-                       stable, dt, n);
+                       fn, stable, dt, n);
     return ws_web_set_substeps(w, web, n < 1.0 ? 1 : (int)n);
 }
 
 ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws_web_id *out)
 {
-    ws_status s = check_world(w, ld, "ws_load_wrap_band");
+    ws_status s = ws_load_check_world(w, ld, "ws_load_wrap_band");
     if (s != WS_OK)
         return s;
     NEED_OUT(w, out, "ws_load_wrap_band");
@@ -820,6 +849,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     wd.material = ld->info.film_material;
     wd.substeps = d.substeps > 0 ? d.substeps : 1;
     wd.name = "film";
+    wd.rupture_strain = wrap_rupture(&d);
     ws_band_def bd;
     ws_band_def_init(&bd);
     bd.bodies = bodies;
@@ -830,18 +860,22 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     bd.n_up = n_up;
     bd.prestretch_around = d.strain_around;
     bd.prestretch_up = d.strain_up;
-    if (s == WS_OK && (s = film_law(w, eh * strip_up, "film around", &around)) == WS_OK &&
-        (s = film_law(w, eh * strip_around, "film up", &up)) == WS_OK) {
+    if (s == WS_OK && (s = ws_load_film_law(w, eh * strip_up, "film around", &around)) == WS_OK &&
+        (s = ws_load_film_law(w, eh * strip_around, "film up", &up)) == WS_OK) {
         wd.law = around;
         wd.law_cross = up;
         s = ws_web_create_band(w, &wd, &bd, &ld->info.film);
     }
-    if (s == WS_OK && d.substeps == 0 && (s = fit_substeps(w, ld->info.film)) != WS_OK) {
+    if (s == WS_OK && d.substeps == 0 &&
+        (s = ws_load_fit_substeps(w, ld->info.film, "ws_load_wrap_band")) != WS_OK) {
         ws_web_destroy(w, ld->info.film);
         ld->info.film = (ws_web_id){0};
     }
     ws_mem_free(&ld->mem, bodies, n * sizeof *bodies);
-    if (s == WS_OK)
+    if (s == WS_OK) {
+        ld->film_nx = n_around;
+        ld->film_ny = n_up;
         *out = ld->info.film;
+    }
     return s;
 }

@@ -79,11 +79,27 @@ static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t
     return 1;
 }
 
+/* Spring s's law at (eps, rate): force and derivatives, times its stiffness scale (a mesh
+ * web's film layers). 1 when the law failed. */
 static int spring_law(const ws_web *web, uint32_t s, double eps, double rate, double t,
                       double since, double *F, double *Fu, double *Fud)
 {
     const double *hist = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-    return ws_law_eval(web->law[web->kind[s]], hist, &eps, &rate, t, since, F, Fu, Fud) != 0;
+    if (ws_law_eval(web->law[web->kind[s]], hist, &eps, &rate, t, since, F, Fu, Fud) != 0)
+        return 1;
+    if (web->kscale) {
+        const double k = web->kscale[s];
+        *F *= k;
+        *Fu *= k;
+        *Fud *= k;
+    }
+    return 0;
+}
+
+/* A broken spring carries nothing (rupture). */
+static int spring_broken(const ws_web *web, uint32_t s)
+{
+    return web->nbroken && web->broken && web->broken[s];
 }
 
 static void sym_add_outer(double *S, double c, v3 e)
@@ -112,7 +128,7 @@ int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double 
         ws_ispring *q = &im->sp[s];
         v3 e, dvel;
         double l, eps, rate, F, Fu, Fud;
-        if (!spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
+        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
             *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             continue;
         }
@@ -470,7 +486,7 @@ int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32
     double l, eps, rate, F, Fu, Fud;
     memset(Jx, 0, 9 * sizeof(double));
     memset(Jv, 0, 9 * sizeof(double));
-    if (!spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel))
+    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel))
         return 0;
     if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud))
         return 1;

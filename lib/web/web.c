@@ -26,6 +26,7 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     memset(web, 0, sizeof *web);
     web->n = n;
     web->ns = ns;
+    web->first_spring = UINT32_MAX;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         ok &= nodes_alloc(mem, &web->x[k], n);
@@ -72,7 +73,9 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->sb, ns * sizeof(uint32_t));
     ws_mem_free(mem, web->inv_l0, ((size_t)web->ns + WS_WEB_PAD) * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
+    ws_mem_free(mem, web->kscale, web->kscale ? (size_t)web->ns * sizeof(double) : 0);
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
+    ws_mem_free(mem, web->broken, web->broken ? (size_t)web->ns + WS_WEB_PAD : 0);
     ws_mem_free_str(mem, web->name);
     ws_implicit_free(mem, web);
     memset(web, 0, sizeof *web);
@@ -156,6 +159,9 @@ int ws_web_law_state(ws_mem *mem, ws_web *web)
 
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
 {
+    web->nbroken_step = 0;
+    if (web->rupture > 0.0)
+        ws_web_rupture_check(web, x, t);
     if (!web->nstate)
         return;
     for (uint32_t s = 0; s < web->ns; s++) {
@@ -242,6 +248,8 @@ static void spring_run_apply(const double *restrict x, const double *restrict y,
 static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p,
                           uint32_t lo, uint32_t hi)
 {
+    if (web->nbroken && web->broken[s])
+        return; /* a broken spring carries nothing */
     v3 d;
     double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
     if (il == 0.0)
@@ -254,6 +262,8 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_
         web->law_failed = 1;
         return;
     }
+    if (web->kscale)
+        F *= web->kscale[s];
     v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
     const uint32_t a = web->sa[s], b = web->sb[s];
     if (a >= lo && a < hi)
@@ -365,6 +375,36 @@ static void row_forces_same_free(size_t k, v3 g, double m1, const double *restri
     row_forces_of(k, g, 0.0, NULL, m1, 1, 0, NULL, NULL, NULL, tx, ty, tz, fx, fy, fz);
 }
 
+/* Rupture in the sweep. While no spring of the web is broken (nbroken 0) none of this runs
+ * and the sweep is what it is without rupture. After a break: a chunk of around-springs is
+ * computed as before and the broken ones' forces are then set to zero (cut_chunk); a broken
+ * wrap spring counts as one whose ends coincide (no force); a row of up-springs with a broken
+ * one among them goes spring by spring (spring_one_in, which skips the broken), as the springs
+ * of a general law do. */
+static int any_broken(const ws_web *web, size_t s0, size_t m)
+{
+    if (!web->nbroken)
+        return 0;
+    const uint8_t *b = web->broken + s0;
+    uint8_t any = 0;
+    for (size_t i = 0; i < m; i++)
+        any |= b[i];
+    return any != 0;
+}
+
+/* The forces t of springs s0 + i, i in [0, m): zero where broken. Selected, not multiplied, so
+ * a broken spring stretched to any length gives a zero. */
+WS_VECTOR_LOOP
+static void cut_chunk(const uint8_t *restrict broken, size_t m, double *restrict tx,
+                      double *restrict ty, double *restrict tz)
+{
+    for (size_t i = 0; i < m; i++) {
+        tx[i] = broken[i] ? 0.0 : tx[i];
+        ty[i] = broken[i] ? 0.0 : ty[i];
+        tz[i] = broken[i] ? 0.0 : tz[i];
+    }
+}
+
 /* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
  * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
  * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
@@ -405,7 +445,12 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, const ws_
         in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
-    wrap_lanes(in, *p, web->tmp + 3 * WS_WEB_CHUNK);
+    double *out = web->tmp + 3 * WS_WEB_CHUNK;
+    wrap_lanes(in, *p, out);
+    if (web->nbroken)
+        for (size_t i = 0; i < L && r + i < ny; i++)
+            if (web->broken[nx * (r + i + 1) - 1])
+                out[3 * L + i] = 0.0; /* broken: no force, as for coincident ends */
 }
 
 /* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
@@ -432,6 +477,8 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
          * after its springs. Cheaper than the left-over springs one at a time. */
         spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
                    il0 + o, p->kc, p->dk, p->w, p->qw, p->c, tx, ty, tz);
+        if (web->nbroken)
+            cut_chunk(web->broken + s0 + o, k, tx, ty, tz);
         v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
         if (o == 0) {
             v3 fa = v3_add(base_force(web, v, g, q), first);
@@ -457,7 +504,7 @@ static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0
                       const ws_spring_form *p)
 {
     const size_t nx = (size_t)web->nx;
-    if (p->gen) {
+    if (p->gen || any_broken(web, s0, nx)) {
         for (size_t i = 0; i < nx; i++)
             spring_one(web, x, v, (uint32_t)(s0 + i), *p);
         return;
@@ -509,7 +556,7 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
     const uint32_t lo = (uint32_t)(nx * r0), hi = (uint32_t)(nx * r1);
     const size_t s0 = cols * ny + nx * j;
     const ws_spring_form *p = &P[WS_SPRING_UP];
-    if (web->law[WS_SPRING_UP] && p->gen) {
+    if (web->law[WS_SPRING_UP] && (p->gen || any_broken(web, s0, nx))) {
         for (size_t i = 0; i < nx; i++)
             spring_one_in(web, x, v, (uint32_t)(s0 + i), *p, lo, hi);
     } else if (web->law[WS_SPRING_UP]) {
@@ -746,8 +793,9 @@ static void node_bounds(const ws_web *web)
         acc.x[i] = acc.y[i] = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_law *L = web->law[web->kind[s]];
-        double k = 2.0 * ws_law_max_stiffness(L) * web->inv_l0[s];
-        double c = 2.0 * ws_law_max_damping(L) * web->inv_l0[s];
+        const double q = web->kscale ? web->kscale[s] : 1.0;
+        double k = 2.0 * ws_law_max_stiffness(L) * q * web->inv_l0[s];
+        double c = 2.0 * ws_law_max_damping(L) * q * web->inv_l0[s];
         acc.x[web->sa[s]] += k;
         acc.x[web->sb[s]] += k;
         acc.y[web->sa[s]] += c;
@@ -816,22 +864,131 @@ double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)
 
 double ws_web_spring_tension(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s)
 {
+    if (web->broken && web->broken[s])
+        return 0.0;
     v3 d;
     double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
     const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
     double F = 0.0;
     if (ws_law_eval(web->law[web->kind[s]], h, &eps, &epsd, 0.0, 0.0, &F, NULL, NULL) != 0)
         return NAN;
-    return F;
+    return web->kscale ? F * web->kscale[s] : F;
 }
 
 double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x)
 {
     double e = 0.0;
     for (uint32_t s = 0; s < web->ns; s++) {
+        if (web->broken && web->broken[s])
+            continue; /* holds nothing */
         double eps = ws_web_spring_strain(web, x, s);
         const double *h = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-        e += ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
+        double q = web->kscale ? web->kscale[s] : 1.0;
+        e += q * ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
     }
     return e;
+}
+
+int ws_web_rupture_alloc(ws_mem *mem, ws_web *web)
+{
+    if (web->broken)
+        return 0;
+    web->broken = ws_mem_calloc(mem, (size_t)web->ns + WS_WEB_PAD, 1);
+    return web->broken ? 0 : -1;
+}
+
+/* The rupture check's pass over the springs: springs broken so far in it, and the most
+ * strained of them. q is a little under (1 + limit)^2: a spring whose squared stretch
+ * (l / l0)^2 is not above it cannot have a strain above the limit, whatever the rounding, and
+ * needs no square root. */
+typedef struct rupture_pass {
+    double lim, q;
+    uint32_t most;
+    double most_eps;
+} rupture_pass;
+
+/* Springs [s0, s1): each intact one strained past the limit breaks. */
+static void break_range(ws_web *web, ws_nodes3 x, uint32_t s0, uint32_t s1, rupture_pass *r)
+{
+    for (uint32_t s = s0; s < s1; s++) {
+        if (web->broken[s])
+            continue;
+        const uint32_t a = web->sa[s], b = web->sb[s];
+        const double dx = x.x[b] - x.x[a], dy = x.y[b] - x.y[a], dz = x.z[b] - x.z[a];
+        const double il0 = web->inv_l0[s];
+        if (!((dx * dx + dy * dy + dz * dz) * il0 * il0 > r->q))
+            continue;
+        /* The strain as every read-out gives it decides. */
+        double eps = ws_web_spring_strain(web, x, s);
+        if (!(eps > r->lim))
+            continue;
+        web->broken[s] = 1;
+        web->nbroken++;
+        web->nbroken_step++;
+        if (r->most == UINT32_MAX || eps > r->most_eps) {
+            r->most = s;
+            r->most_eps = eps;
+        }
+    }
+}
+
+/* How many of the springs from node i to node i + stride, i in [0, m), rest lengths
+ * 1 / il0[i], have a squared stretch above q: a count, so the loop runs on vectors. */
+WS_VECTOR_LOOP
+static size_t stretched(const double *restrict x, const double *restrict y,
+                        const double *restrict z, size_t stride, size_t m,
+                        const double *restrict il0, double q)
+{
+    size_t hits = 0;
+    for (size_t i = 0; i < m; i++) {
+        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
+        hits += (dx * dx + dy * dy + dz * dz) * il0[i] * il0[i] > q;
+    }
+    return hits;
+}
+
+void ws_web_rupture_check(ws_web *web, ws_nodes3 x, double t)
+{
+    /* Strains at the end of the step, as the state will be read: a spring breaks once its
+     * committed strain passes the limit (a strain above it inside the sub-steps of one step
+     * and back below at its end does not break it). NaN never breaks one: the step's health
+     * check reports that. A grid web's around- and up-springs are first screened a row at a
+     * time on vectors; only a row with a spring near the limit (or a broken one) is gone
+     * through spring by spring. */
+    const double lim = web->rupture, one = 1.0 + lim;
+    rupture_pass r = {lim, one * one * (1.0 - 1e-9), UINT32_MAX, 0.0};
+    if (web->nx > 0 && web->ny > 0) {
+        const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+        const size_t cols = web->closed ? nx : nx - 1;
+        for (size_t j = 0; j < ny; j++) {
+            const size_t a = nx * j, s = cols * j;
+            if (nx >= 2 && stretched(x.x + a, x.y + a, x.z + a, 1, nx - 1, web->inv_l0 + s, r.q))
+                break_range(web, x, (uint32_t)s, (uint32_t)(s + nx - 1), &r);
+            if (web->closed)
+                break_range(web, x, (uint32_t)(s + nx - 1), (uint32_t)(s + nx), &r);
+        }
+        for (size_t j = 0; j + 1 < ny; j++) {
+            const size_t a = nx * j, s = cols * ny + nx * j;
+            if (stretched(x.x + a, x.y + a, x.z + a, nx, nx, web->inv_l0 + s, r.q))
+                break_range(web, x, (uint32_t)s, (uint32_t)(s + nx), &r);
+        }
+        break_range(web, x, (uint32_t)(cols * ny + nx * (ny - 1)), web->ns, &r); /* shear */
+    } else {
+        break_range(web, x, 0, web->ns, &r);
+    }
+    if (r.most == UINT32_MAX || web->first_spring != UINT32_MAX)
+        return;
+    web->first_spring = r.most;
+    web->first_time = t;
+    web->first_strain = r.most_eps;
+    web->first_at =
+        v3_scale(v3_add(nodes_get(x, web->sa[r.most]), nodes_get(x, web->sb[r.most])), 0.5);
+}
+
+void ws_web_rupture_recount(ws_web *web)
+{
+    uint32_t n = 0;
+    for (uint32_t s = 0; web->broken && s < web->ns; s++)
+        n += web->broken[s] != 0;
+    web->nbroken = n;
 }

@@ -86,12 +86,29 @@ typedef struct ws_web {
     uint32_t *sa, *sb;       /* spring ends */
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
+    /* Each spring's force as a multiple of its law's (the film layers a spring stands for), or
+     * NULL when every spring takes its law as it is. Mesh webs only: their springs run one by
+     * one (spring_one_in), so the grid's vector loops never read it. */
+    double *kscale;
     ws_law *law[3];          /* by kind; NULL when no spring of that kind */
     /* Laws with history (relaxation...): each spring's own, nstate doubles a spring, spring s
      * at hist + s nstate; committed after an accepted step (ws_web_commit), read during it. */
     double *hist;
     uint32_t nstate;
     int law_failed; /* a spring's law failed in this step (scratch) */
+    /* Rupture (ws_web_rupture_check): a spring whose strain passes `rupture` (> 0; 0: none) at
+     * the end of a step breaks and from then on carries no force. broken[s] is 1 for a broken
+     * spring (state: saved and hashed; NULL until a limit is first set, ns + WS_WEB_PAD bytes);
+     * nbroken counts them, and while it is 0 the sweep runs as if there were no rupture at
+     * all. The rest is the report: springs broken by the last step, and the first break (the
+     * most strained spring of the first step that broke any): its time, spring, strain and the
+     * midpoint of its ends. */
+    double rupture;
+    uint8_t *broken;
+    uint32_t nbroken, nbroken_step;
+    uint32_t first_spring; /* UINT32_MAX: none broken yet */
+    double first_time, first_strain;
+    v3 first_at;
     double layer;
     uint32_t material;
     double damping;          /* node drag, kg/s */
@@ -119,7 +136,8 @@ void ws_web_free(ws_mem *mem, ws_web *web);
 /* Room for the springs' law histories, initialised as just stretched to the strains the nodes
  * (x[0]) are placed at (after the laws are set). 0, or -1 when out of memory. */
 int ws_web_law_state(ws_mem *mem, ws_web *web);
-/* After an accepted step ending at t (state x, v), dt long: commit the springs' histories. */
+/* After an accepted step ending at t (state x, v), dt long: break the springs strained past
+ * the rupture limit (when one is set), commit the springs' histories. */
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 
 /* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays
@@ -170,7 +188,16 @@ double ws_web_stable_dt(const ws_web *web, double kc, double cc);
 double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h);
 /* Smallest node mass and largest 2 sum(k) + kc over the free nodes (for error messages). */
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k);
-/* Strain and tension of spring s in state (x, v), with its committed history. */
+/* Room for the broken flags (all clear) before a rupture limit is first set. 0, or -1 when
+ * out of memory. */
+int ws_web_rupture_alloc(ws_mem *mem, ws_web *web);
+/* After an accepted step ending at t in state x: break every intact spring whose strain is
+ * above web->rupture (> 0), and note them for the report. */
+void ws_web_rupture_check(ws_web *web, ws_nodes3 x, double t);
+/* Count the broken flags into nbroken (after they were restored). */
+void ws_web_rupture_recount(ws_web *web);
+/* Strain and tension of spring s in state (x, v), with its committed history; a broken
+ * spring's tension is 0. */
 double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s);
 double ws_web_spring_tension(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s);
 /* Elastic energy of all springs in state x, J. */

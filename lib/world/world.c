@@ -379,7 +379,7 @@ ws_status ws_world_get_state_hash(const ws_world *w, uint64_t *hash)
     /* The hashed part of the walk that save and restore make (world_state.c): every piece
      * of state that follows the physics, the detection bookkeeping left out (a failed step may
      * change that, and the hash is the same as long as the motion is). The walk only reads. */
-    ws_walk k = {WS_WALK_HASH, WS_HASH_SEED, NULL, NULL, 0, 0, WS_OK, NULL};
+    ws_walk k = {WS_WALK_HASH, WS_HASH_SEED, NULL, NULL, 0, 0, WS_OK, NULL, 0};
     ws_world_walk((ws_world *)w, &k);
     uint64_t h = k.hash;
     *hash = h;

@@ -250,6 +250,7 @@ typedef struct ws_walk {
     size_t pos, len;         /* bytes walked; bytes in `in` */
     ws_status status;
     ws_world *w;
+    uint32_t version; /* CHECK, READ: the save format of `in`; 0: WS_SAVE_FORMAT_VERSION */
 } ws_walk;
 ws_status ws_world_walk(ws_world *w, ws_walk *k);
 

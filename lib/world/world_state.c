@@ -129,6 +129,27 @@ static void f64s(ws_walk *k, double *p, size_t n, int hashed)
     }
 }
 
+/* n flags at p, a byte each: 0 or 1 in the file. */
+static void flags(ws_walk *k, uint8_t *p, size_t n, int hashed, const char *what)
+{
+    if (failed(k) || (k->mode == WS_WALK_HASH && !hashed) || n == 0)
+        return;
+    if (!reading(k)) {
+        emit(k, p, n, hashed);
+        return;
+    }
+    const unsigned char *b = take(k, n);
+    if (!b)
+        return;
+    for (size_t i = 0; i < n; i++)
+        if (b[i] > 1) {
+            fail(k, WS_ERR_FORMAT, "%s %zu is %u in the file; it must be 0 or 1", what, i, b[i]);
+            return;
+        }
+    if (k->mode == WS_WALK_READ)
+        memcpy(p, b, n);
+}
+
 static void v3s(ws_walk *k, v3 *p, int hashed)
 {
     f64s(k, &p->x, 1, hashed);
@@ -561,6 +582,48 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
     C->seg_list = -1; /* the stretches are cut again from the list read */
 }
 
+/* A web's rupture: which springs are broken (in the hash) and the report of the first break.
+ * Only a web given a rupture limit has it, so that a world without one hashes as before
+ * rupture existed; a save of format 1 has none (restored: none broken). */
+static void walk_rupture(ws_walk *k, ws_web *web, uint32_t slot)
+{
+    if (k->version == 1) {
+        if (k->mode == WS_WALK_READ && web->broken) {
+            memset(web->broken, 0, web->ns);
+            web->nbroken = web->nbroken_step = 0;
+            web->first_spring = UINT32_MAX;
+        }
+        return;
+    }
+    if (same(k, web->broken != NULL, "web", slot,
+             "as its rupture flag (1: a rupture limit was set on it)") ||
+        !web->broken)
+        return;
+    flags(k, web->broken, web->ns, HASHED, "a web's broken flag of spring");
+    uint32_t step = web->nbroken_step, first = web->first_spring;
+    double ft = web->first_time, fe = web->first_strain;
+    v3 fa = web->first_at;
+    u32v(k, &step);
+    u32v(k, &first);
+    f64s(k, &ft, 1, 0);
+    f64s(k, &fe, 1, 0);
+    v3s(k, &fa, 0);
+    if (k->mode == WS_WALK_CHECK && !failed(k) &&
+        (step > web->ns || (first != UINT32_MAX && first >= web->ns)))
+        fail(k, WS_ERR_FORMAT,
+             "web %u's rupture report names %u springs broken in the last step and spring %u "
+             "first, of %u",
+             slot, step, first, web->ns);
+    if (k->mode != WS_WALK_READ || failed(k))
+        return;
+    ws_web_rupture_recount(web);
+    web->nbroken_step = step;
+    web->first_spring = first;
+    web->first_time = ft;
+    web->first_strain = fe;
+    web->first_at = fa;
+}
+
 static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
 {
     ws_world *w = k->w;
@@ -573,6 +636,7 @@ static void walk_web(ws_walk *k, ws_web *web, uint32_t slot)
     f64s(k, web->x[cur].x, 3 * (size_t)web->n, HASHED);
     f64s(k, web->v[cur].x, 3 * (size_t)web->n, HASHED);
     f64s(k, web->hist, (size_t)web->ns * web->nstate, HASHED);
+    walk_rupture(k, web, slot);
     /* The last step's contact forces on the nodes and loads on the bodies (reports). */
     f64s(k, &web->fc[cur][0].x, 3 * (size_t)web->n, 0);
     web_body_room(k, web);

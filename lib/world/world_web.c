@@ -88,6 +88,10 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
         !(isfinite(d->node_damping) && d->node_damping >= 0.0))
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': contact_layer and node_damping must be >= 0", c->label);
+    if (!(isfinite(d->rupture_strain) && d->rupture_strain >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': rupture_strain must be finite and >= 0 (0: none), got %g",
+                       c->label, d->rupture_strain);
     if (d->substeps < 1 || d->substeps > WS_WEB_MAX_SUBSTEPS)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': substeps must be 1..%d, got %d",
                        c->label, WS_WEB_MAX_SUBSTEPS, d->substeps);
@@ -195,6 +199,9 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->material = c->material;
     web->damping = c->d.node_damping;
     web->substeps = c->d.substeps;
+    web->rupture = c->d.rupture_strain;
+    if (web->rupture > 0.0 && ws_web_rupture_alloc(&w->mem, web) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     web->integrator = c->d.integrator;
     web->solver_tol = c->d.solver_tolerance;
     web->solver_maxit = c->d.solver_max_iterations;
@@ -202,6 +209,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     web->contact->list = 0;
     web->contact->refresh = 1;
+    web->contact->ref = UINT32_MAX; /* none until a search finds one (a world may have no body) */
     /* Both buffers start equal, so the world's committed index (0 or 1) finds the web. */
     memcpy(web->x[1].x, web->x[0].x, 3 * (size_t)web->n * sizeof(double));
     if (c->d.name && !(web->name = ws_mem_strdup(&w->mem, c->d.name)))
@@ -396,6 +404,23 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
                                                     nodes_get(web.x[0], a)));
         web.inv_l0[k] = 1.0 / l0;
     }
+    if (g.stiffness_scales && web.ns) {
+        if (!(web.kscale = ws_mem_alloc(&w->mem, (size_t)web.ns * sizeof(double)))) {
+            s = ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c.label);
+            return fail_web(w, &web, s);
+        }
+        for (uint32_t k = 0; k < web.ns; k++) {
+            double q = g.stiffness_scales[k];
+            if (!(isfinite(q) && q > 0.0 && q <= 1e6)) {
+                s = ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                            "web '%s': spring %u has stiffness scale %g: need a finite value > 0 "
+                            "and <= 1e6",
+                            c.label, k, q);
+                return fail_web(w, &web, s);
+            }
+            web.kscale[k] = q;
+        }
+    }
     if (c.d.node_mass > 0.0 && g.node_masses)
         c.d.node_mass = 0.0; /* the per-node masses win */
     s = finish_web(w, &c, &web, g.pinned, g.pinned ? g.pinned_count : 0, 0, out);
@@ -583,8 +608,8 @@ static ws_status bulk_done(const ws_world *w, const void *buf, size_t cap, size_
 static ws_status copy_v3(const ws_world *w, ws_web_id id, double *xyz, size_t cap, size_t *count,
                          int which, const char *fn)
 {
-    const ws_web *web;
-    size_t m;
+    const ws_web *web = NULL;
+    size_t m = 0;
     ws_status s = bulk(w, id, xyz, cap, count, 0, fn, &web, &m);
     if (s != WS_OK)
         return s;
@@ -751,5 +776,104 @@ ws_status ws_web_get_energy(const ws_world *w, ws_web_id id, double *kinetic, do
         *gravity = pe;
     if (elastic)
         *elastic = ws_web_elastic_energy(web, x);
+    return WS_OK;
+}
+
+/* ---- rupture ---- */
+
+ws_status ws_web_set_rupture_strain(ws_world *w, ws_web_id id, double strain)
+{
+    NEED_WORLD(w);
+    NOT_IN_STEP(w, "ws_web_set_rupture_strain");
+    uint32_t slot;
+    ws_status s = ws_lookup_web(w, id, &slot);
+    if (s != WS_OK)
+        return s;
+    ws_web *web = w->webs[slot];
+    if (!(isfinite(strain) && strain >= 0.0))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_web_set_rupture_strain: web '%s': the strain must be finite and >= 0 "
+                       "(0: none), got %g",
+                       web->name ? web->name : "(unnamed)", strain);
+    if (strain > 0.0 && ws_web_rupture_alloc(&w->mem, web) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "ws_web_set_rupture_strain: out of memory");
+    web->rupture = strain;
+    return WS_OK;
+}
+
+ws_status ws_web_get_rupture(const ws_world *w, ws_web_id id, ws_web_rupture *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_web_get_rupture");
+    const ws_web *web;
+    ws_status s = get_web(w, id, &web);
+    if (s != WS_OK)
+        return s;
+    memset(out, 0, sizeof *out);
+    out->rupture_strain = web->rupture;
+    out->broken_count = web->nbroken;
+    out->broken_last_step = web->nbroken_step;
+    out->ruptured = web->first_spring != UINT32_MAX;
+    out->first_spring = web->first_spring;
+    if (out->ruptured) {
+        out->first_time = web->first_time;
+        out->first_strain = web->first_strain;
+        out->first_position = web->first_at;
+    }
+    return WS_OK;
+}
+
+ws_status ws_web_copy_broken_springs(const ws_world *w, ws_web_id id, uint32_t *springs,
+                                     size_t cap, size_t *count)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, count, "ws_web_copy_broken_springs");
+    const ws_web *web;
+    ws_status s = get_web(w, id, &web);
+    if (s != WS_OK)
+        return s;
+    if (cap && !springs)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "ws_web_copy_broken_springs: buffer is NULL but capacity is not 0");
+    size_t n = 0;
+    for (uint32_t k = 0; web->broken && k < web->ns; k++) {
+        if (!web->broken[k])
+            continue;
+        if (n < cap)
+            springs[n] = k;
+        n++;
+    }
+    *count = n;
+    return bulk_done(w, springs, cap, n, "ws_web_copy_broken_springs");
+}
+
+ws_status ws_web_get_peak_strain(const ws_world *w, ws_web_id id, ws_web_peak *out)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, out, "ws_web_get_peak_strain");
+    const ws_web *web;
+    ws_status s = get_web(w, id, &web);
+    if (s != WS_OK)
+        return s;
+    memset(out, 0, sizeof *out);
+    const ws_nodes3 x = web->x[w->cur];
+    for (uint32_t k = 0; k < web->ns; k++) {
+        if (web->broken && web->broken[k])
+            continue;
+        double eps = ws_web_spring_strain(web, x, k);
+        if (!out->found || eps > out->strain) {
+            out->found = 1;
+            out->spring = k;
+            out->strain = eps;
+        }
+    }
+    if (!out->found)
+        return WS_OK;
+    const uint32_t k = out->spring, a = web->sa[k], b = web->sb[k];
+    out->tension = ws_web_spring_tension(web, x, web->v[w->cur], k);
+    out->node_a = a;
+    out->node_b = b;
+    out->position_a = nodes_get(x, a);
+    out->position_b = nodes_get(x, b);
     return WS_OK;
 }

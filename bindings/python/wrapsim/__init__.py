@@ -834,8 +834,9 @@ class World:
 
     def web_sheet(self, law, pinned=None, **kwargs):
         """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
-        areal_density, contact_layer, material, node_damping, substeps, name, integrator
-        ("explicit" or "implicit"), solver_tolerance, solver_max_iterations) and ws_sheet_def
+        areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain,
+        integrator ("explicit" or "implicit"), solver_tolerance, solver_max_iterations) and
+        ws_sheet_def
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
         prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""
         wk, sk = _split(kwargs, L.WebDef, L.SheetDef)
@@ -857,9 +858,9 @@ class World:
         return Web(self, out)
 
     def web_band(self, law, bodies, **kwargs):
-        """A band wrapped around `bodies` (as they are now): ws_web_def fields and ws_band_def
-        fields (z_bottom, z_top m, n_around, n_up, prestretch_around, prestretch_up, gap m,
-        shear)."""
+        """A band wrapped around `bodies` (as they are now): ws_web_def fields (as web_sheet,
+        rupture_strain among them) and ws_band_def fields (z_bottom, z_top m, n_around, n_up,
+        prestretch_around, prestretch_up, gap m, shear)."""
         wk, bk = _split(kwargs, L.WebDef, L.BandDef)
         if "body_count" in bk:
             raise TypeError("web_band: body_count is set from `bodies`; leave it out")
@@ -875,10 +876,11 @@ class World:
         return Web(self, out)
 
     def web_mesh(self, law, positions, springs, node_masses=None, rest_lengths=None,
-                 kinds=None, pinned=None, **kwargs):
+                 kinds=None, pinned=None, stiffness_scales=None, **kwargs):
         """A web of raw nodes (positions (n, 3) m) and springs ((m, 2) node indices), with
-        optional node_masses (kg), rest_lengths (m), kinds (ws_spring_kind) and pinned nodes;
-        other keywords are ws_web_def fields."""
+        optional node_masses (kg), rest_lengths (m), kinds (ws_spring_kind), pinned nodes and
+        stiffness_scales (each spring's force as a multiple of its law's, e.g. its film
+        layers); other keywords are ws_web_def fields."""
         kwargs["law"] = law
         wd = self._web_def(kwargs)
         md = _make(L.WebMeshDef, {})
@@ -902,6 +904,9 @@ class World:
         if kinds is not None:
             _, md.kinds = arr(kinds, "kinds", np.uint8, ctypes.c_uint8, length=m,
                               per="one per spring", bound=3)
+        if stiffness_scales is not None:
+            _, md.stiffness_scales = arr(stiffness_scales, "stiffness_scales", np.float64,
+                                         c_double, length=m, per="one per spring")
         if pinned is not None:
             pins, ptr = arr(pinned, "pinned", np.uint32, c_uint32, bound=n)
             if len(pins):
@@ -1451,6 +1456,46 @@ class Web(_Handle):
         """Spring tensions (m,), N; negative in compression."""
         return self._bulk("ws_web_copy_spring_tensions", self.spring_count,
                           (self.spring_count,), np.float64, c_double, out)
+
+    @property
+    def rupture_strain(self):
+        """Strain l/l0 - 1 past which a spring breaks for good (0: none)."""
+        return self.rupture()["rupture_strain"]
+
+    @rupture_strain.setter
+    def rupture_strain(self, strain):
+        self._call("ws_web_set_rupture_strain", float(strain))
+
+    def rupture(self):
+        """dict: rupture_strain, broken_count, broken_last_step (> 0: springs broke in the
+        last step), ruptured, and the first break: first_spring (None before), first_time s,
+        first_strain, first_position (3,) m."""
+        r = L.WebRupture()
+        self._call("ws_web_get_rupture", byref(r))
+        d = _struct_dict(r)
+        d["ruptured"] = bool(d["ruptured"])
+        if not d["ruptured"]:
+            d["first_spring"] = None
+        return d
+
+    def broken_springs(self):
+        """Indices of the broken springs, ascending (uint32 array)."""
+        count = c_size_t()
+        self._call("ws_web_copy_broken_springs", None, 0, byref(count))
+        out = np.zeros(count.value, dtype=np.uint32)
+        if count.value:
+            self._call("ws_web_copy_broken_springs", _ptr(out, c_uint32), len(out),
+                       byref(count))
+        return out
+
+    def peak_strain(self):
+        """The most strained intact spring now: dict of spring, strain, tension N, node_a,
+        node_b, position_a, position_b (3,) m; None when no spring is intact."""
+        p = L.WebPeak()
+        self._call("ws_web_get_peak_strain", byref(p))
+        if not p.found:
+            return None
+        return _struct_dict(p, skip=("found",))
 
     def body_force(self, body):
         """(force N, moment N m about the CoG) the web put on `body` in the last step."""

@@ -383,6 +383,7 @@ class WebDef(Structure):
         ("law_shear", LawId),
         ("substeps", c_int),
         ("name", c_char_p),
+        ("rupture_strain", c_double),
         ("integrator", c_int),
         ("solver_tolerance", c_double),
         ("solver_max_iterations", c_int),
@@ -438,6 +439,7 @@ class WebMeshDef(Structure):
         ("kinds", POINTER(c_uint8)),
         ("pinned", POINTER(c_uint32)),
         ("pinned_count", c_size_t),
+        ("stiffness_scales", POINTER(c_double)),
     ]
 
 
@@ -450,6 +452,32 @@ class WebInfo(Structure):
         ("substeps", c_int),
         ("mass", c_double),
         ("min_node_mass", c_double),
+    ]
+
+
+class WebRupture(Structure):
+    _fields_ = [
+        ("rupture_strain", c_double),
+        ("broken_count", c_uint32),
+        ("broken_last_step", c_uint32),
+        ("ruptured", c_int),
+        ("first_spring", c_uint32),
+        ("first_time", c_double),
+        ("first_strain", c_double),
+        ("first_position", Vec3),
+    ]
+
+
+class WebPeak(Structure):
+    _fields_ = [
+        ("found", c_int),
+        ("spring", c_uint32),
+        ("strain", c_double),
+        ("tension", c_double),
+        ("node_a", c_uint32),
+        ("node_b", c_uint32),
+        ("position_a", Vec3),
+        ("position_b", Vec3),
     ]
 
 
@@ -582,6 +610,30 @@ class WrapDef(Structure):
         ("strain_around", c_double), ("strain_up", c_double), ("z_bottom", c_double),
         ("top_margin", c_double), ("node_pitch", c_double), ("node_mass", c_double),
         ("substeps", c_int),
+        ("elongation_at_break", c_double), ("powered_prestretch", c_double),
+        ("rupture_strain", c_double),
+    ]
+
+
+class SpiralWrapDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("width", c_double), ("gauge", c_double), ("modulus", c_double), ("density", c_double),
+        ("prestretch", c_double), ("neck_in", c_double), ("load_strain", c_double),
+        ("revolutions_bottom", c_double), ("revolutions_top", c_double), ("overlap", c_double),
+        ("passes", c_int), ("pallet_lock", c_int), ("lock_height", c_double),
+        ("top_margin", c_double), ("rope_revolutions", c_double), ("rope_height", c_double),
+        ("top_sheet", c_int), ("top_sheet_gauge", c_double),
+        ("node_pitch", c_double), ("node_mass_min", c_double), ("substeps", c_int),
+        ("elongation_at_break", c_double), ("rupture_strain", c_double),
+    ]
+
+
+class LoadContainment(Structure):
+    _fields_ = [
+        ("z_low", c_double), ("z_high", c_double), ("force", c_double),
+        ("hoop_tension", c_double), ("line_load", c_double), ("contact_force", c_double),
+        ("rows", c_int),
     ]
 
 
@@ -599,6 +651,7 @@ class LoadtestSample(Structure):
         ("carton", POINTER(LoadCartonState)), ("layers", c_int),
         ("layer_displacement", POINTER(c_double)), ("interfaces", c_int),
         ("interface", POINTER(LoadtestInterfaceState)),
+        ("angle", c_double), ("carton_base", POINTER(LoadtestInterfaceState)),
     ]
 
 
@@ -655,6 +708,7 @@ class KvalueDef(Structure):
         ("size", c_uint32), ("magic", c_uint32),
         ("k_low", c_double), ("k_high", c_double), ("tolerance", c_double),
         ("settle_time", c_double), ("wrap", POINTER(WrapDef)),
+        ("spiral", POINTER(SpiralWrapDef)),
     ]
 
 
@@ -662,6 +716,84 @@ class KvalueResult(Structure):
     _fields_ = [
         ("k_value", c_double), ("k_fail", c_double), ("runs", c_int),
         ("last_pass", EumosResult), ("error", c_char * 256),
+    ]
+
+
+LOADTEST_MAX_CHECKS = 8
+LOADTEST_RESPONSE_BINS = 48
+LOADTEST_TILT, LOADTEST_IMPACT, LOADTEST_RANDOM, LOADTEST_SWEEP = 1, 2, 3, 4
+
+
+class TiltTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("rate", c_double), ("target_angle", c_double), ("max_angle", c_double),
+        ("ramp_time", c_double), ("stop_time", c_double), ("hold_time", c_double),
+        ("stop_at_failure", c_int), ("after_failure", c_double), ("direction", Vec3),
+        ("rest_before", c_double), ("slip_speed", c_double), ("tip_fraction", c_double),
+        ("sample_interval", c_int), ("keep_state", c_int),
+        ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class ImpactTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("speed", c_double), ("pulse_duration", c_double), ("gentle_acceleration", c_double),
+        ("coast_time", c_double), ("rest_before", c_double), ("rest_after", c_double),
+        ("direction", Vec3), ("slip_speed", c_double), ("tip_fraction", c_double),
+        ("sample_interval", c_int), ("keep_state", c_int),
+        ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class VibrationTestDef(Structure):
+    _fields_ = [
+        ("size", c_uint32), ("magic", c_uint32),
+        ("sweep", c_int), ("psd_frequency", POINTER(c_double)),
+        ("psd_level", POINTER(c_double)), ("psd_count", c_size_t), ("grms", c_double),
+        ("seed", c_uint64), ("sample_rate", c_double), ("sweep_level", c_double),
+        ("frequency_start", c_double), ("frequency_end", c_double), ("sweep_law", c_enum),
+        ("resonance_min", c_double), ("duration", c_double), ("ramp_time", c_double),
+        ("direction", Vec3), ("rest_before", c_double), ("rest_after", c_double),
+        ("slip_speed", c_double), ("tip_fraction", c_double), ("sample_interval", c_int),
+        ("keep_state", c_int), ("on_sample", SampleFn), ("sample_user", c_void_p),
+    ]
+
+
+class LoadtestCheck(Structure):
+    _fields_ = [
+        ("id", c_int), ("at_least", c_int), ("value", c_double), ("limit", c_double),
+        ("pass", c_int),
+    ]
+
+
+class LoadtestVerdict(Structure):
+    _fields_ = [
+        ("load_height", c_double), ("count", c_int),
+        ("check", LoadtestCheck * LOADTEST_MAX_CHECKS), ("pass", c_int),
+    ]
+
+
+class LoadtestResult(Structure):
+    _fields_ = [
+        ("kind", c_int), ("duration", c_double), ("peak_level", c_double),
+        ("angle_reached", c_double), ("failure_angle", c_double), ("failure_event", c_int),
+        ("impact_speed", c_double), ("velocity_change", c_double),
+        ("peak_deceleration", c_double), ("grms_delivered", c_double),
+        ("grms_target", c_double), ("resonance_frequency", c_double),
+        ("resonance_transmissibility", c_double), ("response_bins", c_int),
+        ("response_frequency", c_double * LOADTEST_RESPONSE_BINS),
+        ("response_transmissibility", c_double * LOADTEST_RESPONSE_BINS),
+        ("layers", c_int),
+        ("layer_max", c_double * LOAD_MAX_LAYERS),
+        ("layer_permanent", c_double * LOAD_MAX_LAYERS),
+        ("layer_tilt", c_double * LOAD_MAX_LAYERS),
+        ("interface_slip_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("interface_use_max", c_double * (LOAD_MAX_LAYERS + 1)),
+        ("cartons_lost", c_int), ("event_count", c_int), ("events_dropped", c_int),
+        ("events", LoadtestEvent * LOADTEST_MAX_EVENTS), ("film_peak_strain", c_double),
+        ("verdict", LoadtestVerdict),
     ]
 
 
@@ -791,6 +923,10 @@ FUNCTIONS = [
     ("ws_web_get_body_force", [World_p, WebId, BodyId, P(Vec3), P(Vec3)], _st),
     ("ws_web_get_containment", [World_p, WebId, P(ContainmentBand), c_size_t], _st),
     ("ws_web_get_energy", [World_p, WebId, P(c_double), P(c_double), P(c_double)], _st),
+    ("ws_web_set_rupture_strain", [World_p, WebId, c_double], _st),
+    ("ws_web_get_rupture", [World_p, WebId, P(WebRupture)], _st),
+    ("ws_web_copy_broken_springs", [World_p, WebId, P(c_uint32), c_size_t, P(c_size_t)], _st),
+    ("ws_web_get_peak_strain", [World_p, WebId, P(WebPeak)], _st),
     # element.h
     ("ws_element_def_init_sized", [P(ElementDef), c_size_t], None),
     ("ws_element_create", [World_p, P(ElementDef), P(ElementId)], _st),
@@ -831,10 +967,24 @@ FUNCTIONS = [
      _st),
     ("ws_wrap_def_init_sized", [P(WrapDef), c_size_t], None),
     ("ws_load_wrap_band", [World_p, Load_p, P(WrapDef), P(WebId)], _st),
+    ("ws_spiral_wrap_def_init_sized", [P(SpiralWrapDef), c_size_t], None),
+    ("ws_load_wrap_spiral", [World_p, Load_p, P(SpiralWrapDef), P(WebId)], _st),
+    ("ws_spiral_wrap_layers", [P(SpiralWrapDef), c_double, c_double, c_double, c_double,
+                               c_double, P(c_int)], _st),
+    ("ws_load_get_containment", [World_p, Load_p, P(LoadContainment), c_size_t], _st),
+    ("ws_load_get_film_peak", [World_p, Load_p, P(c_double), P(c_uint32), P(c_double)], _st),
     ("ws_eumos_def_init_sized", [P(EumosDef), c_size_t], None),
     ("ws_eumos_get_drive", [P(EumosDef), P(DriveDef), P(c_double)], _st),
     ("ws_loadtest_run_eumos", [World_p, Load_p, P(EumosDef), P(EumosResult)], _st),
     ("ws_kvalue_def_init_sized", [P(KvalueDef), c_size_t], None),
+    ("ws_tilt_test_def_init_sized", [P(TiltTestDef), c_size_t], None),
+    ("ws_impact_test_def_init_sized", [P(ImpactTestDef), c_size_t], None),
+    ("ws_vibration_test_def_init_sized", [P(VibrationTestDef), c_size_t], None),
+    ("ws_loadtest_run_tilt", [World_p, Load_p, P(TiltTestDef), P(LoadtestResult)], _st),
+    ("ws_loadtest_run_impact", [World_p, Load_p, P(ImpactTestDef), P(LoadtestResult)], _st),
+    ("ws_loadtest_run_vibration", [World_p, Load_p, P(VibrationTestDef), P(LoadtestResult)],
+     _st),
+    ("ws_loadtest_check_name", [c_int], c_char_p),
     ("ws_loadtest_find_k", [P(WorldDef), P(LoadDef), P(EumosDef), P(KvalueDef), P(KvalueResult)],
      _st),
 ]
@@ -856,6 +1006,9 @@ DEF_INITS = [
     ("ws_web_mesh_def_init_sized", WebMeshDef),
     ("ws_element_def_init_sized", ElementDef),
     ("ws_vtk_series_def_init_sized", VtkSeriesDef),
+    ("ws_tilt_test_def_init_sized", TiltTestDef),
+    ("ws_impact_test_def_init_sized", ImpactTestDef),
+    ("ws_vibration_test_def_init_sized", VibrationTestDef),
 ]
 
 

@@ -57,7 +57,9 @@ def _run(args):
         return _err(e)
     out = args.output or "wrapsim-out"
     import os
-    result, series = loadrun.run(d, progress=not args.quiet, desc=d["name"],
+    # The bar's label stays short so that the bar keeps to one line of a terminal.
+    desc = d["name"] if len(d["name"]) <= 32 else d["name"][:31] + "…"
+    result, series = loadrun.run(d, progress=not args.quiet, desc=desc,
                                  paraview=os.path.join(out, "paraview"))
     report.write_all(out, d, result, series)
     print(f"{d['name']}: {'PASS' if result['passed'] else 'FAIL'}")

@@ -70,7 +70,51 @@ def wrap_def(d):
     wd.top_margin = w["top_margin_m"]
     wd.node_pitch = w["node_pitch_m"]
     wd.node_mass = w["node_mass_kg"]
+    wd.elongation_at_break = w["elongation_at_break_percent"] / 100
+    wd.powered_prestretch = w["powered_prestretch_percent"] / 100
+    wd.rupture_strain = w["rupture_strain_percent"] / 100
     return wd
+
+
+def spiral_def(d):
+    """The ws_spiral_wrap_def of a load file's unit_load.spiral_wrap section, or None."""
+    w = d["unit_load"]["spiral_wrap"]
+    if w is None:
+        return None
+    sd = _init(L.SpiralWrapDef, "ws_spiral_wrap_def_init_sized")
+    sd.width = w["width_m"]
+    sd.gauge = w["gauge_um"] * 1e-6
+    sd.modulus = w["modulus_MPa"] * 1e6
+    sd.density = w["density_kg_per_m3"]
+    sd.prestretch = w["prestretch_percent"] / 100
+    sd.neck_in = w["neck_in_percent"] / 100
+    sd.load_strain = w["load_strain_percent"] / 100
+    sd.revolutions_bottom = w["revolutions_bottom"]
+    sd.revolutions_top = w["revolutions_top"]
+    sd.overlap = w["overlap_percent"] / 100
+    sd.passes = w["passes"]
+    sd.pallet_lock = 1 if w["pallet_lock"] else 0
+    sd.lock_height = w["lock_height_m"]
+    sd.top_margin = w["top_margin_m"]
+    sd.rope_revolutions = w["rope_revolutions"]
+    sd.rope_height = w["rope_height_m"]
+    sd.top_sheet = 1 if w["top_sheet"] else 0
+    sd.top_sheet_gauge = w["top_sheet_gauge_um"] * 1e-6
+    sd.node_pitch = w["node_pitch_m"]
+    sd.node_mass_min = w["node_mass_min_kg"]
+    sd.elongation_at_break = w["elongation_at_break_percent"] / 100
+    sd.rupture_strain = w["rupture_strain_percent"] / 100
+    return sd
+
+
+def containment_bands(w, load, bands=3):
+    """The containment of a wrapped load by height band, bottom first
+    (ws_load_get_containment): a list of dicts in N, N/m and m."""
+    out = (L.LoadContainment * bands)()
+    _check(w, _c().ws_load_get_containment(w.ptr, load, out, bands), "ws_load_get_containment")
+    return [dict(z_low_m=b.z_low, z_high_m=b.z_high, force_N=b.force,
+                 hoop_tension_N=b.hoop_tension, line_load_N_per_m=b.line_load, rows=b.rows)
+            for b in out]
 
 
 def eumos_def(d, k=None):
@@ -122,26 +166,42 @@ def _result_dict(d, res, state_hash):
                 simulated_s=res.duration)
 
 
+def prepare(w, d):
+    """Build the load file's unit load in world `w`, let it settle, wrap it (then settle again)
+    when the file has a wrap. Returns the ws_load pointer; destroy it with ws_load_destroy."""
+    u = d["unit_load"]
+    lib = _c()
+    ld = load_def(d)
+    load = ctypes.c_void_p()
+    _check(w, lib.ws_load_build(w.ptr, byref(ld), byref(load)), "ws_load_build")
+    try:
+        settled, taken = ctypes.c_int(), ctypes.c_double()
+        wd, sd = wrap_def(d), spiral_def(d)
+        if wd is not None or sd is not None:
+            _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
+                                         byref(settled), byref(taken)), "ws_load_settle")
+            web = L.WebId()
+            if wd is not None:
+                _check(w, lib.ws_load_wrap_band(w.ptr, load, byref(wd), byref(web)),
+                       "ws_load_wrap_band")
+            else:
+                _check(w, lib.ws_load_wrap_spiral(w.ptr, load, byref(sd), byref(web)),
+                       "ws_load_wrap_spiral")
+        _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
+                                     byref(settled), byref(taken)), "ws_load_settle")
+    except BaseException:
+        lib.ws_load_destroy(load)
+        raise
+    return load
+
+
 def run(d, progress=False, desc="wrapsim", paraview=None):
     """Build the unit load, wrap it, let it settle, run the EUMOS test. Returns (result, series)
     like loadrun.run: the verdict as a JSON-able dict and the sampled time series."""
-    u = d["unit_load"]
     lib = _c()
     with World(**world_params(d)) as w:
-        ld = load_def(d)
-        load = ctypes.c_void_p()
-        _check(w, lib.ws_load_build(w.ptr, byref(ld), byref(load)), "ws_load_build")
+        load = prepare(w, d)
         try:
-            settled, taken = ctypes.c_int(), ctypes.c_double()
-            wd = wrap_def(d)
-            if wd is not None:
-                _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                             byref(settled), byref(taken)), "ws_load_settle")
-                web = L.WebId()
-                _check(w, lib.ws_load_wrap_band(w.ptr, load, byref(wd), byref(web)),
-                       "ws_load_wrap_band")
-            _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                         byref(settled), byref(taken)), "ws_load_settle")
             info = L.LoadInfo()
             _check(w, lib.ws_load_get_info(load, byref(info)), "ws_load_get_info")
             rows = []
@@ -197,9 +257,11 @@ def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01):
     kd = _init(L.KvalueDef, "ws_kvalue_def_init_sized")
     kd.k_low, kd.k_high, kd.tolerance = k_low, k_high, tolerance
     kd.settle_time = d["unit_load"]["settle_s"]
-    wd = wrap_def(d)
+    wd, sd = wrap_def(d), spiral_def(d)
     if wd is not None:
         kd.wrap = ctypes.pointer(wd)
+    if sd is not None:
+        kd.spiral = ctypes.pointer(sd)
     res = L.KvalueResult()
     st = lib.ws_loadtest_find_k(byref(wdef), byref(ld), byref(ed), byref(kd), byref(res))
     if st != L.WS_OK:

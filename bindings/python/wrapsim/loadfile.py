@@ -9,7 +9,8 @@ path and what is wrong, e.g. "wrap.prestretch_around_percent: -20 is below 0 %".
 Two forms of load: a column of cartons (`stack`) on a tilt table (`platform`, optionally with a
 stop bar on its downhill side; `materials`, an optional film band `wrap`), or a unit load
 (`unit_load`: a pallet with layers of cartons, the interfaces, an optional wrap) for the EUMOS
-40509 test, which the C library's load-test module builds and judges. `test` says which test.
+40509 test, the tilt, the horizontal impact or vibration, which the C library's load-test
+module builds and judges. `test` says which test.
 """
 
 import copy
@@ -36,6 +37,17 @@ def _int(default=None, minimum=None, maximum=None, doc=""):
 
 def _str(choices, default=None, doc=""):
     return dict(kind="string", choices=choices, default=default, doc=doc)
+
+
+def _bool(default, doc=""):
+    return dict(kind="boolean", unit="", default=default, minimum=None, maximum=None,
+                exclusive_min=False, doc=doc)
+
+
+def _pairs(doc=""):
+    """A list of [x, y] pairs of positive numbers, x increasing (PSD breakpoints); [] for
+    none."""
+    return dict(kind="pairs", default=[], doc=doc)
 
 
 def _section(fields, optional=False, doc=""):
@@ -117,7 +129,56 @@ SPEC = _section({
             "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
             "node_mass_kg": _num("kg", 2e-3, 0.0, 10.0,
                                  doc="per node; 0 for the film's real mass"),
+            "elongation_at_break_percent": _num("%", 400.0, 0.0, 10000.0,
+                                                doc="from unstretched; 0: the film never breaks"),
+            "powered_prestretch_percent": _num("%", 250.0, 0.0, 10000.0,
+                                               doc="the pre-stretch before the film is laid"),
+            "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
+                                           doc="the film's rupture strain from its rest length; "
+                                               "0: from the two above"),
         }, optional=True, doc="a band of film around the load (absent: unwrapped)"),
+        "spiral_wrap": _section({
+            "width_m": _num("m", 0.5, 0.0, 10.0, True, doc="film width off the roll"),
+            "gauge_um": _num("um", 20.0, 0.0, 1000.0, True, doc="film thickness off the roll"),
+            "modulus_MPa": _num("MPa", 150.0, 0.0, 1e5, True,
+                                doc="Young's modulus of the film as it lies on the load"),
+            "density_kg_per_m3": _num("kg/m^3", 920.0, 0.0, 1e4, True),
+            "prestretch_percent": _num("%", 200.0, 0.0, 1000.0,
+                                       doc="powered pre-stretch (plastic: thins the film)"),
+            "neck_in_percent": _num("%", 15.0, 0.0, 90.0,
+                                    doc="width the pre-stretch takes away"),
+            "load_strain_percent": _num("%", 10.0, 0.0, 99.0, True,
+                                        doc="elastic strain the film holds on the load"),
+            "revolutions_bottom": _num("", 2.0, 0.0, 1000.0, doc="revolutions at the bottom"),
+            "revolutions_top": _num("", 2.0, 0.0, 1000.0, doc="revolutions at the top"),
+            "overlap_percent": _num("%", 50.0, 0.0, 95.0,
+                                    doc="of the laid width, between spiral revolutions"),
+            "passes": _int(2, 1, 2, doc="1: spiral up; 2: up and down"),
+            "pallet_lock": _bool(True, doc="the film's lower edge goes down onto the pallet"),
+            "lock_height_m": _num("m", 0.05, 0.0, 100.0,
+                                  doc="the film's lower edge above the platform (with the "
+                                      "lock) or above the deck (without)"),
+            "top_margin_m": _num("m", 0.02, 0.0, 100.0,
+                                 doc="the film's upper edge below the load's top"),
+            "rope_revolutions": _num("", 0.0, 0.0, 1000.0,
+                                     doc="revolutions of film rolled into a cable (0: none)"),
+            "rope_height_m": _num("m", 0.2, 0.0, 100.0, True,
+                                  doc="height of the rope above the platform"),
+            "top_sheet": _bool(False, doc="a loose sheet of film over the top face, held by "
+                                          "the top revolutions"),
+            "top_sheet_gauge_um": _num("um", 50.0, 0.0, 10000.0, True,
+                                       doc="thickness of the top sheet"),
+            "node_pitch_m": _num("m", 0.05, 0.0, 10.0, True),
+            "node_mass_min_kg": _num("kg", 0.0, 0.0, 10.0,
+                                     doc="smallest node mass (0: the film's real mass)"),
+            "elongation_at_break_percent": _num("%", 400.0, 0.0, 10000.0,
+                                                doc="from the film off the roll; 0: the film "
+                                                    "never breaks"),
+            "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
+                                           doc="the film's rupture strain from its rest length "
+                                               "on the load; 0: from the elongation at break "
+                                               "and the pre-stretch"),
+        }, optional=True, doc="the spiral wrap of a stretch-wrapping machine (absent: none)"),
     }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
         "carton": _section({
@@ -146,18 +207,42 @@ SPEC = _section({
         "node_mass_kg": _num("kg", 1e-3, 0.0, 10.0, True),
     }, optional=True, doc="a band of film around the stack (absent: unwrapped)"),
     "test": _section({
-        "type": _str(["tilt", "eumos"], "tilt",
-                     doc="tilt table (ISO 10531; a stack) or EUMOS 40509 (a unit_load)"),
+        "type": _str(["tilt", "eumos", "impact", "vibration"], "tilt",
+                     doc="tilt table (ISO 10531; a stack or a unit_load), EUMOS 40509, "
+                         "horizontal impact (ASTM D4003 / D5414, ISTA 3E) or vibration (ASTM "
+                         "D4169 truck random, or a sine sweep); the last three need a unit_load"),
         "k_g": _num("g", 0.3, 0.0, 10.0, True, doc="eumos: the plateau acceleration"),
         "mode": _str(["accelerate", "brake"], "accelerate",
                      doc="eumos: a pulse from rest, or a run-up then braking at k g"),
         "rise_s": _num("s", 0.04, 0.0, 1.0, True, doc="eumos: the rise to k g (<= 0.05)"),
         "hold_s": _num("s", 0.35, 0.0, 100.0, doc="eumos: the plateau (>= 0.3)"),
+        "speed_m_per_s": _num("m/s", 1.2, 0.0, 20.0, True,
+                              doc="impact: the platform's speed at the impact (1.2, 1.75)"),
+        "pulse_ms": _num("ms", 10.0, 0.0, 1000.0, True,
+                         doc="impact: the programmer's half-sine deceleration"),
+        "coast_s": _num("s", 0.2, 0.0, 100.0, doc="impact: at speed before the impact"),
+        "rest_s": _num("s", 0.5, 0.0, 100.0,
+                       doc="impact, vibration: at rest after, before the permanent state"),
+        "vibration": _str(["random", "sweep"], "random",
+                          doc="vibration: random from a PSD, or a sine sweep (resonance)"),
+        "grms_g": _num("g", 0.54, 0.0, 20.0,
+                       doc="vibration, random: the PSD scaled to this Grms (D4169 truck: 0.40, "
+                           "0.54, 0.70); 0 plays the PSD as given"),
+        "psd": _pairs(doc="vibration, random: breakpoints [Hz, g^2/Hz], log-log between; "
+                          "[] (default): the library's truck spectrum"),
+        "seed": _int(1, 0, 2 ** 53, doc="vibration, random: the same seed, the same history"),
+        "sweep_g": _num("g", 0.25, 0.0, 10.0, True, doc="vibration, sweep: amplitude"),
+        "sweep_from_hz": _num("Hz", 2.0, 0.0, 1e4, True, doc="vibration, sweep: start"),
+        "sweep_to_hz": _num("Hz", 40.0, 0.0, 1e4, True, doc="vibration, sweep: end (log law)"),
+        "resonance_min_hz": _num("Hz", 0.0, 0.0, 1e4,
+                                 doc="vibration, sweep: the resonance must be at least this"),
         "start_s": _num("s", 1.0, 0.0, 1e6, doc="the tilt starts (smoothly) at this time"),
         "rate_deg_per_s": _num("deg/s", math.degrees(0.1), 0.0, 90.0, True),
-        "duration_s": _num("s", 7.0, 0.0, 1e6, True, doc="simulated time"),
+        "duration_s": _num("s", 7.0, 0.0, 1e6, True,
+                           doc="tilt of a stack: simulated time; vibration: the shaking"),
         "target_angle_deg": _num("deg", 20.0, 0.0, 89.0, True,
-                                 doc="the load passes when nothing slips or tips below it"),
+                                 doc="tilt: the load passes when nothing slips or tips below "
+                                     "it"),
         "slip_limit_mm": _num("mm", 5.0, 0.0, 1e4, True,
                               doc="relative slip that counts as slipping"),
     }),
@@ -175,6 +260,10 @@ def _unit_text(unit):
 
 def _check_value(spec, value, path):
     kind = spec["kind"]
+    if kind == "boolean":
+        if not isinstance(value, bool):
+            raise LoadFileError(f"{path}: {value!r} is not true or false")
+        return value
     if kind in ("number", "integer"):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise LoadFileError(f"{path}: {value!r} is not a number")
@@ -189,6 +278,22 @@ def _check_value(spec, value, path):
         if hi is not None and value > hi:
             raise LoadFileError(f"{path}: {value:g} is above {hi:g}{unit}")
         return int(value) if kind == "integer" else float(value)
+    if kind == "pairs":
+        if not isinstance(value, list):
+            raise LoadFileError(f"{path}: {value!r} is not a list of [x, y] pairs")
+        out = []
+        for i, pair in enumerate(value):
+            if (not isinstance(pair, list) or len(pair) != 2 or
+                    any(isinstance(x, bool) or not isinstance(x, (int, float)) or
+                        not math.isfinite(x) or x <= 0 for x in pair)):
+                raise LoadFileError(f"{path}[{i}]: {pair!r} is not a pair of numbers > 0")
+            if out and pair[0] <= out[-1][0]:
+                raise LoadFileError(f"{path}[{i}]: {pair[0]:g} does not increase on "
+                                    f"{out[-1][0]:g}")
+            out.append([float(pair[0]), float(pair[1])])
+        if len(out) == 1:
+            raise LoadFileError(f"{path}: one breakpoint; give at least two, or none")
+        return out
     if kind == "string":
         if not isinstance(value, str):
             raise LoadFileError(f"{path}: {value!r} is not a string")
@@ -220,7 +325,7 @@ def _check_section(spec, value, path):
                 raise LoadFileError(f"{sub_path}: missing (a required value"
                                     f"{', in ' + sub['unit'] if sub.get('unit') else ''})")
             else:
-                out[key] = sub["default"]
+                out[key] = copy.deepcopy(sub["default"])
         else:
             out[key] = _check_value(sub, value[key], sub_path)
     return out
@@ -231,11 +336,25 @@ def _cross_checks(d):
     if (d["stack"] is None) == (d["unit_load"] is None):
         raise LoadFileError("stack: give either a stack (a column on a tilt table) or a "
                             "unit_load (a pallet with layers of cartons), not both or neither")
-    kind = d["test"]["type"]
-    if kind == "eumos" and d["unit_load"] is None:
-        raise LoadFileError("test.type: 'eumos' needs a unit_load section")
-    if kind == "tilt" and d["stack"] is None:
-        raise LoadFileError("test.type: 'tilt' needs a stack section")
+    t = d["test"]
+    kind = t["type"]
+    if kind in ("eumos", "impact", "vibration") and d["unit_load"] is None:
+        raise LoadFileError(f"test.type: '{kind}' needs a unit_load section")
+    if t["sweep_to_hz"] <= t["sweep_from_hz"]:
+        raise LoadFileError(f"test.sweep_to_hz: {t['sweep_to_hz']:g} Hz is not above "
+                            f"sweep_from_hz ({t['sweep_from_hz']:g} Hz)")
+    u = d["unit_load"]
+    if u is not None and u["wrap"] is not None and u["spiral_wrap"] is not None:
+        raise LoadFileError("unit_load.spiral_wrap: give a band (unit_load.wrap) or a spiral "
+                            "(unit_load.spiral_wrap), not both")
+    sp = u["spiral_wrap"] if u is not None else None
+    if sp is not None:
+        height = (u["pallet"]["height_m"] + u["layers"] * u["carton"]["height_m"])
+        low = sp["lock_height_m"] + (0.0 if sp["pallet_lock"] else u["pallet"]["height_m"])
+        if low + sp["top_margin_m"] >= height:
+            raise LoadFileError(f"unit_load.spiral_wrap.lock_height_m: the film ({low:g} m "
+                                f"above the platform to {sp['top_margin_m']:g} m below the "
+                                f"top) has no height on a load {height:g} m high")
     if d["stack"] is None:
         return
     c = d["stack"]["carton"]
@@ -313,7 +432,10 @@ def _schema_of(spec):
         if spec.get("doc"):
             out["description"] = spec["doc"]
         return out
-    if kind == "string":
+    if kind == "pairs":
+        out = {"type": "array", "items": {"type": "array", "minItems": 2, "maxItems": 2,
+                                          "items": {"type": "number", "exclusiveMinimum": 0}}}
+    elif kind == "string":
         out = {"type": "string"}
         if spec["choices"]:
             out["enum"] = list(spec["choices"])

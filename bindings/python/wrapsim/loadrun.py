@@ -140,6 +140,9 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
     if d["test"]["type"] == "eumos":
         from . import eumos
         return eumos.run(d, progress, desc, paraview)
+    if d["unit_load"] is not None:
+        from . import loadtests
+        return loadtests.run(d, progress, desc, paraview)
     sc = build(d)
     w, platform, cartons, film = sc["world"], sc["platform"], sc["cartons"], sc["film"]
     test = d["test"]

@@ -10,7 +10,10 @@ import numpy as np
 
 def _unit_header(col):
     """`carton1_slip_mm` -> `carton1_slip [mm]`: the unit in every header."""
-    for suffix, unit in (("_mm", "mm"), ("_deg", "deg"), ("_m_per_s", "m/s"), ("_g", "g"),
+    if col.endswith(("_friction_use", "_tan_theta")):
+        return f"{col} [1]"
+    for suffix, unit in (("_mm_per_s", "mm/s"), ("_mm", "mm"), ("_deg", "deg"),
+                         ("_m_per_s", "m/s"), ("_g", "g"),
                          ("_s", "s"), ("_N", "N")):
         if col.endswith(suffix):
             return f"{col[:-len(suffix)]} [{unit}]"
@@ -78,6 +81,85 @@ def _eumos_plots(plt, folder, d, result, series):
     return names
 
 
+_EVENT_COLOURS = {"slip onset": "tab:orange", "tip onset": "tab:red", "carton lost": "black",
+                  "film rupture": "tab:purple"}
+
+
+def _mark_events(ax, events):
+    """A vertical line at each event, coloured by its kind, each kind once in the legend."""
+    seen = set()
+    for e in events:
+        kind = e["event"]
+        ax.axvline(e["t_s"], color=_EVENT_COLOURS.get(kind, "0.5"), lw=0.8, ls="--",
+                   label=kind if kind not in seen else None)
+        seen.add(kind)
+
+
+def _loadtest_plots(plt, folder, d, result, series):
+    """Tilt (of a unit load), impact and vibration: the layers' displacement with the events,
+    the drive as delivered, the interfaces' friction use, and a sweep's response."""
+    t = series["t_s"]
+    H = 1e3 * result["load_height_m"]
+    kind = result["test"]
+    title = {"tilt": "Tilt (ISO 10531)", "impact": "Horizontal impact",
+             "vibration": f"Vibration ({result.get('vibration', '')})"}[kind]
+    names = []
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    k = 1
+    while f"layer{k}_displacement_mm" in series:
+        ax.plot(t, series[f"layer{k}_displacement_mm"], label=f"layer {k}")
+        k += 1
+    if kind == "impact":
+        ax.axhline(0.05 * H, color="tab:orange", ls=":", lw=1, label="permanent limit 5 % H")
+    _mark_events(ax, result["events"])
+    along = "vertical" if kind == "vibration" else "along the drive"
+    names.append(_finish(plt, fig, ax, folder / "displacement.png", (
+        "time [s]", f"layer displacement relative to the pallet, {along} [mm]",
+        f"{title}: layers against the pallet, with the events")))
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    if kind == "tilt":
+        ax.plot(t, series["platform_angle_deg"], label="platform angle")
+        ax.axhline(result["target_angle_deg"], color="0.3", ls=":", lw=1,
+                   label=f"target {result['target_angle_deg']:g}°")
+        _mark_events(ax, result["events"])
+        labels = ("time [s]", "platform angle [deg]", "The tilt as delivered")
+    else:
+        ax.plot(t, series["platform_acceleration_g"], lw=0.8, label="delivered")
+        if kind == "impact":
+            sub = (f"velocity change {result['velocity_change_m_per_s']:.4f} m/s of "
+                   f"{result['impact_speed_m_per_s']:.4f}, peak "
+                   f"{result['peak_deceleration_g']:.2f} g")
+        elif result.get("vibration") == "random":
+            sub = (f"{result['grms_delivered_g']:.3f} Grms delivered of "
+                   f"{result['grms_target_g']:.3f}")
+        else:
+            sub = f"sweep {d['test']['sweep_from_hz']:g}-{d['test']['sweep_to_hz']:g} Hz"
+        labels = ("time [s]", "platform acceleration [g]", f"The drive as delivered: {sub}")
+    names.append(_finish(plt, fig, ax, folder / "drive.png", labels))
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    i = 0
+    while f"interface{i}_friction_use" in series:
+        name = "pallet on platform" if i == 0 else (
+            "layer 1 on pallet" if i == 1 else f"layer {i} on layer {i - 1}")
+        ax.plot(t, series[f"interface{i}_friction_use"], lw=0.8, label=name)
+        i += 1
+    names.append(_finish(plt, fig, ax, folder / "friction_use.png", (
+        "time [s]", "friction use |Ft| / (mu Fn)", "Friction use of each interface")))
+
+    if result.get("vibration") == "sweep":
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        ax.semilogx(result["response_hz"], result["response_transmissibility"], "o-", ms=3,
+                    label="top layer / platform")
+        if result["resonance_hz"] > 0:
+            ax.axvline(result["resonance_hz"], color="tab:red", ls="--", lw=1,
+                       label=f"resonance {result['resonance_hz']:.2f} Hz")
+        names.append(_finish(plt, fig, ax, folder / "response.png", (
+            "frequency [Hz]", "transmissibility", "The load's response to the sweep")))
+    return names
+
+
 def write_plots(folder, d, result, series):
     """The plots as PNG files; returns their names (none without matplotlib)."""
     try:
@@ -88,6 +170,8 @@ def write_plots(folder, d, result, series):
         return []
     if result["test"] == "eumos":
         return _eumos_plots(plt, folder, d, result, series)
+    if result.get("form") == "unit_load":
+        return _loadtest_plots(plt, folder, d, result, series)
     t, angle = series["t_s"], series["platform_angle_deg"]
     n = d["stack"]["layers"]
     target = result["target_angle_deg"]
