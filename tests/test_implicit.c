@@ -1,7 +1,8 @@
 /* The implicit film integrator (web/implicit.c, contact/node_jacobian.c, world_implicit.c): its
  * derivatives against finite differences, backward Euler's known amplification and phase on a
- * string's mode, the explicit web's analytic answers, convergence to the explicit film as dt
- * shrinks, and a failed solve leaving the world as it was. */
+ * string's mode, the explicit web's analytic answers (row tension, band pressure; the capstan
+ * is in test_web.c, capstan_implicit), convergence to the explicit film as dt shrinks, stiffness
+ * scales and rupture, and a failed solve leaving the world as it was. */
 #include "helpers.h"
 
 #include "contact/node_jacobian.h"
