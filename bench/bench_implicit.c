@@ -6,7 +6,7 @@
  * bottom one, wall time, CG iterations a step and node-updates a second per CG iteration.
  * Never fails on time.
  * Usage: bench_implicit [what] [duration s]: what = ref (the three films at dt 0.25 ms,
- * default), dt (the implicit film at dt 0.25, 1 and 2.5 ms), ratio (the three films' times
+ * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
  * times in each direction, short runs: cost per simulated second and containment). */
 #define TILT_TABLE_NO_MAIN
@@ -57,8 +57,10 @@ int main(int argc, char **argv)
         a.substeps = 285;
         line("explicit, 1.6 mg nodes, 285 sub-steps", &a);
     } else if (!strcmp(what, "dt")) {
-        const double dts[3] = {2.5e-4, 1e-3, 2.5e-3};
-        for (int k = 0; k < 3; k++) {
+        /* 2.5 ms is refused by the box-box contacts' own stable step (2.45 ms: 2e5 N/m on an
+         * effective 2.5 kg over 8 contacts), so the last is 2.4 ms. */
+        const double dts[4] = {2.5e-4, 1e-3, 2.4e-3, 2.5e-3};
+        for (int k = 0; k < 4; k++) {
             tilt_options a = o;
             a.film_mass = 1.6e-6;
             a.implicit = 1;
