@@ -70,6 +70,11 @@ typedef struct tilt_options {
     double stable_fraction; /* the film check's safety factor (world.h); 0 = the default */
     int profile;          /* 1: the library times its phases (ws_world_stats) */
     int workers;          /* workers of a step; 0 = 1 (the results are the same for any) */
+    int implicit;         /* 1: the film's implicit integrator (WS_WEB_IMPLICIT) */
+    double areal_density; /* kg/m^2 of film, in place of film_mass when > 0 (0.018: real) */
+    int refine;           /* film nodes refine x refine as many (each direction); 0 = 1 */
+    double solver_tolerance; /* implicit film: the solve's tolerance; 0 = the default */
+    double dt;            /* s; 0 = 0.25 ms */
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -107,6 +112,8 @@ typedef struct tilt_result {
     double max_relative_slip;             /* m, largest move of the top box on the bottom one */
     double peak_strain, peak_tension;     /* film, largest over the run (wrapped) */
     uint64_t hash;
+    uint32_t film_nodes;                  /* wrapped: nodes of the film */
+    ws_web_solver_stats solver;           /* wrapped, implicit film: its solves */
 } tilt_result;
 
 static void tilt_default_options(tilt_options *o)
@@ -127,7 +134,8 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
 {
     ws_world *w = sc->world;
     const double a = 0.25, layer = 1e-3, k = 2000.0, c = 0.1;
-    const int n_around = 96, n_up = 61;
+    const int r = o->refine > 1 ? o->refine : 1;
+    const int n_around = 96 * r, n_up = 60 * r + 1;
     const double z0 = 0.030, z1 = 2 * a + 2 * 2 * layer - 0.020;
     /* Outline: the square footprint pushed out by the box and node layers. */
     double perimeter = 4 * a + 2 * TILT_PI * 2 * layer;
@@ -158,8 +166,10 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
         return s;
     ws_contact_def cd;
     ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0; /* N/m per node */
-    cd.damping = 1.0;
+    /* N/m per node; a refined band's nodes each stand for 1 / refine^2 of the film, and so
+     * take that share of the stiffness and damping: the same pressure at the same overlap. */
+    cd.stiffness = 4000.0 / (r * r);
+    cd.damping = 1.0 / (r * r);
     cd.friction = 0.9; /* film sticks to cardboard */
     cd.friction_vlim = sc->vlim;
     if ((s = ws_world_set_contact(w, film_mat, box_mat, &cd)) != WS_OK ||
@@ -168,7 +178,12 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
 
     ws_web_def wd;
     ws_web_def_init(&wd);
-    wd.node_mass = o->film_mass > 0 ? o->film_mass : 1e-3;
+    wd.node_mass = o->areal_density > 0 ? 0.0 : o->film_mass > 0 ? o->film_mass : 1e-3;
+    wd.areal_density = o->areal_density;
+    if (o->implicit)
+        wd.integrator = WS_WEB_IMPLICIT;
+    if (o->solver_tolerance > 0)
+        wd.solver_tolerance = o->solver_tolerance;
     wd.contact_layer = layer;
     wd.material = film_mat;
     wd.law = around;
@@ -193,7 +208,7 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
 {
     const double a = 0.25, m = 5.0, layer = 1e-3, gap = 2 * layer;
     memset(sc, 0, sizeof *sc);
-    sc->dt = 2.5e-4;
+    sc->dt = o->dt > 0 ? o->dt : 2.5e-4;
     sc->duration = o->duration > 0 ? o->duration : (o->variant == 'P' ? 6.0 : 7.0);
     sc->vlim = 0.01;
 
@@ -683,6 +698,10 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         fprintf(stderr, "\r  t = %.2f s of %.2f s: done\n", res->end_time, sc.duration);
     res->cog_distance_end = distance(w, sc.box[0], sc.box[1]);
     ws_world_get_state_hash(w, &res->hash);
+    if (sc.film.bits) {
+        res->film_nodes = (uint32_t)nodes;
+        ws_web_get_solver_stats(w, sc.film, &res->solver);
+    }
     if (s != WS_OK)
         snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
     res->status = s;

@@ -31,6 +31,18 @@ typedef enum ws_spring_kind {
     WS_SPRING_SHEAR = 2   /**< diagonals: `law_shear` */
 } ws_spring_kind;
 
+/** How a web's nodes advance over a (sub-)step. */
+typedef enum ws_web_integrator {
+    /** Symplectic Euler: cheap per step, stable only below the web's stable step
+     *  (ws_web_get_stable_dt), so a light or finely meshed film needs sub-steps. */
+    WS_WEB_EXPLICIT = 0,
+    /** Linearly implicit backward Euler (one Newton step, Baraff & Witkin 1998): the springs'
+     *  and the node contacts' stiffness and damping in a linear system solved by conjugate
+     *  gradients each step; stable at any step for the film's stiffness and mass
+     *  (docs/theory.md, "The implicit film"). */
+    WS_WEB_IMPLICIT = 1
+} ws_web_integrator;
+
 /** What every web has. Fill with ws_web_def_init(). */
 typedef struct ws_web_def {
     uint32_t size;  /**< set by ws_web_def_init() */
@@ -56,6 +68,14 @@ typedef struct ws_web_def {
      *  is laid with on the load (a generator's pre-stretch) counts from l0 and so uses part
      *  of it. A trailing field: older callers get 0. */
     double rupture_strain;
+    int integrator;         /**< ws_web_integrator; default WS_WEB_EXPLICIT */
+    double solver_tolerance; /**< implicit webs: the linear solve stops when its residual is
+                                  at most this times the larger of the right-hand side's norm
+                                  and the film's weight times the step (momentum, N s);
+                                  (0, 0.1]; default 1e-6 */
+    int solver_max_iterations; /**< implicit webs: conjugate-gradient iterations at most per
+                                    solve (1..100000); default 1000. A solve that does not
+                                    converge fails the step with WS_ERR_NUMERICAL */
 } ws_web_def;
 
 /** A rectangular sheet: nx x ny nodes at origin + i spacing_x axis_x + j spacing_y axis_y. */
@@ -213,9 +233,24 @@ WS_API ws_status ws_web_get_info(const ws_world *world, ws_web_id id, ws_web_inf
 
 /** The largest stable sub-step of the web, s: the explicit limit 2/omega_max with omega_max^2
  *  bounded by (2 sum of spring stiffnesses + contact stiffness) / node mass over the nodes.
- *  ws_world_step refuses to run (WS_ERR_NUMERICAL, saying the node mass or the sub-steps that
- *  would do) when dt / substeps exceeds it. */
+ *  ws_world_step refuses to run an explicit web (WS_ERR_NUMERICAL, saying the node mass or the
+ *  sub-steps that would do) when dt / substeps exceeds it; an implicit web is never refused
+ *  for it (the figure then says how far beyond the explicit limit it runs). */
 WS_API ws_status ws_web_get_stable_dt(const ws_world *world, ws_web_id id, double *dt);
+/** What the implicit solves of a web did (an explicit web reports zeros). */
+typedef struct ws_web_solver_stats {
+    uint64_t solves;          /**< linear solves since the web was made (one per sub-step) */
+    uint64_t iterations;      /**< conjugate-gradient iterations of all of them */
+    int last_iterations;      /**< iterations of the last solve */
+    double last_residual;     /**< its residual over its scale (<= the tolerance when it
+                                   converged) */
+} ws_web_solver_stats;
+
+/** The implicit solver's counts of a web. @return WS_OK, WS_ERR_STALE_HANDLE,
+ *  WS_ERR_INVALID_ARGUMENT (stats NULL). */
+WS_API ws_status ws_web_get_solver_stats(const ws_world *world, ws_web_id id,
+                                         ws_web_solver_stats *stats);
+
 /** Sub-steps per world step (>= 1). */
 WS_API ws_status ws_web_set_substeps(ws_world *world, ws_web_id id, int substeps);
 

@@ -145,8 +145,9 @@ typedef struct ws_world_stats {
     double seconds_contacts;   /**< evaluating body-body contacts */
     double seconds_web;        /**< film: springs, node contacts, node integration */
     double seconds_total;      /**< whole steps */
-    /** The largest fraction of a web's stable sub-step that dt / substeps uses (0 without
-     *  webs); a web runs while it is <= ws_world_def.stable_fraction. */
+    /** The largest fraction of an explicit web's stable sub-step that dt / substeps uses (0
+     *  without explicit webs); such a web runs while it is <= ws_world_def.stable_fraction.
+     *  Implicit webs have no such limit and are not counted. */
     double web_step_use;
     /** dt as a fraction of the bodies' contact stable step (ws_world_estimate_stable_dt without
      *  the elements; 0 when no two bodies can touch); refused above 1. */

@@ -1,4 +1,5 @@
 #include "web/web.h"
+#include "web/implicit.h"
 
 #include <float.h>
 #include <string.h>
@@ -74,6 +75,7 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free(mem, web->broken, web->broken ? (size_t)web->ns + WS_WEB_PAD : 0);
     ws_mem_free_str(mem, web->name);
+    ws_implicit_free(mem, web);
     memset(web, 0, sizeof *web);
 }
 

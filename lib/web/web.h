@@ -120,6 +120,12 @@ typedef struct ws_web {
     /* Force and moment on each body in the last step (global, moment about the CoG). */
     v3 *bforce[2], *bmoment[2];
     size_t bcap;
+    /* The integrator (ws_web_integrator) and, for the implicit one, the solve's tolerance and
+     * iterations at most, and its scratch (web/implicit.h, made at its first step). */
+    int integrator;
+    double solver_tol;
+    int solver_maxit;
+    struct ws_implicit *imp;
 } ws_web;
 
 /* After the node masses and pins are set: whether they are all alike (same_m, same_inv_m). */

@@ -340,6 +340,8 @@ ws_status ws_world_get_stats(const ws_world *w, ws_world_stats *s)
         if (w->web_slots.dense[k] == UINT32_MAX)
             continue;
         const ws_web *web = w->webs[k];
+        if (web->integrator == WS_WEB_IMPLICIT)
+            continue; /* no explicit limit to use */
         double use = w->def.dt / web->substeps / ws_world_web_stable_dt((ws_world *)w, web);
         s->web_step_use = use > s->web_step_use ? use : s->web_step_use;
     }

@@ -120,6 +120,10 @@ struct ws_world {
     size_t pairs_cap, npairs;
 
     ws_world_stats stats;
+
+    /* The node contacts of an implicit web's step (world_implicit.c), scratch. */
+    struct ws_node_link *links;
+    size_t links_cap;
 };
 
 /* Record an error (and log it) and return the status. The world may be const for callers that
@@ -176,6 +180,12 @@ int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, 
 void ws_world_lanes_free(ws_world *w);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
+/* An implicit web's step (world_implicit.c): its sub-steps from state cur into nxt, the node
+ * contacts of candidate list `list` in the matrix, the loads on the bodies into web->bforce[nxt]
+ * and web->bmoment[nxt] and the bodies' accumulators. WS_ERR_NUMERICAL when a solve does not
+ * converge or a node runs away, WS_ERR_CALLBACK when a law fails, WS_ERR_OUT_OF_MEMORY; the
+ * committed state is not written. */
+ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int list);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 /* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */

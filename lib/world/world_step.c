@@ -154,7 +154,8 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
     return ws_fail(w, WS_ERR_NUMERICAL,
                    "web '%s': %s: it runs at dt/substeps = %.3g s but its stable step is %.3g s, "
                    "of which it may use %g (stable_fraction): %.3g s (smallest node mass %.3g "
-                   "kg). %s %s, or a smaller dt.",
+                   "kg). %s %s, or a smaller dt; or make it implicit (ws_web_def.integrator = "
+                   "WS_WEB_IMPLICIT), which has no such limit.",
                    web_label(web), what, h, stable, f, allowed, mmin, sub, mass);
 }
 
@@ -192,7 +193,8 @@ static ws_status webs_ready(ws_world *w)
             }
             web->bcap = cap;
         }
-        if (w->web_check) {
+        /* An implicit web is stable at any step for its stiffness: no refusal. */
+        if (w->web_check && web->integrator == WS_WEB_EXPLICIT) {
             double h = w->def.dt / web->substeps, stable = ws_world_web_stable_dt(w, web);
             if (!(h <= w->def.stable_fraction * stable)) /* NaN refuses too */
                 return web_unstable(w, web, h, stable, "refused before the step");
@@ -258,6 +260,10 @@ static uint32_t web_lanes(const ws_world *w, const ws_web *web)
     uint32_t lanes = w->def.worker_count > 1 ? most : 1;
     if (lanes > blocks)
         lanes = blocks;
+    /* An implicit web solves on the calling thread (world_implicit.c): one lane, so that the
+     * node contact forces are zeroed here and not by lanes that do not run. */
+    if (web->integrator == WS_WEB_IMPLICIT)
+        return 1;
     return lanes < 2 || !ws_web_sweep_parallel(web) ? 1 : lanes;
 }
 
@@ -500,6 +506,12 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
         web->nfct[nxt] = 0;
         web->fck = nxt;
+        if (web->integrator == WS_WEB_IMPLICIT) {
+            ws_status st = ws_world_web_implicit(w, web, cur, nxt, list);
+            if (st != WS_OK)
+                return st;
+            continue;
+        }
         int n = web->substeps;
         double h = w->def.dt / n, share = 1.0 / n;
         /* Sub-steps alternate between the next state and the web's scratch state so that

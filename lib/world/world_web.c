@@ -1,5 +1,6 @@
 /* Public calls on laws and webs: validation, id lookup, generators, read-out. */
 #include "world/world_internal.h"
+#include "contact/node_jacobian.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -23,6 +24,9 @@ static void web_defaults(ws_web_def *def)
     ws_def_reset(def, sizeof *def);
     def->contact_layer = 1e-3;
     def->substeps = 1;
+    def->integrator = WS_WEB_EXPLICIT;
+    def->solver_tolerance = 1e-6;
+    def->solver_max_iterations = 1000;
 }
 WS_DEF_INITS(ws_web_def, web_defaults, name)
 
@@ -91,6 +95,19 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
     if (d->substeps < 1 || d->substeps > WS_WEB_MAX_SUBSTEPS)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT, "web '%s': substeps must be 1..%d, got %d",
                        c->label, WS_WEB_MAX_SUBSTEPS, d->substeps);
+    if (d->integrator != WS_WEB_EXPLICIT && d->integrator != WS_WEB_IMPLICIT)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': integrator must be WS_WEB_EXPLICIT (0) or WS_WEB_IMPLICIT (1), "
+                       "got %d",
+                       c->label, d->integrator);
+    if (!(d->solver_tolerance > 0.0 && d->solver_tolerance <= 0.1))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': solver_tolerance must be in (0, 0.1], got %g", c->label,
+                       d->solver_tolerance);
+    if (d->solver_max_iterations < 1 || d->solver_max_iterations > 100000)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': solver_max_iterations must be 1..100000, got %d", c->label,
+                       d->solver_max_iterations);
     c->material = 0;
     if (d->material.bits && (s = ws_lookup_material(w, d->material, &c->material)) != WS_OK)
         return s;
@@ -185,6 +202,9 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->rupture = c->d.rupture_strain;
     if (web->rupture > 0.0 && ws_web_rupture_alloc(&w->mem, web) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
+    web->integrator = c->d.integrator;
+    web->solver_tol = c->d.solver_tolerance;
+    web->solver_maxit = c->d.solver_max_iterations;
     if (!(web->contact = ws_node_contact_new(&w->mem, web->n)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     web->contact->list = 0;
@@ -436,6 +456,7 @@ void ws_world_free_webs(ws_world *w)
     ws_mem_free(&w->mem, w->webs, w->web_cap * sizeof *w->webs);
     ws_slots_destroy(&w->mem, &w->web_slots);
     ws_mem_free(&w->mem, w->node_par, w->node_par_cap * sizeof *w->node_par);
+    ws_mem_free(&w->mem, w->links, w->links_cap * sizeof(ws_node_link));
     ws_node_geometry_free(&w->mem, &w->node_geom);
 }
 
@@ -522,6 +543,22 @@ ws_status ws_web_get_stable_dt(const ws_world *w, ws_web_id id, double *dt)
     if (s != WS_OK)
         return s;
     *dt = ws_world_web_stable_dt((ws_world *)w, web);
+    return WS_OK;
+}
+
+ws_status ws_web_get_solver_stats(const ws_world *w, ws_web_id id, ws_web_solver_stats *stats)
+{
+    NEED_WORLD(w);
+    NEED_OUT(w, stats, "ws_web_get_solver_stats");
+    const ws_web *web;
+    ws_status s = get_web(w, id, &web);
+    if (s != WS_OK)
+        return s;
+    const ws_implicit *im = web->imp;
+    *stats = (ws_web_solver_stats){0, 0, 0, 0.0};
+    if (im)
+        *stats = (ws_web_solver_stats){im->solves, im->iterations, im->last_iterations,
+                                       im->last_residual};
     return WS_OK;
 }
 

@@ -423,6 +423,39 @@ def test_sheet_tensions_are_ea_times_prestretch():
             web.tensions(out=np.empty(3))
 
 
+def test_implicit_web_sags_like_a_string():
+    """A pinned string of 21 nodes under gravity on the implicit film at dt 2 ms, beyond its
+    explicit stable step (which it is not refused for): with drag it settles, and its mid-node
+    sag is the discrete string's: H (y[i+1] - 2 y[i] + y[i-1]) / s = -P for node weights P at
+    spacing s gives y[i] = P s i (N - i) / (2 H), at mid-span P s N^2 / (8 H), with H the
+    middle spring's tension (its slope P / (2 H) ~ 0.004 makes T and H differ by 1e-5).
+    Tolerance 2e-3: the formula takes the nodes s apart horizontally, but spring i's run is
+    l0 (cos(theta_i) + H / EA), shorter by theta^2 / 2 (up to 3e-3 at the ends, theta ~ 0.08)
+    where it is steep; the solves' residual (1e-9) and the settling (e^-50) are far below."""
+    n, sp, pre, ea, m = 21, 0.05, 0.05, 50.0, 2e-3
+    with ws.World(gravity=(0, 0, -9.81), dt=2e-3) as w:
+        law = w.law("linear_viscoelastic", stiffness=ea, damping=0.02)
+        web = w.web_sheet(law, nx=n, ny=1, spacing_x=sp, spacing_y=sp, prestretch_x=pre,
+                          node_mass=m, node_damping=0.05, pinned=[0, n - 1],
+                          integrator="implicit", solver_tolerance=1e-9, name="string")
+        assert web.stable_dt < 2e-3
+        w.step(2000)
+        st = web.solver_stats()
+        assert st["solves"] == 2000 and st["iterations"] >= 2000
+        assert st["last_residual"] <= 1e-9
+        p = web.positions()
+        sag = -p[n // 2, 2]
+        H = ea * float(web.strains()[n // 2 - 1])
+        N = n - 1
+        assert sag == pytest.approx(m * 9.81 * sp * N ** 2 / (8 * H), rel=2e-3)
+        with pytest.raises(ValueError):
+            w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                        integrator="backward")
+        with pytest.raises(ws.WrapsimError):
+            w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                        integrator="implicit", solver_tolerance=0.5)
+
+
 def test_drive_callback_and_its_errors():
     with ws.World(gravity=(0, 0, 0)) as w:
         b = w.body(w.box(0.1, 0.1, 0.1), type="kinematic", position=(1, 0, 0))

@@ -86,6 +86,7 @@ def build_features():
 _ENUMS = {
     (L.WorldDef, "integrator"): {"symplectic_euler": 0, "paper_explicit": 1},
     (L.ContactDef, "friction_model"): {"regularized": 0, "stick": 1},
+    (L.WebDef, "integrator"): {"explicit": 0, "implicit": 1},
     (L.BodyDef, "type"): {"dynamic": 0, "kinematic": 1},
     (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3, "pulse": 4,
                            "impact": 5, "table": 6, "random": 7, "sweep": 8},
@@ -844,8 +845,9 @@ class World:
 
     def web_sheet(self, law, pinned=None, **kwargs):
         """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
-        areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain)
-        and ws_sheet_def
+        areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain,
+        integrator ("explicit" or "implicit"), solver_tolerance, solver_max_iterations) and
+        ws_sheet_def
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
         prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""
         wk, sk = _split(kwargs, L.WebDef, L.SheetDef)
@@ -1410,6 +1412,13 @@ class Web(_Handle):
         t = c_double()
         self._call("ws_web_get_stable_dt", byref(t))
         return t.value
+
+    def solver_stats(self):
+        """The implicit film's solves: solves, iterations (CG, all of them), last_iterations,
+        last_residual (over its scale); zeros for an explicit web."""
+        st = L.WebSolverStats()
+        self._call("ws_web_get_solver_stats", byref(st))
+        return _struct_dict(st)
 
     @property
     def substeps(self):

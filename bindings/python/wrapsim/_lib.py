@@ -384,6 +384,18 @@ class WebDef(Structure):
         ("substeps", c_int),
         ("name", c_char_p),
         ("rupture_strain", c_double),
+        ("integrator", c_int),
+        ("solver_tolerance", c_double),
+        ("solver_max_iterations", c_int),
+    ]
+
+
+class WebSolverStats(Structure):
+    _fields_ = [
+        ("solves", c_uint64),
+        ("iterations", c_uint64),
+        ("last_iterations", c_int),
+        ("last_residual", c_double),
     ]
 
 
@@ -901,6 +913,7 @@ FUNCTIONS = [
     ("ws_web_get_info", [World_p, WebId, P(WebInfo)], _st),
     ("ws_web_get_stable_dt", [World_p, WebId, P(c_double)], _st),
     ("ws_web_set_substeps", [World_p, WebId, c_int], _st),
+    ("ws_web_get_solver_stats", [World_p, WebId, P(WebSolverStats)], _st),
     ("ws_web_copy_positions", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
     ("ws_web_copy_velocities", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),
     ("ws_web_copy_contact_forces", [World_p, WebId, P(c_double), c_size_t, P(c_size_t)], _st),

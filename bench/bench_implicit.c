@@ -1,0 +1,163 @@
+/* Benchmark (not a test): the wrapped reference case R (DESIGN.md) with the film at its real
+ * areal density, 1.6 mg nodes (1.6 mg a node), on the implicit film integrator, beside the
+ * explicit film of 1 g nodes (the examples' choice) and the explicit film at the real mass with
+ * the sub-steps its stability needs. Prints, for each run, the uphill edge's lift-off angle,
+ * the tipping angle (the load's CoG over the stop's edge), the top box's largest slide on the
+ * bottom one, wall time, CG iterations a step and node-updates a second per CG iteration.
+ * Never fails on time.
+ * Usage: bench_implicit [what] [duration s]: what = ref (the three films at dt 0.25 ms,
+ * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on), ratio (the three films' times
+ * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
+ * times in each direction, short runs: cost per simulated second and containment). */
+#define TILT_TABLE_NO_MAIN
+#include "../examples/tilt_table.c"
+
+static void line(const char *name, const tilt_options *o)
+{
+    tilt_result r;
+    tilt_run(o, &r);
+    if (r.status != WS_OK) {
+        printf("  %-34s failed: %s\n", name, r.error);
+        return;
+    }
+    const double steps = (double)r.steps;
+    printf("  %-34s lift %7.3f deg  tip %7.3f deg  slide %6.3f mm  %8.2f s wall", name,
+           r.lift_angle, r.over_angle, 1e3 * r.max_relative_slip, r.wall_seconds);
+    if (r.solver.solves)
+        printf("  CG %.1f it/step, %.2f M node-updates/s per CG iteration",
+               (double)r.solver.iterations / steps,
+               (double)r.film_nodes * (double)r.solver.iterations / r.wall_seconds / 1e6);
+    printf("\n");
+    fflush(stdout);
+}
+
+int main(int argc, char **argv)
+{
+    const char *what = argc > 1 ? argv[1] : "ref";
+    const double duration = argc > 2 ? atof(argv[2]) : 0.0;
+    tilt_options o;
+    tilt_default_options(&o);
+    o.variant = 'R';
+    o.wrapped = 1;
+    o.quiet = 1;
+    o.duration = duration;
+    printf("libwrapsim %s: reference case R wrapped%s\n", ws_version_string(),
+           duration > 0 ? " (shortened)" : "");
+    if (!strcmp(what, "ref")) {
+        tilt_options a = o;
+        line("explicit, 1 g nodes, 2 sub-steps", &a);
+        a.film_mass = 1.6e-6;
+        a.substeps = 0;
+        a.implicit = 1;
+        a.substeps = 1;
+        line("implicit, 1.6 mg nodes, dt 0.25 ms", &a);
+        a.implicit = 0;
+        /* The fewest sub-steps the film check accepts for 1.6 mg nodes at the default
+         * stable_fraction 0.5 (its refusal says so). */
+        a.substeps = 285;
+        line("explicit, 1.6 mg nodes, 285 sub-steps", &a);
+    } else if (!strcmp(what, "dt") || !strcmp(what, "dt1")) {
+        const int first_dt = !strcmp(what, "dt1"); /* dt1: from 1 ms on */
+        /* 2.5 ms is refused by the box-box contacts' own stable step (2.45 ms: 2e5 N/m on an
+         * effective 2.5 kg over 8 contacts), so the last is 2.4 ms. */
+        const double dts[4] = {2.5e-4, 1e-3, 2.4e-3, 2.5e-3};
+        for (int k = first_dt; k < 4; k++) {
+            tilt_options a = o;
+            a.film_mass = 1.6e-6;
+            a.implicit = 1;
+            a.substeps = 1;
+            a.dt = dts[k];
+            char name[64];
+            snprintf(name, sizeof name, "implicit, 1.6 mg nodes, dt %.2f ms", 1e3 * dts[k]);
+            line(name, &a);
+        }
+    } else if (!strcmp(what, "ratio")) {
+        /* Time ratios from interleaved rounds of the first `duration` s (default 0.5 s: the
+         * wrapped stack settling, the same work a step as later): the three films of `ref`,
+         * round after round, each round's ratios to the explicit 1 g film, and their medians. */
+        const double T = duration > 0 ? duration : 0.5;
+        enum { ROUNDS = 3 };
+        double t[ROUNDS][3];
+        for (int k = 0; k < ROUNDS; k++) {
+            for (int f = 0; f < 3; f++) {
+                tilt_options a = o;
+                a.duration = T;
+                if (f > 0)
+                    a.film_mass = 1.6e-6;
+                a.implicit = f == 1;
+                a.substeps = f == 0 ? 0 : f == 1 ? 1 : 285;
+                tilt_result r;
+                tilt_run(&a, &r);
+                t[k][f] = r.status == WS_OK ? r.wall_seconds : NAN;
+            }
+            printf("  round %d: explicit 1 g %.2f s, implicit 1.6 mg %.2f s (%.1f x), explicit "
+                   "1.6 mg x 285 %.2f s (%.1f x); implicit / explicit at 1.6 mg %.3f\n",
+                   k + 1, t[k][0], t[k][1], t[k][1] / t[k][0], t[k][2], t[k][2] / t[k][0],
+                   t[k][1] / t[k][2]);
+            fflush(stdout);
+        }
+        double q[ROUNDS];
+        for (int k = 0; k < ROUNDS; k++)
+            q[k] = t[k][1] / t[k][2];
+        for (int i = 0; i < ROUNDS; i++) /* sort the three */
+            for (int j = i + 1; j < ROUNDS; j++)
+                if (q[j] < q[i]) {
+                    const double x = q[i];
+                    q[i] = q[j];
+                    q[j] = x;
+                }
+        printf("  median implicit / explicit at the real mass: %.3f\n", q[ROUNDS / 2]);
+    } else if (!strcmp(what, "refine")) {
+        /* The wrapped stack on the level platform (the tilt starts at 1 s), its band at the
+         * real areal density refined r x r: after the film's first pull-in (`duration`, default
+         * 0.05 s, not timed: the band starts just touching and its light nodes snap onto the
+         * boxes), wall time per simulated second over as long again, and the containment then
+         * (the line load of the hoop tension, N/m, and the bodies' total normal force on the
+         * film, N), which refinement must leave alone. */
+        const double T = duration > 0 ? duration : 0.05;
+        double base = 0;
+        for (int r = 1; r <= 4; r *= 2) {
+            tilt_options a = o;
+            a.areal_density = 0.018;
+            a.implicit = 1;
+            a.substeps = 1;
+            a.refine = r;
+            tilt_scene sc;
+            if (tilt_build(&a, &sc) != WS_OK) {
+                printf("  refine %d: cannot build\n", r);
+                continue;
+            }
+            const long steps = lround(T / sc.dt);
+            ws_status st = ws_world_step_n(sc.world, (uint64_t)steps);
+            ws_web_solver_stats s0;
+            ws_web_get_solver_stats(sc.world, sc.film, &s0);
+            const double t0 = now();
+            if (st == WS_OK)
+                st = ws_world_step_n(sc.world, (uint64_t)steps);
+            const double el = now() - t0;
+            if (st != WS_OK) {
+                printf("  refine %d: %s\n", r, ws_world_last_error(sc.world));
+                ws_world_destroy(sc.world);
+                continue;
+            }
+            ws_containment_band band;
+            ws_web_get_containment(sc.world, sc.film, &band, 1);
+            ws_web_info info;
+            ws_web_get_info(sc.world, sc.film, &info);
+            ws_web_solver_stats ss;
+            ws_web_get_solver_stats(sc.world, sc.film, &ss);
+            if (r == 1)
+                base = el / T;
+            printf("  refine %d (%u nodes): %.1f s wall per simulated s (%.2f x unrefined), CG "
+                   "%.1f it/step; line load %.2f N/m, contact force %.2f N\n",
+                   r, info.node_count, el / T, el / T / base,
+                   (double)(ss.iterations - s0.iterations) / steps,
+                   band.line_load, band.contact_force);
+            fflush(stdout);
+            ws_world_destroy(sc.world);
+        }
+    } else {
+        return 2;
+    }
+    return 0;
+}

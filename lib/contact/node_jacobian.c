@@ -1,0 +1,268 @@
+/* Node contacts of an implicit web: forces at the start of the step and their derivatives
+ * (node_jacobian.h). The contact is the explicit film's (node_force.c): a penalty normal force
+ * on the overlap with damping on its rate, at the contact point midway in the overlap, never
+ * pulling; friction by eq. 13, regularised below v_lim. What differs is how a step takes them:
+ * the explicit film limits friction to what stops the node within its sub-step (deviation (g)
+ * of docs/design.md), while here eq. 13 itself goes into the implicit step as a damper, which
+ * backward Euler keeps stable at any step (docs/theory.md, "The implicit film"). */
+#include "contact/node_jacobian.h"
+
+#include <string.h>
+
+static void outer_add(double *J, double c, v3 a, v3 b)
+{
+    const double av[3] = {a.x, a.y, a.z}, bv[3] = {b.x, b.y, b.z};
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            J[3 * i + k] += c * av[i] * bv[k];
+}
+
+/* J += c M N, 3x3 row-major. */
+static void mul_add(double *J, double c, const double *M, const double *N)
+{
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double s = 0.0;
+            for (int q = 0; q < 3; q++)
+                s += M[3 * i + q] * N[3 * q + k];
+            J[3 * i + k] += c * s;
+        }
+}
+
+static void sym_outer(double *S, double c, v3 e)
+{
+    S[WS_SYM_XX] += c * e.x * e.x;
+    S[WS_SYM_YY] += c * e.y * e.y;
+    S[WS_SYM_ZZ] += c * e.z * e.z;
+    S[WS_SYM_XY] += c * e.x * e.y;
+    S[WS_SYM_XZ] += c * e.x * e.z;
+    S[WS_SYM_YZ] += c * e.y * e.z;
+}
+
+/* One pushing contact, its force and derivatives (see ws_node_link). n: the unit normal from
+ * the body to the node; d: the distance along it; G: dn/dx (zero for a face, (P_e - n n^T) / d
+ * for an edge's rim, P_e the projection across the edge). */
+static int link_of(const ws_node_params *p, v3 x, v3 u, v3 r, v3 vb, v3 wb, v3 n, double d,
+                   double hi, const double G[9], int pinned, ws_node_link *L)
+{
+    const v3 a = v3_sub(v3_madd(x, n, -0.5 * d), r);
+    const v3 vr = v3_sub(u, v3_add(vb, v3_cross(wb, a)));
+    const double vn = v3_dot(vr, n);
+    const double f = p->k * (hi - d) - p->c * vn;
+    memset(L, 0, sizeof *L);
+    L->lever = a;
+    L->n = n;
+    L->fn = f;
+    L->k = p->k;
+    L->c = p->c;
+    /* A node the solved step takes less than 2 % of the window into it is left out of that
+     * step: a film lying on a flat face (no pressure from its tension) hovers at the window's
+     * edge, and each step would bring some of its nodes in by nanometres, at the cost of a
+     * second solve. Their force, at most k hi / 50 (0.16 N, 40 um, on the reference case), comes in
+     * at the next step. */
+    L->fin = 0.02 * p->k * hi;
+    L->active = f > 0.0;
+    L->mu = pinned ? 0.0 : p->mu;
+    {
+        const v3 t = v3_madd(vr, n, -vn);
+        const double tl = v3_norm(t), s = tl / p->vlim;
+        L->t = t;
+        L->phi = 2.0 / p->vlim;
+        L->dp = 2.0 / p->vlim;
+        L->tt = v3_make(0, 0, 0);
+        if (tl > 0.0) {
+            L->phi = (s < 1.0 ? s * (2.0 - s) : 1.0) / tl;
+            L->dp = s < 1.0 ? (2.0 - 2.0 * s) / p->vlim : 0.0;
+            L->tt = v3_scale(t, 1.0 / tl);
+        }
+    }
+    if (!L->active) {
+        /* Not pushing now: the penalty's linear model alone, for the step to take if it
+         * brings the node in (ws_node_link_update, which adds the friction then). */
+        L->f = v3_scale(n, f);
+        sym_outer(L->K, p->k, n);
+        sym_outer(L->D, p->c, n);
+        return 1;
+    }
+    /* df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
+     * df/du = -c n^T. */
+    double dfx[3] = {-p->k * n.x, -p->k * n.y, -p->k * n.z};
+    const double vrv[3] = {vr.x, vr.y, vr.z};
+    for (int k = 0; k < 3; k++)
+        for (int q = 0; q < 3; q++)
+            dfx[k] -= p->c * vrv[q] * G[3 * q + k];
+    const v3 dfxv = v3_make(dfx[0], dfx[1], dfx[2]);
+    outer_add(L->Jx, 1.0, n, dfxv);
+    for (int k = 0; k < 9; k++)
+        L->Jx[k] += f * G[k];
+    outer_add(L->Jv, -p->c, n, n);
+    sym_outer(L->K, p->k, n);
+    sym_outer(L->D, p->c, n);
+    v3 F = v3_scale(n, f);
+    if (p->mu > 0.0 && !pinned) {
+        /* Eq. 13 over the tangential slip t: F_t = -mu f p(s) t / |t|, s = |t| / v_lim,
+         * p(s) = s (2 - s) below 1 and 1 above: F_t = -mu f phi t with phi = p / |t| (2 / v_lim
+         * at rest) and dF_t/dt = -mu f (phi I + (p'/v_lim - phi) tt^T), tt = t / |t|, which is
+         * positive semi-definite across the normal (p' >= 0, phi + p'/v_lim - phi >= 0). */
+        const v3 t = v3_madd(vr, n, -vn);
+        const double tl = v3_norm(t), s = tl / p->vlim;
+        double phi = 2.0 / p->vlim, dp = 2.0 / p->vlim;
+        v3 tt = v3_make(0, 0, 0);
+        if (tl > 0.0) {
+            phi = (s < 1.0 ? s * (2.0 - s) : 1.0) / tl;
+            dp = s < 1.0 ? (2.0 - 2.0 * s) / p->vlim : 0.0;
+            tt = v3_scale(t, 1.0 / tl);
+        }
+        const double mf = p->mu * f;
+        F = v3_madd(F, t, -mf * phi);
+        double T[9] = {0}; /* dF_t/dt at fixed f */
+        for (int i = 0; i < 3; i++)
+            T[4 * i] = -mf * phi;
+        outer_add(T, -mf * (dp - phi), tt, tt);
+        /* dt/du = I - n n^T; dt/dx = -(vn G + n vr^T G). */
+        double Pn[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Tx[9];
+        outer_add(Pn, -1.0, n, n);
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) {
+                double s2 = 0.0;
+                for (int q = 0; q < 3; q++)
+                    s2 += vrv[q] * G[3 * q + k];
+                const double nv[3] = {n.x, n.y, n.z};
+                Tx[3 * i + k] = -(vn * G[3 * i + k] + nv[i] * s2);
+            }
+        mul_add(L->Jx, 1.0, T, Tx);
+        mul_add(L->Jv, 1.0, T, Pn);
+        /* Through the normal force: F_t is proportional to f. */
+        outer_add(L->Jx, -p->mu * phi, t, dfxv);
+        outer_add(L->Jv, p->mu * phi * p->c, t, n);
+        /* The matrix takes friction as the damper its own force is over the slip, mu f phi
+         * across the normal (the secant, not the tangent): at rest they are the same (phi =
+         * p'(0) / v_lim), but a sliding node's tangent has no damping along the slip (Coulomb's
+         * force does not grow with speed), and one linear step would carry the node past the
+         * reversal of its slip with nothing to stop it. As a damper, backward Euler ends the
+         * step with the force -mu f phi t1 against the slip it ends with, which cannot
+         * overshoot. The coupling through f (t n^T) is not symmetric and vanishes at rest. */
+        double Dn[WS_SYM] = {0};
+        sym_outer(Dn, -1.0, n);
+        Dn[WS_SYM_XX] += 1.0;
+        Dn[WS_SYM_YY] += 1.0;
+        Dn[WS_SYM_ZZ] += 1.0;
+        for (int k = 0; k < WS_SYM; k++)
+            L->D[k] += mf * phi * Dn[k];
+    }
+    L->f = F;
+    return 1;
+}
+
+/* A contact that did not push at the start brought into the step, which ends with the normal
+ * force fe > 0 by its linear model: its friction over the slip at the start with that normal
+ * force, as a damper like any other (link_of). */
+static void bring_in(ws_node_link *c, double fe)
+{
+    c->active = 1;
+    if (!(c->mu > 0.0))
+        return;
+    const double mf = c->mu * fe;
+    c->f = v3_madd(v3_scale(c->n, c->fn), c->t, -mf * c->phi);
+    double *Dm = c->D;
+    memset(Dm, 0, WS_SYM * sizeof(double));
+    sym_outer(Dm, c->c - mf * c->phi, c->n);
+    Dm[WS_SYM_XX] += mf * c->phi;
+    Dm[WS_SYM_YY] += mf * c->phi;
+    Dm[WS_SYM_ZZ] += mf * c->phi;
+}
+
+size_t ws_node_links(const ws_body_store *b, int cur, const ws_node_geom *g,
+                     const ws_node_params *pp, const ws_web *web, const ws_ncand *cand,
+                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, const double *guess,
+                     double reach, ws_node_link *out)
+{
+    size_t m = 0;
+    const ws_body_state *st = &b->st[cur];
+    for (size_t k = 0; k < count; k++) {
+        const ws_ncand *c = &cand[k];
+        const uint32_t i = c->node, bi = c->body;
+        const v3 xi = nodes_get(x, i);
+        v3 n;
+        double d, hi;
+        if (!ws_node_touch(b, cur, g, web, c, xi, reach, &n, &d, &hi))
+            continue;
+        double G[9] = {0};
+        if (c->local & WS_NCAND_EDGE) {
+            /* The rim's normal turns with the node: dn/dx = (I - e e^T - n n^T) / d. */
+            const ws_wedge *E = &g->edge[c->feat];
+            const v3 e = v3_scale(E->e, sqrt(E->inv_e2));
+            const double ev[3] = {e.x, e.y, e.z}, nv[3] = {n.x, n.y, n.z};
+            for (int r = 0; r < 3; r++)
+                for (int q = 0; q < 3; q++)
+                    G[3 * r + q] = ((r == q) - ev[r] * ev[q] - nv[r] * nv[q]) / d;
+        }
+        ws_node_link *L = &out[m];
+        if (link_of(&pp[b->material[bi]], xi, nodes_get(v, i), st->r[bi], st->v[bi], b->wg[bi],
+                    n, d, hi, G, web->inv_m[i] == 0.0, L)) {
+            L->node = i;
+            L->body = bi;
+            /* One that the node reaches within the step at its present velocity, plus the
+             * guess of its change (the last step's), comes in now, which spares most steps a
+             * second solve. */
+            v3 u = nodes_get(v, i);
+            if (guess)
+                u = v3_add(u, v3_make(guess[3 * i], guess[3 * i + 1], guess[3 * i + 2]));
+            const double nv = v3_dot(n, u), fe = L->fn - L->k * h * nv;
+            if (!L->active && fe > 0.0)
+                bring_in(L, fe);
+            m++;
+        }
+    }
+    return m;
+}
+
+size_t ws_node_link_loads(const ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
+                          double h, double share, v3 *fc, uint32_t *touched, v3 *bforce,
+                          v3 *bmoment)
+{
+    size_t m = 0;
+    for (size_t k = 0; k < count; k++) {
+        const ws_node_link *c = &L[k];
+        const uint32_t i = c->node;
+        if (!c->active)
+            continue;
+        const double *D = dv + 3 * (size_t)i;
+        const v3 u = nodes_get(v1, i);
+        /* f - K h v1 - D dv: the force the node's solve took over the step. */
+        double o[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(c->K, h * u.x, h * u.y, h * u.z, o);
+        ws_sym_madd(c->D, D[0], D[1], D[2], o);
+        const v3 F = v3_sub(c->f, v3_make(o[0], o[1], o[2]));
+        const v3 load = v3_scale(F, -share);
+        fc[i] = v3_sub(fc[i], load);
+        touched[m++] = i;
+        bforce[c->body] = v3_add(bforce[c->body], load);
+        bmoment[c->body] = v3_add(bmoment[c->body], v3_cross(c->lever, load));
+    }
+    return m;
+}
+
+size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
+                           double h)
+{
+    size_t changed = 0;
+    for (size_t k = 0; k < count; k++) {
+        ws_node_link *c = &L[k];
+        const uint32_t i = c->node;
+        const double *D = dv + 3 * (size_t)i;
+        const double nv = c->n.x * v1.x[i] + c->n.y * v1.y[i] + c->n.z * v1.z[i],
+                     nd = c->n.x * D[0] + c->n.y * D[1] + c->n.z * D[2];
+        const double fe = c->fn - c->k * h * nv - c->c * nd;
+        /* Contacts come in and never leave within a step: a node that would leave its face
+         * keeps the linear model of its force for this one step (which may end pulling a
+         * little, the node's momentum and the body's load agreeing), while the set grows
+         * to a fixed point in a few solves (taken out and put back, a node at the edge of
+         * the window could go on forever). */
+        if (!c->active && fe > c->fin) {
+            bring_in(c, fe);
+            changed++;
+        }
+    }
+    return changed;
+}

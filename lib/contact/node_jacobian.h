@@ -1,0 +1,59 @@
+/* Node contacts of an implicit web (contact module): each contact's force at the start of the
+ * step with its derivatives, for the film's linear solve (web/implicit.h), and the loads on the
+ * bodies from the solved step. */
+#ifndef WS_CONTACT_NODE_JACOBIAN_H
+#define WS_CONTACT_NODE_JACOBIAN_H
+
+#include "contact/node.h"
+#include "web/implicit.h"
+
+/* A pushing contact of node `node` and body `body` at the start of a step: the force on the node
+ * f (normal force and friction), the lever from the body's CoG to the contact point, the
+ * symmetric blocks the matrix takes (K = -df/dx, D = -df/dv, positive semi-definite) and the
+ * exact derivatives Jx = df/dx, Jv = df/dv (row-major) for a body that does not spin. */
+typedef struct ws_node_link {
+    uint32_t node, body;
+    int active;  /* in the step's matrix and forces (ws_node_link_update) */
+    v3 f, lever;
+    v3 n;        /* the unit normal, from the body to the node */
+    double fn;   /* the normal force at the start as the penalty gives it, negative when the
+                    node lies beyond the window (not clamped) */
+    double k, c; /* the contact's stiffness and damping */
+    double fin;  /* the least normal force at the end of the step that brings it in once the
+                    step is solved (ws_node_link_update) */
+    double mu;   /* its friction coefficient, 0 for a pinned node */
+    v3 t, tt;    /* the tangential slip at the start and its direction (zero at rest) */
+    double phi, dp; /* eq. 13 over the slip: F_t = -mu N phi t; dp = p'(s) / v_lim */
+    double K[WS_SYM], D[WS_SYM];
+    double Jx[9], Jv[9];
+} ws_node_link;
+
+/* The contacts of the candidates cand[0, count) (sorted by node) with the node state (x, v) and
+ * the bodies at state cur (features prepared in g), parameters pp by body material, the
+ * window raised by reach: each into out (room for count), their number returned. A contact
+ * that pushes at the start starts active, with its friction, and so does one that the node
+ * reaches within the step h at its present velocity plus `guess` (xyz per node; NULL: none)
+ * (with the normal force it would end with);
+ * any other (beyond the window, or leaving it) starts inactive with its normal force's linear
+ * model alone (f = fn n, K, D along n), which ws_node_link_update may bring in. */
+size_t ws_node_links(const ws_body_store *b, int cur, const ws_node_geom *g,
+                     const ws_node_params *pp, const ws_web *web, const ws_ncand *cand,
+                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, const double *guess,
+                     double reach, ws_node_link *out);
+
+/* After a solve over step h (dv; new velocities v1): each contact's normal force at the end of
+ * the step by its linear model, fn - k h n.v1 - c n.dv; an inactive contact becomes active
+ * when it pushes by more than fin (an active one stays). Returns how many changed. */
+size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
+                           double h);
+
+/* After the web's solve over step h (dv, the new velocities v1): each contact's force at the
+ * end of the step as the solve took it, f + Jx h v1 + Jv dv with the matrix's blocks, times
+ * share into the node's record fc and, opposite, onto its body (bforce, bmoment: about the
+ * CoG), in node order, for the active contacts; the nodes written listed in touched (room for count), their number
+ * returned. */
+size_t ws_node_link_loads(const ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
+                          double h, double share, v3 *fc, uint32_t *touched, v3 *bforce,
+                          v3 *bmoment);
+
+#endif

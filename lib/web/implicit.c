@@ -1,0 +1,508 @@
+/* The implicit film step: linearly implicit backward Euler, solved by conjugate gradients
+ * (web/implicit.h says the scheme; docs/theory.md, "The implicit film", why this one). */
+#include "web/implicit.h"
+
+#include <float.h>
+#include <string.h>
+
+/* Doubles of each per-node array: xyz vectors and symmetric blocks. */
+#define VEC(n) (3 * (size_t)(n))
+#define SYMS(n) (WS_SYM * (size_t)(n))
+
+static size_t scratch_doubles(uint32_t n)
+{
+    return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
+}
+
+int ws_implicit_reserve(ws_mem *mem, ws_web *web)
+{
+    if (web->imp)
+        return 0;
+    ws_implicit *im = ws_mem_calloc(mem, 1, sizeof *im);
+    if (!im)
+        return -1;
+    const uint32_t n = web->n, ns = web->ns;
+    double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
+    ws_ispring *sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
+    if (!blk || !sp) {
+        ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
+        ws_mem_free(mem, sp, sp ? (ns ? ns : 1) * sizeof(ws_ispring) : 0);
+        ws_mem_free(mem, im, sizeof *im);
+        return -1;
+    }
+    im->n = n;
+    im->ns = ns;
+    im->sp = sp;
+    double *q = blk;
+    im->f = q, q += VEC(n);
+    im->b = q, q += VEC(n);
+    im->dv = q, q += VEC(n);
+    im->r = q, q += VEC(n);
+    im->z = q, q += VEC(n);
+    im->p = q, q += VEC(n);
+    im->q = q, q += VEC(n);
+    im->fs = q, q += VEC(n);
+    im->kc = q, q += SYMS(n);
+    im->dc = q, q += SYMS(n);
+    im->pinv = q, q += SYMS(n);
+    im->nd = q;
+    web->imp = im;
+    return 0;
+}
+
+void ws_implicit_free(ws_mem *mem, ws_web *web)
+{
+    ws_implicit *im = web->imp;
+    if (!im)
+        return;
+    ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
+    ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
+    ws_mem_free(mem, im, sizeof *im);
+    web->imp = NULL;
+}
+
+/* Spring s at (x, v): its direction e (unit, a to b), length l, strain and rate. 0 when its
+ * ends coincide (no direction: it then neither pulls nor enters the matrix). */
+static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *e,
+                           double *l, double *eps, double *rate, v3 *dvel)
+{
+    const uint32_t a = web->sa[s], b = web->sb[s];
+    const v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
+    const double l2 = v3_dot(d, d);
+    if (!(l2 > 0.0))
+        return 0;
+    *l = sqrt(l2);
+    *e = v3_scale(d, 1.0 / *l);
+    *dvel = v3_sub(nodes_get(v, b), nodes_get(v, a));
+    *eps = *l * web->inv_l0[s] - 1.0;
+    *rate = v3_dot(*dvel, *e) * web->inv_l0[s];
+    return 1;
+}
+
+/* Spring s's law at (eps, rate): force and derivatives, times its stiffness scale (a mesh
+ * web's film layers). 1 when the law failed. */
+static int spring_law(const ws_web *web, uint32_t s, double eps, double rate, double t,
+                      double since, double *F, double *Fu, double *Fud)
+{
+    const double *hist = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
+    if (ws_law_eval(web->law[web->kind[s]], hist, &eps, &rate, t, since, F, Fu, Fud) != 0)
+        return 1;
+    if (web->kscale) {
+        const double k = web->kscale[s];
+        *F *= k;
+        *Fu *= k;
+        *Fud *= k;
+    }
+    return 0;
+}
+
+/* A broken spring carries nothing (rupture). */
+static int spring_broken(const ws_web *web, uint32_t s)
+{
+    return web->nbroken && web->broken && web->broken[s];
+}
+
+static void sym_add_outer(double *S, double c, v3 e)
+{
+    S[WS_SYM_XX] += c * e.x * e.x;
+    S[WS_SYM_YY] += c * e.y * e.y;
+    S[WS_SYM_ZZ] += c * e.z * e.z;
+    S[WS_SYM_XY] += c * e.x * e.y;
+    S[WS_SYM_XZ] += c * e.x * e.z;
+    S[WS_SYM_YZ] += c * e.y * e.z;
+}
+
+int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t, double since)
+{
+    ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    double *f = im->f;
+    const double c = web->damping;
+    for (uint32_t i = 0; i < n; i++) {
+        const double m = web->m[i];
+        f[3 * i] = m * gravity.x - c * v.x[i];
+        f[3 * i + 1] = m * gravity.y - c * v.y[i];
+        f[3 * i + 2] = m * gravity.z - c * v.z[i];
+    }
+    for (uint32_t s = 0; s < web->ns; s++) {
+        ws_ispring *q = &im->sp[s];
+        v3 e, dvel;
+        double l, eps, rate, F, Fu, Fud;
+        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
+            *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            continue;
+        }
+        if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud) || !isfinite(F))
+            return 1;
+        const uint32_t a = web->sa[s], b = web->sb[s];
+        f[3 * a] += F * e.x;
+        f[3 * a + 1] += F * e.y;
+        f[3 * a + 2] += F * e.z;
+        f[3 * b] -= F * e.x;
+        f[3 * b + 1] -= F * e.y;
+        f[3 * b + 2] -= F * e.z;
+        /* -df_a/dx_a = (dF/du / l0 - F / l) e e^T + (F / l) I. In compression F / l is negative
+         * and would make the matrix indefinite (the buckling instability of a compressed
+         * string): the matrix takes the transverse term only when it pulls, and the axial
+         * stiffness never below zero (a softening table law), so it stays positive
+         * semi-definite. The rate's dependence on the direction (dF/du_dot times the node's
+         * transverse velocity) is left out too: it is not symmetric, and it is small where
+         * the film moves slowly across its springs. */
+        const double il0 = web->inv_l0[s];
+        const double kb = F > 0.0 ? F / l : 0.0;
+        double ka = Fu * il0 - kb;
+        if (ka < -kb)
+            ka = -kb;
+        q->ex = e.x;
+        q->ey = e.y;
+        q->ez = e.z;
+        q->ka = ka;
+        q->kb = kb;
+        q->cs = Fud > 0.0 ? Fud * il0 : 0.0;
+        if (!(isfinite(ka) && isfinite(q->cs)))
+            return 1;
+    }
+    memcpy(im->fs, f, VEC(n) * sizeof(double));
+    ws_implicit_reset(im);
+    return 0;
+}
+
+void ws_implicit_reset(ws_implicit *im)
+{
+    memcpy(im->f, im->fs, VEC(im->n) * sizeof(double));
+    memset(im->kc, 0, SYMS(im->n) * sizeof(double));
+    memset(im->dc, 0, SYMS(im->n) * sizeof(double));
+}
+
+void ws_implicit_add(ws_implicit *im, uint32_t i, v3 f, const double K[WS_SYM],
+                     const double D[WS_SYM])
+{
+    im->f[3 * i] += f.x;
+    im->f[3 * i + 1] += f.y;
+    im->f[3 * i + 2] += f.z;
+    for (int k = 0; k < WS_SYM; k++) {
+        im->kc[WS_SYM * (size_t)i + k] += K[k];
+        im->dc[WS_SYM * (size_t)i + k] += D[k];
+    }
+}
+
+/* y = (cm M + cd D + ck K) p, the web's matrices (K = -df/dx, D = -df/dv as the matrix takes
+ * them), y zero at pinned nodes: A is cm = 1, cd = h, ck = h^2; the right-hand side's K v0
+ * is cm = cd = 0, ck = 1. */
+static void combine(const ws_web *web, double cm, double cd, double ck, const double *p,
+                    double *y)
+{
+    const ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    const double drag = cd * web->damping;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *P = p + 3 * (size_t)i;
+        double *Y = y + 3 * (size_t)i;
+        const double d = cm * web->m[i] + drag;
+        Y[0] = d * P[0];
+        Y[1] = d * P[1];
+        Y[2] = d * P[2];
+        double S[WS_SYM];
+        const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
+        for (int k = 0; k < WS_SYM; k++)
+            S[k] = ck * kc[k] + cd * dc[k];
+        ws_sym_madd(S, P[0], P[1], P[2], Y);
+    }
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_ispring *q = &im->sp[s];
+        const double *A = p + 3 * (size_t)web->sa[s], *B = p + 3 * (size_t)web->sb[s];
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double a = ck * q->ka + cd * q->cs, b = ck * q->kb;
+        const double ed = a * (q->ex * dx + q->ey * dy + q->ez * dz);
+        const double tx = ed * q->ex + b * dx, ty = ed * q->ey + b * dy, tz = ed * q->ez + b * dz;
+        double *YA = y + 3 * (size_t)web->sa[s], *YB = y + 3 * (size_t)web->sb[s];
+        YA[0] += tx;
+        YA[1] += ty;
+        YA[2] += tz;
+        YB[0] -= tx;
+        YB[1] -= ty;
+        YB[2] -= tz;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        if (web->inv_m[i] == 0.0)
+            y[3 * i] = y[3 * i + 1] = y[3 * i + 2] = 0.0;
+}
+
+void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y)
+{
+    combine(web, 1.0, h, h * h, p, y);
+}
+
+/* A's parts for step h: each spring's block (a, b) and each node's own block (nd). */
+static void operator_for(const ws_web *web, double h)
+{
+    ws_implicit *im = web->imp;
+    const double h2 = h * h;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        ws_ispring *q = &im->sp[s];
+        q->a = h2 * q->ka + h * q->cs;
+        q->b = h2 * q->kb;
+    }
+    for (uint32_t i = 0; i < web->n; i++) {
+        double *S = im->nd + WS_SYM * (size_t)i;
+        const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
+        const double d = web->m[i] + h * web->damping;
+        for (int k = 0; k < WS_SYM; k++)
+            S[k] = h2 * kc[k] + h * dc[k];
+        S[WS_SYM_XX] += d;
+        S[WS_SYM_YY] += d;
+        S[WS_SYM_ZZ] += d;
+    }
+}
+
+/* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
+ * preconditioner is), so its y is not needed: it is set to zero. */
+static double apply_fast(const ws_web *web, const double *restrict p, double *restrict y)
+{
+    const ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
+        double *Y = y + 3 * (size_t)i;
+        Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
+        Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
+        Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
+    }
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_ispring *q = &im->sp[s];
+        const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double ed = q->a * (q->ex * dx + q->ey * dy + q->ez * dz);
+        const double tx = ed * q->ex + q->b * dx, ty = ed * q->ey + q->b * dy,
+                     tz = ed * q->ez + q->b * dz;
+        double *YA = y + 3 * (size_t)sa[s], *YB = y + 3 * (size_t)sb[s];
+        YA[0] += tx;
+        YA[1] += ty;
+        YA[2] += tz;
+        YB[0] -= tx;
+        YB[1] -= ty;
+        YB[2] -= tz;
+    }
+    double py = 0.0;
+    if (web->same_inv_m) { /* no pinned node */
+        for (size_t j = 0; j < VEC(n); j++)
+            py += p[j] * y[j];
+        return py;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        double *Y = y + 3 * (size_t)i;
+        if (web->inv_m[i] == 0.0)
+            Y[0] = Y[1] = Y[2] = 0.0;
+        py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
+    }
+    return py;
+}
+
+/* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
+ * its dv stays zero. 0, or -1 when a block is not positive definite (NaN, or a matrix broken
+ * by its inputs). */
+static int preconditioner(const ws_web *web, double h)
+{
+    const ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    const double h2 = h * h;
+    double *P = im->pinv;
+    for (uint32_t i = 0; i < n; i++) {
+        double *S = P + WS_SYM * (size_t)i;
+        const double d = web->m[i] + h * web->damping;
+        for (int k = 0; k < WS_SYM; k++)
+            S[k] = h2 * im->kc[WS_SYM * (size_t)i + k] + h * im->dc[WS_SYM * (size_t)i + k];
+        S[WS_SYM_XX] += d;
+        S[WS_SYM_YY] += d;
+        S[WS_SYM_ZZ] += d;
+    }
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_ispring *q = &im->sp[s];
+        const v3 e = v3_make(q->ex, q->ey, q->ez);
+        const double a = h2 * q->ka + h * q->cs, b = h2 * q->kb;
+        for (int k = 0; k < 2; k++) {
+            double *S = P + WS_SYM * (size_t)(k ? web->sb[s] : web->sa[s]);
+            sym_add_outer(S, a, e);
+            S[WS_SYM_XX] += b;
+            S[WS_SYM_YY] += b;
+            S[WS_SYM_ZZ] += b;
+        }
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        double *S = P + WS_SYM * (size_t)i;
+        if (web->inv_m[i] == 0.0) {
+            memset(S, 0, WS_SYM * sizeof(double));
+            continue;
+        }
+        const double a = S[WS_SYM_XX], b = S[WS_SYM_YY], c = S[WS_SYM_ZZ], d = S[WS_SYM_XY],
+                     e = S[WS_SYM_XZ], f = S[WS_SYM_YZ];
+        /* Cofactors of the symmetric block. */
+        const double cxx = b * c - f * f, cyy = a * c - e * e, czz = a * b - d * d,
+                     cxy = e * f - d * c, cxz = d * f - b * e, cyz = d * e - a * f;
+        const double det = a * cxx + d * cxy + e * cxz;
+        if (!(det > 0.0 && a > 0.0 && czz > 0.0) || !isfinite(det))
+            return -1;
+        const double id = 1.0 / det;
+        S[WS_SYM_XX] = cxx * id;
+        S[WS_SYM_YY] = cyy * id;
+        S[WS_SYM_ZZ] = czz * id;
+        S[WS_SYM_XY] = cxy * id;
+        S[WS_SYM_XZ] = cxz * id;
+        S[WS_SYM_YZ] = cyz * id;
+    }
+    return 0;
+}
+
+static double dot(const double *a, const double *b, size_t m)
+{
+    double s = 0.0;
+    for (size_t k = 0; k < m; k++)
+        s += a[k] * b[k];
+    return s;
+}
+
+/* z = P r, P the block-Jacobi preconditioner; returns r . z. */
+static double precondition(const ws_implicit *im, uint32_t n, const double *restrict r,
+                           double *restrict z)
+{
+    double rz = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *R = r + 3 * (size_t)i, *S = im->pinv + WS_SYM * (size_t)i;
+        double *Z = z + 3 * (size_t)i;
+        Z[0] = S[WS_SYM_XX] * R[0] + S[WS_SYM_XY] * R[1] + S[WS_SYM_XZ] * R[2];
+        Z[1] = S[WS_SYM_XY] * R[0] + S[WS_SYM_YY] * R[1] + S[WS_SYM_YZ] * R[2];
+        Z[2] = S[WS_SYM_XZ] * R[0] + S[WS_SYM_YZ] * R[1] + S[WS_SYM_ZZ] * R[2];
+        rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
+    }
+    return rz;
+}
+
+int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
+{
+    ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    const size_t m = VEC(n);
+    double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
+    im->solves++;
+    im->last_iterations = 0;
+    /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; the scale of the residual: the larger of |b| and
+     * the film's weight over the step, so a film at rest (b about 0) is not asked for a
+     * residual below round-off. */
+    for (uint32_t i = 0; i < n; i++) {
+        z[3 * i] = v.x[i];
+        z[3 * i + 1] = v.y[i];
+        z[3 * i + 2] = v.z[i];
+    }
+    combine(web, 0.0, 0.0, 1.0, z, q);
+    double weight2 = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        for (int k = 0; k < 3; k++) {
+            const size_t j = 3 * (size_t)i + (size_t)k;
+            b[j] = web->inv_m[i] == 0.0 ? 0.0 : h * im->f[j] - h * h * q[j];
+        }
+        weight2 += web->m[i] * web->m[i];
+    }
+    /* The weight scale takes standard gravity whatever the world's: a tolerance of momentum. */
+    const double scale = fmax(sqrt(dot(b, b, m)), h * 9.81 * sqrt(weight2));
+    const double goal = web->solver_tol * scale;
+    if (preconditioner(web, h) != 0) {
+        im->warm = 0;
+        im->last_residual = NAN;
+        return -1;
+    }
+    operator_for(web, h);
+    if (!im->warm)
+        memset(x, 0, m * sizeof(double));
+    for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
+        if (web->inv_m[i] == 0.0)
+            x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
+    (void)apply_fast(web, x, q);
+    for (size_t j = 0; j < m; j++)
+        r[j] = b[j] - q[j];
+    double rr = dot(r, r, m);
+    double rz = precondition(im, n, r, z);
+    memcpy(p, z, m * sizeof(double));
+    int it = 0;
+    while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
+        const double pq = apply_fast(web, p, q);
+        if (!(pq > 0.0) || !isfinite(pq))
+            break; /* not positive definite along p, or NaN: no progress possible */
+        const double alpha = rz / pq;
+        rr = 0.0;
+        for (size_t j = 0; j < m; j++) {
+            x[j] += alpha * p[j];
+            r[j] -= alpha * q[j];
+            rr += r[j] * r[j];
+        }
+        it++;
+        const double rz1 = precondition(im, n, r, z), beta = rz1 / rz;
+        rz = rz1;
+        for (size_t j = 0; j < m; j++)
+            p[j] = z[j] + beta * p[j];
+    }
+    im->iterations += (uint64_t)it;
+    im->last_iterations = it;
+    im->last_residual = scale > 0.0 ? sqrt(rr) / scale : 0.0;
+    const int ok = sqrt(rr) <= goal;
+    im->warm = ok;
+    return ok ? 0 : -1;
+}
+
+void ws_implicit_velocities(const ws_web *web, ws_nodes3 v, ws_nodes3 vd)
+{
+    const double *dv = web->imp->dv;
+    for (uint32_t i = 0; i < web->n; i++) {
+        vd.x[i] = v.x[i] + dv[3 * i];
+        vd.y[i] = v.y[i] + dv[3 * i + 1];
+        vd.z[i] = v.z[i] + dv[3 * i + 2];
+    }
+}
+
+size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, ws_nodes3 vd,
+                          double h, double vmax)
+{
+    const double *dv = web->imp->dv;
+    size_t fast = 0;
+    for (uint32_t i = 0; i < web->n; i++) {
+        const double ux = v.x[i] + dv[3 * i], uy = v.y[i] + dv[3 * i + 1],
+                     uz = v.z[i] + dv[3 * i + 2];
+        vd.x[i] = ux;
+        vd.y[i] = uy;
+        vd.z[i] = uz;
+        xd.x[i] = x.x[i] + h * ux;
+        xd.y[i] = x.y[i] + h * uy;
+        xd.z[i] = x.z[i] + h * uz;
+        const double s2 = ux * ux + uy * uy + uz * uz;
+        fast += !(s2 <= vmax * vmax) || s2 > DBL_MAX;
+    }
+    return fast;
+}
+
+int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, double t,
+                             double since, double Jx[9], double Jv[9])
+{
+    v3 e, dvel;
+    double l, eps, rate, F, Fu, Fud;
+    memset(Jx, 0, 9 * sizeof(double));
+    memset(Jv, 0, 9 * sizeof(double));
+    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel))
+        return 0;
+    if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud))
+        return 1;
+    /* f_a = F e: d/dx_b = e dF/dx_b + F de/dx_b, with de/dx_b = (I - e e^T) / l, deps/dx_b =
+     * e^T / l0 and drate/dx_b = dvel^T (I - e e^T) / (l l0); d/dv_b = Fud e e^T / l0. */
+    const double il0 = web->inv_l0[s];
+    const double ev[3] = {e.x, e.y, e.z}, dv[3] = {dvel.x, dvel.y, dvel.z};
+    double g[3]; /* dvel^T (I - e e^T) */
+    const double de = v3_dot(dvel, e);
+    for (int k = 0; k < 3; k++)
+        g[k] = dv[k] - de * ev[k];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            const double P = (i == k) - ev[i] * ev[k];
+            Jx[3 * i + k] = ev[i] * (Fu * il0 * ev[k] + Fud * il0 * g[k] / l) + F * P / l;
+            Jv[3 * i + k] = Fud * il0 * ev[i] * ev[k];
+        }
+    return 0;
+}

@@ -1,0 +1,99 @@
+/* The implicit film step (web module): linearly implicit backward Euler over a web's nodes, in
+ * the manner of Baraff & Witkin (1998), "Large steps in cloth simulation". Over a step h from
+ * (x0, v0) with forces f(x, v):
+ *
+ *     (M - h df/dv - h^2 df/dx) dv = h f(x0, v0) + h^2 df/dx v0,   v1 = v0 + dv,  x1 = x0 + h v1
+ *
+ * one Newton step of backward Euler. The matrix is never formed: springs keep their direction
+ * and three numbers, nodes a diagonal block, and the system is solved by conjugate gradients
+ * preconditioned with its 3x3 diagonal blocks (block Jacobi), warm-started from the last
+ * solve. Forces from outside the web (the node contacts, contact/node_jacobian.c) come in per
+ * node: a force and two symmetric blocks (ws_implicit_add). The matrix takes only the parts of
+ * the derivatives that are symmetric and keep it positive definite; what it leaves out is
+ * named where it is left (implicit.c, contact/node_jacobian.c) and in docs/theory.md.
+ *
+ * Vectors of the solve are xyz per node (3 n doubles), the symmetric blocks six doubles
+ * (xx, yy, zz, xy, xz, yz). */
+#ifndef WS_WEB_IMPLICIT_H
+#define WS_WEB_IMPLICIT_H
+
+#include "web/web.h"
+
+/* A symmetric 3x3 block: xx, yy, zz, xy, xz, yz. */
+enum { WS_SYM_XX, WS_SYM_YY, WS_SYM_ZZ, WS_SYM_XY, WS_SYM_XZ, WS_SYM_YZ, WS_SYM };
+
+/* A spring as the matrix takes it: its unit direction e from end a to end b, its stiffness
+ * -df_a/dx_a = ka e e^T + kb I and damping -df_a/dv_a = cs e e^T. */
+typedef struct ws_ispring {
+    double ex, ey, ez, ka, kb, cs;
+    double a, b; /* the solve's: A's block of the spring, a e e^T + b I (a = h^2 ka + h cs,
+                    b = h^2 kb), set by ws_implicit_solve */
+} ws_ispring;
+
+typedef struct ws_implicit {
+    uint32_t n, ns;
+    double *f;       /* force on each node at (x0, v0): springs, drag, gravity, contacts */
+    double *fs;      /* the same without the contacts (ws_implicit_reset) */
+    double *kc, *dc; /* per node, symmetric: -df/dx and -df/dv of its contacts */
+    ws_ispring *sp;  /* per spring */
+    double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
+    double *pinv;    /* per node: the inverse of A's diagonal block (symmetric) */
+    double *nd;      /* per node: A's own part of the node, M + h (drag + dc) + h^2 kc (the
+                        solve's, symmetric) */
+    int warm;        /* dv holds the last converged solution */
+    /* Counts (ws_web_get_solver_stats). */
+    uint64_t solves, iterations;
+    int last_iterations;
+    double last_residual;
+} ws_implicit;
+
+/* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
+int ws_implicit_reserve(ws_mem *mem, ws_web *web);
+void ws_implicit_free(ws_mem *mem, ws_web *web);
+
+/* Start a step h from (x, v): the springs' forces and matrix terms from their laws at (t,
+ * since) as the explicit sweep takes them, node drag and gravity; the contacts' terms zeroed.
+ * 0, or 1 when a spring's law failed (a callback or a non-finite value). */
+int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t, double since);
+
+/* The contacts' terms taken out again (for another set of them). */
+void ws_implicit_reset(ws_implicit *im);
+
+/* Node i's share of a force from outside the web: force f, and the symmetric blocks K = -df/dx
+ * and D = -df/dv (positive semi-definite) it adds to the matrix. */
+void ws_implicit_add(ws_implicit *im, uint32_t i, v3 f, const double K[WS_SYM],
+                     const double D[WS_SYM]);
+
+/* Solve for dv over the step h at (x, v) (the state begin took) to web->solver_tol, at most
+ * web->solver_maxit iterations. 0 when it converged, else -1 (dv then holds the last iterate).
+ * The iterations and the residual over its scale are kept in the counts. */
+int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h);
+
+/* The new velocities alone, vd = v + dv. */
+void ws_implicit_velocities(const ws_web *web, ws_nodes3 v, ws_nodes3 vd);
+
+/* The new state: vd = v + dv, xd = x + h vd. Returns how many nodes end faster than vmax, with
+ * a NaN speed or with one whose square overflows. */
+size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, ws_nodes3 vd,
+                          double h, double vmax);
+
+/* y = A p over step h (the matrix the solve uses), p and y xyz per node, y zero at pinned
+ * nodes. */
+void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y);
+
+/* The exact derivatives of spring s's force on its end a at (x, v), the law taken at (t,
+ * since): Jx = df_a/dx_b (= -df_a/dx_a) and Jv = df_a/dv_b, row-major. They hold the terms
+ * the matrix leaves out (compression's negative transverse stiffness, the rate's dependence
+ * on the direction). 0, or 1 when the law failed. */
+int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, double t,
+                             double since, double Jx[9], double Jv[9]);
+
+/* y += S x for a symmetric block S. */
+static inline void ws_sym_madd(const double *S, double x, double y, double z, double *o)
+{
+    o[0] += S[WS_SYM_XX] * x + S[WS_SYM_XY] * y + S[WS_SYM_XZ] * z;
+    o[1] += S[WS_SYM_XY] * x + S[WS_SYM_YY] * y + S[WS_SYM_YZ] * z;
+    o[2] += S[WS_SYM_XZ] * x + S[WS_SYM_YZ] * y + S[WS_SYM_ZZ] * z;
+}
+
+#endif

@@ -1,0 +1,844 @@
+/* The implicit film integrator (web/implicit.c, contact/node_jacobian.c, world_implicit.c): its
+ * derivatives against finite differences, backward Euler's known amplification and phase on a
+ * string's mode, the explicit web's analytic answers (row tension, band pressure; the capstan
+ * is in test_web.c, capstan_implicit), convergence to the explicit film as dt shrinks, stiffness
+ * scales and rupture, and a failed solve leaving the world as it was. */
+#include "helpers.h"
+
+#include "contact/node_jacobian.h"
+#include "web/implicit.h"
+#include "world/world_internal.h"
+
+#define PI 3.14159265358979323846
+
+static const ws_vec3 NO_G = {0, 0, 0};
+
+static ws_world *world_gw(double dt, ws_vec3 g, int workers)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = dt;
+    d.gravity = g;
+    d.worker_count = workers;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    return w;
+}
+
+static ws_world *world_g(double dt, ws_vec3 g) { return world_gw(dt, g, 1); }
+
+static ws_law_id make_law(ws_world *w, ws_law_type type, double k, double kc, double c,
+                          double tr)
+{
+    ws_law_def d;
+    ws_law_def_init(&d);
+    d.type = type;
+    d.stiffness = k;
+    d.compression_stiffness = kc;
+    d.damping = c;
+    if (tr > 0.0)
+        d.transition = tr;
+    ws_law_id id;
+    ck_ok(w, ws_law_create(w, &d, &id));
+    return id;
+}
+
+/* The internal web of an id. */
+static ws_web *web_of(ws_world *w, ws_web_id id)
+{
+    uint32_t slot;
+    ck_assert_int_eq(ws_lookup_web(w, id, &slot), WS_OK);
+    return w->webs[slot];
+}
+
+/* A mesh web of n nodes at pos (xyz), springs pairs, rest lengths rest. */
+static ws_web_id mesh_web(ws_world *w, const ws_web_def *wd, size_t n, const double *pos,
+                          const uint32_t *pairs, size_t ns, const double *rest,
+                          const uint32_t *pins, size_t npins)
+{
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = pos;
+    md.node_count = n;
+    md.springs = pairs;
+    md.spring_count = ns;
+    md.rest_lengths = rest;
+    md.pinned = pins;
+    md.pinned_count = npins;
+    ws_web_id id;
+    ck_ok(w, ws_web_create_mesh(w, wd, &md, &id));
+    return id;
+}
+
+/* Node vectors of n nodes (one block of 3 n doubles). */
+static ws_nodes3 nodes_new(size_t n)
+{
+    double *p = calloc(3 * n, sizeof *p);
+    ck_assert(p);
+    return (ws_nodes3){p, p + n, p + 2 * n};
+}
+
+static double *comp(ws_nodes3 a, int k)
+{
+    return k == 0 ? a.x : k == 1 ? a.y : a.z;
+}
+
+static double max_abs(const double *a, int n)
+{
+    double m = 0.0;
+    for (int k = 0; k < n; k++)
+        m = fmax(m, fabs(a[k]));
+    return m;
+}
+
+/* ---- 1. derivatives against finite differences ---- */
+
+/* The force on node a of the web's only spring at (x, v) (gravity and drag are zero). */
+static v3 spring_force_a(ws_web *web, ws_nodes3 x, ws_nodes3 v)
+{
+    ck_assert_int_eq(ws_implicit_begin(web, x, v, v3_make(0, 0, 0), 0.0, 0.0), 0);
+    const uint32_t a = web->sa[0];
+    return v3_make(web->imp->f[3 * a], web->imp->f[3 * a + 1], web->imp->f[3 * a + 2]);
+}
+
+/* Central differences of f_a with respect to end b's position (which = 0) or velocity (1),
+ * steps hx (m) and hv (m/s): J[3 i + k] = d f_a,i / d (x or v)_b,k. */
+static void spring_fd(ws_web *web, ws_nodes3 x, ws_nodes3 v, int which, double step, double *J)
+{
+    const uint32_t b = web->sb[0];
+    ws_nodes3 s = which ? v : x;
+    for (int k = 0; k < 3; k++) {
+        double *c = comp(s, k), keep = c[b];
+        c[b] = keep + step;
+        v3 fp = which ? spring_force_a(web, x, s) : spring_force_a(web, s, v);
+        c[b] = keep - step;
+        v3 fm = which ? spring_force_a(web, x, s) : spring_force_a(web, s, v);
+        c[b] = keep;
+        J[k] = (fp.x - fm.x) / (2 * step);
+        J[3 + k] = (fp.y - fm.y) / (2 * step);
+        J[6 + k] = (fp.z - fm.z) / (2 * step);
+    }
+}
+
+/* One spring of the law at a strain eps and a rate of stretching plus a sideways velocity: the
+ * exact derivatives equal central differences to 1e-6 of their size; at rest in tension, the
+ * matrix's block (ka e e^T + kb I, cs e e^T) equals them too. */
+static void spring_case(ws_law_type type, double kc, double tr, double eps, int at_rest,
+                        const char *what)
+{
+    ws_world *w = world_g(1e-3, NO_G);
+    const double EA = 50.0, c = 0.4, l0 = 0.02;
+    ws_law_id law = make_law(w, type, EA, kc, c, tr);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    /* The spring leans out of every axis so that each block entry is tested. */
+    const v3 e = v3_scale(v3_make(0.6, -0.48, 0.64), 1.0 / v3_norm(v3_make(0.6, -0.48, 0.64)));
+    const double l = l0 * (1 + eps);
+    const double pos[6] = {0.01, 0.02, 0.03, 0.01 + l * e.x, 0.02 + l * e.y, 0.03 + l * e.z};
+    const uint32_t pair[2] = {0, 1};
+    ws_web_id id = mesh_web(w, &wd, 2, pos, pair, 1, &l0, NULL, 0);
+    ws_web *web = web_of(w, id);
+    ck_assert_int_eq(ws_implicit_reserve(&w->mem, web), 0);
+    ws_nodes3 x = nodes_new(2), v = nodes_new(2);
+    for (int i = 0; i < 2; i++) {
+        x.x[i] = pos[3 * i];
+        x.y[i] = pos[3 * i + 1];
+        x.z[i] = pos[3 * i + 2];
+    }
+    if (!at_rest) { /* stretching at 0.05 /s and a sideways velocity */
+        v.x[1] = 0.05 * l0 * e.x + 0.03;
+        v.y[1] = 0.05 * l0 * e.y + 0.01;
+        v.z[1] = 0.05 * l0 * e.z - 0.02;
+        v.x[0] = -0.01;
+    }
+    double Jx[9], Jv[9], Fx[9], Fv[9];
+    ck_assert_int_eq(ws_implicit_spring_exact(web, x, v, 0, 0.0, 0.0, Jx, Jv), 0);
+    spring_fd(web, x, v, 0, 1e-8, Fx);
+    spring_fd(web, x, v, 1, 1e-7, Fv);
+    double ex = 0, ev = 0;
+    for (int k = 0; k < 9; k++) {
+        ex = fmax(ex, fabs(Jx[k] - Fx[k]));
+        ev = fmax(ev, fabs(Jv[k] - Fv[k]));
+    }
+    const double sx = max_abs(Fx, 9), sv = max_abs(Fv, 9);
+    report("%s: exact vs finite differences: dx %.2g, dv %.2g of %.3g N/m, %.3g N s/m", what,
+           ex / sx, ev / sv, sx, sv);
+    ck_assert_msg(ex <= 1e-6 * sx, "%s: df/dx off by %g of %g", what, ex, sx);
+    ck_assert_msg(ev <= 1e-6 * sv, "%s: df/dv off by %g of %g", what, ev, sv);
+    if (at_rest && eps > tr) {
+        (void)spring_force_a(web, x, v); /* the blocks of this state */
+        const ws_ispring *q = &web->imp->sp[0];
+        const double ev3[3] = {q->ex, q->ey, q->ez};
+        double mx = 0, mv = 0;
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) {
+                const double K = q->ka * ev3[i] * ev3[k] + q->kb * (i == k),
+                             D = q->cs * ev3[i] * ev3[k];
+                mx = fmax(mx, fabs(K - Fx[3 * i + k]));
+                mv = fmax(mv, fabs(D - Fv[3 * i + k]));
+            }
+        report("%s: the matrix's blocks vs finite differences: %.2g, %.2g", what, mx / sx,
+               mv / sv);
+        ck_assert_msg(mx <= 1e-6 * sx, "%s: matrix stiffness off by %g", what, mx);
+        ck_assert_msg(mv <= 1e-6 * sv, "%s: matrix damping off by %g", what, mv);
+    }
+    free(x.x);
+    free(v.x);
+    ws_world_destroy(w);
+}
+
+START_TEST(test_spring_jacobian)
+{
+    /* Tolerance 1e-6 relative: central differences at a step of 1e-8 m on a 2 cm spring err
+     * by (h / l)^2 ~ 1e-12 from the truncation and 1e-16 N / 1e-8 m ~ 1e-8 N/m from round-off,
+     * against blocks of 100 N/m and more; the film law's ramp is C1, so its derivative is
+     * continuous through the join (its second derivative jumps at +-w, where no case sits). */
+    spring_case(WS_LAW_LINEAR_VISCOELASTIC, 0.0, 0.0, 0.3, 0, "Kelvin-Voigt, stretched, moving");
+    spring_case(WS_LAW_LINEAR_VISCOELASTIC, 0.0, 0.0, 0.3, 1, "Kelvin-Voigt, stretched, at rest");
+    spring_case(WS_LAW_TENSION_COMPRESSION, 0.5, 0.01, 0.2, 0, "film law, tension, moving");
+    spring_case(WS_LAW_TENSION_COMPRESSION, 0.5, 0.01, 0.2, 1, "film law, tension, at rest");
+    spring_case(WS_LAW_TENSION_COMPRESSION, 0.5, 0.01, 0.004, 0, "film law, in the join");
+    spring_case(WS_LAW_TENSION_COMPRESSION, 0.5, 0.01, -0.05, 0, "film law, compressed");
+}
+END_TEST
+
+/* The contact force on node i: the sum over its active links at (x, v). */
+static v3 contact_force(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_nodes3 x,
+                        ws_nodes3 v, ws_node_link *L, uint32_t i, int *count)
+{
+    size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c, cl->n,
+                             x, v, 0.0, NULL, 0.0, L);
+    v3 f = v3_make(0, 0, 0);
+    *count = 0;
+    for (size_t k = 0; k < n; k++)
+        if (L[k].node == i && L[k].active) {
+            f = v3_add(f, L[k].f);
+            ++*count;
+        }
+    return f;
+}
+
+static void contact_fd(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_nodes3 x,
+                       ws_nodes3 v, ws_node_link *L, uint32_t i, int which, double step,
+                       double *J)
+{
+    ws_nodes3 s = which ? v : x;
+    int cnt;
+    for (int k = 0; k < 3; k++) {
+        double *c = comp(s, k), keep = c[i];
+        c[i] = keep + step;
+        v3 fp = which ? contact_force(w, web, cl, x, s, L, i, &cnt)
+                      : contact_force(w, web, cl, s, v, L, i, &cnt);
+        ck_assert_int_eq(cnt, 1);
+        c[i] = keep - step;
+        v3 fm = which ? contact_force(w, web, cl, x, s, L, i, &cnt)
+                      : contact_force(w, web, cl, s, v, L, i, &cnt);
+        ck_assert_int_eq(cnt, 1);
+        c[i] = keep;
+        J[k] = (fp.x - fm.x) / (2 * step);
+        J[3 + k] = (fp.y - fm.y) / (2 * step);
+        J[6 + k] = (fp.z - fm.z) / (2 * step);
+    }
+}
+
+START_TEST(test_contact_jacobian)
+{
+    /* A 0.2 m box moving at (10, 20, 0) mm/s without spin, two nodes: node 0 over its top face
+     * 1.5 mm up (the window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along
+     * y, 1.41 mm from it. Each slips on the box: node 0 at 5 mm/s (half of v_lim: the
+     * polynomial part of eq. 13), node 1 at 20 mm/s (beyond v_lim: mu N), and each approaches
+     * it at 1 mm/s. The exact derivatives of their contact forces (normal force, damping,
+     * friction; for the rim its turning normal) equal central differences to 1e-6 of their
+     * size (steps 1e-8 m and 1e-8 m/s: truncation (1e-8 / 1e-3)^2, round-off 1e-16 N / 1e-8
+     * ~ 1e-8 against 1e3 N/m; see below for the rate at rest). At rest on the box (no slip, no approach), the matrix's blocks
+     * of the face contact (k n n^T, c n n^T + mu N phi across n) equal them too. */
+    ws_world *w = world_g(1e-5, NO_G);
+    ws_shape_id box;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &box));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film_mat, box_mat;
+    ck_ok(w, ws_material_create(w, &md, &film_mat));
+    ck_ok(w, ws_material_create(w, &md, &box_mat));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    cd.friction_vlim = 0.01;
+    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = box;
+    bd.mass = 1.0;
+    bd.material = box_mat;
+    const v3 vb = v3_make(0.01, 0.02, 0.0);
+    bd.velocity = vb;
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = law;
+    wd.material = film_mat;
+    wd.integrator = WS_WEB_IMPLICIT;
+    const double r = 1e-3 / sqrt(2.0);
+    const double pos[6] = {0.03, -0.02, 0.1 + 1.5e-3, 0.1 + r, 0.05, 0.1 + r};
+    const uint32_t pair[2] = {0, 1};
+    const double rest = 0.2;
+    ws_web_id id = mesh_web(w, &wd, 2, pos, pair, 1, &rest, NULL, 0);
+    ws_web *web = web_of(w, id);
+    ck_ok(w, ws_world_step(w)); /* candidates found, faces prepared */
+    const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
+    ck_assert_uint_ge(cl->n, 2);
+    ws_node_link *L = calloc(cl->n, sizeof *L);
+    ws_nodes3 x = nodes_new(2), v = nodes_new(2);
+    for (int i = 0; i < 2; i++) {
+        x.x[i] = pos[3 * i];
+        x.y[i] = pos[3 * i + 1];
+        x.z[i] = pos[3 * i + 2];
+    }
+    const ws_body_state *st = &w->bodies.st[w->cur];
+    const v3 vbody = st->v[0];
+    for (int rest_case = 0; rest_case < 2; rest_case++) {
+        const v3 slip0 = rest_case ? v3_make(0, 0, 0) : v3_make(0.003, 0.004, -0.001),
+                 slip1 = rest_case ? v3_make(0, 0, 0) : v3_make(-7e-4, 0.02, -7e-4);
+        v.x[0] = vbody.x + slip0.x, v.y[0] = vbody.y + slip0.y, v.z[0] = vbody.z + slip0.z;
+        v.x[1] = vbody.x + slip1.x, v.y[1] = vbody.y + slip1.y, v.z[1] = vbody.z + slip1.z;
+        for (uint32_t i = 0; i < 2; i++) {
+            if (rest_case && i == 1)
+                continue; /* the rim's matrix block leaves out its turning (docs) */
+            int cnt;
+            (void)contact_force(w, web, cl, x, v, L, i, &cnt);
+            ck_assert_int_eq(cnt, 1);
+            ws_node_link link;
+            size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c,
+                                     cl->n, x, v, 0.0, NULL, 0.0, L);
+            for (size_t k = 0; k < n; k++)
+                if (L[k].node == i && L[k].active)
+                    link = L[k];
+            double Fx[9], Fv[9];
+            contact_fd(w, web, cl, x, v, L, i, 0, 1e-8, Fx);
+            /* At rest eq. 13 bends as |t| t / v_lim^2 about zero slip: central differences
+             * err by step / (2 v_lim) there, so the step is 1e-10 m/s (5e-9). */
+            contact_fd(w, web, cl, x, v, L, i, 1, rest_case ? 1e-10 : 1e-8, Fv);
+            const double sx = max_abs(Fx, 9), sv = max_abs(Fv, 9);
+            double ex = 0, ev = 0, mx = 0, mv = 0;
+            const int sym[9] = {WS_SYM_XX, WS_SYM_XY, WS_SYM_XZ, WS_SYM_XY, WS_SYM_YY,
+                                WS_SYM_YZ, WS_SYM_XZ, WS_SYM_YZ, WS_SYM_ZZ};
+            for (int k = 0; k < 9; k++) {
+                ex = fmax(ex, fabs(link.Jx[k] - Fx[k]));
+                ev = fmax(ev, fabs(link.Jv[k] - Fv[k]));
+                mx = fmax(mx, fabs(-link.K[sym[k]] - Fx[k]));
+                mv = fmax(mv, fabs(-link.D[sym[k]] - Fv[k]));
+            }
+            report("contact, node %u (%s)%s: exact vs finite differences %.2g, %.2g of %.3g "
+                   "N/m, %.3g N s/m; matrix %.2g, %.2g",
+                   i, i ? "rim" : "face", rest_case ? " at rest" : ", slipping", ex / sx,
+                   ev / sv, sx, sv, mx / sx, mv / sv);
+            ck_assert_msg(ex <= 1e-6 * sx, "node %u: df/dx off by %g of %g", i, ex, sx);
+            ck_assert_msg(ev <= 1e-6 * sv, "node %u: df/dv off by %g of %g", i, ev, sv);
+            if (rest_case) {
+                ck_assert_msg(mx <= 1e-6 * sx, "node %u: matrix K off by %g", i, mx);
+                ck_assert_msg(mv <= 1e-6 * sv, "node %u: matrix D off by %g", i, mv);
+            }
+        }
+    }
+    free(L);
+    free(x.x);
+    free(v.x);
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* ---- 2. backward Euler on a string's mode ---- */
+
+START_TEST(test_string_mode_amplification)
+{
+    /* A straight string of N + 1 nodes (ends pinned), linear springs k = EA / l0, masses m,
+     * moving along its length: a linear system (the springs stay in tension), so the one
+     * Newton step is backward Euler exactly. Mode j, u_i = sin(j pi i / N), has omega_j =
+     * 2 sqrt(k / m) sin(j pi / (2 N)) and travels at omega_j / kappa_j (kappa_j = j pi / L).
+     * Backward Euler on x'' = -omega^2 x over h: z = x + i v / omega goes to z / (1 + i omega
+     * h), so each step multiplies the amplitude by 1 / sqrt(1 + omega^2 h^2) and turns the
+     * phase by atan(omega h): from rest at amplitude X, x_n = X rho^n cos(n theta). Its wave
+     * speed is c_h = theta / (kappa h), slower than omega / kappa by atan(omega h) / (omega h),
+     * and it decays. The mode's amplitude after n steps must follow that to 1e-6 of X (the
+     * solve's tolerance is 1e-10 a step; a law's strain is l / l0 - 1, linear in the node
+     * positions along the string). Two steps: omega h = 0.5 and 2. */
+    const int N = 20;
+    const double L = 1.0, sp = L / N, pre = 0.1, EA = 20.0, m = 1e-3, X = 1e-4;
+    const double l0 = sp / (1 + pre), k = EA / l0, j = 1;
+    const double om = 2 * sqrt(k / m) * sin(j * PI / (2 * N)), kappa = j * PI / L;
+    const double oh[2] = {0.5, 2.0};
+    for (int c = 0; c < 2; c++) {
+        const double h = oh[c] / om;
+        ws_world *w = world_g(h, NO_G);
+        ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, EA, 0.0, 0.0, 0.0);
+        ws_web_def wd;
+        ws_web_def_init(&wd);
+        wd.node_mass = m;
+        wd.law = law;
+        wd.integrator = WS_WEB_IMPLICIT;
+        wd.solver_tolerance = 1e-10;
+        double pos[3 * 21] = {0};
+        uint32_t pairs[2 * 20];
+        double rest[20];
+        for (int i = 0; i <= N; i++)
+            pos[3 * i] = i * sp + X * sin(j * PI * i / N);
+        for (int i = 0; i < N; i++) {
+            pairs[2 * i] = (uint32_t)i;
+            pairs[2 * i + 1] = (uint32_t)(i + 1);
+            rest[i] = l0;
+        }
+        const uint32_t pins[2] = {0, (uint32_t)N};
+        ws_web_id id = mesh_web(w, &wd, (size_t)N + 1, pos, pairs, (size_t)N, rest, pins, 2);
+        const double rho = 1 / sqrt(1 + oh[c] * oh[c]), th = atan(oh[c]);
+        double worst = 0;
+        int steps = 12;
+        for (int n = 1; n <= steps; n++) {
+            ck_ok(w, ws_world_step(w));
+            double xyz[3 * 21];
+            size_t cnt;
+            ck_ok(w, ws_web_copy_positions(w, id, xyz, 21, &cnt));
+            /* The mode's amplitude: projection on sin(j pi i / N) (orthogonal, norm N / 2). */
+            double a = 0;
+            for (int i = 1; i < N; i++)
+                a += (xyz[3 * i] - i * sp) * sin(j * PI * i / N);
+            a *= 2.0 / N;
+            const double want = X * pow(rho, n) * cos(n * th);
+            worst = fmax(worst, fabs(a - want));
+        }
+        report("string mode, omega h = %.1f: amplification %.6f a step, phase %.6f rad (exact "
+               "%.6f); wave speed %.4f of the exact; worst |x_n - X rho^n cos(n theta)| = "
+               "%.2g of X",
+               oh[c], rho, th, oh[c], th / oh[c], worst / X);
+        (void)kappa;
+        ck_assert_msg(worst <= 1e-6 * X, "omega h %g: off by %g of X", oh[c], worst / X);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
+/* ---- 3. analytic answers of the explicit web, on the implicit one ---- */
+
+START_TEST(test_row_tension)
+{
+    /* The row of tests/test_web.c (row_prestretch_tension): 11 nodes 0.1 m apart, ends pinned,
+     * pre-stretch 0.25, EA = 100 N, Kelvin-Voigt c = 0.5 N s, disturbed by a gravity along x
+     * for 0.1 s and then left to settle: every spring at T = EA p. Here at dt = 2 ms, 2.7 times
+     * the explicit stable step (0.74 ms): backward Euler damps the disturbance further (its
+     * amplification is below 1 for every mode), so 2 s settle it below 1e-9 as well. */
+    const double dt = 2e-3, EA = 100.0, p = 0.25, sp = 0.1, m = 0.01;
+    ws_world *w = world_g(dt, NO_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.5, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = m;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-10;
+    wd.name = "row";
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 11;
+    sd.ny = 1;
+    sd.spacing_x = sp;
+    sd.spacing_y = sp;
+    sd.prestretch_x = p;
+    uint32_t pins[2] = {0, 10};
+    sd.pinned = pins;
+    sd.pinned_count = 2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    double S;
+    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    ck_assert_msg(dt > S, "not beyond the explicit limit: dt %g, stable %g", dt, S);
+    ws_vec3 gx = {20.0, 0, 0};
+    ck_ok(w, ws_world_set_gravity(w, &gx));
+    ck_ok(w, ws_world_step_n(w, 50));
+    double T[10];
+    size_t ns;
+    ck_ok(w, ws_web_copy_spring_tensions(w, web, T, 10, &ns));
+    double spread = 0;
+    for (int i = 0; i < 10; i++)
+        spread = fmax(spread, fabs(T[i] - EA * p) / (EA * p));
+    ck_assert_msg(spread > 1e-3, "the disturbance did nothing (%g)", spread);
+    ck_ok(w, ws_world_set_gravity(w, &NO_G));
+    ck_ok(w, ws_world_step_n(w, 1000));
+    ck_ok(w, ws_web_copy_spring_tensions(w, web, T, 10, &ns));
+    double worst = 0;
+    for (int i = 0; i < 10; i++)
+        worst = fmax(worst, fabs(T[i] - EA * p) / (EA * p));
+    ws_web_solver_stats st;
+    ck_ok(w, ws_web_get_solver_stats(w, web, &st));
+    report("implicit row at dt %.0f ms (%.1f x the stable step): disturbed %.3g, settled "
+           "|T - EA p| / EA p = %.3g; %.1f CG iterations a step",
+           1e3 * dt, dt / S, spread, worst, (double)st.iterations / (double)st.solves);
+    ck_assert_msg(worst <= 1e-9, "settled tension off by %g", worst);
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* A pinned chain of n nodes under gravity, released from straight, stepped to time t at dt:
+ * the mid node's z. */
+static double chain_mid_z(int implicit, double dt, int substeps, double t)
+{
+    const int n = 21;
+    const double sp = 0.05, p = 0.05, EA = 50.0, m = 2e-3;
+    ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.02, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = m;
+    wd.law = law;
+    wd.integrator = implicit ? WS_WEB_IMPLICIT : WS_WEB_EXPLICIT;
+    wd.substeps = substeps;
+    wd.solver_tolerance = 1e-10;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = n;
+    sd.ny = 1;
+    sd.spacing_x = sp;
+    sd.spacing_y = sp;
+    sd.prestretch_x = p;
+    uint32_t pins[2] = {0, (uint32_t)n - 1};
+    sd.pinned = pins;
+    sd.pinned_count = 2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    ck_ok(w, ws_world_step_n(w, (uint64_t)llround(t / dt)));
+    double xyz[3 * 21];
+    size_t cnt;
+    ck_ok(w, ws_web_copy_positions(w, web, xyz, 21, &cnt));
+    ws_world_destroy(w);
+    return xyz[3 * 10 + 2];
+}
+
+START_TEST(test_converges_to_explicit)
+{
+    /* A chain released under gravity, its mid node's drop at t = 0.1 s (the fundamental's
+     * period is about 0.19 s: mid-swing). The explicit film at 1e-5 s is the reference (its
+     * own error is O(h^2) ~ 1e-10 of the sag). Backward Euler is first order: its error at dt
+     * 2, 1, 0.5 ms must fall by close to half each time (ratio in 0.4..0.6) and reach below
+     * 2 % of the drop at 0.5 ms. */
+    const double t = 0.1;
+    const double ref = chain_mid_z(0, 1e-5, 1, t);
+    const double dts[3] = {2e-3, 1e-3, 5e-4};
+    double err[3];
+    for (int k = 0; k < 3; k++)
+        err[k] = fabs(chain_mid_z(1, dts[k], 1, t) - ref);
+    report("chain released, mid drop %.4g m at 0.1 s: implicit errors %.3g, %.3g, %.3g m at dt "
+           "2, 1, 0.5 ms (ratios %.3f, %.3f)",
+           -ref, err[0], err[1], err[2], err[1] / err[0], err[2] / err[1]);
+    ck_assert(ref < -1e-3);
+    for (int k = 1; k < 3; k++)
+        ck_assert_msg(err[k] / err[k - 1] > 0.4 && err[k] / err[k - 1] < 0.6,
+                      "not first order: %g then %g", err[k - 1], err[k]);
+    ck_assert_msg(err[2] < 0.02 * fabs(ref), "error %g of drop %g", err[2], ref);
+}
+END_TEST
+
+static uint64_t band_case(double mu, int workers)
+{
+    /* The band of tests/test_web.c (band_pressure) on the implicit film: a cylinder R = 0.1 m of
+     * 128 sides, kinematic at rest, a band of 64 x 3 nodes pre-stretched 0.2 around, no
+     * gravity, EA = 100 N (T ~ 20 N), 1 g nodes with drag 0.5 kg/s, film-cylinder pair k =
+     * 4000 N/m, c = 1 kg/s, mu as given; here at dt = 1 ms in one step, 5 times the
+     * explicit stable step (the explicit film would need 10 sub-steps at the check's 0.5). After 0.3 s the band is at rest to e^-75 (backward
+     * Euler damps every mode at least as the drag does), and at rest a step's contact force is
+     * its penalty at the start (the linear terms vanish with v and dv). Each row's contact
+     * forces sum to 2 N T sin(pi / N) for the regular 64-gon of nodes (1e-6: settling and
+     * round-off), and frictionless each is k times its overlap along the face normal (1e-6). */
+    const double R = 0.1, dt = 1e-3, EA = 100.0, kc = 4000.0, reach = 2e-3;
+    const int seg = 128, na = 64, nu = 3;
+    ws_world *w = world_gw(dt, NO_G, workers);
+    ws_shape_id cs;
+    ck_ok(w, ws_shape_create_cylinder(w, R, 0.3, seg, &cs));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = cs;
+    ws_body_id cyl;
+    ck_ok(w, ws_body_create(w, &bd, &cyl));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film, dflt;
+    ck_ok(w, ws_material_create(w, &md, &film));
+    ck_ok(w, ws_world_get_default_material(w, &dflt));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = kc;
+    cd.damping = 1.0;
+    cd.friction = mu;
+    ck_ok(w, ws_world_set_contact(w, film, dflt, &cd));
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.005, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.node_damping = 0.5;
+    wd.law = law;
+    wd.material = film;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-10;
+    ws_band_def bdf;
+    ws_band_def_init(&bdf);
+    bdf.bodies = &cyl;
+    bdf.body_count = 1;
+    bdf.z_bottom = -0.05;
+    bdf.z_top = 0.05;
+    bdf.n_around = na;
+    bdf.n_up = nu;
+    bdf.prestretch_around = 0.2;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_band(w, &wd, &bdf, &web));
+    double S;
+    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    ck_ok(w, ws_world_step_n(w, 300));
+    const size_t nn = (size_t)na * nu;
+    double *x = malloc(3 * nn * sizeof *x), *fc = malloc(3 * nn * sizeof *fc);
+    double *T = malloc(nn * 2 * sizeof *T);
+    ck_assert(x && fc && T);
+    size_t cnt;
+    ck_ok(w, ws_web_copy_positions(w, web, x, nn, &cnt));
+    ck_ok(w, ws_web_copy_contact_forces(w, web, fc, nn, &cnt));
+    ck_ok(w, ws_web_copy_spring_tensions(w, web, T, nn * 2, &cnt));
+    const double a = R * cos(PI / seg);
+    for (int j = 0; j < nu; j++) {
+        double Tm = 0.0, F = 0.0, worst_law = 0.0;
+        for (int i = 0; i < na; i++) {
+            Tm += T[j * na + i] / na;
+            const double *p = x + 3 * (j * na + i), *f = fc + 3 * (j * na + i);
+            const double fn = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+            F += fn;
+            const double ang = atan2(f[1], f[0]);
+            const double fidx = floor((ang < 0 ? ang + 2 * PI : ang) / (2 * PI / seg));
+            const double thf = (fidx + 0.5) * 2 * PI / seg;
+            const double d = p[0] * cos(thf) + p[1] * sin(thf) - a, want = kc * (reach - d);
+            if (mu == 0.0)
+                worst_law = fmax(worst_law, fabs(fn - want) / want);
+        }
+        const double pred = 2 * na * Tm * sin(PI / na);
+        report("implicit band mu %.1f row %d at dt %.0f ms (%.0f x the explicit stable step): "
+               "sum |f| %.6f N, 2 N T sin(pi/N) %.6f N (rel %.2g); contact law %.2g",
+               mu, j, 1e3 * dt, dt / S, F, pred, (F - pred) / pred, worst_law);
+        ck_assert_msg(fabs(F - pred) <= 1e-6 * pred, "row %d: %.9f vs %.9f", j, F, pred);
+        ck_assert_msg(worst_law <= 1e-6, "row %d: contact law off by %g", j, worst_law);
+    }
+    free(x);
+    free(fc);
+    free(T);
+    uint64_t hash;
+    ck_ok(w, ws_world_get_state_hash(w, &hash));
+    ws_world_destroy(w);
+    return hash;
+}
+
+START_TEST(test_band_pressure)
+{
+    band_case(0.0, 1);
+    band_case(0.3, 1);
+}
+END_TEST
+
+/* An implicit web solves on the calling thread whatever the worker count; a world of 2 and of
+ * 3 workers (their lanes run any explicit web beside it) ends in the state of one worker, to
+ * the bit. */
+START_TEST(test_same_on_workers)
+{
+    const uint64_t one = band_case(0.3, 1);
+    ck_assert_uint_eq(band_case(0.3, 2), one);
+    ck_assert_uint_eq(band_case(0.3, 3), one);
+}
+END_TEST
+
+START_TEST(test_scales_and_rupture)
+{
+    /* A mesh web's stiffness scales and broken springs on the implicit film. A row of 5 nodes,
+     * ends pinned, pre-stretch 0.1, EA = 50 N, every spring scaled by 3: settled with drag, each
+     * spring pulls 3 EA 0.1 = 15 N (1e-9). Then a rupture strain of 0.05 breaks them all at the
+     * end of the next step, and from then on the free nodes fall with nothing but gravity and
+     * their drag: the middle node follows backward Euler's recurrence for a free particle
+     * (below) to round-off (1e-12 of its drop). */
+    const double dt = 1e-3, sp = 0.05, l0 = sp / 1.1, EA = 50.0;
+    ws_world *w = world_g(dt, NO_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, EA, 0.0, 0.1, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.node_damping = 0.05;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-10;
+    double pos[15] = {0};
+    uint32_t pairs[8];
+    double rest[4], scale[4];
+    for (int i = 0; i < 5; i++)
+        pos[3 * i] = i * sp;
+    for (int i = 0; i < 4; i++) {
+        pairs[2 * i] = (uint32_t)i;
+        pairs[2 * i + 1] = (uint32_t)i + 1;
+        rest[i] = l0;
+        scale[i] = 3.0;
+    }
+    const uint32_t pins[2] = {0, 4};
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = pos;
+    md.node_count = 5;
+    md.springs = pairs;
+    md.spring_count = 4;
+    md.rest_lengths = rest;
+    md.pinned = pins;
+    md.pinned_count = 2;
+    md.stiffness_scales = scale;
+    ws_web_id id;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &id));
+    const ws_vec3 down = {0, 0, -G0};
+    ck_ok(w, ws_world_set_gravity(w, &down));
+    ck_ok(w, ws_world_step_n(w, 20));
+    ck_ok(w, ws_world_set_gravity(w, &NO_G));
+    ck_ok(w, ws_world_step_n(w, 3000));
+    double T[4];
+    size_t cnt;
+    ck_ok(w, ws_web_copy_spring_tensions(w, id, T, 4, &cnt));
+    for (int i = 0; i < 4; i++)
+        ck_assert_msg(fabs(T[i] - 3 * EA * 0.1) <= 1e-9 * 3 * EA * 0.1, "spring %d: %.12g", i,
+                      T[i]);
+    ck_ok(w, ws_web_set_rupture_strain(w, id, 0.05));
+    ck_ok(w, ws_world_set_gravity(w, &down));
+    ck_ok(w, ws_world_step(w));
+    ws_web_rupture rp;
+    ck_ok(w, ws_web_get_rupture(w, id, &rp));
+    ck_assert_uint_eq(rp.broken_count, 4);
+    double x0[15], v0[15], x1[15];
+    ck_ok(w, ws_web_copy_positions(w, id, x0, 5, &cnt));
+    ck_ok(w, ws_web_copy_velocities(w, id, v0, 5, &cnt));
+    const int K = 50;
+    ck_ok(w, ws_world_step_n(w, K));
+    ck_ok(w, ws_web_copy_positions(w, id, x1, 5, &cnt));
+    /* The middle node alone under gravity and its drag d: backward Euler's step is
+     * v' = (m v + h m g) / (m + h d), z' = z + h v'. */
+    const double m = 1e-3, d = 0.05;
+    double v = v0[3 * 2 + 2], z = x0[3 * 2 + 2];
+    for (int k = 0; k < K; k++) {
+        v = (m * v + dt * m * -G0) / (m + dt * d);
+        z += dt * v;
+    }
+    const double drop = x0[3 * 2 + 2] - z;
+    report("after the break: middle node dropped %.9g m in %d steps, backward Euler's free "
+           "fall %.9g m",
+           x0[3 * 2 + 2] - x1[3 * 2 + 2], K, drop);
+    ck_assert(drop > 1e-3);
+    ck_assert_msg(fabs(x1[3 * 2 + 2] - z) <= 1e-12 * drop, "z %.15g vs %.15g", x1[3 * 2 + 2], z);
+    ws_world_destroy(w);
+    report("scales and rupture on the implicit film: tensions 3 EA p, %u springs broken",
+           rp.broken_count);
+}
+END_TEST
+
+/* ---- 4. a failed solve ---- */
+
+START_TEST(test_failed_solve_leaves_world)
+{
+    /* One CG iteration at a tolerance of 1e-12 cannot solve a 10-node chain's system (CG needs
+     * about as many iterations as distinct eigenvalues): the step fails with WS_ERR_NUMERICAL
+     * naming the web, the residual and the iterations, and the state hash is as before. */
+    ws_world *w = world_g(1e-3, (ws_vec3){0, 0, -G0});
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 50.0, 0.0, 0.02, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-12;
+    wd.solver_max_iterations = 1;
+    wd.name = "stiff chain";
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 10;
+    sd.ny = 1;
+    sd.spacing_x = 0.05;
+    sd.spacing_y = 0.05;
+    sd.prestretch_x = 0.05;
+    uint32_t pins[1] = {0};
+    sd.pinned = pins;
+    sd.pinned_count = 1;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    uint64_t h0, h1;
+    ck_ok(w, ws_world_get_state_hash(w, &h0));
+    ws_status s = ws_world_step(w);
+    ck_ok(w, ws_world_get_state_hash(w, &h1));
+    const char *msg = ws_world_last_error(w);
+    report("failed solve: %s", msg);
+    ck_assert_int_eq(s, WS_ERR_NUMERICAL);
+    ck_assert_msg(strstr(msg, "stiff chain") && strstr(msg, "residual") &&
+                      strstr(msg, "1 iterations"),
+                  "message: %s", msg);
+    ck_assert_msg(h0 == h1, "state changed: %016llx -> %016llx", (unsigned long long)h0,
+                  (unsigned long long)h1);
+    double t;
+    ck_ok(w, ws_world_get_time(w, &t));
+    ck_assert(t == 0.0);
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_bad_solver_defs)
+{
+    ws_world *w = world_g(1e-3, NO_G);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 50.0, 0.0, 0.0, 0.0);
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = 3;
+    sd.ny = 1;
+    sd.spacing_x = sd.spacing_y = 0.05;
+    ws_web_def wd;
+    ws_web_id web;
+    const struct {
+        int integrator;
+        double tol;
+        int maxit;
+        const char *says;
+    } bad[] = {{2, 1e-6, 10, "integrator"},
+               {1, 0.0, 10, "solver_tolerance"},
+               {1, NAN, 10, "solver_tolerance"},
+               {1, 0.5, 10, "solver_tolerance"},
+               {1, 1e-6, 0, "solver_max_iterations"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        ws_web_def_init(&wd);
+        wd.node_mass = 1e-3;
+        wd.law = law;
+        wd.integrator = bad[k].integrator;
+        wd.solver_tolerance = bad[k].tol;
+        wd.solver_max_iterations = bad[k].maxit;
+        ck_assert_int_eq(ws_web_create_sheet(w, &wd, &sd, &web), WS_ERR_INVALID_ARGUMENT);
+        ck_assert_msg(strstr(ws_world_last_error(w), bad[k].says), "%s",
+                      ws_world_last_error(w));
+    }
+    ws_web_solver_stats st;
+    ck_assert_int_eq(ws_web_get_solver_stats(w, web, &st), WS_ERR_STALE_HANDLE);
+    ws_world_destroy(w);
+}
+END_TEST
+
+int main(void)
+{
+    Suite *s = suite_create("implicit");
+    add_case(s, "spring_jacobian", test_spring_jacobian, 10);
+    add_case(s, "contact_jacobian", test_contact_jacobian, 10);
+    add_case(s, "string_mode_amplification", test_string_mode_amplification, 10);
+    add_case(s, "row_tension", test_row_tension, 20);
+    add_case(s, "converges_to_explicit", test_converges_to_explicit, 60);
+    add_case(s, "band_pressure", test_band_pressure, 60);
+    add_case(s, "same_on_workers", test_same_on_workers, 60);
+    add_case(s, "scales_and_rupture", test_scales_and_rupture, 10);
+    add_case(s, "failed_solve_leaves_world", test_failed_solve_leaves_world, 10);
+    add_case(s, "bad_solver_defs", test_bad_solver_defs, 10);
+    return run_suite(s);
+}
