@@ -26,7 +26,8 @@ import sys
 import time
 
 TESTS = ["test_dynamics", "test_contact", "test_web", "test_tilt_table", "test_law",
-         "test_element", "test_detection", "test_drive"]
+         "test_element", "test_detection", "test_drive", "test_implicit", "test_rupture",
+         "test_wrap", "test_loadtest", "test_loadtest_runs"]
 EXAMPLE_RUNS = [
     ("P", False),
     ("P", True),
