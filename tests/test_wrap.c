@@ -194,6 +194,34 @@ END_TEST
 
 /* ---- 3. containment ------------------------------------------------------------------------ */
 
+/* One 0.6 x 0.4 x 0.3 m carton on a pallet of its size, no gap: the box the band tests wrap. */
+static ws_load *one_box_load(ws_world *w)
+{
+    ws_load_def d;
+    ws_load_def_init(&d);
+    d.carton_size = (ws_vec3){0.6, 0.4, 0.3};
+    d.pallet_size = (ws_vec3){0.6, 0.4, 0.1};
+    d.layers = 1;
+    d.count_x = 1;
+    d.count_y = 1;
+    d.gap = 0.0;
+    ws_load *ld;
+    ck_ok(w, ws_load_build(w, &d, &ld));
+    return ld;
+}
+
+/* One revolution of film, one pass, no overlap, 10 mm above the deck: one layer everywhere. */
+static void one_band_def(ws_spiral_wrap_def *sd)
+{
+    ws_spiral_wrap_def_init(sd);
+    sd->revolutions_bottom = 1.0;
+    sd->revolutions_top = 0.0;
+    sd->overlap = 0.0;
+    sd->passes = 1;
+    sd->pallet_lock = 0;
+    sd->lock_height = 0.01;
+}
+
 /* One 0.6 x 0.4 x 0.3 m carton on a pallet, wrapped in one revolution of film wider than the
  * film's band on the carton (10 mm above the deck to 20 mm under the top: one layer
  * everywhere). The film's hoop tension, summed over its rows, is the T it was laid with:
@@ -206,24 +234,9 @@ END_TEST
 START_TEST(a_single_band_contains_with_its_hoop_tension)
 {
     ws_world *w = wrap_world();
-    ws_load_def d;
-    ws_load_def_init(&d);
-    d.carton_size = (ws_vec3){0.6, 0.4, 0.3};
-    d.pallet_size = (ws_vec3){0.6, 0.4, 0.1};
-    d.layers = 1;
-    d.count_x = 1;
-    d.count_y = 1;
-    d.gap = 0.0;
-    ws_load *ld;
-    ck_ok(w, ws_load_build(w, &d, &ld));
+    ws_load *ld = one_box_load(w);
     ws_spiral_wrap_def sd;
-    ws_spiral_wrap_def_init(&sd);
-    sd.revolutions_bottom = 1.0;
-    sd.revolutions_top = 0.0;
-    sd.overlap = 0.0;
-    sd.passes = 1;
-    sd.pallet_lock = 0;
-    sd.lock_height = 0.01;
+    one_band_def(&sd);
     ws_web_id film;
     ck_ok(w, ws_load_wrap_spiral(w, ld, &sd, &film));
     ws_load_info in;
@@ -262,24 +275,9 @@ END_TEST
 START_TEST(roping_adds_its_cross_section)
 {
     ws_world *w = wrap_world();
-    ws_load_def d;
-    ws_load_def_init(&d);
-    d.carton_size = (ws_vec3){0.6, 0.4, 0.3};
-    d.pallet_size = (ws_vec3){0.6, 0.4, 0.1};
-    d.layers = 1;
-    d.count_x = 1;
-    d.count_y = 1;
-    d.gap = 0.0;
-    ws_load *ld;
-    ck_ok(w, ws_load_build(w, &d, &ld));
+    ws_load *ld = one_box_load(w);
     ws_spiral_wrap_def sd;
-    ws_spiral_wrap_def_init(&sd);
-    sd.revolutions_bottom = 1.0;
-    sd.revolutions_top = 0.0;
-    sd.overlap = 0.0;
-    sd.passes = 1;
-    sd.pallet_lock = 0;
-    sd.lock_height = 0.01;
+    one_band_def(&sd);
     sd.rope_revolutions = 0.5;
     sd.rope_height = 0.2;
     ws_web_id film;
