@@ -105,6 +105,13 @@ typedef struct tilt_result {
     double over_theory;                   /* deg: where a rigid load would tip, from its CoG
                                              and the stop edge when the uphill edge lifts
                                              (layers included); NaN when not wrapped R */
+    double stop_height, stop_share;       /* wrapped R, the last 10 ms sample before the
+                                             uphill edge lifted: the height of the stop's push
+                                             above the bottom box's bottom face (m, from its
+                                             moment) and its share of the load's weight down
+                                             the platform (NaN: not measured) */
+    double lift_theory;                   /* deg: where a rigid stack with that push and its
+                                             CoG of that sample unloads its uphill edge */
     double end_time;                      /* s, the run's last time (earlier than the duration
                                              when a box left the platform) */
     double cog_distance_start, cog_distance_end; /* m */
@@ -427,6 +434,50 @@ static double past_stop_edge(ws_world *w, const tilt_scene *sc, ws_vec3 cog)
     return ((cog.x - e.x) * hx + (cog.y - e.y) * hy) / hn;
 }
 
+/* Where the stop pushes on the bottom box: the stack rests on the platform (its friction acts
+ * in the bottom face, at no lever about the downhill bottom edge) and against the stop. The
+ * stop's push S up the platform and its moment about that edge give its height h_s above the
+ * bottom face; with S a share s of the load's weight down the platform, m g sin(theta), the
+ * uphill edge unloads when the moments about the downhill edge balance with the platform's
+ * push all at that edge: m g sin(theta) h = m g cos(theta) x_e + s m g sin(theta) h_s, i.e.
+ * tan(theta) = x_e / (h - s h_s), with h the CoG's height above the bottom face and x_e its
+ * distance up the platform from the edge. A push at the stop's foot (h_s = 0) gives the
+ * textbook (a/2)/h; at its top edge, h_s = 18 mm above the box's bottom face, later. Where
+ * between the two it pushes is not fixed by rigid bodies (the box bears on the stop's whole
+ * face); the contacts' compliance decides it. Returns the rigid angle (deg), NaN without a
+ * push. */
+static double stop_push(ws_world *w, const tilt_scene *sc, ws_vec3 cog, double mass, double theta,
+                        double *height, double *share)
+{
+    ws_contact_info buf[64];
+    size_t n = 0;
+    ws_world_copy_contacts_between(w, sc->stop, sc->box[0], buf, 64, &n);
+    if (n > 64)
+        n = 64;
+    ws_vec3 r, o = {0, 0, 0};
+    ws_body_get_position(w, sc->box[0], &r);
+    ws_vec3 c = in_plane_frame(w, sc->plane, r), origin = in_plane_frame(w, sc->plane, o);
+    double zb = c.z - 0.125, xe = c.x + 0.125; /* bottom face; downhill bottom edge */
+    double push = 0, moment = 0;
+    for (size_t k = 0; k < n; k++) {
+        /* The force on the box (body_b), turned into the platform's frame. */
+        ws_vec3 f = {buf[k].normal_force * buf[k].normal.x + buf[k].friction_force.x,
+                     buf[k].normal_force * buf[k].normal.y + buf[k].friction_force.y,
+                     buf[k].normal_force * buf[k].normal.z + buf[k].friction_force.z};
+        ws_vec3 fp = in_plane_frame(w, sc->plane, f), p = in_plane_frame(w, sc->plane, buf[k].point);
+        fp.x -= origin.x, fp.y -= origin.y, fp.z -= origin.z;
+        push -= fp.x;
+        moment += (p.z - zb) * fp.x + (xe - p.x) * fp.z;
+    }
+    ws_vec3 g = in_plane_frame(w, sc->plane, cog);
+    double down = mass * 9.81 * sin(theta);
+    if (!(push > 0) || !(down > 0))
+        return *height = *share = NAN;
+    *height = -moment / push;
+    *share = push / down;
+    return DEG(atan((xe - g.x) / ((g.z - zb) - *share * *height)));
+}
+
 /* CoG of body b in the frame of body a. */
 static ws_vec3 box_local(ws_world *w, ws_body_id a, ws_body_id b)
 {
@@ -573,6 +624,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
     /* The physical tip is watched in the wrapped R case, where the stack pivots on the stop. */
     int watch_tip = sc.film.bits && sc.stop.bits;
     double past_prev = NAN, theta_prev = 0, t_prev = 0, rigid_now = NAN, rigid_at_lift = NAN;
+    double push_height = NAN, push_share = NAN, push_rigid = NAN;
+    res->stop_height = res->stop_share = res->lift_theory = NAN;
     double t0 = now(), next_report = t0 + 1.0;
     ws_body_id support[2] = {sc.plane, sc.box[0]};
     long slipping_steps[2] = {0, 0};
@@ -620,6 +673,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
                     res->lift_time = t;
                     res->lift_angle = DEG(theta);
                     rigid_at_lift = rigid_now;
+                    res->stop_height = push_height, res->stop_share = push_share;
+                    res->lift_theory = push_rigid;
                 }
                 lift_confirmed = lifted_steps >= lround(0.05 / sc.dt);
                 if (lift_confirmed && watch_tip)
@@ -627,6 +682,7 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
             } else {
                 lifted_steps = 0;
                 res->lift_time = res->lift_angle = NAN;
+                res->stop_height = res->stop_share = res->lift_theory = NAN;
             }
         }
         ws_vec3 rel = box_local(w, sc.box[0], sc.box[1]);
@@ -657,6 +713,12 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
             ws_body_get_world_point(w, sc.stop, &edge_local, &e);
             ws_vec3 ce = in_plane_frame(w, sc.plane, cog), ee = in_plane_frame(w, sc.plane, e);
             rigid_now = DEG(atan((ee.x - ce.x) / (ce.z - ee.z)));
+            if (!lift_confirmed && lifted_steps == 0) {
+                double mass = node_mass * (double)nodes, mk;
+                for (int k = 0; k < 2; k++)
+                    ws_body_get_mass(w, sc.box[k], &mk), mass += mk;
+                push_rigid = stop_push(w, &sc, cog, mass, theta, &push_height, &push_share);
+            }
             if (isnan(res->over_time) && past >= 0.0 && !isnan(past_prev) && past_prev < 0.0) {
                 double f = -past_prev / (past - past_prev);
                 res->over_time = t_prev + f * (t - t_prev);
@@ -891,6 +953,11 @@ int main(int argc, char **argv)
                    "    a rigid stack unloads it at tan(theta) = (a/2) / CoG height = 0.125/0.252, "
                    "%.2f deg\n",
                    r.lift_angle, r.lift_time, DEG(atan(0.125 / 0.252)));
+        if (!isnan(r.lift_time) && !isnan(r.lift_theory))
+            printf("    when pushed at its foot; the stop pushed %.1f mm above the box's bottom "
+                   "face (%.0f %% of the load's weight down the platform), where a rigid stack "
+                   "unloads it at %.2f deg\n",
+                   1e3 * r.stop_height, 100 * r.stop_share, r.lift_theory);
         if (!isnan(r.over_theory))
             printf("  the load's CoG (boxes and film) passes over the stop's edge at %.2f deg "
                    "(t = %.3f s);\n"

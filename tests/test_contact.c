@@ -741,6 +741,62 @@ START_TEST(test_edge_edge_support)
 }
 END_TEST
 
+/* Two equal cubes side by side, pressed face to face with a layer overlap of 0.1 mm, as the
+ * cartons of a wrapped load are: each of the four corners of the shared face carries one
+ * contact, k x 0.1 mm, whichever feature holds it (a corner of one cube in the other's face,
+ * or, where neither corner is inside, the edges that cross there). Shifting the second cube
+ * along the face by a micrometre either way and turning it by a micro-radian about any axis
+ * must not change that: 4 contacts, the total k (4 x 0.1 mm) within the tilt's change of the
+ * overlaps (1e-6 rad x 0.25 m = 0.25 um on 100 um: 0.25 % a corner, and the total cancels to
+ * first order: asserted to 0.5 %). With the cone test exact, a crossing whose edge tilts the
+ * wrong way by a micro-radian was dropped and that corner carried nothing. */
+START_TEST(test_side_by_side_corners_hold)
+{
+    const double a = 0.25, k = 2e5, ov = 1e-4, e = 1e-6, tilt = 1e-6;
+    ws_contact_def cd = contact_params(k, 0.0, 0.0, WS_FRICTION_REGULARIZED);
+    int cases = 0, worst_n = 4;
+    double worst = 0.0;
+    for (int sy = -1; sy <= 1; sy += 2)
+        for (int sz = -1; sz <= 1; sz += 2)
+            for (int axis = 0; axis < 3; axis++)
+                for (int st = -1; st <= 1; st += 2) {
+                    ws_world_def wd;
+                    ws_world_def_init(&wd);
+                    wd.gravity = v3(0, 0, 0);
+                    ws_world *w = NULL;
+                    ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+                    ck_ok(w, ws_world_set_default_contact(w, &cd));
+                    ws_body_id fixed = make_box(w, WS_BODY_KINEMATIC, a, a, a, 0, v3(0, 0, 0),
+                                                Q_ID, v3(0, 0, 0), "fixed");
+                    ws_vec3 ax = v3(axis == 0, axis == 1, axis == 2);
+                    ws_body_id side = make_box(w, WS_BODY_DYNAMIC, a, a, a, 10.0,
+                                               v3(a + 2 * DELTA - ov, sy * e, sz * e),
+                                               quat_axis(ax, st * tilt), v3(0, 0, 0), "side");
+                    ck_ok(w, ws_world_step(w));
+                    contacts cs;
+                    get_contacts(w, &cs);
+                    int n;
+                    unsigned kinds;
+                    double f = normal_force_between(&cs, fixed, side, &n, &kinds);
+                    double rel = fabs(f - 4 * k * ov) / (4 * k * ov);
+                    if (n != 4 || rel > worst) {
+                        worst = fmax(worst, rel);
+                        if (n != 4)
+                            worst_n = n;
+                    }
+                    ck_assert_msg(n == 4 && rel < 5e-3,
+                                  "shift (%d, %d) um, tilt %d urad about axis %d: %d contacts "
+                                  "(kinds 0x%x), %.6g N (4 k ov = %.6g N)",
+                                  sy, sz, st, axis, n, kinds, f, 4 * k * ov);
+                    cases++;
+                    ws_world_destroy(w);
+                }
+    report("side by side cubes: %d shifts and tilts, 4 contacts in each (%d), total force within "
+           "%.3g %% of 4 k overlap",
+           cases, worst_n, 100 * worst);
+}
+END_TEST
+
 /* ======================================================================================== */
 /* Impact                                                                                     */
 /* ======================================================================================== */
@@ -1302,6 +1358,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_resting_penetration_k2e6);
     tcase_add_test(tc, test_stacked_cubes_no_spin);
     tcase_add_test(tc, test_edge_edge_support);
+    tcase_add_test(tc, test_side_by_side_corners_hold);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("friction");

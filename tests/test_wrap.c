@@ -398,7 +398,9 @@ END_TEST
  * turns less than 0.05 degrees, the cartons' mean horizontal move (the load's walk) is under
  * 0.5 mm, and no carton moves outwards by more than 0.5 mm nor further in than the gaps between
  * it and the middle of its row (two and a half gaps of 5 mm). Then the wrapped load passes
- * EUMOS at 0.3 g and the run reports its containment. */
+ * EUMOS at 0.3 g and the run reports its containment. Under WS_TEST_SHORT the run stops after
+ * 0.05 s, while the cartons are still closing their gaps and turn on the way (up to 0.06 deg,
+ * 0.016 deg once they stand): the turn is checked on the load at rest only. */
 START_TEST(the_wrapped_pallet_load_does_not_walk)
 {
     ws_world *w = wrap_world();
@@ -449,7 +451,7 @@ START_TEST(the_wrapped_pallet_load_does_not_walk)
            "at spring %u, %.3f m up",
            b[0].force, b[1].force, b[2].force, b[0].line_load, b[1].line_load, b[2].line_load,
            b[0].hoop_tension, b[1].hoop_tension, b[2].hoop_tension, peak, spring, h);
-    ck_assert(turn < 0.05 * WS_TEST_PI / 180);
+    ck_assert(short_run() || turn < 0.05 * WS_TEST_PI / 180);
     ck_assert(hypot(mx, my) < 0.5e-3);
     ck_assert(outward < 0.5e-3);
     ck_assert(most < 2.5 * 0.005 + 0.5e-3);
@@ -474,6 +476,48 @@ START_TEST(the_wrapped_pallet_load_does_not_walk)
         for (int k = 0; k < 3; k++)
             ck_assert(r.containment[k].line_load > 100);
     }
+    ws_load_destroy(ld);
+    ws_world_destroy(w);
+}
+END_TEST
+
+/* The spiral-wrapped EUR load comes to rest. Once the film has closed the gaps, the cartons
+ * stand pressed side by side, face on equal face, every corner of one on an edge of the next:
+ * the contacts there must hold whichever way a micro-radian tilts them (docs/theory.md,
+ * "Contact geometry"), or the corners' forces switch on and off and the load jitters at
+ * 2-15 mm/s for good. A load at rest has no drift; ws_load_settle's threshold, 0.1 mm/s, is the
+ * issue's, and the load must stay below it for 0.5 s more (the settle holds it for 0.1 s).
+ * Skipped under WS_TEST_SHORT: it needs about 2 s of load time (8000 steps). */
+START_TEST(the_wrapped_pallet_load_comes_to_rest)
+{
+    if (short_run())
+        return;
+    ws_world *w = wrap_world();
+    ws_load_def d;
+    ws_load_def_init(&d);
+    ws_load *ld;
+    ck_ok(w, ws_load_build(w, &d, &ld));
+    int settled = 0;
+    double took = 0, took_wrap = 0;
+    ck_ok(w, ws_load_settle(w, ld, 0.2, 1.0, 1e-4, &settled, &took));
+    ck_assert_msg(settled, "the unwrapped load did not stand still in 1 s");
+    ws_spiral_wrap_def sd;
+    ws_spiral_wrap_def_init(&sd);
+    sd.node_mass_min = 1e-3; /* as the example's */
+    ws_web_id film;
+    ck_ok(w, ws_load_wrap_spiral(w, ld, &sd, &film));
+    ck_ok(w, ws_load_settle(w, ld, 0.5, 4.0, 1e-4, &settled, &took_wrap));
+    double worst = 0, v;
+    for (int k = 0; k < 10; k++) {
+        ck_ok(w, ws_world_step_n(w, 200));
+        ck_ok(w, ws_load_get_drift(w, ld, &v));
+        worst = fmax(worst, v);
+    }
+    report("spiral-wrapped EUR pallet load: unwrapped at rest in %.2f s, wrapped in %.2f s more "
+           "(%s); the next 0.5 s its drift stays under %.4f mm/s",
+           took, took_wrap, settled ? "settled" : "still moving", worst * 1e3);
+    ck_assert_msg(settled, "the wrapped load still moves after 4 s");
+    ck_assert_msg(worst < 1e-4, "drift %.4f mm/s after settling", worst * 1e3);
     ws_load_destroy(ld);
     ws_world_destroy(w);
 }
@@ -714,6 +758,7 @@ int main(void)
     add_case(s, "cubes_stand_still", the_wrapped_cubes_stand_still, 300);
     add_case(s, "top_sheet", a_top_sheet_lies_on_the_top, 300);
     add_case(s, "pallet_does_not_walk", the_wrapped_pallet_load_does_not_walk, 600);
+    add_case(s, "pallet_comes_to_rest", the_wrapped_pallet_load_comes_to_rest, 600);
     add_case(s, "bad_defs", bad_spiral_defs_are_refused_with_the_field_named, 60);
     add_case(s, "rupture", the_spiral_film_breaks_at_its_elongation, 60);
     add_case(s, "out_of_memory", out_of_memory_leaves_the_load_unwrapped, 120);

@@ -16,6 +16,17 @@
  * point-face contacts. */
 #define WS_FEATURE_TOL 1e-9
 
+/* How far an edge-edge normal may lie outside an edge's normal cone (in the cone's coefficients:
+ * about that angle in radians for a square edge). At the cone's boundary the other body's edge
+ * lies across one of the edge's faces: a line contact, such as a box pressed on the top edge of
+ * a stop, or two cartons side by side whose edges meet where their equal faces end. Where the
+ * line crosses the face's border, the edge pair carries it; the contact must not come and go
+ * with the sign of a tilt of a micro-radian (it did with WS_FEATURE_TOL here: loads squeezed
+ * side to side kept jittering, each corner's force switching on and off). 1e-2 is ten times the
+ * tilts a resting load's compliance gives its bodies (overlaps of 0.1-0.3 mm differing across
+ * faces of 0.3 m: 1e-4 to 1e-3), and small beside any edge that truly turns away. */
+#define WS_CONE_TOL 1e-2
+
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)

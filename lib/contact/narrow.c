@@ -25,7 +25,7 @@ int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi,
 }
 
 /* n in the normal cone of an edge whose faces have outward normals n1, n2 (all orthogonal to the
- * edge): n = a n1 + b n2 with a, b >= 0. */
+ * edge): n = a n1 + b n2 with a, b >= 0, up to WS_CONE_TOL. */
 static int in_cone(v3 n, v3 n1, v3 n2)
 {
     double c = v3_dot(n1, n2), r1 = v3_dot(n, n1), r2 = v3_dot(n, n2);
@@ -33,7 +33,7 @@ static int in_cone(v3 n, v3 n1, v3 n2)
     if (den < 1e-12)
         return r1 > -WS_FEATURE_TOL;
     double a = (r1 - c * r2) / den, b = (r2 - c * r1) / den;
-    return a >= -WS_FEATURE_TOL && b >= -WS_FEATURE_TOL;
+    return a >= -WS_CONE_TOL && b >= -WS_CONE_TOL;
 }
 
 /* Edge pi-qi of a against edge pj-qj of b, all in a's frame (eq. 16-17): closest points
