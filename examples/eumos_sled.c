@@ -4,7 +4,8 @@
  * A EUR pallet (1200 x 800 x 144 mm, 25 kg) with 4 layers of 8 cartons (400 x 300 x 250 mm,
  * 10 kg each), unwrapped, or (--wrapped) spiral-wrapped as a machine lays 500 mm film of 20 um
  * at 200 % pre-stretch, or (--band) in a plain band of film, settles on a
- * level platform; the platform then accelerates at k g
+ * level platform until it stands still (at most --settle S seconds, default 4, before and again
+ * after the wrap); the platform then accelerates at k g
  * (reached in 40 ms, held 0.35 s) and stops gently. The program prints what the load did and
  * the verdict of each criterion: elastic displacement <= 10 % of the load's height, permanent
  * <= 5 %, lowest 20 cm <= 40 mm, layer shift < 2 %, no rupture.
@@ -81,7 +82,7 @@ static void print_result(const ws_eumos_result *r)
 
 int main(int argc, char **argv)
 {
-    double k = 0.3, settle = 1.0, rest = 0.5;
+    double k = 0.3, settle = 4.0, rest = 0.5;
     int brake = 0, find_k = 0, wrapped = 0, band = 0;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--k") && i + 1 < argc && number(argv[i + 1], 1e-3, 10, &k) == 0)

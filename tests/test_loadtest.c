@@ -804,7 +804,7 @@ START_TEST(the_k_value_search_brackets_the_pass)
     kd.k_low = 0.1;
     kd.k_high = 0.5;
     kd.tolerance = 0.02;
-    kd.settle_time = 0.8;
+    kd.settle_time = 2.0; /* at most: the load stands still after about 0.85 s */
     if (short_run()) { /* one layer (it slides at mu = 0.45), three runs */
         d.layers = 1;
         kd.tolerance = 0.2;
@@ -816,8 +816,14 @@ START_TEST(the_k_value_search_brackets_the_pass)
     ws_kvalue_result r;
     ws_status s = ws_loadtest_find_k(&wd, &d, &e, &kd, &r);
     ck_assert_msg(s == WS_OK, "%s", r.error);
-    report("unwrapped pallet load of %d layers: k-value %.3f g (fails at %.3f g), %d runs",
-           d.layers, r.k_value, r.k_fail, r.runs);
+    report("unwrapped pallet load of %d layers: k-value %.3f g (fails at %.3f g), %d runs; "
+           "the load %s in %.3f s",
+           d.layers, r.k_value, r.k_fail, r.runs, r.settled ? "stood still" : "still moved",
+           r.settle_taken);
+    /* The search settles until the load stands still, no longer than settle_time. */
+    ck_assert(r.settle_taken <= kd.settle_time + 1e-9);
+    if (!short_run())
+        ck_assert(r.settled == 1 && r.settle_taken < 1.5);
     ck_assert(r.k_value >= kd.k_low && r.k_fail > r.k_value);
     ck_assert(r.k_fail - r.k_value <= kd.tolerance + 1e-12);
     ck_assert_int_eq(r.last_pass.verdict.pass, 1);

@@ -627,9 +627,14 @@ typedef struct ws_kvalue_def {
     double k_low;      /**< lowest k tried, g (> 0); default 0.05 */
     double k_high;     /**< highest k tried, g (> k_low); default 1.0 */
     double tolerance;  /**< the search stops when the bracket is narrower, g (> 0); default 0.01 */
-    double settle_time;  /**< s the fresh load settles before the runs (> 0); default 1.0 */
-    /** A wrap to put on the load after it settled (it then settles settle_time again before the
-     *  state is saved); NULL (default) for the load unwrapped. Read during the call only. */
+    /** Longest time the fresh load settles before the runs, s (> 0): it steps until the load
+     *  stands still (ws_load_settle(): drift under 0.1 mm/s for 0.1 s, after at least 0.2 s or
+     *  settle_time if shorter) or this time has passed; default 4.0 (the spiral-wrapped EUR
+     *  load needs about 2.2 s after its wrap). */
+    double settle_time;
+    /** A wrap to put on the load after it settled (it then settles again, as long at most,
+     *  before the state is saved); NULL (default) for the load unwrapped. Read during the call
+     *  only. */
     const ws_wrap_def *wrap;
     /** A spiral wrap (ws_load_wrap_spiral()) to put on the load after it settled, when `wrap`
      *  is NULL; NULL (default) for none. Read during the call only. */
@@ -643,6 +648,10 @@ typedef struct ws_kvalue_result {
     int runs;         /**< EUMOS runs made */
     ws_eumos_result last_pass; /**< the run at k_value (zero when none passed) */
     char error[256];  /**< the world's last error when a run failed, else "" */
+    /** 1 when the load (and the wrapped load) stood still before the runs; 0 when settle_time
+     *  ran out first (the runs then start from a load still moving) */
+    int settled;
+    double settle_taken; /**< s the load settled, in all (unwrapped and wrapped) */
 } ws_kvalue_result;
 
 /** Fill a k-value Def with the defaults above. NULL is ignored.
@@ -656,8 +665,9 @@ WS_API void(ws_kvalue_def_init)(ws_kvalue_def *def);
 #define ws_kvalue_def_init(def) ws_kvalue_def_init_sized((def), sizeof *(def))
 /** Find the load's k-value: the largest k at which it passes EUMOS 40509, by bisection between
  *  k_low and k_high. Every run starts from the same settled load: a world is created from
- *  `world_def`, the load built from `load_def` and settled for settle_time (then wrapped and
- *  settled again when def->wrap is given), and its state saved
+ *  `world_def`, the load built from `load_def` and settled until it stands still, at most
+ *  settle_time (then wrapped and settled again when def->wrap or def->spiral is given), and its
+ *  state saved
  *  (ws_world_save()); each run restores it (ws_world_restore()) and runs EUMOS at its k with the
  *  rest of `eumos_def`, so each starts from the same state to the bit.
  *  @return WS_OK, WS_ERR_INVALID_ARGUMENT, WS_ERR_UNINITIALIZED_DEF, and any error of a run (its

@@ -34,7 +34,7 @@ static void kvalue_defaults(ws_kvalue_def *def)
     def->k_low = 0.05;
     def->k_high = 1.0;
     def->tolerance = 0.01;
-    def->settle_time = 1.0;
+    def->settle_time = 4.0;
 }
 
 WS_DEF_INITS(ws_kvalue_def, kvalue_defaults, wrap)
@@ -292,26 +292,38 @@ typedef struct kworld {
     size_t len;
 } kworld;
 
+/* Let the load come to rest: until its drift stays under 0.1 mm/s (ws_load_settle), at most
+ * the Def's settle time; *still and *taken add up over the stages (unwrapped, wrapped). */
+static ws_status kworld_settle(kworld *kw, double most, int *still, double *taken)
+{
+    int st = 0;
+    double t = 0;
+    ws_status s = ws_load_settle(kw->w, kw->ld, fmin(0.2, most), most, 1e-4, &st, &t);
+    *still &= st;
+    *taken += t;
+    return s;
+}
+
 static ws_status kworld_make(kworld *kw, const ws_world_def *wd, const ws_load_def *ldef,
-                             const ws_kvalue_def *kd)
+                             const ws_kvalue_def *kd, ws_kvalue_result *result)
 {
     double settle = kd->settle_time;
     memset(kw, 0, sizeof *kw);
     ws_status s = ws_world_create(wd, &kw->w);
     if (s != WS_OK)
         return s;
-    double dt;
+    result->settled = 1;
     if ((s = ws_load_build(kw->w, ldef, &kw->ld)) != WS_OK ||
-        (s = ws_world_get_dt(kw->w, &dt)) != WS_OK ||
-        (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK)
+        (s = kworld_settle(kw, settle, &result->settled, &result->settle_taken)) != WS_OK)
         return s;
     ws_web_id film;
     if (kd->wrap && ((s = ws_load_wrap_band(kw->w, kw->ld, kd->wrap, &film)) != WS_OK ||
-                     (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
+                     (s = kworld_settle(kw, settle, &result->settled, &result->settle_taken)) !=
+                         WS_OK))
         return s;
     if (!kd->wrap && kd->spiral &&
         ((s = ws_load_wrap_spiral(kw->w, kw->ld, kd->spiral, &film)) != WS_OK ||
-         (s = ws_world_step_n(kw->w, (int64_t)ceil(settle / dt - 1e-9))) != WS_OK))
+         (s = kworld_settle(kw, settle, &result->settled, &result->settle_taken)) != WS_OK))
         return s;
     if ((s = ws_world_save(kw->w, NULL, 0, &kw->len)) != WS_OK)
         return s;
@@ -404,7 +416,7 @@ ws_status ws_loadtest_find_k(const ws_world_def *world_def, const ws_load_def *l
         return WS_ERR_INVALID_ARGUMENT;
     }
     kworld kw;
-    ws_status s = kworld_make(&kw, world_def, load_def, &kd);
+    ws_status s = kworld_make(&kw, world_def, load_def, &kd, result);
     if (s == WS_OK)
         s = search(&kw, &ed, &kd, result);
     if (s != WS_OK)

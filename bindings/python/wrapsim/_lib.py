@@ -715,7 +715,8 @@ class KvalueDef(Structure):
 class KvalueResult(Structure):
     _fields_ = [
         ("k_value", c_double), ("k_fail", c_double), ("runs", c_int),
-        ("last_pass", EumosResult), ("error", c_char * 256),
+        ("last_pass", EumosResult), ("error", c_char * 256), ("settled", c_int),
+        ("settle_taken", c_double),
     ]
 
 

@@ -171,7 +171,9 @@ def _result_dict(d, res, state_hash):
 
 def prepare(w, d):
     """Build the load file's unit load in world `w`, let it settle, wrap it (then settle again)
-    when the file has a wrap. Returns the ws_load pointer; destroy it with ws_load_destroy."""
+    when the file has a wrap. Each settling lasts until the load stands still (drift under
+    0.1 mm/s for 0.1 s), at most settle_s. Returns the ws_load pointer; destroy it with
+    ws_load_destroy."""
     u = d["unit_load"]
     lib = _c()
     ld = load_def(d)
@@ -181,8 +183,8 @@ def prepare(w, d):
         settled, taken = ctypes.c_int(), ctypes.c_double()
         wd, sd = wrap_def(d), spiral_def(d)
         if wd is not None or sd is not None:
-            _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                         byref(settled), byref(taken)), "ws_load_settle")
+            _check(w, lib.ws_load_settle(w.ptr, load, min(0.2, u["settle_s"]), u["settle_s"],
+                                         1e-4, byref(settled), byref(taken)), "ws_load_settle")
             web = L.WebId()
             if wd is not None:
                 _check(w, lib.ws_load_wrap_band(w.ptr, load, byref(wd), byref(web)),
@@ -190,8 +192,8 @@ def prepare(w, d):
             else:
                 _check(w, lib.ws_load_wrap_spiral(w.ptr, load, byref(sd), byref(web)),
                        "ws_load_wrap_spiral")
-        _check(w, lib.ws_load_settle(w.ptr, load, u["settle_s"], u["settle_s"], 1e-4,
-                                     byref(settled), byref(taken)), "ws_load_settle")
+        _check(w, lib.ws_load_settle(w.ptr, load, min(0.2, u["settle_s"]), u["settle_s"],
+                                     1e-4, byref(settled), byref(taken)), "ws_load_settle")
     except BaseException:
         lib.ws_load_destroy(load)
         raise
@@ -250,7 +252,8 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
 
 def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01):
     """The EUMOS k-value of the load file's load (ws_loadtest_find_k): every run starts from
-    one settled (and wrapped) state. Returns a dict: k_value, k_fail (g), runs."""
+    one settled (and wrapped) state. Returns a dict: k_value, k_fail (g), runs, settled (the
+    load stood still before the runs) and settle_s (how long it settled)."""
     lib = _c()
     wdef = _init(L.WorldDef, "ws_world_def_init_sized")
     for field, value in world_params(d).items():
@@ -270,4 +273,5 @@ def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01):
     if st != L.WS_OK:
         raise WrapsimError(st, res.error.decode(errors="replace"))
     return dict(name=d["name"], k_value_g=res.k_value, k_fail_g=res.k_fail, runs=res.runs,
+                settled=bool(res.settled), settle_s=res.settle_taken,
                 error=res.error.decode(errors="replace"))

@@ -108,8 +108,9 @@ SPEC = _section({
                             "turned"),
         "gap_m": _num("m", 0.003, 0.0, 1.0, doc="clear gap between neighbouring cartons"),
         "contact_layer_m": _num("m", 1e-3, 0.0, 0.1, True),
-        "settle_s": _num("s", 1.0, 0.0, 100.0, True,
-                         doc="the load settles this long (and again after wrapping)"),
+        "settle_s": _num("s", 4.0, 0.0, 100.0, True,
+                         doc="the load settles until it stands still (drift under 0.1 mm/s), "
+                             "at most this long (and again after wrapping)"),
         "interfaces": _section({
             "carton_carton": _interface(0.4, 2e6, 2000.0, "stick", "per interface"),
             "carton_pallet": _interface(0.45, 2e6, 2000.0, "stick", "per interface"),
