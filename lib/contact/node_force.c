@@ -1163,31 +1163,35 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
 
 /* ---- one candidate through its full tests, for the implicit film (contact/node_jacobian.c) */
 
-int ws_node_touch(const ws_body_store *b, int cur, const ws_node_geom *g, const ws_web *web,
-                  const ws_ncand *c, v3 x, double reach, v3 *n, double *d, double *hi)
+int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x,
+                  double reach, ws_node_touch_at *at)
 {
+    const ws_body_store *b = P->b;
+    const ws_node_geom *g = P->g;
     const uint32_t bi = c->body;
     const ws_shape *sh = b->shape[bi];
-    *hi = b->layer[bi] + web->layer;
+    const double hi = b->layer[bi] + web->layer;
+    at->hi = hi;
     if (c->local & WS_NCAND_EDGE)
-        return in_wedge(&g->edge[c->feat], x, *hi + reach, 0, n, d);
+        return in_wedge(&g->edge[c->feat], x, hi + reach, 0, &at->n, &at->d);
     const ws_wface *F = &g->face[c->feat];
-    const double lo = -*hi - sh->inner;
-    *d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
-    if (!(*d < *hi + reach) || !(*d > lo))
+    const double lo = -hi - sh->inner;
+    const double d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
+    if (!(d < hi + reach) || !(d > lo))
         return 0;
     if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, x))
         return 0;
-    if (*d < 0.0) {
+    if (d < 0.0) {
         const uint32_t f = c->local & ~WS_NCAND_FLAGS;
         const int top = sh->convex
-                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, *d)
+                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, d)
                             : ws_shallowest_face(sh, f, m3_tmul_v(&b->A[bi],
-                                                                  v3_sub(x, b->st[cur].r[bi])),
-                                                 *d);
+                                                                  v3_sub(x, b->st[P->cur].r[bi])),
+                                                 d);
         if (!top)
             return 0;
     }
-    *n = F->n;
+    at->n = F->n;
+    at->d = d;
     return 1;
 }
