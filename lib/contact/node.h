@@ -342,7 +342,7 @@ typedef struct ws_node_touch_at {
  * the bodies of P (b, state cur, features g) and the window's top raised by `reach` (0: the
  * contact window itself): then where, in *at. For the implicit film, which evaluates each
  * node's contacts once a step, and those it may reach within it (contact/node_jacobian.c). */
-int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x,
-                  double reach, ws_node_touch_at *at);
+int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x, double reach,
+                  ws_node_touch_at *at);
 
 #endif

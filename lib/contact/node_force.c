@@ -84,7 +84,7 @@ typedef struct act_load {
  * the normal force fn along n) times share, and its moment about the CoG at lever l; zero for
  * a contact that does not push (push: all bits or none). Adding that zero leaves every sum as it
  * was: the bodies' sums start at +0 and never reach -0, and the moment's zero, of either sign,
- * changes no sum. Both paths (act_friction, run_kernel) take it from here, so their loads agree
+ * changes no sum. Both paths (act_friction, run_apply) take it from here, so their loads agree
  * to the bit. */
 static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double share, v3 l)
 {
@@ -114,8 +114,7 @@ static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double sh
 static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double fn, double mu,
                              double vlim, double h)
 {
-    const ws_friction fr =
-        ws_friction_law(friction_pred(n, t, k, im, h), fn, mu, vlim, mass, h);
+    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), fn, mu, vlim, mass, h);
     const uint64_t free = ws_mask(im != 0.0);
     return v3_make(ws_pick(free, fr.f.x, 0.0), ws_pick(free, fr.f.y, 0.0),
                    ws_pick(free, fr.f.z, 0.0));
@@ -200,7 +199,7 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
  * would pull). The contact laws' (penalty.h) for a node: the penalty on the overlap and damping
  * on its rate, at the contact point midway in the overlap, against the body's velocity there,
  * never pulling. Straight-line code, so loops of it run on vectors; both passes (act_normal,
- * run_kernel) take it from here. */
+ * run_normal) take it from here. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
@@ -222,9 +221,9 @@ static void act_normal(size_t ng, act_group *restrict G)
         act_group *e = &G[g];
         for (size_t l = 0; l < WS_LANES; l++) {
             const ws_motion b = {ws_lane(&e->r, l), ws_lane(&e->v, l), ws_lane(&e->w, l)};
-            const node_normal o = normal_of(ws_lane(&e->n, l), e->d.v[l], e->hi.v[l],
-                                            ws_lane(&e->x, l), ws_lane(&e->u, l), b, e->kp.v[l],
-                                            e->cp.v[l]);
+            const node_normal o =
+                normal_of(ws_lane(&e->n, l), e->d.v[l], e->hi.v[l], ws_lane(&e->x, l),
+                          ws_lane(&e->u, l), b, e->kp.v[l], e->cp.v[l]);
             ws_lane_set(&e->p, l, o.p);
             ws_lane_set(&e->l, l, o.l);
             ws_lane_set(&e->t, l, o.t);
@@ -244,8 +243,8 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
         for (size_t l = 0; l < WS_LANES; l++) {
             const v3 n = ws_lane(&e->n, l);
             const double fn = e->fn.v[l];
-            const v3 a = friction_of(n, ws_lane(&e->t, l), ws_lane(&e->k, l), e->im.v[l],
-                                     e->m.v[l], fn, e->mu.v[l], e->vl.v[l], h);
+            const v3 a = friction_of(n, ws_lane(&e->t, l), ws_lane(&e->k, l), e->im.v[l], e->m.v[l],
+                                     fn, e->mu.v[l], e->vl.v[l], h);
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
              * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = ws_mask(fn > 0.0);
@@ -567,7 +566,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in run_kernel and run_flush: the face's normal and
+/* What a run needs of its face and body in the run passes and run_flush: the face's normal and
  * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
  * parameters, the body's slot. */
 typedef struct run_const {
@@ -586,7 +585,7 @@ typedef struct ws_run_face {
 } ws_run_face;
 
 /* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
- * depths were taken of: the unit of run_kernel. */
+ * depths were taken of: the unit of the run passes. */
 typedef struct run_group {
     const run_const *rc; /* the run's face and body */
     uint32_t node;       /* the first of the four */
@@ -594,8 +593,8 @@ typedef struct run_group {
     uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
-/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and the
- * kernel's scratch (run_tmp). The list of loads keeps their places, so they may wait until the
+/* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
+ * passes' scratch (run_tmp). The list of loads keeps their places, so they may wait until the
  * block's end. */
 typedef struct run_batch {
     run_group *grp;
@@ -615,7 +614,8 @@ typedef struct run_batch {
  * (force and moment about the CoG, zero for a contact that does not push) into out, for every
  * lane. Whole groups, so that the four lanes of a group run on vectors.
  *
- * In passes over all the groups, their values in between in tmp (T_*): a contact's arithmetic
+ * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
+ * between in run_tmp: a contact's arithmetic
  * is one long chain (some 180 cycles from the node's position to its force, with a square root
  * and two divisions in a row), about as long as the window of instructions a processor runs
  * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
@@ -626,7 +626,7 @@ typedef struct run_batch {
 /* The batch's values between the passes and its outputs, each array a value's of every lane
  * (4 g + l for lane l of group g). */
 typedef struct run_tmp {
-    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* force with the normal force */
+    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* normal force, then with f's */
     double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
     double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
     double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
@@ -635,17 +635,18 @@ typedef struct run_tmp {
     double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
 } run_tmp;
 
-/* The restrict arrays stay parameters (17 of them: over the house's 12), since in a struct GCC
- * 12 no longer takes them as apart and runs the kernel with 11 % more instructions. */
+/* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
+ * as apart, and runs the passes with many more instructions); each pass takes only those it
+ * reads or writes.
+ *
+ * normal_of for the groups [0, ng) of the batch: the nodes' positions p, velocities u and
+ * depths, into T (the normal force's vector into T->k). */
 WS_VECTOR_LOOP
-static void run_kernel(size_t ng, const run_group *restrict grp, const double *restrict px,
+static void run_normal(size_t ng, const run_group *restrict grp, const double *restrict px,
                        const double *restrict py, const double *restrict pz,
                        const double *restrict ux, const double *restrict uy,
-                       const double *restrict uz, double *restrict gx, double *restrict gy,
-                       double *restrict gz, const double *restrict im, const double *restrict mass,
-                       const double *restrict depth, double h, double share, run_tmp *restrict T)
+                       const double *restrict uz, const double *restrict depth, run_tmp *restrict T)
 {
-    /* normal_of, to the node's force with its normal force in and its tangential velocity */
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
@@ -660,9 +661,9 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             T->keep[e] = ws_double_of(0 - ((bits >> l) & 1u));
             const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
                                             v3_make(ux[t], uy[t], uz[t]), b, k, c);
-            T->kx[e] = gx[t] + nf.p.x;
-            T->ky[e] = gy[t] + nf.p.y;
-            T->kz[e] = gz[t] + nf.p.z;
+            T->kx[e] = nf.p.x;
+            T->ky[e] = nf.p.y;
+            T->kz[e] = nf.p.z;
             T->tx[e] = nf.t.x;
             T->ty[e] = nf.t.y;
             T->tz[e] = nf.t.z;
@@ -672,23 +673,41 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             T->lz[e] = nf.l.z;
         }
     }
-    /* act_apply's friction */
+}
+
+/* act_apply's friction over sub-step h, from the nodes' forces g (T->k becomes the node's force
+ * with its normal force in), 1 / mass im and mass. */
+WS_VECTOR_LOOP
+static void run_friction(size_t ng, const run_group *restrict grp, const double *restrict gx,
+                         const double *restrict gy, const double *restrict gz,
+                         const double *restrict im, const double *restrict mass, double h,
+                         run_tmp *restrict T)
+{
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
         const v3 n = v3_make(q->nx, q->ny, q->nz);
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
-            const size_t e = 4 * g + l;
-            const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]),
-                                     v3_make(T->kx[e], T->ky[e], T->kz[e]), im[o + l],
-                                     mass[o + l], T->fn[e], mu, vlim, h);
+            const size_t t = o + l, e = 4 * g + l;
+            const v3 k = v3_make(gx[t] + T->kx[e], gy[t] + T->ky[e], gz[t] + T->kz[e]);
+            T->kx[e] = k.x;
+            T->ky[e] = k.y;
+            T->kz[e] = k.z;
+            const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]), k, im[t], mass[t],
+                                     T->fn[e], mu, vlim, h);
             T->ax[e] = a.x;
             T->ay[e] = a.y;
             T->az[e] = a.z;
         }
     }
-    /* the node's new force and the body's share */
+}
+
+/* The nodes' new forces into g, and the body's share of each load into T. */
+WS_VECTOR_LOOP
+static void run_apply(size_t ng, const run_group *restrict grp, double *restrict gx,
+                      double *restrict gy, double *restrict gz, double share, run_tmp *restrict T)
+{
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
@@ -717,7 +736,7 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
     }
 }
 
-/* The batch's contacts: run_kernel, then, in node order, each node's share of its contact
+/* The batch's contacts: the run passes, then, in node order, each node's share of its contact
  * force and its body's load into their places in the list of loads. A contact that does not
  * push has a share of zero, and is listed as touched and loaded all the same (a branch would
  * be a coin toss). */
@@ -728,8 +747,9 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
     run_tmp *T = B->tmp;
-    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m,
-               B->depth, h, share, T);
+    run_normal(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, B->depth, T);
+    run_friction(B->n, B->grp, f.x, f.y, f.z, web->inv_m, web->m, h, T);
+    run_apply(B->n, B->grp, f.x, f.y, f.z, share, T);
     act_list *L = E->L;
     act_load *load = L->load;
     uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
@@ -781,7 +801,7 @@ static const uint8_t run_count4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3,
 
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
  * The groups of four nodes with one in the window join the block's batch (B), with their
- * places in the list of loads, in node order: run_kernel takes them with the arithmetic of
+ * places in the list of loads, in node order: the run passes take them with the arithmetic of
  * contacts_general for a node whose only candidate is a face it lies well inside of, without
  * its look-ups (the face, body and contact are the run's). A chunk with a node below the face's
  * plane (d < 0), where another face may lie shallower, goes to contacts_general. */
@@ -951,7 +971,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     nc->seg_list = -1;
     nc->nseg = 0;
     if (nc->rtmp_cap == 0) {
-        /* A run batch: its groups, run_kernel's scratch, the nodes' depths. */
+        /* A run batch: its groups, the run passes' scratch, the nodes' depths. */
         const size_t need =
             (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
         if (ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double)) != 0)
@@ -1163,8 +1183,8 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
 
 /* ---- one candidate through its full tests, for the implicit film (contact/node_jacobian.c) */
 
-int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x,
-                  double reach, ws_node_touch_at *at)
+int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x, double reach,
+                  ws_node_touch_at *at)
 {
     const ws_body_store *b = P->b;
     const ws_node_geom *g = P->g;
@@ -1185,9 +1205,8 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
         const uint32_t f = c->local & ~WS_NCAND_FLAGS;
         const int top = sh->convex
                             ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, d)
-                            : ws_shallowest_face(sh, f, m3_tmul_v(&b->A[bi],
-                                                                  v3_sub(x, b->st[P->cur].r[bi])),
-                                                 d);
+                            : ws_shallowest_face(
+                                  sh, f, m3_tmul_v(&b->A[bi], v3_sub(x, b->st[P->cur].r[bi])), d);
         if (!top)
             return 0;
     }

@@ -195,8 +195,8 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
         }
         ws_node_link *L = &out[m++];
         const ws_motion mb = {st->r[bi], st->v[bi], b->wg[bi]};
-        link_of(&P->pp[b->material[bi]], xi, nodes_get(P->v, i), mb, &at, G,
-                web->inv_m[i] == 0.0, L);
+        link_of(&P->pp[b->material[bi]], xi, nodes_get(P->v, i), mb, &at, G, web->inv_m[i] == 0.0,
+                L);
         L->node = i;
         L->body = bi;
         /* One that the node reaches within the step at its present velocity, plus the guess of

@@ -25,8 +25,8 @@ static inline ws_normal ws_normal_law(v3 n, v3 vr, double gap, double k, double 
 {
     const double vn = vr.x * n.x + vr.y * n.y + vr.z * n.z;
     const double fn = k * gap - c * vn;
-    return (ws_normal){v3_make(vr.x + n.x * (-vn), vr.y + n.y * (-vn), vr.z + n.z * (-vn)), vn,
-                       fn, fn < 0.0 ? 0.0 : fn};
+    return (ws_normal){v3_make(vr.x + n.x * (-vn), vr.y + n.y * (-vn), vr.z + n.z * (-vn)), vn, fn,
+                       fn < 0.0 ? 0.0 : fn};
 }
 
 /* A body's motion as a contact sees it: its CoG r, velocity v and global spin w. */
@@ -83,8 +83,7 @@ static inline ws_friction ws_friction_law(v3 t, double fn, double mu, double vli
     /* Over the speed, so that the force's direction is t's: at rest a NaN, not taken. */
     const double scale = -(law < stop ? law : stop) / v;
     const uint64_t slips = ws_mask(v > 0.0);
-    return (ws_friction){v3_make(ws_pick(slips, t.x * scale, 0.0),
-                                 ws_pick(slips, t.y * scale, 0.0),
+    return (ws_friction){v3_make(ws_pick(slips, t.x * scale, 0.0), ws_pick(slips, t.y * scale, 0.0),
                                  ws_pick(slips, t.z * scale, 0.0)),
                          v, s};
 }
