@@ -39,7 +39,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     v3 defl = v3_make(0, 0, 0);
     if (pp->model == WS_FRICTION_REGULARIZED) {
         /* eq. 13 itself, without the film's limit on the force (m = +inf) */
-        const ws_friction fr = ws_friction_law(vt, fn, pp->mu, pp->vlim, INFINITY, 1.0);
+        const ws_friction fr = ws_friction_law(vt, pp->mu * fn, pp->vlim, INFINITY, 1.0);
         ft = fr.f;
         slipping = at_cap = !(fr.s < 1.0);
         c->anchored = 0;

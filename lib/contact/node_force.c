@@ -96,8 +96,8 @@ static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double sh
 }
 
 /* The friction on a node: from the contact's normal n, the node's tangential velocity relative
- * to the body t, its force with every normal force in k, its 1 / mass and mass, the normal force
- * fn and the contact's mu and v_lim (ws_friction_law). None for a pinned node or one that does
+ * to the body t, its force with every normal force in k, its 1 / mass and mass, Coulomb's force
+ * mu fn and the contact's v_lim (ws_friction_law). None for a pinned node or one that does
  * not slip; taken only where the contact pushes. Straight-line code, so loops of it run on
  * vectors.
  *
@@ -111,10 +111,10 @@ static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double sh
  * force comes before any friction: a node at a corner touches two faces, and this makes the
  * result independent of the order of the faces (which differs from corner to corner and would
  * twist a symmetric load). */
-static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double fn, double mu,
-                             double vlim, double h)
+static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
+                             double h)
 {
-    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), fn, mu, vlim, mass, h);
+    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), cap, vlim, mass, h);
     const uint64_t free = ws_mask(im != 0.0);
     return v3_make(ws_pick(free, fr.f.x, 0.0), ws_pick(free, fr.f.y, 0.0),
                    ws_pick(free, fr.f.z, 0.0));
@@ -244,7 +244,7 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
             const v3 n = ws_lane(&e->n, l);
             const double fn = e->fn.v[l];
             const v3 a = friction_of(n, ws_lane(&e->t, l), ws_lane(&e->k, l), e->im.v[l], e->m.v[l],
-                                     fn, e->mu.v[l], e->vl.v[l], h);
+                                     e->mu.v[l] * fn, e->vl.v[l], h);
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
              * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = ws_mask(fn > 0.0);
@@ -695,7 +695,7 @@ static void run_friction(size_t ng, const run_group *restrict grp, const double 
             T->ky[e] = k.y;
             T->kz[e] = k.z;
             const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]), k, im[t], mass[t],
-                                     T->fn[e], mu, vlim, h);
+                                     mu * T->fn[e], vlim, h);
             T->ax[e] = a.x;
             T->ay[e] = a.y;
             T->az[e] = a.z;

@@ -63,27 +63,27 @@ static inline double ws_friction_slope(double s)
     return s < 1.0 ? 2.0 - 2.0 * s : 0.0;
 }
 
-/* The friction of a contact slipping at t (a tangential velocity) under the normal force fn, for
- * the pair's mu and v_lim: mu fn p(|t| / v_lim) against t (eq. 13), at most the force that stops
- * a mass m slipping at |t| within a step h, m |t| / h (the explicit film's limit; m = +inf: no
- * limit); zero at rest (|t| = 0), where the direction is none. Also the slip speed v = |t| and
- * s = v / v_lim (at or above 1: sliding at Coulomb's force). */
+/* The friction of a contact slipping at t (a tangential velocity) that slides at the force
+ * cap = mu F_n (Coulomb's), for the pair's v_lim: cap p(|t| / v_lim) against t (eq. 13), at most
+ * the force that stops a mass m slipping at |t| within a step h, m |t| / h (the explicit film's
+ * limit; m = +inf: no limit); zero at rest (|t| = 0), where the direction is none. Also the slip
+ * speed v = |t| and s = v / v_lim (at or above 1: sliding at Coulomb's force). */
 typedef struct ws_friction {
     v3 f;
     double v, s;
 } ws_friction;
 
-static inline ws_friction ws_friction_law(v3 t, double fn, double mu, double vlim, double m,
-                                          double h)
+static inline ws_friction ws_friction_law(v3 t, double cap, double vlim, double m, double h)
 {
     const double v = sqrt(t.x * t.x + t.y * t.y + t.z * t.z);
     const double s = v / vlim;
-    const double law = mu * fn * ws_friction_p(s);
+    const double law = cap * ws_friction_p(s);
     const double stop = m * v / h;
     /* Over the speed, so that the force's direction is t's: at rest a NaN, not taken. */
     const double scale = -(law < stop ? law : stop) / v;
     const uint64_t slips = ws_mask(v > 0.0);
-    return (ws_friction){v3_make(ws_pick(slips, t.x * scale, 0.0), ws_pick(slips, t.y * scale, 0.0),
+    return (ws_friction){v3_make(ws_pick(slips, t.x * scale, 0.0),
+                                 ws_pick(slips, t.y * scale, 0.0),
                                  ws_pick(slips, t.z * scale, 0.0)),
                          v, s};
 }
