@@ -137,7 +137,7 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
  * and mass. Found: the normal force's vector (p), the lever from the body's CoG to the contact
  * point, the tangential velocity relative to the body and the normal force; the node's force
  * with its normal forces in (k); the friction (a) and the body's load, force (b) and moment
- * (m). */
+ * (mm). */
 typedef struct act_group {
     ws_wide3 n;
     ws_wide d, hi;
