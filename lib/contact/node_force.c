@@ -115,9 +115,9 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
                              double h)
 {
     const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), cap, vlim, mass, h);
-    const uint64_t free = ws_mask(im != 0.0);
-    return v3_make(ws_pick(free, fr.f.x, 0.0), ws_pick(free, fr.f.y, 0.0),
-                   ws_pick(free, fr.f.z, 0.0));
+    const uint64_t loose = ws_mask(im != 0.0); /* not pinned */
+    return v3_make(ws_pick(loose, fr.f.x, 0.0), ws_pick(loose, fr.f.y, 0.0),
+                   ws_pick(loose, fr.f.z, 0.0));
 }
 
 /* ---- the contacts of a sweep block gone one by one
