@@ -209,8 +209,9 @@ END_TEST
 static v3 contact_force(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_nodes3 x,
                         ws_nodes3 v, ws_node_link *L, uint32_t i, int *count)
 {
-    size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c, cl->n,
-                             x, v, 0.0, NULL, 0.0, L);
+    const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
+                            x,          v,      0.0,           1.0,         NULL};
+    size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L);
     v3 f = v3_make(0, 0, 0);
     *count = 0;
     for (size_t k = 0; k < n; k++)
@@ -316,8 +317,9 @@ START_TEST(test_contact_jacobian)
             (void)contact_force(w, web, cl, x, v, L, i, &cnt);
             ck_assert_int_eq(cnt, 1);
             ws_node_link link;
-            size_t n = ws_node_links(&w->bodies, w->cur, &w->node_geom, w->node_par, web, cl->c,
-                                     cl->n, x, v, 0.0, NULL, 0.0, L);
+            const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
+                                    x,          v,      0.0,           1.0,         NULL};
+            size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L);
             for (size_t k = 0; k < n; k++)
                 if (L[k].node == i && L[k].active)
                     link = L[k];

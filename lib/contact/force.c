@@ -1,6 +1,8 @@
 /* Contact forces: penalty normal force on the layer overlap (never pulling) and Coulomb friction,
- * regularised (eq. 13) or with a stick anchor. Forces and their moments act on both bodies. */
+ * regularised (eq. 13) or with a stick anchor. Forces and their moments act on both bodies. The
+ * laws are those of every contact (penalty.h), here for one contact at a time. */
 #include "contact/contact.h"
+#include "contact/penalty.h"
 
 static v3 point_velocity(const ws_body_store *b, int cur, uint32_t i, v3 xg)
 {
@@ -27,27 +29,19 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     const ws_pair_params *pp = ws_contact_params(x, ia, ib);
     double overlap = b->layer[ia] + b->layer[ib] - d;
     v3 vrel = v3_sub(point_velocity(b, x->cur, ib, xg), point_velocity(b, x->cur, ia, xg));
-    double vn = v3_dot(vrel, n);
     /* Spring on the overlap and damper on its rate; a contact never pulls. */
-    double fn = pp->k * overlap - pp->c * vn;
-    if (fn < 0.0)
-        fn = 0.0;
-    v3 vt = v3_madd(vrel, n, -vn);
-    double vts = v3_norm(vt);
+    const ws_normal law = ws_normal_law(n, vrel, overlap, pp->k, pp->c);
+    const double fn = law.fp;
+    const v3 vt = law.t;
     v3 ft = v3_make(0, 0, 0);
     int slipping = 0, at_cap = 0;
     double energy_t = 0.0;
     v3 defl = v3_make(0, 0, 0);
     if (pp->model == WS_FRICTION_REGULARIZED) {
-        /* eq. 13 with p(s) = 2s - s^2: below v_lim, F = -mu N (2 - s) vt / v_lim, which is smooth
-         * and needs no division by |vt| at rest. */
-        double s = vts / pp->vlim;
-        if (s < 1.0) {
-            ft = v3_scale(vt, -pp->mu * fn * (2.0 - s) / pp->vlim);
-        } else {
-            ft = v3_scale(vt, -pp->mu * fn / vts);
-            slipping = at_cap = 1;
-        }
+        /* eq. 13 itself, without the film's limit on the force (m = +inf) */
+        const ws_friction fr = ws_friction_law(vt, pp->mu * fn, pp->vlim, INFINITY, 1.0);
+        ft = fr.f;
+        slipping = at_cap = !(fr.s < 1.0);
         c->anchored = 0;
     } else {
         const ws_body_state *st = &b->st[x->cur];
@@ -72,7 +66,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
             at_cap = 1;
             /* Sliding, not a step held at the cap: the anchor moves with the slip, at v_lim or
              * faster (the regularised law's threshold). */
-            slipping = vts >= pp->vlim;
+            slipping = v3_norm(vt) >= pp->vlim;
             dt = dt_new;
         }
         defl = dt;

@@ -330,13 +330,19 @@ typedef struct ws_node_pass {
 void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
                       uint64_t *checks);
 
+/* Where a node touches a body: the unit normal n from the body to the node, the distance d
+ * along it and the window's top hi (the two layers). */
+typedef struct ws_node_touch_at {
+    v3 n;
+    double d, hi;
+} ws_node_touch_at;
+
 /* Whether candidate c holds the node at x, by the full tests of the one-by-one path (no short
  * cuts: eq. 14 for a face with the shallowest-face rule below it, the rim for an edge), with
- * the bodies at state cur and the window's top raised by `reach` (0: the contact window
- * itself): then the unit normal n from the body to the node, the distance d along it and the
- * window's top hi (the two layers). For the implicit film, which evaluates each node's
- * contacts once a step, and those it may reach within it (contact/node_jacobian.c). */
-int ws_node_touch(const ws_body_store *b, int cur, const ws_node_geom *g, const ws_web *web,
-                  const ws_ncand *c, v3 x, double reach, v3 *n, double *d, double *hi);
+ * the bodies of P (b, state cur, features g) and the window's top raised by `reach` (0: the
+ * contact window itself): then where, in *at. For the implicit film, which evaluates each
+ * node's contacts once a step, and those it may reach within it (contact/node_jacobian.c). */
+int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x, double reach,
+                  ws_node_touch_at *at);
 
 #endif

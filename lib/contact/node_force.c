@@ -2,6 +2,7 @@
  * opposite on the bodies (eq. 13, 14). The candidates come from node.c. */
 #include "contact/contact.h"
 #include "contact/node.h"
+#include "contact/penalty.h"
 
 #include <string.h>
 
@@ -63,37 +64,15 @@ static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t coun
     return 1;
 }
 
-/* a where the bits of mask are set (all or none), else b: by their bits, so that a store of
- * the choice stays a store (as a select, the compiler turns a store of b, the value read from
- * the same place, into a masked store of a, which is slow, or a branch). */
-static inline double pick(uint64_t mask, double a, double b)
-{
-    uint64_t ua, ub;
-    memcpy(&ua, &a, sizeof ua);
-    memcpy(&ub, &b, sizeof ub);
-    ua = (ua & mask) | (ub & ~mask);
-    memcpy(&a, &ua, sizeof a);
-    return a;
-}
-
-/* friction_of in parts, which run_kernel takes in different passes. The slip velocity
- * predicted at the end of the sub-step, from t, the other forces k and 1 / mass im. */
+/* The slip velocity predicted at the end of the sub-step h (friction_of), from the contact's
+ * normal n, the node's tangential velocity t, its force with every normal force in k and its
+ * 1 / mass im. */
 static inline v3 friction_pred(v3 n, v3 t, v3 k, double im, double h)
 {
     double dot = k.x * n.x + k.y * n.y + k.z * n.z;
     double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
     double hm = h * im;
     return v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
-}
-
-/* The friction over the predicted slip velocity, of speed vps (for a node that slips). */
-static inline double friction_scale(double vps, double mass, double fn, double mu, double vlim,
-                                    double h)
-{
-    double sr = vps / vlim;
-    double law = mu * fn * (sr < 1.0 ? sr * (2.0 - sr) : 1.0);
-    double stop = mass * vps / h;
-    return -(law < stop ? law : stop) / vps;
 }
 
 /* A load on a body: force and moment about the CoG. */
@@ -105,27 +84,22 @@ typedef struct act_load {
  * the normal force fn along n) times share, and its moment about the CoG at lever l; zero for
  * a contact that does not push (push: all bits or none). Adding that zero leaves every sum as it
  * was: the bodies' sums start at +0 and never reach -0, and the moment's zero, of either sign,
- * changes no sum. Both paths (act_friction, run_kernel) take it from here, so their loads agree
+ * changes no sum. Both paths (act_friction, run_apply) take it from here, so their loads agree
  * to the bit. */
 static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double share, v3 l)
 {
-    const double Bx = pick(push, (a.x + n.x * fn) * -share, 0.0),
-                 By = pick(push, (a.y + n.y * fn) * -share, 0.0),
-                 Bz = pick(push, (a.z + n.z * fn) * -share, 0.0);
+    const double Bx = ws_pick(push, (a.x + n.x * fn) * -share, 0.0),
+                 By = ws_pick(push, (a.y + n.y * fn) * -share, 0.0),
+                 Bz = ws_pick(push, (a.z + n.z * fn) * -share, 0.0);
     return (act_load){v3_make(Bx, By, Bz),
                       v3_make(l.y * Bz - l.z * By, l.z * Bx - l.x * Bz, l.x * By - l.y * Bx)};
 }
 
-/* Whether a node slips (at the predicted speed vps): all bits or none, for pick. */
-static inline uint64_t friction_slips(double vps, double im)
-{
-    return 0 - (uint64_t)((vps > 0.0) & (im != 0.0));
-}
-
-/* The friction on a pushing node: from the contact's normal n, the node's tangential velocity
- * relative to the body t, its force with every normal force in k, its 1 / mass and mass, the
- * normal force fn and the contact's mu and v_lim. None for a pinned node or one that does not
- * slip. Straight-line code, so loops of it run on vectors.
+/* The friction on a node: from the contact's normal n, the node's tangential velocity relative
+ * to the body t, its force with every normal force in k, its 1 / mass and mass, Coulomb's force
+ * mu fn and the contact's v_lim (ws_friction_law). None for a pinned node or one that does
+ * not slip; taken only where the contact pushes. Straight-line code, so loops of it run on
+ * vectors.
  *
  * Eq. 13, limited to the force that stops the node's slip within this sub-step h. Below v_lim
  * eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit step of a light node
@@ -137,14 +111,13 @@ static inline uint64_t friction_slips(double vps, double im)
  * force comes before any friction: a node at a corner touches two faces, and this makes the
  * result independent of the order of the faces (which differs from corner to corner and would
  * twist a symmetric load). */
-static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double fn, double mu,
-                             double vlim, double h)
+static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
+                             double h)
 {
-    const v3 p = friction_pred(n, t, k, im, h);
-    const double vps = sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
-    const double s = friction_scale(vps, mass, fn, mu, vlim, h);
-    const uint64_t slips = friction_slips(vps, im);
-    return v3_make(pick(slips, p.x * s, 0.0), pick(slips, p.y * s, 0.0), pick(slips, p.z * s, 0.0));
+    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), cap, vlim, mass, h);
+    const uint64_t loose = ws_mask(im != 0.0); /* not pinned */
+    return v3_make(ws_pick(loose, fr.f.x, 0.0), ws_pick(loose, fr.f.y, 0.0),
+                   ws_pick(loose, fr.f.z, 0.0));
 }
 
 /* ---- the contacts of a sweep block gone one by one
@@ -156,21 +129,23 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double fn
  * they took. The loads on the bodies of both go to one list of loads in node order, which is
  * summed last: the bodies' totals are added in the same order however the candidates are cut. */
 
-/* Four contacts of the list, lane l the list's contact 4 g + l of group g: each value of the four
- * side by side, so that a pass over the groups runs on vectors with one pointer. As
+/* Four contacts of the list, lane l the list's contact 4 g + l of group g (wide.h): each value
+ * of the four side by side, so that a pass over the groups runs on vectors with one pointer. As
  * contacts_general finds it: the normal (from the body to the node), depth, window top and
  * the node's position. Gathered for the normal force: the node's velocity, the body's CoG,
  * velocity and spin, the contact's stiffness and damping, mu and v_lim, and the node's 1 / mass
  * and mass. Found: the normal force's vector (p), the lever from the body's CoG to the contact
  * point, the tangential velocity relative to the body and the normal force; the node's force
  * with its normal forces in (k); the friction (a) and the body's load, force (b) and moment
- * (m). */
+ * (mm). */
 typedef struct act_group {
-    double nx[4], ny[4], nz[4], d[4], hi[4], xx[4], xy[4], xz[4];
-    double ux[4], uy[4], uz[4], rx[4], ry[4], rz[4], vx[4], vy[4], vz[4], wx[4], wy[4], wz[4];
-    double kp[4], cp[4], mu[4], vl[4], im[4], m[4];
-    double px[4], py[4], pz[4], lx[4], ly[4], lz[4], tx[4], ty[4], tz[4], fn[4];
-    double kx[4], ky[4], kz[4], ax[4], ay[4], az[4], bx[4], by[4], bz[4], mx[4], my[4], mz[4];
+    ws_wide3 n;
+    ws_wide d, hi;
+    ws_wide3 x, u, r, v, w;
+    ws_wide kp, cp, mu, vl, im, m;
+    ws_wide3 p, l, t;
+    ws_wide fn;
+    ws_wide3 k, a, b, mm;
 } act_group;
 
 /* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
@@ -210,49 +185,32 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
     act_group *e = &L->grp[q >> 2];
     L->node[q] = node;
     L->body[q] = body;
-    e->nx[l] = n.x;
-    e->ny[l] = n.y;
-    e->nz[l] = n.z;
-    e->d[l] = d;
-    e->hi[l] = hi;
-    e->xx[l] = x.x;
-    e->xy[l] = x.y;
-    e->xz[l] = x.z;
+    ws_lane_set(&e->n, l, n);
+    e->d.v[l] = d;
+    e->hi.v[l] = hi;
+    ws_lane_set(&e->x, l, x);
     L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of a node at x (velocity u) against a body (CoG r, velocity v, spin w) at
- * depth d along the normal n (from the body to the node), within the window (hi the layers),
- * for the contact's stiffness k and damping c: its vector (p), the lever from the CoG to the
- * contact point (l), the node's tangential velocity relative to the body (t) and the normal
- * force (fn). Penalty on the overlap and damping on its rate, at the contact point midway in
- * the overlap, against the body's velocity there. A contact never pulls: its vector is the
- * force times whether it pushes (0 or 1), without a branch. Straight-line code, so loops of
- * it run on vectors; run_kernel has the same arithmetic for a run's nodes. */
+/* The normal force of a node at x (velocity u) against a body b at depth d along the normal n
+ * (from the body to the node), within the window (hi the layers), for the contact's stiffness k
+ * and damping c: its vector (p), the lever from the CoG to the contact point (l), the node's
+ * tangential velocity relative to the body (t) and the normal force (fn, negative where it
+ * would pull). The contact laws' (penalty.h) for a node: the penalty on the overlap and damping
+ * on its rate, at the contact point midway in the overlap, against the body's velocity there,
+ * never pulling. Straight-line code, so loops of it run on vectors; both passes (act_normal,
+ * run_normal) take it from here. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
 } node_normal;
 
-/* A body's motion as a contact sees it: its CoG, velocity and global spin. */
-typedef struct body_motion {
-    v3 r, v, w;
-} body_motion;
-
-static inline node_normal normal_of(v3 n, double d, double hi, v3 x, v3 u, body_motion b,
-                                    double k, double c)
+static inline node_normal normal_of(v3 n, double d, double hi, v3 x, v3 u, ws_motion b, double k,
+                                    double c)
 {
-    const double nx = n.x, ny = n.y, nz = n.z, s = -0.5 * d;
-    const double ax = (x.x + nx * s) - b.r.x, ay = (x.y + ny * s) - b.r.y,
-                 az = (x.z + nz * s) - b.r.z;
-    const double bx = b.v.x + (b.w.y * az - b.w.z * ay), by = b.v.y + (b.w.z * ax - b.w.x * az),
-                 bz = b.v.z + (b.w.x * ay - b.w.y * ax);
-    const double vrx = u.x - bx, vry = u.y - by, vrz = u.z - bz;
-    const double vn = vrx * nx + vry * ny + vrz * nz;
-    const double f = k * (hi - d) - c * vn;
-    const double push = f > 0.0, fp = f * push;
-    return (node_normal){v3_make(nx * fp, ny * fp, nz * fp), v3_make(ax, ay, az),
-                         v3_make(vrx + nx * (-vn), vry + ny * (-vn), vrz + nz * (-vn)), f};
+    const ws_node_kin kin = ws_node_kinematics(n, d, x, u, b);
+    const ws_normal nl = ws_normal_law(n, kin.vr, hi - d, k, c);
+    return (node_normal){v3_scale(n, nl.fp), kin.lever, nl.t, nl.fn};
 }
 
 /* The normal forces of the contacts of groups [0, ng) (normal_of). */
@@ -261,24 +219,15 @@ static void act_normal(size_t ng, act_group *restrict G)
 {
     for (size_t g = 0; g < ng; g++) {
         act_group *e = &G[g];
-        for (size_t l = 0; l < 4; l++) {
-            const body_motion b = {v3_make(e->rx[l], e->ry[l], e->rz[l]),
-                                   v3_make(e->vx[l], e->vy[l], e->vz[l]),
-                                   v3_make(e->wx[l], e->wy[l], e->wz[l])};
+        for (size_t l = 0; l < WS_LANES; l++) {
+            const ws_motion b = {ws_lane(&e->r, l), ws_lane(&e->v, l), ws_lane(&e->w, l)};
             const node_normal o =
-                normal_of(v3_make(e->nx[l], e->ny[l], e->nz[l]), e->d[l], e->hi[l],
-                          v3_make(e->xx[l], e->xy[l], e->xz[l]),
-                          v3_make(e->ux[l], e->uy[l], e->uz[l]), b, e->kp[l], e->cp[l]);
-            e->px[l] = o.p.x;
-            e->py[l] = o.p.y;
-            e->pz[l] = o.p.z;
-            e->lx[l] = o.l.x;
-            e->ly[l] = o.l.y;
-            e->lz[l] = o.l.z;
-            e->tx[l] = o.t.x;
-            e->ty[l] = o.t.y;
-            e->tz[l] = o.t.z;
-            e->fn[l] = o.fn;
+                normal_of(ws_lane(&e->n, l), e->d.v[l], e->hi.v[l], ws_lane(&e->x, l),
+                          ws_lane(&e->u, l), b, e->kp.v[l], e->cp.v[l]);
+            ws_lane_set(&e->p, l, o.p);
+            ws_lane_set(&e->l, l, o.l);
+            ws_lane_set(&e->t, l, o.t);
+            e->fn.v[l] = o.fn;
         }
     }
 }
@@ -291,26 +240,20 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
 {
     for (size_t g = 0; g < ng; g++) {
         act_group *e = &G[g];
-        for (size_t l = 0; l < 4; l++) {
-            const v3 n = v3_make(e->nx[l], e->ny[l], e->nz[l]);
-            const double fn = e->fn[l];
-            const v3 a = friction_of(n, v3_make(e->tx[l], e->ty[l], e->tz[l]),
-                                     v3_make(e->kx[l], e->ky[l], e->kz[l]), e->im[l], e->m[l],
-                                     fn, e->mu[l], e->vl[l], h);
+        for (size_t l = 0; l < WS_LANES; l++) {
+            const v3 n = ws_lane(&e->n, l);
+            const double fn = e->fn.v[l];
+            const v3 a = friction_of(n, ws_lane(&e->t, l), ws_lane(&e->k, l), e->im.v[l], e->m.v[l],
+                                     e->mu.v[l] * fn, e->vl.v[l], h);
             /* A contact that does not push adds nothing: -0 to the node's force (which leaves
              * every value as it was), +0 to the body's (body_load). */
-            const uint64_t push = 0 - (uint64_t)(fn > 0.0);
-            e->ax[l] = pick(push, a.x, -0.0);
-            e->ay[l] = pick(push, a.y, -0.0);
-            e->az[l] = pick(push, a.z, -0.0);
-            const act_load B =
-                body_load(push, a, n, fn, share, v3_make(e->lx[l], e->ly[l], e->lz[l]));
-            e->bx[l] = B.f.x;
-            e->by[l] = B.f.y;
-            e->bz[l] = B.f.z;
-            e->mx[l] = B.m.x;
-            e->my[l] = B.m.y;
-            e->mz[l] = B.m.z;
+            const uint64_t push = ws_mask(fn > 0.0);
+            ws_lane_set(&e->a, l,
+                        v3_make(ws_pick(push, a.x, -0.0), ws_pick(push, a.y, -0.0),
+                                ws_pick(push, a.z, -0.0)));
+            const act_load B = body_load(push, a, n, fn, share, ws_lane(&e->l, l));
+            ws_lane_set(&e->b, l, B.f);
+            ws_lane_set(&e->mm, l, B.m);
         }
     }
 }
@@ -402,24 +345,16 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
         }
         act_group *e = &G[q >> 2];
         const size_t l = q & 3;
-        e->ux[l] = v.x[i];
-        e->uy[l] = v.y[i];
-        e->uz[l] = v.z[i];
-        e->rx[l] = r.x;
-        e->ry[l] = r.y;
-        e->rz[l] = r.z;
-        e->vx[l] = vb.x;
-        e->vy[l] = vb.y;
-        e->vz[l] = vb.z;
-        e->wx[l] = wb.x;
-        e->wy[l] = wb.y;
-        e->wz[l] = wb.z;
-        e->kp[l] = p.k;
-        e->cp[l] = p.c;
-        e->mu[l] = p.mu;
-        e->vl[l] = p.vlim;
-        e->im[l] = web->inv_m[i];
-        e->m[l] = web->m[i];
+        ws_lane_set(&e->u, l, nodes_get(v, i));
+        ws_lane_set(&e->r, l, r);
+        ws_lane_set(&e->v, l, vb);
+        ws_lane_set(&e->w, l, wb);
+        e->kp.v[l] = p.k;
+        e->cp.v[l] = p.c;
+        e->mu.v[l] = p.mu;
+        e->vl.v[l] = p.vlim;
+        e->im.v[l] = web->inv_m[i];
+        e->m.v[l] = web->m[i];
     }
     act_normal(ng, G);
     /* The normal forces into f in order, and each node's force with all its normal forces in
@@ -429,17 +364,11 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
         act_group *e = &G[q >> 2];
         const size_t l = q & 3;
         const uint32_t i = L->node[q];
-        const v3 k = v3_add(nodes_get(f, i), v3_make(e->px[l], e->py[l], e->pz[l]));
+        const v3 k = v3_add(nodes_get(f, i), ws_lane(&e->p, l));
         nodes_set(f, i, k);
-        e->kx[l] = k.x;
-        e->ky[l] = k.y;
-        e->kz[l] = k.z;
-        for (size_t j = q; j > 0 && L->node[j - 1] == i; j--) {
-            act_group *o = &G[(j - 1) >> 2];
-            o->kx[(j - 1) & 3] = k.x;
-            o->ky[(j - 1) & 3] = k.y;
-            o->kz[(j - 1) & 3] = k.z;
-        }
+        ws_lane_set(&e->k, l, k);
+        for (size_t j = q; j > 0 && L->node[j - 1] == i; j--)
+            ws_lane_set(&G[(j - 1) >> 2].k, (j - 1) & 3, k);
     }
     act_friction(ng, h, share, G);
     uint32_t *touched = web->fct[web->fck];
@@ -448,11 +377,11 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
         const act_group *e = &G[q >> 2];
         const size_t l = q & 3;
         const uint32_t i = L->node[q], at = L->slot[q];
-        const v3 Fb = v3_make(e->bx[l], e->by[l], e->bz[l]);
-        nodes_add(f, i, v3_make(e->ax[l], e->ay[l], e->az[l]));
+        const v3 Fb = ws_lane(&e->b, l);
+        nodes_add(f, i, ws_lane(&e->a, l));
         fc[i] = v3_sub(fc[i], Fb); /* the share of the contact force: -Fb, to the bit */
         touched[nt++] = i;
-        L->load[at] = (act_load){Fb, v3_make(e->mx[l], e->my[l], e->mz[l])};
+        L->load[at] = (act_load){Fb, ws_lane(&e->mm, l)};
         L->lbody[at] = L->body[q];
     }
     web->nfct[web->fck] = nt;
@@ -637,7 +566,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in run_kernel and run_flush: the face's normal and
+/* What a run needs of its face and body in the run passes and run_flush: the face's normal and
  * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
  * parameters, the body's slot. */
 typedef struct run_const {
@@ -656,7 +585,7 @@ typedef struct ws_run_face {
 } ws_run_face;
 
 /* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
- * depths were taken of: the unit of run_kernel. */
+ * depths were taken of: the unit of the run passes. */
 typedef struct run_group {
     const run_const *rc; /* the run's face and body */
     uint32_t node;       /* the first of the four */
@@ -664,8 +593,8 @@ typedef struct run_group {
     uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
-/* The groups of a sweep block's runs waiting for run_kernel (n of RUN_GROUPS), and the
- * kernel's scratch (run_tmp). The list of loads keeps their places, so they may wait until the
+/* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
+ * passes' scratch (run_tmp). The list of loads keeps their places, so they may wait until the
  * block's end. */
 typedef struct run_batch {
     run_group *grp;
@@ -685,7 +614,8 @@ typedef struct run_batch {
  * (force and moment about the CoG, zero for a contact that does not push) into out, for every
  * lane. Whole groups, so that the four lanes of a group run on vectors.
  *
- * In passes over all the groups, their values in between in tmp (T_*): a contact's arithmetic
+ * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
+ * between in run_tmp: a contact's arithmetic
  * is one long chain (some 180 cycles from the node's position to its force, with a square root
  * and two divisions in a row), about as long as the window of instructions a processor runs
  * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
@@ -696,58 +626,44 @@ typedef struct run_batch {
 /* The batch's values between the passes and its outputs, each array a value's of every lane
  * (4 g + l for lane l of group g). */
 typedef struct run_tmp {
-    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* force with the normal force */
+    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* normal force, then with f's */
     double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
     double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
     double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
-    double px[RUN_OSTRIDE], py[RUN_OSTRIDE], pz[RUN_OSTRIDE];    /* predicted slip velocity */
-    double s[RUN_OSTRIDE], slips[RUN_OSTRIDE];                   /* its scale; it slips */
+    double ax[RUN_OSTRIDE], ay[RUN_OSTRIDE], az[RUN_OSTRIDE];    /* friction, if it pushes */
     double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
     double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
 } run_tmp;
 
-static inline uint64_t bits_of(double a)
-{
-    uint64_t u;
-    memcpy(&u, &a, sizeof u);
-    return u;
-}
-
-static inline double double_of(uint64_t u)
-{
-    double a;
-    memcpy(&a, &u, sizeof a);
-    return a;
-}
-
-/* The restrict arrays stay parameters (17 of them: over the house's 12), since in a struct GCC
- * 12 no longer takes them as apart and runs the kernel with 11 % more instructions. */
+/* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
+ * as apart, and runs the passes with many more instructions); each pass takes only those it
+ * reads or writes.
+ *
+ * normal_of for the groups [0, ng) of the batch: the nodes' positions p, velocities u and
+ * depths, into T (the normal force's vector into T->k). */
 WS_VECTOR_LOOP
-static void run_kernel(size_t ng, const run_group *restrict grp, const double *restrict px,
+static void run_normal(size_t ng, const run_group *restrict grp, const double *restrict px,
                        const double *restrict py, const double *restrict pz,
                        const double *restrict ux, const double *restrict uy,
-                       const double *restrict uz, double *restrict gx, double *restrict gy,
-                       double *restrict gz, const double *restrict im, const double *restrict mass,
-                       const double *restrict depth, double h, double share, run_tmp *restrict T)
+                       const double *restrict uz, const double *restrict depth, run_tmp *restrict T)
 {
-    /* normal_of, to the node's force with its normal force in and its tangential velocity */
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
         const v3 n = v3_make(q->nx, q->ny, q->nz);
-        const body_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
-                               v3_make(q->wx, q->wy, q->wz)};
+        const ws_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
+                             v3_make(q->wx, q->wy, q->wz)};
         const double hi = q->hi, k = q->k, c = q->c;
-        for (size_t l = 0; l < 4; l++) {
+        for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            T->keep[e] = double_of(0 - ((bits >> l) & 1u));
+            T->keep[e] = ws_double_of(0 - ((bits >> l) & 1u));
             const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
                                             v3_make(ux[t], uy[t], uz[t]), b, k, c);
-            T->kx[e] = gx[t] + nf.p.x;
-            T->ky[e] = gy[t] + nf.p.y;
-            T->kz[e] = gz[t] + nf.p.z;
+            T->kx[e] = nf.p.x;
+            T->ky[e] = nf.p.y;
+            T->kz[e] = nf.p.z;
             T->tx[e] = nf.t.x;
             T->ty[e] = nf.t.y;
             T->tz[e] = nf.t.z;
@@ -757,45 +673,59 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
             T->lz[e] = nf.l.z;
         }
     }
-    /* act_apply's friction: the slip predicted, and its size */
+}
+
+/* act_apply's friction over sub-step h, from the nodes' forces g (T->k becomes the node's force
+ * with its normal force in), 1 / mass im and mass. */
+WS_VECTOR_LOOP
+static void run_friction(size_t ng, const run_group *restrict grp, const double *restrict gx,
+                         const double *restrict gy, const double *restrict gz,
+                         const double *restrict im, const double *restrict mass, double h,
+                         run_tmp *restrict T)
+{
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
-        const double nx = q->nx, ny = q->ny, nz = q->nz, mu = q->mu, vlim = q->vlim;
-        for (size_t l = 0; l < 4; l++) {
-            const size_t e = 4 * g + l;
-            const v3 p = friction_pred(v3_make(nx, ny, nz), v3_make(T->tx[e], T->ty[e], T->tz[e]),
-                                       v3_make(T->kx[e], T->ky[e], T->kz[e]), im[o + l], h);
-            const double ax = p.x, ay = p.y, az = p.z;
-            T->px[e] = ax;
-            T->py[e] = ay;
-            T->pz[e] = az;
-            const double vps = sqrt(ax * ax + ay * ay + az * az);
-            T->s[e] = friction_scale(vps, mass[o + l], T->fn[e], mu, vlim, h);
-            T->slips[e] = double_of(friction_slips(vps, im[o + l]));
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const double mu = q->mu, vlim = q->vlim;
+        for (size_t l = 0; l < WS_LANES; l++) {
+            const size_t t = o + l, e = 4 * g + l;
+            const v3 k = v3_make(gx[t] + T->kx[e], gy[t] + T->ky[e], gz[t] + T->kz[e]);
+            T->kx[e] = k.x;
+            T->ky[e] = k.y;
+            T->kz[e] = k.z;
+            const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]), k, im[t], mass[t],
+                                     mu * T->fn[e], vlim, h);
+            T->ax[e] = a.x;
+            T->ay[e] = a.y;
+            T->az[e] = a.z;
         }
     }
-    /* the node's new force and the body's share */
+}
+
+/* The nodes' new forces into g, and the body's share of each load into T. */
+WS_VECTOR_LOOP
+static void run_apply(size_t ng, const run_group *restrict grp, double *restrict gx,
+                      double *restrict gy, double *restrict gz, double share, run_tmp *restrict T)
+{
     for (size_t g = 0; g < ng; g++) {
         const run_const *q = grp[g].rc;
         const size_t o = grp[g].node;
-        const double nx = q->nx, ny = q->ny, nz = q->nz;
-        for (size_t l = 0; l < 4; l++) {
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            const double fn = T->fn[e], s = T->s[e];
-            const uint64_t keep = bits_of(T->keep[e]), push = 0 - (uint64_t)(fn > 0.0),
-                           slips = bits_of(T->slips[e]) & push, none = ~push & bits_of(-0.0);
-            /* The friction of a node that pushes (zero unless it slips); -0 for one that does
-             * not push, which leaves its force as it was to the bit when added, as the one by
-             * one pass leaves the force of a contact it does not list. */
-            const double ax = double_of((bits_of(T->px[e] * s) & slips) | none),
-                         ay = double_of((bits_of(T->py[e] * s) & slips) | none),
-                         az = double_of((bits_of(T->pz[e] * s) & slips) | none);
-            gx[t] = pick(keep, T->kx[e] + ax, gx[t]);
-            gy[t] = pick(keep, T->ky[e] + ay, gy[t]);
-            gz[t] = pick(keep, T->kz[e] + az, gz[t]);
-            const act_load B = body_load(push, v3_make(ax, ay, az), v3_make(nx, ny, nz), fn,
-                                         share, v3_make(T->lx[e], T->ly[e], T->lz[e]));
+            const double fn = T->fn[e];
+            const uint64_t keep = ws_bits(T->keep[e]), push = ws_mask(fn > 0.0);
+            /* The friction of a node that pushes; -0 for one that does not push, which leaves
+             * its force as it was to the bit when added, as the one by one pass leaves the
+             * force of a contact it does not list. */
+            const v3 a = v3_make(ws_pick(push, T->ax[e], -0.0), ws_pick(push, T->ay[e], -0.0),
+                                 ws_pick(push, T->az[e], -0.0));
+            gx[t] = ws_pick(keep, T->kx[e] + a.x, gx[t]);
+            gy[t] = ws_pick(keep, T->ky[e] + a.y, gy[t]);
+            gz[t] = ws_pick(keep, T->kz[e] + a.z, gz[t]);
+            const act_load B =
+                body_load(push, a, n, fn, share, v3_make(T->lx[e], T->ly[e], T->lz[e]));
             T->bx[e] = B.f.x;
             T->by[e] = B.f.y;
             T->bz[e] = B.f.z;
@@ -806,7 +736,7 @@ static void run_kernel(size_t ng, const run_group *restrict grp, const double *r
     }
 }
 
-/* The batch's contacts: run_kernel, then, in node order, each node's share of its contact
+/* The batch's contacts: the run passes, then, in node order, each node's share of its contact
  * force and its body's load into their places in the list of loads. A contact that does not
  * push has a share of zero, and is listed as touched and loaded all the same (a branch would
  * be a coin toss). */
@@ -817,8 +747,9 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
     run_tmp *T = B->tmp;
-    run_kernel(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, f.x, f.y, f.z, web->inv_m, web->m,
-               B->depth, h, share, T);
+    run_normal(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, B->depth, T);
+    run_friction(B->n, B->grp, f.x, f.y, f.z, web->inv_m, web->m, h, T);
+    run_apply(B->n, B->grp, f.x, f.y, f.z, share, T);
     act_list *L = E->L;
     act_load *load = L->load;
     uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
@@ -870,7 +801,7 @@ static const uint8_t run_count4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3,
 
 /* A run: its nodes' depths first, on vectors; most lie just outside the window and are done.
  * The groups of four nodes with one in the window join the block's batch (B), with their
- * places in the list of loads, in node order: run_kernel takes them with the arithmetic of
+ * places in the list of loads, in node order: the run passes take them with the arithmetic of
  * contacts_general for a node whose only candidate is a face it lies well inside of, without
  * its look-ups (the face, body and contact are the run's). A chunk with a node below the face's
  * plane (d < 0), where another face may lie shallower, goes to contacts_general. */
@@ -1040,7 +971,7 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     nc->seg_list = -1;
     nc->nseg = 0;
     if (nc->rtmp_cap == 0) {
-        /* A run batch: its groups, run_kernel's scratch, the nodes' depths. */
+        /* A run batch: its groups, the run passes' scratch, the nodes' depths. */
         const size_t need =
             (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
         if (ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double)) != 0)
@@ -1252,31 +1183,34 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
 
 /* ---- one candidate through its full tests, for the implicit film (contact/node_jacobian.c) */
 
-int ws_node_touch(const ws_body_store *b, int cur, const ws_node_geom *g, const ws_web *web,
-                  const ws_ncand *c, v3 x, double reach, v3 *n, double *d, double *hi)
+int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v3 x, double reach,
+                  ws_node_touch_at *at)
 {
+    const ws_body_store *b = P->b;
+    const ws_node_geom *g = P->g;
     const uint32_t bi = c->body;
     const ws_shape *sh = b->shape[bi];
-    *hi = b->layer[bi] + web->layer;
+    const double hi = b->layer[bi] + web->layer;
+    at->hi = hi;
     if (c->local & WS_NCAND_EDGE)
-        return in_wedge(&g->edge[c->feat], x, *hi + reach, 0, n, d);
+        return in_wedge(&g->edge[c->feat], x, hi + reach, 0, &at->n, &at->d);
     const ws_wface *F = &g->face[c->feat];
-    const double lo = -*hi - sh->inner;
-    *d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
-    if (!(*d < *hi + reach) || !(*d > lo))
+    const double lo = -hi - sh->inner;
+    const double d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
+    if (!(d < hi + reach) || !(d > lo))
         return 0;
     if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, x))
         return 0;
-    if (*d < 0.0) {
+    if (d < 0.0) {
         const uint32_t f = c->local & ~WS_NCAND_FLAGS;
         const int top = sh->convex
-                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, *d)
-                            : ws_shallowest_face(sh, f, m3_tmul_v(&b->A[bi],
-                                                                  v3_sub(x, b->st[cur].r[bi])),
-                                                 *d);
+                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, d)
+                            : ws_shallowest_face(
+                                  sh, f, m3_tmul_v(&b->A[bi], v3_sub(x, b->st[P->cur].r[bi])), d);
         if (!top)
             return 0;
     }
-    *n = F->n;
+    at->n = F->n;
+    at->d = d;
     return 1;
 }

@@ -6,6 +6,7 @@
  * of docs/design.md), while here eq. 13 itself goes into the implicit step as a damper, which
  * backward Euler keeps stable at any step (docs/theory.md, "The implicit film"). */
 #include "contact/node_jacobian.h"
+#include "contact/penalty.h"
 
 #include <string.h>
 
@@ -39,18 +40,36 @@ static void sym_outer(double *S, double c, v3 e)
     S[WS_SYM_YZ] += c * e.y * e.z;
 }
 
-/* One pushing contact, its force and derivatives (see ws_node_link). n: the unit normal from
- * the body to the node; d: the distance along it; G: dn/dx (zero for a face, (P_e - n n^T) / d
- * for an edge's rim, P_e the projection across the edge). */
-static int link_of(const ws_node_params *p, v3 x, v3 u, v3 r, v3 vb, v3 wb, v3 n, double d,
-                   double hi, const double G[9], int pinned, ws_node_link *L)
+/* Eq. 13 over the slip t (ws_friction_p): F_t = -mu N phi t, phi = p(s) / |t| (2 / v_lim at
+ * rest, its limit), and dp = p'(s) / v_lim, with the slip's direction tt (zero at rest). */
+static void link_slip(ws_node_link *L, v3 t, double vlim)
 {
-    const v3 a = v3_sub(v3_madd(x, n, -0.5 * d), r);
-    const v3 vr = v3_sub(u, v3_add(vb, v3_cross(wb, a)));
-    const double vn = v3_dot(vr, n);
-    const double f = p->k * (hi - d) - p->c * vn;
+    const double tl = v3_norm(t), s = tl / vlim;
+    L->t = t;
+    L->phi = 2.0 / vlim;
+    L->dp = 2.0 / vlim;
+    L->tt = v3_make(0, 0, 0);
+    if (tl > 0.0) {
+        L->phi = ws_friction_p(s) / tl;
+        L->dp = ws_friction_slope(s) / vlim;
+        L->tt = v3_scale(t, 1.0 / tl);
+    }
+}
+
+/* One contact, its force and derivatives (see ws_node_link), for the node at x (velocity u, a
+ * pinned one without friction) touching a body of motion b at `at`, the contact's parameters p.
+ * G: dn/dx (zero for a face, (P_e - n n^T) / d for an edge's rim, P_e the projection across the
+ * edge). The force is the contact laws' (penalty.h), as the explicit film's. */
+static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_node_touch_at *at,
+                    const double G[9], int pinned, ws_node_link *L)
+{
+    const v3 n = at->n;
+    const ws_node_kin kin = ws_node_kinematics(n, at->d, x, u, b);
+    const ws_normal law = ws_normal_law(n, kin.vr, at->hi - at->d, p->k, p->c);
+    const v3 vr = kin.vr;
+    const double vn = law.vn, f = law.fn;
     memset(L, 0, sizeof *L);
-    L->lever = a;
+    L->lever = kin.lever;
     L->n = n;
     L->fn = f;
     L->k = p->k;
@@ -60,29 +79,17 @@ static int link_of(const ws_node_params *p, v3 x, v3 u, v3 r, v3 vb, v3 wb, v3 n
      * edge, and each step would bring some of its nodes in by nanometres, at the cost of a
      * second solve. Their force, at most k hi / 50 (0.16 N, 40 um, on the reference case), comes in
      * at the next step. */
-    L->fin = 0.02 * p->k * hi;
+    L->fin = 0.02 * p->k * at->hi;
     L->active = f > 0.0;
     L->mu = pinned ? 0.0 : p->mu;
-    {
-        const v3 t = v3_madd(vr, n, -vn);
-        const double tl = v3_norm(t), s = tl / p->vlim;
-        L->t = t;
-        L->phi = 2.0 / p->vlim;
-        L->dp = 2.0 / p->vlim;
-        L->tt = v3_make(0, 0, 0);
-        if (tl > 0.0) {
-            L->phi = (s < 1.0 ? s * (2.0 - s) : 1.0) / tl;
-            L->dp = s < 1.0 ? (2.0 - 2.0 * s) / p->vlim : 0.0;
-            L->tt = v3_scale(t, 1.0 / tl);
-        }
-    }
+    link_slip(L, law.t, p->vlim);
     if (!L->active) {
         /* Not pushing now: the penalty's linear model alone, for the step to take if it
          * brings the node in (ws_node_link_update, which adds the friction then). */
         L->f = v3_scale(n, f);
         sym_outer(L->K, p->k, n);
         sym_outer(L->D, p->c, n);
-        return 1;
+        return;
     }
     /* df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
      * df/du = -c n^T. */
@@ -100,19 +107,11 @@ static int link_of(const ws_node_params *p, v3 x, v3 u, v3 r, v3 vb, v3 wb, v3 n
     sym_outer(L->D, p->c, n);
     v3 F = v3_scale(n, f);
     if (p->mu > 0.0 && !pinned) {
-        /* Eq. 13 over the tangential slip t: F_t = -mu f p(s) t / |t|, s = |t| / v_lim,
-         * p(s) = s (2 - s) below 1 and 1 above: F_t = -mu f phi t with phi = p / |t| (2 / v_lim
-         * at rest) and dF_t/dt = -mu f (phi I + (p'/v_lim - phi) tt^T), tt = t / |t|, which is
-         * positive semi-definite across the normal (p' >= 0, phi + p'/v_lim - phi >= 0). */
-        const v3 t = v3_madd(vr, n, -vn);
-        const double tl = v3_norm(t), s = tl / p->vlim;
-        double phi = 2.0 / p->vlim, dp = 2.0 / p->vlim;
-        v3 tt = v3_make(0, 0, 0);
-        if (tl > 0.0) {
-            phi = (s < 1.0 ? s * (2.0 - s) : 1.0) / tl;
-            dp = s < 1.0 ? (2.0 - 2.0 * s) / p->vlim : 0.0;
-            tt = v3_scale(t, 1.0 / tl);
-        }
+        /* Eq. 13 over the tangential slip t: F_t = -mu f phi t (link_slip) and
+         * dF_t/dt = -mu f (phi I + (p'/v_lim - phi) tt^T), tt = t / |t|, which is positive
+         * semi-definite across the normal (p' >= 0, phi + p'/v_lim - phi >= 0). */
+        const v3 t = L->t, tt = L->tt;
+        const double phi = L->phi, dp = L->dp;
         const double mf = p->mu * f;
         F = v3_madd(F, t, -mf * phi);
         double T[9] = {0}; /* dF_t/dt at fixed f */
@@ -151,7 +150,6 @@ static int link_of(const ws_node_params *p, v3 x, v3 u, v3 r, v3 vb, v3 wb, v3 n
             L->D[k] += mf * phi * Dn[k];
     }
     L->f = F;
-    return 1;
 }
 
 /* A contact that did not push at the start brought into the step, which ends with the normal
@@ -172,47 +170,43 @@ static void bring_in(ws_node_link *c, double fe)
     Dm[WS_SYM_ZZ] += mf * c->phi;
 }
 
-size_t ws_node_links(const ws_body_store *b, int cur, const ws_node_geom *g,
-                     const ws_node_params *pp, const ws_web *web, const ws_ncand *cand,
-                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, const double *guess,
+size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, const double *guess,
                      double reach, ws_node_link *out)
 {
     size_t m = 0;
-    const ws_body_state *st = &b->st[cur];
+    const ws_body_store *b = P->b;
+    const ws_body_state *st = &b->st[P->cur];
     for (size_t k = 0; k < count; k++) {
-        const ws_ncand *c = &cand[k];
+        const ws_ncand *c = &P->cand[k];
         const uint32_t i = c->node, bi = c->body;
-        const v3 xi = nodes_get(x, i);
-        v3 n;
-        double d, hi;
-        if (!ws_node_touch(b, cur, g, web, c, xi, reach, &n, &d, &hi))
+        const v3 xi = nodes_get(P->x, i);
+        ws_node_touch_at at;
+        if (!ws_node_touch(P, web, c, xi, reach, &at))
             continue;
         double G[9] = {0};
         if (c->local & WS_NCAND_EDGE) {
             /* The rim's normal turns with the node: dn/dx = (I - e e^T - n n^T) / d. */
-            const ws_wedge *E = &g->edge[c->feat];
+            const ws_wedge *E = &P->g->edge[c->feat];
             const v3 e = v3_scale(E->e, sqrt(E->inv_e2));
-            const double ev[3] = {e.x, e.y, e.z}, nv[3] = {n.x, n.y, n.z};
+            const double ev[3] = {e.x, e.y, e.z}, nv[3] = {at.n.x, at.n.y, at.n.z};
             for (int r = 0; r < 3; r++)
                 for (int q = 0; q < 3; q++)
-                    G[3 * r + q] = ((r == q) - ev[r] * ev[q] - nv[r] * nv[q]) / d;
+                    G[3 * r + q] = ((r == q) - ev[r] * ev[q] - nv[r] * nv[q]) / at.d;
         }
-        ws_node_link *L = &out[m];
-        if (link_of(&pp[b->material[bi]], xi, nodes_get(v, i), st->r[bi], st->v[bi], b->wg[bi],
-                    n, d, hi, G, web->inv_m[i] == 0.0, L)) {
-            L->node = i;
-            L->body = bi;
-            /* One that the node reaches within the step at its present velocity, plus the
-             * guess of its change (the last step's), comes in now, which spares most steps a
-             * second solve. */
-            v3 u = nodes_get(v, i);
-            if (guess)
-                u = v3_add(u, v3_make(guess[3 * i], guess[3 * i + 1], guess[3 * i + 2]));
-            const double nv = v3_dot(n, u), fe = L->fn - L->k * h * nv;
-            if (!L->active && fe > 0.0)
-                bring_in(L, fe);
-            m++;
-        }
+        ws_node_link *L = &out[m++];
+        const ws_motion mb = {st->r[bi], st->v[bi], b->wg[bi]};
+        link_of(&P->pp[b->material[bi]], xi, nodes_get(P->v, i), mb, &at, G, web->inv_m[i] == 0.0,
+                L);
+        L->node = i;
+        L->body = bi;
+        /* One that the node reaches within the step at its present velocity, plus the guess of
+         * its change (the last step's), comes in now, which spares most steps a second solve. */
+        v3 u = nodes_get(P->v, i);
+        if (guess)
+            u = v3_add(u, v3_make(guess[3 * i], guess[3 * i + 1], guess[3 * i + 2]));
+        const double nv = v3_dot(at.n, u), fe = L->fn - L->k * P->h * nv;
+        if (!L->active && fe > 0.0)
+            bring_in(L, fe);
     }
     return m;
 }

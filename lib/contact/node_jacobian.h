@@ -28,17 +28,15 @@ typedef struct ws_node_link {
     double Jx[9], Jv[9];
 } ws_node_link;
 
-/* The contacts of the candidates cand[0, count) (sorted by node) with the node state (x, v) and
- * the bodies at state cur (features prepared in g), parameters pp by body material, the
- * window raised by reach: each into out (room for count), their number returned. A contact
- * that pushes at the start starts active, with its friction, and so does one that the node
- * reaches within the step h at its present velocity plus `guess` (xyz per node; NULL: none)
- * (with the normal force it would end with);
- * any other (beyond the window, or leaving it) starts inactive with its normal force's linear
- * model alone (f = fn n, K, D along n), which ws_node_link_update may bring in. */
-size_t ws_node_links(const ws_body_store *b, int cur, const ws_node_geom *g,
-                     const ws_node_params *pp, const ws_web *web, const ws_ncand *cand,
-                     size_t count, ws_nodes3 x, ws_nodes3 v, double h, const double *guess,
+/* The contacts of the candidates P->cand[0, count) (sorted by node) with the node state (P->x,
+ * P->v) and the bodies at state P->cur (features prepared in P->g), parameters P->pp by body
+ * material, the window raised by reach: each into out (room for count), their number returned.
+ * A contact that pushes at the start starts active, with its friction, and so does one that the
+ * node reaches within the step P->h at its present velocity plus `guess` (xyz per node; NULL:
+ * none) (with the normal force it would end with); any other (beyond the window, or leaving
+ * it) starts inactive with its normal force's linear model alone (f = fn n, K, D along n),
+ * which ws_node_link_update may bring in. P's share and fc are not read. */
+size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, const double *guess,
                      double reach, ws_node_link *out);
 
 /* After a solve over step h (dv; new velocities v1): each contact's normal force at the end of

@@ -40,8 +40,8 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
                            w->time, label(web));
         /* The contacts the step may reach: those of nodes within a step's travel of the
          * window's top, bounded by the margin the candidates cover. */
-        const size_t nl = ws_node_links(b, cur, &w->node_geom, w->node_par, web, cl->c, cl->n, xs,
-                                        vs, h, im->warm ? im->dv : NULL,
+        const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
+        const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
                                         w->def.contact_margin, w->links);
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
