@@ -61,6 +61,7 @@ typedef struct ws_contact_limit {
 
 struct ws_world {
     ws_mem mem;
+    ws_arena arena; /* a step's scratch, given back when the next step starts */
     ws_world_def def;
     double time;
     uint64_t steps;
@@ -114,10 +115,6 @@ struct ws_world {
     size_t ncand[2], capcand[2];
     ws_contact_rec *rec[2];
     size_t nrec[2], caprec[2];
-    uint32_t *sweep;
-    size_t sweep_cap;
-    uint32_t *pairs;
-    size_t pairs_cap, npairs;
 
     ws_world_stats stats;
 

@@ -74,12 +74,13 @@ static double max_step_travel(const ws_world *w, int k)
 static ws_status detect_full(ws_world *w, ws_contact_ctx *x, int nxt)
 {
     ws_mem *mem = &w->mem;
-    if (ws_broad_pairs(mem, &w->bodies, &w->sweep, &w->sweep_cap, &w->pairs, &w->npairs,
-                       &w->pairs_cap) != 0)
+    uint32_t *pairs;
+    size_t npairs;
+    if (ws_broad_pairs(&w->arena, &w->bodies, &pairs, &npairs) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
     w->ncand[nxt] = 0;
-    for (size_t k = 0; k < w->npairs; k++) {
-        uint32_t i = w->pairs[2 * k], j = w->pairs[2 * k + 1];
+    for (size_t k = 0; k < npairs; k++) {
+        uint32_t i = pairs[2 * k], j = pairs[2 * k + 1];
         if (w->def.use_ccd && !ws_ccd_may_touch_at(&w->bodies, w->cur, i, j, w->def.contact_margin)) {
             w->stats.body_pairs_gated++;
             continue;
@@ -722,6 +723,8 @@ static ws_status step_once(ws_world *w)
     ws_status s;
     if ((s = bodies_ready(w)) != WS_OK)
         return s;
+    /* The last step's scratch is given back; this step's comes from the arena. */
+    ws_arena_reset(&w->arena);
     /* Room for the energy guard's record of the contacts' loads on each body: one block, the
      * forces then the moments, so a failed grow leaves one consistent size. */
     if (w->guard_cap < b->slots) {
