@@ -2331,11 +2331,14 @@ END_TEST
 
 /* A sheet lying on a box on the ground, in a world whose allocator records every block's size
  * and checks the size of each free and realloc against it. */
-static ws_world *draped_world(test_alloc *a)
+/* A box on the ground with a sheet of nx by ny nodes 2 cm apart draped over it, centred, on a
+ * world of `workers` workers. */
+static ws_world *draped_world_of(test_alloc *a, int nx, int ny, int workers)
 {
     ws_world_def d;
     ws_world_def_init(&d);
     d.dt = 1e-4;
+    d.worker_count = workers;
     a->track = 1;
     a->allocs_left = -1;
     test_alloc_install(&d, a);
@@ -2350,27 +2353,31 @@ static ws_world *draped_world(test_alloc *a)
     wd.law = law;
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
-    sd.nx = sd.ny = 12;
+    sd.nx = nx;
+    sd.ny = ny;
     sd.spacing_x = sd.spacing_y = 0.02;
-    /* 0.22 m square, centred over the box, its nodes 0.5 mm above the touching layers. */
-    sd.origin = (ws_vec3){-0.11, -0.11, 0.2 + 2e-3 + 2e-3 + 0.5e-3};
+    /* Centred over the box, its nodes 0.5 mm above the touching layers. */
+    sd.origin = (ws_vec3){-0.01 * (nx - 1), -0.01 * (ny - 1), 0.2 + 2e-3 + 2e-3 + 0.5e-3};
     ws_web_id web;
     ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
     return w;
 }
+
 
 /* Out of memory at each allocation of a film step in turn: the step fails with
  * WS_ERR_OUT_OF_MEMORY and changes nothing, the world steps on once memory is back, and every
  * free and realloc is given the size its block was allocated with (before the fix, the node
  * contact scratch kept one array while its capacity read zero, and the web's per-body force
  * arrays kept the old capacity when only some of them had grown). */
-START_TEST(test_oom_film_step_sizes)
+/* Out of memory at each allocation of a film step in turn (nx by ny nodes, `workers`): see
+ * oom_film_step_sizes. Returns how many of the step's allocations failed in turn. */
+static long oom_film_step(int nx, int ny, int workers)
 {
     int done = 0;
     long n, failures = 0;
     for (n = 0; n < 400 && !done; n++) {
         test_alloc a = {.allocs_left = -1};
-        ws_world *w = draped_world(&a);
+        ws_world *w = draped_world_of(&a, nx, ny, workers);
         uint64_t h0;
         ck_ok(w, ws_world_get_state_hash(w, &h0));
         a.allocs_left = n;
@@ -2395,9 +2402,26 @@ START_TEST(test_oom_film_step_sizes)
         test_alloc_done(&a);
     }
     ck_assert_msg(done, "the film step never succeeded");
+    return failures;
+}
+
+START_TEST(test_oom_film_step_sizes)
+{
     report("film step: out of memory at each of its %ld allocations in turn, every free and "
            "realloc given its block's size",
-           failures);
+           oom_film_step(12, 12, 1));
+}
+END_TEST
+
+/* The same with the film swept in lanes: a 24 x 34 sheet is three sweep blocks of 16 rows
+ * (WS_WEB_BLOCK_NODES), cut into lanes on two workers, whose scratch the step takes from the
+ * world's arena; a failing allocation anywhere in the step, the arena's blocks included,
+ * leaves the world as it was and every byte goes back to the free hook with its size. */
+START_TEST(test_oom_film_step_lanes)
+{
+    report("film step in lanes: out of memory at each of its %ld allocations in turn, every "
+           "free given its block's size, nothing left at destroy",
+           oom_film_step(24, 34, 2));
 }
 END_TEST
 
@@ -2431,6 +2455,7 @@ int main(void)
     add_case(s, "advice_bounded", test_advice_bounded, 10);
     add_case(s, "released_sheet_energy", test_released_sheet_energy, 20);
     add_case(s, "oom_film_step_sizes", test_oom_film_step_sizes, 60);
+    add_case(s, "oom_film_step_lanes", test_oom_film_step_lanes, 120);
     add_case(s, "springs_checked_before_law_histories", test_springs_checked_before_law_histories,
              10);
     return run_suite(s);

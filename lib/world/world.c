@@ -257,7 +257,6 @@ void ws_world_destroy(ws_world *w)
     ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);
     ws_mem_free(m, w->pair_index, w->pair_dim * w->pair_dim * sizeof *w->pair_index);
     ws_mem_free(m, w->mat_mass, w->pair_dim * sizeof *w->mat_mass);
-    ws_mem_free(m, w->guard_f, 2 * w->guard_cap * sizeof *w->guard_f); /* guard_m is in it */
     for (int k = 0; k < 2; k++) {
         ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
         ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
