@@ -175,12 +175,12 @@ typedef struct ws_node_geom {
     uint32_t *face_base, *tri_base, *edge_base;
     size_t face_cap, tri_cap, edge_cap, face_base_cap, tri_base_cap, edge_base_cap;
     /* Scratch of ws_node_candidates (node.c): the bodies near a group of nodes, with the nodes'
-     * values against each. */
+     * values against each, taken from the step's arena (set by the step before the search). */
+    ws_arena *arena;
     struct ws_find_body *find;
     double *find_val;
     uint64_t *find_mask;
     uint32_t *find_node;
-    size_t find_cap, find_val_cap, find_mask_cap, find_node_cap;
     /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
     uint8_t *ready;
     size_t ready_cap;
