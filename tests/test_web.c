@@ -2363,7 +2363,6 @@ static ws_world *draped_world_of(test_alloc *a, int nx, int ny, int workers)
     return w;
 }
 
-
 /* Out of memory at each allocation of a film step in turn: the step fails with
  * WS_ERR_OUT_OF_MEMORY and changes nothing, the world steps on once memory is back, and every
  * free and realloc is given the size its block was allocated with (before the fix, the node

@@ -46,8 +46,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         /* The contacts the step may reach: those of nodes within a step's travel of the
          * window's top, bounded by the margin the candidates cover. */
         const size_t nl = ws_node_links(b, cur, &w->node_geom, w->node_par, web, cl->c, cl->n, xs,
-                                        vs, h, im->warm ? im->dv : NULL,
-                                        S->contact.margin, links);
+                                        vs, h, im->warm ? im->dv : NULL, S->contact.margin, links);
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
@@ -57,8 +56,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                 ws_implicit_reset(im);
             for (size_t k = 0; k < nl; k++)
                 if (links[k].active)
-                    ws_implicit_add(im, links[k].node, links[k].f, links[k].K,
-                                    links[k].D);
+                    ws_implicit_add(im, links[k].node, links[k].f, links[k].K, links[k].D);
             if ((ok = ws_implicit_solve(web, vs, h) == 0) == 0)
                 break;
             ws_implicit_velocities(web, vs, vd);
@@ -88,9 +86,9 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                            label(web), w->time, vmax, w->def.max_speed);
         }
         const size_t nt = web->nfct[nxt];
-        web->nfct[nxt] += ws_node_link_loads(links, nl, im->dv, vd, h, share, web->fc[nxt],
-                                             web->fct[nxt] + nt, web->bforce[nxt],
-                                             web->bmoment[nxt]);
+        web->nfct[nxt] +=
+            ws_node_link_loads(links, nl, im->dv, vd, h, share, web->fc[nxt], web->fct[nxt] + nt,
+                               web->bforce[nxt], web->bmoment[nxt]);
         xs = xd;
         vs = vd;
     }
