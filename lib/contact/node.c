@@ -1148,6 +1148,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
 {
     (void)cur;
+    (void)mem; /* every table is the step's scratch, from its arena */
     size_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++)
         if (b->alive[k]) {
@@ -1155,18 +1156,21 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
             nt += b->shape[k]->triangle_count;
             ne += b->shape[k]->edge_count;
         }
-    if (ws_array_reserve(mem, (void **)&g->face, &g->face_cap, nf + 1, sizeof *g->face) != 0 ||
-        ws_array_reserve(mem, (void **)&g->tri, &g->tri_cap, nt + 1, sizeof *g->tri) != 0 ||
-        ws_array_reserve(mem, (void **)&g->edge, &g->edge_cap, ne + 1, sizeof *g->edge) != 0 ||
-        ws_array_reserve(mem, (void **)&g->edge_base, &g->edge_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0)
+    ws_arena *a = g->arena;
+    ws_wface *face = ws_arena_alloc(a, (nf + 1) * sizeof *face);
+    ws_wtri *tri = ws_arena_alloc(a, (nt + 1) * sizeof *tri);
+    ws_wedge *edge = ws_arena_alloc(a, (ne + 1) * sizeof *edge);
+    uint32_t *base = ws_arena_alloc(a, 3 * (b->slots + 1) * sizeof *base);
+    uint8_t *ready = ws_arena_alloc(a, b->slots + 1);
+    if (!face || !tri || !edge || !base || !ready)
         return -1;
-    if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0 ||
-        ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0 ||
-        ws_array_reserve(mem, (void **)&g->ready, &g->ready_cap, b->slots + 1, 1) != 0)
-        return -1;
+    g->face = face;
+    g->tri = tri;
+    g->edge = edge;
+    g->face_base = base;
+    g->tri_base = base + b->slots + 1;
+    g->edge_base = base + 2 * (b->slots + 1);
+    g->ready = ready;
     uint32_t fo = 0, to = 0, eo = 0;
     for (size_t k = 0; k < b->slots; k++) {
         g->ready[k] = 0;
@@ -1234,13 +1238,8 @@ void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_
 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
 {
-    ws_mem_free(mem, g->face, g->face_cap * sizeof *g->face);
-    ws_mem_free(mem, g->tri, g->tri_cap * sizeof *g->tri);
-    ws_mem_free(mem, g->face_base, g->face_base_cap * sizeof *g->face_base);
-    ws_mem_free(mem, g->tri_base, g->tri_base_cap * sizeof *g->tri_base);
-    ws_mem_free(mem, g->edge, g->edge_cap * sizeof *g->edge);
-    ws_mem_free(mem, g->edge_base, g->edge_base_cap * sizeof *g->edge_base);
-    ws_mem_free(mem, g->ready, g->ready_cap);
+    (void)mem; /* its tables are the arena's, given back with it */
+    memset(g, 0, sizeof *g);
 }
 
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
