@@ -30,10 +30,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
     ws_implicit *im = web->imp;
     const int n = web->substeps;
     const double h = S->dt / n, share = 1.0 / n;
-    S->h = h;
     ws_nodes3 xs = web->x[cur], vs = web->v[cur];
     for (int s = 0; s < n; s++) {
-        S->sub = s;
         const int last_parity = (n - 1 - s) % 2 == 0;
         ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
         ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;

@@ -119,8 +119,8 @@ struct ws_world {
  * pairs' parameters; it counts the narrow checks), the statistics, the arena every phase takes
  * its scratch from, and what the phases hand on: whether this is a full detection, the body
  * pairs it found, the contacts' loads on each body before the elements and the film (for the
- * energy guard), the contact records written. A web's running sub-step: its length h and its
- * number sub. */
+ * energy guard), the contact records written. A web's sub-step is in the lanes' task
+ * (world_step.c), whose node contacts' part (ws_node_pass) contact/ reads. */
 typedef struct ws_step {
     ws_world *w;
     ws_body_store *b;
@@ -134,8 +134,6 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
-    double h;
-    int sub;
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that

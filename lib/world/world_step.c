@@ -515,7 +515,6 @@ static ws_status step_webs(ws_step *S)
         }
         int n = web->substeps;
         double h = S->dt / n, share = 1.0 / n;
-        S->h = h;
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -523,7 +522,6 @@ static ws_status step_webs(ws_step *S)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            S->sub = s;
             ws_web_sweep_laws(web, w->def.gravity, S->t + s * h, s * h);
             lane_task T = {w,
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
