@@ -132,11 +132,69 @@ START_TEST(test_arena_calloc_zeroes_reused_room)
 }
 END_TEST
 
+/* An allocator whose blocks start 56 bytes past a 64-byte boundary (aligned to 8, never to 16
+ * or more; the worst start for the arena's first allocation after its 16-byte header): the
+ * arena's allocations are aligned all the same, and the room of a block holds what it was made
+ * for. The block's true start is kept in the 8 bytes before it. */
+static void *odd_alloc(void *u, size_t n)
+{
+    unsigned char *raw = ta_alloc(u, n + 128);
+    if (!raw)
+        return NULL;
+    unsigned char *p = raw + (64 - (uintptr_t)raw % 64) % 64 + 56;
+    memcpy(p - 8, &raw, sizeof raw);
+    return p;
+}
+static void *odd_realloc(void *u, void *p, size_t o, size_t n)
+{
+    (void)u;
+    (void)p;
+    (void)o;
+    (void)n;
+    return NULL; /* the arena never reallocates */
+}
+static void odd_free(void *u, void *p, size_t n)
+{
+    unsigned char *raw;
+    memcpy(&raw, (unsigned char *)p - 8, sizeof raw);
+    ta_free(u, raw, n + 128);
+}
+
+START_TEST(test_arena_blocks_aligned_to_8)
+{
+    test_alloc a = {0};
+    a.track = 1;
+    a.allocs_left = -1;
+    ws_allocator h = {0};
+    h.alloc = odd_alloc;
+    h.realloc = odd_realloc;
+    h.free = odd_free;
+    h.user = &a;
+    ws_mem m;
+    ws_mem_init(&m, &h);
+    ws_arena ar;
+    ws_arena_init(&ar, &m);
+    for (int s = 0; s < 4; s++) { /* chained, then one block */
+        ck_assert_int_eq(one_step(&ar, 40), 0);
+        ws_arena_reset(&ar);
+    }
+    ck_assert_int_eq(ar.blocks, 1);
+    /* What a step took, in one piece, fits the one block. */
+    ck_assert_ptr_nonnull(ws_arena_alloc(&ar, ar.most));
+    ck_assert_int_eq(ar.blocks, 1);
+    ws_arena_free(&ar);
+    ck_assert_msg(a.live == 0 && a.bytes == 0 && a.size_errors == 0, "%ld blocks, %lld bytes, %s",
+                  a.live, a.bytes, a.size_error);
+    test_alloc_done(&a);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("arena");
     add_case(s, "chain_then_one_block", test_arena_chain_then_one_block, 10);
     add_case(s, "out_of_memory", test_arena_out_of_memory, 10);
     add_case(s, "calloc_zeroes_reused_room", test_arena_calloc_zeroes_reused_room, 10);
+    add_case(s, "blocks_aligned_to_8", test_arena_blocks_aligned_to_8, 10);
     return run_suite(s);
 }

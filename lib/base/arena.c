@@ -19,10 +19,9 @@ typedef struct ws_arena_block {
     size_t size;                 /* bytes of the block with its header, as allocated */
 } ws_arena_block;
 
-/* The header rounded up to the alignment, so a block's room starts aligned when the block does;
- * blocks from the user's hooks are aligned to 16 bytes at least, so WS_ARENA_ALIGN - 16 bytes
- * of slack make room for aligning the first allocation. */
-#define BLOCK_SLACK (WS_ARENA_ALIGN - 16)
+/* Room for aligning a block's first allocation: a user's allocator may hand out blocks aligned
+ * to anything (8 bytes, say), so up to WS_ARENA_ALIGN - 1 bytes after the header may go. */
+#define BLOCK_SLACK (WS_ARENA_ALIGN - 1)
 
 static size_t round_up(size_t n, size_t a)
 {
