@@ -2331,11 +2331,14 @@ END_TEST
 
 /* A sheet lying on a box on the ground, in a world whose allocator records every block's size
  * and checks the size of each free and realloc against it. */
-static ws_world *draped_world(test_alloc *a)
+/* A box on the ground with a sheet of nx by ny nodes 2 cm apart draped over it, centred, on a
+ * world of `workers` workers. */
+static ws_world *draped_world_of(test_alloc *a, int nx, int ny, int workers)
 {
     ws_world_def d;
     ws_world_def_init(&d);
     d.dt = 1e-4;
+    d.worker_count = workers;
     a->track = 1;
     a->allocs_left = -1;
     test_alloc_install(&d, a);
@@ -2350,10 +2353,11 @@ static ws_world *draped_world(test_alloc *a)
     wd.law = law;
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
-    sd.nx = sd.ny = 12;
+    sd.nx = nx;
+    sd.ny = ny;
     sd.spacing_x = sd.spacing_y = 0.02;
-    /* 0.22 m square, centred over the box, its nodes 0.5 mm above the touching layers. */
-    sd.origin = (ws_vec3){-0.11, -0.11, 0.2 + 2e-3 + 2e-3 + 0.5e-3};
+    /* Centred over the box, its nodes 0.5 mm above the touching layers. */
+    sd.origin = (ws_vec3){-0.01 * (nx - 1), -0.01 * (ny - 1), 0.2 + 2e-3 + 2e-3 + 0.5e-3};
     ws_web_id web;
     ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
     return w;
@@ -2364,13 +2368,15 @@ static ws_world *draped_world(test_alloc *a)
  * free and realloc is given the size its block was allocated with (before the fix, the node
  * contact scratch kept one array while its capacity read zero, and the web's per-body force
  * arrays kept the old capacity when only some of them had grown). */
-START_TEST(test_oom_film_step_sizes)
+/* Out of memory at each allocation of a film step in turn (nx by ny nodes, `workers`): see
+ * oom_film_step_sizes. Returns how many of the step's allocations failed in turn. */
+static long oom_film_step(int nx, int ny, int workers)
 {
     int done = 0;
     long n, failures = 0;
     for (n = 0; n < 400 && !done; n++) {
         test_alloc a = {.allocs_left = -1};
-        ws_world *w = draped_world(&a);
+        ws_world *w = draped_world_of(&a, nx, ny, workers);
         uint64_t h0;
         ck_ok(w, ws_world_get_state_hash(w, &h0));
         a.allocs_left = n;
@@ -2395,9 +2401,64 @@ START_TEST(test_oom_film_step_sizes)
         test_alloc_done(&a);
     }
     ck_assert_msg(done, "the film step never succeeded");
+    return failures;
+}
+
+START_TEST(test_oom_film_step_sizes)
+{
     report("film step: out of memory at each of its %ld allocations in turn, every free and "
            "realloc given its block's size",
-           failures);
+           oom_film_step(12, 12, 1));
+}
+END_TEST
+
+/* The same with the film swept in lanes: a 24 x 34 sheet is three sweep blocks of 16 rows
+ * (WS_WEB_BLOCK_NODES), cut into lanes on two workers, whose scratch the step takes from the
+ * world's arena; a failing allocation anywhere in the step, the arena's blocks included,
+ * leaves the world as it was and every byte goes back to the free hook with its size. */
+START_TEST(test_oom_film_step_lanes)
+{
+    report("film step in lanes: out of memory at each of its %ld allocations in turn, every "
+           "free given its block's size, nothing left at destroy",
+           oom_film_step(24, 34, 2));
+}
+END_TEST
+
+/* A step of a running film takes its scratch from the world's arena and allocates nothing
+ * from the user's hooks once the arena and the lists carried from step to step hold what a
+ * step needs (STYLE: the step allocates nothing): a sheet draped on a box, on one worker and
+ * swept in lanes on two, calls the hooks in its first 400 steps (0.04 s) only, while it
+ * settles and its contact lists grow (each array a few doublings: at most 60 calls), and not
+ * once in the 100 steps after. An arena given back to the allocator each step, or one that
+ * never kept the size a step took, would call them every step. */
+static void steady_film(int nx, int ny, int workers, long *first, long *last)
+{
+    test_alloc a = {0};
+    ws_world *w = draped_world_of(&a, nx, ny, workers);
+    a.allocs_left = 1000000000L; /* never fails; counts the hooks' calls down */
+    ck_ok(w, ws_world_step_n(w, 400));
+    *first = 1000000000L - a.allocs_left;
+    const long mid = a.allocs_left;
+    ck_ok(w, ws_world_step_n(w, 100));
+    *last = mid - a.allocs_left;
+    ws_world_destroy(w);
+    ck_assert_msg(a.live == 0 && a.bytes == 0 && a.size_errors == 0, "%ld blocks, %lld bytes, %s",
+                  a.live, a.bytes, a.size_error);
+    test_alloc_done(&a);
+}
+
+START_TEST(test_steady_step_allocates_nothing)
+{
+    long first1, last1, first2, last2;
+    steady_film(12, 12, 1, &first1, &last1);
+    steady_film(24, 34, 2, &first2, &last2);
+    report("allocations from the hooks: one worker %ld in steps 1-400, %ld in steps 401-500; "
+           "lanes on two workers %ld, %ld",
+           first1, last1, first2, last2);
+    ck_assert_int_eq(last1, 0);
+    ck_assert_int_eq(last2, 0);
+    ck_assert_int_le(first1, 60);
+    ck_assert_int_le(first2, 60);
 }
 END_TEST
 
@@ -2431,6 +2492,8 @@ int main(void)
     add_case(s, "advice_bounded", test_advice_bounded, 10);
     add_case(s, "released_sheet_energy", test_released_sheet_energy, 20);
     add_case(s, "oom_film_step_sizes", test_oom_film_step_sizes, 60);
+    add_case(s, "oom_film_step_lanes", test_oom_film_step_lanes, 120);
+    add_case(s, "steady_step_allocates_nothing", test_steady_step_allocates_nothing, 30);
     add_case(s, "springs_checked_before_law_histories", test_springs_checked_before_law_histories,
              10);
     return run_suite(s);

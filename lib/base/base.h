@@ -45,6 +45,34 @@ void ws_mem_free_str(ws_mem *mem, char *s);
  * Returns 0 on success, -1 when out of memory (array unchanged). */
 int ws_array_reserve(ws_mem *mem, void **array, size_t *capacity, size_t need, size_t elem);
 
+/* The world's arena (arena.c): the scratch of one step, bump-allocated from blocks of the
+ * user's allocator and given back at once by the reset at the start of the next step, so a
+ * step in a steady run allocates nothing. Every allocation starts on a WS_ARENA_ALIGN-byte
+ * boundary (a cache line: vector loops load whole lines). One thread allocates: the step takes
+ * the lanes' scratch before it starts them. */
+#define WS_ARENA_ALIGN 64
+#define WS_ARENA_MIN_BLOCK 4096
+typedef struct ws_arena {
+    ws_mem *mem;
+    struct ws_arena_block *top; /* the block allocated from (it chains those before) */
+    size_t used;                /* bytes of top in use, from its start */
+    size_t step_bytes;          /* bytes handed out since the last reset */
+    size_t most;                /* the most step_bytes any step reached */
+    size_t held;                /* bytes of all blocks, as allocated */
+    size_t blocks;
+} ws_arena;
+
+void ws_arena_init(ws_arena *a, ws_mem *mem);
+/* `bytes` of scratch aligned to WS_ARENA_ALIGN, valid until the next reset; NULL when out of
+ * memory (the arena is as it was). calloc: zeroed; NULL too when count * size overflows. */
+void *ws_arena_alloc(ws_arena *a, size_t bytes);
+void *ws_arena_calloc(ws_arena *a, size_t count, size_t size);
+/* Everything allocated is given back. When the last steps chained blocks, one block of the
+ * most a step needed replaces them (kept as they are when that allocation fails). */
+void ws_arena_reset(ws_arena *a);
+/* Its blocks back to the allocator. */
+void ws_arena_free(ws_arena *a);
+
 /* Start filling a Def with defaults: zero it and write its size/magic header. 0 for a NULL Def
  * (the init then does nothing), 1 otherwise. */
 int ws_def_reset(void *def, size_t size);

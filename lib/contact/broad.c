@@ -1,16 +1,17 @@
-/* Broad phase: sweep and prune of the bodies' inflated boxes along x. The sweep order is kept
- * between calls and repaired by insertion sort, which is linear when little has moved. */
+/* Broad phase: sweep and prune of the bodies' inflated boxes along x. The alive slots are put in
+ * order of their boxes' low x by insertion sort (stable, so the order is the same whatever the
+ * bodies did before); the order and the pairs are scratch of the step (the world's arena). */
 #include "contact/contact.h"
 
-int ws_broad_pairs(ws_mem *mem, const ws_body_store *b, uint32_t **order, size_t *order_cap,
-                   uint32_t **pairs, size_t *npairs, size_t *pairs_cap)
+#include <string.h>
+
+int ws_broad_pairs(ws_arena *a, const ws_body_store *b, uint32_t **pairs, size_t *npairs)
 {
-    size_t n = 0;
-    if (ws_array_reserve(mem, (void **)order, order_cap, b->slots + 1, sizeof **order) != 0)
+    size_t n = 0, room = b->slots + 1; /* pairs the room holds: grown by doubling */
+    uint32_t *o = ws_arena_alloc(a, (b->slots + 1) * sizeof *o);
+    uint32_t *pr = ws_arena_alloc(a, 2 * room * sizeof *pr);
+    if (!o || !pr)
         return -1;
-    uint32_t *o = *order;
-    /* Rebuild the list of alive slots, keeping the previous relative order where possible is not
-     * needed for correctness; insertion sort below makes it ordered. */
     for (size_t i = 0; i < b->slots; i++)
         if (b->alive[i])
             o[n++] = (uint32_t)i;
@@ -36,14 +37,22 @@ int ws_broad_pairs(ws_mem *mem, const ws_body_store *b, uint32_t **order, size_t
             if (b->lo[q].y > b->hi[p].y || b->hi[q].y < b->lo[p].y || b->lo[q].z > b->hi[p].z ||
                 b->hi[q].z < b->lo[p].z)
                 continue;
-            if (ws_array_reserve(mem, (void **)pairs, pairs_cap, 2 * (*npairs + 1),
-                                 sizeof **pairs) != 0)
-                return -1;
+            if (*npairs == room) { /* the old room stays in the arena until its reset */
+                uint32_t *more = room <= SIZE_MAX / 8 / sizeof *pr
+                                     ? ws_arena_alloc(a, 4 * room * sizeof *pr)
+                                     : NULL;
+                if (!more)
+                    return -1;
+                memcpy(more, pr, 2 * room * sizeof *pr);
+                pr = more;
+                room *= 2;
+            }
             /* Lower slot first, so candidate keys do not depend on the sweep order. */
-            (*pairs)[2 * *npairs] = p < q ? p : q;
-            (*pairs)[2 * *npairs + 1] = p < q ? q : p;
+            pr[2 * *npairs] = p < q ? p : q;
+            pr[2 * *npairs + 1] = p < q ? q : p;
             (*npairs)++;
         }
     }
+    *pairs = pr;
     return 0;
 }

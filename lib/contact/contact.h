@@ -109,10 +109,10 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
 void ws_contact_sort(ws_cand *c, size_t n);
 void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, size_t n_old);
 
-/* Body pairs whose inflated boxes overlap and not both kinematic, by sweep and prune along x.
- * `order` keeps the sweep order between calls (insertion sort on nearly sorted data). */
-int ws_broad_pairs(ws_mem *mem, const ws_body_store *b, uint32_t **order, size_t *order_cap,
-                   uint32_t **pairs, size_t *npairs, size_t *pairs_cap);
+/* Body pairs whose inflated boxes overlap and not both kinematic, by sweep and prune along x:
+ * *npairs of them in *pairs (two slots each, the lower first), from the arena a, as is the
+ * sweep's order. 0, or -1 when out of memory. */
+int ws_broad_pairs(ws_arena *a, const ws_body_store *b, uint32_t **pairs, size_t *npairs);
 
 /* libccd gate: 1 if the convex hulls of bodies i and j, inflated by their layers + margin/2, may
  * touch (or if the gate cannot tell: non-convex shapes, no libccd). */

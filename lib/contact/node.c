@@ -1044,8 +1044,27 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
     const double pad = web->layer + 0.5 * margin;
     if (!nodes)
         count = web->n;
-    if (ws_array_reserve(mem, (void **)&g->find, &g->find_cap, b->slots + 1, sizeof *g->find) != 0)
+    /* The scratch of the search, from the step's arena, at its most for a group of nodes
+     * (every body near every node of the group), taken once for every group. */
+    size_t most_val = 1, most_mask = 1;
+    for (uint32_t k = 0; k < b->slots; k++) {
+        const ws_shape *sh = b->shape[k];
+        if (b->alive[k] && sh->convex && sh->face_count <= WS_NCAND_FACES) {
+            most_val += (V_FACES + sh->face_count) * (size_t)FIND_CHUNK;
+            most_mask += M_ARRAYS * (size_t)FIND_CHUNK;
+        }
+    }
+    ws_find_body *const find = ws_arena_alloc(g->arena, (b->slots + 1) * sizeof *find);
+    uint32_t *const find_node =
+        ws_arena_alloc(g->arena, (b->slots + 1) * FIND_CHUNK * sizeof(uint32_t));
+    double *const find_val = ws_arena_alloc(g->arena, most_val * sizeof(double));
+    uint64_t *const find_mask = ws_arena_alloc(g->arena, most_mask * sizeof(uint64_t));
+    if (!find || !find_node || !find_val || !find_mask)
         return -1;
+    g->find = find;
+    g->find_node = find_node;
+    g->find_val = find_val;
+    g->find_mask = find_mask;
     double px[FIND_CHUNK], py[FIND_CHUNK], pz[FIND_CHUNK];
     uint64_t hit[FIND_CHUNK];
     for (size_t q0 = 0; q0 < count; q0 += FIND_CHUNK) {
@@ -1067,9 +1086,6 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
             if (!c)
                 continue;
             nc->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
-            if (ws_array_reserve(mem, (void **)&g->find_node, &g->find_node_cap, nnode + m,
-                                 sizeof *g->find_node) != 0)
-                return -1;
             uint32_t *nd = g->find_node + nnode;
             for (size_t j = 0, e = 0; j < m; j++) {
                 nd[e] = (uint32_t)j;
@@ -1086,11 +1102,6 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 nmask += M_ARRAYS * (size_t)FIND_CHUNK;
             }
         }
-        if (ws_array_reserve(mem, (void **)&g->find_val, &g->find_val_cap, nval + 1,
-                             sizeof *g->find_val) != 0 ||
-            ws_array_reserve(mem, (void **)&g->find_mask, &g->find_mask_cap, nmask + 1,
-                             sizeof *g->find_mask) != 0)
-            return -1;
         /* Per convex body, on vectors: the nodes in its frame, their plane distances and
          * their faces' masks. */
         for (size_t q = 0; q < nb; q++) {
@@ -1137,6 +1148,7 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
 int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
 {
     (void)cur;
+    (void)mem; /* every table is the step's scratch, from its arena */
     size_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++)
         if (b->alive[k]) {
@@ -1144,18 +1156,21 @@ int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom 
             nt += b->shape[k]->triangle_count;
             ne += b->shape[k]->edge_count;
         }
-    if (ws_array_reserve(mem, (void **)&g->face, &g->face_cap, nf + 1, sizeof *g->face) != 0 ||
-        ws_array_reserve(mem, (void **)&g->tri, &g->tri_cap, nt + 1, sizeof *g->tri) != 0 ||
-        ws_array_reserve(mem, (void **)&g->edge, &g->edge_cap, ne + 1, sizeof *g->edge) != 0 ||
-        ws_array_reserve(mem, (void **)&g->edge_base, &g->edge_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0)
+    ws_arena *a = g->arena;
+    ws_wface *face = ws_arena_alloc(a, (nf + 1) * sizeof *face);
+    ws_wtri *tri = ws_arena_alloc(a, (nt + 1) * sizeof *tri);
+    ws_wedge *edge = ws_arena_alloc(a, (ne + 1) * sizeof *edge);
+    uint32_t *base = ws_arena_alloc(a, 3 * (b->slots + 1) * sizeof *base);
+    uint8_t *ready = ws_arena_alloc(a, b->slots + 1);
+    if (!face || !tri || !edge || !base || !ready)
         return -1;
-    if (ws_array_reserve(mem, (void **)&g->face_base, &g->face_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0 ||
-        ws_array_reserve(mem, (void **)&g->tri_base, &g->tri_base_cap, b->slots + 1,
-                         sizeof(uint32_t)) != 0 ||
-        ws_array_reserve(mem, (void **)&g->ready, &g->ready_cap, b->slots + 1, 1) != 0)
-        return -1;
+    g->face = face;
+    g->tri = tri;
+    g->edge = edge;
+    g->face_base = base;
+    g->tri_base = base + b->slots + 1;
+    g->edge_base = base + 2 * (b->slots + 1);
+    g->ready = ready;
     uint32_t fo = 0, to = 0, eo = 0;
     for (size_t k = 0; k < b->slots; k++) {
         g->ready[k] = 0;
@@ -1223,17 +1238,8 @@ void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_
 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
 {
-    ws_mem_free(mem, g->face, g->face_cap * sizeof *g->face);
-    ws_mem_free(mem, g->tri, g->tri_cap * sizeof *g->tri);
-    ws_mem_free(mem, g->face_base, g->face_base_cap * sizeof *g->face_base);
-    ws_mem_free(mem, g->tri_base, g->tri_base_cap * sizeof *g->tri_base);
-    ws_mem_free(mem, g->edge, g->edge_cap * sizeof *g->edge);
-    ws_mem_free(mem, g->edge_base, g->edge_base_cap * sizeof *g->edge_base);
-    ws_mem_free(mem, g->find, g->find_cap * sizeof *g->find);
-    ws_mem_free(mem, g->find_val, g->find_val_cap * sizeof *g->find_val);
-    ws_mem_free(mem, g->find_mask, g->find_mask_cap * sizeof *g->find_mask);
-    ws_mem_free(mem, g->find_node, g->find_node_cap * sizeof *g->find_node);
-    ws_mem_free(mem, g->ready, g->ready_cap);
+    (void)mem; /* its tables are the arena's, given back with it */
+    memset(g, 0, sizeof *g);
 }
 
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,

@@ -173,23 +173,21 @@ typedef struct ws_node_geom {
     ws_wtri *tri;
     ws_wedge *edge;
     uint32_t *face_base, *tri_base, *edge_base;
-    size_t face_cap, tri_cap, edge_cap, face_base_cap, tri_base_cap, edge_base_cap;
     /* Scratch of ws_node_candidates (node.c): the bodies near a group of nodes, with the nodes'
-     * values against each. */
+     * values against each, taken from the step's arena (set by the step before the search). */
+    ws_arena *arena;
     struct ws_find_body *find;
     double *find_val;
     uint64_t *find_mask;
     uint32_t *find_node;
-    size_t find_cap, find_val_cap, find_mask_cap, find_node_cap;
     /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
     uint8_t *ready;
-    size_t ready_cap;
 } ws_node_geom;
 
-/* Room in g and the numbers of the bodies' features (face_base, tri_base, edge_base), with no
- * body prepared yet: a step prepares only the bodies some web's candidates may name
- * (ws_node_prepare). 0, or -1 when out of memory (only when bodies were added since the last
- * call). */
+/* Room in g, from its arena (g->arena, the step's), and the numbers of the bodies' features
+ * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
+ * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
+ * reset. 0, or -1 when out of memory. */
 /* The first of the two calls of a step before a web's sub-steps: whether every node is to be
  * found again at state cur (when `all`, the record of the last search is invalid, or a body
  * may have come near: 0 returned), or the per-node move test is to run (1 returned: over every

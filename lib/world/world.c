@@ -176,6 +176,7 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
     if (!w)
         return WS_ERR_OUT_OF_MEMORY;
     w->mem = mem;
+    ws_arena_init(&w->arena, &w->mem);
     w->def = d;
     /* The salt of every slot's first generation, so an id of another world is refused but
      * with odds of about 2^-32 (base.h); no global counter is needed. */
@@ -256,13 +257,11 @@ void ws_world_destroy(ws_world *w)
     ws_mem_free(m, w->params, w->params_cap * sizeof *w->params);
     ws_mem_free(m, w->pair_index, w->pair_dim * w->pair_dim * sizeof *w->pair_index);
     ws_mem_free(m, w->mat_mass, w->pair_dim * sizeof *w->mat_mass);
-    ws_mem_free(m, w->guard_f, 2 * w->guard_cap * sizeof *w->guard_f); /* guard_m is in it */
     for (int k = 0; k < 2; k++) {
         ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
         ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
     }
-    ws_mem_free(m, w->sweep, w->sweep_cap * sizeof *w->sweep);
-    ws_mem_free(m, w->pairs, w->pairs_cap * sizeof *w->pairs);
+    ws_arena_free(&w->arena);
     ws_mem local = *m;
     ws_mem_free(&local, w, sizeof *w);
 }

@@ -16,23 +16,26 @@ static const char *label(const ws_web *web)
     return web->name ? web->name : "(unnamed)";
 }
 
-ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int list)
+ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
 {
-    ws_body_store *b = &w->bodies;
+    ws_world *w = S->w;
+    ws_body_store *b = S->b;
+    const int cur = S->cur, nxt = S->nxt;
     const ws_ncand_list *cl = &web->contact->cand[list];
+    /* The node contacts of the step's sub-steps (scratch of the step). */
+    ws_node_link *links = NULL;
     if (ws_implicit_reserve(&w->mem, web) != 0 ||
-        ws_array_reserve(&w->mem, (void **)&w->links, &w->links_cap, cl->n + 1,
-                         sizeof(ws_node_link)) != 0)
+        !(links = ws_arena_alloc(S->arena, (cl->n + 1) * sizeof *links)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'", label(web));
     ws_implicit *im = web->imp;
     const int n = web->substeps;
-    const double h = w->def.dt / n, share = 1.0 / n;
+    const double h = S->dt / n, share = 1.0 / n;
     ws_nodes3 xs = web->x[cur], vs = web->v[cur];
     for (int s = 0; s < n; s++) {
         const int last_parity = (n - 1 - s) % 2 == 0;
         ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
         ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-        if (ws_implicit_begin(web, xs, vs, w->def.gravity, w->time + s * h, s * h) != 0)
+        if (ws_implicit_begin(web, xs, vs, w->def.gravity, S->t + s * h, s * h) != 0)
             return ws_fail(w, WS_ERR_CALLBACK,
                            "step at t = %.6g s: a spring law of web '%s' failed (its user "
                            "function returned non-zero or gave a non-finite force or "
@@ -42,7 +45,7 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
          * window's top, bounded by the margin the candidates cover. */
         const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
-                                        w->def.contact_margin, w->links);
+                                        S->contact.margin, links);
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
@@ -51,18 +54,17 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
             if (pass > 0)
                 ws_implicit_reset(im);
             for (size_t k = 0; k < nl; k++)
-                if (w->links[k].active)
-                    ws_implicit_add(im, w->links[k].node, w->links[k].f, w->links[k].K,
-                                    w->links[k].D);
+                if (links[k].active)
+                    ws_implicit_add(im, links[k].node, links[k].f, links[k].K, links[k].D);
             if ((ok = ws_implicit_solve(web, vs, h) == 0) == 0)
                 break;
             ws_implicit_velocities(web, vs, vd);
             if (pass + 1 == WS_IMPLICIT_PASSES ||
-                ws_node_link_update(w->links, nl, im->dv, vd, h) == 0)
+                ws_node_link_update(links, nl, im->dv, vd, h) == 0)
                 break;
         }
         if (!ok) {
-            w->stats.numerical_errors++;
+            S->stats->numerical_errors++;
             return ws_fail(w, WS_ERR_NUMERICAL,
                            "web '%s': the implicit step's linear solve did not converge at t = "
                            "%.6g s: residual %.3g of its scale after %d iterations (tolerance "
@@ -73,7 +75,7 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
         }
         const size_t fast = ws_implicit_finish(web, xs, vs, xd, vd, h, w->def.max_speed);
         if (fast) {
-            w->stats.numerical_errors++;
+            S->stats->numerical_errors++;
             const double vmax = ws_web_fastest(web, vd);
             return ws_fail(w, WS_ERR_NUMERICAL,
                            "web '%s': a node ran away in the implicit step at t = %.6g s "
@@ -83,9 +85,9 @@ ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int 
                            label(web), w->time, vmax, w->def.max_speed);
         }
         const size_t nt = web->nfct[nxt];
-        web->nfct[nxt] += ws_node_link_loads(w->links, nl, im->dv, vd, h, share, web->fc[nxt],
-                                             web->fct[nxt] + nt, web->bforce[nxt],
-                                             web->bmoment[nxt]);
+        web->nfct[nxt] +=
+            ws_node_link_loads(links, nl, im->dv, vd, h, share, web->fc[nxt], web->fct[nxt] + nt,
+                               web->bforce[nxt], web->bmoment[nxt]);
         xs = xd;
         vs = vd;
     }

@@ -24,9 +24,9 @@
 
 /* A lane of a parallel sweep of a web (world_step.c): copies of the web and its contact that
  * share their state, with the lane's own scratch (lane 0: the web's); the rows [r0, r1) it
- * sweeps and what it found. Lanes 1.. keep their scratch from web to web and step to step:
- * the spring chunk (tmp, WS_WEB_TMP doubles), the list of touched nodes (fct), the contact
- * lists, run batch and run faces (own). */
+ * sweeps and what it found. Lanes 1.. take the spring chunk (tmp, WS_WEB_TMP doubles) and the
+ * list of touched nodes (fct) from the world's arena for each web of a step, before the lanes
+ * start; they keep the contact lists, run batch and run faces (own) from step to step. */
 typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
@@ -35,7 +35,6 @@ typedef struct ws_lane_job {
     uint64_t checks;
     double *tmp;
     uint32_t *fct;
-    size_t fct_cap;
     ws_node_contact own;
 } ws_lane_job;
 /* Per material, the two lightest dynamic bodies (slots, UINT32_MAX for none) and a kinematic
@@ -61,6 +60,7 @@ typedef struct ws_contact_limit {
 
 struct ws_world {
     ws_mem mem;
+    ws_arena arena; /* a step's scratch, given back when the next step starts */
     ws_world_def def;
     double time;
     uint64_t steps;
@@ -105,26 +105,36 @@ struct ws_world {
     size_t element_cap;
     ws_slot_table element_slots;
 
-    /* Per body slot: the contacts' force and moment (energy guard); one block of 2 guard_cap,
-     * guard_m = guard_f + guard_cap. */
-    v3 *guard_f, *guard_m;
-    size_t guard_cap;
-
     ws_cand *cand[2];
     size_t ncand[2], capcand[2];
     ws_contact_rec *rec[2];
     size_t nrec[2], caprec[2];
-    uint32_t *sweep;
-    size_t sweep_cap;
-    uint32_t *pairs;
-    size_t pairs_cap, npairs;
 
     ws_world_stats stats;
-
-    /* The node contacts of an implicit web's step (world_implicit.c), scratch. */
-    struct ws_node_link *links;
-    size_t links_cap;
 };
+
+/* What the phases of one step share (world_step.c, world_implicit.c), in place of long lists
+ * of arguments: the world and its bodies, the committed buffer cur and the one written (nxt),
+ * the time at the start and the step, the contact evaluation's context (bodies, margin, the
+ * pairs' parameters; it counts the narrow checks), the statistics, the arena every phase takes
+ * its scratch from, and what the phases hand on: whether this is a full detection, the body
+ * pairs it found, the contacts' loads on each body before the elements and the film (for the
+ * energy guard), the contact records written. A web's sub-step is in the lanes' task
+ * (world_step.c), whose node contacts' part (ws_node_pass) contact/ reads. */
+typedef struct ws_step {
+    ws_world *w;
+    ws_body_store *b;
+    int cur, nxt;
+    double t, dt;
+    ws_contact_ctx contact;
+    ws_world_stats *stats;
+    ws_arena *arena;
+    int full;
+    uint32_t *pairs; /* 2 npairs body slots (arena) */
+    size_t npairs;
+    v3 *guard_f, *guard_m; /* by body slot (arena) */
+    size_t nrec;
+} ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that
  * only read: the error text is the one field such calls write. */
@@ -180,12 +190,12 @@ int ws_world_take_slot(ws_world *w, ws_slot_table *t, void ***arr, size_t *cap, 
 void ws_world_lanes_free(ws_world *w);
 /* Node contact parameters of a web's material against every body material (into w->nparams). */
 int ws_world_node_params(ws_world *w, uint32_t web_material);
-/* An implicit web's step (world_implicit.c): its sub-steps from state cur into nxt, the node
+/* An implicit web's step (world_implicit.c): its sub-steps from state S->cur into S->nxt, the node
  * contacts of candidate list `list` in the matrix, the loads on the bodies into web->bforce[nxt]
  * and web->bmoment[nxt] and the bodies' accumulators. WS_ERR_NUMERICAL when a solve does not
  * converge or a node runs away, WS_ERR_CALLBACK when a law fails, WS_ERR_OUT_OF_MEMORY; the
  * committed state is not written. */
-ws_status ws_world_web_implicit(ws_world *w, ws_web *web, int cur, int nxt, int list);
+ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 /* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */

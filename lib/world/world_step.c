@@ -71,26 +71,26 @@ static double max_step_travel(const ws_world *w, int k)
     return most * w->def.dt;
 }
 
-static ws_status detect_full(ws_world *w, ws_contact_ctx *x, int nxt)
+static ws_status detect_full(ws_step *S)
 {
-    ws_mem *mem = &w->mem;
-    if (ws_broad_pairs(mem, &w->bodies, &w->sweep, &w->sweep_cap, &w->pairs, &w->npairs,
-                       &w->pairs_cap) != 0)
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
     w->ncand[nxt] = 0;
-    for (size_t k = 0; k < w->npairs; k++) {
-        uint32_t i = w->pairs[2 * k], j = w->pairs[2 * k + 1];
-        if (w->def.use_ccd && !ws_ccd_may_touch_at(&w->bodies, w->cur, i, j, w->def.contact_margin)) {
-            w->stats.body_pairs_gated++;
+    for (size_t k = 0; k < S->npairs; k++) {
+        uint32_t i = S->pairs[2 * k], j = S->pairs[2 * k + 1];
+        if (w->def.use_ccd && !ws_ccd_may_touch_at(S->b, S->cur, i, j, S->contact.margin)) {
+            S->stats->body_pairs_gated++;
             continue;
         }
-        w->stats.body_pairs_tested++;
-        if (ws_contact_candidates(mem, x, i, j, &w->cand[nxt], &w->ncand[nxt], &w->capcand[nxt]) !=
-            0)
+        S->stats->body_pairs_tested++;
+        if (ws_contact_candidates(&w->mem, &S->contact, i, j, &w->cand[nxt], &w->ncand[nxt],
+                                  &w->capcand[nxt]) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
     }
     ws_contact_sort(w->cand[nxt], w->ncand[nxt]);
-    ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[w->cur], w->ncand[w->cur]);
+    ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[S->cur], w->ncand[S->cur]);
     return WS_OK;
 }
 
@@ -303,16 +303,17 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     J[lanes - 1].r1 = ny;
 }
 
-/* The scratch of each of the lanes ready for ncand candidates; 0 when out of memory. */
-static int lanes_ready(ws_world *w, ws_web *web, uint32_t lanes, size_t ncand)
+/* The scratch of each of the lanes ready for ncand candidates: the spring chunk and the list
+ * of touched nodes from the step's arena, here on the calling thread before the lanes start
+ * (they never share the arena's bump pointer); the contact scratch the lanes keep. 0 when out
+ * of memory. */
+static int lanes_ready(ws_step *S, ws_web *web, uint32_t lanes, size_t ncand)
 {
     for (uint32_t i = 1; i < lanes; i++) {
-        ws_lane_job *J = &w->lane_job[i];
-        if (!J->tmp && !(J->tmp = ws_mem_calloc(&w->mem, WS_WEB_TMP, sizeof(double))))
-            return 0;
-        if (ws_node_lane_scratch(&w->mem, &J->own, web->contact, web->n, ncand) != 0 ||
-            ws_array_reserve(&w->mem, (void **)&J->fct, &J->fct_cap, ncand + 1, sizeof(uint32_t)) !=
-                0)
+        ws_lane_job *J = &S->w->lane_job[i];
+        if (!(J->tmp = ws_arena_calloc(S->arena, WS_WEB_TMP, sizeof(double))) ||
+            !(J->fct = ws_arena_alloc(S->arena, (ncand + 1) * sizeof(uint32_t))) ||
+            ws_node_lane_scratch(&S->w->mem, &J->own, web->contact, web->n, ncand) != 0)
             return 0;
     }
     return 1;
@@ -381,11 +382,8 @@ void ws_world_lanes_free(ws_world *w)
     for (size_t i = 0; w->lane_job && i < jobs; i++) {
         ws_lane_job *J = &w->lane_job[i];
         ws_node_scratch_free(&w->mem, &J->own);
-        ws_mem_free(&w->mem, J->tmp, J->tmp ? WS_WEB_TMP * sizeof(double) : 0);
-        ws_mem_free(&w->mem, J->fct, J->fct_cap * sizeof(uint32_t));
-        J->tmp = NULL;
+        J->tmp = NULL; /* the arena's */
         J->fct = NULL;
-        J->fct_cap = 0;
     }
 }
 
@@ -409,7 +407,7 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
         return;
     v->tmp = J->tmp;
     v->fct[v->fck] = J->fct;
-    v->fct_cap[v->fck] = J->fct_cap;
+    v->fct_cap[v->fck] = 0; /* the arena's room: nothing grows or frees it through the view */
     v->nfct[v->fck] = 0;
     c->act = J->own.act;
     c->act_id = J->own.act_id;
@@ -462,9 +460,12 @@ static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
  * swept block by block (ws_web_forces_block). Forces on the bodies go into their accumulators,
  * averaged over the sub-steps. */
-static ws_status step_webs(ws_world *w, int cur, int nxt)
+static ws_status step_webs(ws_step *S)
 {
-    ws_body_store *b = &w->bodies;
+    ws_world *w = S->w;
+    ws_body_store *b = S->b;
+    const int cur = S->cur, nxt = S->nxt;
+    w->node_geom.arena = S->arena; /* the bodies' features and the node search's tables */
     if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
     for (size_t k = 0; k < w->web_slots.slot_count; k++) {
@@ -476,16 +477,16 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         int searched = 0;
         const uint32_t lanes = web_lanes(w, web);
         size_t flagged = 0;
-        if (ws_node_contact_begin(b, cur, web, w->def.dt, w->def.contact_margin, !w->cand_valid))
+        if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
             flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
-        if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, w->def.contact_margin,
-                                   flagged, &w->stats.narrow_checks, &searched) != 0)
+        if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, S->contact.margin, flagged,
+                                   &S->stats->narrow_checks, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
-            w->stats.seconds_detection += clock_now(w) - t0;
-            w->stats.seconds_web -= clock_now(w) - t0;
+            S->stats->seconds_detection += clock_now(w) - t0;
+            S->stats->seconds_web -= clock_now(w) - t0;
         }
         const int list = nc->next_list;
         if (ws_world_node_params(w, web->material) != 0)
@@ -493,7 +494,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         /* Room to list every contact of every sub-step, before anything changes. */
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
                              (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0 ||
-            !lanes_ready(w, web, lanes, nc->cand[list].n))
+            !lanes_ready(S, web, lanes, nc->cand[list].n))
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         lanes_cut(w, web, lanes);
@@ -507,13 +508,13 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (web->integrator == WS_WEB_IMPLICIT) {
-            ws_status st = ws_world_web_implicit(w, web, cur, nxt, list);
+            ws_status st = ws_world_web_implicit(S, web, list);
             if (st != WS_OK)
                 return st;
             continue;
         }
         int n = web->substeps;
-        double h = w->def.dt / n, share = 1.0 / n;
+        double h = S->dt / n, share = 1.0 / n;
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -521,7 +522,7 @@ static ws_status step_webs(ws_world *w, int cur, int nxt)
             int last_parity = (n - 1 - s) % 2 == 0;
             ws_nodes3 xd = last_parity ? web->x[nxt] : web->xsub;
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
-            ws_web_sweep_laws(web, w->def.gravity, w->time + s * h, s * h);
+            ws_web_sweep_laws(web, w->def.gravity, S->t + s * h, s * h);
             lane_task T = {w,
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
                             web->fc[nxt]},
@@ -636,24 +637,26 @@ static double kinetic(const ws_body_store *b, const ws_body_state *st, size_t i)
  * its mean velocities; drives: the contact forces of kinematic bodies times their speed) plus
  * WS_ENERGY_GROWTH_FACTOR times the kinetic and contact energy at its start. Stable penalty
  * contacts release at most what they store; more is a runaway, whatever max_speed says. */
-static ws_status energy_guard(ws_world *w, int cur, int nxt, size_t nrec)
+static ws_status energy_guard(const ws_step *S)
 {
-    const ws_body_store *b = &w->bodies;
-    const ws_body_state *s0 = &b->st[cur], *s1 = &b->st[nxt];
-    const double dt = w->def.dt;
+    ws_world *w = S->w;
+    const ws_body_store *b = S->b;
+    const ws_body_state *s0 = &b->st[S->cur], *s1 = &b->st[S->nxt];
+    const double dt = S->dt;
+    const size_t nrec = S->nrec;
     double t0 = 0.0, t1 = 0.0, work = 0.0, stored = 0.0;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
             continue;
         t0 += kinetic(b, s0, i);
         t1 += kinetic(b, s1, i);
-        v3 f = v3_sub(b->f[i], w->guard_f[i]), m = v3_sub(b->m[i], w->guard_m[i]);
+        v3 f = v3_sub(b->f[i], S->guard_f[i]), m = v3_sub(b->m[i], S->guard_m[i]);
         v3 w1 = m3_mul_v(&b->A[i], s1->w[i]);
         work += 0.5 * dt *
                 (v3_dot(f, v3_add(s0->v[i], s1->v[i])) + v3_dot(m, v3_add(b->wg[i], w1)));
     }
     for (size_t k = 0; k < nrec; k++) {
-        const ws_contact_rec *r = &w->rec[nxt][k];
+        const ws_contact_rec *r = &w->rec[S->nxt][k];
         stored += r->energy + r->energy_t;
         v3 F = v3_add(v3_scale(r->n, r->fn), r->ft); /* on b; a gets -F */
         uint32_t ends[2] = {r->a, r->b};
@@ -671,7 +674,7 @@ static ws_status energy_guard(ws_world *w, int cur, int nxt, size_t nrec)
                      1e-9 * (t0 + t1) + 1e-300;
     if (t1 - t0 <= allowed)
         return WS_OK;
-    w->stats.numerical_errors++;
+    S->stats->numerical_errors++;
     ws_contact_limit L;
     ws_world_contact_limit(w, &L);
     return ws_fail(w, WS_ERR_NUMERICAL,
@@ -685,10 +688,11 @@ static ws_status energy_guard(ws_world *w, int cur, int nxt, size_t nrec)
                    ws_world_stable_dt(w), material_label(w, L.mat_a), material_label(w, L.mat_b));
 }
 
-static ws_status health(ws_world *w, int nxt)
+static ws_status health(const ws_step *S)
 {
-    const ws_body_store *b = &w->bodies;
-    const ws_body_state *n = &b->st[nxt];
+    ws_world *w = S->w;
+    const ws_body_store *b = S->b;
+    const ws_body_state *n = &b->st[S->nxt];
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
             continue;
@@ -697,7 +701,7 @@ static ws_status health(ws_world *w, int nxt)
                      isfinite(qt_norm(n->p[i]));
         if (finite && sp <= w->def.max_speed && om <= w->def.max_angular_speed)
             continue;
-        w->stats.numerical_errors++;
+        S->stats->numerical_errors++;
         double dts = ws_world_stable_dt(w);
         const char *what = !finite ? "its state became NaN or infinite"
                            : sp > w->def.max_speed ? "it ran away (speed above max_speed)"
@@ -712,42 +716,21 @@ static ws_status health(ws_world *w, int nxt)
     return WS_OK;
 }
 
-/* One step; ws_world_step guards it against calls from its own callbacks. */
-static ws_status step_once(ws_world *w)
+/* Detection (stage 2): a full one, or the cached candidates copied as they are; then room for
+ * one contact record per candidate, so that evaluation cannot fail half-way. */
+static ws_status detect(ws_step *S)
 {
-    ws_body_store *b = &w->bodies;
-    const int cur = w->cur, nxt = cur ^ 1;
-    const double dt = w->def.dt, t = w->time;
-    const double t_start = clock_now(w);
-    ws_status s;
-    if ((s = bodies_ready(w)) != WS_OK)
-        return s;
-    /* Room for the energy guard's record of the contacts' loads on each body: one block, the
-     * forces then the moments, so a failed grow leaves one consistent size. */
-    if (w->guard_cap < b->slots) {
-        size_t cap = b->capacity;
-        v3 *f = ws_mem_realloc(&w->mem, w->guard_f, 2 * w->guard_cap * sizeof(v3),
-                               2 * cap * sizeof(v3));
-        if (!f)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
-        w->guard_f = f;
-        w->guard_m = f + cap;
-        w->guard_cap = cap;
-    }
-
-    prepare(w);
-
-    ws_contact_ctx x = {b, cur, w->def.contact_margin, w->params, w->pair_index,
-                        (uint32_t)w->pair_dim, 0};
+    ws_world *w = S->w;
+    const int cur = S->cur, nxt = S->nxt;
     /* Cached candidates hold every feature pair within the layers + margin at the last full
      * detection. Two bodies can close that margin only if each has moved by half of it, so a
      * full detection is forced early when the travel bound says so, whatever the interval. */
-    int full = !w->cand_valid || t < w->def.full_detection_until ||
-               w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval ||
-               2.0 * w->travel >= w->def.contact_margin;
-    double t_mark = clock_now(w);
-    if (full) {
-        if ((s = detect_full(w, &x, nxt)) != WS_OK)
+    S->full = !w->cand_valid || S->t < w->def.full_detection_until ||
+              w->steps - w->last_full_step >= (uint64_t)w->def.detection_interval ||
+              2.0 * w->travel >= w->def.contact_margin;
+    ws_status s;
+    if (S->full) {
+        if ((s = detect_full(S)) != WS_OK)
             return s;
     } else {
         if (ws_array_reserve(&w->mem, (void **)&w->cand[nxt], &w->capcand[nxt], w->ncand[cur],
@@ -757,37 +740,42 @@ static ws_status step_once(ws_world *w)
             memcpy(w->cand[nxt], w->cand[cur], w->ncand[cur] * sizeof *w->cand[nxt]);
         w->ncand[nxt] = w->ncand[cur];
     }
-    /* Every candidate can be one contact: reserve now so evaluation cannot fail half-way. */
     if (ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
                          sizeof *w->rec[nxt]) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact records");
+    return WS_OK;
+}
 
-    double t_eval = clock_now(w);
-    w->stats.seconds_detection += t_eval - t_mark;
+/* The body contacts (stage 3): every candidate evaluated into a record of nxt, and the
+ * contacts' share of each body's load kept for the energy guard (gravity taken out). */
+static void body_contacts(ws_step *S)
+{
+    ws_world *w = S->w;
+    const ws_body_store *b = S->b;
+    const int nxt = S->nxt;
     size_t nrec = 0;
     for (size_t k = 0; k < w->ncand[nxt]; k++)
-        if (ws_contact_eval(&x, &w->cand[nxt][k], &w->rec[nxt][nrec]))
+        if (ws_contact_eval(&S->contact, &w->cand[nxt][k], &w->rec[nxt][nrec]))
             nrec++;
-    /* The contacts' share of each body's load, for the energy guard (gravity taken out). */
+    S->nrec = nrec;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
         v3 g = b->type[i] == WS_BODY_DYNAMIC ? v3_scale(w->def.gravity, b->mass[i])
                                               : v3_make(0, 0, 0);
-        w->guard_f[i] = v3_sub(b->f[i], g);
-        w->guard_m[i] = b->m[i];
+        S->guard_f[i] = v3_sub(b->f[i], g);
+        S->guard_m[i] = b->m[i];
     }
-    if ((s = ws_world_element_forces(w, cur, t)) != WS_OK) /* rods, springs, bushings */
-        return s;
+}
 
-    double t_web = clock_now(w);
-    w->stats.seconds_contacts += t_web - t_eval;
-    if (w->web_slots.slot_count) {
-        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(w, cur, nxt)) != WS_OK)
-            return s;
-        w->stats.seconds_web += clock_now(w) - t_web;
-    }
-
+/* Stage 4: dynamic bodies integrated into nxt; kinematic ones held, or posed by their drives
+ * at t + dt. */
+static ws_status integrate(ws_step *S)
+{
+    ws_world *w = S->w;
+    ws_body_store *b = S->b;
+    const int cur = S->cur, nxt = S->nxt;
+    const double t = S->t, dt = S->dt;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
@@ -815,7 +803,7 @@ static ws_status step_once(ws_world *w)
                                "its callback returned non-zero or gave a non-finite pose or "
                                "velocity at t = %.6g s; the step was undone",
                                t, body_label(w, i), i, t + dt);
-            w->stats.numerical_errors++;
+            S->stats->numerical_errors++;
             return ws_fail(w, WS_ERR_NUMERICAL,
                            "step at t = %.6g s: the drive of body '%s' (index %zu) gives a "
                            "non-finite pose or velocity at t = %.6g s; the step was undone",
@@ -827,20 +815,21 @@ static ws_status step_once(ws_world *w)
         n->v[i] = v;
         n->w[i] = m3_tmul_v(&A, om);
     }
+    return WS_OK;
+}
 
-    w->stats.narrow_checks += x.narrow_checks;
-    if ((s = health(w, nxt)) != WS_OK || (s = energy_guard(w, cur, nxt, nrec)) != WS_OK)
-        return s;
-
-    /* Commit. */
-    w->nrec[nxt] = nrec;
-    ws_world_commit_elements(w, t); /* the law histories of the strains this step used */
-    w->cur = nxt;
-    w->time = t + dt;
-    if (full) {
+/* Stage 6: what the step wrote becomes the committed state. */
+static void commit(ws_step *S)
+{
+    ws_world *w = S->w;
+    w->nrec[S->nxt] = S->nrec;
+    ws_world_commit_elements(w, S->t); /* the law histories of the strains this step used */
+    w->cur = S->nxt;
+    w->time = S->t + S->dt;
+    if (S->full) {
         w->last_full_step = w->steps;
         w->cand_valid = 1;
-        w->stats.full_detections++;
+        S->stats->full_detections++;
         w->travel = 0.0;
     }
     w->travel += max_step_travel(w, w->cur); /* this step's motion bound */
@@ -849,10 +838,60 @@ static ws_status step_once(ws_world *w)
             continue;
         ws_web *web = w->webs[k];
         ws_node_contact_commit(web->contact);
-        ws_web_commit(web, web->x[w->cur], web->v[w->cur], w->time, w->def.dt);
+        ws_web_commit(web, web->x[w->cur], web->v[w->cur], w->time, S->dt);
     }
     w->steps++;
-    w->stats.seconds_total += clock_now(w) - t_start;
+}
+
+/* One step; ws_world_step guards it against calls from its own callbacks. */
+static ws_status step_once(ws_world *w)
+{
+    const double t_start = clock_now(w);
+    ws_status s;
+    if ((s = bodies_ready(w)) != WS_OK)
+        return s;
+    /* The last step's scratch is given back; this step's comes from the arena. */
+    ws_arena_reset(&w->arena);
+    ws_body_store *b = &w->bodies;
+    ws_step S = {.w = w,
+                 .b = b,
+                 .cur = w->cur,
+                 .nxt = w->cur ^ 1,
+                 .t = w->time,
+                 .dt = w->def.dt,
+                 .contact = {b, w->cur, w->def.contact_margin, w->params, w->pair_index,
+                             (uint32_t)w->pair_dim, 0},
+                 .stats = &w->stats,
+                 .arena = &w->arena};
+    /* The energy guard's record of the contacts' loads on each body. */
+    if (!(S.guard_f = ws_arena_alloc(S.arena, 2 * (b->slots + 1) * sizeof(v3))))
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+    S.guard_m = S.guard_f + b->slots + 1;
+
+    prepare(w);
+    double t_mark = clock_now(w);
+    if ((s = detect(&S)) != WS_OK)
+        return s;
+    double t_eval = clock_now(w);
+    S.stats->seconds_detection += t_eval - t_mark;
+    body_contacts(&S);
+    if ((s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK) /* rods, springs, bushings */
+        return s;
+
+    double t_web = clock_now(w);
+    S.stats->seconds_contacts += t_web - t_eval;
+    if (w->web_slots.slot_count) {
+        if ((s = webs_ready(w)) != WS_OK || (s = step_webs(&S)) != WS_OK)
+            return s;
+        S.stats->seconds_web += clock_now(w) - t_web;
+    }
+    if ((s = integrate(&S)) != WS_OK)
+        return s;
+    S.stats->narrow_checks += S.contact.narrow_checks;
+    if ((s = health(&S)) != WS_OK || (s = energy_guard(&S)) != WS_OK)
+        return s;
+    commit(&S);
+    S.stats->seconds_total += clock_now(w) - t_start;
     return WS_OK;
 }
 
