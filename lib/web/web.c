@@ -189,8 +189,8 @@ static inline double film_pull(const ws_spring_form *p, v3 d, v3 u, double il0)
 
 /* Node vectors as the vector loops take them, from node i on: restrict, as no two arrays that
  * a loop reads and writes overlap, so the compiler runs the loop on vectors without checking
- * first. The compiler takes the restrict of a struct's fields where the struct is a function's
- * argument by value (not behind a pointer, not a local variable). */
+ * first. GCC honours the restrict of a struct's fields where the struct is a parameter passed
+ * by value (also into an inlined function), not where it is reached through a pointer. */
 typedef struct in3 {
     const double *restrict x, *restrict y, *restrict z;
 } in3;
