@@ -61,37 +61,47 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     web->imp = NULL;
 }
 
-/* Spring s at (x, v): its direction e (unit, a to b), length l, strain and rate. 0 when its
- * ends coincide (no direction: it then neither pulls nor enters the matrix). */
-static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *e,
-                           double *l, double *eps, double *rate, v3 *dvel)
+/* A spring in a state (x, v): its direction e (unit, a to b), the velocity of b relative to a,
+ * its length l, strain and strain rate; then its law's force F there and the force's
+ * derivatives by the strain (Fu) and by the rate (Fud). */
+typedef struct spring_state {
+    v3 e, dvel;
+    double l, eps, rate;
+    double F, Fu, Fud;
+} spring_state;
+
+/* Spring s at (x, v): its geometry into q. 0 when its ends coincide (no direction: it then
+ * neither pulls nor enters the matrix). */
+static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
+                           spring_state *q)
 {
     const uint32_t a = web->sa[s], b = web->sb[s];
     const v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
     const double l2 = v3_dot(d, d);
     if (!(l2 > 0.0))
         return 0;
-    *l = sqrt(l2);
-    *e = v3_scale(d, 1.0 / *l);
-    *dvel = v3_sub(nodes_get(v, b), nodes_get(v, a));
-    *eps = *l * web->inv_l0[s] - 1.0;
-    *rate = v3_dot(*dvel, *e) * web->inv_l0[s];
+    q->l = sqrt(l2);
+    q->e = v3_scale(d, 1.0 / q->l);
+    q->dvel = v3_sub(nodes_get(v, b), nodes_get(v, a));
+    q->eps = q->l * web->inv_l0[s] - 1.0;
+    q->rate = v3_dot(q->dvel, q->e) * web->inv_l0[s];
     return 1;
 }
 
-/* Spring s's law at (eps, rate): force and derivatives, times its stiffness scale (a mesh
- * web's film layers). 1 when the law failed. */
-static int spring_law(const ws_web *web, uint32_t s, double eps, double rate, double t,
-                      double since, double *F, double *Fu, double *Fud)
+/* Spring s's law at q's strain and rate, at t, since after its history was committed: force
+ * and derivatives into q, times its stiffness scale (a mesh web's film layers). 1 when the law
+ * failed. */
+static int spring_law(const ws_web *web, uint32_t s, double t, double since, spring_state *q)
 {
     const double *hist = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-    if (ws_law_eval(web->law[web->kind[s]], hist, &eps, &rate, t, since, F, Fu, Fud) != 0)
+    if (ws_law_eval(web->law[web->kind[s]], hist, &q->eps, &q->rate, t, since, &q->F, &q->Fu,
+                    &q->Fud) != 0)
         return 1;
     if (web->kscale) {
         const double k = web->kscale[s];
-        *F *= k;
-        *Fu *= k;
-        *Fud *= k;
+        q->F *= k;
+        q->Fu *= k;
+        q->Fud *= k;
     }
     return 0;
 }
@@ -126,14 +136,15 @@ int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double 
     }
     for (uint32_t s = 0; s < web->ns; s++) {
         ws_ispring *q = &im->sp[s];
-        v3 e, dvel;
-        double l, eps, rate, F, Fu, Fud;
-        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
+        spring_state z;
+        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &z)) {
             *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             continue;
         }
-        if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud) || !isfinite(F))
+        if (spring_law(web, s, t, since, &z) || !isfinite(z.F))
             return 1;
+        const v3 e = z.e;
+        const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
         const uint32_t a = web->sa[s], b = web->sb[s];
         f[3 * a] += F * e.x;
         f[3 * a + 1] += F * e.y;
@@ -482,14 +493,15 @@ size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, w
 int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, double t,
                              double since, double Jx[9], double Jv[9])
 {
-    v3 e, dvel;
-    double l, eps, rate, F, Fu, Fud;
+    spring_state z;
     memset(Jx, 0, 9 * sizeof(double));
     memset(Jv, 0, 9 * sizeof(double));
-    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel))
+    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &z))
         return 0;
-    if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud))
+    if (spring_law(web, s, t, since, &z))
         return 1;
+    const v3 e = z.e, dvel = z.dvel;
+    const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
     /* f_a = F e: d/dx_b = e dF/dx_b + F de/dx_b, with de/dx_b = (I - e e^T) / l, deps/dx_b =
      * e^T / l0 and drate/dx_b = dvel^T (I - e e^T) / (l l0); d/dv_b = Fud e e^T / l0. */
     const double il0 = web->inv_l0[s];
