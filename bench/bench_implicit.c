@@ -6,7 +6,8 @@
  * bottom one, wall time, CG iterations a step and node-updates a second per CG iteration.
  * Never fails on time.
  * Usage: bench_implicit [what] [duration s]: what = ref (the three films at dt 0.25 ms,
- * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on), ratio (the three films' times
+ * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on; dt1sub:
+ * dt 1 ms with the film in 1 and in 4 sub-steps), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
  * times in each direction, short runs: cost per simulated second and containment). */
 #define TILT_TABLE_NO_MAIN
@@ -79,6 +80,21 @@ int main(int argc, char **argv)
             char name[64];
             snprintf(name, sizeof name, "implicit, 1.6 mg nodes, dt %.2f ms", 1e3 * dts[k]);
             line(name, &a);
+        }
+    } else if (!strcmp(what, "dt1sub")) {
+        /* What limits dt 1 ms: the world (bodies and their contacts) at 1 ms with the film at
+         * 4 sub-steps of 0.25 ms each, beside both at 1 ms (dt1's first line). When the film's
+         * sub-steps bring the slide back to the 0.25 ms run's, the film's own step (its
+         * contacts' and friction's linearisation over h) is what limits; when not, the
+         * bodies' step and their coupling to the film are. */
+        for (int k = 0; k < 2; k++) {
+            tilt_options a = o;
+            a.film_mass = 1.6e-6;
+            a.implicit = 1;
+            a.substeps = k ? 4 : 1;
+            a.dt = 1e-3;
+            line(k ? "implicit, dt 1 ms, 4 film sub-steps" : "implicit, dt 1 ms, 1 film step",
+                 &a);
         }
     } else if (!strcmp(what, "ratio")) {
         /* Time ratios from interleaved rounds of the first `duration` s (default 0.5 s: the

@@ -14,7 +14,7 @@
  * (A = N + sum over springs of E^T K E with E = e_a - e_b, and 2 D - A = N + sum (e_a + e_b)^T
  * K (e_a + e_b) >= 0), so any weight below 1 contracts in A's norm and the cycle stays positive
  * definite; 2/3 is the weight that damps the grid's upper half of frequencies best. */
-#define MG_SWEEPS 1
+#define MG_SWEEPS 2
 #define MG_OMEGA (2.0 / 3.0)
 #define BLK 9           /* a full 3x3 block, row-major */
 /* A coarse node's row holds its own block and those of its forward neighbours (slots 4 to 8 of
@@ -340,36 +340,76 @@ static void row_times(const mg_level *L, size_t k, const int64_t *j, int side, d
 
 /* One sweep of block Gauss-Seidel on coarse level L: forward from x = 0 (a node then meets
  * only the nodes before it, those after being still zero), which leaves the residual r - A x
- * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j); or backward
- * from the x there is. */
+ * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
+ * as that node is solved, with the block its own solve has just read); or backward from the x
+ * there is. */
 static void gauss_seidel(mg_level *L, int backward)
 {
     const int nx = L->nx, ny = L->ny;
     int64_t j[9];
+    if (!backward)
+        memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
     for (int q = 0; q < nx * ny; q++) {
         const int k = backward ? nx * ny - 1 - q : q;
         neighbours(L, k % nx, k / nx, j);
         const double *R = L->r + 3 * (size_t)k;
         double s[3] = {R[0], R[1], R[2]};
-        row_times(L, (size_t)k, j, backward ? 0 : -1, s);
+        if (backward) {
+            row_times(L, (size_t)k, j, 0, s);
+        } else {
+            /* A_kj for the nodes j before k: the transpose of j's forward block, or k's own
+             * forward block across a band's seam. */
+            const double *B[9];
+            int tr[9];
+            for (int o = 0; o < 9; o++) {
+                B[o] = NULL;
+                if (j[o] < 0 || o == CENTRE || j[o] > k)
+                    continue;
+                tr[o] = o < CENTRE;
+                B[o] = tr[o] ? AT(L, j[o], 8 - o) : AT(L, k, o);
+                const double *X = L->x + 3 * (size_t)j[o], *M = B[o];
+                if (tr[o]) {
+                    s[0] -= M[0] * X[0] + M[3] * X[1] + M[6] * X[2];
+                    s[1] -= M[1] * X[0] + M[4] * X[1] + M[7] * X[2];
+                    s[2] -= M[2] * X[0] + M[5] * X[1] + M[8] * X[2];
+                } else {
+                    s[0] -= M[0] * X[0] + M[1] * X[1] + M[2] * X[2];
+                    s[1] -= M[3] * X[0] + M[4] * X[1] + M[5] * X[2];
+                    s[2] -= M[6] * X[0] + M[7] * X[1] + M[8] * X[2];
+                }
+            }
+            const double *S = L->dinv + WS_SYM * (size_t)k;
+            double *X = L->x + 3 * (size_t)k;
+            X[0] = X[1] = X[2] = 0.0;
+            ws_sym_madd(S, s[0], s[1], s[2], X);
+            for (int o = 0; o < 9; o++) { /* t_j -= A_jk x_k, A_jk = A_kj^T */
+                if (!B[o])
+                    continue;
+                const double *M = B[o];
+                double *T = L->t + 3 * (size_t)j[o];
+                if (tr[o]) {
+                    T[0] -= M[0] * X[0] + M[1] * X[1] + M[2] * X[2];
+                    T[1] -= M[3] * X[0] + M[4] * X[1] + M[5] * X[2];
+                    T[2] -= M[6] * X[0] + M[7] * X[1] + M[8] * X[2];
+                } else {
+                    T[0] -= M[0] * X[0] + M[3] * X[1] + M[6] * X[2];
+                    T[1] -= M[1] * X[0] + M[4] * X[1] + M[7] * X[2];
+                    T[2] -= M[2] * X[0] + M[5] * X[1] + M[8] * X[2];
+                }
+            }
+            continue;
+        }
         const double *S = L->dinv + WS_SYM * (size_t)k;
         double *X = L->x + 3 * (size_t)k;
         X[0] = X[1] = X[2] = 0.0;
         ws_sym_madd(S, s[0], s[1], s[2], X);
     }
-    if (backward)
-        return;
-    for (int k = 0; k < nx * ny; k++) {
-        neighbours(L, k % nx, k / nx, j);
-        double *T = L->t + 3 * (size_t)k;
-        T[0] = T[1] = T[2] = 0.0;
-        row_times(L, (size_t)k, j, 1, T);
-    }
 }
 
-/* c->r = P^T t (t a level-f vector; f the film's when web is given, its pinned nodes then
- * left out), and prolongation x += P c->x. */
-static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *t)
+/* c->r = P^T (r - t), or P^T t when r is NULL (r, t level-f vectors; f the film's when web is
+ * given, its pinned nodes then left out), and prolongation x += P c->x. */
+static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *r,
+                        const double *t)
 {
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
@@ -382,11 +422,16 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
                 continue;
             pmap_of(f, c, ix, iy, &p);
             const double *T = t + 3 * (size_t)i;
+            double d[3] = {T[0], T[1], T[2]};
+            if (r) {
+                const double *F = r + 3 * (size_t)i;
+                d[0] = F[0] - d[0], d[1] = F[1] - d[1], d[2] = F[2] - d[2];
+            }
             for (int q = 0; q < p.n; q++) {
                 double *R = c->r + 3 * (size_t)p.idx[q];
-                R[0] += p.w[q] * T[0];
-                R[1] += p.w[q] * T[1];
-                R[2] += p.w[q] * T[2];
+                R[0] += p.w[q] * d[0];
+                R[1] += p.w[q] * d[1];
+                R[2] += p.w[q] * d[2];
             }
         }
 }
@@ -443,7 +488,7 @@ static void cycle(ws_mg *mg, int k)
     }
     mg_level *L = &mg->lv[k];
     gauss_seidel(L, 0);
-    restrict_to(mg, NULL, k, L->t);
+    restrict_to(mg, NULL, k, NULL, L->t);
     cycle(mg, k + 1);
     prolong_add(mg, NULL, k, L->x);
     gauss_seidel(L, 1);
@@ -478,9 +523,7 @@ double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
         jacobi(web, r, t, z);
     }
     (void)ws_implicit_apply_op(web, z, t);
-    for (size_t j = 0; j < m; j++)
-        t[j] = r[j] - t[j];
-    restrict_to(mg, web, 0, t);
+    restrict_to(mg, web, 0, r, t);
     cycle(mg, 1);
     prolong_add(mg, web, 0, z);
     for (int s = 0; s < MG_SWEEPS; s++) {
