@@ -847,23 +847,29 @@ static double dot3(const double *a, const double *b, uint32_t n)
     return s;
 }
 
-START_TEST(test_multigrid)
+/* The sheet of test_multigrid refined r times in each direction (the same film: a spring's
+ * EA and damping with its share of the width, a node's mass with its share of the area), 5
+ * steps: its film solve to 1e-11 from zero by multigrid and by block Jacobi, their iterations;
+ * with checks, the cycle's symmetry and definiteness and a known solution too. */
+static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg_out,
+                       int *it_bj_out)
 {
-    /* A sheet of 41 x 23 nodes with shear springs (every neighbour of the grid's 9-point
-     * stencil), pinned along one edge, sagging under gravity at dt 2 ms (its springs' h^2 k
-     * 400 times a node's mass: block Jacobi's condition number of a few thousand). On its
-     * matrix, the V-cycle B must be symmetric (u.Bv = v.Bu to round-off, 1e-12 of |u||Bv|) and
-     * positive definite (u.Bu > 0), conjugate gradients with it must reach a known solution
-     * (to 1e-12 of the residual's scale, so to 1e-8 of the solution with a condition number
-     * under 1e4), and the film's solve with it must give block Jacobi's dv (both to residual
-     * 1e-11 of its scale: 1e-7 of dv) in fewer iterations. */
-    const int nx = 41, ny = 23;
+    /* A drum: a sheet of 41 x 23 nodes (r = 1) pinned along its whole edge, pre-stretched
+     * 40 % and 20 % as the reference film, with shear springs (every neighbour of the grid's
+     * 9-point stencil), sagging under gravity at dt 2 ms (a spring's h^2 k 1600 times a
+     * node's mass at r = 1). On its matrix, the V-cycle B must be symmetric (u.Bv = v.Bu to
+     * round-off, 1e-12 of |u||Bv|) and positive definite (u.Bu > 0), conjugate gradients with
+     * it must reach a known solution (to 1e-12 of the residual's scale, so to 1e-8 of the
+     * solution with a condition number under 1e4), and the film's solve with it must give
+     * block Jacobi's dv (both to residual 1e-11 of its scale: 1e-7 of dv) in fewer
+     * iterations. */
+    const int nx = 40 * r + 1, ny = 22 * r + 1;
     const double dt = 2e-3;
     ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 20.0, 0.0, 0.01, 0.0);
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 20.0 / r, 0.0, 0.01 / r, 0.0);
     ws_web_def wd;
     ws_web_def_init(&wd);
-    wd.node_mass = 1e-4;
+    wd.node_mass = 1e-4 / (r * r);
     wd.law = law;
     wd.law_shear = law;
     wd.integrator = WS_WEB_IMPLICIT;
@@ -873,21 +879,27 @@ START_TEST(test_multigrid)
     ws_sheet_def_init(&sd);
     sd.nx = nx;
     sd.ny = ny;
-    sd.spacing_x = sd.spacing_y = 0.01;
-    sd.prestretch_x = 0.1;
-    sd.prestretch_y = 0.05;
+    sd.spacing_x = sd.spacing_y = 0.01 / r;
+    sd.prestretch_x = pre_x;
+    sd.prestretch_y = pre_y;
     sd.shear = 1;
-    uint32_t pins[41];
-    for (int i = 0; i < nx; i++)
-        pins[i] = (uint32_t)i;
+    uint32_t pins[2 * (161 + 89)]; /* the whole edge: a drum */
+    ck_assert_int_le(nx, 161);
+    ck_assert_int_le(ny, 89);
+    size_t np = 0;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++)
+            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
+                pins[np++] = (uint32_t)(i + nx * j);
     sd.pinned = pins;
-    sd.pinned_count = (size_t)nx;
+    sd.pinned_count = np;
     ws_web_id id;
     ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &id));
     ck_ok(w, ws_world_step_n(w, 5));
     ws_web *web = web_of(w, id);
     ws_implicit *im = web->imp;
     ck_assert_msg(im && im->mg, "a grid web takes the multigrid preconditioner");
+    im->mg_ready = 0; /* coarse matrices of this solve's matrix */
     const uint32_t n = web->n;
     const int cur = w->cur;
     ws_nodes3 x = web->x[cur], v = web->v[cur];
@@ -901,6 +913,8 @@ START_TEST(test_multigrid)
     const int it_mg = im->last_iterations;
     memcpy(dv_mg, im->dv, 3 * n * sizeof(double));
     /* B on the operator of this solve (the block-Jacobi solve below leaves it as it is). */
+    if (!checks)
+        goto jacobi;
     random_vector(web, 1, u);
     random_vector(web, 2, y);
     (void)ws_mg_apply(im->mg, web, u, Bu);
@@ -916,22 +930,22 @@ START_TEST(test_multigrid)
     /* Conjugate gradients with B on A x = b for a known x (u). */
     {
         double *b = malloc(3 * n * sizeof(double)), *xs = calloc(3 * n, sizeof(double)),
-               *r = malloc(3 * n * sizeof(double)), *z = malloc(3 * n * sizeof(double)),
+               *res = malloc(3 * n * sizeof(double)), *z = malloc(3 * n * sizeof(double)),
                *p = malloc(3 * n * sizeof(double)), *q = malloc(3 * n * sizeof(double));
-        ck_assert(b && xs && r && z && p && q);
+        ck_assert(b && xs && res && z && p && q);
         (void)ws_implicit_apply_op(web, u, b);
-        memcpy(r, b, 3 * n * sizeof(double));
-        double rz = ws_mg_apply(im->mg, web, r, z);
+        memcpy(res, b, 3 * n * sizeof(double));
+        double rz = ws_mg_apply(im->mg, web, res, z);
         memcpy(p, z, 3 * n * sizeof(double));
         const double bb = sqrt(dot3(b, b, n));
         int it = 0;
-        while (sqrt(dot3(r, r, n)) > 1e-12 * bb && it < 500) {
+        while (sqrt(dot3(res, res, n)) > 1e-12 * bb && it < 500) {
             const double alpha = rz / ws_implicit_apply_op(web, p, q);
             for (uint32_t k = 0; k < 3 * n; k++) {
                 xs[k] += alpha * p[k];
-                r[k] -= alpha * q[k];
+                res[k] -= alpha * q[k];
             }
-            const double rz1 = ws_mg_apply(im->mg, web, r, z);
+            const double rz1 = ws_mg_apply(im->mg, web, res, z);
             for (uint32_t k = 0; k < 3 * n; k++)
                 p[k] = z[k] + rz1 / rz * p[k];
             rz = rz1;
@@ -943,8 +957,9 @@ START_TEST(test_multigrid)
         report("multigrid CG on a known solution: %d iterations, error %.2g of 0.5", it, err);
         ck_assert_msg(it < 500, "multigrid CG did not converge");
         ck_assert_msg(err <= 1e-8 * 0.5, "multigrid CG's solution off by %g", err);
-        free(b), free(xs), free(r), free(z), free(p), free(q);
+        free(b), free(xs), free(res), free(z), free(p), free(q);
     }
+jacobi:
     im->jacobi_only = 1;
     im->warm = 0;
     ck_assert_int_eq(ws_implicit_solve(web, v, dt), 0);
@@ -954,13 +969,31 @@ START_TEST(test_multigrid)
         diff = fmax(diff, fabs(dv_mg[k] - im->dv[k]));
         size = fmax(size, fabs(im->dv[k]));
     }
-    report("film solve to 1e-11: multigrid %d iterations, block Jacobi %d; dv apart by %.2g of "
-           "%.3g m/s",
-           it_mg, it_bj, diff, size);
+    report("sheet %d x %d: film solve to 1e-11: multigrid %d iterations, block Jacobi %d; dv apart "
+           "by %.2g of %.3g m/s",
+           nx, ny, it_mg, it_bj, diff, size);
     ck_assert_msg(size > 0.0 && diff <= 1e-7 * size, "dv apart by %g of %g", diff, size);
     ck_assert_msg(it_mg < it_bj, "multigrid took %d iterations, block Jacobi %d", it_mg, it_bj);
     free(dv_mg), free(u), free(y), free(Bu), free(Bv);
     ws_world_destroy(w);
+    *it_mg_out = it_mg;
+    *it_bj_out = it_bj;
+}
+
+START_TEST(test_multigrid)
+{
+    /* Refined 2x in each direction, a node's h^2 k / m grows 4x: block Jacobi's iterations
+     * about double (at least 1.6x here), the multigrid's must stay within 1.25x (the issue's
+     * budget: 16x the nodes at 20x the cost). */
+    int mg1, bj1, mg2, bj2;
+    sheet_case(1, 0.4, 0.2, 1, &mg1, &bj1);
+    if (getenv("WS_TEST_SHORT"))
+        return;
+    sheet_case(2, 0.4, 0.2, 0, &mg2, &bj2);
+    report("refined 2x: multigrid %d -> %d iterations (%.2f x), block Jacobi %d -> %d (%.2f x)",
+           mg1, mg2, (double)mg2 / mg1, bj1, bj2, (double)bj2 / bj1);
+    ck_assert_msg(bj2 >= 1.6 * bj1, "block Jacobi did not degrade: %d -> %d", bj1, bj2);
+    ck_assert_msg(mg2 <= 1.25 * mg1, "multigrid degraded: %d -> %d", mg1, mg2);
 }
 END_TEST
 
@@ -1042,8 +1075,7 @@ START_TEST(test_refined_band_pressure)
     /* The band's contact pressure is its hoop tension over the radius, T / R with T = E
      * (strain) per unit height, whatever the mesh: refining 2 x in each direction must leave
      * it within 2 % (the polygon's chord effect is 2e-4 at 64 around, the contact layer's
-     * overlap k / kc 1e-3). The multigrid's iterations must stay about flat (within 1.5 x)
-     * though the nodes' h^2 k / m grows four times. */
+     * overlap k / kc 1e-3). */
     const int short_run = getenv("WS_TEST_SHORT") != NULL;
     double it1, it2;
     const double p1 = refined_band_pressure(1, &it1);
@@ -1053,7 +1085,6 @@ START_TEST(test_refined_band_pressure)
     report("band pressure refined 1 x: %.3f Pa (%.1f CG it/step), 2 x: %.3f Pa (%.1f), rel %.2g",
            p1, it1, p2, it2, (p2 - p1) / p1);
     ck_assert_msg(p1 > 0.0 && fabs(p2 - p1) <= 0.02 * p1, "pressure %g vs %g", p2, p1);
-    ck_assert_msg(it2 <= 1.5 * it1, "iterations grew from %.1f to %.1f", it1, it2);
 }
 END_TEST
 
