@@ -899,7 +899,6 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
     ws_web *web = web_of(w, id);
     ws_implicit *im = web->imp;
     ck_assert_msg(im && im->mg, "a grid web takes the multigrid preconditioner");
-    im->mg_ready = 0; /* coarse matrices of this solve's matrix */
     const uint32_t n = web->n;
     const int cur = w->cur;
     ws_nodes3 x = web->x[cur], v = web->v[cur];

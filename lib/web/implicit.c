@@ -395,29 +395,6 @@ static double precondition(const ws_implicit *im, uint32_t n, const double *rest
     return rz;
 }
 
-/* The multigrid of this solve, its coarse matrices made again from the solve's matrix when
- * they are WS_MG_KEEP solves old, or when the last solve took more than 1.5 times (and 2 more
- * than) the iterations of the first after they were made: contacts that came and went, the
- * springs' tension and the step change the film's matrix, and an outdated coarse level costs
- * iterations, never the answer. NULL: block Jacobi. */
-#define WS_MG_KEEP 16
-static ws_mg *multigrid_for(ws_web *web, int prev_iterations)
-{
-    ws_implicit *im = web->imp;
-    if (!im->mg || im->jacobi_only)
-        return NULL;
-    if (!im->mg_ready || im->mg_age >= WS_MG_KEEP ||
-        (im->mg_base >= 0 && prev_iterations > 3 * im->mg_base / 2 + 2)) {
-        im->mg_ready = ws_mg_setup(im->mg, web) == 0;
-        im->mg_age = 0;
-        im->mg_base = -1;
-    }
-    if (!im->mg_ready)
-        return NULL;
-    im->mg_age++;
-    return im->mg;
-}
-
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
 {
     ws_implicit *im = web->imp;
@@ -425,7 +402,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     const size_t m = VEC(n);
     double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
     im->solves++;
-    const int prev_iterations = im->last_iterations;
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; the scale of the residual: the larger of |b| and
      * the film's weight over the step, so a film at rest (b about 0) is not asked for a
@@ -453,7 +429,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         return -1;
     }
     operator_for(web, h);
-    ws_mg *mg = multigrid_for(web, prev_iterations);
+    ws_mg *mg = im->mg && !im->jacobi_only && ws_mg_setup(im->mg, web) == 0 ? im->mg : NULL;
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
@@ -486,8 +462,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     }
     im->iterations += (uint64_t)it;
     im->last_iterations = it;
-    if (mg && im->mg_base < 0)
-        im->mg_base = it;
     im->last_residual = scale > 0.0 ? sqrt(rr) / scale : 0.0;
     const int ok = sqrt(rr) <= goal;
     im->warm = ok;

@@ -48,11 +48,6 @@ typedef struct ws_implicit {
      * test's comparison). */
     struct ws_mg *mg;
     int jacobi_only;
-    /* The multigrid's coarse matrices are kept from solve to solve (any symmetric positive
-     * definite coarse matrices keep the cycle so; the film's level always takes the solve's own
-     * matrix): mg_ready when they hold a factored set, made mg_age solves ago, whose first solve
-     * took mg_base iterations (-1: not yet). */
-    int mg_ready, mg_age, mg_base;
     /* Counts (ws_web_get_solver_stats). */
     uint64_t solves, iterations;
     int last_iterations;
