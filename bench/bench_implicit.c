@@ -9,7 +9,8 @@
  * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on; dt1sub:
  * dt 1 ms with the film in 1 and in 4 sub-steps), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
- * times in each direction, short runs: cost per simulated second and containment). */
+ * times in each direction, short runs: cost per simulated second and containment; `refine
+ * [duration] [r] [tolerance]` runs refinement r alone, at that solve tolerance). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -141,6 +142,7 @@ int main(int argc, char **argv)
          * film, N), which refinement must leave alone. */
         const double T = duration > 0 ? duration : 0.05;
         const int only = argc > 3 ? atoi(argv[3]) : 0; /* one refinement alone */
+        const double tol = argc > 4 ? atof(argv[4]) : 0.0; /* the solve's tolerance; 0: 1e-6 */
         double base = 0;
         for (int r = 1; r <= 4; r *= 2) {
             if (only > 0 && r != only)
@@ -150,6 +152,7 @@ int main(int argc, char **argv)
             a.implicit = 1;
             a.substeps = 1;
             a.refine = r;
+            a.solver_tolerance = tol;
             tilt_scene sc;
             if (tilt_build(&a, &sc) != WS_OK) {
                 printf("  refine %d: cannot build\n", r);
