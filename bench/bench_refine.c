@@ -240,6 +240,7 @@ int main(int argc, char **argv)
             return 1;
         if (ws_world_save_file(f.sc.world, argv[3]) != WS_OK) {
             fprintf(stderr, "bench_refine: %s\n", ws_world_last_error(f.sc.world));
+            ws_world_destroy(f.sc.world);
             return 1;
         }
         printf("refine %d: %u nodes x %d sub-steps settled to t = %.3f s, saved to %s\n", r,
@@ -256,6 +257,7 @@ int main(int argc, char **argv)
             return 1;
         if (ws_world_restore_file(f.sc.world, argv[3]) != WS_OK) {
             fprintf(stderr, "bench_refine: %s\n", ws_world_last_error(f.sc.world));
+            ws_world_destroy(f.sc.world);
             return 1;
         }
         const double c0 = cpu_now();
