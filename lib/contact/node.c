@@ -58,10 +58,12 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
     ws_mem_free(mem, nc, sizeof *nc);
 }
 
-static int inside_box(v3 p, v3 lo, v3 hi, double e)
+/* 1 when p lies in the open box (lo, hi) grown by e on every side, else 0; without branches,
+ * so that the loops over nodes run on vectors. */
+static inline uint64_t inside_box(v3 p, v3 lo, v3 hi, double e)
 {
-    return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
-           p.z > lo.z - e && p.z < hi.z + e;
+    return (uint64_t)((p.x > lo.x - e) & (p.x < hi.x + e) & (p.y > lo.y - e) & (p.y < hi.y + e) &
+                      (p.z > lo.z - e) & (p.z < hi.z + e));
 }
 
 /* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
@@ -195,24 +197,18 @@ enum { T_X, T_S = 3, T_G = 6, T_L2 = 9, T_ROWS };
 WS_VECTOR_LOOP
 static void ref_chunk(size_t m, const ref_frames *F, double (*restrict t)[REF_CHUNK])
 {
-    const double *a = F->A->m, *c = F->E->m;
+    const m3 A = *F->A, E = *F->E;
     const v3 r = F->r, e = F->e;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
-                 c7 = c[7], c8 = c[8];
     for (size_t i = 0; i < m; i++) {
-        double qx = t[T_X][i] - r.x, qy = t[T_X + 1][i] - r.y, qz = t[T_X + 2][i] - r.z;
-        double ux = a0 * qx + a3 * qy + a6 * qz;
-        double uy = a1 * qx + a4 * qy + a7 * qz;
-        double uz = a2 * qx + a5 * qy + a8 * qz;
-        t[T_S][i] = ux;
-        t[T_S + 1][i] = uy;
-        t[T_S + 2][i] = uz;
-        t[T_G][i] = e.x + (c0 * ux + c1 * uy + c2 * uz);
-        t[T_G + 1][i] = e.y + (c3 * ux + c4 * uy + c5 * uz);
-        t[T_G + 2][i] = e.z + (c6 * ux + c7 * uy + c8 * uz);
-        t[T_L2][i] = ux * ux + uy * uy + uz * uz;
+        v3 u = m3_tmul_v(&A, v3_sub(v3_make(t[T_X][i], t[T_X + 1][i], t[T_X + 2][i]), r));
+        v3 g = v3_add(e, m3_mul_v(&E, u));
+        t[T_S][i] = u.x;
+        t[T_S + 1][i] = u.y;
+        t[T_S + 2][i] = u.z;
+        t[T_G][i] = g.x;
+        t[T_G + 1][i] = g.y;
+        t[T_G + 2][i] = g.z;
+        t[T_L2][i] = v3_norm2(u);
     }
 }
 
@@ -299,7 +295,6 @@ static int track_bodies(const ws_node_step *S, ws_web *web)
     return 0;
 }
 
-
 /* The flags of a group of e nodes (0 or 1, as 64-bit values) narrowed into their bytes of redo;
  * a group with none (any = 0) is cleared, not narrowed. */
 static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict flag, size_t e,
@@ -313,53 +308,30 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
         redo[i] = (uint8_t)flag[i];
 }
 
-/* The per-node test of ws_node_moved: 1 in nc->redo for a node whose measure reaches the
- * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
- * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
- * have none flagged: their bytes are cleared, not narrowed. */
+/* The per-node test of ws_node_moved with sub-steps (c > 0): 1 in nc->redo for a node whose
+ * measure |u| + c |w| reaches the bound (or is NaN), else 0; how many are flagged. u is the
+ * node's move in the reference frame since it was found, w its velocity relative to the
+ * reference body's point where it is. Straight-line code, on vectors. Most groups of nodes have
+ * none flagged: their bytes are cleared, not narrowed. */
 WS_VECTOR_LOOP
 static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
-    const ws_move_test *M = &nc->move;
-    const v3 r = M->r, vr = M->vr, wr = M->wr;
-    const double c = M->c, lim = M->lim, *a = M->A.m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lim2 = lim * lim;
+    const ws_move_test M = nc->move;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
         const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
                                *restrict oz = nc->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
-        const size_t before = count;
-        if (c > 0.0) {
-            for (size_t i = 0; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-                double m =
-                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-                uint64_t f = !(m < lim);
-                flag[i] = f;
-                count += f;
-            }
-        } else { /* one sub-step: the contacts see only where the nodes are now */
-            for (size_t i = 0; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
-            }
+        for (size_t i = 0; i < e; i++) {
+            v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
+            v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(ox[i], oy[i], oz[i]));
+            v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
+            uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
+            flag[i] = f;
+            count += f;
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
@@ -373,42 +345,29 @@ static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n
 WS_VECTOR_LOOP
 static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
 {
-    const v3 r = nc->move.r;
-    const double lim = nc->move.lim, *a = nc->move.A.m;
-    const int renew = nc->move.renew;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lim2 = lim * lim;
+    const ws_move_test M = nc->move;
+    const double lim2 = M.lim * M.lim;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
         double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
                          *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
-        const size_t before = count;
-        if (renew) {
-            const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
-                                   *restrict sz = nc->xdet.z + i0;
+        const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
+                               *restrict sz = nc->xdet.z + i0;
+        if (M.renew)
             for (size_t i = 0; i < e; i++) {
-                double gx = r.x + (a0 * sx[i] + a1 * sy[i] + a2 * sz[i]);
-                double gy = r.y + (a3 * sx[i] + a4 * sy[i] + a5 * sz[i]);
-                double gz = r.z + (a6 * sx[i] + a7 * sy[i] + a8 * sz[i]);
-                ox[i] = gx;
-                oy[i] = gy;
-                oz[i] = gz;
-                double ux = qx[i] - gx, uy = qy[i] - gy, uz = qz[i] - gz;
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
+                v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
+                ox[i] = g.x;
+                oy[i] = g.y;
+                oz[i] = g.z;
             }
-        } else {
-            for (size_t i = 0; i < e; i++) {
-                double ux = qx[i] - ox[i], uy = qy[i] - oy[i], uz = qz[i] - oz[i];
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
-            }
+        for (size_t i = 0; i < e; i++) {
+            uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
+                                           v3_make(ox[i], oy[i], oz[i]))) < lim2);
+            flag[i] = f;
+            count += f;
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
@@ -447,33 +406,28 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
     return count;
 }
 
-/* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
- * open box (lo, hi). Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those of a
- * group with none in the box are left as they are). */
+/* Flag (1 in `flag`) the nodes whose coordinates in body k's frame at state cur, A^T (x - r),
+ * lie in its box grown by e. Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those
+ * of a group with none in the box are left as they are). */
 WS_VECTOR_LOOP
-static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo, v3 hi)
+static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const ws_body_store *b, int cur,
+                        uint32_t k, double e)
 {
-    const double *a = A->m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
+    const m3 A = b->A[k];
+    const v3 r = b->st[cur].r[k], lo = b->shape[k]->lo, hi = b->shape[k]->hi;
     uint64_t in[FLAG_CHUNK];
     for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        const size_t m = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         uint64_t any = 0;
-        for (size_t i = 0; i < e; i++) {
-            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-            double sx = a0 * px + a3 * py + a6 * pz;
-            double sy = a1 * px + a4 * py + a7 * pz;
-            double sz = a2 * px + a5 * py + a8 * pz;
-            in[i] = (uint64_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) & (sz > lo.z) &
-                               (sz < hi.z));
+        for (size_t i = 0; i < m; i++) {
+            in[i] = inside_box(m3_tmul_v(&A, v3_sub(v3_make(qx[i], qy[i], qz[i]), r)), lo, hi, e);
             any |= in[i];
         }
         if (!any)
             continue;
         uint8_t *restrict f = flag + i0;
-        for (size_t i = 0; i < e; i++)
+        for (size_t i = 0; i < m; i++)
             f[i] |= (uint8_t)in[i];
     }
 }
@@ -487,11 +441,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
 {
     ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
-    const ws_shape *sh = b->shape[k];
-    const double e = b->layer[k] + web->layer + margin;
-    flag_in_box(nc->redo, x, web->n, &b->A[k], b->st[cur].r[k],
-                v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
-                v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
+    flag_in_box(nc->redo, x, web->n, b, cur, k, b->layer[k] + web->layer + margin);
     const ws_ncand *c = nc->cand[nc->list].c;
     if (nc->seg_list == nc->list) {
         /* The list's stretches: a run's candidates are of one face, so of one body. */
@@ -787,19 +737,16 @@ enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_NEAR, M_ARRAYS };
  * faces in M_PASS, those it is not well inside of (see convex_candidates); M_NEAR: the faces
  * whose plane it is not a margin or more behind. */
 
-/* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0; how
- * many do. */
+/* hit[j] = 1 when node j of the group (rows x, y, z of p) lies in the open box (lo, hi)
+ * grown by e, else 0; how many do. */
 WS_VECTOR_LOOP
-static size_t find_near(uint64_t *restrict hit, const double *restrict px,
-                        const double *restrict py, const double *restrict pz, size_t m, v3 lo,
-                        v3 hi)
+static size_t find_near(uint64_t *restrict hit, double (*restrict p)[FIND_CHUNK], size_t m,
+                        v3 lo, v3 hi, double e)
 {
     size_t count = 0;
     for (size_t j = 0; j < m; j++) {
-        uint64_t h = (uint64_t)((px[j] > lo.x) & (px[j] < hi.x) & (py[j] > lo.y) &
-                                (py[j] < hi.y) & (pz[j] > lo.z) & (pz[j] < hi.z));
-        hit[j] = h;
-        count += h;
+        hit[j] = inside_box(v3_make(p[0][j], p[1][j], p[2][j]), lo, hi, e);
+        count += hit[j];
     }
     return count;
 }
@@ -811,11 +758,7 @@ WS_VECTOR_LOOP
 static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, double margin, size_t m,
                        double *val, uint64_t *mask)
 {
-    const double *a = A->m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lx = sh->lo.x - reach, ly = sh->lo.y - reach, lz = sh->lo.z - reach,
-                 hx = sh->hi.x + reach, hy = sh->hi.y + reach, hz = sh->hi.z + reach;
+    const m3 At = *A;
     double *restrict sx = val + V_X * FIND_CHUNK, *restrict sy = val + V_Y * FIND_CHUNK,
                      *restrict sz = val + V_Z * FIND_CHUNK, *restrict D = val + V_D * FIND_CHUNK;
     uint64_t *restrict local = mask + M_LOCAL * FIND_CHUNK,
@@ -823,32 +766,24 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                        *restrict boxes = mask + M_BOXES * FIND_CHUNK,
                        *restrict near = mask + M_NEAR * FIND_CHUNK;
     for (size_t j = 0; j < m; j++) {
-        double px = sx[j] - r.x, py = sy[j] - r.y, pz = sz[j] - r.z;
-        double x = a0 * px + a3 * py + a6 * pz;
-        double y = a1 * px + a4 * py + a7 * pz;
-        double z = a2 * px + a5 * py + a8 * pz;
-        sx[j] = x;
-        sy[j] = y;
-        sz[j] = z;
-        local[j] = (uint64_t)((x > lx) & (x < hx) & (y > ly) & (y < hy) & (z > lz) & (z < hz));
+        v3 s = m3_tmul_v(&At, v3_sub(v3_make(sx[j], sy[j], sz[j]), r));
+        sx[j] = s.x;
+        sy[j] = s.y;
+        sz[j] = s.z;
+        local[j] = inside_box(s, sh->lo, sh->hi, reach);
         D[j] = -INFINITY;
         pass[j] = boxes[j] = near[j] = 0;
     }
     for (uint32_t f = 0; f < sh->face_count; f++) {
-        const ws_face *F = &sh->faces[f];
-        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z, off = F->offset;
-        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
-                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        const ws_face F = sh->faces[f];
         double *restrict dg = val + (V_FACES + f) * FIND_CHUNK;
         for (size_t j = 0; j < m; j++) {
-            double x = sx[j], y = sy[j], z = sz[j];
-            double d = nx * x + ny * y + nz * z - off;
+            v3 s = v3_make(sx[j], sy[j], sz[j]);
+            double d = v3_dot(F.normal, s) - F.offset;
             dg[j] = d;
             D[j] = d > D[j] ? d : D[j];
             near[j] |= (uint64_t)(!(d <= -margin)) << f;
-            boxes[j] |=
-                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
-                << f;
+            boxes[j] |= inside_box(s, F.lo, F.hi, reach) << f;
         }
     }
     const double deep = -reach - sh->inner;
@@ -869,19 +804,12 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
     }
     for (; any; any &= any - 1) {
         const uint32_t f = ws_lowest_bit(any);
-        const ws_face *F = &sh->faces[f];
-        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z;
-        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
-                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        const ws_face F = sh->faces[f];
         const double *restrict df = val + (V_FACES + f) * FIND_CHUNK;
         const uint64_t drop = ~((uint64_t)1 << f);
         for (size_t j = 0; j < m; j++) {
-            double d = -df[j];
-            double x = sx[j] + nx * d, y = sy[j] + ny * d, z = sz[j] + nz * d;
-            pass[j] &=
-                drop |
-                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
-                    << f;
+            v3 s = v3_madd(v3_make(sx[j], sy[j], sz[j]), F.normal, -df[j]);
+            pass[j] &= drop | inside_box(s, F.lo, F.hi, reach) << f;
         }
         /* The projection on f's plane lies dg - df c out of face o's plane: dg itself for a
          * face square to f (c = 0, and df is finite), whose test is then the node's own
@@ -890,7 +818,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
         for (uint32_t o = 0; o < sh->face_count; o++) {
             if (o == f)
                 continue;
-            const double c = v3_dot(sh->faces[o].normal, F->normal);
+            const double c = v3_dot(sh->faces[o].normal, F.normal);
             if (c == 0.0) {
                 square |= (uint64_t)1 << o;
                 continue;
@@ -1058,7 +986,8 @@ static int find_scratch(const ws_body_store *b, ws_node_geom *g)
  * each with the group's nodes in its box grown by the web's layer and half the margin (they
  * move less than that before they are found again); how many. A body with no node of any group
  * in its box has no candidate: the others are marked in web->cbody. */
-static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK], size_t m)
+static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK],
+                          size_t m)
 {
     const ws_body_store *b = S->b;
     ws_node_geom *g = S->g;
@@ -1068,9 +997,7 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
     for (uint32_t k = 0; k < b->slots; k++) {
         if (!b->alive[k])
             continue;
-        const uint32_t c = (uint32_t)find_near(
-            hit, p[0], p[1], p[2], m, v3_make(b->lo[k].x - pad, b->lo[k].y - pad, b->lo[k].z - pad),
-            v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
+        const uint32_t c = (uint32_t)find_near(hit, p, m, b->lo[k], b->hi[k], pad);
         if (!c)
             continue;
         web->contact->cbody[k] = 1;
