@@ -27,16 +27,14 @@ ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
     if (!nc)
         return NULL;
     nc->seg_list = -1;
-    int ok = ws_nodes_alloc(mem, &nc->xdet, n);
-    ok &= ws_nodes_alloc(mem, &nc->xep, n);
+    int ok = ws_nodes_alloc(mem, &nc->xdet, n) & ws_nodes_alloc(mem, &nc->xep, n);
     ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
     ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
-    if (!ok) {
-        ws_node_contact_free(mem, nc, n);
-        return NULL;
-    }
-    return nc;
+    if (ok)
+        return nc;
+    ws_node_contact_free(mem, nc, n);
+    return NULL;
 }
 
 void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
@@ -985,7 +983,8 @@ static int find_scratch(const ws_body_store *b, ws_node_geom *g)
 /* The bodies near a group of m nodes at p (global x, y, z rows), in slot order, into g->find,
  * each with the group's nodes in its box grown by the web's layer and half the margin (they
  * move less than that before they are found again); how many. A body with no node of any group
- * in its box has no candidate: the others are marked in web->cbody. */
+ * in its box has no candidate: the others are marked in web->cbody. Per convex body, on
+ * vectors: the nodes in its frame, their plane distances and their faces' masks. */
 static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK],
                           size_t m)
 {
@@ -1007,9 +1006,16 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
             e += hit[j];
         }
         const size_t nv = face_values(b->shape[k]);
-        g->find[nb++] = (ws_find_body){.body = k, .count = c, .general = nv == 0,
-                                       .reach = b->layer[k] + web->layer + S->margin,
-                                       .node = nnode, .val = nval, .mask = nmask};
+        ws_find_body *fb = &g->find[nb++];
+        *fb = (ws_find_body){.body = k, .count = c, .general = nv == 0,
+                             .reach = b->layer[k] + web->layer + S->margin,
+                             .node = nnode, .val = nval, .mask = nmask};
+        for (uint32_t q = 0; nv && q < c; q++)
+            for (int j = 0; j < 3; j++)
+                g->find_val[nval + (V_X + j) * FIND_CHUNK + q] = p[j][nd[q]];
+        if (nv)
+            find_faces(b->shape[k], &b->A[k], b->st[S->cur].r[k], fb->reach, S->margin, c,
+                       g->find_val + nval, g->find_mask + nmask);
         nnode += c;
         nval += nv;
         nmask += nv ? M_ARRAYS * (size_t)FIND_CHUNK : 0;
@@ -1048,20 +1054,6 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
             p[2][j] = x.z[i];
         }
         const size_t nb = near_bodies(S, web, p, m);
-        /* Per convex body, on vectors: the nodes in its frame, their plane distances and
-         * their faces' masks. */
-        for (size_t q = 0; q < nb; q++) {
-            const ws_find_body *fb = &g->find[q];
-            if (fb->general)
-                continue;
-            const uint32_t k = fb->body, *nd = g->find_node + fb->node;
-            double *v = g->find_val + fb->val;
-            for (uint32_t c = 0; c < fb->count; c++)
-                for (int j = 0; j < 3; j++)
-                    v[(V_X + j) * FIND_CHUNK + c] = p[j][nd[c]];
-            find_faces(b->shape[k], &b->A[k], b->st[S->cur].r[k], fb->reach, S->margin, fb->count,
-                       v, g->find_mask + fb->mask);
-        }
         /* Node by node (the order the sub-steps take them in), against each body near it. */
         for (size_t j = 0; j < m; j++) {
             const uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
@@ -1081,46 +1073,32 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
     return 0;
 }
 
-int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
+int ws_node_geometry(const ws_body_store *b, ws_node_geom *g)
 {
-    (void)cur;
-    (void)mem; /* every table is the step's scratch, from its arena */
-    size_t nf = 0, nt = 0, ne = 0;
-    for (size_t k = 0; k < b->slots; k++)
-        if (b->alive[k]) {
-            nf += b->shape[k]->face_count;
-            nt += b->shape[k]->triangle_count;
-            ne += b->shape[k]->edge_count;
-        }
-    ws_arena *a = g->arena;
-    ws_wface *face = ws_arena_alloc(a, (nf + 1) * sizeof *face);
-    ws_wtri *tri = ws_arena_alloc(a, (nt + 1) * sizeof *tri);
-    ws_wedge *edge = ws_arena_alloc(a, (ne + 1) * sizeof *edge);
-    uint32_t *base = ws_arena_alloc(a, 3 * (b->slots + 1) * sizeof *base);
-    uint8_t *ready = ws_arena_alloc(a, b->slots + 1);
-    if (!face || !tri || !edge || !base || !ready)
+    const size_t ns = b->slots + 1;
+    uint32_t *base = ws_arena_alloc(g->arena, 3 * ns * sizeof *base);
+    g->ready = ws_arena_calloc(g->arena, ns, 1);
+    if (!base || !g->ready)
         return -1;
-    g->face = face;
-    g->tri = tri;
-    g->edge = edge;
     g->face_base = base;
-    g->tri_base = base + b->slots + 1;
-    g->edge_base = base + 2 * (b->slots + 1);
-    g->ready = ready;
-    uint32_t fo = 0, to = 0, eo = 0;
+    g->tri_base = base + ns;
+    g->edge_base = base + 2 * ns;
+    uint32_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++) {
-        g->ready[k] = 0;
         if (!b->alive[k])
             continue;
         const ws_shape *sh = b->shape[k];
-        g->face_base[k] = fo;
-        g->tri_base[k] = to;
-        g->edge_base[k] = eo;
-        fo += sh->face_count;
-        to += sh->triangle_count;
-        eo += sh->edge_count;
+        g->face_base[k] = nf;
+        g->tri_base[k] = nt;
+        g->edge_base[k] = ne;
+        nf += sh->face_count;
+        nt += sh->triangle_count;
+        ne += sh->edge_count;
     }
-    return 0;
+    g->face = ws_arena_alloc(g->arena, (nf + 1) * sizeof *g->face);
+    g->tri = ws_arena_alloc(g->arena, (nt + 1) * sizeof *g->tri);
+    g->edge = ws_arena_alloc(g->arena, (ne + 1) * sizeof *g->edge);
+    return g->face && g->tri && g->edge ? 0 : -1;
 }
 
 /* Body k's faces, triangles and edges in the global frame at state cur. */

@@ -216,7 +216,7 @@ void ws_node_contact_commit(ws_node_contact *nc);
  * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
  * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
  * reset. 0, or -1 when out of memory. */
-int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
+int ws_node_geometry(const ws_body_store *b, ws_node_geom *g);
 
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
  * (web->cbody) and that are not prepared yet in this step. */

@@ -466,7 +466,7 @@ static ws_status step_webs(ws_step *S)
     ws_body_store *b = S->b;
     const int cur = S->cur, nxt = S->nxt;
     w->node_geom.arena = S->arena; /* the bodies' features and the node search's tables */
-    if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
+    if (ws_node_geometry(b, &w->node_geom) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
     for (size_t k = 0; k < w->web_slots.slot_count; k++) {
         if (w->web_slots.dense[k] == UINT32_MAX)
