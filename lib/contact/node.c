@@ -64,7 +64,7 @@ static inline uint64_t inside_box(v3 p, v3 lo, v3 hi, double e)
                       (p.z > lo.z - e) & (p.z < hi.z + e));
 }
 
-/* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
+/* The box of the web's nodes x. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
     v3 l = nodes_get(x, 0), h = l;
@@ -180,23 +180,18 @@ static int may_reach(double d, double gap, double margin)
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* The reference frame (A, r) and the epoch's (E, e). */
-typedef struct ref_frames {
-    const m3 *A, *E;
-    v3 r, e;
-} ref_frames;
-
 /* The rows of to_ref's scratch: the nodes' global x, y, z; in the reference frame, s; at the
  * epoch, g; |s|^2. */
 enum { T_X, T_S = 3, T_G = 6, T_L2 = 9, T_ROWS };
 
-/* m nodes (rows T_X of t) to the reference frame: s = A^T (x - r) into rows T_S, and their
- * place at the epoch, e + E s, into rows T_G, |s|^2 into row T_L2. On vectors. */
+/* m nodes (rows T_X of t) to the reference frame M: s = A^T (x - r) into rows T_S, and their
+ * place at nc's epoch, epoch_r + epoch_A s, into rows T_G, |s|^2 into row T_L2. On vectors. */
 WS_VECTOR_LOOP
-static void ref_chunk(size_t m, const ref_frames *F, double (*restrict t)[REF_CHUNK])
+static void ref_chunk(size_t m, const ws_move_test *M, const ws_node_contact *nc,
+                      double (*restrict t)[REF_CHUNK])
 {
-    const m3 A = *F->A, E = *F->E;
-    const v3 r = F->r, e = F->e;
+    const m3 A = M->A, E = nc->epoch_A;
+    const v3 r = M->r, e = nc->epoch_r;
     for (size_t i = 0; i < m; i++) {
         v3 u = m3_tmul_v(&A, v3_sub(v3_make(t[T_X][i], t[T_X + 1][i], t[T_X + 2][i]), r));
         v3 g = v3_add(e, m3_mul_v(&E, u));
@@ -218,7 +213,6 @@ static void to_ref(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32
                    size_t count)
 {
     ws_node_contact *nc = web->contact;
-    const ref_frames F = {&M->A, &nc->epoch_A, M->r, nc->epoch_r};
     double t[T_ROWS][REF_CHUNK], lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
@@ -229,7 +223,7 @@ static void to_ref(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32
             t[T_X + 1][j] = x.y[i];
             t[T_X + 2][j] = x.z[i];
         }
-        ref_chunk(m, &F, t);
+        ref_chunk(m, M, nc, t);
         for (size_t j = 0; j < m; j++) {
             const size_t i = only ? only[q0 + j] : q0 + j;
             nc->xdet.x[i] = t[T_S][j];
@@ -588,13 +582,20 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     return count;
 }
 
+/* The end of node m's candidates in the list c (n of them, sorted by node), from f on. */
+static size_t run_end(const ws_ncand *c, size_t n, size_t f, uint32_t m)
+{
+    for (; f < n && c[f].node == m; f++)
+        ;
+    return f;
+}
+
 void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
 {
     size_t q = 0;
     for (uint32_t i = 0; i < n; i++) {
         start[i] = q;
-        while (q < nc && c[q].node == i)
-            q++;
+        q = run_end(c, nc, q, i);
     }
     start[n] = nc;
 }
@@ -622,14 +623,6 @@ static inline int same_run(const ws_ncand *a, size_t i, const ws_ncand *b, size_
     if (len == 1)
         return a[i].body == b[j].body && a[i].feat == b[j].feat && a[i].local == b[j].local;
     return !memcmp(a + i, b + j, len * sizeof *a);
-}
-
-/* The end of node m's candidates in the list c (n of them, sorted by node), from f on. */
-static size_t run_end(const ws_ncand *c, size_t n, size_t f, uint32_t m)
-{
-    for (; f < n && c[f].node == m; f++)
-        ;
-    return f;
 }
 
 int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *old)
