@@ -707,11 +707,11 @@ static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
 enum { FIND_CHUNK = 64 };
 
 /* A body near a group of nodes: its slot, its reach (the layers and the margin), how many of the
- * group's nodes lie in its grown box and
- * where their values are in the scratch: their places in the group at find_node + node; at
- * find_val + val, FIND_CHUNK apart, their body-frame x, y, z, the largest plane distance D, then
- * their distance to each face's plane; at find_mask + mask, FIND_CHUNK apart, the masks M_*.
- * general: searched node by node, without values. next: the next of its nodes to list. */
+ * group's nodes lie in its grown box and where their values are in the scratch: their places
+ * in the group at find_node + node; at find_val + val, FIND_CHUNK apart, their body-frame x,
+ * y, z, the largest plane distance D, then their distance to each face's plane; at find_mask +
+ * mask, FIND_CHUNK apart, the masks M_*. general: searched node by node, without values. next:
+ * the next of its nodes to list. */
 typedef struct ws_find_body {
     uint32_t body, count, next;
     int general;
