@@ -93,16 +93,21 @@ static double sphere_lever(const ws_body_store *b, uint32_t k, const ws_web *web
     return b->shape[k]->radius + b->layer[k] + web->layer + margin;
 }
 
-/* Body k's box along its own axis j (global, a), grown by its layer and the web's. */
-static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int j, v3 *a,
-                      double *lo, double *hi)
+/* Body k's own axis j at state cur (global, a), its box along it grown by its layer and the
+ * web's (lo, hi), and the CoG's coordinate on it (o): a point x lies a . x - o along it. */
+typedef struct axis_span {
+    v3 a;
+    double lo, hi, o;
+} axis_span;
+
+static axis_span body_span(const ws_body_store *b, int cur, uint32_t k, const ws_web *web, int j)
 {
     const ws_shape *sh = b->shape[k];
-    const double *A = b->A[k].m;
-    double grow = b->layer[k] + web->layer;
-    *a = v3_make(A[j], A[3 + j], A[6 + j]);
-    *lo = (j == 0 ? sh->lo.x : j == 1 ? sh->lo.y : sh->lo.z) - grow;
-    *hi = (j == 0 ? sh->hi.x : j == 1 ? sh->hi.y : sh->hi.z) + grow;
+    const double *A = b->A[k].m, grow = b->layer[k] + web->layer;
+    const v3 a = v3_make(A[j], A[3 + j], A[6 + j]);
+    return (axis_span){a, (j == 0 ? sh->lo.x : j == 1 ? sh->lo.y : sh->lo.z) - grow,
+                       (j == 0 ? sh->hi.x : j == 1 ? sh->hi.y : sh->hi.z) + grow,
+                       v3_dot(a, b->st[cur].r[k])};
 }
 
 /* How far body k is from every node: the largest gap between the nodes and the body's box
@@ -111,24 +116,21 @@ static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int
 static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web,
                        ws_nodes3 x, ws_track *t)
 {
-    v3 r = b->st[cur].r[k];
     double best = -INFINITY;
     for (int j = 0; j < 3; j++) {
-        v3 a;
-        double blo, bhi;
-        body_span(b, k, web, j, &a, &blo, &bhi);
-        double lo = INFINITY, hi = -INFINITY, o = v3_dot(a, r);
+        const axis_span S = body_span(b, cur, k, web, j);
+        double lo = INFINITY, hi = -INFINITY;
         for (uint32_t i = 0; i < web->n; i++) {
-            double c = a.x * x.x[i] + a.y * x.y[i] + a.z * x.z[i] - o;
+            double c = v3_dot(S.a, nodes_get(x, i)) - S.o;
             lo = c < lo ? c : lo;
             hi = c > hi ? c : hi;
         }
-        double gap = fmax(lo - bhi, blo - hi);
+        double gap = fmax(lo - S.hi, S.lo - hi);
         if (gap > best) {
             best = gap;
             t->axis = j;
-            t->lo = blo;
-            t->hi = bhi;
+            t->lo = S.lo;
+            t->hi = S.hi;
         }
     }
     return best;
@@ -560,15 +562,11 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
         ws_track *t = &nc->track[q];
         if (t->near)
             continue;
-        uint32_t k = t->body;
-        v3 ax;
-        double blo, bhi;
-        body_span(b, k, web, t->axis, &ax, &blo, &bhi);
-        double o = v3_dot(ax, st->r[k]), least = INFINITY;
+        const axis_span S = body_span(b, cur, t->body, web, t->axis);
+        double least = INFINITY;
         for (long m = 0; m < count; m++) {
-            uint32_t i = nc->moved[m];
-            double cc = ax.x * x.x[i] + ax.y * x.y[i] + ax.z * x.z[i] - o;
-            double g = fmax(cc - bhi, blo - cc);
+            double c = v3_dot(S.a, nodes_get(x, nc->moved[m])) - S.o;
+            double g = fmax(c - S.hi, S.lo - c);
             least = g < least ? g : least;
         }
         const double d = body_move(t, st, M, M->reach);
