@@ -5,7 +5,7 @@
 
 #include <string.h>
 
-/* The move test's budget (ws_node_track, ws_node_moved), in sixteenths of the contact margin.
+/* The move test's budget (track_bodies, ws_node_moved), in sixteenths of the contact margin.
  * A full detection lists every node-feature pair within the layers and the margin; the list
  * holds while no node has come half the margin (COVER) closer to any near body, since that is
  * what it covers on either side. The half is spent as: a node's own move from where it was
@@ -100,21 +100,25 @@ typedef struct axis_span {
     double lo, hi, o;
 } axis_span;
 
+static double v3_at(v3 v, int j)
+{
+    return j == 0 ? v.x : j == 1 ? v.y : v.z;
+}
+
 static axis_span body_span(const ws_body_store *b, int cur, uint32_t k, const ws_web *web, int j)
 {
     const ws_shape *sh = b->shape[k];
     const double *A = b->A[k].m, grow = b->layer[k] + web->layer;
     const v3 a = v3_make(A[j], A[3 + j], A[6 + j]);
-    return (axis_span){a, (j == 0 ? sh->lo.x : j == 1 ? sh->lo.y : sh->lo.z) - grow,
-                       (j == 0 ? sh->hi.x : j == 1 ? sh->hi.y : sh->hi.z) + grow,
+    return (axis_span){a, v3_at(sh->lo, j) - grow, v3_at(sh->hi, j) + grow,
                        v3_dot(a, b->st[cur].r[k])};
 }
 
 /* How far body k is from every node: the largest gap between the nodes and the body's box
  * (grown by the layers) along one of the body's three axes, with that axis. A tilted
  * platform's global box swells over a film it is far from; its own axes tell them apart. */
-static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web,
-                       ws_nodes3 x, ws_track *t)
+static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web, ws_nodes3 x,
+                       ws_track *t)
 {
     double best = -INFINITY;
     for (int j = 0; j < 3; j++) {
@@ -729,8 +733,8 @@ enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_NEAR, M_ARRAYS };
 /* hit[j] = 1 when node j of the group (rows x, y, z of p) lies in the open box (lo, hi)
  * grown by e, else 0; how many do. */
 WS_VECTOR_LOOP
-static size_t find_near(uint64_t *restrict hit, double (*restrict p)[FIND_CHUNK], size_t m,
-                        v3 lo, v3 hi, double e)
+static size_t find_near(uint64_t *restrict hit, double (*restrict p)[FIND_CHUNK], size_t m, v3 lo,
+                        v3 hi, double e)
 {
     size_t count = 0;
     for (size_t j = 0; j < m; j++) {
@@ -976,8 +980,7 @@ static int find_scratch(const ws_body_store *b, ws_node_geom *g)
  * move less than that before they are found again); how many. A body with no node of any group
  * in its box has no candidate: the others are marked in web->cbody. Per convex body, on
  * vectors: the nodes in its frame, their plane distances and their faces' masks. */
-static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK],
-                          size_t m)
+static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK], size_t m)
 {
     const ws_body_store *b = S->b;
     ws_node_geom *g = S->g;
@@ -998,9 +1001,8 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
         }
         const size_t nv = face_values(b->shape[k]);
         ws_find_body *fb = &g->find[nb++];
-        *fb = (ws_find_body){.body = k, .count = c, .general = nv == 0,
-                             .reach = b->layer[k] + web->layer + S->margin,
-                             .node = nnode, .val = nval, .mask = nmask};
+        *fb = (ws_find_body){k,     c,    0,    nv == 0, b->layer[k] + web->layer + S->margin,
+                             nnode, nval, nmask};
         for (uint32_t q = 0; nv && q < c; q++)
             for (int j = 0; j < 3; j++)
                 g->find_val[nval + (V_X + j) * FIND_CHUNK + q] = p[j][nd[q]];
@@ -1017,8 +1019,8 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
 /* Node candidates of a web at state S->cur: every node-face and node-edge pair within the
  * layers + margin, for the nodes listed (all when `nodes` is NULL), sorted by node, into L. 0,
  * or -1 when out of memory. */
-static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes,
-                           size_t count, ws_ncand_list *L)
+static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
+                           ws_ncand_list *L)
 {
     const ws_body_store *b = S->b;
     ws_node_contact *nc = web->contact;
@@ -1171,7 +1173,8 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
     }
     /* nc->moved keeps the nodes whose candidates changed. */
     ws_ncand_list *L = &nc->cand[*list];
-    const long changed = ws_node_merge(S->mem, &F, web->n, nc->cstart, &nc->cand[old], L, nc->moved);
+    const long changed =
+        ws_node_merge(S->mem, &F, web->n, nc->cstart, &nc->cand[old], L, nc->moved);
     return changed < 0 || ws_node_segments_merged(S->mem, web, L->c, L->n, *list, old, nc->moved,
                                                   (size_t)changed)
                ? -1
@@ -1189,8 +1192,8 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
      * shows it). */
     int list = nc->list, all = nc->search_all;
     long moved = 0;
-    if (!all && (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin,
-                                           flagged)) < 0)
+    if (!all &&
+        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, flagged)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {

@@ -132,7 +132,7 @@ typedef struct ws_node_contact {
      * ws_node_index). */
     size_t *cstart;
     /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
-     * some node searched since the full detection, ws_node_candidates). */
+     * some node searched since the full detection, find_candidates in node.c). */
     uint8_t *cbody;
     size_t cbody_cap;
 } ws_node_contact;
@@ -173,7 +173,7 @@ typedef struct ws_node_geom {
     ws_wtri *tri;
     ws_wedge *edge;
     uint32_t *face_base, *tri_base, *edge_base;
-    /* Scratch of ws_node_candidates (node.c): the bodies near a group of nodes, with the nodes'
+    /* Scratch of the candidates' search (node.c): the bodies near a group of nodes, with the nodes'
      * values against each, taken from the step's arena (set by the step before the search). */
     ws_arena *arena;
     struct ws_find_body *find;
