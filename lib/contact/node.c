@@ -494,15 +494,13 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
         if (!t->near && may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
-     * the reference frame since it was found, w its velocity relative to the reference body's
-     * point where it is, h_more the time its sub-steps go beyond this state. Two near bodies'
-     * deviations (margin / 4) and the rest (margin / 16, for what the sub-steps' forces add)
-     * keep a node's move relative to any near body under half the margin: what the
-     * candidates were found to cover. With one sub-step the contacts see the nodes only where
-     * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
-     * the margin. Either way a node stays within a quarter margin of where it was found
-     * wherever the contacts see it. */
+    /* Per node (flag_moved): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
+     * h_more the time its sub-steps go beyond this state. Two near bodies' deviations (margin /
+     * 4) and the rest (margin / 16, for what the sub-steps' forces add) keep a node's move
+     * relative to any near body under half the margin: what the candidates were found to
+     * cover. With one sub-step the contacts see the nodes only where they are now, which the
+     * test measures, and nothing is added: flagged at |u| = 1/4 of the margin. Either way a
+     * node stays within a quarter margin of where it was found wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin;
     M->c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     M->lim = lim;
