@@ -440,11 +440,21 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
     ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
     flag_in_box(nc->redo, x, web->n, b, cur, k, b->layer[k] + web->layer + margin);
-    /* One pass over the list: a body is re-based seldom, and the pass costs less than the
-     * box test over every node above. */
     const ws_ncand *c = nc->cand[nc->list].c;
-    for (size_t q = 0; q < nc->cand[nc->list].n; q++)
-        nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    if (nc->seg_list == nc->list) {
+        /* The list's stretches: a run's candidates are of one face, so of one body. */
+        for (size_t s = 0; s < nc->nseg; s++) {
+            const ws_nseg *sg = &nc->seg[s];
+            if (sg->run && c[sg->c0].body == k)
+                memset(nc->redo + sg->n0, 1, sg->n1 - sg->n0);
+            else if (!sg->run)
+                for (size_t q = sg->c0; q < sg->c1; q++)
+                    nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+        }
+    } else {
+        for (size_t q = 0; q < nc->cand[nc->list].n; q++)
+            nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    }
     record_body(t, &b->st[cur], &nc->move);
     t->lever = sphere_lever(b, k, web, margin);
 }
