@@ -5,7 +5,7 @@
 
 #include <string.h>
 
-/* The move test's budget (ws_node_track, ws_node_moved), in sixteenths of the contact margin.
+/* The move test's budget (track_bodies, ws_node_moved), in sixteenths of the contact margin.
  * A full detection lists every node-feature pair within the layers and the margin; the list
  * holds while no node has come half the margin (COVER) closer to any near body, since that is
  * what it covers on either side. The half is spent as: a node's own move from where it was
@@ -27,16 +27,14 @@ ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
     if (!nc)
         return NULL;
     nc->seg_list = -1;
-    int ok = ws_nodes_alloc(mem, &nc->xdet, n);
-    ok &= ws_nodes_alloc(mem, &nc->xep, n);
+    int ok = ws_nodes_alloc(mem, &nc->xdet, n) & ws_nodes_alloc(mem, &nc->xep, n);
     ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
     ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
-    if (!ok) {
-        ws_node_contact_free(mem, nc, n);
-        return NULL;
-    }
-    return nc;
+    if (ok)
+        return nc;
+    ws_node_contact_free(mem, nc, n);
+    return NULL;
 }
 
 void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
@@ -58,13 +56,15 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
     ws_mem_free(mem, nc, sizeof *nc);
 }
 
-static int inside_box(v3 p, v3 lo, v3 hi, double e)
+/* 1 when p lies in the open box (lo, hi) grown by e on every side, else 0; without branches,
+ * so that the loops over nodes run on vectors. */
+static inline uint64_t inside_box(v3 p, v3 lo, v3 hi, double e)
 {
-    return p.x > lo.x - e && p.x < hi.x + e && p.y > lo.y - e && p.y < hi.y + e &&
-           p.z > lo.z - e && p.z < hi.z + e;
+    return (uint64_t)((p.x > lo.x - e) & (p.x < hi.x + e) & (p.y > lo.y - e) & (p.y < hi.y + e) &
+                      (p.z > lo.z - e) & (p.z < hi.z + e));
 }
 
-/* The web's box and the bodies whose (layer- and margin-inflated) boxes reach it. */
+/* The box of the web's nodes x. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
     v3 l = nodes_get(x, 0), h = l;
@@ -93,65 +93,91 @@ static double sphere_lever(const ws_body_store *b, uint32_t k, const ws_web *web
     return b->shape[k]->radius + b->layer[k] + web->layer + margin;
 }
 
-/* Body k's box along its own axis j (global, a), grown by its layer and the web's. */
-static void body_span(const ws_body_store *b, uint32_t k, const ws_web *web, int j, v3 *a,
-                      double *lo, double *hi)
+/* Body k's own axis j at state cur (global, a), its box along it grown by its layer and the
+ * web's (lo, hi), and the CoG's coordinate on it (o): a point x lies a . x - o along it. */
+typedef struct axis_span {
+    v3 a;
+    double lo, hi, o;
+} axis_span;
+
+static double v3_at(v3 v, int j)
+{
+    return j == 0 ? v.x : j == 1 ? v.y : v.z;
+}
+
+static axis_span body_span(const ws_body_store *b, int cur, uint32_t k, const ws_web *web, int j)
 {
     const ws_shape *sh = b->shape[k];
-    const double *A = b->A[k].m;
-    double grow = b->layer[k] + web->layer;
-    *a = v3_make(A[j], A[3 + j], A[6 + j]);
-    *lo = (j == 0 ? sh->lo.x : j == 1 ? sh->lo.y : sh->lo.z) - grow;
-    *hi = (j == 0 ? sh->hi.x : j == 1 ? sh->hi.y : sh->hi.z) + grow;
+    const double *A = b->A[k].m, grow = b->layer[k] + web->layer;
+    const v3 a = v3_make(A[j], A[3 + j], A[6 + j]);
+    return (axis_span){a, v3_at(sh->lo, j) - grow, v3_at(sh->hi, j) + grow,
+                       v3_dot(a, b->st[cur].r[k])};
 }
 
 /* How far body k is from every node: the largest gap between the nodes and the body's box
  * (grown by the layers) along one of the body's three axes, with that axis. A tilted
  * platform's global box swells over a film it is far from; its own axes tell them apart. */
-static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web,
-                       ws_nodes3 x, ws_track *t)
+static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web *web, ws_nodes3 x,
+                       ws_track *t)
 {
-    v3 r = b->st[cur].r[k];
     double best = -INFINITY;
     for (int j = 0; j < 3; j++) {
-        v3 a;
-        double blo, bhi;
-        body_span(b, k, web, j, &a, &blo, &bhi);
-        double lo = INFINITY, hi = -INFINITY, o = v3_dot(a, r);
+        const axis_span S = body_span(b, cur, k, web, j);
+        double lo = INFINITY, hi = -INFINITY;
         for (uint32_t i = 0; i < web->n; i++) {
-            double c = a.x * x.x[i] + a.y * x.y[i] + a.z * x.z[i] - o;
+            double c = v3_dot(S.a, nodes_get(x, i)) - S.o;
             lo = c < lo ? c : lo;
             hi = c > hi ? c : hi;
         }
-        double gap = fmax(lo - bhi, blo - hi);
+        double gap = fmax(lo - S.hi, S.lo - hi);
         if (gap > best) {
             best = gap;
             t->axis = j;
-            t->lo = blo;
-            t->hi = bhi;
+            t->lo = S.lo;
+            t->hi = S.hi;
         }
     }
     return best;
 }
 
-/* The reference frame of a web's moves: the pose of its reference body in state cur, or the
- * global frame. Local coordinates of a global point p: A^T (p - r). */
-static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, v3 *r, v3 *v,
-                     v3 *w, qt *p)
+/* The reference frame of a web's moves: the pose and velocity of its reference body in state
+ * cur, or the global frame, as the move test holds them (A, r, vr, wr and the conjugate
+ * orientation pc; the rest zero). Local coordinates of a global point p: A^T (p - r). */
+static ws_move_test ref_frame(const ws_body_store *b, int cur, const ws_web *web)
 {
-    ws_node_contact *nc = web->contact;
-    if (nc->ref == UINT32_MAX) {
-        *A = m3_identity();
-        *r = *v = *w = v3_make(0, 0, 0);
-        *p = qt_identity();
-        return;
-    }
-    uint32_t k = nc->ref;
-    *A = b->A[k];
-    *r = b->st[cur].r[k];
-    *v = b->st[cur].v[k];
-    *w = b->wg[k];
-    *p = b->st[cur].p[k];
+    const uint32_t k = web->contact->ref;
+    if (k == UINT32_MAX)
+        return (ws_move_test){.A = m3_identity(), .pc = qt_conj(qt_identity())};
+    return (ws_move_test){.A = b->A[k],
+                          .r = b->st[cur].r[k],
+                          .vr = b->st[cur].v[k],
+                          .wr = b->wg[k],
+                          .pc = qt_conj(b->st[cur].p[k])};
+}
+
+/* Body t->body's record (rho, q) in the reference frame M, from its pose at state st. */
+static void record_body(ws_track *t, const ws_body_state *st, const ws_move_test *M)
+{
+    t->rho = m3_tmul_v(&M->A, v3_sub(st->r[t->body], M->r));
+    t->q = qt_mul(M->pc, st->p[t->body]);
+}
+
+/* How far a point of body t->body at `lever` + `far` from its CoG has come since its record,
+ * relative to the reference frame M: its CoG's move plus its turn at that lever. */
+static double body_move(const ws_track *t, const ws_body_state *st, const ws_move_test *M,
+                        double far)
+{
+    const uint32_t k = t->body;
+    v3 rho = m3_tmul_v(&M->A, v3_sub(st->r[k], M->r));
+    double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(M->pc, st->p[k]))));
+    return v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + far);
+}
+
+/* Whether a far body that came d closer may reach a node within its gap: the node itself may
+ * go a quarter of the margin (MOVE_NODE + MOVE_SUBSTEP) before it is found again. */
+static int may_reach(double d, double gap, double margin)
+{
+    return d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= gap;
 }
 
 /* Nodes are turned to the reference frame REF_CHUNK at a time (to_ref). Flags are found
@@ -160,89 +186,77 @@ static void ref_pose(const ws_body_store *b, int cur, const ws_web *web, m3 *A, 
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* The reference frame (A, r) and the epoch's (E, e). */
-typedef struct ref_frames {
-    const m3 *A, *E;
-    v3 r, e;
-} ref_frames;
+/* The rows of to_ref's scratch: the nodes' global x, y, z; in the reference frame, s; at the
+ * epoch, g; |s|^2. */
+enum { T_X, T_S = 3, T_G = 6, T_L2 = 9, T_ROWS };
 
-/* m nodes at (px, py, pz) to the reference frame: s = A^T (x - r) into (sx, sy, sz), and their
- * place at the epoch, e + E s, into (gx, gy, gz), |s|^2 into l2. On vectors. */
+/* m nodes (rows T_X of t) to the reference frame M: s = A^T (x - r) into rows T_S, and their
+ * place at nc's epoch, epoch_r + epoch_A s, into rows T_G, |s|^2 into row T_L2. On vectors. */
 WS_VECTOR_LOOP
-static void ref_chunk(size_t m, const double *restrict px, const double *restrict py,
-                      const double *restrict pz, const ref_frames *F, double *restrict sx,
-                      double *restrict sy, double *restrict sz, double *restrict gx,
-                      double *restrict gy, double *restrict gz, double *restrict l2)
+static void ref_chunk(size_t m, const ws_move_test *M, const ws_node_contact *nc,
+                      double (*restrict t)[REF_CHUNK])
 {
-    const double *a = F->A->m, *c = F->E->m;
-    const v3 r = F->r, e = F->e;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
-                 c7 = c[7], c8 = c[8];
+    const m3 A = M->A, E = nc->epoch_A;
+    const v3 r = M->r, e = nc->epoch_r;
     for (size_t i = 0; i < m; i++) {
-        double qx = px[i] - r.x, qy = py[i] - r.y, qz = pz[i] - r.z;
-        double ux = a0 * qx + a3 * qy + a6 * qz;
-        double uy = a1 * qx + a4 * qy + a7 * qz;
-        double uz = a2 * qx + a5 * qy + a8 * qz;
-        sx[i] = ux;
-        sy[i] = uy;
-        sz[i] = uz;
-        gx[i] = e.x + (c0 * ux + c1 * uy + c2 * uz);
-        gy[i] = e.y + (c3 * ux + c4 * uy + c5 * uz);
-        gz[i] = e.z + (c6 * ux + c7 * uy + c8 * uz);
-        l2[i] = ux * ux + uy * uy + uz * uz;
+        v3 u = m3_tmul_v(&A, v3_sub(v3_make(t[T_X][i], t[T_X + 1][i], t[T_X + 2][i]), r));
+        v3 g = v3_add(e, m3_mul_v(&E, u));
+        t[T_S][i] = u.x;
+        t[T_S + 1][i] = u.y;
+        t[T_S + 2][i] = u.z;
+        t[T_G][i] = g.x;
+        t[T_G + 1][i] = g.y;
+        t[T_G + 2][i] = g.z;
+        t[T_L2][i] = v3_norm2(u);
     }
 }
 
-/* Nodes to the reference frame (A, r): s = A^T (x - r), into xdet, and their place at the
- * epoch, epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the
- * listed ones when `only` is set (gathered REF_CHUNK at a time, turned on vectors, put back). */
-static void to_ref(ws_web *web, ws_nodes3 x, const m3 *A, v3 r, const uint32_t *only,
+/* Nodes to the reference frame M: s = A^T (x - r), into xdet, and their place at the epoch,
+ * epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the listed
+ * ones when `only` is set. Gathered REF_CHUNK at a time, turned on vectors, put back: the
+ * gather costs little beside the search that follows every call. */
+static void to_ref(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
                    size_t count)
 {
     ws_node_contact *nc = web->contact;
-    const ref_frames F = {A, &nc->epoch_A, r, nc->epoch_r};
-    double t[10][REF_CHUNK], lever2 = nc->lever2;
+    double t[T_ROWS][REF_CHUNK], lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
         const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
-        if (!only) {
-            ref_chunk(m, x.x + q0, x.y + q0, x.z + q0, &F, nc->xdet.x + q0, nc->xdet.y + q0,
-                      nc->xdet.z + q0, nc->xep.x + q0, nc->xep.y + q0, nc->xep.z + q0, t[9]);
-        } else {
-            const uint32_t *nd = only + q0;
-            for (size_t j = 0; j < m; j++) {
-                t[0][j] = x.x[nd[j]];
-                t[1][j] = x.y[nd[j]];
-                t[2][j] = x.z[nd[j]];
-            }
-            ref_chunk(m, t[0], t[1], t[2], &F, t[3], t[4], t[5], t[6], t[7], t[8], t[9]);
-            for (size_t j = 0; j < m; j++) {
-                const uint32_t i = nd[j];
-                nc->xdet.x[i] = t[3][j];
-                nc->xdet.y[i] = t[4][j];
-                nc->xdet.z[i] = t[5][j];
-                nc->xep.x[i] = t[6][j];
-                nc->xep.y[i] = t[7][j];
-                nc->xep.z[i] = t[8][j];
-            }
+        for (size_t j = 0; j < m; j++) {
+            const size_t i = only ? only[q0 + j] : q0 + j;
+            t[T_X][j] = x.x[i];
+            t[T_X + 1][j] = x.y[i];
+            t[T_X + 2][j] = x.z[i];
         }
-        for (size_t j = 0; j < m; j++)
-            lever2 = t[9][j] > lever2 ? t[9][j] : lever2;
+        ref_chunk(m, M, nc, t);
+        for (size_t j = 0; j < m; j++) {
+            const size_t i = only ? only[q0 + j] : q0 + j;
+            nc->xdet.x[i] = t[T_S][j];
+            nc->xdet.y[i] = t[T_S + 1][j];
+            nc->xdet.z[i] = t[T_S + 2][j];
+            nc->xep.x[i] = t[T_G][j];
+            nc->xep.y[i] = t[T_G + 1][j];
+            nc->xep.z[i] = t[T_G + 2][j];
+            lever2 = t[T_L2][j] > lever2 ? t[T_L2][j] : lever2;
+        }
     }
     nc->lever2 = lever2;
 }
 
-int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
-                  double margin)
+/* A full detection's record (see ws_node_contact): the web's box from its nodes at state cur
+ * and every body, near the web or how far from it, with its pose then; xdet from the nodes. 0,
+ * or -1 when out of memory. */
+static int track_bodies(const ws_node_step *S, ws_web *web)
 {
+    const ws_body_store *b = S->b;
+    const ws_nodes3 x = web->x[S->cur];
     ws_node_contact *nc = web->contact;
     nc->ntrack = 0;
     nc->ref = UINT32_MAX;
     if (web->n == 0)
         return 0;
-    if (ws_array_reserve(mem, (void **)&nc->track, &nc->track_cap, b->slots + 1,
+    if (ws_array_reserve(S->mem, (void **)&nc->track, &nc->track_cap, b->slots + 1,
                          sizeof *nc->track) != 0)
         return -1;
     web_box(web, x, &nc->box_lo, &nc->box_hi);
@@ -254,12 +268,12 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
             continue;
         ws_track *t = &nc->track[nc->ntrack++];
         t->body = k;
-        t->gap = body_gap(b, cur, k, web, x, t);
-        t->near = t->gap <= MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin;
+        t->gap = body_gap(b, S->cur, k, web, x, t);
+        t->near = t->gap <= MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * S->margin;
         /* A point of the body touches a node only within its bounding sphere grown by the
          * layers and the margin, and only in the web's box. */
-        t->lever = fmin(sphere_lever(b, k, web, margin),
-                        far_corner(b->st[cur].r[k], nc->box_lo, nc->box_hi));
+        t->lever = fmin(sphere_lever(b, k, web, S->margin),
+                        far_corner(b->st[S->cur].r[k], nc->box_lo, nc->box_hi));
         /* The reference: the heaviest dynamic body near the web (the load the film rides
          * on), else a kinematic one. */
         double m = b->type[k] == WS_BODY_DYNAMIC ? b->mass[k] : 0.0;
@@ -268,25 +282,16 @@ int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_
             nc->ref = k;
         }
     }
-    m3 A;
-    v3 r, v, w;
-    qt p;
-    ref_pose(b, cur, web, &A, &r, &v, &w, &p);
-    qt pc = qt_conj(p);
-    for (size_t q = 0; q < nc->ntrack; q++) {
-        ws_track *t = &nc->track[q];
-        uint32_t k = t->body;
-        t->rho = m3_tmul_v(&A, v3_sub(b->st[cur].r[k], r));
-        t->q = qt_mul(pc, b->st[cur].p[k]);
-    }
-    nc->epoch_A = A;
-    nc->epoch_r = r;
-    nc->epoch_q = p;
+    const ws_move_test M = ref_frame(b, S->cur, web);
+    for (size_t q = 0; q < nc->ntrack; q++)
+        record_body(&nc->track[q], &b->st[S->cur], &M);
+    nc->epoch_A = M.A;
+    nc->epoch_r = M.r;
+    nc->epoch_q = qt_conj(M.pc);
     nc->lever2 = 0.0;
-    to_ref(web, x, &A, r, NULL, 0);
+    to_ref(web, x, &M, NULL, 0);
     return 0;
 }
-
 
 /* The flags of a group of e nodes (0 or 1, as 64-bit values) narrowed into their bytes of redo;
  * a group with none (any = 0) is cleared, not narrowed. */
@@ -301,53 +306,30 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
         redo[i] = (uint8_t)flag[i];
 }
 
-/* The per-node test of ws_node_moved: 1 in nc->redo for a node whose measure reaches the
- * bound (or is NaN), else 0; how many are flagged. Straight-line code, on vectors; the measure
- * is squared when there is one sub-step (c = 0: no square root needed). Most groups of nodes
- * have none flagged: their bytes are cleared, not narrowed. */
+/* The per-node test of ws_node_moved with sub-steps (c > 0): 1 in nc->redo for a node whose
+ * measure |u| + c |w| reaches the bound (or is NaN), else 0; how many are flagged. u is the
+ * node's move in the reference frame since it was found, w its velocity relative to the
+ * reference body's point where it is. Straight-line code, on vectors. Most groups of nodes have
+ * none flagged: their bytes are cleared, not narrowed. */
 WS_VECTOR_LOOP
 static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
-    const ws_move_test *M = &nc->move;
-    const v3 r = M->r, vr = M->vr, wr = M->wr;
-    const double c = M->c, lim = M->lim, *a = M->A.m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lim2 = lim * lim;
+    const ws_move_test M = nc->move;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
         const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
                                *restrict oz = nc->xdet.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
-        const size_t before = count;
-        if (c > 0.0) {
-            for (size_t i = 0; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                double wx = vx[i] - vr.x - (wr.y * pz - wr.z * py);
-                double wy = vy[i] - vr.y - (wr.z * px - wr.x * pz);
-                double wz = vz[i] - vr.z - (wr.x * py - wr.y * px);
-                double m =
-                    sqrt(ux * ux + uy * uy + uz * uz) + c * sqrt(wx * wx + wy * wy + wz * wz);
-                uint64_t f = !(m < lim);
-                flag[i] = f;
-                count += f;
-            }
-        } else { /* one sub-step: the contacts see only where the nodes are now */
-            for (size_t i = 0; i < e; i++) {
-                double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-                double ux = a0 * px + a3 * py + a6 * pz - ox[i];
-                double uy = a1 * px + a4 * py + a7 * pz - oy[i];
-                double uz = a2 * px + a5 * py + a8 * pz - oz[i];
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
-            }
+        for (size_t i = 0; i < e; i++) {
+            v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
+            v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(ox[i], oy[i], oz[i]));
+            v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
+            uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
+            flag[i] = f;
+            count += f;
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
@@ -361,42 +343,29 @@ static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n
 WS_VECTOR_LOOP
 static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
 {
-    const v3 r = nc->move.r;
-    const double lim = nc->move.lim, *a = nc->move.A.m;
-    const int renew = nc->move.renew;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lim2 = lim * lim;
+    const ws_move_test M = nc->move;
+    const double lim2 = M.lim * M.lim;
     uint64_t flag[FLAG_CHUNK];
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK;
+        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
         double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
                          *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
-        const size_t before = count;
-        if (renew) {
-            const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
-                                   *restrict sz = nc->xdet.z + i0;
+        const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
+                               *restrict sz = nc->xdet.z + i0;
+        if (M.renew)
             for (size_t i = 0; i < e; i++) {
-                double gx = r.x + (a0 * sx[i] + a1 * sy[i] + a2 * sz[i]);
-                double gy = r.y + (a3 * sx[i] + a4 * sy[i] + a5 * sz[i]);
-                double gz = r.z + (a6 * sx[i] + a7 * sy[i] + a8 * sz[i]);
-                ox[i] = gx;
-                oy[i] = gy;
-                oz[i] = gz;
-                double ux = qx[i] - gx, uy = qy[i] - gy, uz = qz[i] - gz;
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
+                v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
+                ox[i] = g.x;
+                oy[i] = g.y;
+                oz[i] = g.z;
             }
-        } else {
-            for (size_t i = 0; i < e; i++) {
-                double ux = qx[i] - ox[i], uy = qy[i] - oy[i], uz = qz[i] - oz[i];
-                uint64_t f = !(ux * ux + uy * uy + uz * uz < lim2);
-                flag[i] = f;
-                count += f;
-            }
+        for (size_t i = 0; i < e; i++) {
+            uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
+                                           v3_make(ox[i], oy[i], oz[i]))) < lim2);
+            flag[i] = f;
+            count += f;
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
@@ -435,54 +404,47 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
     return count;
 }
 
-/* Flag (1 in `flag`) the nodes whose coordinates in the frame (A, r), A^T (x - r), lie in the
- * open box (lo, hi). Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those of a
- * group with none in the box are left as they are). */
+/* Flag (1 in `flag`) the nodes whose coordinates in body k's frame at state cur, A^T (x - r),
+ * lie in its box grown by e. Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those
+ * of a group with none in the box are left as they are). */
 WS_VECTOR_LOOP
-static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const m3 *A, v3 r, v3 lo, v3 hi)
+static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const ws_body_store *b, int cur,
+                        uint32_t k, double e)
 {
-    const double *a = A->m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
+    const m3 A = b->A[k];
+    const v3 r = b->st[cur].r[k], lo = b->shape[k]->lo, hi = b->shape[k]->hi;
     uint64_t in[FLAG_CHUNK];
     for (size_t i0 = 0; i0 < n; i0 += FLAG_CHUNK) {
-        const size_t e = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
+        const size_t m = n - i0 < FLAG_CHUNK ? n - i0 : (size_t)FLAG_CHUNK;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
         uint64_t any = 0;
-        for (size_t i = 0; i < e; i++) {
-            double px = qx[i] - r.x, py = qy[i] - r.y, pz = qz[i] - r.z;
-            double sx = a0 * px + a3 * py + a6 * pz;
-            double sy = a1 * px + a4 * py + a7 * pz;
-            double sz = a2 * px + a5 * py + a8 * pz;
-            in[i] = (uint64_t)((sx > lo.x) & (sx < hi.x) & (sy > lo.y) & (sy < hi.y) & (sz > lo.z) &
-                               (sz < hi.z));
+        for (size_t i = 0; i < m; i++) {
+            in[i] = inside_box(m3_tmul_v(&A, v3_sub(v3_make(qx[i], qy[i], qz[i]), r)), lo, hi, e);
             any |= in[i];
         }
         if (!any)
             continue;
         uint8_t *restrict f = flag + i0;
-        for (size_t i = 0; i < e; i++)
+        for (size_t i = 0; i < m; i++)
             f[i] |= (uint8_t)in[i];
     }
 }
 
-/* Re-base near body k (see ws_node_moved) at state cur: its record (rho, q) in the reference
- * frame (A, r, conjugate orientation pc) and its lever from now, and the nodes it may meet
- * flagged in nc->redo: those in its box grown by the reach (layers + margin), in its frame
- * now, and those that hold a candidate of it in the committed list. */
+/* Re-base near body t->body (see ws_node_moved) at state cur: its record in the reference frame
+ * (nc->move) and its lever from now, and the nodes it may meet flagged in nc->redo: those in
+ * its box grown by the reach (layers + margin), in its frame now, and those that hold a
+ * candidate of it in the committed list. */
 static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
-                        double margin, const m3 *A, v3 r, qt pc)
+                        double margin)
 {
     ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
-    const ws_shape *sh = b->shape[k];
-    const double e = b->layer[k] + web->layer + margin;
-    flag_in_box(nc->redo, x, web->n, &b->A[k], b->st[cur].r[k],
-                v3_make(sh->lo.x - e, sh->lo.y - e, sh->lo.z - e),
-                v3_make(sh->hi.x + e, sh->hi.y + e, sh->hi.z + e));
+    flag_in_box(nc->redo, x, web->n, b, cur, k, b->layer[k] + web->layer + margin);
     const ws_ncand *c = nc->cand[nc->list].c;
     if (nc->seg_list == nc->list) {
-        /* The list's stretches: a run's candidates are of one face, so of one body. */
+        /* The list's stretches: a run's candidates are of one face, so of one body, and its
+         * nodes are flagged at once. The reference case re-bases a body often enough that a
+         * pass over every candidate costs it about 2 % of its step. */
         for (size_t s = 0; s < nc->nseg; s++) {
             const ws_nseg *sg = &nc->seg[s];
             if (sg->run && c[sg->c0].body == k)
@@ -495,8 +457,7 @@ static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *we
         for (size_t q = 0; q < nc->cand[nc->list].n; q++)
             nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
     }
-    t->rho = m3_tmul_v(A, v3_sub(b->st[cur].r[k], r));
-    t->q = qt_mul(pc, b->st[cur].p[k]);
+    record_body(t, &b->st[cur], &nc->move);
     t->lever = sphere_lever(b, k, web, margin);
 }
 
@@ -513,12 +474,9 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
         if (b->alive[k])
             return -1;
     }
-    m3 A;
-    v3 r, vr, wr;
-    qt p;
-    ref_pose(b, cur, web, &A, &r, &vr, &wr, &p);
-    qt pc = qt_conj(p);
-    double reach = far_corner(r, nc->box_lo, nc->box_hi) + margin;
+    ws_move_test *M = &nc->move;
+    *M = ref_frame(b, cur, web);
+    M->reach = far_corner(M->r, nc->box_lo, nc->box_hi) + margin;
     /* The contacts of this step are evaluated with the bodies as they are now (state cur),
      * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
      * move relative to the reference counts as it stands: its CoG's move and its turn times
@@ -540,32 +498,25 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
      * needs no candidate of it. The holders of its
      * candidates are found again too: the body may have jumped, so that they are out of its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
-    int rebase = 0;
-    ws_move_test *M = &nc->move;
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
-        uint32_t k = t->body;
-        v3 rho = m3_tmul_v(&A, v3_sub(st->r[k], r));
-        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(pc, st->p[k]))));
-        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + (t->near ? 0.0 : reach));
+        const double d = body_move(t, st, M, t->near ? 0.0 : M->reach);
         t->rebase = t->near && d >= MOVE_PART(MOVE_BODY) * margin;
-        rebase |= t->rebase;
-        if (!t->near && d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
+        M->rebase |= t->rebase;
+        if (!t->near && may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Per node: flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin, u its move in
-     * the reference frame since it was found, w its velocity relative to the reference body's
-     * point where it is, h_more the time its sub-steps go beyond this state. Two near bodies'
-     * deviations (margin / 4) and the rest (margin / 16, for what the sub-steps' forces add)
-     * keep a node's move relative to any near body under half the margin: what the
-     * candidates were found to cover. With one sub-step the contacts see the nodes only where
-     * they are now, which the test measures, and nothing is added: flagged at |u| = 1/4 of
-     * the margin. Either way a node stays within a quarter margin of where it was found
-     * wherever the contacts see it. */
-    const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin,
-                 c = 1.5 * dt * (web->substeps - 1) / web->substeps;
-    *M = (ws_move_test){A, r, vr, wr, pc, c, lim, reach, 0, rebase};
-    if (c <= 0.0) {
+    /* Per node (flag_moved): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
+     * h_more the time its sub-steps go beyond this state. Two near bodies' deviations (margin /
+     * 4) and the rest (margin / 16, for what the sub-steps' forces add) keep a node's move
+     * relative to any near body under half the margin: what the candidates were found to
+     * cover. With one sub-step the contacts see the nodes only where they are now, which the
+     * test measures, and nothing is added: flagged at |u| = 1/4 of the margin. Either way a
+     * node stays within a quarter margin of where it was found wherever the contacts see it. */
+    const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin;
+    M->c = 1.5 * dt * (web->substeps - 1) / web->substeps;
+    M->lim = lim;
+    if (M->c <= 0.0) {
         /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
          * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
          * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
@@ -577,12 +528,13 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
          * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
          * node is flagged before it has moved 7/8 of the bound; it costs about what turning
          * every node costs, and a load that rocks on its film needs one every few steps. */
+        const qt p = qt_conj(M->pc);
         const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
-        double drift = v3_norm(v3_sub(r, nc->epoch_r)) + turn * sqrt(nc->lever2);
+        double drift = v3_norm(v3_sub(M->r, nc->epoch_r)) + turn * sqrt(nc->lever2);
         M->renew = !(drift < 0.125 * lim);
         if (M->renew) {
-            nc->epoch_A = A;
-            nc->epoch_r = r;
+            nc->epoch_A = M->A;
+            nc->epoch_r = M->r;
             nc->epoch_q = p;
             drift = 0.0;
         }
@@ -605,7 +557,7 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     const ws_move_test *M = &nc->move;
     for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
-            rebase_body(b, cur, &nc->track[q], web, x, margin, &M->A, M->r, M->pc);
+            rebase_body(b, cur, &nc->track[q], web, x, margin);
     /* Most steps flag no node. */
     long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
@@ -614,28 +566,30 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
         ws_track *t = &nc->track[q];
         if (t->near)
             continue;
-        uint32_t k = t->body;
-        v3 ax;
-        double blo, bhi;
-        body_span(b, k, web, t->axis, &ax, &blo, &bhi);
-        double o = v3_dot(ax, st->r[k]), least = INFINITY;
+        const axis_span S = body_span(b, cur, t->body, web, t->axis);
+        double least = INFINITY;
         for (long m = 0; m < count; m++) {
-            uint32_t i = nc->moved[m];
-            double cc = ax.x * x.x[i] + ax.y * x.y[i] + ax.z * x.z[i] - o;
-            double g = fmax(cc - bhi, blo - cc);
+            double c = v3_dot(S.a, nodes_get(x, nc->moved[m])) - S.o;
+            double g = fmax(c - S.hi, S.lo - c);
             least = g < least ? g : least;
         }
-        v3 rho = m3_tmul_v(&M->A, v3_sub(st->r[k], M->r));
-        double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(t->q), qt_mul(M->pc, st->p[k]))));
-        double d = v3_norm(v3_sub(rho, t->rho)) + turn * (t->lever + M->reach);
+        const double d = body_move(t, st, M, M->reach);
         if (least - d < t->gap)
             t->gap = least - d;
-        if (d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= t->gap)
+        if (may_reach(d, t->gap, margin))
             return -1;
     }
     /* Found again now: their moves count from here. */
-    to_ref(web, x, &M->A, M->r, nc->moved, (size_t)count);
+    to_ref(web, x, M, nc->moved, (size_t)count);
     return count;
+}
+
+/* The end of node m's candidates in the list c (n of them, sorted by node), from f on. */
+static size_t run_end(const ws_ncand *c, size_t n, size_t f, uint32_t m)
+{
+    for (; f < n && c[f].node == m; f++)
+        ;
+    return f;
 }
 
 void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
@@ -643,8 +597,7 @@ void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
     size_t q = 0;
     for (uint32_t i = 0; i < n; i++) {
         start[i] = q;
-        while (q < nc && c[q].node == i)
-            q++;
+        q = run_end(c, nc, q, i);
     }
     start[n] = nc;
 }
@@ -674,16 +627,13 @@ static inline int same_run(const ws_ncand *a, size_t i, const ws_ncand *b, size_
     return !memcmp(a + i, b + j, len * sizeof *a);
 }
 
-int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
-                 const ws_ncand *fresh, size_t nfresh)
+int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *old)
 {
+    const ws_ncand *fresh = F->fresh->c;
     size_t f = 0;
-    for (size_t q = 0; q < count; q++) {
-        const uint32_t m = nodes[q];
-        const size_t a = start[m], len = start[m + 1] - a;
-        size_t f1 = f;
-        for (; f1 < nfresh && fresh[f1].node == m; f1++)
-            ;
+    for (size_t q = 0; q < F->count; q++) {
+        const uint32_t m = F->nodes[q];
+        const size_t a = start[m], len = start[m + 1] - a, f1 = run_end(fresh, F->fresh->n, f, m);
         if (f1 - f != len || !same_run(old, a, fresh, f, len))
             return 0;
         f = f1;
@@ -699,31 +649,26 @@ static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
         start[i] += shift;
 }
 
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand_list *old_list, const ws_ncand_list *fresh_list,
-                  ws_ncand_list *out_list, uint32_t *changed, size_t *nchanged)
+long ws_node_merge(ws_mem *mem, const ws_node_found *F, uint32_t nn, size_t *start,
+                   const ws_ncand_list *old_list, ws_ncand_list *out, uint32_t *changed)
 {
-    const ws_ncand *old = old_list->c, *fresh = fresh_list->c;
-    const size_t nold = old_list->n, nfresh = fresh_list->n;
-    ws_ncand **out = &out_list->c;
-    size_t *n = &out_list->n, *cap = &out_list->cap;
-    if (ws_array_reserve(mem, (void **)out, cap, nold + nfresh + 1, sizeof **out) != 0)
+    const ws_ncand *old = old_list->c, *fresh = F->fresh->c;
+    const size_t nold = old_list->n, nfresh = F->fresh->n;
+    if (ws_array_reserve(mem, (void **)&out->c, &out->cap, nold + nfresh + 1, sizeof *out->c) != 0)
         return -1;
-    ws_ncand *o = *out;
+    ws_ncand *o = out->c;
     size_t k = 0, a = 0, f = 0, c = 0, i0 = 0;
     /* Node by node found again: the old candidates of the nodes before it as they are, its
      * old ones dropped, its fresh ones in their place. The nodes from i0 through it start
      * k - a later in the merged list than in the old one (the shift of their stretch, read
      * before it is applied: start[m + 1] is still the old list's). */
-    for (size_t q = 0; q < count; q++) {
-        const uint32_t m = nodes[q];
-        const size_t e = start[m];
+    for (size_t q = 0; q < F->count; q++) {
+        const uint32_t m = F->nodes[q];
+        const size_t e = start[m], f0 = f;
         append_run(o, &k, old, a, e - a);
         shift_index(start, i0, (size_t)m + 1, k - e);
         a = start[m + 1];
-        const size_t f0 = f;
-        for (; f < nfresh && fresh[f].node == m; f++)
-            ;
+        f = run_end(fresh, nfresh, f, m);
         if (a - e != f - f0 || !same_run(old, e, fresh, f0, f - f0))
             changed[c++] = m;
         append_run(o, &k, fresh, f0, f - f0);
@@ -731,18 +676,8 @@ int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn,
     }
     shift_index(start, i0, (size_t)nn + 1, k - a);
     append_run(o, &k, old, a, nold - a);
-    *n = k;
-    *nchanged = c;
-    return 0;
-}
-
-/* Append c to the list. 0, or -1 when out of memory. */
-static int push_cand(ws_mem *mem, ws_ncand **out, size_t *n, size_t *cap, ws_ncand c)
-{
-    if (*n == *cap && ws_array_reserve(mem, (void **)out, cap, *n + 1, sizeof **out) != 0)
-        return -1;
-    (*out)[(*n)++] = c;
-    return 0;
+    out->n = k;
+    return (long)c;
 }
 
 /* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
@@ -774,11 +709,11 @@ static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
 enum { FIND_CHUNK = 64 };
 
 /* A body near a group of nodes: its slot, its reach (the layers and the margin), how many of the
- * group's nodes lie in its grown box and
- * where their values are in the scratch: their places in the group at find_node + node; at
- * find_val + val, FIND_CHUNK apart, their body-frame x, y, z, the largest plane distance D, then
- * their distance to each face's plane; at find_mask + mask, FIND_CHUNK apart, the masks M_*.
- * general: searched node by node, without values. next: the next of its nodes to list. */
+ * group's nodes lie in its grown box and where their values are in the scratch: their places
+ * in the group at find_node + node; at find_val + val, FIND_CHUNK apart, their body-frame x,
+ * y, z, the largest plane distance D, then their distance to each face's plane; at find_mask +
+ * mask, FIND_CHUNK apart, the masks M_*. general: searched node by node, without values. next:
+ * the next of its nodes to list. */
 typedef struct ws_find_body {
     uint32_t body, count, next;
     int general;
@@ -795,19 +730,16 @@ enum { M_LOCAL, M_PASS, M_BOXES, M_OUT, M_NEAR, M_ARRAYS };
  * faces in M_PASS, those it is not well inside of (see convex_candidates); M_NEAR: the faces
  * whose plane it is not a margin or more behind. */
 
-/* hit[j] = 1 when node j of the group (px, py, pz) lies in the open box (lo, hi), else 0; how
- * many do. */
+/* hit[j] = 1 when node j of the group (rows x, y, z of p) lies in the open box (lo, hi)
+ * grown by e, else 0; how many do. */
 WS_VECTOR_LOOP
-static size_t find_near(uint64_t *restrict hit, const double *restrict px,
-                        const double *restrict py, const double *restrict pz, size_t m, v3 lo,
-                        v3 hi)
+static size_t find_near(uint64_t *restrict hit, double (*restrict p)[FIND_CHUNK], size_t m, v3 lo,
+                        v3 hi, double e)
 {
     size_t count = 0;
     for (size_t j = 0; j < m; j++) {
-        uint64_t h = (uint64_t)((px[j] > lo.x) & (px[j] < hi.x) & (py[j] > lo.y) &
-                                (py[j] < hi.y) & (pz[j] > lo.z) & (pz[j] < hi.z));
-        hit[j] = h;
-        count += h;
+        hit[j] = inside_box(v3_make(p[0][j], p[1][j], p[2][j]), lo, hi, e);
+        count += hit[j];
     }
     return count;
 }
@@ -819,11 +751,7 @@ WS_VECTOR_LOOP
 static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, double margin, size_t m,
                        double *val, uint64_t *mask)
 {
-    const double *a = A->m;
-    const double a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5], a6 = a[6],
-                 a7 = a[7], a8 = a[8];
-    const double lx = sh->lo.x - reach, ly = sh->lo.y - reach, lz = sh->lo.z - reach,
-                 hx = sh->hi.x + reach, hy = sh->hi.y + reach, hz = sh->hi.z + reach;
+    const m3 At = *A;
     double *restrict sx = val + V_X * FIND_CHUNK, *restrict sy = val + V_Y * FIND_CHUNK,
                      *restrict sz = val + V_Z * FIND_CHUNK, *restrict D = val + V_D * FIND_CHUNK;
     uint64_t *restrict local = mask + M_LOCAL * FIND_CHUNK,
@@ -831,32 +759,24 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
                        *restrict boxes = mask + M_BOXES * FIND_CHUNK,
                        *restrict near = mask + M_NEAR * FIND_CHUNK;
     for (size_t j = 0; j < m; j++) {
-        double px = sx[j] - r.x, py = sy[j] - r.y, pz = sz[j] - r.z;
-        double x = a0 * px + a3 * py + a6 * pz;
-        double y = a1 * px + a4 * py + a7 * pz;
-        double z = a2 * px + a5 * py + a8 * pz;
-        sx[j] = x;
-        sy[j] = y;
-        sz[j] = z;
-        local[j] = (uint64_t)((x > lx) & (x < hx) & (y > ly) & (y < hy) & (z > lz) & (z < hz));
+        v3 s = m3_tmul_v(&At, v3_sub(v3_make(sx[j], sy[j], sz[j]), r));
+        sx[j] = s.x;
+        sy[j] = s.y;
+        sz[j] = s.z;
+        local[j] = inside_box(s, sh->lo, sh->hi, reach);
         D[j] = -INFINITY;
         pass[j] = boxes[j] = near[j] = 0;
     }
     for (uint32_t f = 0; f < sh->face_count; f++) {
-        const ws_face *F = &sh->faces[f];
-        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z, off = F->offset;
-        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
-                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        const ws_face F = sh->faces[f];
         double *restrict dg = val + (V_FACES + f) * FIND_CHUNK;
         for (size_t j = 0; j < m; j++) {
-            double x = sx[j], y = sy[j], z = sz[j];
-            double d = nx * x + ny * y + nz * z - off;
+            v3 s = v3_make(sx[j], sy[j], sz[j]);
+            double d = v3_dot(F.normal, s) - F.offset;
             dg[j] = d;
             D[j] = d > D[j] ? d : D[j];
             near[j] |= (uint64_t)(!(d <= -margin)) << f;
-            boxes[j] |=
-                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
-                << f;
+            boxes[j] |= inside_box(s, F.lo, F.hi, reach) << f;
         }
     }
     const double deep = -reach - sh->inner;
@@ -877,19 +797,12 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
     }
     for (; any; any &= any - 1) {
         const uint32_t f = ws_lowest_bit(any);
-        const ws_face *F = &sh->faces[f];
-        const double nx = F->normal.x, ny = F->normal.y, nz = F->normal.z;
-        const double bx0 = F->lo.x - reach, by0 = F->lo.y - reach, bz0 = F->lo.z - reach,
-                     bx1 = F->hi.x + reach, by1 = F->hi.y + reach, bz1 = F->hi.z + reach;
+        const ws_face F = sh->faces[f];
         const double *restrict df = val + (V_FACES + f) * FIND_CHUNK;
         const uint64_t drop = ~((uint64_t)1 << f);
         for (size_t j = 0; j < m; j++) {
-            double d = -df[j];
-            double x = sx[j] + nx * d, y = sy[j] + ny * d, z = sz[j] + nz * d;
-            pass[j] &=
-                drop |
-                (uint64_t)((x > bx0) & (x < bx1) & (y > by0) & (y < by1) & (z > bz0) & (z < bz1))
-                    << f;
+            v3 s = v3_madd(v3_make(sx[j], sy[j], sz[j]), F.normal, -df[j]);
+            pass[j] &= drop | inside_box(s, F.lo, F.hi, reach) << f;
         }
         /* The projection on f's plane lies dg - df c out of face o's plane: dg itself for a
          * face square to f (c = 0, and df is finite), whose test is then the node's own
@@ -898,7 +811,7 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
         for (uint32_t o = 0; o < sh->face_count; o++) {
             if (o == f)
                 continue;
-            const double c = v3_dot(sh->faces[o].normal, F->normal);
+            const double c = v3_dot(sh->faces[o].normal, F.normal);
             if (c == 0.0) {
                 square |= (uint64_t)1 << o;
                 continue;
@@ -913,39 +826,60 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
     }
 }
 
-/* Node i, the c-th of body fb's nodes, against that convex body of shape sh, from its values
- * and masks (find_faces): the faces and edges the general search below would list, in the same
- * order. Only here may a face candidate be marked INSIDE. */
-static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom *g,
-                             const ws_find_body *fb, uint32_t c, uint32_t i, double reach,
-                             double margin, ws_ncand_list *L, uint64_t *checks)
+/* Room in L for every face and edge of shape sh past its end: one check, not one per
+ * candidate. The list's candidates, or NULL when out of memory. */
+static ws_ncand *room_for(ws_mem *mem, ws_ncand_list *L, const ws_shape *sh)
 {
-    ws_ncand **out = &L->c;
-    size_t *n = &L->n, *cap = &L->cap;
-    const uint32_t nf = sh->face_count, k = fb->body;
+    const size_t room = L->n + sh->face_count + sh->edge_count;
+    if (room > L->cap && ws_array_reserve(mem, (void **)&L->c, &L->cap, room, sizeof *L->c) != 0)
+        return NULL;
+    return L->c;
+}
+
+/* Whether edge E of shape sh, the rounded rim of the contact layer, lies within reach of the
+ * node at s (body frame), a check counted when s is in the edge's grown box. The segment's
+ * parameter is clamped to it: a node past an end may slide along the edge into its span before
+ * it is found again. */
+static int near_edge(const ws_shape *sh, const ws_edge *E, v3 s, double reach, uint64_t *checks)
+{
+    if (!inside_box(s, E->lo, E->hi, reach))
+        return 0;
+    (*checks)++;
+    v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
+    double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    return v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach;
+}
+
+/* Node i, the c-th of body fb's nodes, against that convex body, from its values and masks
+ * (find_faces): the faces and edges the general search below would list, in the same order,
+ * into L. Only here may a face candidate be marked INSIDE. */
+static int convex_candidates(const ws_node_step *S, const ws_find_body *fb, uint32_t c, uint32_t i,
+                             ws_ncand_list *L)
+{
+    const uint32_t k = fb->body;
+    const ws_shape *sh = S->b->shape[k];
+    const ws_node_geom *g = S->g;
     const double *v = g->find_val + fb->val + c;
     const uint64_t *mk = g->find_mask + fb->mask + c;
     const v3 s = v3_make(v[V_X * FIND_CHUNK], v[V_Y * FIND_CHUNK], v[V_Z * FIND_CHUNK]);
-    const uint64_t boxes = mk[M_BOXES * FIND_CHUNK];
-    const uint64_t outside = mk[M_OUT * FIND_CHUNK];
-    const size_t n0 = *n;
-    *checks += nf;
-    /* Room for every face and edge of the shape: one check, not one per candidate. */
-    const size_t room = n0 + nf + sh->edge_count;
-    if (room > *cap && ws_array_reserve(mem, (void **)out, cap, room, sizeof **out) != 0)
+    const uint64_t boxes = mk[M_BOXES * FIND_CHUNK], outside = mk[M_OUT * FIND_CHUNK];
+    const size_t n0 = L->n;
+    *S->checks += sh->face_count;
+    ws_ncand *o = room_for(S->mem, L, sh);
+    if (!o)
         return -1;
-    ws_ncand *o = *out;
     size_t q = n0;
     /* Well inside a face's outline: its projection on the plane lies a margin or more behind
      * every other face's plane (those planes bound the face on a convex body, and a plane
      * distance never exceeds the distance within the face's plane). Nodes and bodies move less
      * than half the margin relative to each other until the candidates are found again. */
-    const uint32_t fbase = g->face_base[k];
     for (uint64_t pass = mk[M_PASS * FIND_CHUNK]; pass; pass &= pass - 1) {
         const uint32_t f = ws_lowest_bit(pass);
-        o[q++] = (ws_ncand){i, k, fbase + f, f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
+        o[q++] = (ws_ncand){i, k, g->face_base[k] + f,
+                            f | (((outside >> f) & 1u) ? 0u : WS_NCAND_INSIDE)};
     }
-    *n = q;
+    L->n = q;
     /* An edge's box lies in the boxes of both its faces, so an edge within reach of the node
      * needs two of them: most nodes, over the middle of a face, have at most one and skip the
      * edges. */
@@ -959,34 +893,29 @@ static int convex_candidates(ws_mem *mem, const ws_shape *sh, const ws_node_geom
     const uint64_t near = boxes & ~(mk[M_PASS * FIND_CHUNK] & ~outside);
     for (uint32_t e = 0; e < sh->edge_count; e++) {
         const ws_edge *E = &sh->edges[e];
-        if (!((near >> E->f1) & (near >> E->f2) & 1u) || !inside_box(s, E->lo, E->hi, reach))
-            continue;
-        (*checks)++;
-        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
-        /* Within reach of the segment (t clamped to it): a node past an end may slide along
-         * the edge into its span before it is found again. */
-        double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach)
+        if (((near >> E->f1) & (near >> E->f2) & 1u) && near_edge(sh, E, s, fb->reach, S->checks))
             o[q++] = (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE};
     }
-    *n = q;
+    L->n = q;
     mark_corner(sh, o, n0, q);
     return 0;
 }
 
-/* Node i at p (global) against body k of any shape, one by one. */
-static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, const ws_node_geom *g,
-                              uint32_t i, uint32_t k, v3 p, double reach, double margin,
-                              ws_ncand_list *L, uint64_t *checks)
+/* Node i at p (global) against body fb of any shape, feature by feature, into L. */
+static int general_candidates(const ws_node_step *S, const ws_find_body *fb, uint32_t i, v3 p,
+                              ws_ncand_list *L)
 {
-    ws_ncand **out = &L->c;
-    size_t *n = &L->n, *cap = &L->cap;
-    const ws_shape *sh = b->shape[k];
-    v3 s = m3_tmul_v(&b->A[k], v3_sub(p, b->st[cur].r[k]));
+    const uint32_t k = fb->body;
+    const ws_shape *sh = S->b->shape[k];
+    const double reach = fb->reach;
+    v3 s = m3_tmul_v(&S->b->A[k], v3_sub(p, S->b->st[S->cur].r[k]));
     if (!inside_box(s, sh->lo, sh->hi, reach))
         return 0;
-    const size_t n0 = *n;
+    ws_ncand *o = room_for(S->mem, L, sh);
+    if (!o)
+        return -1;
+    const size_t n0 = L->n;
+    size_t q = n0;
     /* On a convex body a node touches face f only while f is the face whose plane it is
      * farthest out of (the largest signed distance D): over a face it projects into, d_g <= d_f
      * for every other face g, and inside the body the shallowest face is the one of largest d.
@@ -1002,122 +931,122 @@ static int general_candidates(ws_mem *mem, const ws_body_store *b, int cur, cons
         }
     for (uint32_t f = 0; f < sh->face_count; f++) {
         const ws_face *fc = &sh->faces[f];
-        (*checks)++;
+        (*S->checks)++;
         double d = v3_dot(fc->normal, s) - fc->offset;
         /* Depth counts along the normal only: the point's projection on the face's plane must
          * lie within reach of the face. */
-        if (d > -reach - sh->inner && d < reach && d >= D - margin &&
-            inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach) &&
-            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->face_base[k] + f, f}))
-            return -1;
+        if (d > -reach - sh->inner && d < reach && d >= D - S->margin &&
+            inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
+            o[q++] = (ws_ncand){i, k, S->g->face_base[k] + f, f};
     }
-    /* Convex edges within reach of the node: the rounded rim of the contact layer. */
-    for (uint32_t e = 0; e < sh->edge_count; e++) {
-        const ws_edge *E = &sh->edges[e];
-        if (!inside_box(s, E->lo, E->hi, reach))
-            continue;
-        (*checks)++;
-        v3 a = sh->vertices[E->a], d = v3_sub(sh->vertices[E->b], a);
-        double t = v3_dot(v3_sub(s, a), d) / v3_dot(d, d);
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t; /* within reach of the segment */
-        if (v3_norm2(v3_sub(s, v3_madd(a, d, t))) < reach * reach &&
-            push_cand(mem, out, n, cap, (ws_ncand){i, k, g->edge_base[k] + e, e | WS_NCAND_EDGE}))
-            return -1;
-    }
-    mark_corner(sh, *out, n0, *n);
+    for (uint32_t e = 0; e < sh->edge_count; e++)
+        if (near_edge(sh, &sh->edges[e], s, reach, S->checks))
+            o[q++] = (ws_ncand){i, k, S->g->edge_base[k] + e, e | WS_NCAND_EDGE};
+    L->n = q;
+    mark_corner(sh, o, n0, q);
     return 0;
 }
 
-int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
-                       ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand_list *L, uint64_t *checks)
+/* The values a node takes against a body of shape sh searched on vectors (find_faces): its
+ * place, its largest plane distance and one distance per face; 0 for a body searched node by
+ * node (general_candidates), whose faces do not fit the masks. */
+static size_t face_values(const ws_shape *sh)
 {
-    size_t *n = &L->n;
+    return sh->convex && sh->face_count <= WS_NCAND_FACES
+               ? (V_FACES + sh->face_count) * (size_t)FIND_CHUNK
+               : 0;
+}
+
+/* The scratch of the search in g, from the step's arena, at its most for a group of nodes
+ * (every body near every node of the group), taken once for every group. 0, or -1 when out of
+ * memory. */
+static int find_scratch(const ws_body_store *b, ws_node_geom *g)
+{
+    size_t most_val = 1, most_mask = 1;
+    for (uint32_t k = 0; k < b->slots; k++) {
+        const size_t nv = b->alive[k] ? face_values(b->shape[k]) : 0;
+        most_val += nv;
+        most_mask += nv ? M_ARRAYS * (size_t)FIND_CHUNK : 0;
+    }
+    g->find = ws_arena_alloc(g->arena, (b->slots + 1) * sizeof *g->find);
+    g->find_node = ws_arena_alloc(g->arena, (b->slots + 1) * FIND_CHUNK * sizeof(uint32_t));
+    g->find_val = ws_arena_alloc(g->arena, most_val * sizeof(double));
+    g->find_mask = ws_arena_alloc(g->arena, most_mask * sizeof(uint64_t));
+    return g->find && g->find_node && g->find_val && g->find_mask ? 0 : -1;
+}
+
+/* The bodies near a group of m nodes at p (global x, y, z rows), in slot order, into g->find,
+ * each with the group's nodes in its box grown by the web's layer and half the margin (they
+ * move less than that before they are found again); how many. A body with no node of any group
+ * in its box has no candidate: the others are marked in web->cbody. Per convex body, on
+ * vectors: the nodes in its frame, their plane distances and their faces' masks. */
+static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_CHUNK], size_t m)
+{
+    const ws_body_store *b = S->b;
+    ws_node_geom *g = S->g;
+    const double pad = web->layer + 0.5 * S->margin;
+    uint64_t hit[FIND_CHUNK];
+    size_t nb = 0, nnode = 0, nval = 0, nmask = 0;
+    for (uint32_t k = 0; k < b->slots; k++) {
+        if (!b->alive[k])
+            continue;
+        const uint32_t c = (uint32_t)find_near(hit, p, m, b->lo[k], b->hi[k], pad);
+        if (!c)
+            continue;
+        web->contact->cbody[k] = 1;
+        uint32_t *nd = g->find_node + nnode;
+        for (size_t j = 0, e = 0; j < m; j++) {
+            nd[e] = (uint32_t)j;
+            e += hit[j];
+        }
+        const size_t nv = face_values(b->shape[k]);
+        ws_find_body *fb = &g->find[nb++];
+        *fb = (ws_find_body){k,     c,    0,    nv == 0, b->layer[k] + web->layer + S->margin,
+                             nnode, nval, nmask};
+        for (uint32_t q = 0; nv && q < c; q++)
+            for (int j = 0; j < 3; j++)
+                g->find_val[nval + (V_X + j) * FIND_CHUNK + q] = p[j][nd[q]];
+        if (nv)
+            find_faces(b->shape[k], &b->A[k], b->st[S->cur].r[k], fb->reach, S->margin, c,
+                       g->find_val + nval, g->find_mask + nmask);
+        nnode += c;
+        nval += nv;
+        nmask += nv ? M_ARRAYS * (size_t)FIND_CHUNK : 0;
+    }
+    return nb;
+}
+
+/* Node candidates of a web at state S->cur: every node-face and node-edge pair within the
+ * layers + margin, for the nodes listed (all when `nodes` is NULL), sorted by node, into L. 0,
+ * or -1 when out of memory. */
+static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
+                           ws_ncand_list *L)
+{
+    const ws_body_store *b = S->b;
     ws_node_contact *nc = web->contact;
-    *n = 0;
-    if (ws_array_reserve(mem, (void **)&nc->cbody, &nc->cbody_cap, b->slots + 1, 1) != 0)
+    const ws_nodes3 x = web->x[S->cur];
+    ws_node_geom *g = S->g;
+    L->n = 0;
+    if (ws_array_reserve(S->mem, (void **)&nc->cbody, &nc->cbody_cap, b->slots + 1, 1) != 0)
         return -1;
     if (!nodes) /* a full search: the list holds no other candidates */
         memset(nc->cbody, 0, nc->cbody_cap);
     if (web->n == 0)
         return 0;
-    const double pad = web->layer + 0.5 * margin;
     if (!nodes)
         count = web->n;
-    /* The scratch of the search, from the step's arena, at its most for a group of nodes
-     * (every body near every node of the group), taken once for every group. */
-    size_t most_val = 1, most_mask = 1;
-    for (uint32_t k = 0; k < b->slots; k++) {
-        const ws_shape *sh = b->shape[k];
-        if (b->alive[k] && sh->convex && sh->face_count <= WS_NCAND_FACES) {
-            most_val += (V_FACES + sh->face_count) * (size_t)FIND_CHUNK;
-            most_mask += M_ARRAYS * (size_t)FIND_CHUNK;
-        }
-    }
-    ws_find_body *const find = ws_arena_alloc(g->arena, (b->slots + 1) * sizeof *find);
-    uint32_t *const find_node =
-        ws_arena_alloc(g->arena, (b->slots + 1) * FIND_CHUNK * sizeof(uint32_t));
-    double *const find_val = ws_arena_alloc(g->arena, most_val * sizeof(double));
-    uint64_t *const find_mask = ws_arena_alloc(g->arena, most_mask * sizeof(uint64_t));
-    if (!find || !find_node || !find_val || !find_mask)
+    if (find_scratch(b, g) != 0)
         return -1;
-    g->find = find;
-    g->find_node = find_node;
-    g->find_val = find_val;
-    g->find_mask = find_mask;
-    double px[FIND_CHUNK], py[FIND_CHUNK], pz[FIND_CHUNK];
-    uint64_t hit[FIND_CHUNK];
+    double p[3][FIND_CHUNK];
     for (size_t q0 = 0; q0 < count; q0 += FIND_CHUNK) {
         const size_t m = count - q0 < FIND_CHUNK ? count - q0 : (size_t)FIND_CHUNK;
         for (size_t j = 0; j < m; j++) {
             uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
-            px[j] = x.x[i];
-            py[j] = x.y[i];
-            pz[j] = x.z[i];
+            p[0][j] = x.x[i];
+            p[1][j] = x.y[i];
+            p[2][j] = x.z[i];
         }
-        /* The bodies near the group, in slot order, with the group's nodes in their boxes. */
-        size_t nb = 0, nnode = 0, nval = 0, nmask = 0;
-        for (uint32_t k = 0; k < b->slots; k++) {
-            if (!b->alive[k])
-                continue;
-            const uint32_t c = (uint32_t)find_near(
-                hit, px, py, pz, m, v3_make(b->lo[k].x - pad, b->lo[k].y - pad, b->lo[k].z - pad),
-                v3_make(b->hi[k].x + pad, b->hi[k].y + pad, b->hi[k].z + pad));
-            if (!c)
-                continue;
-            nc->cbody[k] = 1; /* a body with no node of any group in its box has no candidate */
-            uint32_t *nd = g->find_node + nnode;
-            for (size_t j = 0, e = 0; j < m; j++) {
-                nd[e] = (uint32_t)j;
-                e += hit[j];
-            }
-            const ws_shape *sh = b->shape[k];
-            ws_find_body *fb = &g->find[nb++];
-            *fb = (ws_find_body){.body = k, .count = c, .node = nnode, .val = nval, .mask = nmask};
-            fb->reach = b->layer[k] + web->layer + margin;
-            fb->general = !sh->convex || sh->face_count > WS_NCAND_FACES;
-            nnode += c;
-            if (!fb->general) {
-                nval += (V_FACES + sh->face_count) * (size_t)FIND_CHUNK;
-                nmask += M_ARRAYS * (size_t)FIND_CHUNK;
-            }
-        }
-        /* Per convex body, on vectors: the nodes in its frame, their plane distances and
-         * their faces' masks. */
-        for (size_t q = 0; q < nb; q++) {
-            const ws_find_body *fb = &g->find[q];
-            if (fb->general)
-                continue;
-            const uint32_t k = fb->body, *nd = g->find_node + fb->node;
-            double *v = g->find_val + fb->val;
-            for (uint32_t c = 0; c < fb->count; c++) {
-                v[V_X * FIND_CHUNK + c] = px[nd[c]];
-                v[V_Y * FIND_CHUNK + c] = py[nd[c]];
-                v[V_Z * FIND_CHUNK + c] = pz[nd[c]];
-            }
-            find_faces(b->shape[k], &b->A[k], b->st[cur].r[k], fb->reach, margin, fb->count, v,
-                       g->find_mask + fb->mask);
-        }
+        const size_t nb = near_bodies(S, web, p, m);
         /* Node by node (the order the sub-steps take them in), against each body near it. */
         for (size_t j = 0; j < m; j++) {
             const uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
@@ -1125,19 +1054,11 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
                 ws_find_body *fb = &g->find[q];
                 if (fb->next == fb->count || g->find_node[fb->node + fb->next] != j)
                     continue;
-                const uint32_t c = fb->next++, k = fb->body;
-                const double reach = fb->reach;
-                int bad;
-                if (fb->general) {
-                    bad = general_candidates(mem, b, cur, g, i, k, v3_make(px[j], py[j], pz[j]),
-                                             reach, margin, L, checks);
-                } else {
-                    if (!g->find_mask[fb->mask + M_LOCAL * FIND_CHUNK + c])
-                        continue;
-                    bad =
-                        convex_candidates(mem, b->shape[k], g, fb, c, i, reach, margin, L, checks);
-                }
-                if (bad)
+                const uint32_t c = fb->next++;
+                if (fb->general
+                        ? general_candidates(S, fb, i, v3_make(p[0][j], p[1][j], p[2][j]), L)
+                        : g->find_mask[fb->mask + M_LOCAL * FIND_CHUNK + c] &&
+                              convex_candidates(S, fb, c, i, L))
                     return -1;
             }
         }
@@ -1145,46 +1066,32 @@ int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geo
     return 0;
 }
 
-int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g)
+int ws_node_geometry(const ws_body_store *b, ws_node_geom *g)
 {
-    (void)cur;
-    (void)mem; /* every table is the step's scratch, from its arena */
-    size_t nf = 0, nt = 0, ne = 0;
-    for (size_t k = 0; k < b->slots; k++)
-        if (b->alive[k]) {
-            nf += b->shape[k]->face_count;
-            nt += b->shape[k]->triangle_count;
-            ne += b->shape[k]->edge_count;
-        }
-    ws_arena *a = g->arena;
-    ws_wface *face = ws_arena_alloc(a, (nf + 1) * sizeof *face);
-    ws_wtri *tri = ws_arena_alloc(a, (nt + 1) * sizeof *tri);
-    ws_wedge *edge = ws_arena_alloc(a, (ne + 1) * sizeof *edge);
-    uint32_t *base = ws_arena_alloc(a, 3 * (b->slots + 1) * sizeof *base);
-    uint8_t *ready = ws_arena_alloc(a, b->slots + 1);
-    if (!face || !tri || !edge || !base || !ready)
+    const size_t ns = b->slots + 1;
+    uint32_t *base = ws_arena_alloc(g->arena, 3 * ns * sizeof *base);
+    g->ready = ws_arena_calloc(g->arena, ns, 1);
+    if (!base || !g->ready)
         return -1;
-    g->face = face;
-    g->tri = tri;
-    g->edge = edge;
     g->face_base = base;
-    g->tri_base = base + b->slots + 1;
-    g->edge_base = base + 2 * (b->slots + 1);
-    g->ready = ready;
-    uint32_t fo = 0, to = 0, eo = 0;
+    g->tri_base = base + ns;
+    g->edge_base = base + 2 * ns;
+    uint32_t nf = 0, nt = 0, ne = 0;
     for (size_t k = 0; k < b->slots; k++) {
-        g->ready[k] = 0;
         if (!b->alive[k])
             continue;
         const ws_shape *sh = b->shape[k];
-        g->face_base[k] = fo;
-        g->tri_base[k] = to;
-        g->edge_base[k] = eo;
-        fo += sh->face_count;
-        to += sh->triangle_count;
-        eo += sh->edge_count;
+        g->face_base[k] = nf;
+        g->tri_base[k] = nt;
+        g->edge_base[k] = ne;
+        nf += sh->face_count;
+        nt += sh->triangle_count;
+        ne += sh->edge_count;
     }
-    return 0;
+    g->face = ws_arena_alloc(g->arena, (nf + 1) * sizeof *g->face);
+    g->tri = ws_arena_alloc(g->arena, (nt + 1) * sizeof *g->tri);
+    g->edge = ws_arena_alloc(g->arena, (ne + 1) * sizeof *g->edge);
+    return g->face && g->tri && g->edge ? 0 : -1;
 }
 
 /* Body k's faces, triangles and edges in the global frame at state cur. */
@@ -1250,12 +1157,33 @@ int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double d
     return !nc->search_all;
 }
 
-int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
-                           ws_web *web, double margin, size_t flagged, uint64_t *checks,
-                           int *searched)
+/* The moved nodes' candidates found again (nc->fresh) and brought into the committed list
+ * `old`: it serves again, uncopied, when they are those it holds (mostly so), else the merge
+ * goes into the other list, `*list`, and its stretches are cut again in the sweep blocks of
+ * the nodes whose candidates changed alone. 0, or -1 when out of memory. */
+static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int old, int *list)
 {
     ws_node_contact *nc = web->contact;
-    const ws_nodes3 x = web->x[cur];
+    const ws_node_found F = {nc->moved, moved, &nc->fresh};
+    if (find_candidates(S, web, nc->moved, moved, &nc->fresh) != 0)
+        return -1;
+    if (ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
+        *list = old;
+        return 0;
+    }
+    /* nc->moved keeps the nodes whose candidates changed. */
+    ws_ncand_list *L = &nc->cand[*list];
+    const long changed =
+        ws_node_merge(S->mem, &F, web->n, nc->cstart, &nc->cand[old], L, nc->moved);
+    return changed < 0 || ws_node_segments_merged(S->mem, web, L->c, L->n, *list, old, nc->moved,
+                                                  (size_t)changed)
+               ? -1
+               : 0;
+}
+
+int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, int *searched)
+{
+    ws_node_contact *nc = web->contact;
     /* Node candidates: all found again when asked, when the record is invalid or when a body
      * may have come near (ws_node_moved says -1); else those of the nodes that moved far
      * enough relative to the near bodies, or that a near body past its bound may meet, merged
@@ -1264,8 +1192,8 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
      * shows it). */
     int list = nc->list, all = nc->search_all;
     long moved = 0;
-    size_t changed = 0;
-    if (!all && (moved = ws_node_moved_end(b, cur, web, x, margin, flagged)) < 0)
+    if (!all &&
+        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, flagged)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {
@@ -1278,37 +1206,21 @@ int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node
             nc->seg_list = -1;
         int bad;
         if (all) {
-            bad = ws_node_track(mem, b, cur, web, x, margin) ||
-                  ws_node_candidates(mem, b, cur, g, web, x, margin, NULL, 0, &nc->cand[list],
-                                     checks);
+            bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]);
             if (!bad)
                 ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
         } else {
-            bad = ws_node_candidates(mem, b, cur, g, web, x, margin, nc->moved, (size_t)moved,
-                                     &nc->fresh, checks);
-            /* Mostly the nodes found again have the candidates they had: then the committed
-             * list serves again, uncopied. */
-            if (!bad && ws_node_same(nc->moved, (size_t)moved, nc->cstart, nc->cand[old].c,
-                                     nc->fresh.c, nc->fresh.n))
-                list = old;
-            else /* moved keeps the nodes whose candidates changed: their sweep blocks alone
-                    are cut into stretches again */
-                bad =
-                    bad ||
-                    ws_node_merge(mem, nc->moved, (size_t)moved, web->n, nc->cstart, &nc->cand[old],
-                                  &nc->fresh, &nc->cand[list], nc->moved, &changed) ||
-                    ws_node_segments_merged(mem, web, nc->cand[list].c, nc->cand[list].n, list, old,
-                                            nc->moved, changed);
+            bad = search_moved(S, web, (size_t)moved, old, &list);
         }
-        if (bad || ws_node_scratch(mem, nc, nc->cand[list].n) != 0)
+        if (bad || ws_node_scratch(S->mem, nc, nc->cand[list].n) != 0)
             return -1;
     }
     nc->next_list = list;
-    ws_node_prepare(b, cur, g, web);
+    ws_node_prepare(S->b, S->cur, S->g, web);
     /* The list cut into stretches for the evaluation: again whenever it changed (a list that
      * serves again keeps its stretches). */
     if (nc->seg_list != list &&
-        ws_node_segments(mem, web, nc->cand[list].c, nc->cand[list].n, list) != 0)
+        ws_node_segments(S->mem, web, nc->cand[list].c, nc->cand[list].n, list) != 0)
         return -1;
     return 0;
 }

@@ -132,7 +132,7 @@ typedef struct ws_node_contact {
      * ws_node_index). */
     size_t *cstart;
     /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
-     * some node searched since the full detection, ws_node_candidates). */
+     * some node searched since the full detection, find_candidates in node.c). */
     uint8_t *cbody;
     size_t cbody_cap;
 } ws_node_contact;
@@ -173,7 +173,7 @@ typedef struct ws_node_geom {
     ws_wtri *tri;
     ws_wedge *edge;
     uint32_t *face_base, *tri_base, *edge_base;
-    /* Scratch of ws_node_candidates (node.c): the bodies near a group of nodes, with the nodes'
+    /* Scratch of the candidates' search (node.c): the bodies near a group of nodes, with the nodes'
      * values against each, taken from the step's arena (set by the step before the search). */
     ws_arena *arena;
     struct ws_find_body *find;
@@ -184,10 +184,18 @@ typedef struct ws_node_geom {
     uint8_t *ready;
 } ws_node_geom;
 
-/* Room in g, from its arena (g->arena, the step's), and the numbers of the bodies' features
- * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
- * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
- * reset. 0, or -1 when out of memory. */
+/* What a step's search of node candidates reads and counts: the world's allocator, the bodies
+ * at state cur with their features (g, whose scratch the search uses), the contact margin, and
+ * where feature checks are counted. */
+typedef struct ws_node_step {
+    ws_mem *mem;
+    const ws_body_store *b;
+    int cur;
+    ws_node_geom *g;
+    double margin;
+    uint64_t *checks;
+} ws_node_step;
+
 /* The first of the two calls of a step before a web's sub-steps: whether every node is to be
  * found again at state cur (when `all`, the record of the last search is invalid, or a body
  * may have come near: 0 returned), or the per-node move test is to run (1 returned: over every
@@ -200,30 +208,20 @@ int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double d
  * The list to evaluate is nc->next_list, nc->cand[next_list]; *searched says whether nodes
  * were searched. Feature checks are counted in *checks. 0, or -1 when out of memory (nothing
  * committed changed; the next step searches every node). */
-int ws_node_contact_update(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g,
-                           ws_web *web, double margin, size_t flagged, uint64_t *checks,
-                           int *searched);
+int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, int *searched);
 /* After an accepted step: its list becomes the committed one. */
 void ws_node_contact_commit(ws_node_contact *nc);
 
-int ws_node_geometry(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g);
+/* Room in g, from its arena (g->arena, the step's), and the numbers of the bodies' features
+ * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
+ * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
+ * reset. 0, or -1 when out of memory. */
+int ws_node_geometry(const ws_body_store *b, ws_node_geom *g);
 
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
  * (web->cbody) and that are not prepared yet in this step. */
 void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
-
-/* Node candidates of a web: every node-face and node-edge pair within the layers + margin, for
- * the nodes listed (all when `nodes` is NULL), sorted by node; g's scratch is used. 0, or -1
- * when out of memory. */
-int ws_node_candidates(ws_mem *mem, const ws_body_store *b, int cur, ws_node_geom *g, ws_web *web,
-                       ws_nodes3 x, double margin, const uint32_t *nodes, size_t count,
-                       ws_ncand_list *out, uint64_t *checks);
-
-/* A full detection's record (see ws_node_contact): the web's box from x and the bodies whose boxes come
- * within reach of it, with their pose at state cur; xdet = x. 0, or -1 when out of memory. */
-int ws_node_track(ws_mem *mem, const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
-                  double margin);
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
@@ -258,20 +256,24 @@ static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, w
  * is the first of node i or of a later node, start[n] = nc. */
 void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start);
 
-/* Whether the found candidates `fresh` of `nodes` (count of them, in increasing order) are
- * those the committed list `old` (indexed by start, ws_node_index) holds for them: then it
- * stays as it is. */
-int ws_node_same(const uint32_t *nodes, size_t count, const size_t *start, const ws_ncand *old,
-                 const ws_ncand *fresh, size_t nfresh);
+/* Nodes found again: `count` of them in increasing order, and their candidates as found
+ * (fresh, sorted by node). */
+typedef struct ws_node_found {
+    const uint32_t *nodes;
+    size_t count;
+    const ws_ncand_list *fresh;
+} ws_node_found;
 
-/* Candidates of the committed list `old` (indexed by start, of web->n nodes) for the nodes not
- * in `nodes` (count of them, in increasing order) and the found ones `fresh` (of those nodes,
- * in that order), merged by node into out, start becoming its index; the nodes whose fresh
- * candidates are not those they had into `changed` (room for count; it may be `nodes`
- * itself), in order, *nchanged of them. 0, or -1 when out of memory (start unchanged). */
-int ws_node_merge(ws_mem *mem, const uint32_t *nodes, size_t count, uint32_t nn, size_t *start,
-                  const ws_ncand_list *old, const ws_ncand_list *fresh, ws_ncand_list *out,
-                  uint32_t *changed, size_t *nchanged);
+/* Whether the candidates found F are those the committed list `old` (indexed by start,
+ * ws_node_index) holds for F's nodes: then it stays as it is. */
+int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *old);
+
+/* Candidates of the committed list `old` (indexed by start, of nn nodes) for the nodes not in
+ * F and F's fresh ones, merged by node into out, start becoming its index; the nodes whose
+ * fresh candidates are not those they had into `changed` (room for F->count; it may be
+ * F->nodes itself), in order: how many, or -1 when out of memory (start unchanged). */
+long ws_node_merge(ws_mem *mem, const ws_node_found *F, uint32_t nn, size_t *start,
+                   const ws_ncand_list *old, ws_ncand_list *out, uint32_t *changed);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand);

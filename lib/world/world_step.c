@@ -466,7 +466,7 @@ static ws_status step_webs(ws_step *S)
     ws_body_store *b = S->b;
     const int cur = S->cur, nxt = S->nxt;
     w->node_geom.arena = S->arena; /* the bodies' features and the node search's tables */
-    if (ws_node_geometry(&w->mem, b, cur, &w->node_geom) != 0)
+    if (ws_node_geometry(b, &w->node_geom) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
     for (size_t k = 0; k < w->web_slots.slot_count; k++) {
         if (w->web_slots.dense[k] == UINT32_MAX)
@@ -480,8 +480,9 @@ static ws_status step_webs(ws_step *S)
         if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
             flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
-        if (ws_node_contact_update(&w->mem, b, cur, &w->node_geom, web, S->contact.margin, flagged,
-                                   &S->stats->narrow_checks, &searched) != 0)
+        const ws_node_step ns = {&w->mem, b, cur, &w->node_geom, S->contact.margin,
+                                 &S->stats->narrow_checks};
+        if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
