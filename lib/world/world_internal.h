@@ -55,8 +55,9 @@ typedef struct ws_contact_limit {
 /* Simultaneous contacts the bodies' stable-step bound assumes on one body (docs/theory.md). */
 #define WS_CONTACTS_PER_BODY 8.0
 /* The contacts now acting are measured against dt (their highest mode, by this many power
- * iterations) once dt passes this fraction of the per-pair bound: below it no stack of boxes
- * reaches its bound (docs/theory.md, section 8), and the measure is skipped. */
+ * iterations) once dt passes this fraction of the per-pair bound: below it a mode would need
+ * omega^2 16 times the pair's, more than solid boxes touching on two faces can have
+ * (docs/theory.md, section 8), and the measure is skipped. */
 #define WS_CONTACT_CHECK_FRACTION 0.25
 #define WS_CONTACT_RATE_ITERATIONS 40
 /* The energy guard's allowance: a step's kinetic energy may grow by the known loads' work plus
