@@ -6,12 +6,23 @@
  * bottom one, wall time, CG iterations a step and node-updates a second per CG iteration.
  * Never fails on time.
  * Usage: bench_implicit [what] [duration s]: what = ref (the three films at dt 0.25 ms,
- * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on), ratio (the three films' times
+ * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on; dt1sub:
+ * dt 1 ms with the film in 1 and in 4 sub-steps), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
- * times in each direction, short runs: cost per simulated second and containment), rigid (the
+ * times in each direction, short runs: cost per simulated second and containment; `refine
+ * [duration] [r] [tolerance]` runs refinement r alone, at that solve tolerance), rigid (the
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
+
+/* CPU seconds of this process: on a machine shared with other work the process's own time,
+ * not the wall clock, is what a refinement costs (the runs are single-threaded). */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
 
 static void line(const char *name, const tilt_options *o)
 {
@@ -105,6 +116,21 @@ int main(int argc, char **argv)
             snprintf(name, sizeof name, "implicit, 1.6 mg nodes, dt %.2f ms", 1e3 * dts[k]);
             line(name, &a);
         }
+    } else if (!strcmp(what, "dt1sub")) {
+        /* What limits dt 1 ms: the world (bodies and their contacts) at 1 ms with the film at
+         * 4 sub-steps of 0.25 ms each, beside both at 1 ms (dt1's first line). When the film's
+         * sub-steps bring the slide back to the 0.25 ms run's, the film's own step (its
+         * contacts' and friction's linearisation over h) is what limits; when not, the
+         * bodies' step and their coupling to the film are. */
+        for (int k = 0; k < 2; k++) {
+            tilt_options a = o;
+            a.film_mass = 1.6e-6;
+            a.implicit = 1;
+            a.substeps = k ? 4 : 1;
+            a.dt = 1e-3;
+            line(k ? "implicit, dt 1 ms, 4 film sub-steps" : "implicit, dt 1 ms, 1 film step",
+                 &a);
+        }
     } else if (!strcmp(what, "ratio")) {
         /* Time ratios from interleaved rounds of the first `duration` s (default 0.5 s: the
          * wrapped stack settling, the same work a step as later): the three films of `ref`,
@@ -145,17 +171,22 @@ int main(int argc, char **argv)
         /* The wrapped stack on the level platform (the tilt starts at 1 s), its band at the
          * real areal density refined r x r: after the film's first pull-in (`duration`, default
          * 0.05 s, not timed: the band starts just touching and its light nodes snap onto the
-         * boxes), wall time per simulated second over as long again, and the containment then
+         * boxes), CPU time per simulated second over as long again, and the containment then
          * (the line load of the hoop tension, N/m, and the bodies' total normal force on the
          * film, N), which refinement must leave alone. */
         const double T = duration > 0 ? duration : 0.05;
+        const int only = argc > 3 ? atoi(argv[3]) : 0; /* one refinement alone */
+        const double tol = argc > 4 ? atof(argv[4]) : 0.0; /* the solve's tolerance; 0: 1e-6 */
         double base = 0;
         for (int r = 1; r <= 4; r *= 2) {
+            if (only > 0 && r != only)
+                continue;
             tilt_options a = o;
             a.areal_density = 0.018;
             a.implicit = 1;
             a.substeps = 1;
             a.refine = r;
+            a.solver_tolerance = tol;
             tilt_scene sc;
             if (tilt_build(&a, &sc) != WS_OK) {
                 printf("  refine %d: cannot build\n", r);
@@ -165,10 +196,10 @@ int main(int argc, char **argv)
             ws_status st = ws_world_step_n(sc.world, (uint64_t)steps);
             ws_web_solver_stats s0;
             ws_web_get_solver_stats(sc.world, sc.film, &s0);
-            const double t0 = now();
+            const double t0 = now(), c0 = cpu_now();
             if (st == WS_OK)
                 st = ws_world_step_n(sc.world, (uint64_t)steps);
-            const double el = now() - t0;
+            const double wall = now() - t0, el = cpu_now() - c0;
             if (st != WS_OK) {
                 printf("  refine %d: %s\n", r, ws_world_last_error(sc.world));
                 ws_world_destroy(sc.world);
@@ -182,9 +213,9 @@ int main(int argc, char **argv)
             ws_web_get_solver_stats(sc.world, sc.film, &ss);
             if (r == 1)
                 base = el / T;
-            printf("  refine %d (%u nodes): %.1f s wall per simulated s (%.2f x unrefined), CG "
-                   "%.1f it/step; line load %.2f N/m, contact force %.2f N\n",
-                   r, info.node_count, el / T, el / T / base,
+            printf("  refine %d (%u nodes): %.1f s CPU (%.1f s wall) per simulated s (%.2f x "
+                   "unrefined), CG %.1f it/step; line load %.2f N/m, contact force %.2f N\n",
+                   r, info.node_count, el / T, wall / T, el / T / base,
                    (double)(ss.iterations - s0.iterations) / steps,
                    band.line_load, band.contact_force);
             fflush(stdout);

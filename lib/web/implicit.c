@@ -2,12 +2,15 @@
  * (web/implicit.h says the scheme; docs/theory.md, "The implicit film", why this one). */
 #include "web/implicit.h"
 
+#include "web/multigrid.h"
+
 #include <float.h>
 #include <string.h>
 
 /* Doubles of each per-node array: xyz vectors and symmetric blocks. */
 #define VEC(n) (3 * (size_t)(n))
 #define SYMS(n) (WS_SYM * (size_t)(n))
+#define OPS(ns) (5 * (size_t)((ns) ? (ns) : 1))
 
 static size_t scratch_doubles(uint32_t n)
 {
@@ -24,15 +27,18 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     const uint32_t n = web->n, ns = web->ns;
     double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
     ws_ispring *sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
-    if (!blk || !sp) {
+    double *op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
+    if (!blk || !sp || !op) {
         ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
         ws_mem_free(mem, sp, sp ? (ns ? ns : 1) * sizeof(ws_ispring) : 0);
+        ws_mem_free(mem, op, op ? OPS(ns) * sizeof(double) : 0);
         ws_mem_free(mem, im, sizeof *im);
         return -1;
     }
     im->n = n;
     im->ns = ns;
     im->sp = sp;
+    im->op = op;
     double *q = blk;
     im->f = q, q += VEC(n);
     im->b = q, q += VEC(n);
@@ -46,6 +52,13 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->dc = q, q += SYMS(n);
     im->pinv = q, q += SYMS(n);
     im->nd = q;
+    if (ws_mg_reserve(mem, web, &im->mg) != 0) {
+        ws_mem_free(mem, blk, scratch_doubles(n) * sizeof(double));
+        ws_mem_free(mem, sp, (ns ? ns : 1) * sizeof(ws_ispring));
+        ws_mem_free(mem, op, OPS(ns) * sizeof(double));
+        ws_mem_free(mem, im, sizeof *im);
+        return -1;
+    }
     web->imp = im;
     return 0;
 }
@@ -55,43 +68,55 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     ws_implicit *im = web->imp;
     if (!im)
         return;
+    ws_mg_free(mem, im->mg);
     ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
     ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
+    ws_mem_free(mem, im->op, OPS(im->ns) * sizeof(double));
     ws_mem_free(mem, im, sizeof *im);
     web->imp = NULL;
 }
 
-/* Spring s at (x, v): its direction e (unit, a to b), length l, strain and rate. 0 when its
- * ends coincide (no direction: it then neither pulls nor enters the matrix). */
-static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *e,
-                           double *l, double *eps, double *rate, v3 *dvel)
+/* A spring in a state (x, v): its direction e (unit, a to b), the velocity of b relative to a,
+ * its length l, strain and strain rate; then its law's force F there and the force's
+ * derivatives by the strain (Fu) and by the rate (Fud). */
+typedef struct spring_state {
+    v3 e, dvel;
+    double l, eps, rate;
+    double F, Fu, Fud;
+} spring_state;
+
+/* Spring s at (x, v): its geometry into q. 0 when its ends coincide (no direction: it then
+ * neither pulls nor enters the matrix). */
+static int spring_geometry(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
+                           spring_state *q)
 {
     const uint32_t a = web->sa[s], b = web->sb[s];
     const v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
     const double l2 = v3_dot(d, d);
     if (!(l2 > 0.0))
         return 0;
-    *l = sqrt(l2);
-    *e = v3_scale(d, 1.0 / *l);
-    *dvel = v3_sub(nodes_get(v, b), nodes_get(v, a));
-    *eps = *l * web->inv_l0[s] - 1.0;
-    *rate = v3_dot(*dvel, *e) * web->inv_l0[s];
+    q->l = sqrt(l2);
+    q->e = v3_scale(d, 1.0 / q->l);
+    q->dvel = v3_sub(nodes_get(v, b), nodes_get(v, a));
+    q->eps = q->l * web->inv_l0[s] - 1.0;
+    q->rate = v3_dot(q->dvel, q->e) * web->inv_l0[s];
     return 1;
 }
 
-/* Spring s's law at (eps, rate): force and derivatives, times its stiffness scale (a mesh
- * web's film layers). 1 when the law failed. */
-static int spring_law(const ws_web *web, uint32_t s, double eps, double rate, double t,
-                      double since, double *F, double *Fu, double *Fud)
+/* Spring s's law at q's strain and rate, at t, since after its history was committed: force
+ * and derivatives into q, times its stiffness scale (a mesh web's film layers). 1 when the law
+ * failed. */
+static int spring_law(const ws_web *web, uint32_t s, double t, double since, spring_state *q)
 {
     const double *hist = web->nstate ? web->hist + (size_t)s * web->nstate : NULL;
-    if (ws_law_eval(web->law[web->kind[s]], hist, &eps, &rate, t, since, F, Fu, Fud) != 0)
+    if (ws_law_eval(web->law[web->kind[s]], hist, &q->eps, &q->rate, t, since, &q->F, &q->Fu,
+                    &q->Fud) != 0)
         return 1;
     if (web->kscale) {
         const double k = web->kscale[s];
-        *F *= k;
-        *Fu *= k;
-        *Fud *= k;
+        q->F *= k;
+        q->Fu *= k;
+        q->Fud *= k;
     }
     return 0;
 }
@@ -126,14 +151,15 @@ int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double 
     }
     for (uint32_t s = 0; s < web->ns; s++) {
         ws_ispring *q = &im->sp[s];
-        v3 e, dvel;
-        double l, eps, rate, F, Fu, Fud;
-        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel)) {
+        spring_state z;
+        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &z)) {
             *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             continue;
         }
-        if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud) || !isfinite(F))
+        if (spring_law(web, s, t, since, &z) || !isfinite(z.F))
             return 1;
+        const v3 e = z.e;
+        const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
         const uint32_t a = web->sa[s], b = web->sb[s];
         f[3 * a] += F * e.x;
         f[3 * a + 1] += F * e.y;
@@ -242,6 +268,8 @@ static void operator_for(const ws_web *web, double h)
         ws_ispring *q = &im->sp[s];
         q->a = h2 * q->ka + h * q->cs;
         q->b = h2 * q->kb;
+        double *o = im->op + 5 * (size_t)s;
+        o[0] = q->ex, o[1] = q->ey, o[2] = q->ez, o[3] = q->a, o[4] = q->b;
     }
     for (uint32_t i = 0; i < web->n; i++) {
         double *S = im->nd + WS_SYM * (size_t)i;
@@ -257,7 +285,7 @@ static void operator_for(const ws_web *web, double h)
 
 /* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
  * preconditioner is), so its y is not needed: it is set to zero. */
-static double apply_fast(const ws_web *web, const double *restrict p, double *restrict y)
+double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
     const uint32_t n = web->n;
@@ -270,12 +298,12 @@ static double apply_fast(const ws_web *web, const double *restrict p, double *re
     }
     const uint32_t *sa = web->sa, *sb = web->sb;
     for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_ispring *q = &im->sp[s];
+        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
         const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
         const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
-        const double ed = q->a * (q->ex * dx + q->ey * dy + q->ez * dz);
-        const double tx = ed * q->ex + q->b * dx, ty = ed * q->ey + q->b * dy,
-                     tz = ed * q->ez + q->b * dz;
+        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
+        const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
+                     tz = ed * q[2] + q[4] * dz;
         double *YA = y + 3 * (size_t)sa[s], *YB = y + 3 * (size_t)sb[s];
         YA[0] += tx;
         YA[1] += ty;
@@ -412,20 +440,21 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         return -1;
     }
     operator_for(web, h);
+    ws_mg *mg = im->mg && !im->jacobi_only && ws_mg_setup(im->mg, web) == 0 ? im->mg : NULL;
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
-    (void)apply_fast(web, x, q);
+    (void)ws_implicit_apply_op(web, x, q);
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
     double rr = dot(r, r, m);
-    double rz = precondition(im, n, r, z);
+    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
     memcpy(p, z, m * sizeof(double));
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
-        const double pq = apply_fast(web, p, q);
+        const double pq = ws_implicit_apply_op(web, p, q);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
         const double alpha = rz / pq;
@@ -436,7 +465,8 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
             rr += r[j] * r[j];
         }
         it++;
-        const double rz1 = precondition(im, n, r, z), beta = rz1 / rz;
+        const double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z),
+                     beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)
             p[j] = z[j] + beta * p[j];
@@ -482,14 +512,15 @@ size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, w
 int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, double t,
                              double since, double Jx[9], double Jv[9])
 {
-    v3 e, dvel;
-    double l, eps, rate, F, Fu, Fud;
+    spring_state z;
     memset(Jx, 0, 9 * sizeof(double));
     memset(Jv, 0, 9 * sizeof(double));
-    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &e, &l, &eps, &rate, &dvel))
+    if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &z))
         return 0;
-    if (spring_law(web, s, eps, rate, t, since, &F, &Fu, &Fud))
+    if (spring_law(web, s, t, since, &z))
         return 1;
+    const v3 e = z.e, dvel = z.dvel;
+    const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
     /* f_a = F e: d/dx_b = e dF/dx_b + F de/dx_b, with de/dx_b = (I - e e^T) / l, deps/dx_b =
      * e^T / l0 and drate/dx_b = dvel^T (I - e e^T) / (l l0); d/dv_b = Fud e e^T / l0. */
     const double il0 = web->inv_l0[s];

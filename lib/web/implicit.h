@@ -36,11 +36,18 @@ typedef struct ws_implicit {
     double *fs;      /* the same without the contacts (ws_implicit_reset) */
     double *kc, *dc; /* per node, symmetric: -df/dx and -df/dv of its contacts */
     ws_ispring *sp;  /* per spring */
+    double *op;      /* per spring, the solve's A block as its products read it, packed: e and
+                        a, b of ws_ispring (5 doubles a spring; ws_implicit_apply_op) */
     double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
     double *pinv;    /* per node: the inverse of A's diagonal block (symmetric) */
     double *nd;      /* per node: A's own part of the node, M + h (drag + dc) + h^2 kc (the
                         solve's, symmetric) */
     int warm;        /* dv holds the last converged solution */
+    /* The preconditioner: multigrid on grid webs (web/multigrid.h; NULL for a web that is not
+     * a grid of neighbour springs), block Jacobi otherwise or when jacobi_only is set (a
+     * test's comparison). */
+    struct ws_mg *mg;
+    int jacobi_only;
     /* Counts (ws_web_get_solver_stats). */
     uint64_t solves, iterations;
     int last_iterations;
@@ -80,6 +87,10 @@ size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, w
 /* y = A p over step h (the matrix the solve uses), p and y xyz per node, y zero at pinned
  * nodes. */
 void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y);
+
+/* y = A p with the parts the running solve set (its springs' and nodes' blocks), p and y xyz
+ * per node, y zero at pinned nodes; returns p . y. */
+double ws_implicit_apply_op(const ws_web *web, const double *p, double *y);
 
 /* The exact derivatives of spring s's force on its end a at (x, v), the law taken at (t,
  * since): Jx = df_a/dx_b (= -df_a/dx_a) and Jv = df_a/dv_b, row-major. They hold the terms

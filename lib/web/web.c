@@ -172,91 +172,108 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
     }
 }
 
-/* Tension / length of a spring of film form whose second end is at d = (dx, dy, dz) from its
- * first and moves at u = (ux, uy, uz) relative to it, rest length 1 / il0. Computed
- * unconditionally and then selected, so the loops over springs have no branches. A spring whose
- * ends coincide has no direction to pull along and gets no force. */
-static inline double film_pull(const ws_spring_form *p, double dx, double dy, double dz, double ux,
-                               double uy, double uz, double il0)
+/* Tension / length of a spring of film form p whose second end is at d from its first and moves
+ * at u relative to it, rest length 1 / il0. Computed unconditionally and then selected, so the
+ * loops over springs have no branches. A spring whose ends coincide has no direction to pull
+ * along and gets no force. */
+static inline double film_pull(const ws_spring_form *p, v3 d, v3 u, double il0)
 {
-    double l2 = dx * dx + dy * dy + dz * dz;
+    double l2 = d.x * d.x + d.y * d.y + d.z * d.z;
     double l = sqrt(l2);
     double inv = 1.0 / l;
     double il = l2 > 0.0 ? inv : 0.0;
     double eps = l * il0 - 1.0;
-    double epsd = (ux * dx + uy * dy + uz * dz) * il * il0;
+    double epsd = (u.x * d.x + u.y * d.y + u.z * d.z) * il * il0;
     return film_force(p, eps, epsd) * il;
 }
 
-/* Springs from node a + i to node a + i + 1, i in [0, m), all of one law, with rest lengths
- * inv_l0[i]: the force on the first end (the second gets its opposite) into tx, ty, tz.
- * Straight-line code on contiguous arrays, so the compiler runs it on vectors. The law's film
- * form comes as its five numbers, which a call passes in registers (a ws_spring_form goes
- * through the stack). */
-WS_VECTOR_LOOP
-static void spring_run(const double *restrict x, const double *restrict y, const double *restrict z,
-                       const double *restrict vx, const double *restrict vy,
-                       const double *restrict vz, size_t m, const double *restrict inv_l0,
-                       double kc, double dk, double w, double qw, double c, double *restrict tx,
-                       double *restrict ty, double *restrict tz)
+/* Node vectors as the vector loops take them, from node i on: restrict, as no two arrays that
+ * a loop reads and writes overlap, so the compiler runs the loop on vectors without checking
+ * first. GCC honours the restrict of a struct's fields where the struct is a parameter passed
+ * by value (also into an inlined function), not where it is reached through a pointer. */
+typedef struct in3 {
+    const double *restrict x, *restrict y, *restrict z;
+} in3;
+typedef struct out3 {
+    double *restrict x, *restrict y, *restrict z;
+} out3;
+
+static inline in3 in_at(ws_nodes3 a, size_t i)
 {
-    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
+    return (in3){a.x + i, a.y + i, a.z + i};
+}
+
+static inline out3 out_at(ws_nodes3 a, size_t i)
+{
+    return (out3){a.x + i, a.y + i, a.z + i};
+}
+
+/* The web's scratch for the forces of a chunk of springs (WS_WEB_CHUNK of them). */
+static inline ws_nodes3 chunk_forces(const ws_web *web)
+{
+    return (ws_nodes3){web->tmp, web->tmp + WS_WEB_CHUNK, web->tmp + 2 * WS_WEB_CHUNK};
+}
+
+/* Springs from node i to node i + 1, i in [0, m), all of the film form p, with rest lengths
+ * 1 / il0[i] (x and v from the first end of the first spring): the force on each first end
+ * into t. Straight-line code on contiguous arrays, so the compiler runs it on vectors. */
+WS_VECTOR_LOOP
+static void spring_run(const ws_spring_form *p, in3 x, in3 v, size_t m, const double *restrict il0,
+                       out3 t)
+{
+    const ws_spring_form q = *p; /* a local: loads through p would stay in the loop */
     for (size_t i = 0; i < m; i++) {
-        double dx = x[i + 1] - x[i], dy = y[i + 1] - y[i], dz = z[i + 1] - z[i];
-        double ux = vx[i + 1] - vx[i], uy = vy[i + 1] - vy[i], uz = vz[i + 1] - vz[i];
-        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
-        tx[i] = dx * s;
-        ty[i] = dy * s;
-        tz[i] = dz * s;
+        v3 d = v3_make(x.x[i + 1] - x.x[i], x.y[i + 1] - x.y[i], x.z[i + 1] - x.z[i]);
+        v3 u = v3_make(v.x[i + 1] - v.x[i], v.y[i + 1] - v.y[i], v.z[i + 1] - v.z[i]);
+        double s = film_pull(&q, d, u, il0[i]);
+        t.x[i] = d.x * s;
+        t.y[i] = d.y * s;
+        t.z[i] = d.z * s;
     }
 }
 
-/* Springs from node a + i to node a + i + stride, i in [0, m), stride >= m (no node is an end
- * of two of them), all of one law, with rest lengths inv_l0[i]: their forces straight onto
- * both ends, fa[i] += t and fb[i] -= t (fa = f + a, fb = f + a + stride), in the loop that
- * computes them. */
+/* Springs from node i to node i + stride, i in [0, m), stride >= m (no node is an end of two of
+ * them), as spring_run: their forces straight onto both ends, fa[i] += t and fb[i] -= t (fb at
+ * stride from fa), in the loop that computes them. */
 WS_VECTOR_LOOP
-static void spring_run_apply(const double *restrict x, const double *restrict y,
-                             const double *restrict z, const double *restrict vx,
-                             const double *restrict vy, const double *restrict vz, size_t stride,
-                             size_t m, const double *restrict inv_l0, double kc, double dk,
-                             double w, double qw, double c, double *restrict fax,
-                             double *restrict fay, double *restrict faz, double *restrict fbx,
-                             double *restrict fby, double *restrict fbz)
+static void spring_apply(const ws_spring_form *p, in3 x, in3 v, size_t stride, size_t m,
+                         const double *restrict il0, out3 fa, out3 fb)
 {
-    const ws_spring_form p = {kc, dk, w, qw, c, NULL, 0.0, 0.0};
+    const ws_spring_form q = *p;
     for (size_t i = 0; i < m; i++) {
-        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
-        double ux = vx[i + stride] - vx[i], uy = vy[i + stride] - vy[i],
-               uz = vz[i + stride] - vz[i];
-        double s = film_pull(&p, dx, dy, dz, ux, uy, uz, inv_l0[i]);
-        double tx = dx * s, ty = dy * s, tz = dz * s;
-        fax[i] += tx;
-        fay[i] += ty;
-        faz[i] += tz;
-        fbx[i] -= tx;
-        fby[i] -= ty;
-        fbz[i] -= tz;
+        const size_t k = i + stride;
+        v3 d = v3_make(x.x[k] - x.x[i], x.y[k] - x.y[i], x.z[k] - x.z[i]);
+        v3 u = v3_make(v.x[k] - v.x[i], v.y[k] - v.y[i], v.z[k] - v.z[i]);
+        double s = film_pull(&q, d, u, il0[i]);
+        v3 t = v3_make(d.x * s, d.y * s, d.z * s);
+        fa.x[i] += t.x;
+        fa.y[i] += t.y;
+        fa.z[i] += t.z;
+        fb.x[i] -= t.x;
+        fb.y[i] -= t.y;
+        fb.z[i] -= t.z;
     }
 }
 
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
- * spring of a general law, which is evaluated with the spring's history as committed, at
- * (t, since). A law that fails (a user callback) marks the web; the step reports it. */
-static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p,
-                          uint32_t lo, uint32_t hi)
+ * spring of a general law, which is evaluated with the spring's history as committed, at the
+ * sweep's (t, since), onto those of its ends in nodes [lo, hi). A law that fails (a user
+ * callback) marks the web; the step reports it. */
+static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uint32_t lo,
+                          uint32_t hi)
 {
     if (web->nbroken && web->broken[s])
         return; /* a broken spring carries nothing */
+    const ws_spring_form *p = &web->form[web->kind[s]];
     v3 d;
     double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
     if (il == 0.0)
         return; /* coincident ends: no direction to pull along */
     double F = 0.0;
-    if (!p.gen) {
-        F = film_force(&p, eps, epsd);
-    } else if (ws_law_eval(p.gen, web->nstate ? web->hist + (size_t)s * web->nstate : NULL, &eps,
-                           &epsd, p.t, p.since, &F, NULL, NULL) != 0) {
+    if (!p->gen) {
+        F = film_force(p, eps, epsd);
+    } else if (ws_law_eval(p->gen, web->nstate ? web->hist + (size_t)s * web->nstate : NULL, &eps,
+                           &epsd, p->t, p->since, &F, NULL, NULL) != 0) {
         web->law_failed = 1;
         return;
     }
@@ -271,106 +288,81 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_
 }
 
 /* The same onto both ends. */
-static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, ws_spring_form p)
+static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s)
 {
-    spring_one_in(web, x, v, s, p, 0, UINT32_MAX);
+    spring_one_in(web, x, v, s, 0, UINT32_MAX);
 }
 
-/* Gravity and node drag on nodes [n0, n1): the start of their force. */
-static inline void base_forces_of(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1, int same)
+/* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
+ * web's one mass for every node when same (then m is not read). */
+static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double *restrict m,
+                                  size_t n, int same)
 {
+    const v3 g = web->g;
     const double c = web->damping, m1 = web->m1;
-    const double *restrict m = web->m;
-    double *restrict fx = web->f.x, *restrict fy = web->f.y, *restrict fz = web->f.z;
-    /* The arrays into locals: loads through the struct would stay in the loop. */
-    const double *restrict vx = v.x, *restrict vy = v.y, *restrict vz = v.z;
-    for (size_t i = n0; i < n1; i++) {
+    for (size_t i = 0; i < n; i++) {
         const double mi = same ? m1 : m[i];
-        fx[i] = g.x * mi - c * vx[i];
-        fy[i] = g.y * mi - c * vy[i];
-        fz[i] = g.z * mi - c * vz[i];
+        f.x[i] = g.x * mi - c * v.x[i];
+        f.y[i] = g.y * mi - c * v.y[i];
+        f.z[i] = g.z * mi - c * v.z[i];
     }
 }
 
+/* The same on nodes [n0, n1), the case chosen outside the loop: each case a loop of its own. */
 WS_VECTOR_LOOP
-static void base_forces_each(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
+static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
 {
-    base_forces_of(web, v, g, n0, n1, 0);
-}
-
-WS_VECTOR_LOOP
-static void base_forces_same(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
-{
-    base_forces_of(web, v, g, n0, n1, 1);
-}
-
-static void base_forces(ws_web *web, ws_nodes3 v, v3 g, size_t n0, size_t n1)
-{
+    const in3 vi = in_at(v, n0);
+    const out3 f = out_at(web->f, n0);
     if (web->same_m)
-        base_forces_same(web, v, g, n0, n1);
+        base_forces_of(web, vi, f, NULL, n1 - n0, 1);
     else
-        base_forces_each(web, v, g, n0, n1);
+        base_forces_of(web, vi, f, web->m + n0, n1 - n0, 0);
 }
 
 /* Gravity and node drag on node i. */
-static inline v3 base_force(const ws_web *web, ws_nodes3 v, v3 g, size_t i)
+static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
+    const v3 g = web->g;
     const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
     return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
  * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. Node i's mass is m[i], or m1 for
- * every node when same (then m is not read). */
-static inline void row_forces_of(size_t k, v3 g, double c, const double *restrict m, double m1,
-                                 int same, int drag, const double *restrict vx,
-                                 const double *restrict vy, const double *restrict vz,
-                                 const double *restrict tx, const double *restrict ty,
-                                 const double *restrict tz, double *restrict fx,
-                                 double *restrict fy, double *restrict fz)
+ * order is that of the results (the state hash): keep it. Masses as in base_forces_of; without
+ * drag the velocities are not read. */
+static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
+                                 size_t k, int same, int drag)
 {
+    const v3 g = web->g;
+    const double c = web->damping, m1 = web->m1;
     for (size_t i = 1; i < k; i++) {
         const double mi = same ? m1 : m[i];
         if (drag) {
-            fx[i] = g.x * mi - c * vx[i] + tx[i] - tx[i - 1];
-            fy[i] = g.y * mi - c * vy[i] + ty[i] - ty[i - 1];
-            fz[i] = g.z * mi - c * vz[i] + tz[i] - tz[i - 1];
+            f.x[i] = g.x * mi - c * v.x[i] + t.x[i] - t.x[i - 1];
+            f.y[i] = g.y * mi - c * v.y[i] + t.y[i] - t.y[i - 1];
+            f.z[i] = g.z * mi - c * v.z[i] + t.z[i] - t.z[i - 1];
         } else {
-            fx[i] = g.x * mi + tx[i] - tx[i - 1];
-            fy[i] = g.y * mi + ty[i] - ty[i - 1];
-            fz[i] = g.z * mi + tz[i] - tz[i - 1];
+            f.x[i] = g.x * mi + t.x[i] - t.x[i - 1];
+            f.y[i] = g.y * mi + t.y[i] - t.y[i - 1];
+            f.z[i] = g.z * mi + t.z[i] - t.z[i - 1];
         }
     }
 }
 
+/* The same for the row's nodes from node q, t the web's chunk scratch. */
 WS_VECTOR_LOOP
-static void row_forces_each(size_t k, v3 g, double c, const double *restrict m,
-                            const double *restrict vx, const double *restrict vy,
-                            const double *restrict vz, const double *restrict tx,
-                            const double *restrict ty, const double *restrict tz,
-                            double *restrict fx, double *restrict fy, double *restrict fz)
+static void row_forces(ws_web *web, ws_nodes3 v, size_t q, size_t k)
 {
-    row_forces_of(k, g, c, m, 0.0, 0, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
-}
-
-WS_VECTOR_LOOP
-static void row_forces_same(size_t k, v3 g, double c, double m1, const double *restrict vx,
-                            const double *restrict vy, const double *restrict vz,
-                            const double *restrict tx, const double *restrict ty,
-                            const double *restrict tz, double *restrict fx, double *restrict fy,
-                            double *restrict fz)
-{
-    row_forces_of(k, g, c, NULL, m1, 1, 1, vx, vy, vz, tx, ty, tz, fx, fy, fz);
-}
-
-/* Nodes of one mass and no drag (web->no_drag): the velocities are not read. */
-WS_VECTOR_LOOP
-static void row_forces_same_free(size_t k, v3 g, double m1, const double *restrict tx,
-                                 const double *restrict ty, const double *restrict tz,
-                                 double *restrict fx, double *restrict fy, double *restrict fz)
-{
-    row_forces_of(k, g, 0.0, NULL, m1, 1, 0, NULL, NULL, NULL, tx, ty, tz, fx, fy, fz);
+    const in3 vq = in_at(v, q), t = in_at(chunk_forces(web), 0);
+    const out3 f = out_at(web->f, q);
+    if (web->same_m && web->no_drag)
+        row_forces_of(web, vq, t, f, NULL, k, 1, 0);
+    else if (web->same_m)
+        row_forces_of(web, vq, t, f, NULL, k, 1, 1);
+    else
+        row_forces_of(web, vq, t, f, web->m + q, k, 0, 1);
 }
 
 /* Rupture in the sweep. While no spring of the web is broken (nbroken 0) none of this runs
@@ -393,13 +385,12 @@ static int any_broken(const ws_web *web, size_t s0, size_t m)
 /* The forces t of springs s0 + i, i in [0, m): zero where broken. Selected, not multiplied, so
  * a broken spring stretched to any length gives a zero. */
 WS_VECTOR_LOOP
-static void cut_chunk(const uint8_t *restrict broken, size_t m, double *restrict tx,
-                      double *restrict ty, double *restrict tz)
+static void cut_chunk(const uint8_t *restrict broken, size_t m, out3 t)
 {
     for (size_t i = 0; i < m; i++) {
-        tx[i] = broken[i] ? 0.0 : tx[i];
-        ty[i] = broken[i] ? 0.0 : ty[i];
-        tz[i] = broken[i] ? 0.0 : tz[i];
+        t.x[i] = broken[i] ? 0.0 : t.x[i];
+        t.y[i] = broken[i] ? 0.0 : t.y[i];
+        t.z[i] = broken[i] ? 0.0 : t.z[i];
     }
 }
 
@@ -415,19 +406,19 @@ static void wrap_lanes(const double *restrict in, ws_spring_form p, double *rest
 {
     enum { L = WS_WEB_WRAPS };
     for (size_t i = 0; i < L; i++) {
-        double dx = in[i], dy = in[L + i], dz = in[2 * L + i];
-        double ux = in[3 * L + i], uy = in[4 * L + i], uz = in[5 * L + i], il0 = in[6 * L + i];
-        double q = film_pull(&p, dx, dy, dz, ux, uy, uz, il0);
-        out[i] = dx * q;
-        out[L + i] = dy * q;
-        out[2 * L + i] = dz * q;
-        out[3 * L + i] = dx * dx + dy * dy + dz * dz > 0.0 ? 1.0 : 0.0;
+        v3 d = v3_make(in[i], in[L + i], in[2 * L + i]);
+        v3 u = v3_make(in[3 * L + i], in[4 * L + i], in[5 * L + i]);
+        double q = film_pull(&p, d, u, in[6 * L + i]);
+        out[i] = d.x * q;
+        out[L + i] = d.y * q;
+        out[2 * L + i] = d.z * q;
+        out[3 * L + i] = d.x * d.x + d.y * d.y + d.z * d.z > 0.0 ? 1.0 : 0.0;
     }
 }
 
 /* The wrap springs of rows [r, r + WS_WEB_WRAPS) (those below ny) into the web's scratch
  * (wrap_lanes' out); lanes past the last row have ends that coincide. */
-static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, const ws_spring_form *p)
+static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
@@ -444,27 +435,27 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, const ws_
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
     double *out = web->tmp + 3 * WS_WEB_CHUNK;
-    wrap_lanes(in, *p, out);
+    wrap_lanes(in, web->form[WS_SPRING_AROUND], out);
     if (web->nbroken)
         for (size_t i = 0; i < L && r + i < ny; i++)
             if (web->broken[nx * (r + i + 1) - 1])
                 out[3 * L + i] = 0.0; /* broken: no force, as for coincident ends */
 }
 
-/* The around-springs from node a + i to a + i + 1, i in [0, m), the first s0, one law of film
- * form, with the base forces of nodes [a, a + m]: in chunks small enough for the scratch to
- * stay in the first-level cache, each chunk's forces computed, then put on its nodes in one
- * pass. A node at the start of a chunk after the first has had the previous chunk's spring
- * already and gets its right-hand one after it. wrap, unless NULL, is the row's lane of
- * wrap_rows' out: the wrap spring from node a + m to node a, which these two nodes get last. */
-static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, size_t m, size_t s0,
-                       const ws_spring_form *p, const double *wrap)
+/* The around-springs of row r of a grid, one law of film form, with the base forces of its
+ * nodes: in chunks small enough for the scratch to stay in the first-level cache, each chunk's
+ * forces computed, then put on its nodes in one pass. A node at the start of a chunk after the
+ * first has had the previous chunk's spring already and gets its right-hand one after it. The
+ * wrap spring of a closed band (from the row's last node to its first, in wrap_rows' out) goes
+ * onto those two nodes last. */
+static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
-    const double *il0 = web->inv_l0 + s0;
-    const ws_nodes3 f = web->f;
-    double *tx = web->tmp, *ty = tx + WS_WEB_CHUNK, *tz = ty + WS_WEB_CHUNK;
+    const size_t nx = (size_t)web->nx, m = nx - 1, a = nx * r;
+    const size_t s0 = (web->closed ? nx : nx - 1) * r; /* ws_web_build_grid's numbering */
+    const ws_nodes3 f = web->f, t = chunk_forces(web);
+    const double *wrap = web->tmp + 3 * WS_WEB_CHUNK + r % WS_WEB_WRAPS;
     v3 fw = v3_make(0.0, 0.0, 0.0);
-    if (wrap && wrap[3 * WS_WEB_WRAPS] != 0.0) /* else coincident ends: no direction to pull */
+    if (web->closed && wrap[3 * WS_WEB_WRAPS] != 0.0) /* else no wrap, or coincident ends */
         fw = v3_make(wrap[0], wrap[WS_WEB_WRAPS], wrap[2 * WS_WEB_WRAPS]);
     else
         wrap = NULL;
@@ -473,107 +464,69 @@ static void around_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t a, si
         /* Whole vectors: up to three springs more, whose forces are not used, from the nodes
          * after the row (the next row's, or the padding after the last) and the rest lengths
          * after its springs. Cheaper than the left-over springs one at a time. */
-        spring_run(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, (k + 3) & ~(size_t)3,
-                   il0 + o, p->kc, p->dk, p->w, p->qw, p->c, tx, ty, tz);
+        spring_run(&web->form[WS_SPRING_AROUND], in_at(x, q), in_at(v, q), (k + 3) & ~(size_t)3,
+                   web->inv_l0 + s0 + o, out_at(t, 0));
         if (web->nbroken)
-            cut_chunk(web->broken + s0 + o, k, tx, ty, tz);
-        v3 first = v3_make(tx[0], ty[0], tz[0]), last = v3_make(tx[k - 1], ty[k - 1], tz[k - 1]);
+            cut_chunk(web->broken + s0 + o, k, out_at(t, 0));
         if (o == 0) {
-            v3 fa = v3_add(base_force(web, v, g, q), first);
+            v3 fa = v3_add(base_force(web, v, q), nodes_get(t, 0));
             nodes_set(f, (uint32_t)q, wrap ? v3_add(fa, v3_scale(fw, -1.0)) : fa);
         } else {
-            nodes_add(f, (uint32_t)q, first);
+            nodes_add(f, (uint32_t)q, nodes_get(t, 0));
         }
-        if (web->same_m && web->no_drag)
-            row_forces_same_free(k, g, web->m1, tx, ty, tz, f.x + q, f.y + q, f.z + q);
-        else if (web->same_m)
-            row_forces_same(k, g, web->damping, web->m1, v.x + q, v.y + q, v.z + q, tx, ty, tz,
-                            f.x + q, f.y + q, f.z + q);
-        else
-            row_forces_each(k, g, web->damping, web->m + q, v.x + q, v.y + q, v.z + q, tx, ty, tz,
-                            f.x + q, f.y + q, f.z + q);
-        v3 fb = v3_sub(base_force(web, v, g, q + k), last);
+        row_forces(web, v, q, k);
+        v3 fb = v3_sub(base_force(web, v, q + k), nodes_get(t, (uint32_t)(k - 1)));
         nodes_set(f, (uint32_t)(q + k), wrap && o + k == m ? v3_add(fb, fw) : fb);
     }
 }
 
-/* The up-springs from row j (its first node a, its first up-spring s0) to row j + 1. */
-static void spring_up(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t a, size_t s0,
-                      const ws_spring_form *p)
-{
-    const size_t nx = (size_t)web->nx;
-    if (p->gen || any_broken(web, s0, nx)) {
-        for (size_t i = 0; i < nx; i++)
-            spring_one(web, x, v, (uint32_t)(s0 + i), *p);
-        return;
-    }
-    ws_nodes3 f = web->f;
-    spring_run_apply(x.x + a, x.y + a, x.z + a, v.x + a, v.y + a, v.z + a, nx, nx, web->inv_l0 + s0,
-                     p->kc, p->dk, p->w, p->qw, p->c, f.x + a, f.y + a, f.z + a, f.x + a + nx,
-                     f.y + a + nx, f.z + a + nx);
-}
-
 /* Row r of a grid: its base forces and its around-springs (ws_web_build_grid numbers them row
- * by row, cols a row: node nx r + i to the next, and the wrap of a closed band last). */
-static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t r, const ws_spring_form *P)
+ * by row, cols a row: node nx r + i to the next, and the wrap of a closed band last). A sweep
+ * starts rows in order from row 0, so the first of each WS_WEB_WRAPS rows finds the wraps of
+ * them all; the first row of a lane (lane_first) finds its group's as that row would. */
+static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, int lane_first)
 {
     const size_t nx = (size_t)web->nx, cols = web->closed ? nx : nx - 1;
-    const ws_spring_form *p = &P[WS_SPRING_AROUND];
-    if (!web->law[WS_SPRING_AROUND] || nx < 2) {
-        base_forces(web, v, g, nx * r, nx * (r + 1));
+    const ws_spring_form *p = &web->form[WS_SPRING_AROUND];
+    if (p->gen || !web->law[WS_SPRING_AROUND] || nx < 2) {
+        base_forces(web, v, nx * r, nx * (r + 1));
+        for (size_t s = cols * r; p->gen && nx >= 2 && s < cols * (r + 1); s++)
+            spring_one(web, x, v, (uint32_t)s);
         return;
     }
-    if (p->gen) {
-        base_forces(web, v, g, nx * r, nx * (r + 1));
-        for (size_t i = 0; i < nx - 1; i++)
-            spring_one(web, x, v, (uint32_t)(cols * r + i), *p);
-        if (web->closed)
-            spring_one(web, x, v, (uint32_t)(cols * r + nx - 1), *p);
-    } else if (web->closed) {
-        /* A sweep starts rows in order from row 0, so the first of each WS_WEB_WRAPS rows
-         * finds the wraps of them all. */
-        if (r % WS_WEB_WRAPS == 0)
-            wrap_rows(web, x, v, r, p);
-        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p,
-                   web->tmp + 3 * WS_WEB_CHUNK + r % WS_WEB_WRAPS);
-    } else {
-        around_row(web, x, v, g, nx * r, nx - 1, cols * r, p, NULL);
-    }
+    if (web->closed && (r % WS_WEB_WRAPS == 0 || lane_first))
+        wrap_rows(web, x, v, r - r % WS_WEB_WRAPS);
+    around_row(web, x, v, r);
 }
 
-/* The up-springs and shear pairs from row j to row j + 1 onto the ends in rows [r0, r1) alone
- * (j and j + 1 both for all of them), in the order grid_step puts them: at the edge of a lane
- * (ws_web_forces_rows) each of the two lanes computes the springs and takes its own row's
- * side, which gets the values and the order it gets in one sweep. The other side's forces go
- * to the scratch. */
-static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1,
-                         const ws_spring_form *P)
+/* The up-springs and shear pairs from row j to row j + 1 onto their ends in rows [r0, r1)
+ * (all of the grid's rows for both ends). At the edge of a lane (ws_web_forces_rows) each of
+ * the two lanes computes these springs and takes its own row's side, which gets the values and
+ * the order it gets in one sweep. */
+static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1)
 {
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     const size_t cols = web->closed ? nx : nx - 1, a = nx * j;
     const uint32_t lo = (uint32_t)(nx * r0), hi = (uint32_t)(nx * r1);
     const size_t s0 = cols * ny + nx * j;
-    const ws_spring_form *p = &P[WS_SPRING_UP];
+    const ws_spring_form *p = &web->form[WS_SPRING_UP];
     if (web->law[WS_SPRING_UP] && (p->gen || any_broken(web, s0, nx))) {
         for (size_t i = 0; i < nx; i++)
-            spring_one_in(web, x, v, (uint32_t)(s0 + i), *p, lo, hi);
+            spring_one_in(web, x, v, (uint32_t)(s0 + i), lo, hi);
     } else if (web->law[WS_SPRING_UP]) {
-        const ws_nodes3 f = web->f;
+        /* The side that is not the lane's goes to the scratch. */
         const int up = j >= r0 && j < r1, down = j + 1 >= r0 && j + 1 < r1;
-        double *dx = web->tmp, *dy = dx + WS_WEB_CHUNK, *dz = dy + WS_WEB_CHUNK;
+        const ws_nodes3 f = web->f, t = chunk_forces(web);
         for (size_t o = 0; o < nx; o += WS_WEB_CHUNK) {
             const size_t q = a + o, m = nx - o < WS_WEB_CHUNK ? nx - o : WS_WEB_CHUNK;
-            spring_run_apply(x.x + q, x.y + q, x.z + q, v.x + q, v.y + q, v.z + q, nx, m,
-                             web->inv_l0 + s0 + o, p->kc, p->dk, p->w, p->qw, p->c,
-                             up ? f.x + q : dx, up ? f.y + q : dy, up ? f.z + q : dz,
-                             down ? f.x + q + nx : dx, down ? f.y + q + nx : dy,
-                             down ? f.z + q + nx : dz);
+            spring_apply(p, in_at(x, q), in_at(v, q), nx, m, web->inv_l0 + s0 + o,
+                         out_at(up ? f : t, up ? q : 0), out_at(down ? f : t, down ? q + nx : 0));
         }
     }
     size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
     if (shear0 < web->ns)
         for (size_t s = shear0; s < shear0 + 2 * cols; s++)
-            spring_one_in(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR], lo, hi);
+            spring_one_in(web, x, v, (uint32_t)s, lo, hi);
 }
 
 uint32_t ws_web_block_rows(const ws_web *web)
@@ -595,28 +548,11 @@ uint32_t ws_web_block_count(const ws_web *web)
     return (uint32_t)(((size_t)web->ny + r - 1) / r);
 }
 
-/* Row j of a grid web complete: row j + 1 started (base forces, its around-springs), then the
- * up-springs and shear pairs between the two (row 0 is started by the sweep's first block). */
-static void grid_step(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, size_t j,
-                      const ws_spring_form *P)
-{
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
-    const size_t cols = web->closed ? nx : nx - 1;
-    if (j + 1 >= ny)
-        return;
-    grid_row(web, x, v, g, j + 1, P);
-    if (web->law[WS_SPRING_UP])
-        spring_up(web, x, v, nx * j, cols * ny + nx * j, &P[WS_SPRING_UP]);
-    size_t shear0 = cols * ny + nx * (ny - 1) + 2 * cols * j;
-    if (shear0 < web->ns)
-        for (size_t s = shear0; s < shear0 + 2 * cols; s++)
-            spring_one(web, x, v, (uint32_t)s, P[WS_SPRING_SHEAR]);
-}
-
 void ws_web_sweep_laws(ws_web *web, v3 g, double t, double since)
 {
     for (int q = 0; q < 3; q++)
         web->form[q] = form_of(web->law[q], t, since);
+    web->g = g;
     /* Without drag, gravity and drag m g - c v is m g to the bit: c v is a zero (the
      * velocities are finite, or the step fails on them), which leaves any m g but -0 as
      * it is. */
@@ -635,105 +571,93 @@ int ws_web_sweep_parallel(const ws_web *web)
     return 1;
 }
 
-void ws_web_forces_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 g, uint32_t j0, uint32_t j1,
-                        int edges, uint32_t *n0, uint32_t *n1)
+void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,
+                        uint32_t *n0, uint32_t *n1)
 {
-    /* The laws' parameters by spring kind, taken once a sweep (ws_web_sweep_laws). */
-    const ws_spring_form *P = web->form;
+    const ws_nodes3 x = p->x, v = p->v;
     if (web->nx == 0) {
-        base_forces(web, v, g, 0, web->n);
+        base_forces(web, v, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
-            spring_one(web, x, v, s, P[web->kind[s]]);
+            spring_one(web, x, v, s);
         *n0 = 0;
         *n1 = web->n;
         return;
     }
-    /* Row j is complete once the springs to row j + 1 are in (grid_step). */
+    /* Row j is complete once row j + 1 is started and the springs between the two are in. A
+     * lane's first row is started as the lane before would have started it, and gets the
+     * springs from the row before. */
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     if (j0 == 0) {
-        grid_row(web, x, v, g, 0, P);
+        grid_row(web, x, v, 0, 0);
     } else if (edges & WS_WEB_LANE_FIRST) {
-        /* The lane's first row as the lane before would have started it: its wraps (computed
-         * a group of rows at once, as the rows from 0 find them), the row, the springs from
-         * the row before onto it. */
-        if (web->closed && !P[WS_SPRING_AROUND].gen && web->law[WS_SPRING_AROUND] && nx >= 2 &&
-            j0 % WS_WEB_WRAPS != 0)
-            wrap_rows(web, x, v, j0 - j0 % WS_WEB_WRAPS, &P[WS_SPRING_AROUND]);
-        grid_row(web, x, v, g, j0, P);
-        pair_springs(web, x, v, j0 - 1, j0, j1, P);
+        grid_row(web, x, v, j0, 1);
+        pair_springs(web, x, v, j0 - 1, j0, j1);
     }
     for (size_t j = j0; j < j1; j++) {
-        if (j + 1 == j1 && j1 < ny && (edges & WS_WEB_LANE_LAST))
-            pair_springs(web, x, v, j, j0, j1, P); /* the next lane starts row j1 */
-        else
-            grid_step(web, x, v, g, j, P);
+        if (j + 1 == j1 && j1 < ny && (edges & WS_WEB_LANE_LAST)) {
+            pair_springs(web, x, v, j, j0, j1); /* the next lane starts row j1 */
+        } else if (j + 1 < ny) {
+            grid_row(web, x, v, j + 1, 0);
+            pair_springs(web, x, v, j, 0, ny);
+        }
     }
     *n0 = (uint32_t)(nx * j0);
     *n1 = (uint32_t)(nx * j1);
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when
- * pinned), x1 = x0 + h v1, the force f read from where v1 goes (fv: f in, v1 out); 1 / m is
- * im[i], or im1 > 0 for every node when same (none pinned; im is not read). Distinct arrays
- * otherwise (restrict), so the loop runs on vectors. Returns how many nodes end faster than
- * sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop keeps its vectors,
- * and taken from the new velocity while it is at hand. */
-static inline size_t advance_of(size_t m, double h, double lim2, const double *restrict im,
-                                double im1, int same, const double *restrict vx0,
-                                const double *restrict vy0, const double *restrict vz0,
-                                const double *restrict x0, const double *restrict y0,
-                                const double *restrict z0, double *restrict fvx,
-                                double *restrict fvy, double *restrict fvz, double *restrict x1,
-                                double *restrict y1, double *restrict z1)
+ * pinned), x1 = x0 + h v1, the force f read from where v1 goes (vd: f in, v1 out); 1 / m is
+ * inv_m[i], or inv_m1 > 0 for every node when same (none pinned; the array is not read). The
+ * arrays are distinct (restrict), so the loop runs on vectors. Returns how many nodes end
+ * faster than sqrt(lim2) or with a NaN speed (!(s <= lim2) counts it): a count, so the loop
+ * keeps its vectors, and taken from the new velocity while it is at hand. */
+typedef struct advance_run {
+    in3 x, v;
+    out3 xd, vd;
+    const double *restrict inv_m;
+    double inv_m1, h, lim2;
+    size_t m;
+} advance_run;
+
+static inline size_t advance_of(advance_run r, int same)
 {
+    const double h = r.h;
     size_t bad = 0;
-    for (size_t i = 0; i < m; i++) {
+    for (size_t i = 0; i < r.m; i++) {
         /* Computed, then selected: no branch. */
-        const double imi = same ? im1 : im[i];
+        const double imi = same ? r.inv_m1 : r.inv_m[i];
         double unpinned = (double)(imi != 0.0), hi = h * imi;
-        double ux = vx0[i] + hi * fvx[i], uy = vy0[i] + hi * fvy[i], uz = vz0[i] + hi * fvz[i];
+        double ux = r.v.x[i] + hi * r.vd.x[i], uy = r.v.y[i] + hi * r.vd.y[i],
+               uz = r.v.z[i] + hi * r.vd.z[i];
         if (!same) { /* else none is pinned: the product by 1 would change nothing */
             ux *= unpinned;
             uy *= unpinned;
             uz *= unpinned;
         }
-        fvx[i] = ux;
-        fvy[i] = uy;
-        fvz[i] = uz;
-        x1[i] = x0[i] + h * ux;
-        y1[i] = y0[i] + h * uy;
-        z1[i] = z0[i] + h * uz;
-        bad += !(ux * ux + uy * uy + uz * uz <= lim2);
+        r.vd.x[i] = ux;
+        r.vd.y[i] = uy;
+        r.vd.z[i] = uz;
+        r.xd.x[i] = r.x.x[i] + h * ux;
+        r.xd.y[i] = r.x.y[i] + h * uy;
+        r.xd.z[i] = r.x.z[i] + h * uz;
+        bad += !(ux * ux + uy * uy + uz * uz <= r.lim2);
     }
     return bad;
 }
 
+/* The same for the sweep's nodes [n0, n0 + m), the case chosen outside the loop. */
 WS_VECTOR_LOOP
-static size_t advance_each(size_t m, double h, double lim2, const double *restrict im,
-                           const double *restrict vx0, const double *restrict vy0,
-                           const double *restrict vz0, const double *restrict x0,
-                           const double *restrict y0, const double *restrict z0,
-                           double *restrict fvx, double *restrict fvy, double *restrict fvz,
-                           double *restrict x1, double *restrict y1, double *restrict z1)
+static size_t advance(const ws_web *web, const ws_web_pass *p, size_t n0, size_t m, double lim2)
 {
-    return advance_of(m, h, lim2, im, 0.0, 0, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1, z1);
+    const int same = web->same_inv_m && web->inv_m1 != 0.0;
+    const advance_run r = {in_at(p->x, n0), in_at(p->v, n0), out_at(p->xd, n0),
+                           out_at(p->vd, n0), web->inv_m + n0, web->inv_m1, p->h, lim2, m};
+    return same ? advance_of(r, 1) : advance_of(r, 0);
 }
 
-WS_VECTOR_LOOP
-static size_t advance_same(size_t m, double h, double lim2, double im1, const double *restrict vx0,
-                           const double *restrict vy0, const double *restrict vz0,
-                           const double *restrict x0, const double *restrict y0,
-                           const double *restrict z0, double *restrict fvx, double *restrict fvy,
-                           double *restrict fvz, double *restrict x1, double *restrict y1,
-                           double *restrict z1)
+void ws_web_sweep_begin(ws_web *web, const ws_web_pass *p)
 {
-    return advance_of(m, h, lim2, NULL, im1, 1, vx0, vy0, vz0, x0, y0, z0, fvx, fvy, fvz, x1, y1,
-                      z1);
-}
-
-void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd)
-{
-    web->f = vd;
+    web->f = p->vd;
 }
 
 void ws_web_sweep_end(ws_web *web)
@@ -741,20 +665,13 @@ void ws_web_sweep_end(ws_web *web)
     web->f = web->fmem;
 }
 
-size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
-                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax)
+size_t ws_web_integrate_block(ws_web *web, const ws_web_pass *p, uint32_t n0, uint32_t n1)
 {
     /* A speed whose square overflows counts as too fast even without a limit (max_speed
      * infinite): a node's state never goes infinite unnoticed. */
-    double lim2 = vmax * vmax;
+    double lim2 = p->vmax * p->vmax;
     lim2 = lim2 <= DBL_MAX ? lim2 : DBL_MAX;
-    if (web->same_inv_m && web->inv_m1 != 0.0)
-        return advance_same(n1 - n0, h, lim2, web->inv_m1, vs.x + n0, vs.y + n0, vs.z + n0,
-                            xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0,
-                            xd.x + n0, xd.y + n0, xd.z + n0);
-    return advance_each(n1 - n0, h, lim2, web->inv_m + n0, vs.x + n0, vs.y + n0, vs.z + n0,
-                        xs.x + n0, xs.y + n0, xs.z + n0, vd.x + n0, vd.y + n0, vd.z + n0, xd.x + n0,
-                        xd.y + n0, xd.z + n0);
+    return advance(web, p, n0, n1 - n0, lim2);
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)

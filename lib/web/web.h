@@ -70,8 +70,11 @@ typedef struct ws_web {
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
                                 WS_WEB_WRAPS wrap springs (scratch, WS_WEB_TMP) */
-    ws_spring_form form[3];  /* the laws by spring kind in the running sweep (scratch) */
-    int no_drag;             /* the running sweep's nodes have no drag (scratch) */
+    /* The running sweep's laws by spring kind, its gravity, and whether its nodes have no
+     * drag (scratch, ws_web_sweep_laws). */
+    ws_spring_form form[3];
+    v3 g;
+    int no_drag;
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
                                 zeroed at the start of a step that writes fc[k] */
@@ -151,7 +154,7 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * [n0, n1) may then get their contact forces and be integrated. A grid web's blocks are whole
  * rows, ws_web_block_rows of them (enough for WS_WEB_BLOCK_NODES nodes; a lane may end with
  * fewer); a mesh web is one block, whatever the rows asked. Every sweep first takes the laws at
- * (t, since) (ws_web_sweep_laws).
+ * (t, since) and the gravity (ws_web_sweep_laws).
  *
  * Lanes: consecutive blocks swept apart, at once, by copies of the web that share its state
  * and have scratch of their own (world_step.c). The block that starts a lane (edges has
@@ -166,22 +169,26 @@ uint32_t ws_web_block_count(const ws_web *web);
 uint32_t ws_web_block_rows(const ws_web *web); /* rows of a grid web's block; 1 for a mesh */
 #define WS_WEB_LANE_FIRST 1
 #define WS_WEB_LANE_LAST 2
+/* A sweep's state: the state it reads (x, v) and the one it writes (xd, vd; distinct from x,
+ * v), its sub-step h (s), and the speed above which a node counts as too fast, vmax (m/s). */
+typedef struct ws_web_pass {
+    ws_nodes3 x, v, xd, vd;
+    double h, vmax;
+} ws_web_pass;
 void ws_web_sweep_laws(ws_web *web, v3 gravity, double t, double since);
 int ws_web_sweep_parallel(const ws_web *web);
-void ws_web_forces_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, uint32_t j0, uint32_t j1,
-                        int edges, uint32_t *n0, uint32_t *n1);
-/* A sweep that writes the velocities vd keeps the nodes' forces in vd until it integrates
+void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,
+                        uint32_t *n0, uint32_t *n1);
+/* A sweep keeps the nodes' forces in the velocities it writes (p->vd) until it integrates
  * them, in place of an array of its own: each node's force is complete before its new
  * velocity is written over it, and the state the sweep streams is smaller by an n-node array
  * (f is then vd; ws_web_sweep_end makes it the scratch again). */
-void ws_web_sweep_begin(ws_web *web, ws_nodes3 vd);
+void ws_web_sweep_begin(ws_web *web, const ws_web_pass *p);
 void ws_web_sweep_end(ws_web *web);
-/* Symplectic Euler for nodes [n0, n1) over h: v' = v + h f/m, x' = x + h v', f read from vd
- * (ws_web_sweep_begin). Returns how many of them end faster than vmax (m/s), with a NaN
- * speed or with one whose square overflows (whatever vmax). Source and destination are
- * distinct. */
-size_t ws_web_integrate_block(ws_web *web, ws_nodes3 xs, ws_nodes3 vs, ws_nodes3 xd,
-                              ws_nodes3 vd, double h, uint32_t n0, uint32_t n1, double vmax);
+/* Symplectic Euler for nodes [n0, n1) over p->h: v' = v + h f/m, x' = x + h v', f read from
+ * p->vd (ws_web_sweep_begin). Returns how many of them end faster than p->vmax, with a NaN
+ * speed or with one whose square overflows (whatever vmax). */
+size_t ws_web_integrate_block(ws_web *web, const ws_web_pass *p, uint32_t n0, uint32_t n1);
 /* The largest node speed in v (NaN when one is NaN), m/s. */
 double ws_web_fastest(const ws_web *web, ws_nodes3 v);
 /* Largest stable step for the springs and node drag alone plus a contact of stiffness kc and

@@ -226,16 +226,16 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     if (T->zero)
         memset(T->pass.fc + n0, 0, (J->cview.lane_end - n0) * sizeof(v3));
     ws_node_substep(&J->cview);
-    ws_web_sweep_begin(web, T->vd);
+    const ws_web_pass P = {T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, w->def.max_speed};
+    ws_web_sweep_begin(web, &P);
     /* Blocks of r rows from the lane's first row (the last may be shorter). */
     for (uint32_t j = J->r0; j < J->r1; j += r) {
         const uint32_t j1 = J->r1 - j > r ? j + r : J->r1;
         const int edges = (j == J->r0 && j > 0 ? WS_WEB_LANE_FIRST : 0) |
                           (j1 == J->r1 && j1 < rows ? WS_WEB_LANE_LAST : 0);
-        ws_web_forces_rows(web, T->pass.x, T->pass.v, w->def.gravity, j, j1, edges, &n0, &n1);
+        ws_web_forces_rows(web, &P, j, j1, edges, &n0, &n1);
         ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
-        J->fast += ws_web_integrate_block(web, T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, n0,
-                                          n1, w->def.max_speed);
+        J->fast += ws_web_integrate_block(web, &P, n0, n1);
     }
     ws_web_sweep_end(web);
 }

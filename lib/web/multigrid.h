@@ -1,0 +1,37 @@
+/* A geometric multigrid preconditioner for the implicit film's solve on grid webs (web module,
+ * used by web/implicit.c; docs/theory.md, "The implicit film", says why). The film's grid
+ * (node i + nx j, closed around when it is a band) is coarsened by two in each direction, level
+ * after level, to a few dozen nodes; each coarser matrix is the Galerkin product P^T A P of the
+ * finer one with bilinear interpolation P, so it stays symmetric positive definite and needs no
+ * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
+ * matrix-free operator, symmetric block Gauss-Seidel (forward before, backward after the coarse
+ * correction) on the coarse levels, a dense Cholesky factor on the coarsest. The cycle is the
+ * same linear, symmetric positive definite map on every call, so conjugate gradients stay
+ * valid with it.
+ *
+ * Node vectors are xyz per node (3 n doubles), as in web/implicit.h. */
+#ifndef WS_WEB_MULTIGRID_H
+#define WS_WEB_MULTIGRID_H
+
+#include "web/web.h"
+
+typedef struct ws_mg ws_mg;
+
+/* The hierarchy of a web (sizes only; the matrices come with ws_mg_setup). *out is NULL, with
+ * 0 returned, when the web is not a grid whose springs all join grid neighbours, or is too
+ * small to coarsen: block Jacobi then serves alone. -1 when out of memory. */
+int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out);
+void ws_mg_free(ws_mem *mem, ws_mg *mg);
+
+/* The coarse matrices for the operator the solve has just set (web->imp: the springs' blocks a,
+ * b, the nodes' blocks nd and the block-Jacobi inverses pinv of web/implicit.c). 0, or -1 when
+ * a coarse matrix is not positive definite (then the solve keeps block Jacobi). */
+int ws_mg_setup(ws_mg *mg, const ws_web *web);
+
+/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. */
+double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z);
+
+/* The number of levels (the film's own one included), for the counts. */
+int ws_mg_levels(const ws_mg *mg);
+
+#endif
