@@ -46,8 +46,9 @@ static void line(const char *name, const tilt_options *o)
 /* The unwrapped stack of case R on the level platform for its first second at step dt: the
  * bodies' largest kinetic energy (J) and the bottom box's highest rise above its start (m). A
  * stack that settles keeps both small (millijoules, tenths of a millimetre); a runaway does not. */
-static void settle_motion(double dt, double *kmax, double *rise)
+static void settle_motion(double dt, double *kmax, double *rise, char *why, size_t why_size)
 {
+    why[0] = 0;
     tilt_options a;
     tilt_default_options(&a);
     a.variant = 'R';
@@ -62,6 +63,7 @@ static void settle_motion(double dt, double *kmax, double *rise)
     *kmax = *rise = 0.0;
     for (long n = lround(1.0 / dt); n > 0; n--) {
         if (ws_world_step(sc.world) != WS_OK) {
+            snprintf(why, why_size, "%s", ws_world_last_error(sc.world));
             *kmax = *rise = NAN;
             break;
         }
@@ -238,7 +240,12 @@ int main(int argc, char **argv)
                 slide[stick] = r.status == WS_OK ? r.slide_angle[1] : NAN;
             }
             double kmax, rise;
-            settle_motion(dts[k], &kmax, &rise);
+            char why[512];
+            settle_motion(dts[k], &kmax, &rise, why, sizeof why);
+            if (why[0]) {
+                printf("  unwrapped, dt %.2f ms: failed: %s\n", 1e3 * dts[k], why);
+                continue;
+            }
             printf("  unwrapped, dt %.2f ms: top box slides at %6.2f deg (regularised), %6.2f deg "
                    "(stick); first second: kinetic energy <= %.3g J, bottom box rises <= %.3g mm\n",
                    1e3 * dts[k], slide[0], slide[1], kmax, 1e3 * rise);
