@@ -140,6 +140,7 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
+    double pair_dt; /* the bodies' per-pair stable step (ws_world_contact_limit), s */
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that

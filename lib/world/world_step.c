@@ -590,11 +590,12 @@ static double round_down_3(double x)
 
 /* Bodies and their contact pairs against the stable step, before the step (as webs are): the
  * pair with the smallest stable step, and what would do. */
-static ws_status bodies_ready(ws_world *w)
+static ws_status bodies_ready(ws_world *w, double *pair_dt)
 {
     ws_contact_limit L;
     ws_world_contact_limit(w, &L);
     double dt = w->def.dt;
+    *pair_dt = L.dt;
     if (dt <= L.dt)
         return WS_OK;
     w->stats.numerical_errors++;
@@ -855,7 +856,7 @@ static double contact_rate(const ws_step *S, int damper, v3 *x, v3 *y)
 static ws_status contacts_ready(ws_step *S)
 {
     ws_world *w = S->w;
-    if (S->nrec == 0 || !(S->dt > WS_CONTACT_CHECK_FRACTION * ws_world_stable_dt(w)))
+    if (S->nrec == 0 || !(S->dt > WS_CONTACT_CHECK_FRACTION * S->pair_dt))
         return WS_OK;
     const size_t n = S->b->slots;
     v3 *x = ws_arena_alloc(S->arena, 4 * (n + 1) * sizeof(v3));
@@ -875,7 +876,7 @@ static ws_status contacts_ready(ws_step *S)
                    "rad/s, damping rate %.3g 1/s; bodies rocking and bouncing on several "
                    "partners at once, which the per-pair bound of %.3g s leaves out), below dt "
                    "= %.3g s. Use dt <= %.3g s (ws_world_set_dt), or softer contacts.",
-                   w->time, S->nrec, stable, sqrt(K), C, ws_world_stable_dt(w), S->dt,
+                   w->time, S->nrec, stable, sqrt(K), C, S->pair_dt, S->dt,
                    round_down_3(stable));
 }
 
@@ -959,7 +960,8 @@ static ws_status step_once(ws_world *w)
 {
     const double t_start = clock_now(w);
     ws_status s;
-    if ((s = bodies_ready(w)) != WS_OK)
+    double pair_dt;
+    if ((s = bodies_ready(w, &pair_dt)) != WS_OK)
         return s;
     /* The last step's scratch is given back; this step's comes from the arena. */
     ws_arena_reset(&w->arena);
@@ -973,7 +975,8 @@ static ws_status step_once(ws_world *w)
                  .contact = {b, w->cur, w->def.contact_margin, w->params, w->pair_index,
                              (uint32_t)w->pair_dim, 0},
                  .stats = &w->stats,
-                 .arena = &w->arena};
+                 .arena = &w->arena,
+                 .pair_dt = pair_dt};
     /* The energy guard's record of the contacts' loads on each body. */
     if (!(S.guard_f = ws_arena_alloc(S.arena, 2 * (b->slots + 1) * sizeof(v3))))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
