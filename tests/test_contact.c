@@ -1131,6 +1131,86 @@ START_TEST(test_stick_stack_settles_on_tilt)
 }
 END_TEST
 
+/* Two 0.25 m, 5 kg cubes stacked on a level kinematic plane (k = 2e5 N/m, c = 10 kg/s per
+ * point, the reference case's normal contacts; no friction, whose regularised law has a limit
+ * of its own, bench/NOTES.md), each near its static overlap, the top one spinning at `spin`
+ * rad/s about y to stir its rocking; stepped at dt for up to 1 s. Returns the status of the
+ * first failing step (WS_OK: none), the step count done, the largest kinetic energy over the
+ * run and over its last tenth. */
+static ws_status rocking_stack(double dt, double spin, long *done, double *kmax, double *kend)
+{
+    const double a = 0.25, m = 5.0, k = 2e5;
+    ws_contact_def cd = contact_params(k, 10.0, 0.0, WS_FRICTION_REGULARIZED);
+    ws_world *w = contact_world(dt, &cd);
+    make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID, v3(0, 0, 0),
+             "plane");
+    const double z0 = a / 2 + 2 * DELTA - 2 * m * G0 / (4 * k);
+    ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, z0), Q_ID, v3(0, 0, 0),
+                              "bottom");
+    (void)bot;
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, a, a, a, &cube));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.mass = m;
+    bd.position = v3(0, 0, z0 + a + 2 * DELTA - m * G0 / (8 * k));
+    bd.angular_velocity = v3(0, spin, 0);
+    bd.name = "top";
+    ws_body_id top;
+    ck_ok(w, ws_body_create(w, &bd, &top));
+    double S;
+    ck_ok(w, ws_world_estimate_stable_dt(w, &S));
+    ck_assert_msg(dt < S, "the per-pair bound %g s already refuses dt %g s", S, dt);
+    ws_status st = WS_OK;
+    *kmax = *kend = 0.0;
+    const long steps = lround(1.0 / dt);
+    for (*done = 0; *done < steps; (*done)++) {
+        if ((st = ws_world_step(w)) != WS_OK) {
+            report("rocking stack at dt %.3g ms: %s", 1e3 * dt, ws_world_last_error(w));
+            break;
+        }
+        ws_energy e;
+        ck_ok(w, ws_world_get_energy(w, &e));
+        *kmax = fmax(*kmax, e.kinetic);
+        if (*done >= steps - steps / 10)
+            *kend = fmax(*kend, e.kinetic);
+    }
+    ws_world_destroy(w);
+    return st;
+}
+
+START_TEST(test_stack_modes_bound_the_step)
+{
+    /* The per-pair bound (8 contacts on the pair's effective mass 2.5 kg: omega^2 = 16 k/m, 2.45
+     * ms with the damping) is above the stack's own highest mode: the two cubes rocking against
+     * each other on their 8-point interface, the bottom one also on the plane's 4 corners:
+     * omega^2 = 27.37 k/m (the 6 x 6 eigenproblem in z, theta_x, theta_y of both cubes, J = m
+     * a^2 / 6; docs/theory.md section 8), so with c the stable step is (sqrt(C^2 + 4 K) - C) /
+     * K with K = 27.37 k/m, C = 27.37 c/m: 1.862 ms. Above it (2.0 ms, 0.82 of the per-pair
+     * bound) the first step with the contacts must be refused before the bodies move
+     * (unrefused, the reference stack bounces off the plane within 0.2 s at 2.4 ms). Below it
+     * (1.75 ms, 0.94 of the bound) the second runs out without a runaway: its largest kinetic
+     * energy is within the swing symplectic Euler's energy may take near the bound, (1 + r) /
+     * (1 - r) with r = omega dt / 2 = 0.915 (22.5 x; docs/theory.md section 8), of the same
+     * stack's at 0.25 ms, and its last tenth's is below its peak (a runaway grows by lambda^2
+     * a step and passes both within a few dozen steps). Without friction the stirred spin
+     * leaves the top box drifting, so the energy need not die away. */
+    long done;
+    double kmax, klast, kref, kref_last;
+    ck_assert_int_eq(rocking_stack(2.0e-3, 0.01, &done, &kmax, &klast), WS_ERR_NUMERICAL);
+    ck_assert_msg(done == 0, "refused after %ld steps", done);
+    ck_assert_int_eq(rocking_stack(2.5e-4, 0.01, &done, &kref, &kref_last), WS_OK);
+    ck_assert_int_eq(rocking_stack(1.75e-3, 0.01, &done, &kmax, &klast), WS_OK);
+    const double r = 0.5 * sqrt(27.37 * 2e5 / 5.0) * 1.75e-3, swing = (1 + r) / (1 - r);
+    report("rocking stack: largest kinetic energy %.3g J at 1.75 ms, %.3g J at 0.25 ms (%.1f x, "
+           "swing %.1f x); last tenth %.3g J",
+           kmax, kref, kmax / kref, swing, klast);
+    ck_assert_msg(kmax < swing * kref && klast < kmax, "kinetic %g J at most, %g J last, %g J at "
+                  "0.25 ms", kmax, klast, kref);
+}
+END_TEST
+
 /* ======================================================================================== */
 /* Contact geometry: interface stiffness, reports by pair, the layers in the reference stack  */
 /* ======================================================================================== */
@@ -1395,6 +1475,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_stiff_but_stable_runs);
     tcase_add_test(tc, test_energy_guard_without_speed_limit);
     tcase_add_test(tc, test_stick_stack_settles_on_tilt);
+    tcase_add_test(tc, test_stack_modes_bound_the_step);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -54,6 +54,12 @@ typedef struct ws_contact_limit {
 
 /* Simultaneous contacts the bodies' stable-step bound assumes on one body (docs/theory.md). */
 #define WS_CONTACTS_PER_BODY 8.0
+/* The contacts now acting are measured against dt (their highest mode, by this many power
+ * iterations) once dt passes this fraction of the per-pair bound: below it a mode would need
+ * omega^2 16 times the pair's, more than solid boxes touching on two faces can have
+ * (docs/theory.md, section 8), and the measure is skipped. */
+#define WS_CONTACT_CHECK_FRACTION 0.25
+#define WS_CONTACT_RATE_ITERATIONS 40
 /* The energy guard's allowance: a step's kinetic energy may grow by the known loads' work plus
  * this multiple of the kinetic and contact energy at its start (docs/theory.md, section 8). */
 #define WS_ENERGY_GROWTH_FACTOR 10.0
@@ -134,6 +140,7 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
+    double pair_dt; /* the bodies' per-pair stable step (ws_world_contact_limit), s */
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that

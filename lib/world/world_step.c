@@ -591,11 +591,12 @@ static double round_down_3(double x)
 
 /* Bodies and their contact pairs against the stable step, before the step (as webs are): the
  * pair with the smallest stable step, and what would do. */
-static ws_status bodies_ready(ws_world *w)
+static ws_status bodies_ready(ws_world *w, double *pair_dt)
 {
     ws_contact_limit L;
     ws_world_contact_limit(w, &L);
     double dt = w->def.dt;
+    *pair_dt = L.dt;
     if (dt <= L.dt)
         return WS_OK;
     w->stats.numerical_errors++;
@@ -769,6 +770,117 @@ static void body_contacts(ws_step *S)
     }
 }
 
+/* One application of the bodies' contact operator, y = M^-1 K x over the contacts of this step
+ * (K from each contact's normal spring, or its damper when `damper`): x and y hold a velocity
+ * and a spin a body slot (kinematic bodies' are zero: they do not move with the contacts). */
+static void contact_operator(const ws_step *S, int damper, const v3 *x, v3 *y)
+{
+    const ws_world *w = S->w;
+    const ws_body_store *b = S->b;
+    const ws_body_state *st = &b->st[S->cur];
+    const size_t n = b->slots;
+    for (size_t i = 0; i < 2 * n; i++)
+        y[i] = v3_make(0, 0, 0);
+    for (size_t k = 0; k < S->nrec; k++) {
+        const ws_contact_rec *r = &w->rec[S->nxt][k];
+        const ws_pair_params *p =
+            &w->params[w->pair_index[b->material[r->a] * w->pair_dim + b->material[r->b]]];
+        const double kc = damper ? p->c : p->k;
+        const v3 ra = v3_sub(r->x, st->r[r->a]), rb = v3_sub(r->x, st->r[r->b]);
+        /* The normal motion of b relative to a at the point, and the spring's pull on a. */
+        const double g = v3_dot(r->n, v3_sub(v3_add(x[r->b], v3_cross(x[n + r->b], rb)),
+                                             v3_add(x[r->a], v3_cross(x[n + r->a], ra))));
+        const v3 f = v3_scale(r->n, kc * g);
+        y[r->a] = v3_add(y[r->a], f);
+        y[n + r->a] = v3_add(y[n + r->a], v3_cross(ra, f));
+        y[r->b] = v3_sub(y[r->b], f);
+        y[n + r->b] = v3_sub(y[n + r->b], v3_cross(rb, f));
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC) {
+            y[i] = y[n + i] = v3_make(0, 0, 0);
+            continue;
+        }
+        y[i] = v3_scale(y[i], b->inv_mass[i]);
+        /* The world inverse inertia A Jinv A^T. */
+        y[n + i] = m3_mul_v(&b->A[i], m3_mul_v(&b->Jinv[i], m3_tmul_v(&b->A[i], y[n + i])));
+    }
+}
+
+/* The kinetic-energy norm of x, sqrt(x^T M x). */
+static double mass_norm(const ws_body_store *b, const v3 *x)
+{
+    const size_t n = b->slots;
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (!b->alive[i] || b->type[i] != WS_BODY_DYNAMIC)
+            continue;
+        s += b->mass[i] * v3_norm2(x[i]) +
+             v3_dot(x[n + i], m3_mul_v(&b->A[i], m3_mul_v(&b->J[i], m3_tmul_v(&b->A[i], x[n + i]))));
+    }
+    return sqrt(s);
+}
+
+/* The largest eigenvalue of M^-1 K (or M^-1 C) for the contacts of this step, by power
+ * iteration in the M inner product, where the operator is symmetric: each iterate's ratio
+ * |y|_M / |x|_M is at most the eigenvalue and rises to it. x and y: scratch of 2 slots each. */
+static double contact_rate(const ws_step *S, int damper, v3 *x, v3 *y)
+{
+    const ws_body_store *b = S->b;
+    const size_t n = b->slots;
+    /* A start with a share of every mode: no symmetry of a stack (all bodies alike, all
+     * moving alike) can hide one. */
+    for (size_t i = 0; i < n; i++) {
+        const double q = 1.0 + 0.37 * (double)(i % 7);
+        x[i] = v3_make(0.9 * q, -0.55, 1.3 / q);
+        x[n + i] = v3_make(2.1 / q, 3.3 * q, -1.7);
+    }
+    double lam = 0.0, nx = mass_norm(b, x);
+    for (int it = 0; it < WS_CONTACT_RATE_ITERATIONS && nx > 0.0; it++) {
+        contact_operator(S, damper, x, y);
+        const double ny = mass_norm(b, y);
+        lam = ny / nx;
+        if (!(ny > 0.0))
+            break;
+        for (size_t i = 0; i < 2 * n; i++)
+            x[i] = v3_scale(y[i], 1.0 / ny);
+        nx = 1.0;
+    }
+    return lam;
+}
+
+/* The contacts now acting against the step (docs/theory.md, section 8): the per-pair bound that
+ * bodies_ready checks leaves out bodies that rock and bounce on several partners at once (two
+ * boxes stacked on a platform: omega^2 = 27.4 k/m against the pair's 16 k/m), so when dt is
+ * within WS_CONTACT_CHECK_FRACTION of that bound the system's own highest mode is measured, and
+ * a step beyond its bound is refused before the bodies move. */
+static ws_status contacts_ready(ws_step *S)
+{
+    ws_world *w = S->w;
+    if (S->nrec == 0 || !(S->dt > WS_CONTACT_CHECK_FRACTION * S->pair_dt))
+        return WS_OK;
+    const size_t n = S->b->slots;
+    v3 *x = ws_arena_alloc(S->arena, 4 * (n + 1) * sizeof(v3));
+    if (!x)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+    v3 *y = x + 2 * (n + 1);
+    const double K = contact_rate(S, 0, x, y), C = contact_rate(S, 1, x, y);
+    if (!(K > 0.0))
+        return WS_OK;
+    const double stable = (sqrt(C * C + 4.0 * K) - C) / K; /* ws_contact_stable_dt with m = 1 */
+    if (S->dt <= stable)
+        return WS_OK;
+    S->stats->numerical_errors++;
+    return ws_fail(w, WS_ERR_NUMERICAL,
+                   "step at t = %.6g s refused before the step: the %zu contacts now acting on "
+                   "the bodies have a stable step of %.3g s (their highest mode: omega = %.3g "
+                   "rad/s, damping rate %.3g 1/s; bodies rocking and bouncing on several "
+                   "partners at once, which the per-pair bound of %.3g s leaves out), below dt "
+                   "= %.3g s. Use dt <= %.3g s (ws_world_set_dt), or softer contacts.",
+                   w->time, S->nrec, stable, sqrt(K), C, S->pair_dt, S->dt,
+                   round_down_3(stable));
+}
+
 /* Stage 4: dynamic bodies integrated into nxt; kinematic ones held, or posed by their drives
  * at t + dt. */
 static ws_status integrate(ws_step *S)
@@ -849,7 +961,8 @@ static ws_status step_once(ws_world *w)
 {
     const double t_start = clock_now(w);
     ws_status s;
-    if ((s = bodies_ready(w)) != WS_OK)
+    double pair_dt;
+    if ((s = bodies_ready(w, &pair_dt)) != WS_OK)
         return s;
     /* The last step's scratch is given back; this step's comes from the arena. */
     ws_arena_reset(&w->arena);
@@ -863,7 +976,8 @@ static ws_status step_once(ws_world *w)
                  .contact = {b, w->cur, w->def.contact_margin, w->params, w->pair_index,
                              (uint32_t)w->pair_dim, 0},
                  .stats = &w->stats,
-                 .arena = &w->arena};
+                 .arena = &w->arena,
+                 .pair_dt = pair_dt};
     /* The energy guard's record of the contacts' loads on each body. */
     if (!(S.guard_f = ws_arena_alloc(S.arena, 2 * (b->slots + 1) * sizeof(v3))))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
@@ -876,6 +990,8 @@ static ws_status step_once(ws_world *w)
     double t_eval = clock_now(w);
     S.stats->seconds_detection += t_eval - t_mark;
     body_contacts(&S);
+    if ((s = contacts_ready(&S)) != WS_OK)
+        return s;
     if ((s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK) /* rods, springs, bushings */
         return s;
 
