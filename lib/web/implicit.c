@@ -363,22 +363,29 @@ static int preconditioner(const ws_web *web, double h)
             memset(S, 0, WS_SYM * sizeof(double));
             continue;
         }
-        const double a = S[WS_SYM_XX], b = S[WS_SYM_YY], c = S[WS_SYM_ZZ], d = S[WS_SYM_XY],
-                     e = S[WS_SYM_XZ], f = S[WS_SYM_YZ];
-        /* Cofactors of the symmetric block. */
-        const double cxx = b * c - f * f, cyy = a * c - e * e, czz = a * b - d * d,
-                     cxy = e * f - d * c, cxz = d * f - b * e, cyz = d * e - a * f;
-        const double det = a * cxx + d * cxy + e * cxz;
-        if (!(det > 0.0 && a > 0.0 && czz > 0.0) || !isfinite(det))
+        if (ws_sym_invert(S, S) != 0)
             return -1;
-        const double id = 1.0 / det;
-        S[WS_SYM_XX] = cxx * id;
-        S[WS_SYM_YY] = cyy * id;
-        S[WS_SYM_ZZ] = czz * id;
-        S[WS_SYM_XY] = cxy * id;
-        S[WS_SYM_XZ] = cxz * id;
-        S[WS_SYM_YZ] = cyz * id;
     }
+    return 0;
+}
+
+int ws_sym_invert(const double *S, double *out)
+{
+    const double a = S[WS_SYM_XX], b = S[WS_SYM_YY], c = S[WS_SYM_ZZ], d = S[WS_SYM_XY],
+                 e = S[WS_SYM_XZ], f = S[WS_SYM_YZ];
+    /* Cofactors of the symmetric block. */
+    const double cxx = b * c - f * f, cyy = a * c - e * e, czz = a * b - d * d,
+                 cxy = e * f - d * c, cxz = d * f - b * e, cyz = d * e - a * f;
+    const double det = a * cxx + d * cxy + e * cxz;
+    if (!(det > 0.0 && a > 0.0 && czz > 0.0) || !isfinite(det))
+        return -1;
+    const double id = 1.0 / det;
+    out[WS_SYM_XX] = cxx * id;
+    out[WS_SYM_YY] = cyy * id;
+    out[WS_SYM_ZZ] = czz * id;
+    out[WS_SYM_XY] = cxy * id;
+    out[WS_SYM_XZ] = cxz * id;
+    out[WS_SYM_YZ] = cyz * id;
     return 0;
 }
 

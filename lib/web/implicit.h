@@ -99,6 +99,10 @@ double ws_implicit_apply_op(const ws_web *web, const double *p, double *y);
 int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, double t,
                              double since, double Jx[9], double Jv[9]);
 
+/* S's inverse into out (out may be S) for a symmetric positive definite block, by its
+ * cofactors; -1 (out untouched) when S is not positive definite or the result not finite. */
+int ws_sym_invert(const double *S, double *out);
+
 /* y += S x for a symmetric block S. */
 static inline void ws_sym_madd(const double *S, double x, double y, double z, double *o)
 {

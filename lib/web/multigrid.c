@@ -224,30 +224,36 @@ static void galerkin_level(ws_mg *mg, int k)
         }
 }
 
+/* o -= M x, or o -= M^T x when transposed (M a row-major 3x3 block). */
+static inline void block_sub(const double *M, int transposed, const double *x, double *o)
+{
+    if (transposed) {
+        o[0] -= M[0] * x[0] + M[3] * x[1] + M[6] * x[2];
+        o[1] -= M[1] * x[0] + M[4] * x[1] + M[7] * x[2];
+        o[2] -= M[2] * x[0] + M[5] * x[1] + M[8] * x[2];
+    } else {
+        o[0] -= M[0] * x[0] + M[1] * x[1] + M[2] * x[2];
+        o[1] -= M[3] * x[0] + M[4] * x[1] + M[5] * x[2];
+        o[2] -= M[6] * x[0] + M[7] * x[1] + M[8] * x[2];
+    }
+}
+
 /* The inverse of a node's own block (symmetrised), or zeros for a node no fine node reaches
  * (all of its fine nodes pinned: its right-hand side is always zero). 0, or -1 when the block
  * is not positive definite. */
 static int own_inverse(const double *B, double *S)
 {
-    const double a = B[0], b = B[4], c = B[8], d = 0.5 * (B[1] + B[3]), e = 0.5 * (B[2] + B[6]),
-                 f = 0.5 * (B[5] + B[7]);
-    if (a == 0.0 && b == 0.0 && c == 0.0) {
+    const double sym[WS_SYM] = {[WS_SYM_XX] = B[0],
+                                [WS_SYM_YY] = B[4],
+                                [WS_SYM_ZZ] = B[8],
+                                [WS_SYM_XY] = 0.5 * (B[1] + B[3]),
+                                [WS_SYM_XZ] = 0.5 * (B[2] + B[6]),
+                                [WS_SYM_YZ] = 0.5 * (B[5] + B[7])};
+    if (sym[WS_SYM_XX] == 0.0 && sym[WS_SYM_YY] == 0.0 && sym[WS_SYM_ZZ] == 0.0) {
         memset(S, 0, WS_SYM * sizeof(double));
         return 0;
     }
-    const double cxx = b * c - f * f, cyy = a * c - e * e, czz = a * b - d * d,
-                 cxy = e * f - d * c, cxz = d * f - b * e, cyz = d * e - a * f;
-    const double det = a * cxx + d * cxy + e * cxz;
-    if (!(det > 0.0 && a > 0.0 && czz > 0.0) || !isfinite(det))
-        return -1;
-    const double id = 1.0 / det;
-    S[WS_SYM_XX] = cxx * id;
-    S[WS_SYM_YY] = cyy * id;
-    S[WS_SYM_ZZ] = czz * id;
-    S[WS_SYM_XY] = cxy * id;
-    S[WS_SYM_XZ] = cxz * id;
-    S[WS_SYM_YZ] = cyz * id;
-    return 0;
+    return ws_sym_invert(sym, S);
 }
 
 /* The coarsest level's dense matrix and its Cholesky factor. 0, or -1 when it is not positive
@@ -368,15 +374,7 @@ static void gauss_seidel(mg_level *L, int backward)
                 tr[o] = o < CENTRE;
                 B[o] = tr[o] ? AT(L, j[o], 8 - o) : AT(L, k, o);
                 const double *X = L->x + 3 * (size_t)j[o], *M = B[o];
-                if (tr[o]) {
-                    s[0] -= M[0] * X[0] + M[3] * X[1] + M[6] * X[2];
-                    s[1] -= M[1] * X[0] + M[4] * X[1] + M[7] * X[2];
-                    s[2] -= M[2] * X[0] + M[5] * X[1] + M[8] * X[2];
-                } else {
-                    s[0] -= M[0] * X[0] + M[1] * X[1] + M[2] * X[2];
-                    s[1] -= M[3] * X[0] + M[4] * X[1] + M[5] * X[2];
-                    s[2] -= M[6] * X[0] + M[7] * X[1] + M[8] * X[2];
-                }
+                block_sub(M, tr[o], X, s);
             }
             const double *S = L->dinv + WS_SYM * (size_t)k;
             double *X = L->x + 3 * (size_t)k;
@@ -387,15 +385,7 @@ static void gauss_seidel(mg_level *L, int backward)
                     continue;
                 const double *M = B[o];
                 double *T = L->t + 3 * (size_t)j[o];
-                if (tr[o]) {
-                    T[0] -= M[0] * X[0] + M[1] * X[1] + M[2] * X[2];
-                    T[1] -= M[3] * X[0] + M[4] * X[1] + M[5] * X[2];
-                    T[2] -= M[6] * X[0] + M[7] * X[1] + M[8] * X[2];
-                } else {
-                    T[0] -= M[0] * X[0] + M[3] * X[1] + M[6] * X[2];
-                    T[1] -= M[1] * X[0] + M[4] * X[1] + M[7] * X[2];
-                    T[2] -= M[2] * X[0] + M[5] * X[1] + M[8] * X[2];
-                }
+                block_sub(M, !tr[o], X, T);
             }
             continue;
         }
