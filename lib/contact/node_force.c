@@ -260,8 +260,9 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
 
 /* The loads on the bodies, added to their totals in order (the running sums of the body at
  * hand kept in registers). */
-static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
+void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
 {
+    const act_list L0 = act_open(nc), *L = &L0;
     uint32_t body = UINT32_MAX;
     v3 bf = v3_make(0, 0, 0), bm = bf;
     for (size_t q = 0; q < L->nl; q++) {
@@ -282,7 +283,7 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
         bforce[body] = bf;
         bmoment[body] = bm;
     }
-    L->nl = 0;
+    nc->act_nl = 0;
 }
 
 /* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
@@ -305,11 +306,16 @@ typedef struct node_env {
     struct corner_memo *memo;
 } node_env;
 
-/* Kept out of line where GCC would inline it: see shallowest. */
+/* Out of line where GCC would inline it: see shallowest. Inlined, node_prefetch: as a call of
+ * its own, GCC takes a function that only prefetches for one without effects, and drops it. */
 #if defined(__GNUC__)
 #define NODE_OUT_OF_LINE __attribute__((noinline))
+#define NODE_INLINE __attribute__((always_inline))
+#define NODE_PREFETCH(p) __builtin_prefetch(p)
 #else
 #define NODE_OUT_OF_LINE
+#define NODE_INLINE
+#define NODE_PREFETCH(p) ((void)(p))
 #endif
 
 /* The list's contacts, each node's all in (its candidates lie in one stretch): the values of
@@ -950,17 +956,32 @@ static uint32_t seg_block(const ws_web *web)
     return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
 }
 
-/* The stretches cut (sc) are list `list`'s: room for the faces their runs lie on. */
+/* Room for the run batch of a web of n nodes: its groups, the run passes' scratch, the nodes'
+ * depths. */
+static int rtmp_reserve(ws_mem *mem, ws_node_contact *nc, size_t n)
+{
+    const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + n;
+    return ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double));
+}
+
+/* Room for the faces [0, faces) that runs lie on. */
+static int rface_reserve(ws_mem *mem, ws_node_contact *nc, size_t faces)
+{
+    const size_t had = nc->rface_cap;
+    if (ws_array_reserve(mem, (void **)&nc->rface, &nc->rface_cap, faces, sizeof *nc->rface) != 0)
+        return -1;
+    for (size_t f = had; f < nc->rface_cap; f++)
+        nc->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
+    return 0;
+}
+
+/* The stretches cut (sc) are list `list`'s. */
 static int seg_done(ws_mem *mem, ws_web *web, const seg_cut *sc, int list)
 {
     ws_node_contact *nc = web->contact;
     nc->nseg = sc->nseg;
-    const size_t had = nc->rface_cap;
-    if (ws_array_reserve(mem, (void **)&nc->rface, &nc->rface_cap, sc->faces, sizeof *nc->rface) !=
-        0)
+    if (rface_reserve(mem, nc, sc->faces) != 0)
         return -1;
-    for (size_t f = had; f < nc->rface_cap; f++)
-        nc->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
     nc->seg_list = list;
     return 0;
 }
@@ -970,13 +991,8 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     ws_node_contact *nc = web->contact;
     nc->seg_list = -1;
     nc->nseg = 0;
-    if (nc->rtmp_cap == 0) {
-        /* A run batch: its groups, the run passes' scratch, the nodes' depths. */
-        const size_t need =
-            (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
-        if (ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double)) != 0)
-            return -1;
-    }
+    if (rtmp_reserve(mem, nc, web->n) != 0)
+        return -1;
     if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
         return -1;
     seg_cut sc = {cand, nc->seg, 0, 0, 0, 0, 0};
@@ -1031,12 +1047,8 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
  * they arrive while the block's springs are evaluated: from one step to the next they leave
  * the caches, and a block reads them in a few places (the first candidate of a run, a
  * one-by-one stretch), each a wait for the memory otherwise. */
-#if defined(__GNUC__)
-/* Inlined: as a call of its own, GCC takes a function that only prefetches for one without
- * effects, and drops the call. */
-__attribute__((always_inline)) static inline void node_prefetch(const ws_web *web,
-                                                                const ws_ncand *cand, size_t k,
-                                                                uint32_t n1)
+static inline NODE_INLINE void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k,
+                                             uint32_t n1)
 {
     ws_node_contact *nc = web->contact;
     const uint64_t end = (uint64_t)n1 + seg_block(web);
@@ -1044,21 +1056,15 @@ __attribute__((always_inline)) static inline void node_prefetch(const ws_web *we
     const size_t nseg = nc->nseg;
     size_t s = k;
     for (; s < nseg && seg[s].n0 < end; s++) {
-        __builtin_prefetch(cand + seg[s].c0);
+        NODE_PREFETCH(cand + seg[s].c0);
         if (!seg[s].run) /* a run reads its first candidate only */
-            __builtin_prefetch(cand + seg[s].c1 - 1);
+            NODE_PREFETCH(cand + seg[s].c1 - 1);
     }
     /* And the first stretches of the block after, whose places the next call reads (a dozen
      * stretches, 20 bytes each). */
     for (size_t q = s; q < s + 12 && q < nseg; q += 3)
-        __builtin_prefetch(seg + q);
+        NODE_PREFETCH(seg + q);
 }
-#else
-static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uint32_t n1)
-{
-    (void)web, (void)cand, (void)k, (void)n1;
-}
-#endif
 
 void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
                       uint64_t *checks)
@@ -1101,13 +1107,6 @@ void ws_node_substep(ws_node_contact *nc)
     nc->act_nl = 0;
 }
 
-void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
-{
-    act_list L = act_open(nc);
-    loads_apply(&L, bforce, bmoment);
-    nc->act_nl = 0;
-}
-
 size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0)
 {
     size_t lo = 0, hi = nc->nseg;
@@ -1124,21 +1123,9 @@ size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0)
 int ws_node_lane_scratch(ws_mem *mem, ws_node_contact *lane, const ws_node_contact *nc, uint32_t n,
                          size_t ncand)
 {
-    if (ws_node_scratch(mem, lane, ncand) != 0)
+    if (ws_node_scratch(mem, lane, ncand) != 0 || rtmp_reserve(mem, lane, n) != 0)
         return -1;
-    const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + n;
-    if (lane->rtmp_cap < need &&
-        ws_array_reserve(mem, (void **)&lane->rtmp, &lane->rtmp_cap, need, sizeof(double)) != 0)
-        return -1;
-    const size_t had = lane->rface_cap;
-    if (nc->rface_cap > had) {
-        if (ws_array_reserve(mem, (void **)&lane->rface, &lane->rface_cap, nc->rface_cap,
-                             sizeof *lane->rface) != 0)
-            return -1;
-        for (size_t f = had; f < lane->rface_cap; f++)
-            lane->rface[f].gen = 0; /* rface_gen is 1 from the first sub-step on */
-    }
-    return 0;
+    return rface_reserve(mem, lane, nc->rface_cap);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
@@ -1201,15 +1188,9 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
         return 0;
     if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, x))
         return 0;
-    if (d < 0.0) {
-        const uint32_t f = c->local & ~WS_NCAND_FLAGS;
-        const int top = sh->convex
-                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, d)
-                            : ws_shallowest_face(
-                                  sh, f, m3_tmul_v(&b->A[bi], v3_sub(x, b->st[P->cur].r[bi])), d);
-        if (!top)
-            return 0;
-    }
+    const node_env E = {.b = b, .st = &b->st[P->cur], .g = g};
+    if (d < 0.0 && !shallowest(&E, sh, bi, c, x.x, x.y, x.z, d))
+        return 0;
     at->n = F->n;
     at->d = d;
     return 1;
