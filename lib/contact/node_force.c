@@ -55,8 +55,8 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
 
 /* Whether face f is the shallowest of a convex body for a point at distance d under it: no
  * other face's plane has the point farther out (the prepared faces, global). */
-static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f,
-                             v3 x, double d)
+static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f, v3 x,
+                             double d)
 {
     for (uint32_t q = 0; q < count; q++)
         if (q != f && v3_dot(g->face[base + q].n, x) - g->face[base + q].off > d)
@@ -398,8 +398,7 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
  * (xx, xy, xz) under it at depth d. Out of line: the few nodes below a face need it, and
  * inlined its values would crowd contacts_general's registers. */
 NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
-                                       const ws_ncand *c, double xx, double xy, double xz,
-                                       double d)
+                                       const ws_ncand *c, double xx, double xy, double xz, double d)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const v3 xi = v3_make(xx, xy, xz);
@@ -434,8 +433,8 @@ static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *
 {
     if (memo->body != bi) {
         memo->body = bi;
-        memo->eps = 1e-7 * sh->radius + 1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius +
-                                                  sh->inner + hi);
+        memo->eps = 1e-7 * sh->radius +
+                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
     }
     return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
 }
@@ -537,16 +536,21 @@ _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty ba
  * power of two apart they crowd into a few sets and evict each other). */
 #define RUN_OSTRIDE (4 * RUN_GROUPS + 8)
 
-/* A run's face as its depth pass needs it. */
-typedef struct run_face {
-    double nx, ny, nz, off; /* the face's plane, global: d = n . x - off */
-    double hi, lo;          /* the contact window of d */
+/* What a run needs of its face and body, the same for every run on the face in a sub-step:
+ * filled by the first of them (run_face_of). */
+typedef struct ws_run_face {
+    double nx, ny, nz, off;                    /* the face's plane, global: d = n . x - off */
+    double hi, lo;                             /* the contact window of d */
+    double rx, ry, rz, vx, vy, vz, wx, wy, wz; /* the body's CoG, velocity and spin */
+    double k, c, mu, vlim;                     /* the contact's parameters */
+    uint32_t body;                             /* the body's slot */
+    uint64_t gen;                              /* the sub-step filled in, nc->rface_gen */
 } run_face;
 
 /* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
  * rather than a shift by its own index, which takes more work on vectors. */
-#define RUN_BIT4(k) (uint64_t)1 << (k), (uint64_t)1 << ((k) + 1), (uint64_t)1 << ((k) + 2), \
-                    (uint64_t)1 << ((k) + 3)
+#define RUN_BIT4(k)                                                                                \
+    (uint64_t)1 << (k), (uint64_t)1 << ((k) + 1), (uint64_t)1 << ((k) + 2), (uint64_t)1 << ((k) + 3)
 #define RUN_BIT16(k) RUN_BIT4(k), RUN_BIT4((k) + 4), RUN_BIT4((k) + 8), RUN_BIT4((k) + 12)
 static const uint64_t run_bit[RUN_CHUNK] = {RUN_BIT16(0), RUN_BIT16(16), RUN_BIT16(32),
                                             RUN_BIT16(48)};
@@ -572,31 +576,13 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in the run passes and run_flush: the face's normal and
- * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
- * parameters, the body's slot. */
-typedef struct run_const {
-    double nx, ny, nz, hi;
-    double rx, ry, rz, vx, vy, vz, wx, wy, wz;
-    double k, c, mu, vlim;
-    uint32_t body;
-} run_const;
-
-/* What a run needs of its face and body, the same for every run on the face in a sub-step:
- * filled by the first of them (gen: the sub-step, nc->rface_gen). */
-typedef struct ws_run_face {
-    run_face q;
-    run_const rc;
-    uint64_t gen;
-} ws_run_face;
-
 /* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
  * depths were taken of: the unit of the run passes. */
 typedef struct run_group {
-    const run_const *rc; /* the run's face and body */
-    uint32_t node;       /* the first of the four */
-    uint32_t slot;       /* the place of the first of them in the list of loads */
-    uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
+    const run_face *rf; /* the run's face and body */
+    uint32_t node;      /* the first of the four */
+    uint32_t slot;      /* the place of the first of them in the list of loads */
+    uint64_t bits;      /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
 /* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
@@ -632,13 +618,13 @@ typedef struct run_batch {
 /* The batch's values between the passes and its outputs, each array a value's of every lane
  * (4 g + l for lane l of group g). */
 typedef struct run_tmp {
-    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* normal force, then with f's */
-    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
-    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
-    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
-    double ax[RUN_OSTRIDE], ay[RUN_OSTRIDE], az[RUN_OSTRIDE];    /* friction, if it pushes */
-    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
-    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
+    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE]; /* normal force, then with f's */
+    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE]; /* tangential velocity */
+    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                /* normal force; in the window */
+    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE]; /* lever */
+    double ax[RUN_OSTRIDE], ay[RUN_OSTRIDE], az[RUN_OSTRIDE]; /* friction, if it pushes */
+    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE]; /* the body's share: force */
+    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE]; /* and moment about the CoG */
 } run_tmp;
 
 /* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
@@ -654,7 +640,7 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
                        const double *restrict uz, const double *restrict depth, run_tmp *restrict T)
 {
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
@@ -666,7 +652,7 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
             const size_t t = o + l, e = 4 * g + l;
             T->keep[e] = ws_double_of(0 - ((bits >> l) & 1u));
             const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
-                                            v3_make(ux[t], uy[t], uz[t]), b, k, c);
+                                             v3_make(ux[t], uy[t], uz[t]), b, k, c);
             T->kx[e] = nf.p.x;
             T->ky[e] = nf.p.y;
             T->kz[e] = nf.p.z;
@@ -690,7 +676,7 @@ static void run_friction(size_t ng, const run_group *restrict grp, const double 
                          run_tmp *restrict T)
 {
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const v3 n = v3_make(q->nx, q->ny, q->nz);
         const double mu = q->mu, vlim = q->vlim;
@@ -715,7 +701,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
                       double *restrict gy, double *restrict gz, double share, run_tmp *restrict T)
 {
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const v3 n = v3_make(q->nx, q->ny, q->nz);
         for (size_t l = 0; l < WS_LANES; l++) {
@@ -763,7 +749,7 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
         /* Read here: as far as the compiler knows, the stores below could change them. */
-        const uint32_t body = G->rc->body, node = G->node;
+        const uint32_t body = G->rf->body, node = G->node;
         size_t s = G->slot;
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
             const uint32_t l = ws_lowest_bit(bits), i = node + l;
@@ -781,11 +767,11 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
 
 /* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
  * from the face, its body and their materials by the first run on it. */
-static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
+static const run_face *run_face_of(const node_env *E, const ws_ncand *c)
 {
     ws_web *web = E->web;
     ws_node_contact *nc = web->contact;
-    ws_run_face *e = &nc->rface[c->feat];
+    run_face *e = &nc->rface[c->feat];
     if (e->gen == nc->rface_gen)
         return e;
     const ws_body_store *b = E->b;
@@ -795,10 +781,8 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
-    e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   r.x,  r.y,  r.z,   vb.x,    vb.y,
-                        vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim, bi};
-    e->gen = nc->rface_gen;
+    *e = (run_face){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,   r.y,     r.z, vb.x,         vb.y,
+                    vb.z, wb.x, wb.y, wb.z,   p->k, p->c, p->mu, p->vlim, bi,  nc->rface_gen};
     return e;
 }
 
@@ -819,7 +803,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
     const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
-    const ws_run_face *rf = run_face_of(E, c);
+    const run_face *rf = run_face_of(E, c);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK;
         /* Depths on whole vectors, past the run (its row goes on), the bits of the nodes past
@@ -828,7 +812,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
         uint64_t below = 0, in = 0;
         int whole = o + 4 * nv <= web->n;
         if (whole) {
-            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
+            in = run_depth(nv, rf, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
         nc->run_nodes += m;
@@ -856,7 +840,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
             const uint32_t start = o + e < cap ? o + e : cap;
             const uint32_t bits = (uint32_t)(in >> e) & 15u;
             in &= ~((uint64_t)15u << e);
-            B->grp[B->n++] = (run_group){&rf->rc, start, slot, bits << (o + e - start)};
+            B->grp[B->n++] = (run_group){rf, start, slot, bits << (o + e - start)};
             slot += run_count4[bits];
         }
         L->nl = slot;
