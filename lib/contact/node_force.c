@@ -618,14 +618,26 @@ typedef struct run_batch {
 /* The batch's values between the passes and its outputs, each array a value's of every lane
  * (4 g + l for lane l of group g). */
 typedef struct run_tmp {
-    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE]; /* normal force, then with f's */
-    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE]; /* tangential velocity */
-    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                /* normal force; in the window */
-    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE]; /* lever */
-    double ax[RUN_OSTRIDE], ay[RUN_OSTRIDE], az[RUN_OSTRIDE]; /* friction, if it pushes */
-    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE]; /* the body's share: force */
-    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE]; /* and moment about the CoG */
+    double k[3][RUN_OSTRIDE];                    /* normal force, then the node's force with it */
+    double t[3][RUN_OSTRIDE];                    /* tangential velocity */
+    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];   /* normal force; in the window */
+    double l[3][RUN_OSTRIDE];                    /* lever */
+    double a[3][RUN_OSTRIDE];                    /* friction, if it pushes */
+    double b[3][RUN_OSTRIDE], m[3][RUN_OSTRIDE]; /* the body's share: force, moment about the CoG */
 } run_tmp;
+
+/* Lane e of a vector of run_tmp, and back. */
+static inline v3 tmp_get(double (*a)[RUN_OSTRIDE], size_t e)
+{
+    return v3_make(a[0][e], a[1][e], a[2][e]);
+}
+
+static inline void tmp_set(double (*a)[RUN_OSTRIDE], size_t e, v3 p)
+{
+    a[0][e] = p.x;
+    a[1][e] = p.y;
+    a[2][e] = p.z;
+}
 
 /* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
  * as apart, and runs the passes with many more instructions); each pass takes only those it
@@ -653,16 +665,10 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
             T->keep[e] = ws_double_of(0 - ((bits >> l) & 1u));
             const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
                                              v3_make(ux[t], uy[t], uz[t]), b, k, c);
-            T->kx[e] = nf.p.x;
-            T->ky[e] = nf.p.y;
-            T->kz[e] = nf.p.z;
-            T->tx[e] = nf.t.x;
-            T->ty[e] = nf.t.y;
-            T->tz[e] = nf.t.z;
+            tmp_set(T->k, e, nf.p);
+            tmp_set(T->t, e, nf.t);
             T->fn[e] = nf.fn;
-            T->lx[e] = nf.l.x;
-            T->ly[e] = nf.l.y;
-            T->lz[e] = nf.l.z;
+            tmp_set(T->l, e, nf.l);
         }
     }
 }
@@ -682,15 +688,10 @@ static void run_friction(size_t ng, const run_group *restrict grp, const double 
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            const v3 k = v3_make(gx[t] + T->kx[e], gy[t] + T->ky[e], gz[t] + T->kz[e]);
-            T->kx[e] = k.x;
-            T->ky[e] = k.y;
-            T->kz[e] = k.z;
-            const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]), k, im[t], mass[t],
-                                     mu * T->fn[e], vlim, h);
-            T->ax[e] = a.x;
-            T->ay[e] = a.y;
-            T->az[e] = a.z;
+            const v3 k = v3_make(gx[t] + T->k[0][e], gy[t] + T->k[1][e], gz[t] + T->k[2][e]);
+            tmp_set(T->k, e, k);
+            tmp_set(T->a, e,
+                    friction_of(n, tmp_get(T->t, e), k, im[t], mass[t], mu * T->fn[e], vlim, h));
         }
     }
 }
@@ -711,19 +712,14 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
             /* The friction of a node that pushes; -0 for one that does not push, which leaves
              * its force as it was to the bit when added, as the one by one pass leaves the
              * force of a contact it does not list. */
-            const v3 a = v3_make(ws_pick(push, T->ax[e], -0.0), ws_pick(push, T->ay[e], -0.0),
-                                 ws_pick(push, T->az[e], -0.0));
-            gx[t] = ws_pick(keep, T->kx[e] + a.x, gx[t]);
-            gy[t] = ws_pick(keep, T->ky[e] + a.y, gy[t]);
-            gz[t] = ws_pick(keep, T->kz[e] + a.z, gz[t]);
-            const act_load B =
-                body_load(push, a, n, fn, share, v3_make(T->lx[e], T->ly[e], T->lz[e]));
-            T->bx[e] = B.f.x;
-            T->by[e] = B.f.y;
-            T->bz[e] = B.f.z;
-            T->mx[e] = B.m.x;
-            T->my[e] = B.m.y;
-            T->mz[e] = B.m.z;
+            const v3 a = v3_make(ws_pick(push, T->a[0][e], -0.0), ws_pick(push, T->a[1][e], -0.0),
+                                 ws_pick(push, T->a[2][e], -0.0));
+            gx[t] = ws_pick(keep, T->k[0][e] + a.x, gx[t]);
+            gy[t] = ws_pick(keep, T->k[1][e] + a.y, gy[t]);
+            gz[t] = ws_pick(keep, T->k[2][e] + a.z, gz[t]);
+            const act_load B = body_load(push, a, n, fn, share, tmp_get(T->l, e));
+            tmp_set(T->b, e, B.f);
+            tmp_set(T->m, e, B.m);
         }
     }
 }
@@ -754,10 +750,10 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
             const uint32_t l = ws_lowest_bit(bits), i = node + l;
             const size_t e = 4 * g + l;
-            const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
+            const v3 Fb = tmp_get(T->b, e);
             fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
             touched[nt++] = i;
-            load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
+            load[s] = (act_load){Fb, tmp_get(T->m, e)};
             lbody[s] = body;
         }
     }
