@@ -853,14 +853,18 @@ typedef struct seg_cut {
     uint32_t faces; /* one past the highest face a run lies on */
 } seg_cut;
 
+static void seg_put(seg_cut *sc, ws_nseg sg)
+{
+    sc->seg[sc->nseg++] = sg;
+    if (sg.run && sc->cand[sg.c0].feat >= sc->faces)
+        sc->faces = sc->cand[sg.c0].feat + 1;
+}
+
 static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    if (c0 == c1)
-        return;
-    sc->seg[sc->nseg++] =
-        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
-    if (run && sc->cand[c0].feat >= sc->faces)
-        sc->faces = sc->cand[c0].feat + 1;
+    if (c0 != c1)
+        seg_put(sc, (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0,
+                              (uint32_t)c1, run});
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -890,30 +894,22 @@ static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t 
         size_t e = k + 1;
         while (e < n && cand[e].node == node)
             e++;
+        /* Whatever ran before ends here: the loop below took every node that carries it on. */
+        seg_close_run(sc);
         if (node >= end) { /* a new block: nothing pending crosses into it */
-            seg_close_run(sc);
             seg_emit(sc, sc->g0, k, 0);
-            sc->g0 = sc->r0 = sc->r1 = k;
+            sc->g0 = k;
             end = (uint64_t)(node / bl + 1) * bl;
             end = end < stop ? end : stop;
         }
-        int single =
-            !nc->runs_off && e == k + 1 && (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
-        if (single && sc->r1 > sc->r0 && sc->r1 == k && cand[k].feat == cand[sc->r0].feat &&
-            node == cand[k - 1].node + 1) {
-            sc->r1 = e; /* the run goes on */
+        if (nc->runs_off || e != k + 1 || (cand[k].local & WS_NCAND_FLAGS) != WS_NCAND_INSIDE) {
+            sc->r0 = sc->r1 = e; /* one by one: pending from g0 */
         } else {
-            seg_close_run(sc);
-            sc->r0 = k; /* a new run starts here, or an empty one */
-            sc->r1 = single ? e : k;
-            if (!single)
-                sc->r0 = sc->r1 = e; /* one by one: pending from g0 */
-        }
-        if (single) {
-            /* The run goes on over the next nodes of the block, each with one inside candidate
-             * of its face, as the steps above would find one by one. */
-            const uint32_t feat = cand[sc->r0].feat;
+            /* A run starts, and goes on over the next nodes of the block, each with one inside
+             * candidate of its face. */
+            const uint32_t feat = cand[k].feat;
             uint32_t prev = node;
+            sc->r0 = k;
             while (e < n && cand[e].node == prev + 1 && cand[e].node < end &&
                    cand[e].feat == feat && (cand[e].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE &&
                    (e + 1 == n || cand[e + 1].node != cand[e].node)) {
@@ -1005,9 +1001,7 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
             sg.c1 = (uint32_t)k + (sg.c1 - sg.c0);
             sg.c0 = (uint32_t)k;
             k = sg.c1;
-            sc.seg[sc.nseg++] = sg;
-            if (sg.run && cand[sg.c0].feat >= sc.faces)
-                sc.faces = cand[sg.c0].feat + 1;
+            seg_put(&sc, sg);
         }
         if (q == count)
             break;
