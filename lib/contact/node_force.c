@@ -306,8 +306,10 @@ typedef struct node_env {
     struct corner_memo *memo;
 } node_env;
 
-/* Out of line where GCC would inline it: see shallowest. Inlined, node_prefetch: as a call of
- * its own, GCC takes a function that only prefetches for one without effects, and drops it. */
+/* Out of line where GCC would inline it: see shallowest. Inlined where GCC would not: touch_of
+ * (as a call, contacts_general's values go through memory, 2 % of the step) and node_prefetch
+ * (as a call of its own, GCC takes a function that only prefetches for one without effects,
+ * and drops it). */
 #if defined(__GNUC__)
 #define NODE_OUT_OF_LINE __attribute__((noinline))
 #define NODE_INLINE __attribute__((always_inline))
@@ -407,6 +409,32 @@ NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, ui
     return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
 }
 
+/* Whether candidate c (of body bi, shape sh) holds the node at xi in the window (lo, top): eq.
+ * 14 for a face, the shallowest under it, or the rim of an edge (in_wedge, sure as there); the
+ * normal from the body to the node and the distance. The one-by-one pass's and the implicit
+ * film's test alike (inlined: NODE_INLINE). */
+static inline NODE_INLINE int touch_of(const node_env *E, const ws_shape *sh, const ws_ncand *c,
+                                       v3 xi, double lo, double top, int sure, v3 *nrm,
+                                       double *dist)
+{
+    const ws_node_geom *g = E->g;
+    if (c->local & WS_NCAND_EDGE)
+        return in_wedge(&g->edge[c->feat], xi, top, sure, nrm, dist);
+    const ws_wface *F = &g->face[c->feat];
+    const double d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
+    if (!(d < top) || !(d > lo))
+        return 0;
+    /* A node found well inside the face's outline stays over the face while the candidates
+     * are valid: no need to find its triangle. */
+    if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
+        return 0;
+    if (d < 0.0 && !shallowest(E, sh, c->body, c, xi.x, xi.y, xi.z, d))
+        return 0;
+    *nrm = F->n;
+    *dist = d;
+    return 1;
+}
+
 /* ---- a node at a convex body's edge
  *
  * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
@@ -502,23 +530,8 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
-            if (c->local & WS_NCAND_EDGE) {
-                if (!in_wedge(&g->edge[c->feat], xi, hi, sure, &nrm, &d))
-                    continue;
-            } else {
-                const ws_wface *F = &g->face[c->feat];
-                d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
-                if (!(d < hi) || !(d > lo))
-                    continue;
-                /* A node found well inside the face's outline stays over the face while the
-                 * candidates are valid: no need to find its triangle. */
-                if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
-                    continue;
-                if (d < 0.0 && !shallowest(E, sh, bi, c, xi.x, xi.y, xi.z, d))
-                    continue;
-                nrm = F->n; /* from the body to the node */
-            }
-            act_push(E->L, i, bi, nrm, d, hi, xi);
+            if (touch_of(E, sh, c, xi, lo, hi, sure, &nrm, &d))
+                act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
 }
@@ -1148,24 +1161,8 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
                   ws_node_touch_at *at)
 {
     const ws_body_store *b = P->b;
-    const ws_node_geom *g = P->g;
-    const uint32_t bi = c->body;
-    const ws_shape *sh = b->shape[bi];
-    const double hi = b->layer[bi] + web->layer;
-    at->hi = hi;
-    if (c->local & WS_NCAND_EDGE)
-        return in_wedge(&g->edge[c->feat], x, hi + reach, 0, &at->n, &at->d);
-    const ws_wface *F = &g->face[c->feat];
-    const double lo = -hi - sh->inner;
-    const double d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
-    if (!(d < hi + reach) || !(d > lo))
-        return 0;
-    if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, x))
-        return 0;
-    const node_env E = {.b = b, .st = &b->st[P->cur], .g = g};
-    if (d < 0.0 && !shallowest(&E, sh, bi, c, x.x, x.y, x.z, d))
-        return 0;
-    at->n = F->n;
-    at->d = d;
-    return 1;
+    const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
+    const ws_shape *sh = b->shape[c->body];
+    at->hi = b->layer[c->body] + web->layer;
+    return touch_of(&E, sh, c, x, -at->hi - sh->inner, at->hi + reach, 0, &at->n, &at->d);
 }
