@@ -129,23 +129,16 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
  * they took. The loads on the bodies of both go to one list of loads in node order, which is
  * summed last: the bodies' totals are added in the same order however the candidates are cut. */
 
-/* Four contacts of the list, lane l the list's contact 4 g + l of group g (wide.h): each value
- * of the four side by side, so that a pass over the groups runs on vectors with one pointer. As
- * contacts_general finds it: the normal (from the body to the node), depth, window top and
- * the node's position. Gathered for the normal force: the node's velocity, the body's CoG,
- * velocity and spin, the contact's stiffness and damping, mu and v_lim, and the node's 1 / mass
- * and mass. Found: the normal force's vector (p), the lever from the body's CoG to the contact
- * point, the tangential velocity relative to the body and the normal force; the node's force
- * with its normal forces in (k); the friction (a) and the body's load, force (b) and moment
- * (mm). */
+/* Four contacts of the list side by side (wide.h), lane l of group g the list's contact
+ * 4 g + l, so that a pass over the groups runs on vectors with one pointer. */
 typedef struct act_group {
-    ws_wide3 n;
-    ws_wide d, hi;
-    ws_wide3 x, u, r, v, w;
-    ws_wide kp, cp, mu, vl, im, m;
-    ws_wide3 p, l, t;
-    ws_wide fn;
-    ws_wide3 k, a, b, mm;
+    ws_wide3 n;                    /* as contacts_general finds it: normal (body to node), */
+    ws_wide d, hi;                 /* depth, window top */
+    ws_wide3 x, u, r, v, w;        /* the node's position, velocity; the body's CoG, v, spin */
+    ws_wide kp, cp, mu, vl, im, m; /* the contact's parameters; the node's 1 / mass, mass */
+    ws_wide3 p, l, t;              /* normal_of's force vector, lever, tangential velocity */
+    ws_wide fn;                    /* and normal force */
+    ws_wide3 k, a, b, mm; /* the node's force with its normal forces in; friction; body's load */
 } act_group;
 
 /* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
@@ -155,9 +148,8 @@ enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS =
 _Static_assert(sizeof(act_load) == 6 * sizeof(double) && sizeof(act_group) % 32 == 0,
                "a list's loads take 6 doubles each, its groups whole vectors");
 
-/* The list: its groups (grp), the contacts' nodes, the bodies' slots and their places in the
- * loads (node, body, slot), n of them. The loads: per load on a body its force and moment
- * (load) and the body's slot (lbody), nl of them. */
+/* The list: n contacts (their groups, nodes, bodies' slots and places in the loads), and nl
+ * loads on bodies (each body's slot in lbody). */
 typedef struct act_list {
     act_group *grp;
     uint32_t *node, *body, *slot, *lbody;
@@ -192,14 +184,11 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
     L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of a node at x (velocity u) against a body b at depth d along the normal n
- * (from the body to the node), within the window (hi the layers), for the contact's stiffness k
- * and damping c: its vector (p), the lever from the CoG to the contact point (l), the node's
- * tangential velocity relative to the body (t) and the normal force (fn, negative where it
- * would pull). The contact laws' (penalty.h) for a node: the penalty on the overlap and damping
- * on its rate, at the contact point midway in the overlap, against the body's velocity there,
- * never pulling. Straight-line code, so loops of it run on vectors; both passes (act_normal,
- * run_normal) take it from here. */
+/* The normal force of the contact laws (penalty.h) on a node at x (velocity u) against a body
+ * b at depth d along n (body to node), in the window of top hi, stiffness k, damping c: its
+ * vector p, the lever l from the CoG, the tangential velocity t relative to the body, and fn
+ * (negative where it would pull). Straight-line code, so loops of it run on vectors; both
+ * passes (act_normal, run_normal) take it from here. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
@@ -320,12 +309,10 @@ typedef struct node_env {
 #define NODE_PREFETCH(p) ((void)(p))
 #endif
 
-/* The list's contacts, each node's all in (its candidates lie in one stretch): the values of
- * the node, the body and the material each needs gathered, their normal forces on vectors and
- * into f in order, then, with every normal force in, their frictions on vectors and each
- * contact applied: friction to the node, the contact force's share to the node's record, the
- * opposite to its place in the loads. The lanes past the last contact compute on what the list
- * held (its first values were zeros), and are not read. */
+/* The list's contacts, each node's all in (its candidates lie in one stretch): gathered, their
+ * normal forces into f in order, then, with every normal force in (order-free friction), their
+ * frictions, each applied to its node, its share to fc and the opposite to its place in the
+ * loads. The lanes past the last contact compute on what the list held, and are not read. */
 static void act_apply(const node_env *E, double h, double share, v3 *fc)
 {
     ws_web *web = E->web;
@@ -611,25 +598,20 @@ typedef struct run_batch {
 } run_batch;
 
 /* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
- * the nodes' arrays: the contact of normal_of, and for one that pushes the friction of
- * act_apply, with the same arithmetic operation by operation (film_runs_equal_one_by_one holds
- * them to it, to the bit). A run's node has no other contact, so its force with every normal
- * force in is its force with this one. The nodes' new forces go into f (the lanes of the group
- * that are not in the window, or not the run's, keep theirs); the body's share of each load
- * (force and moment about the CoG, zero for a contact that does not push) into out, for every
- * lane. Whole groups, so that the four lanes of a group run on vectors.
+ * the nodes' arrays, with act_apply's arithmetic operation by operation
+ * (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other
+ * contact, so its force with every normal force in is its force with this one. Lanes of a group
+ * not in the window, or not the run's, keep their forces.
  *
  * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
- * between in run_tmp: a contact's arithmetic
- * is one long chain (some 180 cycles from the node's position to its force, with a square root
- * and two divisions in a row), about as long as the window of instructions a processor runs
- * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
- * friction's square root and divisions in one: a pass of their own each cost more instructions
- * and saved no time), the chains of several groups run side by side. The values a later pass
- * takes only under a condition are read there as masks (as a select, the compiler would read
- * them under the condition: slow masked loads). */
-/* The batch's values between the passes and its outputs, each array a value's of every lane
- * (4 g + l for lane l of group g). */
+ * between in run_tmp: a contact's arithmetic is one long chain (some 180 cycles, a square root
+ * and two divisions in a row), about as long as the window a processor runs ahead in; in one
+ * pass a group's chain held back the next group's. Cut in three, the chains of several groups
+ * run side by side (the friction's square root and divisions apart cost more instructions and
+ * saved no time). Values a later pass takes only under a condition are read there as masks (as
+ * a select, the compiler would read them under the condition: slow masked loads).
+ *
+ * run_tmp: each array a value of every lane (4 g + l for lane l of group g). */
 typedef struct run_tmp {
     double k[3][RUN_OSTRIDE];                    /* normal force, then the node's force with it */
     double t[3][RUN_OSTRIDE];                    /* tangential velocity */
