@@ -634,18 +634,19 @@ static inline void tmp_set(double (*a)[RUN_OSTRIDE], size_t e, v3 p)
     a[2][e] = p.z;
 }
 
-/* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
- * as apart, and runs the passes with many more instructions); each pass takes only those it
- * reads or writes.
+/* The passes' arrays are restrict pointers, parameters or the function's first locals: read
+ * through a struct, GCC 12 no longer takes them as apart, and runs the passes with many more
+ * instructions. An array a pass writes stays a parameter (as a local, GCC 12 checks it against
+ * the others at run time: twice the instructions). Each pass takes only those it uses.
  *
  * normal_of for the groups [0, ng) of the batch: the nodes' positions p, velocities u and
  * depths, into T (the normal force's vector into T->k). */
 WS_VECTOR_LOOP
-static void run_normal(size_t ng, const run_group *restrict grp, const double *restrict px,
-                       const double *restrict py, const double *restrict pz,
-                       const double *restrict ux, const double *restrict uy,
-                       const double *restrict uz, const double *restrict depth, run_tmp *restrict T)
+static void run_normal(size_t ng, const run_group *restrict grp, ws_nodes3 p, ws_nodes3 u,
+                       const double *restrict depth, run_tmp *restrict T)
 {
+    const double *restrict px = p.x, *restrict py = p.y, *restrict pz = p.z;
+    const double *restrict ux = u.x, *restrict uy = u.y, *restrict uz = u.z;
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
@@ -671,11 +672,11 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
 /* act_apply's friction over sub-step h, from the nodes' forces g (T->k becomes the node's force
  * with its normal force in), 1 / mass im and mass. */
 WS_VECTOR_LOOP
-static void run_friction(size_t ng, const run_group *restrict grp, const double *restrict gx,
-                         const double *restrict gy, const double *restrict gz,
+static void run_friction(size_t ng, const run_group *restrict grp, ws_nodes3 f,
                          const double *restrict im, const double *restrict mass, double h,
                          run_tmp *restrict T)
 {
+    const double *restrict gx = f.x, *restrict gy = f.y, *restrict gz = f.z;
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
@@ -730,8 +731,8 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
     run_tmp *T = B->tmp;
-    run_normal(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, B->depth, T);
-    run_friction(B->n, B->grp, f.x, f.y, f.z, web->inv_m, web->m, h, T);
+    run_normal(B->n, B->grp, x, v, B->depth, T);
+    run_friction(B->n, B->grp, f, web->inv_m, web->m, h, T);
     run_apply(B->n, B->grp, f.x, f.y, f.z, share, T);
     act_list *L = E->L;
     act_load *load = L->load;
