@@ -396,13 +396,12 @@ NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, ui
     return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
 }
 
-/* Whether candidate c (of body bi, shape sh) holds the node at xi in the window (lo, top): eq.
- * 14 for a face, the shallowest under it, or the rim of an edge (in_wedge, sure as there); the
- * normal from the body to the node and the distance. The one-by-one pass's and the implicit
- * film's test alike (inlined: NODE_INLINE). */
-static inline NODE_INLINE int touch_of(const node_env *E, const ws_shape *sh, const ws_ncand *c,
-                                       v3 xi, double lo, double top, int sure, v3 *nrm,
-                                       double *dist)
+/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, the
+ * shallowest under it, or the rim of an edge (in_wedge, sure as there); the normal from the
+ * body to the node and the distance. The one-by-one pass's and the implicit film's test alike
+ * (inlined: NODE_INLINE). */
+static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
+                                       double top, int sure, v3 *nrm, double *dist)
 {
     const ws_node_geom *g = E->g;
     if (c->local & WS_NCAND_EDGE)
@@ -415,7 +414,7 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_shape *sh, co
      * are valid: no need to find its triangle. */
     if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
         return 0;
-    if (d < 0.0 && !shallowest(E, sh, c->body, c, xi.x, xi.y, xi.z, d))
+    if (d < 0.0 && !shallowest(E, E->b->shape[c->body], c->body, c, xi.x, xi.y, xi.z, d))
         return 0;
     *nrm = F->n;
     *dist = d;
@@ -517,7 +516,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
-            if (touch_of(E, sh, c, xi, lo, hi, sure, &nrm, &d))
+            if (touch_of(E, c, xi, lo, hi, sure, &nrm, &d))
                 act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
@@ -1147,5 +1146,5 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
     const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
     const ws_shape *sh = b->shape[c->body];
     at->hi = b->layer[c->body] + web->layer;
-    return touch_of(&E, sh, c, x, -at->hi - sh->inner, at->hi + reach, 0, &at->n, &at->d);
+    return touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, 0, &at->n, &at->d);
 }
