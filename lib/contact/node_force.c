@@ -55,8 +55,8 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
 
 /* Whether face f is the shallowest of a convex body for a point at distance d under it: no
  * other face's plane has the point farther out (the prepared faces, global). */
-static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f,
-                             v3 x, double d)
+static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f, v3 x,
+                             double d)
 {
     for (uint32_t q = 0; q < count; q++)
         if (q != f && v3_dot(g->face[base + q].n, x) - g->face[base + q].off > d)
@@ -129,23 +129,16 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
  * they took. The loads on the bodies of both go to one list of loads in node order, which is
  * summed last: the bodies' totals are added in the same order however the candidates are cut. */
 
-/* Four contacts of the list, lane l the list's contact 4 g + l of group g (wide.h): each value
- * of the four side by side, so that a pass over the groups runs on vectors with one pointer. As
- * contacts_general finds it: the normal (from the body to the node), depth, window top and
- * the node's position. Gathered for the normal force: the node's velocity, the body's CoG,
- * velocity and spin, the contact's stiffness and damping, mu and v_lim, and the node's 1 / mass
- * and mass. Found: the normal force's vector (p), the lever from the body's CoG to the contact
- * point, the tangential velocity relative to the body and the normal force; the node's force
- * with its normal forces in (k); the friction (a) and the body's load, force (b) and moment
- * (mm). */
+/* Four contacts of the list side by side (wide.h), lane l of group g the list's contact
+ * 4 g + l, so that a pass over the groups runs on vectors with one pointer. */
 typedef struct act_group {
-    ws_wide3 n;
-    ws_wide d, hi;
-    ws_wide3 x, u, r, v, w;
-    ws_wide kp, cp, mu, vl, im, m;
-    ws_wide3 p, l, t;
-    ws_wide fn;
-    ws_wide3 k, a, b, mm;
+    ws_wide3 n;                    /* as contacts_general finds it: normal (body to node), */
+    ws_wide d, hi;                 /* depth, window top */
+    ws_wide3 x, u, r, v, w;        /* the node's position, velocity; the body's CoG, v, spin */
+    ws_wide kp, cp, mu, vl, im, m; /* the contact's parameters; the node's 1 / mass, mass */
+    ws_wide3 p, l, t;              /* normal_of's force vector, lever, tangential velocity */
+    ws_wide fn;                    /* and normal force */
+    ws_wide3 k, a, b, mm; /* the node's force with its normal forces in; friction; body's load */
 } act_group;
 
 /* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
@@ -155,9 +148,8 @@ enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS =
 _Static_assert(sizeof(act_load) == 6 * sizeof(double) && sizeof(act_group) % 32 == 0,
                "a list's loads take 6 doubles each, its groups whole vectors");
 
-/* The list: its groups (grp), the contacts' nodes, the bodies' slots and their places in the
- * loads (node, body, slot), n of them. The loads: per load on a body its force and moment
- * (load) and the body's slot (lbody), nl of them. */
+/* The list: n contacts (their groups, nodes, bodies' slots and places in the loads), and nl
+ * loads on bodies (each body's slot in lbody). */
 typedef struct act_list {
     act_group *grp;
     uint32_t *node, *body, *slot, *lbody;
@@ -192,14 +184,11 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
     L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of a node at x (velocity u) against a body b at depth d along the normal n
- * (from the body to the node), within the window (hi the layers), for the contact's stiffness k
- * and damping c: its vector (p), the lever from the CoG to the contact point (l), the node's
- * tangential velocity relative to the body (t) and the normal force (fn, negative where it
- * would pull). The contact laws' (penalty.h) for a node: the penalty on the overlap and damping
- * on its rate, at the contact point midway in the overlap, against the body's velocity there,
- * never pulling. Straight-line code, so loops of it run on vectors; both passes (act_normal,
- * run_normal) take it from here. */
+/* The normal force of the contact laws (penalty.h) on a node at x (velocity u) against a body
+ * b at depth d along n (body to node), in the window of top hi, stiffness k, damping c: its
+ * vector p, the lever l from the CoG, the tangential velocity t relative to the body, and fn
+ * (negative where it would pull). Straight-line code, so loops of it run on vectors; both
+ * passes (act_normal, run_normal) take it from here. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
@@ -260,8 +249,9 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
 
 /* The loads on the bodies, added to their totals in order (the running sums of the body at
  * hand kept in registers). */
-static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
+void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
 {
+    const act_list L0 = act_open(nc), *L = &L0;
     uint32_t body = UINT32_MAX;
     v3 bf = v3_make(0, 0, 0), bm = bf;
     for (size_t q = 0; q < L->nl; q++) {
@@ -282,7 +272,7 @@ static void loads_apply(act_list *L, v3 *bforce, v3 *bmoment)
         bforce[body] = bf;
         bmoment[body] = bm;
     }
-    L->nl = 0;
+    nc->act_nl = 0;
 }
 
 /* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
@@ -305,19 +295,24 @@ typedef struct node_env {
     struct corner_memo *memo;
 } node_env;
 
-/* Kept out of line where GCC would inline it: see shallowest. */
+/* Out of line where GCC would inline it: see shallowest. Inlined where GCC would not: touch_of
+ * (as a call, contacts_general's values go through memory, 2 % of the step) and node_prefetch
+ * (as a call of its own, GCC takes a function that only prefetches for one without effects,
+ * and drops it). */
 #if defined(__GNUC__)
 #define NODE_OUT_OF_LINE __attribute__((noinline))
+#define NODE_INLINE __attribute__((always_inline))
+#define NODE_PREFETCH(p) __builtin_prefetch(p)
 #else
 #define NODE_OUT_OF_LINE
+#define NODE_INLINE
+#define NODE_PREFETCH(p) ((void)(p))
 #endif
 
-/* The list's contacts, each node's all in (its candidates lie in one stretch): the values of
- * the node, the body and the material each needs gathered, their normal forces on vectors and
- * into f in order, then, with every normal force in, their frictions on vectors and each
- * contact applied: friction to the node, the contact force's share to the node's record, the
- * opposite to its place in the loads. The lanes past the last contact compute on what the list
- * held (its first values were zeros), and are not read. */
+/* The list's contacts, each node's all in (its candidates lie in one stretch): gathered, their
+ * normal forces into f in order, then, with every normal force in (order-free friction), their
+ * frictions, each applied to its node, its share to fc and the opposite to its place in the
+ * loads. The lanes past the last contact compute on what the list held, and are not read. */
 static void act_apply(const node_env *E, double h, double share, v3 *fc)
 {
     ws_web *web = E->web;
@@ -392,14 +387,38 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
  * (xx, xy, xz) under it at depth d. Out of line: the few nodes below a face need it, and
  * inlined its values would crowd contacts_general's registers. */
 NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
-                                       const ws_ncand *c, double xx, double xy, double xz,
-                                       double d)
+                                       const ws_ncand *c, double xx, double xy, double xz, double d)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const v3 xi = v3_make(xx, xy, xz);
     if (sh->convex)
         return convex_shallowest(E->g, c->feat - f, sh->face_count, f, xi, d);
     return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+}
+
+/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, the
+ * shallowest under it, or the rim of an edge (in_wedge, sure as there); the normal from the
+ * body to the node and the distance. The one-by-one pass's and the implicit film's test alike
+ * (inlined: NODE_INLINE). */
+static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
+                                       double top, int sure, v3 *nrm, double *dist)
+{
+    const ws_node_geom *g = E->g;
+    if (c->local & WS_NCAND_EDGE)
+        return in_wedge(&g->edge[c->feat], xi, top, sure, nrm, dist);
+    const ws_wface *F = &g->face[c->feat];
+    const double d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
+    if (!(d < top) || !(d > lo))
+        return 0;
+    /* A node found well inside the face's outline stays over the face while the candidates
+     * are valid: no need to find its triangle. */
+    if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
+        return 0;
+    if (d < 0.0 && !shallowest(E, E->b->shape[c->body], c->body, c, xi.x, xi.y, xi.z, d))
+        return 0;
+    *nrm = F->n;
+    *dist = d;
+    return 1;
 }
 
 /* ---- a node at a convex body's edge
@@ -428,8 +447,8 @@ static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *
 {
     if (memo->body != bi) {
         memo->body = bi;
-        memo->eps = 1e-7 * sh->radius + 1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius +
-                                                  sh->inner + hi);
+        memo->eps = 1e-7 * sh->radius +
+                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
     }
     return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
 }
@@ -497,23 +516,8 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
-            if (c->local & WS_NCAND_EDGE) {
-                if (!in_wedge(&g->edge[c->feat], xi, hi, sure, &nrm, &d))
-                    continue;
-            } else {
-                const ws_wface *F = &g->face[c->feat];
-                d = F->n.x * xi.x + F->n.y * xi.y + F->n.z * xi.z - F->off;
-                if (!(d < hi) || !(d > lo))
-                    continue;
-                /* A node found well inside the face's outline stays over the face while the
-                 * candidates are valid: no need to find its triangle. */
-                if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
-                    continue;
-                if (d < 0.0 && !shallowest(E, sh, bi, c, xi.x, xi.y, xi.z, d))
-                    continue;
-                nrm = F->n; /* from the body to the node */
-            }
-            act_push(E->L, i, bi, nrm, d, hi, xi);
+            if (touch_of(E, c, xi, lo, hi, sure, &nrm, &d))
+                act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
 }
@@ -531,16 +535,21 @@ _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty ba
  * power of two apart they crowd into a few sets and evict each other). */
 #define RUN_OSTRIDE (4 * RUN_GROUPS + 8)
 
-/* A run's face as its depth pass needs it. */
-typedef struct run_face {
-    double nx, ny, nz, off; /* the face's plane, global: d = n . x - off */
-    double hi, lo;          /* the contact window of d */
+/* What a run needs of its face and body, the same for every run on the face in a sub-step:
+ * filled by the first of them (run_face_of). */
+typedef struct ws_run_face {
+    double nx, ny, nz, off;                    /* the face's plane, global: d = n . x - off */
+    double hi, lo;                             /* the contact window of d */
+    double rx, ry, rz, vx, vy, vz, wx, wy, wz; /* the body's CoG, velocity and spin */
+    double k, c, mu, vlim;                     /* the contact's parameters */
+    uint32_t body;                             /* the body's slot */
+    uint64_t gen;                              /* the sub-step filled in, nc->rface_gen */
 } run_face;
 
 /* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
  * rather than a shift by its own index, which takes more work on vectors. */
-#define RUN_BIT4(k) (uint64_t)1 << (k), (uint64_t)1 << ((k) + 1), (uint64_t)1 << ((k) + 2), \
-                    (uint64_t)1 << ((k) + 3)
+#define RUN_BIT4(k)                                                                                \
+    (uint64_t)1 << (k), (uint64_t)1 << ((k) + 1), (uint64_t)1 << ((k) + 2), (uint64_t)1 << ((k) + 3)
 #define RUN_BIT16(k) RUN_BIT4(k), RUN_BIT4((k) + 4), RUN_BIT4((k) + 8), RUN_BIT4((k) + 12)
 static const uint64_t run_bit[RUN_CHUNK] = {RUN_BIT16(0), RUN_BIT16(16), RUN_BIT16(32),
                                             RUN_BIT16(48)};
@@ -566,31 +575,13 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
     return in;
 }
 
-/* What a run needs of its face and body in the run passes and run_flush: the face's normal and
- * the window's top as in run_face, the body's CoG, velocity and spin, the contact's
- * parameters, the body's slot. */
-typedef struct run_const {
-    double nx, ny, nz, hi;
-    double rx, ry, rz, vx, vy, vz, wx, wy, wz;
-    double k, c, mu, vlim;
-    uint32_t body;
-} run_const;
-
-/* What a run needs of its face and body, the same for every run on the face in a sub-step:
- * filled by the first of them (gen: the sub-step, nc->rface_gen). */
-typedef struct ws_run_face {
-    run_face q;
-    run_const rc;
-    uint64_t gen;
-} ws_run_face;
-
 /* Four consecutive nodes from a node of a run in the window on, within the nodes its chunk's
  * depths were taken of: the unit of the run passes. */
 typedef struct run_group {
-    const run_const *rc; /* the run's face and body */
-    uint32_t node;       /* the first of the four */
-    uint32_t slot;       /* the place of the first of them in the list of loads */
-    uint64_t bits;       /* those in the window: bit l for node + l (none past the run) */
+    const run_face *rf; /* the run's face and body */
+    uint32_t node;      /* the first of the four */
+    uint32_t slot;      /* the place of the first of them in the list of loads */
+    uint64_t bits;      /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
 /* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
@@ -606,49 +597,57 @@ typedef struct run_batch {
 } run_batch;
 
 /* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
- * the nodes' arrays: the contact of normal_of, and for one that pushes the friction of
- * act_apply, with the same arithmetic operation by operation (film_runs_equal_one_by_one holds
- * them to it, to the bit). A run's node has no other contact, so its force with every normal
- * force in is its force with this one. The nodes' new forces go into f (the lanes of the group
- * that are not in the window, or not the run's, keep theirs); the body's share of each load
- * (force and moment about the CoG, zero for a contact that does not push) into out, for every
- * lane. Whole groups, so that the four lanes of a group run on vectors.
+ * the nodes' arrays, with act_apply's arithmetic operation by operation
+ * (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other
+ * contact, so its force with every normal force in is its force with this one. Lanes of a group
+ * not in the window, or not the run's, keep their forces.
  *
  * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
- * between in run_tmp: a contact's arithmetic
- * is one long chain (some 180 cycles from the node's position to its force, with a square root
- * and two divisions in a row), about as long as the window of instructions a processor runs
- * ahead in holds; in one pass a group's chain held back the next group's. Cut in three (the
- * friction's square root and divisions in one: a pass of their own each cost more instructions
- * and saved no time), the chains of several groups run side by side. The values a later pass
- * takes only under a condition are read there as masks (as a select, the compiler would read
- * them under the condition: slow masked loads). */
-/* The batch's values between the passes and its outputs, each array a value's of every lane
- * (4 g + l for lane l of group g). */
+ * between in run_tmp: a contact's arithmetic is one long chain (some 180 cycles, a square root
+ * and two divisions in a row), about as long as the window a processor runs ahead in; in one
+ * pass a group's chain held back the next group's. Cut in three, the chains of several groups
+ * run side by side (the friction's square root and divisions apart cost more instructions and
+ * saved no time). Values a later pass takes only under a condition are read there as masks (as
+ * a select, the compiler would read them under the condition: slow masked loads).
+ *
+ * run_tmp: each array a value of every lane (4 g + l for lane l of group g). */
 typedef struct run_tmp {
-    double kx[RUN_OSTRIDE], ky[RUN_OSTRIDE], kz[RUN_OSTRIDE];    /* normal force, then with f's */
-    double tx[RUN_OSTRIDE], ty[RUN_OSTRIDE], tz[RUN_OSTRIDE];    /* tangential velocity */
-    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];                   /* normal force; in the window */
-    double lx[RUN_OSTRIDE], ly[RUN_OSTRIDE], lz[RUN_OSTRIDE];    /* lever */
-    double ax[RUN_OSTRIDE], ay[RUN_OSTRIDE], az[RUN_OSTRIDE];    /* friction, if it pushes */
-    double bx[RUN_OSTRIDE], by[RUN_OSTRIDE], bz[RUN_OSTRIDE];    /* the body's share: force */
-    double mx[RUN_OSTRIDE], my[RUN_OSTRIDE], mz[RUN_OSTRIDE];    /* and moment about the CoG */
+    double k[3][RUN_OSTRIDE];                    /* normal force, then the node's force with it */
+    double t[3][RUN_OSTRIDE];                    /* tangential velocity */
+    double fn[RUN_OSTRIDE], keep[RUN_OSTRIDE];   /* normal force; in the window */
+    double l[3][RUN_OSTRIDE];                    /* lever */
+    double a[3][RUN_OSTRIDE];                    /* friction, if it pushes */
+    double b[3][RUN_OSTRIDE], m[3][RUN_OSTRIDE]; /* the body's share: force, moment about the CoG */
 } run_tmp;
 
-/* The passes' arrays are their parameters, restrict (in a struct, GCC 12 no longer takes them
- * as apart, and runs the passes with many more instructions); each pass takes only those it
- * reads or writes.
+/* Lane e of a vector of run_tmp, and back. */
+static inline v3 tmp_get(double (*a)[RUN_OSTRIDE], size_t e)
+{
+    return v3_make(a[0][e], a[1][e], a[2][e]);
+}
+
+static inline void tmp_set(double (*a)[RUN_OSTRIDE], size_t e, v3 p)
+{
+    a[0][e] = p.x;
+    a[1][e] = p.y;
+    a[2][e] = p.z;
+}
+
+/* The passes' arrays are restrict pointers, parameters or the function's first locals: read
+ * through a struct, GCC 12 no longer takes them as apart, and runs the passes with many more
+ * instructions. An array a pass writes stays a parameter (as a local, GCC 12 checks it against
+ * the others at run time: twice the instructions). Each pass takes only those it uses.
  *
  * normal_of for the groups [0, ng) of the batch: the nodes' positions p, velocities u and
  * depths, into T (the normal force's vector into T->k). */
 WS_VECTOR_LOOP
-static void run_normal(size_t ng, const run_group *restrict grp, const double *restrict px,
-                       const double *restrict py, const double *restrict pz,
-                       const double *restrict ux, const double *restrict uy,
-                       const double *restrict uz, const double *restrict depth, run_tmp *restrict T)
+static void run_normal(size_t ng, const run_group *restrict grp, ws_nodes3 p, ws_nodes3 u,
+                       const double *restrict depth, run_tmp *restrict T)
 {
+    const double *restrict px = p.x, *restrict py = p.y, *restrict pz = p.z;
+    const double *restrict ux = u.x, *restrict uy = u.y, *restrict uz = u.z;
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
@@ -660,17 +659,11 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
             const size_t t = o + l, e = 4 * g + l;
             T->keep[e] = ws_double_of(0 - ((bits >> l) & 1u));
             const node_normal nf = normal_of(n, depth[t], hi, v3_make(px[t], py[t], pz[t]),
-                                            v3_make(ux[t], uy[t], uz[t]), b, k, c);
-            T->kx[e] = nf.p.x;
-            T->ky[e] = nf.p.y;
-            T->kz[e] = nf.p.z;
-            T->tx[e] = nf.t.x;
-            T->ty[e] = nf.t.y;
-            T->tz[e] = nf.t.z;
+                                             v3_make(ux[t], uy[t], uz[t]), b, k, c);
+            tmp_set(T->k, e, nf.p);
+            tmp_set(T->t, e, nf.t);
             T->fn[e] = nf.fn;
-            T->lx[e] = nf.l.x;
-            T->ly[e] = nf.l.y;
-            T->lz[e] = nf.l.z;
+            tmp_set(T->l, e, nf.l);
         }
     }
 }
@@ -678,27 +671,22 @@ static void run_normal(size_t ng, const run_group *restrict grp, const double *r
 /* act_apply's friction over sub-step h, from the nodes' forces g (T->k becomes the node's force
  * with its normal force in), 1 / mass im and mass. */
 WS_VECTOR_LOOP
-static void run_friction(size_t ng, const run_group *restrict grp, const double *restrict gx,
-                         const double *restrict gy, const double *restrict gz,
+static void run_friction(size_t ng, const run_group *restrict grp, ws_nodes3 f,
                          const double *restrict im, const double *restrict mass, double h,
                          run_tmp *restrict T)
 {
+    const double *restrict gx = f.x, *restrict gy = f.y, *restrict gz = f.z;
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const v3 n = v3_make(q->nx, q->ny, q->nz);
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
-            const v3 k = v3_make(gx[t] + T->kx[e], gy[t] + T->ky[e], gz[t] + T->kz[e]);
-            T->kx[e] = k.x;
-            T->ky[e] = k.y;
-            T->kz[e] = k.z;
-            const v3 a = friction_of(n, v3_make(T->tx[e], T->ty[e], T->tz[e]), k, im[t], mass[t],
-                                     mu * T->fn[e], vlim, h);
-            T->ax[e] = a.x;
-            T->ay[e] = a.y;
-            T->az[e] = a.z;
+            const v3 k = v3_make(gx[t] + T->k[0][e], gy[t] + T->k[1][e], gz[t] + T->k[2][e]);
+            tmp_set(T->k, e, k);
+            tmp_set(T->a, e,
+                    friction_of(n, tmp_get(T->t, e), k, im[t], mass[t], mu * T->fn[e], vlim, h));
         }
     }
 }
@@ -709,7 +697,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
                       double *restrict gy, double *restrict gz, double share, run_tmp *restrict T)
 {
     for (size_t g = 0; g < ng; g++) {
-        const run_const *q = grp[g].rc;
+        const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const v3 n = v3_make(q->nx, q->ny, q->nz);
         for (size_t l = 0; l < WS_LANES; l++) {
@@ -719,19 +707,14 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
             /* The friction of a node that pushes; -0 for one that does not push, which leaves
              * its force as it was to the bit when added, as the one by one pass leaves the
              * force of a contact it does not list. */
-            const v3 a = v3_make(ws_pick(push, T->ax[e], -0.0), ws_pick(push, T->ay[e], -0.0),
-                                 ws_pick(push, T->az[e], -0.0));
-            gx[t] = ws_pick(keep, T->kx[e] + a.x, gx[t]);
-            gy[t] = ws_pick(keep, T->ky[e] + a.y, gy[t]);
-            gz[t] = ws_pick(keep, T->kz[e] + a.z, gz[t]);
-            const act_load B =
-                body_load(push, a, n, fn, share, v3_make(T->lx[e], T->ly[e], T->lz[e]));
-            T->bx[e] = B.f.x;
-            T->by[e] = B.f.y;
-            T->bz[e] = B.f.z;
-            T->mx[e] = B.m.x;
-            T->my[e] = B.m.y;
-            T->mz[e] = B.m.z;
+            const v3 a = v3_make(ws_pick(push, T->a[0][e], -0.0), ws_pick(push, T->a[1][e], -0.0),
+                                 ws_pick(push, T->a[2][e], -0.0));
+            gx[t] = ws_pick(keep, T->k[0][e] + a.x, gx[t]);
+            gy[t] = ws_pick(keep, T->k[1][e] + a.y, gy[t]);
+            gz[t] = ws_pick(keep, T->k[2][e] + a.z, gz[t]);
+            const act_load B = body_load(push, a, n, fn, share, tmp_get(T->l, e));
+            tmp_set(T->b, e, B.f);
+            tmp_set(T->m, e, B.m);
         }
     }
 }
@@ -747,8 +730,8 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     ws_web *web = E->web;
     const ws_nodes3 x = E->x, v = E->v, f = web->f;
     run_tmp *T = B->tmp;
-    run_normal(B->n, B->grp, x.x, x.y, x.z, v.x, v.y, v.z, B->depth, T);
-    run_friction(B->n, B->grp, f.x, f.y, f.z, web->inv_m, web->m, h, T);
+    run_normal(B->n, B->grp, x, v, B->depth, T);
+    run_friction(B->n, B->grp, f, web->inv_m, web->m, h, T);
     run_apply(B->n, B->grp, f.x, f.y, f.z, share, T);
     act_list *L = E->L;
     act_load *load = L->load;
@@ -757,15 +740,15 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
         /* Read here: as far as the compiler knows, the stores below could change them. */
-        const uint32_t body = G->rc->body, node = G->node;
+        const uint32_t body = G->rf->body, node = G->node;
         size_t s = G->slot;
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
             const uint32_t l = ws_lowest_bit(bits), i = node + l;
             const size_t e = 4 * g + l;
-            const v3 Fb = v3_make(T->bx[e], T->by[e], T->bz[e]);
+            const v3 Fb = tmp_get(T->b, e);
             fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
             touched[nt++] = i;
-            load[s] = (act_load){Fb, v3_make(T->mx[e], T->my[e], T->mz[e])};
+            load[s] = (act_load){Fb, tmp_get(T->m, e)};
             lbody[s] = body;
         }
     }
@@ -775,11 +758,11 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
 
 /* The face of candidate c, which a run lies on, as the run needs it in this sub-step: taken
  * from the face, its body and their materials by the first run on it. */
-static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
+static const run_face *run_face_of(const node_env *E, const ws_ncand *c)
 {
     ws_web *web = E->web;
     ws_node_contact *nc = web->contact;
-    ws_run_face *e = &nc->rface[c->feat];
+    run_face *e = &nc->rface[c->feat];
     if (e->gen == nc->rface_gen)
         return e;
     const ws_body_store *b = E->b;
@@ -789,10 +772,8 @@ static const ws_run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
     const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
-    e->q = (run_face){n.x, n.y, n.z, F->off, hi, lo};
-    e->rc = (run_const){n.x,  n.y,  n.z,  hi,   r.x,  r.y,  r.z,   vb.x,    vb.y,
-                        vb.z, wb.x, wb.y, wb.z, p->k, p->c, p->mu, p->vlim, bi};
-    e->gen = nc->rface_gen;
+    *e = (run_face){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,   r.y,     r.z, vb.x,         vb.y,
+                    vb.z, wb.x, wb.y, wb.z,   p->k, p->c, p->mu, p->vlim, bi,  nc->rface_gen};
     return e;
 }
 
@@ -813,7 +794,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
     const ws_nodes3 x = E->x;
     act_list *L = E->L;
     const ws_ncand *c = &cand[sg->c0];
-    const ws_run_face *rf = run_face_of(E, c);
+    const run_face *rf = run_face_of(E, c);
     for (uint32_t o = sg->n0; o < sg->n1; o += RUN_CHUNK) {
         size_t m = sg->n1 - o < RUN_CHUNK ? sg->n1 - o : RUN_CHUNK;
         /* Depths on whole vectors, past the run (its row goes on), the bits of the nodes past
@@ -822,7 +803,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
         uint64_t below = 0, in = 0;
         int whole = o + 4 * nv <= web->n;
         if (whole) {
-            in = run_depth(nv, &rf->q, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
+            in = run_depth(nv, rf, x.x + o, x.y + o, x.z + o, B->depth + o, &below);
             in &= m < RUN_CHUNK ? ((uint64_t)1 << m) - 1 : ~(uint64_t)0;
         }
         nc->run_nodes += m;
@@ -850,7 +831,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
             const uint32_t start = o + e < cap ? o + e : cap;
             const uint32_t bits = (uint32_t)(in >> e) & 15u;
             in &= ~((uint64_t)15u << e);
-            B->grp[B->n++] = (run_group){&rf->rc, start, slot, bits << (o + e - start)};
+            B->grp[B->n++] = (run_group){rf, start, slot, bits << (o + e - start)};
             slot += run_count4[bits];
         }
         L->nl = slot;
@@ -867,14 +848,18 @@ typedef struct seg_cut {
     uint32_t faces; /* one past the highest face a run lies on */
 } seg_cut;
 
+static void seg_put(seg_cut *sc, ws_nseg sg)
+{
+    sc->seg[sc->nseg++] = sg;
+    if (sg.run && sc->cand[sg.c0].feat >= sc->faces)
+        sc->faces = sc->cand[sg.c0].feat + 1;
+}
+
 static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    if (c0 == c1)
-        return;
-    sc->seg[sc->nseg++] =
-        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
-    if (run && sc->cand[c0].feat >= sc->faces)
-        sc->faces = sc->cand[c0].feat + 1;
+    if (c0 != c1)
+        seg_put(sc, (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0,
+                              (uint32_t)c1, run});
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -904,30 +889,22 @@ static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t 
         size_t e = k + 1;
         while (e < n && cand[e].node == node)
             e++;
+        /* Whatever ran before ends here: the loop below took every node that carries it on. */
+        seg_close_run(sc);
         if (node >= end) { /* a new block: nothing pending crosses into it */
-            seg_close_run(sc);
             seg_emit(sc, sc->g0, k, 0);
-            sc->g0 = sc->r0 = sc->r1 = k;
+            sc->g0 = k;
             end = (uint64_t)(node / bl + 1) * bl;
             end = end < stop ? end : stop;
         }
-        int single =
-            !nc->runs_off && e == k + 1 && (cand[k].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE;
-        if (single && sc->r1 > sc->r0 && sc->r1 == k && cand[k].feat == cand[sc->r0].feat &&
-            node == cand[k - 1].node + 1) {
-            sc->r1 = e; /* the run goes on */
+        if (nc->runs_off || e != k + 1 || (cand[k].local & WS_NCAND_FLAGS) != WS_NCAND_INSIDE) {
+            sc->r0 = sc->r1 = e; /* one by one: pending from g0 */
         } else {
-            seg_close_run(sc);
-            sc->r0 = k; /* a new run starts here, or an empty one */
-            sc->r1 = single ? e : k;
-            if (!single)
-                sc->r0 = sc->r1 = e; /* one by one: pending from g0 */
-        }
-        if (single) {
-            /* The run goes on over the next nodes of the block, each with one inside candidate
-             * of its face, as the steps above would find one by one. */
-            const uint32_t feat = cand[sc->r0].feat;
+            /* A run starts, and goes on over the next nodes of the block, each with one inside
+             * candidate of its face. */
+            const uint32_t feat = cand[k].feat;
             uint32_t prev = node;
+            sc->r0 = k;
             while (e < n && cand[e].node == prev + 1 && cand[e].node < end &&
                    cand[e].feat == feat && (cand[e].local & WS_NCAND_FLAGS) == WS_NCAND_INSIDE &&
                    (e + 1 == n || cand[e + 1].node != cand[e].node)) {
@@ -950,17 +927,32 @@ static uint32_t seg_block(const ws_web *web)
     return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
 }
 
-/* The stretches cut (sc) are list `list`'s: room for the faces their runs lie on. */
+/* Room for the run batch of a web of n nodes: its groups, the run passes' scratch, the nodes'
+ * depths. */
+static int rtmp_reserve(ws_mem *mem, ws_node_contact *nc, size_t n)
+{
+    const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + n;
+    return ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double));
+}
+
+/* Room for the faces [0, faces) that runs lie on. */
+static int rface_reserve(ws_mem *mem, ws_node_contact *nc, size_t faces)
+{
+    const size_t had = nc->rface_cap;
+    if (ws_array_reserve(mem, (void **)&nc->rface, &nc->rface_cap, faces, sizeof *nc->rface) != 0)
+        return -1;
+    for (size_t f = had; f < nc->rface_cap; f++)
+        nc->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
+    return 0;
+}
+
+/* The stretches cut (sc) are list `list`'s. */
 static int seg_done(ws_mem *mem, ws_web *web, const seg_cut *sc, int list)
 {
     ws_node_contact *nc = web->contact;
     nc->nseg = sc->nseg;
-    const size_t had = nc->rface_cap;
-    if (ws_array_reserve(mem, (void **)&nc->rface, &nc->rface_cap, sc->faces, sizeof *nc->rface) !=
-        0)
+    if (rface_reserve(mem, nc, sc->faces) != 0)
         return -1;
-    for (size_t f = had; f < nc->rface_cap; f++)
-        nc->rface[f].gen = 0; /* filled in no sub-step: rface_gen is 1 from the first on */
     nc->seg_list = list;
     return 0;
 }
@@ -970,13 +962,8 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     ws_node_contact *nc = web->contact;
     nc->seg_list = -1;
     nc->nseg = 0;
-    if (nc->rtmp_cap == 0) {
-        /* A run batch: its groups, the run passes' scratch, the nodes' depths. */
-        const size_t need =
-            (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + web->n;
-        if (ws_array_reserve(mem, (void **)&nc->rtmp, &nc->rtmp_cap, need, sizeof(double)) != 0)
-            return -1;
-    }
+    if (rtmp_reserve(mem, nc, web->n) != 0)
+        return -1;
     if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
         return -1;
     seg_cut sc = {cand, nc->seg, 0, 0, 0, 0, 0};
@@ -1009,9 +996,7 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
             sg.c1 = (uint32_t)k + (sg.c1 - sg.c0);
             sg.c0 = (uint32_t)k;
             k = sg.c1;
-            sc.seg[sc.nseg++] = sg;
-            if (sg.run && cand[sg.c0].feat >= sc.faces)
-                sc.faces = cand[sg.c0].feat + 1;
+            seg_put(&sc, sg);
         }
         if (q == count)
             break;
@@ -1031,12 +1016,8 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
  * they arrive while the block's springs are evaluated: from one step to the next they leave
  * the caches, and a block reads them in a few places (the first candidate of a run, a
  * one-by-one stretch), each a wait for the memory otherwise. */
-#if defined(__GNUC__)
-/* Inlined: as a call of its own, GCC takes a function that only prefetches for one without
- * effects, and drops the call. */
-__attribute__((always_inline)) static inline void node_prefetch(const ws_web *web,
-                                                                const ws_ncand *cand, size_t k,
-                                                                uint32_t n1)
+static inline NODE_INLINE void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k,
+                                             uint32_t n1)
 {
     ws_node_contact *nc = web->contact;
     const uint64_t end = (uint64_t)n1 + seg_block(web);
@@ -1044,21 +1025,15 @@ __attribute__((always_inline)) static inline void node_prefetch(const ws_web *we
     const size_t nseg = nc->nseg;
     size_t s = k;
     for (; s < nseg && seg[s].n0 < end; s++) {
-        __builtin_prefetch(cand + seg[s].c0);
+        NODE_PREFETCH(cand + seg[s].c0);
         if (!seg[s].run) /* a run reads its first candidate only */
-            __builtin_prefetch(cand + seg[s].c1 - 1);
+            NODE_PREFETCH(cand + seg[s].c1 - 1);
     }
     /* And the first stretches of the block after, whose places the next call reads (a dozen
      * stretches, 20 bytes each). */
     for (size_t q = s; q < s + 12 && q < nseg; q += 3)
-        __builtin_prefetch(seg + q);
+        NODE_PREFETCH(seg + q);
 }
-#else
-static void node_prefetch(const ws_web *web, const ws_ncand *cand, size_t k, uint32_t n1)
-{
-    (void)web, (void)cand, (void)k, (void)n1;
-}
-#endif
 
 void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *next,
                       uint64_t *checks)
@@ -1101,13 +1076,6 @@ void ws_node_substep(ws_node_contact *nc)
     nc->act_nl = 0;
 }
 
-void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
-{
-    act_list L = act_open(nc);
-    loads_apply(&L, bforce, bmoment);
-    nc->act_nl = 0;
-}
-
 size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0)
 {
     size_t lo = 0, hi = nc->nseg;
@@ -1124,21 +1092,9 @@ size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0)
 int ws_node_lane_scratch(ws_mem *mem, ws_node_contact *lane, const ws_node_contact *nc, uint32_t n,
                          size_t ncand)
 {
-    if (ws_node_scratch(mem, lane, ncand) != 0)
+    if (ws_node_scratch(mem, lane, ncand) != 0 || rtmp_reserve(mem, lane, n) != 0)
         return -1;
-    const size_t need = (RUN_GROUPS * sizeof(run_group) + sizeof(run_tmp)) / sizeof(double) + n;
-    if (lane->rtmp_cap < need &&
-        ws_array_reserve(mem, (void **)&lane->rtmp, &lane->rtmp_cap, need, sizeof(double)) != 0)
-        return -1;
-    const size_t had = lane->rface_cap;
-    if (nc->rface_cap > had) {
-        if (ws_array_reserve(mem, (void **)&lane->rface, &lane->rface_cap, nc->rface_cap,
-                             sizeof *lane->rface) != 0)
-            return -1;
-        for (size_t f = had; f < lane->rface_cap; f++)
-            lane->rface[f].gen = 0; /* rface_gen is 1 from the first sub-step on */
-    }
-    return 0;
+    return rface_reserve(mem, lane, nc->rface_cap);
 }
 
 int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
@@ -1187,30 +1143,8 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
                   ws_node_touch_at *at)
 {
     const ws_body_store *b = P->b;
-    const ws_node_geom *g = P->g;
-    const uint32_t bi = c->body;
-    const ws_shape *sh = b->shape[bi];
-    const double hi = b->layer[bi] + web->layer;
-    at->hi = hi;
-    if (c->local & WS_NCAND_EDGE)
-        return in_wedge(&g->edge[c->feat], x, hi + reach, 0, &at->n, &at->d);
-    const ws_wface *F = &g->face[c->feat];
-    const double lo = -hi - sh->inner;
-    const double d = F->n.x * x.x + F->n.y * x.y + F->n.z * x.z - F->off;
-    if (!(d < hi + reach) || !(d > lo))
-        return 0;
-    if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, x))
-        return 0;
-    if (d < 0.0) {
-        const uint32_t f = c->local & ~WS_NCAND_FLAGS;
-        const int top = sh->convex
-                            ? convex_shallowest(g, c->feat - f, sh->face_count, f, x, d)
-                            : ws_shallowest_face(
-                                  sh, f, m3_tmul_v(&b->A[bi], v3_sub(x, b->st[P->cur].r[bi])), d);
-        if (!top)
-            return 0;
-    }
-    at->n = F->n;
-    at->d = d;
-    return 1;
+    const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
+    const ws_shape *sh = b->shape[c->body];
+    at->hi = b->layer[c->body] + web->layer;
+    return touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, 0, &at->n, &at->d);
 }
