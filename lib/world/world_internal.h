@@ -60,6 +60,21 @@ typedef struct ws_contact_limit {
  * (docs/theory.md, section 8), and the measure is skipped. */
 #define WS_CONTACT_CHECK_FRACTION 0.25
 #define WS_CONTACT_RATE_ITERATIONS 40
+/* The measured bound is kept this many steps (the contacts of a load change little in 16 ms
+ * at dt 0.25 ms, and the energy guard stands behind every step), or until the contacts grow by
+ * a quarter, the per-pair bound changes or the world is restored: measured every step, 80
+ * power iterations over a 33-body load cost more than the step itself. */
+#define WS_CONTACT_CHECK_EVERY 64
+
+/* The contacts' measured stable step (world_step.c, contacts_ready) and when it was taken. */
+typedef struct ws_contact_check {
+    int valid;
+    uint64_t step;  /* w->steps when measured */
+    size_t nrec;    /* contacts then */
+    double pair_dt; /* the per-pair bound then */
+    double stable;  /* s; 0: no bound (no contact pushed) */
+    double omega, rate;
+} ws_contact_check;
 /* The energy guard's allowance: a step's kinetic energy may grow by the known loads' work plus
  * this multiple of the kinetic and contact energy at its start (docs/theory.md, section 8). */
 #define WS_ENERGY_GROWTH_FACTOR 10.0
@@ -72,6 +87,7 @@ struct ws_world {
     uint64_t steps;
     uint64_t last_full_step;
     int cand_valid; /* 0 forces a full detection on the next step */
+    ws_contact_check contact_check; /* not state: measured again after a restore */
     double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
     int in_step;    /* 1 while ws_world_step runs: its callbacks may only read */

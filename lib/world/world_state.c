@@ -330,6 +330,7 @@ static void walk_contacts(ws_walk *k)
         w->steps = steps;
         w->last_full_step = last_full;
         w->cand_valid = valid;
+        w->contact_check.valid = 0;
     }
     f64s(k, &w->travel, 1, 0);
     /* The candidate feature pairs, with the stick anchors (in the hash). */

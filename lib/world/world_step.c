@@ -859,16 +859,22 @@ static ws_status contacts_ready(ws_step *S)
     ws_world *w = S->w;
     if (S->nrec == 0 || !(S->dt > WS_CONTACT_CHECK_FRACTION * S->pair_dt))
         return WS_OK;
-    const size_t n = S->b->slots;
-    v3 *x = ws_arena_alloc(S->arena, 4 * (n + 1) * sizeof(v3));
-    if (!x)
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
-    v3 *y = x + 2 * (n + 1);
-    const double K = contact_rate(S, 0, x, y), C = contact_rate(S, 1, x, y);
-    if (!(K > 0.0))
-        return WS_OK;
-    const double stable = (sqrt(C * C + 4.0 * K) - C) / K; /* ws_contact_stable_dt with m = 1 */
-    if (S->dt <= stable)
+    ws_contact_check *cc = &w->contact_check;
+    if (!cc->valid || w->steps < cc->step || w->steps - cc->step >= WS_CONTACT_CHECK_EVERY ||
+        4 * S->nrec > 5 * cc->nrec || cc->pair_dt != S->pair_dt) {
+        const size_t n = S->b->slots;
+        v3 *x = ws_arena_alloc(S->arena, 4 * (n + 1) * sizeof(v3));
+        if (!x)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        v3 *y = x + 2 * (n + 1);
+        const double K = contact_rate(S, 0, x, y), C = contact_rate(S, 1, x, y);
+        /* ws_contact_stable_dt with m = 1; no bound when no contact pushes. */
+        *cc = (ws_contact_check){1,         w->steps, S->nrec, S->pair_dt,
+                                 K > 0.0 ? (sqrt(C * C + 4.0 * K) - C) / K : 0.0,
+                                 sqrt(K > 0.0 ? K : 0.0), C};
+    }
+    const double stable = cc->stable, K = cc->omega * cc->omega, C = cc->rate;
+    if (!(stable > 0.0) || S->dt <= stable)
         return WS_OK;
     S->stats->numerical_errors++;
     return ws_fail(w, WS_ERR_NUMERICAL,
