@@ -30,16 +30,6 @@ static void mul_add(double *J, double c, const double *M, const double *N)
         }
 }
 
-static void sym_outer(double *S, double c, v3 e)
-{
-    S[WS_SYM_XX] += c * e.x * e.x;
-    S[WS_SYM_YY] += c * e.y * e.y;
-    S[WS_SYM_ZZ] += c * e.z * e.z;
-    S[WS_SYM_XY] += c * e.x * e.y;
-    S[WS_SYM_XZ] += c * e.x * e.z;
-    S[WS_SYM_YZ] += c * e.y * e.z;
-}
-
 /* Eq. 13 over the slip t (ws_friction_p): F_t = -mu N phi t, phi = p(s) / |t| (2 / v_lim at
  * rest, its limit), and dp = p'(s) / v_lim, with the slip's direction tt (zero at rest). */
 static void link_slip(ws_node_link *L, v3 t, double vlim)
@@ -87,8 +77,8 @@ static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_n
         /* Not pushing now: the penalty's linear model alone, for the step to take if it
          * brings the node in (ws_node_link_update, which adds the friction then). */
         L->f = v3_scale(n, f);
-        sym_outer(L->K, p->k, n);
-        sym_outer(L->D, p->c, n);
+        ws_sym_add_outer(L->K, p->k, n);
+        ws_sym_add_outer(L->D, p->c, n);
         return;
     }
     /* df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
@@ -103,8 +93,8 @@ static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_n
     for (int k = 0; k < 9; k++)
         L->Jx[k] += f * G[k];
     outer_add(L->Jv, -p->c, n, n);
-    sym_outer(L->K, p->k, n);
-    sym_outer(L->D, p->c, n);
+    ws_sym_add_outer(L->K, p->k, n);
+    ws_sym_add_outer(L->D, p->c, n);
     v3 F = v3_scale(n, f);
     if (p->mu > 0.0 && !pinned) {
         /* Eq. 13 over the tangential slip t: F_t = -mu f phi t (link_slip) and
@@ -142,7 +132,7 @@ static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_n
          * step with the force -mu f phi t1 against the slip it ends with, which cannot
          * overshoot. The coupling through f (t n^T) is not symmetric and vanishes at rest. */
         double Dn[WS_SYM] = {0};
-        sym_outer(Dn, -1.0, n);
+        ws_sym_add_outer(Dn, -1.0, n);
         Dn[WS_SYM_XX] += 1.0;
         Dn[WS_SYM_YY] += 1.0;
         Dn[WS_SYM_ZZ] += 1.0;
@@ -164,7 +154,7 @@ static void bring_in(ws_node_link *c, double fe)
     c->f = v3_madd(v3_scale(c->n, c->fn), c->t, -mf * c->phi);
     double *Dm = c->D;
     memset(Dm, 0, WS_SYM * sizeof(double));
-    sym_outer(Dm, c->c - mf * c->phi, c->n);
+    ws_sym_add_outer(Dm, c->c - mf * c->phi, c->n);
     Dm[WS_SYM_XX] += mf * c->phi;
     Dm[WS_SYM_YY] += mf * c->phi;
     Dm[WS_SYM_ZZ] += mf * c->phi;

@@ -127,16 +127,6 @@ static int spring_broken(const ws_web *web, uint32_t s)
     return web->nbroken && web->broken && web->broken[s];
 }
 
-static void sym_add_outer(double *S, double c, v3 e)
-{
-    S[WS_SYM_XX] += c * e.x * e.x;
-    S[WS_SYM_YY] += c * e.y * e.y;
-    S[WS_SYM_ZZ] += c * e.z * e.z;
-    S[WS_SYM_XY] += c * e.x * e.y;
-    S[WS_SYM_XZ] += c * e.x * e.z;
-    S[WS_SYM_YZ] += c * e.y * e.z;
-}
-
 int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t, double since)
 {
     ws_implicit *im = web->imp;
@@ -351,7 +341,7 @@ static int preconditioner(const ws_web *web, double h)
         const double a = h2 * q->ka + h * q->cs, b = h2 * q->kb;
         for (int k = 0; k < 2; k++) {
             double *S = P + WS_SYM * (size_t)(k ? web->sb[s] : web->sa[s]);
-            sym_add_outer(S, a, e);
+            ws_sym_add_outer(S, a, e);
             S[WS_SYM_XX] += b;
             S[WS_SYM_YY] += b;
             S[WS_SYM_ZZ] += b;

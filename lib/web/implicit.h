@@ -103,6 +103,17 @@ int ws_implicit_spring_exact(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32
  * cofactors; -1 (out untouched) when S is not positive definite or the result not finite. */
 int ws_sym_invert(const double *S, double *out);
 
+/* S += c e e^T for a symmetric block S. */
+static inline void ws_sym_add_outer(double *S, double c, v3 e)
+{
+    S[WS_SYM_XX] += c * e.x * e.x;
+    S[WS_SYM_YY] += c * e.y * e.y;
+    S[WS_SYM_ZZ] += c * e.z * e.z;
+    S[WS_SYM_XY] += c * e.x * e.y;
+    S[WS_SYM_XZ] += c * e.x * e.z;
+    S[WS_SYM_YZ] += c * e.y * e.z;
+}
+
 /* y += S x for a symmetric block S. */
 static inline void ws_sym_madd(const double *S, double x, double y, double z, double *o)
 {
