@@ -219,25 +219,19 @@ static void to_ref(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32
                    size_t count)
 {
     ws_node_contact *nc = web->contact;
+    const double *in[3] = {x.x, x.y, x.z};
+    double *out[6] = {nc->xdet.x, nc->xdet.y, nc->xdet.z, nc->xep.x, nc->xep.y, nc->xep.z};
     double t[T_ROWS][REF_CHUNK], lever2 = nc->lever2;
     const size_t n = only ? count : web->n;
     for (size_t q0 = 0; q0 < n; q0 += REF_CHUNK) {
         const size_t m = n - q0 < REF_CHUNK ? n - q0 : (size_t)REF_CHUNK;
-        for (size_t j = 0; j < m; j++) {
-            const size_t i = only ? only[q0 + j] : q0 + j;
-            t[T_X][j] = x.x[i];
-            t[T_X + 1][j] = x.y[i];
-            t[T_X + 2][j] = x.z[i];
-        }
+        for (size_t j = 0; j < m; j++)
+            for (int r = 0; r < 3; r++)
+                t[T_X + r][j] = in[r][only ? only[q0 + j] : q0 + j];
         ref_chunk(m, M, nc, t);
         for (size_t j = 0; j < m; j++) {
-            const size_t i = only ? only[q0 + j] : q0 + j;
-            nc->xdet.x[i] = t[T_S][j];
-            nc->xdet.y[i] = t[T_S + 1][j];
-            nc->xdet.z[i] = t[T_S + 2][j];
-            nc->xep.x[i] = t[T_G][j];
-            nc->xep.y[i] = t[T_G + 1][j];
-            nc->xep.z[i] = t[T_G + 2][j];
+            for (int r = 0; r < 6; r++) /* rows T_S, then T_G */
+                out[r][only ? only[q0 + j] : q0 + j] = t[T_S + r][j];
             lever2 = t[T_L2][j] > lever2 ? t[T_L2][j] : lever2;
         }
     }

@@ -127,6 +127,20 @@ static double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
     return l * il0 - 1.0;
 }
 
+/* The histories of the springs whose law keeps one, advanced at their strains and rates at
+ * (x, v), time t, over dt. */
+static void commit_laws(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
+{
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_law *L = web->law[web->kind[s]];
+        if (!L->nstate)
+            continue;
+        v3 d;
+        double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+        ws_law_commit(L, web->hist + (size_t)s * web->nstate, &eps, &epsd, t, dt);
+    }
+}
+
 int ws_web_law_state(ws_mem *mem, ws_web *web)
 {
     uint32_t most = 0;
@@ -142,16 +156,9 @@ int ws_web_law_state(ws_mem *mem, ws_web *web)
     /* The film was stretched to its pre-stretch when it was put on: each spring starts with the
      * history of a strain step to where it is now (committed over no time), from which a
      * relaxation law relaxes. */
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_law *L = web->law[web->kind[s]];
-        double *h = web->hist + (size_t)s * most;
-        ws_law_state_init(L, h);
-        if (!L->nstate)
-            continue;
-        v3 d;
-        double epsd, il, eps = strain_of(web, web->x[0], web->v[0], s, &d, &epsd, &il);
-        ws_law_commit(L, h, &eps, &epsd, 0.0, 0.0);
-    }
+    for (uint32_t s = 0; s < web->ns; s++)
+        ws_law_state_init(web->law[web->kind[s]], web->hist + (size_t)s * most);
+    commit_laws(web, web->x[0], web->v[0], 0.0, 0.0);
     return 0;
 }
 
@@ -160,16 +167,8 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
     web->nbroken_step = 0;
     if (web->rupture > 0.0)
         ws_web_rupture_check(web, x, t);
-    if (!web->nstate)
-        return;
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_law *L = web->law[web->kind[s]];
-        if (!L->nstate)
-            continue;
-        v3 d;
-        double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
-        ws_law_commit(L, web->hist + (size_t)s * web->nstate, &eps, &epsd, t, dt);
-    }
+    if (web->nstate)
+        commit_laws(web, x, v, t, dt);
 }
 
 /* Tension / length of a spring of film form p whose second end is at d from its first and moves
@@ -287,10 +286,12 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
-/* The same onto both ends. */
-static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s)
+/* Gravity and node drag on node i of mass m (g, c: the web's); without drag, gravity alone
+ * (the velocity is not read). */
+static inline v3 weight_drag(v3 g, double c, double m, in3 v, size_t i, int drag)
 {
-    spring_one_in(web, x, v, s, 0, UINT32_MAX);
+    return drag ? v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i])
+                : v3_make(g.x * m, g.y * m, g.z * m);
 }
 
 /* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
@@ -301,10 +302,10 @@ static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double
     const v3 g = web->g;
     const double c = web->damping, m1 = web->m1;
     for (size_t i = 0; i < n; i++) {
-        const double mi = same ? m1 : m[i];
-        f.x[i] = g.x * mi - c * v.x[i];
-        f.y[i] = g.y * mi - c * v.y[i];
-        f.z[i] = g.z * mi - c * v.z[i];
+        const v3 b = weight_drag(g, c, same ? m1 : m[i], v, i, 1);
+        f.x[i] = b.x;
+        f.y[i] = b.y;
+        f.z[i] = b.z;
     }
 }
 
@@ -323,31 +324,23 @@ static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
-    const v3 g = web->g;
-    const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
-    return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
+    return weight_drag(web->g, web->damping, web->same_m ? web->m1 : web->m[i], in_at(v, 0), i, 1);
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
- * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. Masses as in base_forces_of; without
- * drag the velocities are not read. */
+ * their first ends are t[i - 1] and t[i]: gravity and drag (weight_drag), then + t[i], then
+ * - t[i - 1]. The order is that of the results (the state hash): keep it. Masses as in
+ * base_forces_of. */
 static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
                                  size_t k, int same, int drag)
 {
     const v3 g = web->g;
     const double c = web->damping, m1 = web->m1;
     for (size_t i = 1; i < k; i++) {
-        const double mi = same ? m1 : m[i];
-        if (drag) {
-            f.x[i] = g.x * mi - c * v.x[i] + t.x[i] - t.x[i - 1];
-            f.y[i] = g.y * mi - c * v.y[i] + t.y[i] - t.y[i - 1];
-            f.z[i] = g.z * mi - c * v.z[i] + t.z[i] - t.z[i - 1];
-        } else {
-            f.x[i] = g.x * mi + t.x[i] - t.x[i - 1];
-            f.y[i] = g.y * mi + t.y[i] - t.y[i - 1];
-            f.z[i] = g.z * mi + t.z[i] - t.z[i - 1];
-        }
+        const v3 b = weight_drag(g, c, same ? m1 : m[i], v, i, drag);
+        f.x[i] = b.x + t.x[i] - t.x[i - 1];
+        f.y[i] = b.y + t.y[i] - t.y[i - 1];
+        f.z[i] = b.z + t.z[i] - t.z[i - 1];
     }
 }
 
@@ -422,16 +415,13 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const double *xv[6] = {x.x, x.y, x.z, v.x, v.y, v.z};
     double in[7 * L];
     for (size_t i = 0; i < L; i++) {
         const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
         const int row = r + i < ny;
-        in[i] = row ? x.x[b] - x.x[a] : 0.0;
-        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
-        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
-        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
-        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
-        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
+        for (size_t c = 0; c < 6; c++)
+            in[c * L + i] = row ? xv[c][b] - xv[c][a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
     double *out = web->tmp + 3 * WS_WEB_CHUNK;
@@ -491,7 +481,7 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, int lane_f
     if (p->gen || !web->law[WS_SPRING_AROUND] || nx < 2) {
         base_forces(web, v, nx * r, nx * (r + 1));
         for (size_t s = cols * r; p->gen && nx >= 2 && s < cols * (r + 1); s++)
-            spring_one(web, x, v, (uint32_t)s);
+            spring_one_in(web, x, v, (uint32_t)s, 0, UINT32_MAX);
         return;
     }
     if (web->closed && (r % WS_WEB_WRAPS == 0 || lane_first))
@@ -578,7 +568,7 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
     if (web->nx == 0) {
         base_forces(web, v, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
-            spring_one(web, x, v, s);
+            spring_one_in(web, x, v, s, 0, UINT32_MAX);
         *n0 = 0;
         *n1 = web->n;
         return;
