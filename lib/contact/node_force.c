@@ -53,17 +53,6 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
     return 1;
 }
 
-/* The slip velocity predicted at the end of the sub-step h (friction_of), from the contact's
- * normal n, the node's tangential velocity t, its force with every normal force in k and its
- * 1 / mass im. */
-static inline v3 friction_pred(v3 n, v3 t, v3 k, double im, double h)
-{
-    double dot = k.x * n.x + k.y * n.y + k.z * n.z;
-    double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
-    double hm = h * im;
-    return v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
-}
-
 /* A load on a body: force and moment about the CoG. */
 typedef struct act_load {
     v3 f, m;
@@ -104,7 +93,11 @@ static inline v3 pushed(uint64_t push, v3 a)
 static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
                              double h)
 {
-    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), cap, vlim, mass, h);
+    /* The slip predicted at the end of the sub-step: t and the force across n, k's part o. */
+    const double dot = k.x * n.x + k.y * n.y + k.z * n.z, hm = h * im;
+    const double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
+    const v3 pred = v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
+    const ws_friction fr = ws_friction_law(pred, cap, vlim, mass, h);
     const uint64_t loose = ws_mask(im != 0.0); /* not pinned */
     return v3_make(ws_pick(loose, fr.f.x, 0.0), ws_pick(loose, fr.f.y, 0.0),
                    ws_pick(loose, fr.f.z, 0.0));
@@ -263,12 +256,6 @@ void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
     nc->act_nl = 0;
 }
 
-/* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
-typedef struct corner_memo {
-    uint32_t body;
-    double eps;
-} corner_memo;
-
 /* What the node contacts of a sweep block read: the bodies and their state, their faces in the
  * global frame, the web and its node state (x, v), the contact parameters by body material and
  * the list of contacts gone one by one. */
@@ -280,7 +267,6 @@ typedef struct node_env {
     ws_nodes3 x, v;
     const ws_node_params *pp;
     act_list *L;
-    struct corner_memo *memo;
 } node_env;
 
 /* Out of line where GCC would inline it: see shallowest. Inlined where GCC would not: touch_of
@@ -418,40 +404,29 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 
  * one holds the node, told apart by the two planes' distances dA, dB, by a margin eps that the
  * full tests cannot disagree with (docs/theory.md, section 6, "Corners"). */
 
-/* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
- * the window's top hi: its faces' outlines stand out of the other faces' planes by its
- * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few 1e-9
- * of its radius; round-off and the flatness of its faces (1e-12) come at the size of the
- * coordinates and distances. Both with room to spare: a node that close to a boundary takes
- * the full test. (On the reference case the closest calls stand 2.4e-10 m out of the other
- * plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) The body's part is
- * kept in memo for the next node. */
-static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *sh, v3 xi, v3 r,
-                                double hi)
-{
-    if (memo->body != bi) {
-        memo->body = bi;
-        memo->eps = 1e-7 * sh->radius +
-                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
-    }
-    return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
-}
-
-/* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
- * to their full tests, one bit each: a face within the window's top and not turned down, the
- * edge unless turned down. *sure: the node lies out of both planes and each face's projection
- * of it out of the other's plane, by eps, so that in_wedge's tests of the direction (r . n1,
- * r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off, as for
- * turning the edge down) hold and need not be taken. */
+/* Of a corner c[0, 3) of node xi (the shape sh at r, the window's top hi), those the planes
+ * leave to their full tests, one bit each: a face within the window's top and not turned down,
+ * the edge unless turned down. *sure: the node lies out of both planes and each face's
+ * projection of it out of the other's plane, by eps, so that in_wedge's tests of the direction
+ * (r . n1, r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off,
+ * as for turning the edge down) hold and need not be taken. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
-                                   v3 xi, v3 r, double hi, corner_memo *memo, int *sure)
+                                   v3 xi, v3 r, double hi, int *sure)
 {
     const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
     /* The planes' distances as the one-by-one pass takes them. */
     const double dA = A->n.x * xi.x + A->n.y * xi.y + A->n.z * xi.z - A->off,
                  dB = B->n.x * xi.x + B->n.y * xi.y + B->n.z * xi.z - B->off;
     const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
-    const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
+    /* The margin: the faces' outlines stand out of the other faces' planes by the shape's
+     * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few
+     * 1e-9 of its radius; round-off and the flatness of its faces (1e-12) come at the size of
+     * the coordinates and distances. Both with room to spare: a node that close to a boundary
+     * takes the full test. (On the reference case the closest calls stand 2.4e-10 m out of the
+     * other plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) */
+    const double eps = 1e-7 * sh->radius +
+                       1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi) +
+                       1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
     const uint32_t a = (dA < hi) & !(qB > eps);
     const uint32_t z = (dB < hi) & !(qA > eps);
@@ -486,7 +461,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         uint32_t left;
         int sure = 0;
         if ((c0->local & WS_NCAND_CORNER) && !E->web->contact->runs_off) {
-            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo, &sure);
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, &sure);
             E->web->contact->corners++;
             k += 3;
         } else {
@@ -522,13 +497,12 @@ _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty ba
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
  * filled by the first of them (run_face_of). */
 typedef struct ws_run_face {
-    v3 n;
-    double off;            /* the face's plane, global: d = n . x - off */
-    double hi, lo;         /* the contact window of d */
-    ws_motion b;           /* the body's CoG, velocity and spin */
-    double k, c, mu, vlim; /* the contact's parameters */
-    uint32_t body;         /* the body's slot */
-    uint64_t gen;          /* the sub-step filled in, nc->rface_gen */
+    double nx, ny, nz, off;                    /* the face's plane, global: d = n . x - off */
+    double hi, lo;                             /* the contact window of d */
+    double rx, ry, rz, vx, vy, vz, wx, wy, wz; /* the body's CoG, velocity and spin */
+    double k, c, mu, vlim;                     /* the contact's parameters */
+    uint32_t body;                             /* the body's slot */
+    uint64_t gen;                              /* the sub-step filled in, nc->rface_gen */
 } run_face;
 
 /* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
@@ -547,7 +521,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
                           const double *restrict y, const double *restrict z, double *restrict d,
                           uint64_t *restrict below)
 {
-    const double nx = q->n.x, ny = q->n.y, nz = q->n.z, off = q->off, hi = q->hi, lo = q->lo;
+    const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
     uint64_t in = 0, neg = 0;
     for (size_t i = 0; i < 4 * nv; i++) {
         double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
@@ -633,8 +607,9 @@ static void run_normal(size_t ng, const run_group *restrict grp, ws_nodes3 p, ws
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
         /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const v3 n = q->n;
-        const ws_motion b = q->b;
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const ws_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
+                             v3_make(q->wx, q->wy, q->wz)};
         const double hi = q->hi, k = q->k, c = q->c;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -660,7 +635,7 @@ static void run_friction(size_t ng, const run_group *restrict grp, ws_nodes3 f,
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = q->n;
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -680,7 +655,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = q->n;
+        const v3 n = v3_make(q->nx, q->ny, q->nz);
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
             const double fn = T->fn[e];
@@ -748,8 +723,9 @@ static const run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const ws_wface *F = &E->g->face[c->feat];
     const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
-    const ws_motion m = {st->r[bi], st->v[bi], b->wg[bi]};
-    *e = (run_face){F->n, F->off, hi, lo, m, p->k, p->c, p->mu, p->vlim, bi, nc->rface_gen};
+    const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
+    *e = (run_face){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,   r.y,     r.z, vb.x,         vb.y,
+                    vb.z, wb.x, wb.y, wb.z,   p->k, p->c, p->mu, p->vlim, bi,  nc->rface_gen};
     return e;
 }
 
@@ -1019,8 +995,7 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
     const double h = P->h, share = P->share;
     v3 *fc = P->fc;
     act_list L = act_open(web->contact);
-    corner_memo memo = {UINT32_MAX, 0.0};
-    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L, &memo};
+    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L};
     double *tmp = nc->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
     run_batch B = {(run_group *)nc->rtmp, (struct run_tmp *)tmp,
                    tmp + sizeof(run_tmp) / sizeof(double), 0,

@@ -286,14 +286,6 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
-/* Gravity and node drag on node i of mass m (g, c: the web's); without drag, gravity alone
- * (the velocity is not read). */
-static inline v3 weight_drag(v3 g, double c, double m, in3 v, size_t i, int drag)
-{
-    return drag ? v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i])
-                : v3_make(g.x * m, g.y * m, g.z * m);
-}
-
 /* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
  * web's one mass for every node when same (then m is not read). */
 static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double *restrict m,
@@ -302,10 +294,10 @@ static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double
     const v3 g = web->g;
     const double c = web->damping, m1 = web->m1;
     for (size_t i = 0; i < n; i++) {
-        const v3 b = weight_drag(g, c, same ? m1 : m[i], v, i, 1);
-        f.x[i] = b.x;
-        f.y[i] = b.y;
-        f.z[i] = b.z;
+        const double mi = same ? m1 : m[i];
+        f.x[i] = g.x * mi - c * v.x[i];
+        f.y[i] = g.y * mi - c * v.y[i];
+        f.z[i] = g.z * mi - c * v.z[i];
     }
 }
 
@@ -324,23 +316,31 @@ static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
-    return weight_drag(web->g, web->damping, web->same_m ? web->m1 : web->m[i], in_at(v, 0), i, 1);
+    const v3 g = web->g;
+    const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
+    return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
- * their first ends are t[i - 1] and t[i]: gravity and drag (weight_drag), then + t[i], then
- * - t[i - 1]. The order is that of the results (the state hash): keep it. Masses as in
- * base_forces_of. */
+ * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
+ * order is that of the results (the state hash): keep it. Masses as in base_forces_of; without
+ * drag the velocities are not read. */
 static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
                                  size_t k, int same, int drag)
 {
     const v3 g = web->g;
     const double c = web->damping, m1 = web->m1;
     for (size_t i = 1; i < k; i++) {
-        const v3 b = weight_drag(g, c, same ? m1 : m[i], v, i, drag);
-        f.x[i] = b.x + t.x[i] - t.x[i - 1];
-        f.y[i] = b.y + t.y[i] - t.y[i - 1];
-        f.z[i] = b.z + t.z[i] - t.z[i - 1];
+        const double mi = same ? m1 : m[i];
+        if (drag) {
+            f.x[i] = g.x * mi - c * v.x[i] + t.x[i] - t.x[i - 1];
+            f.y[i] = g.y * mi - c * v.y[i] + t.y[i] - t.y[i - 1];
+            f.z[i] = g.z * mi - c * v.z[i] + t.z[i] - t.z[i - 1];
+        } else {
+            f.x[i] = g.x * mi + t.x[i] - t.x[i - 1];
+            f.y[i] = g.y * mi + t.y[i] - t.y[i - 1];
+            f.z[i] = g.z * mi + t.z[i] - t.z[i - 1];
+        }
     }
 }
 
@@ -415,13 +415,16 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
-    const double *xv[6] = {x.x, x.y, x.z, v.x, v.y, v.z};
     double in[7 * L];
     for (size_t i = 0; i < L; i++) {
         const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
         const int row = r + i < ny;
-        for (size_t c = 0; c < 6; c++)
-            in[c * L + i] = row ? xv[c][b] - xv[c][a] : 0.0;
+        in[i] = row ? x.x[b] - x.x[a] : 0.0;
+        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
+        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
+        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
+        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
+        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
     double *out = web->tmp + 3 * WS_WEB_CHUNK;
@@ -674,10 +677,16 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v)
     return most;
 }
 
-/* Per free node, into the force scratch (not state; no step is running when this is asked):
- * f.x = 2 sum of its springs' largest stiffness / l0 -- the Gershgorin bound of its row of the
- * stiffness matrix -- and f.y = 2 sum of their damping / l0. */
-static void node_bounds(const ws_web *web)
+/* What the free nodes can bear: from the Gershgorin bound of each node's row of the stiffness
+ * matrix, k = kc + 2 sum of its springs' largest stiffness / l0, and its damping c = cc + 2 sum
+ * of theirs / l0 + the node drag (summed in the force scratch: not state, no step is running
+ * when this is asked), the least stable step, the least mass stable at sub-step h, the least
+ * mass and the largest k. */
+typedef struct node_limits {
+    double dt, mass, min_mass, max_k;
+} node_limits;
+
+static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
 {
     ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
@@ -692,58 +701,45 @@ static void node_bounds(const ws_web *web)
         acc.y[web->sa[s]] += c;
         acc.y[web->sb[s]] += c;
     }
+    node_limits o = {INFINITY, 0.0, INFINITY, 0.0};
+    for (uint32_t i = 0; i < web->n; i++) {
+        if (web->inv_m[i] == 0.0)
+            continue;
+        const double k = acc.x[i] + kc, c = acc.y[i] + cc + web->damping;
+        /* Symplectic Euler on m x'' + c x' + k x = 0 is stable for
+         * dt < 2/omega (sqrt(1 + z^2) - z), omega^2 = k/m, z = c/(2 m omega). */
+        const double om = sqrt(k * web->inv_m[i]);
+        if (om > 0.0) {
+            double z = c * web->inv_m[i] / (2.0 * om);
+            double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
+            o.dt = dt < o.dt ? dt : o.dt;
+        }
+        /* The same bound in closed form: 2/omega (sqrt(1 + z^2) - z) = (sqrt(c^2 + 4 m k) - c)
+         * / k, which is >= h exactly when m >= h^2 k / 4 + h c / 2. A light node is held by its
+         * damping (the h c / 2 term), not by its stiffness. */
+        const double m = 0.25 * h * h * k + 0.5 * h * c;
+        o.mass = m <= o.mass ? o.mass : m; /* NaN wins */
+        o.min_mass = fmin(o.min_mass, web->m[i]);
+        o.max_k = fmax(o.max_k, k);
+    }
+    return o;
 }
 
 double ws_web_stable_dt(const ws_web *web, double kc, double cc)
 {
-    /* Symplectic Euler on m x'' + c x' + k x = 0 is stable for
-     * dt < 2/omega (sqrt(1 + z^2) - z), omega^2 = k/m, z = c/(2 m omega). */
-    double best = INFINITY;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
-        double om = sqrt(k * web->inv_m[i]);
-        if (!(om > 0.0))
-            continue;
-        double z = c * web->inv_m[i] / (2.0 * om);
-        double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
-        if (dt < best)
-            best = dt;
-    }
-    return best;
+    return limits_of(web, kc, cc, 0.0).dt;
 }
 
 double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h)
 {
-    /* ws_web_stable_dt's bound in closed form: 2/omega (sqrt(1 + z^2) - z) = (sqrt(c^2 + 4 m k)
-     * - c) / k, which is >= h exactly when m >= h^2 k / 4 + h c / 2. A light node is held by
-     * its damping (the h c / 2 term), not by its stiffness. */
-    double most = 0.0;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
-        double m = 0.25 * h * h * k + 0.5 * h * c;
-        most = m <= most ? most : m; /* NaN wins */
-    }
-    return most;
+    return limits_of(web, kc, cc, h).mass;
 }
 
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k)
 {
-    double mm = INFINITY, mk = 0.0;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        mm = fmin(mm, web->m[i]);
-        mk = fmax(mk, web->f.x[i] + kc);
-    }
-    *min_mass = mm;
-    *max_k = mk;
+    const node_limits o = limits_of(web, kc, 0.0, 0.0);
+    *min_mass = o.min_mass;
+    *max_k = o.max_k;
 }
 
 double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)
