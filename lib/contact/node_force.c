@@ -256,6 +256,13 @@ void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
     nc->act_nl = 0;
 }
 
+/* The body part of corner_left's margin for the body met last in a sweep block (UINT32_MAX:
+ * none): most corners in a row are of one body. */
+typedef struct corner_memo {
+    uint32_t body;
+    double eps;
+} corner_memo;
+
 /* What the node contacts of a sweep block read: the bodies and their state, their faces in the
  * global frame, the web and its node state (x, v), the contact parameters by body material and
  * the list of contacts gone one by one. */
@@ -267,6 +274,7 @@ typedef struct node_env {
     ws_nodes3 x, v;
     const ws_node_params *pp;
     act_list *L;
+    corner_memo *memo;
 } node_env;
 
 /* Out of line where GCC would inline it: see shallowest. Inlined where GCC would not: touch_of
@@ -411,7 +419,7 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 
  * (r . n1, r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off,
  * as for turning the edge down) hold and need not be taken. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
-                                   v3 xi, v3 r, double hi, int *sure)
+                                   v3 xi, v3 r, double hi, corner_memo *memo, int *sure)
 {
     const ws_wface *A = &g->face[c[0].feat], *B = &g->face[c[1].feat];
     /* The planes' distances as the one-by-one pass takes them. */
@@ -424,9 +432,12 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
      * the coordinates and distances. Both with room to spare: a node that close to a boundary
      * takes the full test. (On the reference case the closest calls stand 2.4e-10 m out of the
      * other plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) */
-    const double eps = 1e-7 * sh->radius +
-                       1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi) +
-                       1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
+    if (memo->body != c[0].body) {
+        memo->body = c[0].body;
+        memo->eps = 1e-7 * sh->radius +
+                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
+    }
+    const double eps = memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
     const uint32_t a = (dA < hi) & !(qB > eps);
     const uint32_t z = (dB < hi) & !(qA > eps);
@@ -461,7 +472,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         uint32_t left;
         int sure = 0;
         if ((c0->local & WS_NCAND_CORNER) && !E->web->contact->runs_off) {
-            left = corner_left(g, sh, c0, xi, st->r[bi], hi, &sure);
+            left = corner_left(g, sh, c0, xi, st->r[bi], hi, E->memo, &sure);
             E->web->contact->corners++;
             k += 3;
         } else {
@@ -995,7 +1006,8 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
     const double h = P->h, share = P->share;
     v3 *fc = P->fc;
     act_list L = act_open(web->contact);
-    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L};
+    corner_memo memo = {UINT32_MAX, 0.0};
+    const node_env E = {P->b, &P->b->st[P->cur], P->g, web, P->x, P->v, P->pp, &L, &memo};
     double *tmp = nc->rtmp + RUN_GROUPS * sizeof(run_group) / sizeof(double);
     run_batch B = {(run_group *)nc->rtmp, (struct run_tmp *)tmp,
                    tmp + sizeof(run_tmp) / sizeof(double), 0,
