@@ -419,72 +419,68 @@ static inline const float *off_block(const mg_level *L, size_t k, int o, int64_t
     return o > CENTRE ? AT(L, k, o) : AT(L, (size_t)j, 8 - o);
 }
 
-/* One sweep of block Gauss-Seidel on coarse level L: forward from x = 0 (a node then meets
- * only the nodes before it, those after being still zero), which leaves the residual r - A x
- * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
- * as that node is solved, with the block its own solve has just read); or backward from the x
- * there is. */
-/* Node k's neighbour j in slot o (-1: none) in a sweep: s -= A_kj x_j when the sweep takes
- * it (backward: every neighbour; forward: those before k, the nodes after being still zero),
- * its block into *B (NULL when not taken). */
-static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, int forward,
-                           const float **B, double *s)
+/* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
+ * k (the nodes after are still zero), its block into *B (NULL when not). */
+static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const float **B,
+                           double *s)
 {
     *B = NULL;
-    if (j < 0 || (forward && j > k))
+    if (j < 0 || j > k)
         return;
     *B = off_block(L, (size_t)k, o, j);
     fsym_sub(*B, L->x + 3 * (size_t)j, s);
 }
 
-/* Node k of a sweep with its 8 neighbours j (slot order, the centre's entry unused). */
-static inline void gs_node(mg_level *L, int64_t k, const int64_t *j, int forward)
+/* x_k = D_k^-1 s. */
+static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
 {
-    const double *R = L->r + 3 * (size_t)k;
-    double s[3] = {R[0], R[1], R[2]};
-    const float *B[9];
-    gs_take(L, k, 0, j[0], forward, &B[0], s);
-    gs_take(L, k, 1, j[1], forward, &B[1], s);
-    gs_take(L, k, 2, j[2], forward, &B[2], s);
-    gs_take(L, k, 3, j[3], forward, &B[3], s);
-    gs_take(L, k, 5, j[5], forward, &B[5], s);
-    gs_take(L, k, 6, j[6], forward, &B[6], s);
-    gs_take(L, k, 7, j[7], forward, &B[7], s);
-    gs_take(L, k, 8, j[8], forward, &B[8], s);
     const double *S = L->dinv + WS_SYM * (size_t)k;
     double *X = L->x + 3 * (size_t)k;
     X[0] = X[1] = X[2] = 0.0;
     ws_sym_madd(S, s[0], s[1], s[2], X);
-    if (!forward)
-        return;
-    for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
-        if (o != CENTRE && B[o])
-            fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
 }
 
-static void gauss_seidel(mg_level *L, int backward)
+/* The sweeps of block Gauss-Seidel on a coarse level L. Forward from x = 0: a node meets only
+ * the nodes before it (those after are still zero), and the sweep leaves the residual r - A x
+ * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
+ * as that node is solved, with the block its own solve has just read). */
+static void gauss_seidel_forward(mg_level *L)
 {
-    const int nx = L->nx, ny = L->ny;
-    if (!backward)
-        memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
-    for (int qy = 0; qy < ny; qy++) {
-        const int iy = backward ? ny - 1 - qy : qy;
-        /* the rows below, at and above iy (-1: none) */
-        const int64_t rows[3] = {iy > 0 ? (int64_t)nx * (iy - 1) : -1, (int64_t)nx * iy,
-                                 iy + 1 < ny ? (int64_t)nx * (iy + 1) : -1};
-        for (int qx = 0; qx < nx; qx++) {
-            const int ix = backward ? nx - 1 - qx : qx;
-            const int64_t cols[3] = {ix > 0 ? ix - 1 : L->closed ? nx - 1 : -1, ix,
-                                     ix + 1 < nx ? ix + 1 : L->closed ? 0 : -1};
+    memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
+    for (int iy = 0; iy < L->ny; iy++)
+        for (int ix = 0; ix < L->nx; ix++) {
+            const int64_t k = ix + (int64_t)L->nx * iy;
             int64_t j[9];
+            neighbours(L, ix, iy, j);
+            const double *R = L->r + 3 * (size_t)k;
+            double s[3] = {R[0], R[1], R[2]};
+            const float *B[9];
             for (int o = 0; o < 9; o++)
-                j[o] = rows[o / 3] < 0 || cols[o % 3] < 0 ? -1 : rows[o / 3] + cols[o % 3];
-            if (backward)
-                gs_node(L, rows[1] + ix, j, 0);
-            else
-                gs_node(L, rows[1] + ix, j, 1);
+                if (o != CENTRE)
+                    gs_take(L, k, o, j[o], &B[o], s);
+            gs_solve(L, k, s);
+            const double *X = L->x + 3 * (size_t)k;
+            for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
+                if (o != CENTRE && B[o])
+                    fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
         }
-    }
+}
+
+/* Backward from the x there is: node k meets every neighbour. */
+static void gauss_seidel_backward(mg_level *L)
+{
+    for (int iy = L->ny - 1; iy >= 0; iy--)
+        for (int ix = L->nx - 1; ix >= 0; ix--) {
+            const int64_t k = ix + (int64_t)L->nx * iy;
+            int64_t j[9];
+            neighbours(L, ix, iy, j);
+            const double *R = L->r + 3 * (size_t)k;
+            double s[3] = {R[0], R[1], R[2]};
+            for (int o = 0; o < 9; o++)
+                if (o != CENTRE && j[o] >= 0)
+                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
+            gs_solve(L, k, s);
+        }
 }
 
 /* Whether fine node i of level k is left out of P (a pinned film node: its dv is zero). */
@@ -529,8 +525,10 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
 }
 
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
- * interpolated along y into mg->row, then along x. */
-static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x)
+ * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
+ * of the product that follows is taken on the way: t = r - N x. */
+static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
+                        double *t)
 {
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
@@ -548,16 +546,22 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x)
         }
         for (int ix = 0; ix < f->nx; ix++) {
             const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-            if (left_out(web, k, i))
-                continue;
-            const map1d *mx = &f->mx[ix];
             double *X = x + 3 * (size_t)i;
-            for (int a = 0; a < mx->n; a++) {
-                const double *U = u + 3 * (size_t)mx->c[a];
-                const double w = mx->w[a];
-                X[0] += w * U[0];
-                X[1] += w * U[1];
-                X[2] += w * U[2];
+            if (!left_out(web, k, i)) {
+                const map1d *mx = &f->mx[ix];
+                for (int a = 0; a < mx->n; a++) {
+                    const double *U = u + 3 * (size_t)mx->c[a];
+                    const double w = mx->w[a];
+                    X[0] += w * U[0];
+                    X[1] += w * U[1];
+                    X[2] += w * U[2];
+                }
+            }
+            if (r) {
+                const double *R = r + 3 * (size_t)i;
+                double *T = t + 3 * (size_t)i;
+                T[0] = R[0], T[1] = R[1], T[2] = R[2];
+                fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
             }
         }
     }
@@ -593,11 +597,11 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
         return;
     }
     mg_level *L = &mg->lv[k];
-    gauss_seidel(L, 0);
+    gauss_seidel_forward(L);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
-    prolong_add(mg, web, k, L->x);
-    gauss_seidel(L, 1);
+    prolong_add(mg, web, k, L->x, NULL, NULL);
+    gauss_seidel_backward(L);
 }
 
 /* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
@@ -674,8 +678,7 @@ double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
     }
     restrict_to(mg, web, 0, t);
     cycle(mg, web, 1);
-    prolong_add(mg, web, 0, z);
-    (void)film_nodes(mg, n, r, t, z, JACOBI_NONE, 1);
+    prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
     film_springs(mg, web, z, t);
     for (int s = 1; s < MG_SWEEPS; s++) {
         (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
