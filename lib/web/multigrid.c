@@ -221,10 +221,10 @@ static void pmap_diff(const pmap *p, const pmap *q, pmap *d)
     d->n = k;
 }
 
-/* The springs' part of level 1, P^T (sum over springs of E^T K E) P, into mg->sacc: it changes
- * only when the springs' blocks do (once a step; the contacts, which change between the solves
- * of a step, are on the nodes' blocks). */
-static void galerkin_springs(ws_mg *mg, const ws_web *web)
+/* The part of level 1 that stays over a step h, into mg->sacc: P^T (sum over springs of E^T K
+ * E + the nodes' (m + h c) I) P. It changes only when the springs' blocks do (once a step); the
+ * contacts, which change between the solves of a step, add to the nodes' blocks. */
+static void galerkin_springs(ws_mg *mg, const ws_web *web, double h)
 {
     const ws_implicit *im = web->imp;
     const mg_level *c = &mg->lv[1];
@@ -248,18 +248,34 @@ static void galerkin_springs(ws_mg *mg, const ws_web *web)
         pmap_diff(&p, &q, &d);
         add_outer(c, mg->sacc, &d, S);
     }
+    for (uint32_t i = 0; i < web->n; i++) {
+        const double m = web->m[i] + h * web->damping;
+        const double S[WS_SYM] = {[WS_SYM_XX] = m, [WS_SYM_YY] = m, [WS_SYM_ZZ] = m};
+        film_pmap(mg, web, i, &p);
+        add_outer(c, mg->sacc, &p, S);
+    }
 }
 
-/* Level 1 = P^T A P: the springs' part (kept) and the nodes' blocks as operator_for set them. */
-static void galerkin_film(ws_mg *mg, const ws_web *web)
+/* Level 1 = P^T A P over step h: the part kept over the step and the contacts' blocks of the
+ * nodes that have any, h^2 K + h D as operator_for takes them. */
+static void galerkin_film(ws_mg *mg, const ws_web *web, double h)
 {
     const ws_implicit *im = web->imp;
     const mg_level *c = &mg->lv[1];
     memcpy(mg->acc, mg->sacc, STEN * (size_t)c->n * sizeof(double));
     pmap p;
     for (uint32_t i = 0; i < web->n; i++) {
+        const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
+        double S[WS_SYM];
+        int any = 0;
+        for (int k = 0; k < WS_SYM; k++) {
+            S[k] = h * h * kc[k] + h * dc[k];
+            any |= S[k] != 0.0;
+        }
+        if (!any)
+            continue;
         film_pmap(mg, web, i, &p);
-        add_outer(c, mg->acc, &p, im->nd + WS_SYM * (size_t)i);
+        add_outer(c, mg->acc, &p, S);
     }
 }
 
@@ -388,7 +404,7 @@ static int factor_coarsest(ws_mg *mg)
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
-        galerkin_springs(mg, web);
+        galerkin_springs(mg, web, h);
         mg->springs_kept = 1;
         mg->kept_begun = begun;
         mg->kept_h = h;
@@ -398,7 +414,7 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
         mg->fnd[q] = (float)im->nd[q];
         mg->fpinv[q] = (float)(MG_OMEGA * im->pinv[q]);
     }
-    galerkin_film(mg, web);
+    galerkin_film(mg, web, h);
     store_level(mg, 1);
     for (int k = 1; k + 1 < mg->nlev; k++) {
         galerkin_level(mg, k);
