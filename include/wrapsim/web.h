@@ -61,7 +61,7 @@ typedef enum ws_web_preconditioner {
 
 /** WS_WEB_PRECONDITIONER_AUTO takes multigrid from this many nodes of a grid web on: below it,
  *  block Jacobi's cheaper iterations win (bench/NOTES.md, "the crossing"). */
-#define WS_WEB_MULTIGRID_AUTO_NODES 1500
+#define WS_WEB_MULTIGRID_AUTO_NODES 15000
 
 /** What every web has. Fill with ws_web_def_init(). */
 typedef struct ws_web_def {
