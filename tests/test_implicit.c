@@ -1168,8 +1168,8 @@ static ws_world *choice_drum(int nx, int ny, int pre, double tol, ws_web_id *id,
 
 START_TEST(test_preconditioner_choice)
 {
-    /* Bad values are refused by name; MULTIGRID on a web it cannot serve (a string: no grid to
-     * coarsen) too; AUTO takes the multigrid on a grid web from WS_WEB_MULTIGRID_AUTO_NODES
+    /* Bad values are refused by name; MULTIGRID on a web it cannot serve (a grid of 4 x 4
+     * nodes: WS_MG_MIN_NODES is 17, a coarse level and a coarsest one) too; AUTO takes the multigrid on a grid web from WS_WEB_MULTIGRID_AUTO_NODES
      * nodes on and block Jacobi below; BLOCK_JACOBI is taken as asked. */
     ws_web_id id;
     ws_status st;
@@ -1194,7 +1194,8 @@ START_TEST(test_preconditioner_choice)
                       ws_world_last_error(w));
         ws_world_destroy(w);
     }
-    ck_assert_ptr_null(choice_drum(40, 1, WS_WEB_PRECONDITIONER_MULTIGRID, 1e-6, &id, &st));
+    ck_assert_int_eq(WS_MG_MIN_NODES, 17);
+    ck_assert_ptr_null(choice_drum(4, 4, WS_WEB_PRECONDITIONER_MULTIGRID, 1e-6, &id, &st));
     ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
     const int nx = 40, ny = (WS_WEB_MULTIGRID_AUTO_NODES + nx - 1) / nx; /* nx ny >= AUTO */
     const struct {

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
-#define MG_COARSEST 64 /* a level of this many nodes or fewer is the coarsest */
+#define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
 /* The film level's smoother: damped block Jacobi, this many sweeps before and after the coarse
  * correction, with weight MG_OMEGA. The film's matrix is at most twice its block diagonal
  * (A = N + sum over springs of E^T K E with E = e_a - e_b, and 2 D - A = N + sum (e_a + e_b)^T

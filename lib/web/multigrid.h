@@ -17,9 +17,9 @@
 
 typedef struct ws_mg ws_mg;
 
-/* A grid web has at least this many nodes (one coarse level of at most 64), and its coarsest
- * level at most WS_MG_COARSEST_MAX (a dense factor). */
-#define WS_MG_MIN_NODES 65
+/* A grid web has at least this many nodes (one coarse level of at most MG_COARSEST, 16), and
+ * its coarsest level at most WS_MG_COARSEST_MAX (a dense factor). */
+#define WS_MG_MIN_NODES 17
 #define WS_MG_COARSEST_MAX 128
 
 /* Whether the multigrid can serve the web: a grid (sheet or band) whose springs all join grid
