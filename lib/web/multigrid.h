@@ -1,13 +1,14 @@
 /* A geometric multigrid preconditioner for the implicit film's solve on grid webs (web module,
  * used by web/implicit.c; docs/theory.md, "The implicit film", says why). The film's grid
  * (node i + nx j, closed around when it is a band) is coarsened by two in each direction, level
- * after level, to a few dozen nodes; each coarser matrix is the Galerkin product P^T A P of the
+ * after level, to at most 16 nodes; each coarser matrix is the Galerkin product P^T A P of the
  * finer one with bilinear interpolation P, so it stays symmetric positive definite and needs no
  * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
- * matrix-free operator, symmetric block Gauss-Seidel (forward before, backward after the coarse
- * correction) on the coarse levels, a dense Cholesky factor on the coarsest. The cycle is the
- * same linear, symmetric positive definite map on every call, so conjugate gradients stay
- * valid with it.
+ * matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
+ * Gauss-Seidel (forward before, backward after the coarse correction) on the coarse levels
+ * (their blocks in single precision too), a dense Cholesky factor on the coarsest. The cycle is
+ * the same linear, symmetric positive definite map on every call of a solve, so conjugate
+ * gradients stay valid with it (docs/theory.md 8a: why the rounding keeps it so).
  *
  * Node vectors are xyz per node (3 n doubles), as in web/implicit.h. */
 #ifndef WS_WEB_MULTIGRID_H
