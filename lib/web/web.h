@@ -128,6 +128,7 @@ typedef struct ws_web {
     int integrator;
     double solver_tol;
     int solver_maxit;
+    int precond; /* ws_web_preconditioner (web/multigrid.c's ws_mg_reserve takes it) */
     struct ws_implicit *imp;
 } ws_web;
 
