@@ -83,7 +83,7 @@ typedef struct ws_node_contact {
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
-    size_t act_nl;      /* loads listed in act since the sub-step began (contact/node_force.c) */
+    size_t act_nl;      /* loads (or their folds) listed in act since the sub-step began */
     uint32_t lane_end;  /* one past the last node of the lane sweeping this copy (n: one lane) */
     int runs_off;       /* no short cuts: no runs and no corners, every candidate one by one
                            through its full tests (tests compare the two) */
@@ -293,11 +293,15 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
 /* A sub-step starts (on the web or a lane of it): the runs' faces are taken afresh, the list of
  * loads is empty. */
 void ws_node_substep(ws_node_contact *nc);
-/* The loads on the bodies listed since ws_node_substep, in node order, added to the per-body
- * totals bforce and bmoment (global, moment about the CoG), which the step adds to the
- * bodies. Lanes' lists are added in the order of their nodes, so the totals are those of one
- * sweep to the bit. */
+/* The loads on the bodies listed since ws_node_substep, in the list's order, added to the
+ * per-body totals bforce and bmoment (global, moment about the CoG), which the step adds to the
+ * bodies; the list is then empty. */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment);
+/* The loads listed from place `from` on (in node order) folded in place: each run of loads on
+ * one body summed from its first, the list then ending after the sums. A sweep folds each row's
+ * loads (world_step.c), whose cut, unlike the lanes', does not depend on the worker count; the
+ * totals (ws_node_loads) are then the same to the bit for any number of lanes. */
+void ws_node_loads_fold(ws_node_contact *nc, size_t from);
 /* The first stretch whose nodes start at n0 or later (where a lane starting at n0 begins). */
 size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0);
 /* Room in `lane`, a lane's own scratch (world_step.c), for evaluating ncand candidates of a

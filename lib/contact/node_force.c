@@ -247,32 +247,30 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
     }
 }
 
-/* The loads on the bodies, added to their totals in order (the running sums of the body at
- * hand kept in registers). */
+/* The loads on the bodies, added to their totals in the list's order. */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
 {
-    const act_list L0 = act_open(nc), *L = &L0;
-    uint32_t body = UINT32_MAX;
-    v3 bf = v3_make(0, 0, 0), bm = bf;
-    for (size_t q = 0; q < L->nl; q++) {
-        const uint32_t bi = L->lbody[q];
-        if (bi != body) {
-            if (body != UINT32_MAX) {
-                bforce[body] = bf;
-                bmoment[body] = bm;
-            }
-            body = bi;
-            bf = bforce[bi];
-            bm = bmoment[bi];
-        }
-        bf = v3_add(bf, L->load[q].f);
-        bm = v3_add(bm, L->load[q].m);
-    }
-    if (body != UINT32_MAX) {
-        bforce[body] = bf;
-        bmoment[body] = bm;
+    const act_list L = act_open(nc);
+    for (size_t q = 0; q < L.nl; q++) {
+        bforce[L.lbody[q]] = v3_add(bforce[L.lbody[q]], L.load[q].f);
+        bmoment[L.lbody[q]] = v3_add(bmoment[L.lbody[q]], L.load[q].m);
     }
     nc->act_nl = 0;
+}
+
+void ws_node_loads_fold(ws_node_contact *nc, size_t from)
+{
+    const act_list L = act_open(nc);
+    size_t k = from;
+    for (size_t q = from; q < L.nl; k++) {
+        const uint32_t bi = L.lbody[q];
+        act_load s = L.load[q++];
+        for (; q < L.nl && L.lbody[q] == bi; q++)
+            s = (act_load){v3_add(s.f, L.load[q].f), v3_add(s.m, L.load[q].m)};
+        L.load[k] = s;
+        L.lbody[k] = bi;
+    }
+    nc->act_nl = k;
 }
 
 /* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */

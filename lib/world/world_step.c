@@ -234,7 +234,11 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
         const int edges = (j == J->r0 && j > 0 ? WS_WEB_LANE_FIRST : 0) |
                           (j1 == J->r1 && j1 < rows ? WS_WEB_LANE_LAST : 0);
         ws_web_forces_rows(web, &P, j, j1, edges, &n0, &n1);
+        /* The block's loads on the bodies folded apart: blocks, unlike lanes, do not depend
+         * on the worker count, so neither do the totals (lane_close). */
+        const size_t from = J->cview.act_nl;
         ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
+        ws_node_loads_fold(&J->cview, from);
         J->fast += ws_web_integrate_block(web, &P, n0, n1);
     }
     ws_web_sweep_end(web);
@@ -270,9 +274,10 @@ static uint32_t web_lanes(const ws_world *w, const ws_web *web)
 /* The rows of each of the lanes (r0, r1), cut so that their work is about equal: a row costs
  * its nodes (springs, integration, a contact each in a run) and 0.6 of a node for each
  * candidate it takes one by one (a fit of the lanes' times on the wrapped reference case).
- * Every lane but the last holds a block's rows at least, the last a row: the run kernel's
- * groups, which may start up to three nodes before a node of the lane's end, stay within it.
- * The results do not depend on the cut. */
+ * Lanes are cut between sweep blocks (of r rows from the first), each lane a block at least:
+ * a block's loads on the bodies are summed apart (sweep_lane), so that the totals do not
+ * depend on the cut, and the run kernel's groups, which may start up to three nodes before a
+ * node of the lane's end, stay within it. */
 static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
 {
     ws_lane_job *J = w->lane_job;
@@ -283,6 +288,7 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     }
     const ws_node_contact *nc = web->contact;
     const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny, r = ws_web_block_rows(web);
+    const uint32_t blocks = ws_web_block_count(web);
     const int segs = nc->seg_list == nc->next_list;
     uint64_t total = 5ull * nx * ny, acc = 0;
     for (size_t s = 0; segs && s < nc->nseg; s++)
@@ -293,9 +299,12 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
         acc += 5ull * nx; /* row j, with its stretches */
         for (; segs && s < nc->nseg && nc->seg[s].n0 < nx * (j + 1); s++)
             acc += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
-        /* Lane i starts after row j once the lanes before have their share, within room. */
-        const uint32_t lo = J[i - 1].r0 + r, hi = ny - (lanes - i - 1) * r - 1;
-        if ((acc * lanes >= total * i && j + 1 >= lo) || j + 1 == hi) {
+        /* Lane i starts after block (j + 1) / r - 1 once the lanes before have their share,
+         * leaving a block to each lane after it. */
+        if ((j + 1) % r)
+            continue;
+        const uint32_t done = (j + 1) / r;
+        if ((acc * lanes >= total * i && j + 1 > J[i - 1].r0) || done == blocks - (lanes - i)) {
             J[i - 1].r1 = J[i].r0 = j + 1;
             i++;
         }
@@ -419,8 +428,8 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
     c->rface_gen = J->own.rface_gen;
 }
 
-/* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
- * its counts. Returns its nodes too fast. */
+/* What lane i found into the web, in lane order: its loads on the bodies (folded by rows and
+ * bodies, ws_node_loads_fold), its touched nodes, its counts. Returns its nodes too fast. */
 static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *bmoment)
 {
     ws_lane_job *J = &w->lane_job[i];
