@@ -184,9 +184,17 @@ typedef struct ws_node_geom {
     uint8_t *ready;
 } ws_node_geom;
 
+struct ws_node_step;
+/* A search of node candidates as ws_node_find does it from first = 0, for the nodes listed
+ * (0 .. count - 1 when nodes is NULL), into L (empty): the world's, in pieces on its threads.
+ * 0, or -1 when out of memory. */
+typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const uint32_t *nodes,
+                              size_t count, ws_ncand_list *L);
+
 /* What a step's search of node candidates reads and counts: the world's allocator, the bodies
- * at state cur with their features (g, whose scratch the search uses), the contact margin, and
- * where feature checks are counted. */
+ * at state cur with their features (g, whose scratch the search uses), the contact margin,
+ * where feature checks are counted, and who searches (search; NULL: ws_node_find, here), with
+ * its context. */
 typedef struct ws_node_step {
     ws_mem *mem;
     const ws_body_store *b;
@@ -194,7 +202,21 @@ typedef struct ws_node_step {
     ws_node_geom *g;
     double margin;
     uint64_t *checks;
+    ws_node_search_fn *search;
+    void *search_ctx;
 } ws_node_step;
+
+/* The search's scratch in g, from its arena (g->arena), at its most for a group of nodes: for
+ * ws_node_find. 0, or -1 when out of memory. */
+int ws_node_find_scratch(const ws_body_store *b, ws_node_geom *g);
+/* The candidates of `count` nodes of web at state S->cur, nodes[0, count) (increasing) or, when
+ * nodes is NULL, first .. first + count - 1, appended to L in node order, body by body in slot
+ * order: the same for a node however the nodes are cut into pieces. Each body near one of them
+ * is marked in web->contact->cbody (room for every body slot). Checks count in *S->checks.
+ * With S->mem NULL (a piece on a worker) L does not grow: -1 when its room runs out, as when
+ * out of memory. 0 otherwise. */
+int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint32_t first,
+                 size_t count, ws_ncand_list *L);
 
 /* The first of the two calls of a step before a web's sub-steps: whether every node is to be
  * found again at state cur (when `all`, the record of the last search is invalid, or a body

@@ -387,12 +387,110 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
     return flagged;
 }
 
+/* The search of node candidates in pieces on the world's threads (ws_node_search_fn, its
+ * context the world): the nodes cut into pieces of about equal counts, one a lane at most and
+ * SEARCH_PIECE nodes each at least, each piece searched (ws_node_find) with its own scratch,
+ * into its own list, marking the bodies near in its own copy of the marks; then, here, the
+ * lists joined in piece order (node order), the marks and the checks added. A node's
+ * candidates do not depend on the pieces (ws_node_find), so neither does the list. The pieces
+ * cannot grow their lists (the allocator is the calling thread's): one whose room runs out is
+ * searched again here. */
+enum { SEARCH_PIECE = 48 };
+
+typedef struct search_task {
+    ws_world *w;
+    const ws_node_step *S;
+    const uint32_t *nodes;
+    size_t count;
+    uint32_t pieces;
+} search_task;
+
+/* Piece i, its list growing through mem (NULL: not at all). */
+static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
+{
+    ws_lane_job *J = &T->w->lane_job[i];
+    const size_t q0 = (size_t)((uint64_t)i * T->count / T->pieces),
+                 q1 = (size_t)((uint64_t)(i + 1) * T->count / T->pieces);
+    ws_node_step s = *T->S;
+    s.mem = mem;
+    s.g = &J->geom;
+    s.checks = &J->found_checks;
+    s.search = NULL;
+    J->found.n = 0;
+    J->found_checks = 0;
+    J->found_bad = ws_node_find(&s, &J->view, T->nodes ? T->nodes + q0 : NULL, (uint32_t)q0,
+                                q1 - q0, &J->found) != 0;
+}
+
+static void search_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker;
+    for (int32_t i = start; i < end; i++)
+        search_piece(ctx, (uint32_t)i, NULL);
+}
+
+static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
+                        ws_ncand_list *L)
+{
+    ws_world *w = S->search_ctx;
+    uint32_t pieces = web_lanes(w, web);
+    if (count / SEARCH_PIECE < pieces)
+        pieces = (uint32_t)(count / SEARCH_PIECE);
+    if (pieces < 2) {
+        ws_node_step s = *S;
+        s.search = NULL;
+        return ws_node_find_scratch(S->b, S->g) ? -1 : ws_node_find(&s, web, nodes, 0, count, L);
+    }
+    const size_t slots = S->b->slots + 1, room = w->search_tight ? 8 : 2 * (count / pieces) + 64;
+    for (uint32_t i = 0; i < pieces; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        J->geom = *S->g;
+        J->view = *web;
+        J->cview = *web->contact;
+        J->view.contact = &J->cview;
+        J->cview.cbody_cap = slots;
+        if (ws_node_find_scratch(S->b, &J->geom) != 0 ||
+            !(J->cview.cbody = ws_arena_calloc(S->g->arena, slots, 1)) ||
+            ws_array_reserve(S->mem, (void **)&J->found.c, &J->found.cap, room,
+                             sizeof *J->found.c) != 0)
+            return -1;
+    }
+    const search_task T = {w, S, nodes, count, pieces};
+    run_task(w, search_items, pieces, (void *)&T);
+    size_t total = 0;
+    for (uint32_t i = 0; i < pieces; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        if (J->found_bad) {
+            w->search_reruns++;
+            search_piece(&T, i, S->mem);
+        }
+        if (J->found_bad)
+            return -1;
+        total += J->found.n;
+    }
+    if (ws_array_reserve(S->mem, (void **)&L->c, &L->cap, total + 1, sizeof *L->c) != 0)
+        return -1;
+    L->n = 0;
+    for (uint32_t i = 0; i < pieces; i++) {
+        const ws_lane_job *J = &w->lane_job[i];
+        if (J->found.n)
+            memcpy(L->c + L->n, J->found.c, J->found.n * sizeof *L->c);
+        L->n += J->found.n;
+        *S->checks += J->found_checks;
+        for (size_t k = 0; k + 1 < slots; k++)
+            web->contact->cbody[k] |= J->cview.cbody[k];
+    }
+    return 0;
+}
+
 void ws_world_lanes_free(ws_world *w)
 {
     const size_t jobs = (size_t)WS_LANES_PER_WORKER * w->def.worker_count;
     for (size_t i = 0; w->lane_job && i < jobs; i++) {
         ws_lane_job *J = &w->lane_job[i];
         ws_node_scratch_free(&w->mem, &J->own);
+        ws_mem_free(&w->mem, J->found.c, J->found.cap * sizeof *J->found.c);
+        J->found = (ws_ncand_list){NULL, 0, 0};
         J->tmp = NULL; /* the arena's */
         J->fct = NULL;
     }
@@ -491,8 +589,14 @@ static ws_status step_webs(ws_step *S)
         if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
             flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
-        const ws_node_step ns = {&w->mem, b, cur, &w->node_geom, S->contact.margin,
-                                 &S->stats->narrow_checks};
+        const ws_node_step ns = {&w->mem,
+                                 b,
+                                 cur,
+                                 &w->node_geom,
+                                 S->contact.margin,
+                                 &S->stats->narrow_checks,
+                                 lanes > 1 ? search_lanes : NULL,
+                                 w};
         if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
