@@ -1016,7 +1016,8 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
 
 /* Node candidates of a web at state S->cur: every node-face and node-edge pair within the
  * layers + margin, for the nodes listed (all when `nodes` is NULL), sorted by node, into L (by
- * S->search when set). 0, or -1 when out of memory. */
+ * S->search when set, which may say 1: the same as the committed list's). 0, or -1 when out of
+ * memory. */
 static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
                            ws_ncand_list *L)
 {
@@ -1165,9 +1166,10 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
 {
     ws_node_contact *nc = web->contact;
     const ws_node_found F = {nc->moved, moved, &nc->fresh};
-    if (find_candidates(S, web, nc->moved, moved, &nc->fresh) != 0)
+    const int found = find_candidates(S, web, nc->moved, moved, &nc->fresh);
+    if (found < 0)
         return -1;
-    if (ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
+    if (found == 1 || ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
         *list = old;
         return 0;
     }
@@ -1206,7 +1208,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
             nc->seg_list = -1;
         int bad;
         if (all) {
-            bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]);
+            bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]) < 0;
             if (!bad)
                 ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
         } else {

@@ -187,7 +187,8 @@ typedef struct ws_node_geom {
 struct ws_node_step;
 /* A search of node candidates as ws_node_find does it from first = 0, for the nodes listed
  * (0 .. count - 1 when nodes is NULL), into L (empty): the world's, in pieces on its threads.
- * 0, or -1 when out of memory. */
+ * 0, or 1 when the nodes are listed and their candidates found are those the committed list
+ * holds for them (ws_node_same, which it may leave undone: then 0), or -1 when out of memory. */
 typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const uint32_t *nodes,
                               size_t count, ws_ncand_list *L);
 

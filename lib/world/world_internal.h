@@ -42,7 +42,8 @@ typedef struct ws_lane_job {
     ws_node_geom geom;
     ws_ncand_list found;
     uint64_t found_checks;
-    int found_bad; /* the piece ran out of room in found (or of memory) */
+    int found_bad;  /* the piece ran out of room in found (or of memory) */
+    int found_same; /* its nodes' candidates found are those the committed list holds */
 } ws_lane_job;
 /* Per material, the two lightest dynamic bodies (slots, UINT32_MAX for none) and a kinematic
  * body of it (scratch of ws_world_contact_limit). */

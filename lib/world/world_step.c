@@ -391,8 +391,10 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
  * context the world): the nodes cut into pieces of about equal counts, one a lane at most and
  * SEARCH_PIECE nodes each at least, each piece searched (ws_node_find) with its own scratch,
  * into its own list, marking the bodies near in its own copy of the marks; then, here, the
- * lists joined in piece order (node order), the marks and the checks added. A node's
- * candidates do not depend on the pieces (ws_node_find), so neither does the list. The pieces
+ * lists joined in piece order (node order), the marks and the checks added; each piece also
+ * compares its nodes' candidates with the committed list's (ws_node_same), which is the same
+ * when every piece's is. A node's candidates do not depend on the pieces (ws_node_find), so
+ * neither does the list. The pieces
  * cannot grow their lists (the allocator is the calling thread's): one whose room runs out is
  * searched again here. */
 enum { SEARCH_PIECE = 48 };
@@ -400,6 +402,7 @@ enum { SEARCH_PIECE = 48 };
 typedef struct search_task {
     ws_world *w;
     const ws_node_step *S;
+    const ws_web *web;
     const uint32_t *nodes;
     size_t count;
     uint32_t pieces;
@@ -418,8 +421,11 @@ static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
     s.search = NULL;
     J->found.n = 0;
     J->found_checks = 0;
-    J->found_bad = ws_node_find(&s, &J->view, T->nodes ? T->nodes + q0 : NULL, (uint32_t)q0,
-                                q1 - q0, &J->found) != 0;
+    const uint32_t *nodes = T->nodes ? T->nodes + q0 : NULL;
+    J->found_bad = ws_node_find(&s, &J->view, nodes, (uint32_t)q0, q1 - q0, &J->found) != 0;
+    const ws_node_contact *nc = T->web->contact;
+    const ws_node_found F = {nodes, q1 - q0, &J->found};
+    J->found_same = nodes && !J->found_bad && ws_node_same(&F, nc->cstart, nc->cand[nc->list].c);
 }
 
 static void search_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
@@ -455,7 +461,7 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
                              sizeof *J->found.c) != 0)
             return -1;
     }
-    const search_task T = {w, S, nodes, count, pieces};
+    const search_task T = {w, S, web, nodes, count, pieces};
     run_task(w, search_items, pieces, (void *)&T);
     size_t total = 0;
     for (uint32_t i = 0; i < pieces; i++) {
@@ -471,8 +477,10 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
     if (ws_array_reserve(S->mem, (void **)&L->c, &L->cap, total + 1, sizeof *L->c) != 0)
         return -1;
     L->n = 0;
+    int same = nodes != NULL;
     for (uint32_t i = 0; i < pieces; i++) {
         const ws_lane_job *J = &w->lane_job[i];
+        same &= J->found_same;
         if (J->found.n)
             memcpy(L->c + L->n, J->found.c, J->found.n * sizeof *L->c);
         L->n += J->found.n;
@@ -480,7 +488,7 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
         for (size_t k = 0; k + 1 < slots; k++)
             web->contact->cbody[k] |= J->cview.cbody[k];
     }
-    return 0;
+    return same;
 }
 
 void ws_world_lanes_free(ws_world *w)
