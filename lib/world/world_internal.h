@@ -129,6 +129,8 @@ struct ws_world {
     ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
     ws_pool *pool;            /* the world's own threads (worker_count > 1, no host scheduler) */
     struct ws_lane_job *lane_job; /* a parallel sweep's lanes, WS_LANES_PER_WORKER a worker */
+    const struct ws_web *cut_web; /* the web whose lanes' cut lane_job holds, made at step */
+    uint64_t cut_step;            /* cut_step (world_step.c, lanes_cut) */
     int search_tight;       /* tests: the pieces of a search start with room for 8 candidates */
     uint64_t search_reruns; /* pieces of a search searched again, their room run out */
     size_t node_par_cap;

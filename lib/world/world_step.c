@@ -271,6 +271,19 @@ static uint32_t web_lanes(const ws_world *w, const ws_web *web)
     return lanes < 2 || !ws_web_sweep_parallel(web) ? 1 : lanes;
 }
 
+/* Whether the lanes' rows cover the web's ny rows in order, each lane some, cut between blocks
+ * of r rows (1: anywhere). */
+static int lanes_cover(const ws_lane_job *J, uint32_t lanes, uint32_t ny, uint32_t r)
+{
+    int ok = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
+    for (uint32_t i = 0; i < lanes; i++)
+        ok &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1) &&
+              J[i].r0 % r == 0;
+    return ok;
+}
+
+enum { LANES_CUT_EVERY = 16 };
+
 /* The rows of each of the lanes (r0, r1), cut so that their work is about equal: a row costs
  * its nodes (springs, integration, a contact each in a run) and 0.6 of a node for each
  * candidate it takes one by one (a fit of the lanes' times on the wrapped reference case).
@@ -288,6 +301,14 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     }
     const ws_node_contact *nc = web->contact;
     const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny, r = ws_web_block_rows(web);
+    /* The cut of the last steps serves this web for LANES_CUT_EVERY steps while it is whole
+     * blocks: the work moves slowly, and the cost of a cut (a pass over the stretches) came to
+     * 0.9 instructions a node-update, alone on the calling thread. */
+    if (w->cut_web == web && w->steps - w->cut_step < LANES_CUT_EVERY &&
+        lanes_cover(J, lanes, ny, r))
+        return;
+    w->cut_web = web;
+    w->cut_step = w->steps;
     const uint32_t blocks = ws_web_block_count(web);
     const int segs = nc->seg_list == nc->next_list;
     uint64_t total = 5ull * nx * ny, acc = 0;
@@ -372,9 +393,7 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
 {
     ws_lane_job *J = w->lane_job;
     const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
-    int cut = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
-    for (uint32_t i = 0; i < lanes; i++)
-        cut &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1);
+    const int cut = lanes_cover(J, lanes, ny, 1);
     for (uint32_t i = 0; i < lanes && !cut; i++) {
         J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
         J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
