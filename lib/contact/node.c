@@ -1014,10 +1014,9 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
     return nb;
 }
 
-/* Node candidates of a web at state S->cur: every node-face and node-edge pair within the
- * layers + margin, for the nodes listed (all when `nodes` is NULL), sorted by node, into L (by
- * S->search when set, which may say 1: the same as the committed list's). 0, or -1 when out of
- * memory. */
+/* Node candidates of a web at state S->cur (the node-feature pairs within the layers + margin)
+ * of the nodes listed (all when NULL), sorted by node, into L; by S->search when set (1: those
+ * the committed list holds). 0, or -1 when out of memory. */
 static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
                            ws_ncand_list *L)
 {
@@ -1030,7 +1029,8 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
     count = nodes ? count : web->n;
     if (S->search && count)
         return S->search(S, web, nodes, count, L);
-    return count && ws_node_find_scratch(S->b, S->g) ? -1 : ws_node_find(S, web, nodes, 0, count, L);
+    return count && ws_node_find_scratch(S->b, S->g) ? -1
+                                                     : ws_node_find(S, web, nodes, 0, count, L);
 }
 
 int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint32_t first,

@@ -84,6 +84,8 @@ typedef struct ws_node_contact {
     size_t nseg, seg_cap;
     int seg_list;
     size_t act_nl;      /* loads (or their folds) listed in act since the sub-step began */
+    size_t *row_mark;   /* when set (a grid web's lane), where each row's loads start in the */
+    size_t nrow_mark;   /* list, noted by ws_node_contacts (room for a sweep block's rows) */
     uint32_t lane_end;  /* one past the last node of the lane sweeping this copy (n: one lane) */
     int runs_off;       /* no short cuts: no runs and no corners, every candidate one by one
                            through its full tests (tests compare the two) */
@@ -320,11 +322,11 @@ void ws_node_substep(ws_node_contact *nc);
  * per-body totals bforce and bmoment (global, moment about the CoG), which the step adds to the
  * bodies; the list is then empty. */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment);
-/* The loads listed from place `from` on (in node order) folded in place: each run of loads on
- * one body summed from its first, the list then ending after the sums. A sweep folds each row's
- * loads (world_step.c), whose cut, unlike the lanes', does not depend on the worker count; the
- * totals (ws_node_loads) are then the same to the bit for any number of lanes. */
-void ws_node_loads_fold(ws_node_contact *nc, size_t from);
+/* The loads listed at [from, to) (in node order) folded, each run of loads on one body summed
+ * from its first, the sums written from place `at` (<= from) on: the place after them. A sweep
+ * folds each row's loads (world_step.c), rows, unlike lanes, do not depend on the worker count,
+ * so the totals (ws_node_loads) are the same to the bit for any number of lanes. */
+size_t ws_node_loads_fold(ws_node_contact *nc, size_t from, size_t to, size_t at);
 /* The first stretch whose nodes start at n0 or later (where a lane starting at n0 begins). */
 size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0);
 /* Room in `lane`, a lane's own scratch (world_step.c), for evaluating ncand candidates of a

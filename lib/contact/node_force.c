@@ -247,7 +247,6 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
     }
 }
 
-/* The loads on the bodies, added to their totals in the list's order. */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
 {
     const act_list L = act_open(nc);
@@ -258,19 +257,18 @@ void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
     nc->act_nl = 0;
 }
 
-void ws_node_loads_fold(ws_node_contact *nc, size_t from)
+size_t ws_node_loads_fold(ws_node_contact *nc, size_t from, size_t to, size_t at)
 {
     const act_list L = act_open(nc);
-    size_t k = from;
-    for (size_t q = from; q < L.nl; k++) {
+    for (size_t q = from; q < to; at++) {
         const uint32_t bi = L.lbody[q];
         act_load s = L.load[q++];
-        for (; q < L.nl && L.lbody[q] == bi; q++)
+        for (; q < to && L.lbody[q] == bi; q++)
             s = (act_load){v3_add(s.f, L.load[q].f), v3_add(s.m, L.load[q].m)};
-        L.load[k] = s;
-        L.lbody[k] = bi;
+        L.load[at] = s;
+        L.lbody[at] = bi;
     }
-    nc->act_nl = k;
+    return at;
 }
 
 /* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
@@ -1052,9 +1050,11 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
     const ws_nseg *seg = nc->seg;
     const size_t nseg = nc->nseg;
     uint64_t tried = 0;
-    for (; k < nseg && seg[k].n0 < n1; k++) {
+    for (uint32_t row = UINT32_MAX; k < nseg && seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &seg[k];
         tried += sg->c1 - sg->c0;
+        if (nc->row_mark && sg->n0 / (uint32_t)web->nx != row) /* a row's first stretch */
+            nc->row_mark[nc->nrow_mark++] = L.nl, row = sg->n0 / (uint32_t)web->nx;
         if (sg->run)
             contacts_run(&E, &B, cand, sg, h, share, fc);
         else

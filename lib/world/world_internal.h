@@ -38,6 +38,7 @@ typedef struct ws_lane_job {
     uint64_t checks;
     double *tmp;
     uint32_t *fct;
+    size_t *marks; /* where each row of a block starts in its loads (from the arena) */
     ws_node_contact own;
     ws_node_geom geom;
     ws_ncand_list found;
