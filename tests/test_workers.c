@@ -11,6 +11,7 @@
 #include <stdatomic.h>
 
 #include "base/pool.h"
+#include "world/world_internal.h"
 #include "helpers.h"
 
 static int short_run(void)
@@ -124,6 +125,8 @@ typedef struct sheet_run {
     int workers;
     int host; /* 0: the world's threads (or none), 1: reverse order, 2: a thread an item */
     int law_type;
+    int tight; /* the pieces of a search start with little room, so that some run again */
+    uint64_t *reruns; /* where to put how many did (may be NULL) */
 } sheet_run;
 
 /* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, dropped from
@@ -148,6 +151,7 @@ static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
     }
     ws_world *w = NULL;
     ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    w->search_tight = r->tight;
     add_ground(w, 2.0, no_material());
     ws_body_id box =
         add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
@@ -192,6 +196,8 @@ static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
     ck_assert_msg(press > 0.0, "the sheet never pressed on the box");
     uint64_t h = 0;
     ck_ok(w, ws_world_get_state_hash(w, &h));
+    if (r->reruns)
+        *r->reruns = w->search_reruns;
     ws_world_destroy(w);
     if (enqueued)
         *enqueued = calls;
@@ -208,7 +214,7 @@ static long sheet_steps(void)
 START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
         r.workers = k;
@@ -218,17 +224,27 @@ START_TEST(test_sheet_same_for_any_workers)
     }
     /* A host's scheduler: the pieces last first, then each on a thread of its own. */
     int calls = 0;
-    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC};
+    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
     uint64_t h = sheet_hash(&r, steps, &calls);
     ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
     ck_assert_msg(calls > 0, "the host's scheduler was never called");
-    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC};
+    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
     h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
-    report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers and both schedulers", steps,
-           (unsigned long long)one, short_run() ? 2 : 4);
+    /* The search of node candidates in pieces, each piece's list given little room: the
+     * pieces that run out are searched again on the world's thread, and the list is the
+     * same. */
+    uint64_t reruns = 0;
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns};
+    h = sheet_hash(&r, steps, NULL);
+    ck_assert_msg(h == one, "pieces searched again: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    ck_assert_msg(reruns > 0, "no piece of a search ran out of room");
+    report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers, both schedulers and %llu "
+           "pieces of searches run again",
+           steps, (unsigned long long)one, short_run() ? 2 : 4, (unsigned long long)reruns);
 }
 END_TEST
 
@@ -238,14 +254,14 @@ START_TEST(test_sheet_law_with_history)
      * history or a user's function would be) sweeps in one lane whatever the workers: the
      * same hash, and the host's scheduler never called. */
     const long steps = short_run() ? 120 : 500;
-    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC};
+    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     int calls = 0;
-    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC};
+    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL};
     ck_assert(sheet_hash(&r, steps, &calls) == one);
     ck_assert_int_eq(calls, 0);
     if (!short_run()) {
-        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC};
+        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL};
         ck_assert(sheet_hash(&r, steps, NULL) == one);
     }
 }

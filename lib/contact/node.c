@@ -822,11 +822,12 @@ static void find_faces(const ws_shape *sh, const m3 *A, v3 r, double reach, doub
 }
 
 /* Room in L for every face and edge of shape sh past its end: one check, not one per
- * candidate. The list's candidates, or NULL when out of memory. */
+ * candidate. The list's candidates, or NULL when out of memory (or of room, mem NULL). */
 static ws_ncand *room_for(ws_mem *mem, ws_ncand_list *L, const ws_shape *sh)
 {
     const size_t room = L->n + sh->face_count + sh->edge_count;
-    if (room > L->cap && ws_array_reserve(mem, (void **)&L->c, &L->cap, room, sizeof *L->c) != 0)
+    if (room > L->cap &&
+        (!mem || ws_array_reserve(mem, (void **)&L->c, &L->cap, room, sizeof *L->c) != 0))
         return NULL;
     return L->c;
 }
@@ -946,10 +947,7 @@ static size_t face_values(const ws_shape *sh)
                : 0;
 }
 
-/* The scratch of the search in g, from the step's arena, at its most for a group of nodes
- * (every body near every node of the group), taken once for every group. 0, or -1 when out of
- * memory. */
-static int find_scratch(const ws_body_store *b, ws_node_geom *g)
+int ws_node_find_scratch(const ws_body_store *b, ws_node_geom *g)
 {
     size_t most_val = 1, most_mask = 1;
     for (uint32_t k = 0; k < b->slots; k++) {
@@ -1005,32 +1003,35 @@ static size_t near_bodies(const ws_node_step *S, ws_web *web, double (*p)[FIND_C
     return nb;
 }
 
-/* Node candidates of a web at state S->cur: every node-face and node-edge pair within the
- * layers + margin, for the nodes listed (all when `nodes` is NULL), sorted by node, into L. 0,
- * or -1 when out of memory. */
+/* Node candidates of a web at state S->cur (the node-feature pairs within the layers + margin)
+ * of the nodes listed (all when NULL), sorted by node, into L; by S->search when set (1: those
+ * the committed list holds). 0, or -1 when out of memory. */
 static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
                            ws_ncand_list *L)
 {
-    const ws_body_store *b = S->b;
     ws_node_contact *nc = web->contact;
-    const ws_nodes3 x = web->x[S->cur];
-    ws_node_geom *g = S->g;
     L->n = 0;
-    if (ws_array_reserve(S->mem, (void **)&nc->cbody, &nc->cbody_cap, b->slots + 1, 1) != 0)
+    if (ws_array_reserve(S->mem, (void **)&nc->cbody, &nc->cbody_cap, S->b->slots + 1, 1) != 0)
         return -1;
     if (!nodes) /* a full search: the list holds no other candidates */
         memset(nc->cbody, 0, nc->cbody_cap);
-    if (web->n == 0)
-        return 0;
-    if (!nodes)
-        count = web->n;
-    if (find_scratch(b, g) != 0)
-        return -1;
+    count = nodes ? count : web->n;
+    if (S->search && count)
+        return S->search(S, web, nodes, count, L);
+    return count && ws_node_find_scratch(S->b, S->g) ? -1
+                                                     : ws_node_find(S, web, nodes, 0, count, L);
+}
+
+int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint32_t first,
+                 size_t count, ws_ncand_list *L)
+{
+    const ws_nodes3 x = web->x[S->cur];
+    ws_node_geom *g = S->g;
     double p[3][FIND_CHUNK];
     for (size_t q0 = 0; q0 < count; q0 += FIND_CHUNK) {
         const size_t m = count - q0 < FIND_CHUNK ? count - q0 : (size_t)FIND_CHUNK;
         for (size_t j = 0; j < m; j++) {
-            uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
+            uint32_t i = nodes ? nodes[q0 + j] : first + (uint32_t)(q0 + j);
             p[0][j] = x.x[i];
             p[1][j] = x.y[i];
             p[2][j] = x.z[i];
@@ -1038,7 +1039,7 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
         const size_t nb = near_bodies(S, web, p, m);
         /* Node by node (the order the sub-steps take them in), against each body near it. */
         for (size_t j = 0; j < m; j++) {
-            const uint32_t i = nodes ? nodes[q0 + j] : (uint32_t)(q0 + j);
+            const uint32_t i = nodes ? nodes[q0 + j] : first + (uint32_t)(q0 + j);
             for (size_t q = 0; q < nb; q++) {
                 ws_find_body *fb = &g->find[q];
                 if (fb->next == fb->count || g->find_node[fb->node + fb->next] != j)
@@ -1154,9 +1155,10 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
 {
     ws_node_contact *nc = web->contact;
     const ws_node_found F = {nc->moved, moved, &nc->fresh};
-    if (find_candidates(S, web, nc->moved, moved, &nc->fresh) != 0)
+    const int found = find_candidates(S, web, nc->moved, moved, &nc->fresh);
+    if (found < 0)
         return -1;
-    if (ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
+    if (found == 1 || ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
         *list = old;
         return 0;
     }
@@ -1195,7 +1197,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
             nc->seg_list = -1;
         int bad;
         if (all) {
-            bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]);
+            bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]) < 0;
             if (!bad)
                 ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
         } else {

@@ -83,7 +83,9 @@ typedef struct ws_node_contact {
     ws_nseg *seg; /* the stretches of the list seg_list (-1: none built) */
     size_t nseg, seg_cap;
     int seg_list;
-    size_t act_nl;      /* loads listed in act since the sub-step began (contact/node_force.c) */
+    size_t act_nl;      /* loads (or their folds) listed in act since the sub-step began */
+    size_t *row_mark;   /* when set (a grid web's lane), where each row's loads start in the */
+    size_t nrow_mark;   /* list, noted by ws_node_contacts (room for a sweep block's rows) */
     uint32_t lane_end;  /* one past the last node of the lane sweeping this copy (n: one lane) */
     int runs_off;       /* no short cuts: no runs and no corners, every candidate one by one
                            through its full tests (tests compare the two) */
@@ -184,9 +186,18 @@ typedef struct ws_node_geom {
     uint8_t *ready;
 } ws_node_geom;
 
+struct ws_node_step;
+/* A search of node candidates as ws_node_find does it from first = 0, for the nodes listed
+ * (0 .. count - 1 when nodes is NULL), into L (empty): the world's, in pieces on its threads.
+ * 0, or 1 when the nodes are listed and their candidates found are those the committed list
+ * holds for them (ws_node_same, which it may leave undone: then 0), or -1 when out of memory. */
+typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const uint32_t *nodes,
+                              size_t count, ws_ncand_list *L);
+
 /* What a step's search of node candidates reads and counts: the world's allocator, the bodies
- * at state cur with their features (g, whose scratch the search uses), the contact margin, and
- * where feature checks are counted. */
+ * at state cur with their features (g, whose scratch the search uses), the contact margin,
+ * where feature checks are counted, and who searches (search; NULL: ws_node_find, here), with
+ * its context. */
 typedef struct ws_node_step {
     ws_mem *mem;
     const ws_body_store *b;
@@ -194,7 +205,21 @@ typedef struct ws_node_step {
     ws_node_geom *g;
     double margin;
     uint64_t *checks;
+    ws_node_search_fn *search;
+    void *search_ctx;
 } ws_node_step;
+
+/* The search's scratch in g, from its arena (g->arena), at its most for a group of nodes: for
+ * ws_node_find. 0, or -1 when out of memory. */
+int ws_node_find_scratch(const ws_body_store *b, ws_node_geom *g);
+/* The candidates of `count` nodes of web at state S->cur, nodes[0, count) (increasing) or, when
+ * nodes is NULL, first .. first + count - 1, appended to L in node order, body by body in slot
+ * order: the same for a node however the nodes are cut into pieces. Each body near one of them
+ * is marked in web->contact->cbody (room for every body slot). Checks count in *S->checks.
+ * With S->mem NULL (a piece on a worker) L does not grow: -1 when its room runs out, as when
+ * out of memory. 0 otherwise. */
+int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint32_t first,
+                 size_t count, ws_ncand_list *L);
 
 /* The first of the two calls of a step before a web's sub-steps: whether every node is to be
  * found again at state cur (when `all`, the record of the last search is invalid, or a body
@@ -293,11 +318,15 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size
 /* A sub-step starts (on the web or a lane of it): the runs' faces are taken afresh, the list of
  * loads is empty. */
 void ws_node_substep(ws_node_contact *nc);
-/* The loads on the bodies listed since ws_node_substep, in node order, added to the per-body
- * totals bforce and bmoment (global, moment about the CoG), which the step adds to the
- * bodies. Lanes' lists are added in the order of their nodes, so the totals are those of one
- * sweep to the bit. */
+/* The loads on the bodies listed since ws_node_substep, in the list's order, added to the
+ * per-body totals bforce and bmoment (global, moment about the CoG), which the step adds to the
+ * bodies; the list is then empty. */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment);
+/* The loads listed at [from, to) (in node order) folded, each run of loads on one body summed
+ * from its first, the sums written from place `at` (<= from) on: the place after them. A sweep
+ * folds each row's loads (world_step.c), rows, unlike lanes, do not depend on the worker count,
+ * so the totals (ws_node_loads) are the same to the bit for any number of lanes. */
+size_t ws_node_loads_fold(ws_node_contact *nc, size_t from, size_t to, size_t at);
 /* The first stretch whose nodes start at n0 or later (where a lane starting at n0 begins). */
 size_t ws_node_first_segment(const ws_node_contact *nc, uint32_t n0);
 /* Room in `lane`, a lane's own scratch (world_step.c), for evaluating ncand candidates of a

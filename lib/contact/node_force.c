@@ -228,32 +228,28 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
     }
 }
 
-/* The loads on the bodies, added to their totals in order (the running sums of the body at
- * hand kept in registers). */
 void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
 {
-    const act_list L0 = act_open(nc), *L = &L0;
-    uint32_t body = UINT32_MAX;
-    v3 bf = v3_make(0, 0, 0), bm = bf;
-    for (size_t q = 0; q < L->nl; q++) {
-        const uint32_t bi = L->lbody[q];
-        if (bi != body) {
-            if (body != UINT32_MAX) {
-                bforce[body] = bf;
-                bmoment[body] = bm;
-            }
-            body = bi;
-            bf = bforce[bi];
-            bm = bmoment[bi];
-        }
-        bf = v3_add(bf, L->load[q].f);
-        bm = v3_add(bm, L->load[q].m);
-    }
-    if (body != UINT32_MAX) {
-        bforce[body] = bf;
-        bmoment[body] = bm;
+    const act_list L = act_open(nc);
+    for (size_t q = 0; q < L.nl; q++) {
+        bforce[L.lbody[q]] = v3_add(bforce[L.lbody[q]], L.load[q].f);
+        bmoment[L.lbody[q]] = v3_add(bmoment[L.lbody[q]], L.load[q].m);
     }
     nc->act_nl = 0;
+}
+
+size_t ws_node_loads_fold(ws_node_contact *nc, size_t from, size_t to, size_t at)
+{
+    const act_list L = act_open(nc);
+    for (size_t q = from; q < to; at++) {
+        const uint32_t bi = L.lbody[q];
+        act_load s = L.load[q++];
+        for (; q < to && L.lbody[q] == bi; q++)
+            s = (act_load){v3_add(s.f, L.load[q].f), v3_add(s.m, L.load[q].m)};
+        L.load[at] = s;
+        L.lbody[at] = bi;
+    }
+    return at;
 }
 
 /* The body part of corner_left's margin for the body met last in a sweep block (UINT32_MAX:
@@ -1017,9 +1013,11 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
     const ws_nseg *seg = nc->seg;
     const size_t nseg = nc->nseg;
     uint64_t tried = 0;
-    for (; k < nseg && seg[k].n0 < n1; k++) {
+    for (uint32_t row = UINT32_MAX; k < nseg && seg[k].n0 < n1; k++) {
         const ws_nseg *sg = &seg[k];
         tried += sg->c1 - sg->c0;
+        if (nc->row_mark && sg->n0 / (uint32_t)web->nx != row) /* a row's first stretch */
+            nc->row_mark[nc->nrow_mark++] = L.nl, row = sg->n0 / (uint32_t)web->nx;
         if (sg->run)
             contacts_run(&E, &B, cand, sg, h, share, fc);
         else

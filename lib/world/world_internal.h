@@ -26,7 +26,10 @@
  * share their state, with the lane's own scratch (lane 0: the web's); the rows [r0, r1) it
  * sweeps and what it found. Lanes 1.. take the spring chunk (tmp, WS_WEB_TMP doubles) and the
  * list of touched nodes (fct) from the world's arena for each web of a step, before the lanes
- * start; they keep the contact lists, run batch and run faces (own) from step to step. */
+ * start; they keep the contact lists, run batch and run faces (own) from step to step. A
+ * search of node candidates in pieces (world_step.c, search_lanes) uses the same jobs, before
+ * the sweep: piece i searches with its scratch (geom, from the arena) into its list (found,
+ * kept from step to step), marking the bodies near in its copy's cbody (from the arena). */
 typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
@@ -35,7 +38,13 @@ typedef struct ws_lane_job {
     uint64_t checks;
     double *tmp;
     uint32_t *fct;
+    size_t *marks; /* where each row of a block starts in its loads (from the arena) */
     ws_node_contact own;
+    ws_node_geom geom;
+    ws_ncand_list found;
+    uint64_t found_checks;
+    int found_bad;  /* the piece ran out of room in found (or of memory) */
+    int found_same; /* its nodes' candidates found are those the committed list holds */
 } ws_lane_job;
 /* Per material, the two lightest dynamic bodies (slots, UINT32_MAX for none) and a kinematic
  * body of it (scratch of ws_world_contact_limit). */
@@ -121,6 +130,10 @@ struct ws_world {
     ws_node_geom node_geom;   /* bodies' faces in the global frame, scratch */
     ws_pool *pool;            /* the world's own threads (worker_count > 1, no host scheduler) */
     struct ws_lane_job *lane_job; /* a parallel sweep's lanes, WS_LANES_PER_WORKER a worker */
+    const struct ws_web *cut_web; /* the web whose lanes' cut lane_job holds, made at step */
+    uint64_t cut_step;            /* cut_step (world_step.c, lanes_cut) */
+    int search_tight;       /* tests: the pieces of a search start with room for 8 candidates */
+    uint64_t search_reruns; /* pieces of a search searched again, their room run out */
     size_t node_par_cap;
 
     ws_element **elements; /* by id slot (world_element.c) */

@@ -234,7 +234,18 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
         const int edges = (j == J->r0 && j > 0 ? WS_WEB_LANE_FIRST : 0) |
                           (j1 == J->r1 && j1 < rows ? WS_WEB_LANE_LAST : 0);
         ws_web_forces_rows(web, &P, j, j1, edges, &n0, &n1);
+        /* Each row's loads on the bodies folded apart (a mesh web's all together): rows,
+         * unlike lanes, do not depend on the worker count, so neither do the totals
+         * (lane_close). */
+        ws_node_contact *c = &J->cview;
+        const size_t from = c->act_nl;
+        c->nrow_mark = 0;
         ws_node_contacts(&T->pass, web, n1, &next, &J->checks);
+        size_t at = c->row_mark ? from : ws_node_loads_fold(c, from, c->act_nl, from);
+        for (size_t m = 0; m < c->nrow_mark; m++)
+            at = ws_node_loads_fold(c, c->row_mark[m],
+                                    m + 1 < c->nrow_mark ? c->row_mark[m + 1] : c->act_nl, at);
+        c->act_nl = at;
         J->fast += ws_web_integrate_block(web, &P, n0, n1);
     }
     ws_web_sweep_end(web);
@@ -267,12 +278,24 @@ static uint32_t web_lanes(const ws_world *w, const ws_web *web)
     return lanes < 2 || !ws_web_sweep_parallel(web) ? 1 : lanes;
 }
 
+/* Whether the lanes' rows cover the web's ny rows in order, each lane some. */
+static int lanes_cover(const ws_lane_job *J, uint32_t lanes, uint32_t ny)
+{
+    int ok = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
+    for (uint32_t i = 0; i < lanes; i++)
+        ok &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1);
+    return ok;
+}
+
+enum { LANES_CUT_EVERY = 16 };
+
 /* The rows of each of the lanes (r0, r1), cut so that their work is about equal: a row costs
  * its nodes (springs, integration, a contact each in a run) and 0.6 of a node for each
  * candidate it takes one by one (a fit of the lanes' times on the wrapped reference case).
  * Every lane but the last holds a block's rows at least, the last a row: the run kernel's
  * groups, which may start up to three nodes before a node of the lane's end, stay within it.
- * The results do not depend on the cut. */
+ * The results do not depend on the cut. (A cut between blocks, tried, left the two workers'
+ * shares of the wrapped case 8 % apart, against 5.5 % by rows.) */
 static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
 {
     ws_lane_job *J = w->lane_job;
@@ -283,6 +306,14 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     }
     const ws_node_contact *nc = web->contact;
     const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny, r = ws_web_block_rows(web);
+    /* The cut of the last steps serves this web for LANES_CUT_EVERY steps: the work moves
+     * slowly, and a cut (two passes over the stretches) cost 0.9 instructions a node-update,
+     * alone on the calling thread. */
+    if (w->cut_web == web && w->steps - w->cut_step < LANES_CUT_EVERY &&
+        lanes_cover(J, lanes, ny))
+        return;
+    w->cut_web = web;
+    w->cut_step = w->steps;
     const int segs = nc->seg_list == nc->next_list;
     uint64_t total = 5ull * nx * ny, acc = 0;
     for (size_t s = 0; segs && s < nc->nseg; s++)
@@ -305,15 +336,20 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
 
 /* The scratch of each of the lanes ready for ncand candidates: the spring chunk and the list
  * of touched nodes from the step's arena, here on the calling thread before the lanes start
- * (they never share the arena's bump pointer); the contact scratch the lanes keep. 0 when out
- * of memory. */
+ * (they never share the arena's bump pointer), and every lane's marks of where its rows' loads
+ * start (a block's rows); the contact scratch the lanes keep. The chunk
+ * is not cleared: the springs write it before they read it (lane 0's, the web's own, holds
+ * the last sub-step's values), and clearing it cost the calling thread 20 kB a step. 0 when
+ * out of memory. */
 static int lanes_ready(ws_step *S, ws_web *web, uint32_t lanes, size_t ncand)
 {
-    for (uint32_t i = 1; i < lanes; i++) {
+    for (uint32_t i = 0; i < lanes; i++) {
         ws_lane_job *J = &S->w->lane_job[i];
-        if (!(J->tmp = ws_arena_calloc(S->arena, WS_WEB_TMP, sizeof(double))) ||
-            !(J->fct = ws_arena_alloc(S->arena, (ncand + 1) * sizeof(uint32_t))) ||
-            ws_node_lane_scratch(&S->w->mem, &J->own, web->contact, web->n, ncand) != 0)
+        if (!(J->marks = ws_arena_alloc(S->arena, (ws_web_block_rows(web) + 1) * sizeof(size_t))))
+            return 0;
+        if (i > 0 && (!(J->tmp = ws_arena_alloc(S->arena, WS_WEB_TMP * sizeof(double))) ||
+                      !(J->fct = ws_arena_alloc(S->arena, (ncand + 1) * sizeof(uint32_t))) ||
+                      ws_node_lane_scratch(&S->w->mem, &J->own, web->contact, web->n, ncand) != 0))
             return 0;
     }
     return 1;
@@ -361,9 +397,9 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
 {
     ws_lane_job *J = w->lane_job;
     const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
-    int cut = J[0].r0 == 0 && J[lanes - 1].r1 == ny;
-    for (uint32_t i = 0; i < lanes; i++)
-        cut &= J[i].r0 < J[i].r1 && J[i].r1 <= ny && (i == 0 || J[i].r0 == J[i - 1].r1);
+    const int cut = lanes_cover(J, lanes, ny);
+    if (!cut)
+        w->cut_web = NULL; /* not lanes_cut's */
     for (uint32_t i = 0; i < lanes && !cut; i++) {
         J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
         J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
@@ -376,12 +412,118 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
     return flagged;
 }
 
+/* The search of node candidates in pieces on the world's threads (ws_node_search_fn, its
+ * context the world): the nodes cut into pieces of about equal counts, one a lane at most and
+ * SEARCH_PIECE nodes each at least, each piece searched (ws_node_find) with its own scratch,
+ * into its own list, marking the bodies near in its own copy of the marks; then, here, the
+ * lists joined in piece order (node order), the marks and the checks added; each piece also
+ * compares its nodes' candidates with the committed list's (ws_node_same), which is the same
+ * when every piece's is. A node's candidates do not depend on the pieces (ws_node_find), so
+ * neither does the list. The pieces
+ * cannot grow their lists (the allocator is the calling thread's): one whose room runs out is
+ * searched again here. */
+enum { SEARCH_PIECE = 48 };
+
+typedef struct search_task {
+    ws_world *w;
+    const ws_node_step *S;
+    const ws_web *web;
+    const uint32_t *nodes;
+    size_t count;
+    uint32_t pieces;
+} search_task;
+
+/* Piece i, its list growing through mem (NULL: not at all). */
+static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
+{
+    ws_lane_job *J = &T->w->lane_job[i];
+    const size_t q0 = (size_t)((uint64_t)i * T->count / T->pieces),
+                 q1 = (size_t)((uint64_t)(i + 1) * T->count / T->pieces);
+    ws_node_step s = *T->S;
+    s.mem = mem;
+    s.g = &J->geom;
+    s.checks = &J->found_checks;
+    s.search = NULL;
+    J->found.n = 0;
+    J->found_checks = 0;
+    const uint32_t *nodes = T->nodes ? T->nodes + q0 : NULL;
+    J->found_bad = ws_node_find(&s, &J->view, nodes, (uint32_t)q0, q1 - q0, &J->found) != 0;
+    const ws_node_contact *nc = T->web->contact;
+    const ws_node_found F = {nodes, q1 - q0, &J->found};
+    J->found_same = nodes && !J->found_bad && ws_node_same(&F, nc->cstart, nc->cand[nc->list].c);
+}
+
+static void search_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker;
+    for (int32_t i = start; i < end; i++)
+        search_piece(ctx, (uint32_t)i, NULL);
+}
+
+static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *nodes, size_t count,
+                        ws_ncand_list *L)
+{
+    ws_world *w = S->search_ctx;
+    uint32_t pieces = web_lanes(w, web);
+    if (count / SEARCH_PIECE < pieces)
+        pieces = (uint32_t)(count / SEARCH_PIECE);
+    if (pieces < 2) {
+        ws_node_step s = *S;
+        s.search = NULL;
+        return ws_node_find_scratch(S->b, S->g) ? -1 : ws_node_find(&s, web, nodes, 0, count, L);
+    }
+    const size_t slots = S->b->slots + 1, room = w->search_tight ? 8 : 2 * (count / pieces) + 64;
+    for (uint32_t i = 0; i < pieces; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        J->geom = *S->g;
+        J->view = *web;
+        J->cview = *web->contact;
+        J->view.contact = &J->cview;
+        J->cview.cbody_cap = slots;
+        if (ws_node_find_scratch(S->b, &J->geom) != 0 ||
+            !(J->cview.cbody = ws_arena_calloc(S->g->arena, slots, 1)) ||
+            ws_array_reserve(S->mem, (void **)&J->found.c, &J->found.cap, room,
+                             sizeof *J->found.c) != 0)
+            return -1;
+    }
+    const search_task T = {w, S, web, nodes, count, pieces};
+    run_task(w, search_items, pieces, (void *)&T);
+    size_t total = 0;
+    for (uint32_t i = 0; i < pieces; i++) {
+        ws_lane_job *J = &w->lane_job[i];
+        if (J->found_bad) {
+            w->search_reruns++;
+            search_piece(&T, i, S->mem);
+        }
+        if (J->found_bad)
+            return -1;
+        total += J->found.n;
+    }
+    if (ws_array_reserve(S->mem, (void **)&L->c, &L->cap, total + 1, sizeof *L->c) != 0)
+        return -1;
+    L->n = 0;
+    int same = nodes != NULL;
+    for (uint32_t i = 0; i < pieces; i++) {
+        const ws_lane_job *J = &w->lane_job[i];
+        same &= J->found_same;
+        if (J->found.n)
+            memcpy(L->c + L->n, J->found.c, J->found.n * sizeof *L->c);
+        L->n += J->found.n;
+        *S->checks += J->found_checks;
+        for (size_t k = 0; k + 1 < slots; k++)
+            web->contact->cbody[k] |= J->cview.cbody[k];
+    }
+    return same;
+}
+
 void ws_world_lanes_free(ws_world *w)
 {
     const size_t jobs = (size_t)WS_LANES_PER_WORKER * w->def.worker_count;
     for (size_t i = 0; w->lane_job && i < jobs; i++) {
         ws_lane_job *J = &w->lane_job[i];
         ws_node_scratch_free(&w->mem, &J->own);
+        ws_mem_free(&w->mem, J->found.c, J->found.cap * sizeof *J->found.c);
+        J->found = (ws_ncand_list){NULL, 0, 0};
         J->tmp = NULL; /* the arena's */
         J->fct = NULL;
     }
@@ -402,6 +544,7 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
     ws_node_contact *c = &J->cview;
     c->lane_end = web->nx > 0 ? (uint32_t)web->nx * J->r1 : web->n;
     c->run_nodes = c->run_deep = c->corners = 0;
+    c->row_mark = web->nx > 0 ? J->marks : NULL; /* where each row's loads start */
     v->law_failed = 0;
     if (i == 0)
         return;
@@ -419,8 +562,8 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
     c->rface_gen = J->own.rface_gen;
 }
 
-/* What lane i found into the web, in lane order: its loads on the bodies, its touched nodes,
- * its counts. Returns its nodes too fast. */
+/* What lane i found into the web, in lane order: its loads on the bodies (folded by rows and
+ * bodies, ws_node_loads_fold), its touched nodes, its counts. Returns its nodes too fast. */
 static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *bmoment)
 {
     ws_lane_job *J = &w->lane_job[i];
@@ -480,8 +623,14 @@ static ws_status step_webs(ws_step *S)
         if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
             flagged = flag_lanes(w, web, lanes, cur);
         const double t0 = clock_now(w);
-        const ws_node_step ns = {&w->mem, b, cur, &w->node_geom, S->contact.margin,
-                                 &S->stats->narrow_checks};
+        const ws_node_step ns = {&w->mem,
+                                 b,
+                                 cur,
+                                 &w->node_geom,
+                                 S->contact.margin,
+                                 &S->stats->narrow_checks,
+                                 lanes > 1 ? search_lanes : NULL,
+                                 w};
         if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
