@@ -11,7 +11,9 @@
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
  * times in each direction, short runs: cost per simulated second and containment; `refine
  * [duration] [r] [tolerance]` runs refinement r alone, at that solve tolerance), rigid (the
- * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit). */
+ * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
+ * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
+ * regularised or stick; `why [duration] [case]` runs case 0..4 alone). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -222,6 +224,33 @@ int main(int argc, char **argv)
                    band.line_load, band.contact_force);
             fflush(stdout);
             ws_world_destroy(sc.world);
+        }
+    } else if (!strcmp(what, "why")) {
+        /* What limits dt 1 ms, one cause at a time (`why [duration] [case]`, case alone or
+         * all): the implicit film at 1 ms with the boxes held during its solve (the explicit
+         * coupling) or in it (the default), each with the box-box friction regularised (the
+         * paper's law) and with the stick model, and the coupled film at 0.25 ms. */
+        static const struct {
+            const char *name;
+            double dt;
+            int hold, stick;
+        } cases[5] = {{"1 ms, held, regularised", 1e-3, 1, 0},
+                      {"1 ms, held, stick", 1e-3, 1, 1},
+                      {"1 ms, in the solve, regularised", 1e-3, 0, 0},
+                      {"1 ms, in the solve, stick", 1e-3, 0, 1},
+                      {"0.25 ms, in the solve, regularised", 2.5e-4, 0, 0}};
+        const int only = argc > 3 ? atoi(argv[3]) : -1;
+        for (int k = 0; k < 5; k++) {
+            if (only >= 0 && k != only)
+                continue;
+            tilt_options a = o;
+            a.film_mass = 1.6e-6;
+            a.implicit = 1;
+            a.substeps = 1;
+            a.dt = cases[k].dt;
+            a.hold_bodies = cases[k].hold;
+            a.stick = cases[k].stick;
+            line(cases[k].name, &a);
         }
     } else if (!strcmp(what, "rigid")) {
         /* The rigid contacts' share of the step limit, without the film: the top box's slide

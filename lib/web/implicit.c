@@ -2,6 +2,7 @@
  * (web/implicit.h says the scheme; docs/theory.md, "The implicit film", why this one). */
 #include "web/implicit.h"
 
+#include "web/coupled.h"
 #include "web/multigrid.h"
 
 #include <float.h>
@@ -409,6 +410,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     const uint32_t n = web->n;
     const size_t m = VEC(n);
     double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
+    ws_rigid *R = im->rig && im->rig->nb ? im->rig : NULL; /* bodies in the solve */
     im->solves++;
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; the scale of the residual: the larger of |b| and
@@ -429,9 +431,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         weight2 += web->m[i] * web->m[i];
     }
     /* The weight scale takes standard gravity whatever the world's: a tolerance of momentum. */
-    const double scale = fmax(sqrt(dot(b, b, m)), h * 9.81 * sqrt(weight2));
+    const double bb = dot(b, b, m) + (R ? ws_rigid_dot(R, R->b, R->b) : 0.0);
+    const double scale = fmax(sqrt(bb), h * 9.81 * sqrt(weight2));
     const double goal = web->solver_tol * scale;
-    if (preconditioner(web, h) != 0) {
+    if (preconditioner(web, h) != 0 || (R && ws_rigid_factor(R) != 0)) {
         im->warm = 0;
         im->last_residual = NAN;
         return -1;
@@ -444,29 +447,42 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
     (void)ws_implicit_apply_op(web, x, q);
+    double rr = 0.0, rz = 0.0;
+    if (R) {
+        (void)ws_rigid_apply(R, web, x, R->x, q, R->q);
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->r[j] = R->b[j] - R->q[j];
+        rr = ws_rigid_dot(R, R->r, R->r);
+        rz = ws_rigid_precondition(R, R->r, R->z);
+        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
+    }
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
-    double rr = dot(r, r, m);
-    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+    rr += dot(r, r, m);
+    rz += mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
     memcpy(p, z, m * sizeof(double));
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
-        const double pq = ws_implicit_apply_op(web, p, q);
+        const double pq = ws_implicit_apply_op(web, p, q) +
+                          (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
         const double alpha = rz / pq;
-        rr = 0.0;
+        rr = R ? ws_rigid_step(R, alpha) : 0.0;
         for (size_t j = 0; j < m; j++) {
             x[j] += alpha * p[j];
             r[j] -= alpha * q[j];
             rr += r[j] * r[j];
         }
         it++;
-        const double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z),
+        const double rz1 = (mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z)) +
+                           (R ? ws_rigid_precondition(R, R->r, R->z) : 0.0),
                      beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)
             p[j] = z[j] + beta * p[j];
+        if (R)
+            ws_rigid_direction(R, beta);
     }
     im->iterations += (uint64_t)it;
     im->last_iterations = it;

@@ -48,6 +48,9 @@ typedef struct ws_implicit {
      * test's comparison). */
     struct ws_mg *mg;
     int jacobi_only;
+    /* Rigid bodies in the solve beside the nodes (web/coupled.h), set by the caller around a
+     * solve; NULL: none (the bodies held). */
+    struct ws_rigid *rig;
     /* Counts (ws_web_get_solver_stats). */
     uint64_t solves, iterations;
     int last_iterations;
@@ -72,8 +75,10 @@ void ws_implicit_add(ws_implicit *im, uint32_t i, v3 f, const double K[WS_SYM],
                      const double D[WS_SYM]);
 
 /* Solve for dv over the step h at (x, v) (the state begin took) to web->solver_tol, at most
- * web->solver_maxit iterations. 0 when it converged, else -1 (dv then holds the last iterate).
- * The iterations and the residual over its scale are kept in the counts. */
+ * web->solver_maxit iterations; with imp->rig set, its bodies' velocity changes too (their
+ * rows, right-hand side and start in it: web/coupled.h), the residual and its scale over both
+ * parts. 0 when it converged, else -1 (dv then holds the last iterate). The iterations and the
+ * residual over its scale are kept in the counts. */
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h);
 
 /* The new velocities alone, vd = v + dv. */

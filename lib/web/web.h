@@ -128,6 +128,7 @@ typedef struct ws_web {
     int integrator;
     double solver_tol;
     int solver_maxit;
+    int hold_bodies; /* ws_web_def.hold_bodies: the bodies held during the solve */
     struct ws_implicit *imp;
 } ws_web;
 
