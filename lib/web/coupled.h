@@ -28,15 +28,20 @@ typedef struct ws_rigid_link {
 } ws_rigid_link;
 
 typedef struct ws_rigid {
-    uint32_t nb;          /* bodies in the solve */
-    size_t nl, cap;       /* contacts in the solve, room for them */
+    uint32_t nb;    /* bodies in the solve */
+    size_t nl, cap; /* contacts in the solve, room for them */
     ws_rigid_link *link;
-    double *mass;         /* per body: its mass, kg */
-    double *inertia;      /* per body: its global inertia, symmetric (WS_SYM doubles) */
-    double *fac;          /* per body: the Cholesky factor of its diagonal block of the
-                             coupled matrix (36 doubles, lower triangle row-major) */
+    double *mass;                  /* per body: its mass, kg */
+    double *inertia;               /* per body: its global inertia, symmetric (WS_SYM doubles) */
+    double *fac;                   /* per body: the Cholesky factor of its diagonal block of the
+                                      coupled matrix (36 doubles, lower triangle row-major) */
     double *b, *x, *r, *z, *p, *q; /* the solve's vectors, 6 a body (x: dU, kept between
                                       the solves of one step) */
+    /* The coarse space of the preconditioner: a column per body and direction, the body
+     * moving (or turning) by one unit and every node it touches with the contact point, Phi.
+     * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles;
+     * fa, fb: 3 doubles a film node (scratch). NULL coarse: none. */
+    double *coarse, *cb, *cq, *fa, *fb;
 } ws_rigid;
 
 /* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
@@ -49,8 +54,16 @@ int ws_rigid_factor(ws_rigid *R);
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
                       double *y, double *yr);
 
-/* z = B^-1 r per body (B its factored block); returns r . z. */
-double ws_rigid_precondition(const ws_rigid *R, const double *r, double *z);
+/* Phi^T A Phi for the operator the running solve set (its film part by ws_implicit_apply_op),
+ * factored into R->coarse. 0, or -1 when it is not positive definite. */
+int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
+
+/* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
+ * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
+ * Phi c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
+ * r . z. */
+double ws_rigid_precondition(const ws_rigid *R, const ws_web *web, const double *rf, double *zf,
+                             const double *rr, double *zr);
 
 /* The CG's update of the bodies' part: x += alpha p, r -= alpha q; returns r . r. */
 double ws_rigid_step(ws_rigid *R, double alpha);

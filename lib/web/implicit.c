@@ -440,6 +440,11 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         return -1;
     }
     operator_for(web, h);
+    if (R && R->coarse && ws_rigid_coarse(R, web) != 0) {
+        im->warm = 0;
+        im->last_residual = NAN;
+        return -1;
+    }
     ws_mg *mg = im->mg && !im->jacobi_only && ws_mg_setup(im->mg, web) == 0 ? im->mg : NULL;
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
@@ -447,19 +452,19 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
     (void)ws_implicit_apply_op(web, x, q);
-    double rr = 0.0, rz = 0.0;
-    if (R) {
+    if (R)
         (void)ws_rigid_apply(R, web, x, R->x, q, R->q);
-        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
-            R->r[j] = R->b[j] - R->q[j];
-        rr = ws_rigid_dot(R, R->r, R->r);
-        rz = ws_rigid_precondition(R, R->r, R->z);
-        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
-    }
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
-    rr += dot(r, r, m);
-    rz += mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+    double rr = dot(r, r, m);
+    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+    if (R) { /* after the film's part, which its coarse correction adds to */
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->r[j] = R->b[j] - R->q[j];
+        rr += ws_rigid_dot(R, R->r, R->r);
+        rz += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
+    }
     memcpy(p, z, m * sizeof(double));
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
@@ -475,9 +480,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
             rr += r[j] * r[j];
         }
         it++;
-        const double rz1 = (mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z)) +
-                           (R ? ws_rigid_precondition(R, R->r, R->z) : 0.0),
-                     beta = rz1 / rz;
+        double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+        if (R)
+            rz1 += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+        const double beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)
             p[j] = z[j] + beta * p[j];

@@ -45,7 +45,8 @@ typedef struct ws_implicit {
     int warm;        /* dv holds the last converged solution */
     /* The preconditioner: multigrid on grid webs (web/multigrid.h; NULL for a web that is not
      * a grid of neighbour springs), block Jacobi otherwise or when jacobi_only is set (a
-     * test's comparison). */
+     * test's comparison; the bodies in the solve then go without their coarse space,
+     * web/coupled.h). */
     struct ws_mg *mg;
     int jacobi_only;
     /* Rigid bodies in the solve beside the nodes (web/coupled.h), set by the caller around a

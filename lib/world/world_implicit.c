@@ -22,10 +22,10 @@ static const char *label(const ws_web *web)
 
 /* The solve's bodies for the contacts L[0, nl): every dynamic body one of them touches gets
  * an index (slot[body], UINT32_MAX for the others) and its mass and global inertia; the
- * scratch from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
+ * scratch (with the coarse space's, for a web of `nodes` nodes) from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
  * with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
-                            size_t nl, uint32_t **slot_out, int *fail)
+                            size_t nl, uint32_t nodes, uint32_t **slot_out, int *fail)
 {
     *fail = 1;
     uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
@@ -44,9 +44,10 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     memset(R, 0, sizeof *R);
     R->nb = nb;
     R->cap = nl;
-    const size_t v6 = 6 * (size_t)nb;
+    const size_t v6 = 6 * (size_t)nb, m = 3 * (size_t)nodes;
     R->link = ws_arena_alloc(arena, (nl + 1) * sizeof *R->link);
-    double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 6 * v6) * sizeof(double));
+    double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 2 * m) *
+                                          sizeof(double));
     if (!R->link || !d) {
         *fail = 1;
         return NULL;
@@ -57,6 +58,11 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->mass = d + 6 * v6;
     R->inertia = R->mass + nb;
     R->fac = R->inertia + WS_SYM * (size_t)nb;
+    R->cb = R->fac + 36 * (size_t)nb;
+    R->cq = R->cb + v6;
+    R->coarse = R->cq + v6;
+    R->fa = R->coarse + v6 * v6;
+    R->fb = R->fa + m;
     for (size_t i = 0; i < b->slots; i++) {
         const uint32_t j = slot[i];
         if (j == UINT32_MAX)
@@ -185,10 +191,14 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                                         S->contact.margin, links);
         uint32_t *slot = NULL;
         int nomem = 0;
-        ws_rigid *R = web->hold_bodies ? NULL : rigid_make(S->arena, b, links, nl, &slot, &nomem);
+        ws_rigid *R = web->hold_bodies
+                          ? NULL
+                          : rigid_make(S->arena, b, links, nl, web->n, &slot, &nomem);
         if (nomem)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
+        if (R && im->jacobi_only)
+            R->coarse = NULL; /* a test's comparison: the plain block-diagonal preconditioner */
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
