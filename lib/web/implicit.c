@@ -431,8 +431,9 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         weight2 += web->m[i] * web->m[i];
     }
     /* The weight scale takes standard gravity whatever the world's: a tolerance of momentum. */
-    const double bb = dot(b, b, m) + (R ? ws_rigid_dot(R, R->b, R->b) : 0.0);
-    const double scale = fmax(sqrt(bb), h * 9.81 * sqrt(weight2));
+    /* The film's alone, with bodies in the solve too: their loads' impulse (a box's weight)
+     * would loosen the film's tolerance by orders; their rows' residual is held to it. */
+    const double scale = fmax(sqrt(dot(b, b, m)), h * 9.81 * sqrt(weight2));
     const double goal = web->solver_tol * scale;
     if (preconditioner(web, h) != 0 || (R && ws_rigid_factor(R) != 0)) {
         im->warm = 0;

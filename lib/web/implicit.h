@@ -77,8 +77,8 @@ void ws_implicit_add(ws_implicit *im, uint32_t i, v3 f, const double K[WS_SYM],
 
 /* Solve for dv over the step h at (x, v) (the state begin took) to web->solver_tol, at most
  * web->solver_maxit iterations; with imp->rig set, its bodies' velocity changes too (their
- * rows, right-hand side and start in it: web/coupled.h), the residual and its scale over both
- * parts. 0 when it converged, else -1 (dv then holds the last iterate). The iterations and the
+ * rows, right-hand side and start in it: web/coupled.h), the residual over both parts, its
+ * scale the film's. 0 when it converged, else -1 (dv then holds the last iterate). The iterations and the
  * residual over its scale are kept in the counts. */
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h);
 
