@@ -793,6 +793,64 @@ START_TEST(test_failed_solve_leaves_world)
 }
 END_TEST
 
+START_TEST(test_failed_solve_with_body)
+{
+    /* A box resting on a pinned sheet (box_on_sheet's scene, here built by hand) whose solve,
+     * the box's rows in it, is allowed one CG iteration at a tolerance of 1e-12: the step
+     * fails with WS_ERR_NUMERICAL and the world (nodes, box, time) is as before, hash and all. */
+    ws_world *w = world_g(1e-3, (ws_vec3){0, 0, -G0});
+    ws_shape_id box;
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &box));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = box;
+    bd.mass = 0.05;
+    bd.position = v3_make(0.0, 0.0, 0.05 + 1.5e-3);
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 200.0, 0.0, 0.5, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-4;
+    wd.law = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = 1e-12;
+    wd.solver_max_iterations = 1;
+    wd.name = "sheet under a box";
+    enum { N = 9 };
+    uint32_t pins[4 * N];
+    size_t np = 0;
+    for (uint32_t j = 0; j < N; j++)
+        for (uint32_t i = 0; i < N; i++)
+            if (i == 0 || j == 0 || i == N - 1 || j == N - 1)
+                pins[np++] = i + N * j;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = N;
+    sd.origin = v3_make(-0.08, -0.08, 0.0);
+    sd.spacing_x = sd.spacing_y = 0.02;
+    sd.prestretch_x = sd.prestretch_y = 0.05;
+    sd.pinned = pins;
+    sd.pinned_count = np;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    uint64_t h0, h1;
+    ck_ok(w, ws_world_get_state_hash(w, &h0));
+    const ws_status s = ws_world_step(w);
+    ck_ok(w, ws_world_get_state_hash(w, &h1));
+    const char *msg = ws_world_last_error(w);
+    report("failed solve with a body in it: %s", msg);
+    ck_assert_int_eq(s, WS_ERR_NUMERICAL);
+    ck_assert_msg(strstr(msg, "sheet under a box") && strstr(msg, "residual"), "%s", msg);
+    ck_assert_msg(h0 == h1, "state changed: %016llx -> %016llx", (unsigned long long)h0,
+                  (unsigned long long)h1);
+    ws_vec3 r;
+    ck_ok(w, ws_body_get_position(w, body, &r));
+    ck_assert(r.z == 0.05 + 1.5e-3);
+    ws_world_destroy(w);
+}
+END_TEST
+
 START_TEST(test_bad_solver_defs)
 {
     ws_world *w = world_g(1e-3, NO_G);
@@ -1520,6 +1578,7 @@ int main(void)
     add_case(s, "same_on_workers", test_same_on_workers, 60);
     add_case(s, "scales_and_rupture", test_scales_and_rupture, 10);
     add_case(s, "failed_solve_leaves_world", test_failed_solve_leaves_world, 10);
+    add_case(s, "failed_solve_with_body", test_failed_solve_with_body, 10);
     add_case(s, "bad_solver_defs", test_bad_solver_defs, 10);
     add_case(s, "multigrid", test_multigrid, 30);
     add_case(s, "refined_band_pressure", test_refined_band_pressure, 60);
