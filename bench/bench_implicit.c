@@ -13,7 +13,8 @@
  * [duration] [r] [tolerance]` runs refinement r alone, at that solve tolerance), rigid (the
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
- * regularised or stick; `why [duration] [case]` runs case 0..4 alone). */
+ * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
+ * alone). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -235,13 +236,16 @@ int main(int argc, char **argv)
             const char *name;
             double dt;
             int hold, stick;
-        } cases[5] = {{"1 ms, held, regularised", 1e-3, 1, 0},
+        } cases[8] = {{"1 ms, held, regularised", 1e-3, 1, 0},
                       {"1 ms, held, stick", 1e-3, 1, 1},
                       {"1 ms, in the solve, regularised", 1e-3, 0, 0},
                       {"1 ms, in the solve, stick", 1e-3, 0, 1},
-                      {"0.25 ms, in the solve, regularised", 2.5e-4, 0, 0}};
+                      {"0.25 ms, in the solve, regularised", 2.5e-4, 0, 0},
+                      {"0.25 ms, held, regularised", 2.5e-4, 1, 0},
+                      {"0.125 ms, held, regularised", 1.25e-4, 1, 0},
+                      {"0.125 ms, in the solve, regularised", 1.25e-4, 0, 0}};
         const int only = argc > 3 ? atoi(argv[3]) : -1;
-        for (int k = 0; k < 5; k++) {
+        for (int k = 0; k < 8; k++) {
             if (only >= 0 && k != only)
                 continue;
             tilt_options a = o;
