@@ -231,7 +231,8 @@ int main(int argc, char **argv)
         /* What limits dt 1 ms, one cause at a time (`why [duration] [case]`, case alone or
          * all): the implicit film at 1 ms with the boxes held during its solve (the explicit
          * coupling) or in it (the default), each with the box-box friction regularised (the
-         * paper's law) and with the stick model, and the coupled film at 0.25 ms. */
+         * paper's law) and with the stick model; then both couplings at 0.25 and 0.125 ms
+         * (which answer the step converges to). */
         static const struct {
             const char *name;
             double dt;
