@@ -10,8 +10,11 @@
  * dt 1 ms with the film in 1 and in 4 sub-steps), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
  * times in each direction, short runs: cost per simulated second and containment; `refine
- * [duration] [r] [tolerance]` runs refinement r alone, at that solve tolerance), rigid (the
+ * [duration] [r] [tolerance] [preconditioner]` runs refinement r alone, at that solve
+ * tolerance, with that ws_web_preconditioner: 1 block Jacobi, 2 multigrid, 0 AUTO), rigid (the
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
+ * crossing (drums of the real film from 10 x 10 to 96 x 96 nodes, block Jacobi and multigrid
+ * in turn: CPU time a step and CG iterations, where the multigrid starts to pay),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -78,6 +81,65 @@ static void settle_motion(double dt, double *kmax, double *rise, char *why, size
         *rise = fmax(*rise, r.z - r0.z);
     }
     ws_world_destroy(sc.world);
+}
+
+/* A drum of the real film, n x n nodes 1 cm apart pinned along the edge, pre-stretched 40 % and
+ * 20 % as the reference band, its laws (2000 N/m a spring, 1 % in compression) and areal
+ * density, sagging under gravity at dt 0.25 ms from flat: after 40 steps untimed, CPU seconds
+ * a step and CG iterations a step over 200 more, with preconditioner pre. */
+static ws_status drum_run(int n, int pre, double *cpu_per_step, double *iterations)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 2.5e-4;
+    ws_world *w = NULL;
+    ws_status s = ws_world_create(&d, &w);
+    if (s != WS_OK)
+        return s;
+    ws_law_def ld;
+    ws_law_id law;
+    ws_law_def_init(&ld);
+    ld.type = WS_LAW_TENSION_COMPRESSION;
+    ld.stiffness = 2000.0 * 0.01 / 1.4;
+    ld.compression_stiffness = 0.01 * ld.stiffness;
+    ld.damping = 0.1 * 0.01 / 1.4;
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.areal_density = 0.018;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.preconditioner = pre;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = n;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    sd.prestretch_x = 0.4;
+    sd.prestretch_y = 0.2;
+    sd.shear = 1;
+    uint32_t pins[4 * 96];
+    size_t np = 0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            if (i == 0 || j == 0 || i == n - 1 || j == n - 1)
+                pins[np++] = (uint32_t)(i + n * j);
+    sd.pinned = pins;
+    sd.pinned_count = np;
+    ws_web_id id;
+    if ((s = ws_law_create(w, &ld, &law)) == WS_OK) {
+        wd.law = wd.law_shear = law;
+        s = ws_web_create_sheet(w, &wd, &sd, &id);
+    }
+    if (s == WS_OK)
+        s = ws_world_step_n(w, 40);
+    ws_web_solver_stats s0, s1;
+    const int steps = 200;
+    double c0 = cpu_now();
+    if (s == WS_OK && (s = ws_web_get_solver_stats(w, id, &s0)) == WS_OK)
+        s = ws_world_step_n(w, steps);
+    *cpu_per_step = (cpu_now() - c0) / steps;
+    if (s == WS_OK && (s = ws_web_get_solver_stats(w, id, &s1)) == WS_OK)
+        *iterations = (double)(s1.iterations - s0.iterations) / steps;
+    ws_world_destroy(w);
+    return s;
 }
 
 int main(int argc, char **argv)
@@ -183,6 +245,7 @@ int main(int argc, char **argv)
         const double T = duration > 0 ? duration : 0.05;
         const int only = argc > 3 ? atoi(argv[3]) : 0; /* one refinement alone */
         const double tol = argc > 4 ? atof(argv[4]) : 0.0; /* the solve's tolerance; 0: 1e-6 */
+        const int pre = argc > 5 ? atoi(argv[5]) : 0; /* ws_web_preconditioner; 0: AUTO */
         double base = 0;
         for (int r = 1; r <= 4; r *= 2) {
             if (only > 0 && r != only)
@@ -193,6 +256,7 @@ int main(int argc, char **argv)
             a.substeps = 1;
             a.refine = r;
             a.solver_tolerance = tol;
+            a.preconditioner = pre;
             tilt_scene sc;
             if (tilt_build(&a, &sc) != WS_OK) {
                 printf("  refine %d: cannot build\n", r);
@@ -226,6 +290,29 @@ int main(int argc, char **argv)
                    band.line_load, band.contact_force);
             fflush(stdout);
             ws_world_destroy(sc.world);
+        }
+    } else if (!strcmp(what, "crossing")) {
+        const int sides[] = {10, 12, 16, 24, 32, 40, 48, 64, 96};
+        for (size_t k = 0; k < sizeof sides / sizeof sides[0]; k++) {
+            double cpu[2], its[2];
+            for (int round = 0; round < 3; round++) /* interleaved; the least of 3 kept */
+                for (int m = 0; m < 2; m++) {
+                    double c, it;
+                    if (drum_run(sides[k], m ? WS_WEB_PRECONDITIONER_MULTIGRID
+                                             : WS_WEB_PRECONDITIONER_BLOCK_JACOBI,
+                                 &c, &it) != WS_OK) {
+                        printf("  drum %d: failed\n", sides[k]);
+                        return 1;
+                    }
+                    if (round == 0 || c < cpu[m])
+                        cpu[m] = c;
+                    its[m] = it;
+                }
+            printf("  drum %2d x %2d (%4d nodes): block Jacobi %7.1f us a step (CG %5.1f it), "
+                   "multigrid %7.1f us (CG %4.1f it): multigrid / block Jacobi %.2f\n",
+                   sides[k], sides[k], sides[k] * sides[k], 1e6 * cpu[0], its[0], 1e6 * cpu[1],
+                   its[1], cpu[1] / cpu[0]);
+            fflush(stdout);
         }
     } else if (!strcmp(what, "why")) {
         /* What limits dt 1 ms, one cause at a time (`why [duration] [case]`, case alone or

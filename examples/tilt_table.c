@@ -74,6 +74,7 @@ typedef struct tilt_options {
     double areal_density; /* kg/m^2 of film, in place of film_mass when > 0 (0.018: real) */
     int refine;           /* film nodes refine x refine as many (each direction); 0 = 1 */
     double solver_tolerance; /* implicit film: the solve's tolerance; 0 = the default */
+    int preconditioner;   /* implicit film: ws_web_preconditioner; 0 = AUTO */
     double dt;            /* s; 0 = 0.25 ms */
     int hold_bodies;      /* implicit film: 1 holds the boxes during its solve (ws_web_def) */
 } tilt_options;
@@ -192,6 +193,7 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
         wd.integrator = WS_WEB_IMPLICIT;
     if (o->solver_tolerance > 0)
         wd.solver_tolerance = o->solver_tolerance;
+    wd.preconditioner = o->preconditioner;
     wd.hold_bodies = o->hold_bodies;
     wd.contact_layer = layer;
     wd.material = film_mat;

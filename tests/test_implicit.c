@@ -939,6 +939,7 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
     wd.integrator = WS_WEB_IMPLICIT;
     wd.solver_tolerance = 1e-11;
     wd.solver_max_iterations = 5000;
+    wd.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
     sd.nx = nx;
@@ -990,6 +991,41 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
     ck_assert_msg(fabs(uBv - vBu) <= 1e-12 * scale, "B not symmetric: %.17g vs %.17g", uBv,
                   vBu);
     ck_assert_msg(dot3(u, Bu, n) > 0.0 && dot3(y, Bv, n) > 0.0, "B not positive");
+    /* The cycle as an iteration, e <- (I - B A) e, by power iteration in A's inner product (40
+     * steps from a random e): the exact cycle's I - B A has its eigenvalues in [0, 1) (the
+     * smoothers and their adjoints around a coarse correction that removes at most all of the
+     * error), so B A's lie in (0, 1]. The cycle keeps the film's operator and the coarse
+     * levels in single precision, which moves them by the rounding (6e-8 of a block, times the
+     * blocks' condition): its factor must stay below 1 (with B symmetric, that is B positive
+     * definite) and B A's largest eigenvalue below 1 + 1e-5. */
+    {
+        double *e = malloc(3 * n * sizeof(double)), *Ae = malloc(3 * n * sizeof(double)),
+               *BAe = malloc(3 * n * sizeof(double));
+        ck_assert(e && Ae && BAe);
+        double lmax = 0.0, rho = 0.0;
+        for (int pass = 0; pass < 2; pass++) { /* B A, then I - B A */
+            random_vector(web, 3 + (uint64_t)pass, e);
+            for (int k = 0; k < 40; k++) {
+                const double eAe = ws_implicit_apply_op(web, e, Ae);
+                (void)ws_mg_apply(im->mg, web, Ae, BAe);
+                double lam = dot3(Ae, BAe, n) / eAe; /* (e, B A e)_A / (e, e)_A */
+                if (pass)
+                    lam = 1.0 - lam;
+                const double norm = sqrt(eAe);
+                for (uint32_t q = 0; q < 3 * n; q++)
+                    e[q] = (pass ? e[q] - BAe[q] : BAe[q]) / norm;
+                if (pass)
+                    rho = lam;
+                else
+                    lmax = lam;
+            }
+        }
+        report("multigrid cycle: largest eigenvalue of B A %.9f, factor of I - B A %.3f", lmax,
+               rho);
+        ck_assert_msg(lmax > 0.0 && lmax <= 1.0 + 1e-5, "B A's largest eigenvalue %.9f", lmax);
+        ck_assert_msg(rho < 1.0, "the cycle does not contract: factor %g", rho);
+        free(e), free(Ae), free(BAe);
+    }
     /* Conjugate gradients with B on A x = b for a known x (u). */
     {
         double *b = malloc(3 * n * sizeof(double)), *xs = calloc(3 * n, sizeof(double)),
@@ -1148,6 +1184,144 @@ START_TEST(test_refined_band_pressure)
     report("band pressure refined 1 x: %.3f Pa (%.1f CG it/step), 2 x: %.3f Pa (%.1f), rel %.2g",
            p1, it1, p2, it2, (p2 - p1) / p1);
     ck_assert_msg(p1 > 0.0 && fabs(p2 - p1) <= 0.02 * p1, "pressure %g vs %g", p2, p1);
+}
+END_TEST
+
+/* A drum of nx x ny nodes (the sheet of sheet_case at r = 1, its edge pinned) with
+ * preconditioner pre and solve tolerance tol: its world, or NULL (the status in *st) when the
+ * web is refused. */
+static ws_world *choice_drum(int nx, int ny, int pre, double tol, ws_web_id *id, ws_status *st)
+{
+    ws_world *w = world_g(2e-3, (ws_vec3){0, 0, -G0});
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 20.0, 0.0, 0.01, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-4;
+    wd.law = wd.law_shear = law;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = tol;
+    wd.solver_max_iterations = 5000;
+    wd.preconditioner = pre;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = nx;
+    sd.ny = ny;
+    sd.spacing_x = sd.spacing_y = 0.01;
+    sd.prestretch_x = 0.4;
+    sd.prestretch_y = 0.2;
+    sd.shear = 1;
+    uint32_t *pins = malloc(2 * (size_t)(nx + ny) * sizeof *pins);
+    ck_assert(pins);
+    size_t np = 0;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++)
+            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
+                pins[np++] = (uint32_t)(i + nx * j);
+    sd.pinned = pins;
+    sd.pinned_count = np;
+    *st = ws_web_create_sheet(w, &wd, &sd, id);
+    free(pins);
+    if (*st != WS_OK) {
+        ws_world_destroy(w);
+        return NULL;
+    }
+    return w;
+}
+
+START_TEST(test_preconditioner_choice)
+{
+    /* Bad values are refused by name; MULTIGRID on a web it cannot serve (a grid of 4 x 4
+     * nodes: WS_MG_MIN_NODES is 17, a coarse level and a coarsest one) too; AUTO takes the multigrid on a grid web from WS_WEB_MULTIGRID_AUTO_NODES
+     * nodes on and block Jacobi below; BLOCK_JACOBI is taken as asked. */
+    ws_web_id id;
+    ws_status st;
+    const int bad[] = {-1, 3, 99};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        ws_world *w = world_g(2e-3, (ws_vec3){0, 0, -G0});
+        ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 20.0, 0.0, 0.01, 0.0);
+        ws_web_def wd;
+        ws_web_def_init(&wd);
+        ck_assert_int_eq(wd.preconditioner, WS_WEB_PRECONDITIONER_AUTO);
+        wd.node_mass = 1e-4;
+        wd.law = law;
+        wd.integrator = WS_WEB_IMPLICIT;
+        wd.preconditioner = bad[k];
+        ws_sheet_def sd;
+        ws_sheet_def_init(&sd);
+        sd.nx = 3;
+        sd.ny = 1;
+        sd.spacing_x = sd.spacing_y = 0.01;
+        ck_assert_int_eq(ws_web_create_sheet(w, &wd, &sd, &id), WS_ERR_INVALID_ARGUMENT);
+        ck_assert_msg(strstr(ws_world_last_error(w), "preconditioner must be"), "%s",
+                      ws_world_last_error(w));
+        ws_world_destroy(w);
+    }
+    ck_assert_int_eq(WS_MG_MIN_NODES, 17);
+    ck_assert_ptr_null(choice_drum(4, 4, WS_WEB_PRECONDITIONER_MULTIGRID, 1e-6, &id, &st));
+    ck_assert_int_eq(st, WS_ERR_INVALID_ARGUMENT);
+    const int nx = 40, ny = (WS_WEB_MULTIGRID_AUTO_NODES + nx - 1) / nx; /* nx ny >= AUTO */
+    const struct {
+        int ny, pre, mg;
+    } cases[] = {{ny, WS_WEB_PRECONDITIONER_AUTO, 1},
+                 {ny - 1, WS_WEB_PRECONDITIONER_AUTO, 0},
+                 {ny, WS_WEB_PRECONDITIONER_BLOCK_JACOBI, 0},
+                 {ny - 1, WS_WEB_PRECONDITIONER_MULTIGRID, 1}};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        ws_world *w = choice_drum(nx, cases[k].ny, cases[k].pre, 1e-6, &id, &st);
+        ck_assert_msg(w, "drum %d x %d refused", nx, cases[k].ny);
+        ck_ok(w, ws_world_step_n(w, 1));
+        const ws_implicit *im = web_of(w, id)->imp;
+        ck_assert_msg((im->mg != NULL) == cases[k].mg, "%d x %d nodes, preconditioner %d: %s",
+                      nx, cases[k].ny, cases[k].pre,
+                      im->mg ? "multigrid" : "block Jacobi");
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
+START_TEST(test_preconditioners_agree)
+{
+    /* The drum of sheet_case, 10 steps of its sag at tolerance 1e-11 with each preconditioner
+     * through the public Def: each solve stops at 1e-11 of its scale, so dv agrees to about
+     * that times the condition number (~1e3 here: 1e-7 of dv, as sheet_case measures), and the
+     * positions, h times the sum of dv, to 1e-7 of the sag. */
+    ws_web_id id[2];
+    ws_world *w[2];
+    ws_status st;
+    double *x[2];
+    uint64_t its[2];
+    for (int k = 0; k < 2; k++) {
+        w[k] = choice_drum(41, 23,
+                           k ? WS_WEB_PRECONDITIONER_MULTIGRID
+                             : WS_WEB_PRECONDITIONER_BLOCK_JACOBI,
+                           1e-11, &id[k], &st);
+        ck_assert(w[k]);
+        ck_ok(w[k], ws_world_step_n(w[k], 10));
+        ws_web_solver_stats ss;
+        ck_ok(w[k], ws_web_get_solver_stats(w[k], id[k], &ss));
+        its[k] = ss.iterations;
+        x[k] = malloc(3 * 41 * 23 * sizeof(double));
+        ck_assert(x[k]);
+        size_t cnt;
+        ck_ok(w[k], ws_web_copy_positions(w[k], id[k], x[k], 41 * 23, &cnt));
+    }
+    double diff = 0.0, sag = 0.0;
+    for (size_t q = 0; q < 41 * 23; q++) {
+        diff = fmax(diff, fabs(x[0][3 * q + 2] - x[1][3 * q + 2]));
+        diff = fmax(diff, fabs(x[0][3 * q] - x[1][3 * q]));
+        diff = fmax(diff, fabs(x[0][3 * q + 1] - x[1][3 * q + 1]));
+        sag = fmax(sag, -x[0][3 * q + 2]);
+    }
+    report("drum 41 x 23, 10 steps at tolerance 1e-11: block Jacobi %llu iterations, multigrid "
+           "%llu; positions apart by %.2g m of a sag of %.3g m",
+           (unsigned long long)its[0], (unsigned long long)its[1], diff, sag);
+    ck_assert_msg(sag > 0.0 && diff <= 1e-7 * sag, "apart by %g of %g", diff, sag);
+    ck_assert_msg(its[1] < its[0], "multigrid %llu iterations, block Jacobi %llu",
+                  (unsigned long long)its[1], (unsigned long long)its[0]);
+    for (int k = 0; k < 2; k++) {
+        free(x[k]);
+        ws_world_destroy(w[k]);
+    }
 }
 END_TEST
 
@@ -1581,6 +1755,8 @@ int main(void)
     add_case(s, "failed_solve_with_body", test_failed_solve_with_body, 10);
     add_case(s, "bad_solver_defs", test_bad_solver_defs, 10);
     add_case(s, "multigrid", test_multigrid, 30);
+    add_case(s, "preconditioner_choice", test_preconditioner_choice, 20);
+    add_case(s, "preconditioners_agree", test_preconditioners_agree, 20);
     add_case(s, "refined_band_pressure", test_refined_band_pressure, 60);
     return run_suite(s);
 }

@@ -43,6 +43,26 @@ typedef enum ws_web_integrator {
     WS_WEB_IMPLICIT = 1
 } ws_web_integrator;
 
+/** How an implicit web's linear solve is preconditioned (docs/theory.md, "The implicit film";
+ *  the answers are the same to the solve's tolerance, only the cost differs). */
+typedef enum ws_web_preconditioner {
+    /** The cheaper of the two for the web: multigrid on a grid web (sheet or band, springs
+     *  between grid neighbours) of at least WS_WEB_MULTIGRID_AUTO_NODES nodes, block Jacobi
+     *  otherwise. */
+    WS_WEB_PRECONDITIONER_AUTO = 0,
+    /** Each node's 3x3 diagonal block: cheap an iteration, but the iterations grow with the
+     *  nodes across the film and its stiffness over its mass (h^2 k / m). */
+    WS_WEB_PRECONDITIONER_BLOCK_JACOBI = 1,
+    /** A geometric multigrid V-cycle on the web's grid: dearer an iteration, iterations
+     *  nearly independent of the refinement. Grid webs only (ws_web_create_* refuses it on
+     *  another web with WS_ERR_INVALID_ARGUMENT). */
+    WS_WEB_PRECONDITIONER_MULTIGRID = 2
+} ws_web_preconditioner;
+
+/** WS_WEB_PRECONDITIONER_AUTO takes multigrid from this many nodes of a grid web on: below it,
+ *  block Jacobi's cheaper iterations win (bench/NOTES.md, "the crossing"). */
+#define WS_WEB_MULTIGRID_AUTO_NODES 15000
+
 /** What every web has. Fill with ws_web_def_init(). */
 typedef struct ws_web_def {
     uint32_t size;  /**< set by ws_web_def_init() */
@@ -76,6 +96,9 @@ typedef struct ws_web_def {
     int solver_max_iterations; /**< implicit webs: conjugate-gradient iterations at most per
                                     solve (1..100000); default 1000. A solve that does not
                                     converge fails the step with WS_ERR_NUMERICAL */
+    int preconditioner;     /**< implicit webs: ws_web_preconditioner; default
+                                 WS_WEB_PRECONDITIONER_AUTO. A trailing field: older callers
+                                 get AUTO */
     /** Implicit webs: how the dynamic bodies the film touches take part in its solve. 0, the
      *  default: their velocities are unknowns of the film's linear system beside the nodes',
      *  so the film's loads on them are those of the end of the step (docs/theory.md, section

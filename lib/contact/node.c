@@ -697,15 +697,10 @@ static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
         out[n0].local |= WS_NCAND_CORNER;
 }
 
-/* ---- the search
- *
- * Nodes are taken FIND_CHUNK at a time. For each body, in slot order, the nodes of the group in
- * its box (grown by the web's layer and half the margin) are listed (find_near). On a convex
- * body of at most WS_NCAND_FACES faces their body-frame positions, their distances to the
- * faces' planes and the faces' tests as bit masks are found for all of them on vectors
- * (find_faces); a node then pays only for the few features near it (convex_candidates) and
- * takes few branches. Any other body is searched node by node (general_candidates). The
- * candidates are listed node by node, and for a node body by body. */
+/* ---- the search, FIND_CHUNK nodes at a time: per body, in slot order, those in its grown box
+ * (find_near); on a convex body of at most WS_NCAND_FACES faces their plane distances and face
+ * tests on vectors (find_faces), any other body node by node (general_candidates); listed node
+ * by node, and for a node body by body (docs/design.md, deviation (f)). */
 enum { FIND_CHUNK = 64 };
 
 /* A body near a group of nodes: its slot, its reach (the layers and the margin), how many of the
@@ -885,11 +880,8 @@ static int convex_candidates(const ws_node_step *S, const ws_find_body *fb, uint
      * edges. */
     if (!(boxes & (boxes - 1)))
         return 0;
-    /* Nor can an edge of a face the node is well inside of hold it: the edge holds only a node
-     * that is a positive sum of its two faces' normals (in_wedge), whose projection on either
-     * face's plane lies past the other's plane, and this node's projection on that face lies
-     * a margin or more behind every other plane, with less than half a margin to move until it
-     * is found again. Dropped, the node is a face's alone and may join a run. */
+    /* Nor can an edge of a face the node is well inside of hold it (docs/design.md, deviation
+     * (f)): dropped, the node is a face's alone and may join a run. */
     const uint64_t near = boxes & ~(mk[M_PASS * FIND_CHUNK] & ~outside);
     for (uint32_t e = 0; e < sh->edge_count; e++) {
         const ws_edge *E = &sh->edges[e];
@@ -917,12 +909,9 @@ static int general_candidates(const ws_node_step *S, const ws_find_body *fb, uin
     const size_t n0 = L->n;
     size_t q = n0;
     /* On a convex body a node touches face f only while f is the face whose plane it is
-     * farthest out of (the largest signed distance D): over a face it projects into, d_g <= d_f
-     * for every other face g, and inside the body the shallowest face is the one of largest d.
-     * Until the next detection nodes and bodies move less than half the margin together, which
-     * changes d_f - D by less than the margin: faces further behind than that cannot come into
-     * contact and are not candidates. On a box this drops the side faces next to the one a node
-     * lies on. */
+     * farthest out of (the largest signed distance D); until the next detection d_f - D
+     * changes by less than the margin, so faces further behind are no candidates (the side
+     * faces next to the one a node lies on; docs/design.md, deviation (f)). */
     double D = -INFINITY;
     if (sh->convex)
         for (uint32_t f = 0; f < sh->face_count; f++) {

@@ -53,28 +53,6 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
     return 1;
 }
 
-/* Whether face f is the shallowest of a convex body for a point at distance d under it: no
- * other face's plane has the point farther out (the prepared faces, global). */
-static int convex_shallowest(const ws_node_geom *g, uint32_t base, uint32_t count, uint32_t f, v3 x,
-                             double d)
-{
-    for (uint32_t q = 0; q < count; q++)
-        if (q != f && v3_dot(g->face[base + q].n, x) - g->face[base + q].off > d)
-            return 0;
-    return 1;
-}
-
-/* The slip velocity predicted at the end of the sub-step h (friction_of), from the contact's
- * normal n, the node's tangential velocity t, its force with every normal force in k and its
- * 1 / mass im. */
-static inline v3 friction_pred(v3 n, v3 t, v3 k, double im, double h)
-{
-    double dot = k.x * n.x + k.y * n.y + k.z * n.z;
-    double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
-    double hm = h * im;
-    return v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
-}
-
 /* A load on a body: force and moment about the CoG. */
 typedef struct act_load {
     v3 f, m;
@@ -95,26 +73,31 @@ static inline act_load body_load(uint64_t push, v3 a, v3 n, double fn, double sh
                       v3_make(l.y * Bz - l.z * By, l.z * Bx - l.x * Bz, l.x * By - l.y * Bx)};
 }
 
+/* A contact's friction a on its node where it pushes (push: all bits or none); -0 where it does
+ * not, which leaves the node's force as it was to the bit when added, as the one-by-one pass
+ * leaves the force of a contact it does not list (the body's load is then +0, body_load). */
+static inline v3 pushed(uint64_t push, v3 a)
+{
+    return v3_make(ws_pick(push, a.x, -0.0), ws_pick(push, a.y, -0.0), ws_pick(push, a.z, -0.0));
+}
+
 /* The friction on a node: from the contact's normal n, the node's tangential velocity relative
  * to the body t, its force with every normal force in k, its 1 / mass and mass, Coulomb's force
  * mu fn and the contact's v_lim (ws_friction_law). None for a pinned node or one that does
  * not slip; taken only where the contact pushes. Straight-line code, so loops of it run on
  * vectors.
  *
- * Eq. 13, limited to the force that stops the node's slip within this sub-step h. Below v_lim
- * eq. 13 is a damper of slope 2 mu N / v_lim, far too stiff for an explicit step of a light node
- * (it would reverse the slip and chatter), so the slip is predicted at the end of the sub-step
- * with the other forces on the node (springs, gravity and every normal force, none of the
- * frictions: order-free), and the friction is the smaller of what stops that slip
- * (m |v_pred| / h) and what eq. 13 gives for it, against it. Sticking nodes hold their
- * tangential load; sliding ones get mu N; for heavy masses this is eq. 13 itself. Every normal
- * force comes before any friction: a node at a corner touches two faces, and this makes the
- * result independent of the order of the faces (which differs from corner to corner and would
- * twist a symmetric load). */
+ * Eq. 13, limited to the force that stops the node's slip within this sub-step h, its slip
+ * predicted with every normal force in and none of the frictions, so that the result does not
+ * depend on the order of a corner's faces (docs/theory.md, section 6). */
 static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
                              double h)
 {
-    const ws_friction fr = ws_friction_law(friction_pred(n, t, k, im, h), cap, vlim, mass, h);
+    /* The slip predicted at the end of the sub-step: t and the force across n, k's part o. */
+    const double dot = k.x * n.x + k.y * n.y + k.z * n.z, hm = h * im;
+    const double ox = k.x + n.x * (-dot), oy = k.y + n.y * (-dot), oz = k.z + n.z * (-dot);
+    const v3 pred = v3_make(t.x + ox * hm, t.y + oy * hm, t.z + oz * hm);
+    const ws_friction fr = ws_friction_law(pred, cap, vlim, mass, h);
     const uint64_t loose = ws_mask(im != 0.0); /* not pinned */
     return v3_make(ws_pick(loose, fr.f.x, 0.0), ws_pick(loose, fr.f.y, 0.0),
                    ws_pick(loose, fr.f.z, 0.0));
@@ -141,8 +124,10 @@ typedef struct act_group {
     ws_wide3 k, a, b, mm; /* the node's force with its normal forces in; friction; body's load */
 } act_group;
 
-/* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load. */
+/* The doubles of nc->act per contact of its room (act_cap): its group's share, then its load;
+ * and its bytes, with its four ids (act_list). */
 enum { ACT_GROUP = (int)(sizeof(act_group) / (4 * sizeof(double))), ACT_ARRAYS = ACT_GROUP + 6 };
+enum { ACT_BYTES = ACT_ARRAYS * sizeof(double) + 4 * sizeof(uint32_t) };
 
 /* The list's loads (act_load) come after its groups. */
 _Static_assert(sizeof(act_load) == 6 * sizeof(double) && sizeof(act_group) % 32 == 0,
@@ -234,12 +219,8 @@ static void act_friction(size_t ng, double h, double share, act_group *restrict 
             const double fn = e->fn.v[l];
             const v3 a = friction_of(n, ws_lane(&e->t, l), ws_lane(&e->k, l), e->im.v[l], e->m.v[l],
                                      e->mu.v[l] * fn, e->vl.v[l], h);
-            /* A contact that does not push adds nothing: -0 to the node's force (which leaves
-             * every value as it was), +0 to the body's (body_load). */
             const uint64_t push = ws_mask(fn > 0.0);
-            ws_lane_set(&e->a, l,
-                        v3_make(ws_pick(push, a.x, -0.0), ws_pick(push, a.y, -0.0),
-                                ws_pick(push, a.z, -0.0)));
+            ws_lane_set(&e->a, l, pushed(push, a));
             const act_load B = body_load(push, a, n, fn, share, ws_lane(&e->l, l));
             ws_lane_set(&e->b, l, B.f);
             ws_lane_set(&e->mm, l, B.m);
@@ -275,7 +256,8 @@ void ws_node_loads(ws_node_contact *nc, v3 *bforce, v3 *bmoment)
     nc->act_nl = 0;
 }
 
-/* The body part of corner_eps for the body met last in a sweep block (UINT32_MAX: none). */
+/* The body part of corner_left's margin for the body met last in a sweep block (UINT32_MAX:
+ * none): most corners in a row are of one body. */
 typedef struct corner_memo {
     uint32_t body;
     double eps;
@@ -292,7 +274,7 @@ typedef struct node_env {
     ws_nodes3 x, v;
     const ws_node_params *pp;
     act_list *L;
-    struct corner_memo *memo;
+    corner_memo *memo;
 } node_env;
 
 /* Out of line where GCC would inline it: see shallowest. Inlined where GCC would not: touch_of
@@ -384,16 +366,21 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
 }
 
 /* Whether the face of candidate c (of body bi, shape sh) is the shallowest for a node at
- * (xx, xy, xz) under it at depth d. Out of line: the few nodes below a face need it, and
- * inlined its values would crowd contacts_general's registers. */
+ * (xx, xy, xz) under it at depth d: on a convex body, no other face's plane has the node
+ * farther out (the prepared faces, global). Out of line: the few nodes below a face need it,
+ * and inlined its values would crowd contacts_general's registers. */
 NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
                                        const ws_ncand *c, double xx, double xy, double xz, double d)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const v3 xi = v3_make(xx, xy, xz);
-    if (sh->convex)
-        return convex_shallowest(E->g, c->feat - f, sh->face_count, f, xi, d);
-    return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+    if (!sh->convex)
+        return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+    const ws_wface *F = E->g->face + (c->feat - f);
+    for (uint32_t q = 0; q < sh->face_count; q++)
+        if (q != f && v3_dot(F[q].n, xi) - F[q].off > d)
+            return 0;
+    return 1;
 }
 
 /* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, the
@@ -421,44 +408,16 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 
     return 1;
 }
 
-/* ---- a node at a convex body's edge
- *
- * Most candidates that do not run are nodes at a box's edge: faces A, B and the edge between
- * them, and at most one of the three holds the node. On a convex body every face lies behind
- * every other face's plane, so the two planes' distances dA, dB tell them apart at once: face A
- * is turned down when the node's projection on its plane stands out of B's plane, and the
- * reverse; the edge when the node is not a positive sum of the two normals (it lies over a
- * face, or behind it) or lies beyond the window of either plane (in_wedge's distances along
- * the normals are dA, dB to round-off). Only by a margin eps that the full tests (eq. 14's for
- * a face, in_wedge) cannot disagree with: the feature left, if any, takes its full test, and
- * the contacts are the same as one by one. No face of a corner is one the node was found well
- * inside of (mark_corner): that face alone would hold it, and its edge is no candidate. */
+/* ---- a node at a convex body's edge: faces A, B and the edge between them, of which at most
+ * one holds the node, told apart by the two planes' distances dA, dB, by a margin eps that the
+ * full tests cannot disagree with (docs/theory.md, section 6, "Corners"). */
 
-/* The margin of the planes' tests for a node at xi and body bi, a flat convex shape at r with
- * the window's top hi: its faces' outlines stand out of the other faces' planes by its
- * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few 1e-9
- * of its radius; round-off and the flatness of its faces (1e-12) come at the size of the
- * coordinates and distances. Both with room to spare: a node that close to a boundary takes
- * the full test. (On the reference case the closest calls stand 2.4e-10 m out of the other
- * plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) The body's part is
- * kept in memo for the next node. */
-static inline double corner_eps(corner_memo *memo, uint32_t bi, const ws_shape *sh, v3 xi, v3 r,
-                                double hi)
-{
-    if (memo->body != bi) {
-        memo->body = bi;
-        memo->eps = 1e-7 * sh->radius +
-                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
-    }
-    return memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
-}
-
-/* Of a corner c[0, 3) of node xi (the shape at r, the window's top hi), those the planes leave
- * to their full tests, one bit each: a face within the window's top and not turned down, the
- * edge unless turned down. *sure: the node lies out of both planes and each face's projection
- * of it out of the other's plane, by eps, so that in_wedge's tests of the direction (r . n1,
- * r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off, as for
- * turning the edge down) hold and need not be taken. */
+/* Of a corner c[0, 3) of node xi (the shape sh at r, the window's top hi), those the planes
+ * leave to their full tests, one bit each: a face within the window's top and not turned down,
+ * the edge unless turned down. *sure: the node lies out of both planes and each face's
+ * projection of it out of the other's plane, by eps, so that in_wedge's tests of the direction
+ * (r . n1, r . n2 and r = a n1 + b n2 with a, b > 0, which are dA, dB, qA and qB to round-off,
+ * as for turning the edge down) hold and need not be taken. */
 static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, const ws_ncand *c,
                                    v3 xi, v3 r, double hi, corner_memo *memo, int *sure)
 {
@@ -467,7 +426,18 @@ static inline uint32_t corner_left(const ws_node_geom *g, const ws_shape *sh, co
     const double dA = A->n.x * xi.x + A->n.y * xi.y + A->n.z * xi.z - A->off,
                  dB = B->n.x * xi.x + B->n.y * xi.y + B->n.z * xi.z - B->off;
     const double cn = v3_dot(A->n, B->n), qA = dA - cn * dB, qB = dB - cn * dA;
-    const double eps = corner_eps(memo, c[0].body, sh, xi, r, hi);
+    /* The margin: the faces' outlines stand out of the other faces' planes by the shape's
+     * convexity tolerance (1e-9 of its size) and eq. 14's (1e-9 of a triangle) at most, a few
+     * 1e-9 of its radius; round-off and the flatness of its faces (1e-12) come at the size of
+     * the coordinates and distances. Both with room to spare: a node that close to a boundary
+     * takes the full test. (On the reference case the closest calls stand 2.4e-10 m out of the
+     * other plane, where eq. 14's tolerance still takes them; eps is 2.2e-8 m there.) */
+    if (memo->body != c[0].body) {
+        memo->body = c[0].body;
+        memo->eps = 1e-7 * sh->radius +
+                    1e-10 * (fabs(r.x) + fabs(r.y) + fabs(r.z) + sh->radius + sh->inner + hi);
+    }
+    const double eps = memo->eps + 1e-10 * (fabs(xi.x) + fabs(xi.y) + fabs(xi.z));
     /* A's projection of the node stands out of B's plane by qB, B's out of A's by qA. */
     const uint32_t a = (dA < hi) & !(qB > eps);
     const uint32_t z = (dB < hi) & !(qA > eps);
@@ -603,12 +573,9 @@ typedef struct run_batch {
  * not in the window, or not the run's, keep their forces.
  *
  * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
- * between in run_tmp: a contact's arithmetic is one long chain (some 180 cycles, a square root
- * and two divisions in a row), about as long as the window a processor runs ahead in; in one
- * pass a group's chain held back the next group's. Cut in three, the chains of several groups
- * run side by side (the friction's square root and divisions apart cost more instructions and
- * saved no time). Values a later pass takes only under a condition are read there as masks (as
- * a select, the compiler would read them under the condition: slow masked loads).
+ * between in run_tmp, so that the long chains of several groups' arithmetic overlap
+ * (docs/design.md, deviation (i)). Values a later pass takes only under a condition are read
+ * there as masks (as a select, the compiler would read them under the condition: slow loads).
  *
  * run_tmp: each array a value of every lane (4 g + l for lane l of group g). */
 typedef struct run_tmp {
@@ -704,11 +671,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
             const size_t t = o + l, e = 4 * g + l;
             const double fn = T->fn[e];
             const uint64_t keep = ws_bits(T->keep[e]), push = ws_mask(fn > 0.0);
-            /* The friction of a node that pushes; -0 for one that does not push, which leaves
-             * its force as it was to the bit when added, as the one by one pass leaves the
-             * force of a contact it does not list. */
-            const v3 a = v3_make(ws_pick(push, T->a[0][e], -0.0), ws_pick(push, T->a[1][e], -0.0),
-                                 ws_pick(push, T->a[2][e], -0.0));
+            const v3 a = pushed(push, tmp_get(T->a, e));
             gx[t] = ws_pick(keep, T->k[0][e] + a.x, gx[t]);
             gy[t] = ws_pick(keep, T->k[1][e] + a.y, gy[t]);
             gz[t] = ws_pick(keep, T->k[2][e] + a.z, gz[t]);
@@ -1108,17 +1071,14 @@ int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
             ncand + 4 > nc->act_cap + nc->act_cap / 2 ? ncand + 4 : nc->act_cap + nc->act_cap / 2;
         need = (((need + 7) / 8) | 1) * 8;
         /* The new room is taken before the old is let go: out of memory, the web keeps the
-         * room it had, of the size it had (a restore that fails leaves the world as it was). */
-        double *act = ws_mem_calloc(mem, need * ACT_ARRAYS, sizeof(double));
-        uint32_t *act_id = act ? ws_mem_calloc(mem, need * 4, sizeof(uint32_t)) : NULL;
-        if (!act_id) {
-            ws_mem_free(mem, act, act ? need * ACT_ARRAYS * sizeof(double) : 0);
+         * room it had, of the size it had (a restore that fails leaves the world as it was).
+         * The ids' four arrays follow the doubles' in one block. */
+        double *act = ws_mem_calloc(mem, need, ACT_BYTES);
+        if (!act)
             return -1;
-        }
-        ws_mem_free(mem, nc->act, nc->act_cap * ACT_ARRAYS * sizeof(double));
-        ws_mem_free(mem, nc->act_id, nc->act_cap * 4 * sizeof(uint32_t));
+        ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
         nc->act = act;
-        nc->act_id = act_id;
+        nc->act_id = (uint32_t *)(act + need * ACT_ARRAYS);
         nc->act_cap = need;
     }
     return 0;
@@ -1126,8 +1086,7 @@ int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
 
 void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
 {
-    ws_mem_free(mem, nc->act, nc->act_cap * ACT_ARRAYS * sizeof(double));
-    ws_mem_free(mem, nc->act_id, nc->act_cap * 4 * sizeof(uint32_t));
+    ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
     ws_mem_free(mem, nc->rtmp, nc->rtmp_cap * sizeof(double));
     ws_mem_free(mem, nc->rface, nc->rface_cap * sizeof *nc->rface);
     nc->rface = NULL;

@@ -134,6 +134,7 @@ int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double 
     const uint32_t n = web->n;
     double *f = im->f;
     const double c = web->damping;
+    im->begun++; /* the springs' blocks are about to change */
     for (uint32_t i = 0; i < n; i++) {
         const double m = web->m[i];
         f[3 * i] = m * gravity.x - c * v.x[i];
@@ -446,7 +447,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         im->last_residual = NAN;
         return -1;
     }
-    ws_mg *mg = im->mg && !im->jacobi_only && ws_mg_setup(im->mg, web) == 0 ? im->mg : NULL;
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
@@ -458,6 +458,12 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
     double rr = dot(r, r, m);
+    /* The multigrid's coarse levels only for a solve that iterates: a calm film's warm start
+     * often meets the tolerance already. */
+    ws_mg *mg = im->mg && !im->jacobi_only && !(sqrt(rr) <= goal) &&
+                        ws_mg_setup(im->mg, web, im->begun, h) == 0
+                    ? im->mg
+                    : NULL;
     double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
     if (R) { /* after the film's part, which its coarse correction adds to */
         for (size_t j = 0; j < 6 * (size_t)R->nb; j++)

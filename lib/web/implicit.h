@@ -43,9 +43,10 @@ typedef struct ws_implicit {
     double *nd;      /* per node: A's own part of the node, M + h (drag + dc) + h^2 kc (the
                         solve's, symmetric) */
     int warm;        /* dv holds the last converged solution */
-    /* The preconditioner: multigrid on grid webs (web/multigrid.h; NULL for a web that is not
-     * a grid of neighbour springs), block Jacobi otherwise or when jacobi_only is set (a
-     * test's comparison; the bodies in the solve then go without their coarse space,
+    uint64_t begun;  /* steps begun (ws_implicit_begin): the springs' blocks change with it */
+    /* The preconditioner: multigrid (web/multigrid.h; NULL when the web's Def chooses block
+     * Jacobi, ws_mg_chosen), block Jacobi otherwise or when jacobi_only is set (a test's
+     * comparison; the bodies in the solve then go without their coarse space,
      * web/coupled.h). */
     struct ws_mg *mg;
     int jacobi_only;

@@ -7,8 +7,7 @@
 #include <string.h>
 
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
-#define MG_COARSEST 64 /* a level of this many nodes or fewer is the coarsest */
-#define MG_DENSE 128   /* the coarsest level's nodes at most: its factor is (3 n)^2 doubles */
+#define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
 /* The film level's smoother: damped block Jacobi, this many sweeps before and after the coarse
  * correction, with weight MG_OMEGA. The film's matrix is at most twice its block diagonal
  * (A = N + sum over springs of E^T K E with E = e_a - e_b, and 2 D - A = N + sum (e_a + e_b)^T
@@ -16,14 +15,18 @@
  * definite; 2/3 is the weight that damps the grid's upper half of frequencies best. */
 #define MG_SWEEPS 2
 #define MG_OMEGA (2.0 / 3.0)
-#define BLK 9           /* a full 3x3 block, row-major */
 /* A coarse node's row holds its own block and those of its forward neighbours (slots 4 to 8 of
- * the 9 with dx, dy in -1..1, slot 3 (dy + 1) + dx + 1); a backward neighbour's block is the
- * transpose of that neighbour's forward one (the matrix is symmetric), which halves what a
- * sweep reads. */
+ * the 9 with dx, dy in -1..1, slot 3 (dy + 1) + dx + 1); a backward neighbour's block is that
+ * neighbour's forward one (every block is symmetric: P is a scalar weight times the 3x3
+ * identity, and the film's blocks are), which halves what a sweep reads. A block is kept as its
+ * six numbers (implicit.h's WS_SYM order) in single precision: the coarse levels are a
+ * preconditioner's, and halving them halves what a cycle streams (docs/theory.md 8a says why
+ * the cycle stays symmetric positive definite); they are summed in double (`acc`) and rounded
+ * once. */
 #define CENTRE 4
-#define STEN (5 * BLK)
-#define AT(L, k, o) ((L)->a + STEN * (size_t)(k) + BLK * (size_t)((o) - CENTRE))
+#define STEN (5 * WS_SYM)
+#define AT(L, k, o) ((L)->a + STEN * (size_t)(k) + WS_SYM * (size_t)((o) - CENTRE))
+#define ACC(acc, k, o) ((acc) + STEN * (size_t)(k) + WS_SYM * (size_t)((o) - CENTRE))
 
 /* One direction's interpolation for one fine index: n coarse indices c with weights w. */
 typedef struct map1d {
@@ -36,7 +39,7 @@ typedef struct mg_level {
     int cx, cy;         /* whether x and y are halved for the next level */
     map1d *mx, *my;     /* interpolation from the next level, by ix and by iy */
     uint32_t n;
-    double *a;              /* STEN n: each node's row of blocks (coarse levels) */
+    float *a;               /* STEN n: each node's row of blocks (coarse levels) */
     double *dinv;           /* WS_SYM n: inverse of each node's own block (coarse levels) */
     double *x, *r, *t;      /* 3 n each: the level's solution, right-hand side, scratch (the
                                film's level has t alone) */
@@ -47,7 +50,19 @@ struct ws_mg {
     mg_level lv[MG_LEVELS];
     uint32_t m;   /* unknowns of the coarsest level */
     double *chol; /* its Cholesky factor, lower, m x m */
-    double *blk;  /* every array above, in one allocation of `doubles` */
+    double *acc;  /* a coarse level's blocks as they are summed (level 1's size) */
+    double *row;  /* a coarse row of vectors (level 1's nx), for restriction and prolongation */
+    double *sacc; /* level 1's springs' part, kept while the springs' blocks are: made for the
+                     step ws_implicit_begin began (its count kept_begun) and the step h */
+    int springs_kept;
+    uint64_t kept_begun;
+    double kept_h;
+    double *blk;  /* every array above but the levels' blocks, in one allocation of `doubles` */
+    float *fop;   /* the film's springs for the sweeps: e, a, b (5 a spring; with sacc) */
+    float *fnd;   /* the film's nodes' own blocks N (WS_SYM a node; at every setup) */
+    float *fpinv; /* w times the inverse of the film's diagonal blocks D (likewise) */
+    float *fblk;  /* every float array above, `floats` */
+    size_t floats;
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
@@ -81,9 +96,9 @@ static int map1(int i, int n, int closed, int coarsen, int *c, double *w)
 /* A fine node's row of P: the coarse nodes (coordinates and index) and their weights. */
 typedef struct pmap {
     int n;
-    int X[4], Y[4];
-    uint32_t idx[4];
-    double w[4];
+    int X[8], Y[8];
+    uint32_t idx[8];
+    double w[8];
 } pmap;
 
 static void pmap_of(const mg_level *f, const mg_level *c, int ix, int iy, pmap *p)
@@ -114,7 +129,7 @@ static int slot(const mg_level *c, int X1, int Y1, int X2, int Y2)
 }
 
 /* The 9 neighbours of (ix, iy) on level L, by slot; -1 beyond the grid's edge. */
-static void neighbours(const mg_level *L, int ix, int iy, int64_t *j)
+static inline void neighbours(const mg_level *L, int ix, int iy, int64_t *j)
 {
     int64_t xs[3] = {ix - 1, ix, ix + 1};
     if (ix == 0)
@@ -129,27 +144,47 @@ static void neighbours(const mg_level *L, int ix, int iy, int64_t *j)
     }
 }
 
-/* Coarse level c += s P_p^T B P_q: block B between fine rows p and q, through P (its centre
- * and forward blocks; the caller adds the pair (q, p, B^T) too). */
-static void galerkin_add(mg_level *c, const pmap *p, const pmap *q, const double *B, double s)
+/* A list of coarse nodes with weights, each node once: a fine node's row of P (up to 4), or
+ * the difference of two rows (a spring's E P, up to 8). */
+static void sym_axpy(double *D, double w, const double *S)
+{
+    for (int k = 0; k < WS_SYM; k++)
+        D[k] += w * S[k];
+}
+
+/* Where the block between coarse nodes u and v (u != v, grid neighbours) is kept: the forward
+ * one's row. */
+static double *pair_block(const mg_level *c, double *acc, const pmap *p, int i, const pmap *q,
+                          int j)
+{
+    const int o = slot(c, p->X[i], p->Y[i], q->X[j], q->Y[j]);
+    return o > CENTRE ? ACC(acc, p->idx[i], o) : ACC(acc, q->idx[j], 8 - o);
+}
+
+/* acc += (P^T u)(P^T u)^T (x) S for the list p of u's coarse nodes and weights: the Galerkin
+ * image of a block S on one fine node, or of a spring's E^T S E (p its E P). */
+static void add_outer(const mg_level *c, double *acc, const pmap *p, const double *S)
+{
+    for (int i = 0; i < p->n; i++) {
+        sym_axpy(ACC(acc, p->idx[i], CENTRE), p->w[i] * p->w[i], S);
+        for (int j = i + 1; j < p->n; j++)
+            sym_axpy(pair_block(c, acc, p, i, p, j), p->w[i] * p->w[j], S);
+    }
+}
+
+/* acc += the image of a fine off-diagonal pair (i, j), block S in both (i, j) and (j, i):
+ * (P_i^T P_j + P_j^T P_i) (x) S, p and q their rows of P. */
+static void add_cross(const mg_level *c, double *acc, const pmap *p, const pmap *q,
+                      const double *S)
 {
     for (int i = 0; i < p->n; i++)
         for (int j = 0; j < q->n; j++) {
-            const int o = slot(c, p->X[i], p->Y[i], q->X[j], q->Y[j]);
-            if (o < CENTRE)
-                continue; /* the transpose of (J, I)'s, which the pair (q, p) adds */
-            double *D = AT(c, p->idx[i], o);
-            const double w = s * p->w[i] * q->w[j];
-            for (int k = 0; k < BLK; k++)
-                D[k] += w * B[k];
+            const double w = p->w[i] * q->w[j];
+            if (p->idx[i] == q->idx[j])
+                sym_axpy(ACC(acc, p->idx[i], CENTRE), 2.0 * w, S);
+            else
+                sym_axpy(pair_block(c, acc, p, i, q, j), w, S);
         }
-}
-
-static void sym_full(const double *S, double *B)
-{
-    B[0] = S[WS_SYM_XX], B[1] = S[WS_SYM_XY], B[2] = S[WS_SYM_XZ];
-    B[3] = S[WS_SYM_XY], B[4] = S[WS_SYM_YY], B[5] = S[WS_SYM_YZ];
-    B[6] = S[WS_SYM_XZ], B[7] = S[WS_SYM_YZ], B[8] = S[WS_SYM_ZZ];
 }
 
 /* The film's node (ix, iy)'s row of P; none for a pinned node (its dv is zero). */
@@ -163,92 +198,147 @@ static void film_pmap(const ws_mg *mg, const ws_web *web, uint32_t i, pmap *p)
     pmap_of(f, &mg->lv[1], (int)(i % (uint32_t)f->nx), (int)(i / (uint32_t)f->nx), p);
 }
 
-/* Level 1 = P^T A P from the film's nodes and springs as operator_for set them. */
-static void galerkin_film(ws_mg *mg, const ws_web *web)
+/* d = p - q as one list (a spring's E P from its ends' rows), zero weights dropped. */
+static void pmap_diff(const pmap *p, const pmap *q, pmap *d)
+{
+    *d = *p;
+    for (int j = 0; j < q->n; j++) {
+        int i = 0;
+        while (i < d->n && d->idx[i] != q->idx[j])
+            i++;
+        if (i == d->n) {
+            d->X[i] = q->X[j], d->Y[i] = q->Y[j], d->idx[i] = q->idx[j], d->w[i] = 0.0;
+            d->n++;
+        }
+        d->w[i] -= q->w[j];
+    }
+    int k = 0;
+    for (int i = 0; i < d->n; i++)
+        if (d->w[i] != 0.0) {
+            d->X[k] = d->X[i], d->Y[k] = d->Y[i], d->idx[k] = d->idx[i], d->w[k] = d->w[i];
+            k++;
+        }
+    d->n = k;
+}
+
+/* The part of level 1 that stays over a step h, into mg->sacc: P^T (sum over springs of E^T K
+ * E + the nodes' (m + h c) I) P. It changes only when the springs' blocks do (once a step); the
+ * contacts, which change between the solves of a step, add to the nodes' blocks. */
+static void galerkin_springs(ws_mg *mg, const ws_web *web, double h)
 {
     const ws_implicit *im = web->imp;
-    mg_level *c = &mg->lv[1];
-    memset(c->a, 0, STEN * (size_t)c->n * sizeof(double));
-    double B[BLK];
-    pmap p, q;
-    for (uint32_t i = 0; i < web->n; i++) {
-        film_pmap(mg, web, i, &p);
-        sym_full(im->nd + WS_SYM * (size_t)i, B);
-        galerkin_add(c, &p, &p, B, 1.0);
-    }
+    const mg_level *c = &mg->lv[1];
+    memset(mg->sacc, 0, STEN * (size_t)c->n * sizeof(double));
+    pmap p, q, d;
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_ispring *k = &im->sp[s];
+        float *o = mg->fop + 5 * (size_t)s;
+        o[0] = (float)k->ex, o[1] = (float)k->ey, o[2] = (float)k->ez;
+        o[3] = (float)k->a, o[4] = (float)k->b;
         if (k->a == 0.0 && k->b == 0.0)
             continue;
-        const double e[3] = {k->ex, k->ey, k->ez};
-        for (int r = 0; r < 3; r++)
-            for (int col = 0; col < 3; col++)
-                B[3 * r + col] = k->a * e[r] * e[col] + (r == col ? k->b : 0.0);
+        const double S[WS_SYM] = {[WS_SYM_XX] = k->a * k->ex * k->ex + k->b,
+                                  [WS_SYM_YY] = k->a * k->ey * k->ey + k->b,
+                                  [WS_SYM_ZZ] = k->a * k->ez * k->ez + k->b,
+                                  [WS_SYM_XY] = k->a * k->ex * k->ey,
+                                  [WS_SYM_XZ] = k->a * k->ex * k->ez,
+                                  [WS_SYM_YZ] = k->a * k->ey * k->ez};
         film_pmap(mg, web, web->sa[s], &p);
         film_pmap(mg, web, web->sb[s], &q);
-        galerkin_add(c, &p, &p, B, 1.0);
-        galerkin_add(c, &q, &q, B, 1.0);
-        galerkin_add(c, &p, &q, B, -1.0);
-        galerkin_add(c, &q, &p, B, -1.0);
+        pmap_diff(&p, &q, &d);
+        add_outer(c, mg->sacc, &d, S);
+    }
+    for (uint32_t i = 0; i < web->n; i++) {
+        const double m = web->m[i] + h * web->damping;
+        const double S[WS_SYM] = {[WS_SYM_XX] = m, [WS_SYM_YY] = m, [WS_SYM_ZZ] = m};
+        film_pmap(mg, web, i, &p);
+        add_outer(c, mg->sacc, &p, S);
     }
 }
 
-/* Level k + 1 = P^T A_k P. */
+/* Level 1 = P^T A P over step h: the part kept over the step and the contacts' blocks of the
+ * nodes that have any, h^2 K + h D as operator_for takes them. */
+static void galerkin_film(ws_mg *mg, const ws_web *web, double h)
+{
+    const ws_implicit *im = web->imp;
+    const mg_level *c = &mg->lv[1];
+    memcpy(mg->acc, mg->sacc, STEN * (size_t)c->n * sizeof(double));
+    pmap p;
+    for (uint32_t i = 0; i < web->n; i++) {
+        const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
+        double S[WS_SYM];
+        int any = 0;
+        for (int k = 0; k < WS_SYM; k++) {
+            S[k] = h * h * kc[k] + h * dc[k];
+            any |= S[k] != 0.0;
+        }
+        if (!any)
+            continue;
+        film_pmap(mg, web, i, &p);
+        add_outer(c, mg->acc, &p, S);
+    }
+}
+
+/* A float block as doubles. */
+static void block_of(const float *B, double *S)
+{
+    for (int k = 0; k < WS_SYM; k++)
+        S[k] = B[k];
+}
+
+/* Level k + 1 = P^T A_k P, into mg->acc. */
 static void galerkin_level(ws_mg *mg, int k)
 {
     const mg_level *f = &mg->lv[k];
-    mg_level *c = &mg->lv[k + 1];
-    memset(c->a, 0, STEN * (size_t)c->n * sizeof(double));
+    const mg_level *c = &mg->lv[k + 1];
+    memset(mg->acc, 0, STEN * (size_t)c->n * sizeof(double));
     pmap p, q;
     int64_t j[9];
+    double S[WS_SYM];
     for (int iy = 0; iy < f->ny; iy++)
         for (int ix = 0; ix < f->nx; ix++) {
             const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
             pmap_of(f, c, ix, iy, &p);
             neighbours(f, ix, iy, j);
-            galerkin_add(c, &p, &p, AT(f, i, CENTRE), 1.0);
+            block_of(AT(f, i, CENTRE), S);
+            add_outer(c, mg->acc, &p, S);
             for (int o = CENTRE + 1; o < 9; o++) {
-                const double *B = AT(f, i, o);
-                if (j[o] < 0 || (B[0] == 0.0 && B[4] == 0.0 && B[8] == 0.0 && B[1] == 0.0 &&
-                                 B[2] == 0.0 && B[5] == 0.0 && B[3] == 0.0 && B[6] == 0.0 &&
-                                 B[7] == 0.0))
+                const float *B = AT(f, i, o);
+                if (j[o] < 0 || (B[0] == 0.0f && B[1] == 0.0f && B[2] == 0.0f &&
+                                 B[3] == 0.0f && B[4] == 0.0f && B[5] == 0.0f))
                     continue;
-                double Bt[BLK];
-                for (int r = 0; r < 3; r++)
-                    for (int col = 0; col < 3; col++)
-                        Bt[3 * col + r] = B[3 * r + col];
+                block_of(B, S);
                 pmap_of(f, c, (int)(j[o] % f->nx), (int)(j[o] / f->nx), &q);
-                galerkin_add(c, &p, &q, B, 1.0);
-                galerkin_add(c, &q, &p, Bt, 1.0);
+                add_cross(c, mg->acc, &p, &q, S);
             }
         }
 }
 
-/* o -= M x, or o -= M^T x when transposed (M a row-major 3x3 block). */
-static inline void block_sub(const double *M, int transposed, const double *x, double *o)
+/* The level's blocks rounded from the sums in mg->acc. */
+static void store_level(ws_mg *mg, int k)
 {
-    if (transposed) {
-        o[0] -= M[0] * x[0] + M[3] * x[1] + M[6] * x[2];
-        o[1] -= M[1] * x[0] + M[4] * x[1] + M[7] * x[2];
-        o[2] -= M[2] * x[0] + M[5] * x[1] + M[8] * x[2];
-    } else {
-        o[0] -= M[0] * x[0] + M[1] * x[1] + M[2] * x[2];
-        o[1] -= M[3] * x[0] + M[4] * x[1] + M[5] * x[2];
-        o[2] -= M[6] * x[0] + M[7] * x[1] + M[8] * x[2];
-    }
+    mg_level *L = &mg->lv[k];
+    for (size_t q = 0; q < STEN * (size_t)L->n; q++)
+        L->a[q] = (float)mg->acc[q];
 }
 
-/* The inverse of a node's own block (symmetrised), or zeros for a node no fine node reaches
- * (all of its fine nodes pinned: its right-hand side is always zero). 0, or -1 when the block
- * is not positive definite. */
-static int own_inverse(const double *B, double *S)
+/* o -= S x for a symmetric block S kept in floats. */
+static inline void fsym_sub(const float *S, const double *x, double *o)
 {
-    const double sym[WS_SYM] = {[WS_SYM_XX] = B[0],
-                                [WS_SYM_YY] = B[4],
-                                [WS_SYM_ZZ] = B[8],
-                                [WS_SYM_XY] = 0.5 * (B[1] + B[3]),
-                                [WS_SYM_XZ] = 0.5 * (B[2] + B[6]),
-                                [WS_SYM_YZ] = 0.5 * (B[5] + B[7])};
+    const double xx = S[WS_SYM_XX], yy = S[WS_SYM_YY], zz = S[WS_SYM_ZZ], xy = S[WS_SYM_XY],
+                 xz = S[WS_SYM_XZ], yz = S[WS_SYM_YZ];
+    o[0] -= xx * x[0] + xy * x[1] + xz * x[2];
+    o[1] -= xy * x[0] + yy * x[1] + yz * x[2];
+    o[2] -= xz * x[0] + yz * x[1] + zz * x[2];
+}
+
+/* The inverse of a node's own block, or zeros for a node no fine node reaches (all of its
+ * fine nodes pinned: its right-hand side is always zero). 0, or -1 when the block is not
+ * positive definite. */
+static int own_inverse(const float *B, double *S)
+{
+    double sym[WS_SYM];
+    block_of(B, sym);
     if (sym[WS_SYM_XX] == 0.0 && sym[WS_SYM_YY] == 0.0 && sym[WS_SYM_ZZ] == 0.0) {
         memset(S, 0, WS_SYM * sizeof(double));
         return 0;
@@ -268,18 +358,23 @@ static int factor_coarsest(ws_mg *mg)
     for (int iy = 0; iy < L->ny; iy++)
         for (int ix = 0; ix < L->nx; ix++) {
             const uint32_t i = (uint32_t)ix + (uint32_t)L->nx * (uint32_t)iy;
-            const double *own = AT(L, i, CENTRE);
-            if (own[0] == 0.0 && own[4] == 0.0 && own[8] == 0.0) { /* unreached: identity */
+            const float *own = AT(L, i, CENTRE);
+            if (own[WS_SYM_XX] == 0.0f && own[WS_SYM_YY] == 0.0f &&
+                own[WS_SYM_ZZ] == 0.0f) { /* unreached: identity */
                 for (int k = 0; k < 3; k++)
                     D[(3 * (size_t)i + k) * m + 3 * i + k] = 1.0;
                 continue;
             }
             neighbours(L, ix, iy, nb);
-            for (int o = CENTRE; o < 9; o++) { /* the block and its transpose */
+            for (int o = CENTRE; o < 9; o++) { /* the block and its mirror */
                 if (nb[o] < 0)
                     continue;
                 const size_t j = (size_t)nb[o];
-                const double *B = AT(L, i, o);
+                double B[9];
+                const float *S = AT(L, i, o);
+                B[0] = S[WS_SYM_XX], B[1] = S[WS_SYM_XY], B[2] = S[WS_SYM_XZ];
+                B[3] = S[WS_SYM_XY], B[4] = S[WS_SYM_YY], B[5] = S[WS_SYM_YZ];
+                B[6] = S[WS_SYM_XZ], B[7] = S[WS_SYM_YZ], B[8] = S[WS_SYM_ZZ];
                 for (int r = 0; r < 3; r++)
                     for (int col = 0; col < 3; col++) {
                         D[(3 * (size_t)i + r) * m + 3 * j + col] += B[3 * r + col];
@@ -306,145 +401,186 @@ static int factor_coarsest(ws_mg *mg)
     return 0;
 }
 
-int ws_mg_setup(ws_mg *mg, const ws_web *web)
+int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
-    galerkin_film(mg, web);
-    for (int k = 1; k + 1 < mg->nlev; k++)
+    if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
+        galerkin_springs(mg, web, h);
+        mg->springs_kept = 1;
+        mg->kept_begun = begun;
+        mg->kept_h = h;
+    }
+    const ws_implicit *im = web->imp;
+    for (size_t q = 0; q < WS_SYM * (size_t)web->n; q++) {
+        mg->fnd[q] = (float)im->nd[q];
+        mg->fpinv[q] = (float)(MG_OMEGA * im->pinv[q]);
+    }
+    galerkin_film(mg, web, h);
+    store_level(mg, 1);
+    for (int k = 1; k + 1 < mg->nlev; k++) {
         galerkin_level(mg, k);
+        store_level(mg, k + 1);
+    }
     for (int k = 1; k + 1 < mg->nlev; k++) {
         const mg_level *L = &mg->lv[k];
         for (uint32_t i = 0; i < L->n; i++)
-            if (own_inverse(AT(L, i, CENTRE),
-                            L->dinv + WS_SYM * (size_t)i) != 0)
+            if (own_inverse(AT(L, i, CENTRE), L->dinv + WS_SYM * (size_t)i) != 0)
                 return -1;
     }
     return factor_coarsest(mg);
 }
 
-/* s -= sum over node k's neighbours j of A_kj x_j: those before k (side < 0), after k (side >
- * 0) or all (side 0), its own block left out. */
-static void row_times(const mg_level *L, size_t k, const int64_t *j, int side, double *s)
+/* A_kj of coarse level L for k's neighbour j in slot o (o != CENTRE). */
+static inline const float *off_block(const mg_level *L, size_t k, int o, int64_t j)
 {
-    for (int o = 0; o < 9; o++) {
-        if (j[o] < 0 || o == CENTRE || (side < 0 && (size_t)j[o] > k) ||
-            (side > 0 && (size_t)j[o] < k))
-            continue;
-        const double *X = L->x + 3 * (size_t)j[o];
-        if (o > CENTRE) {
-            const double *B = AT(L, k, o);
-            s[0] -= B[0] * X[0] + B[1] * X[1] + B[2] * X[2];
-            s[1] -= B[3] * X[0] + B[4] * X[1] + B[5] * X[2];
-            s[2] -= B[6] * X[0] + B[7] * X[1] + B[8] * X[2];
-        } else { /* the neighbour's forward block, transposed */
-            const double *B = AT(L, j[o], 8 - o);
-            s[0] -= B[0] * X[0] + B[3] * X[1] + B[6] * X[2];
-            s[1] -= B[1] * X[0] + B[4] * X[1] + B[7] * X[2];
-            s[2] -= B[2] * X[0] + B[5] * X[1] + B[8] * X[2];
-        }
-    }
+    return o > CENTRE ? AT(L, k, o) : AT(L, (size_t)j, 8 - o);
 }
 
-/* One sweep of block Gauss-Seidel on coarse level L: forward from x = 0 (a node then meets
- * only the nodes before it, those after being still zero), which leaves the residual r - A x
+/* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
+ * k (the nodes after are still zero), its block into *B (NULL when not). */
+static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const float **B,
+                           double *s)
+{
+    *B = NULL;
+    if (j < 0 || j > k)
+        return;
+    *B = off_block(L, (size_t)k, o, j);
+    fsym_sub(*B, L->x + 3 * (size_t)j, s);
+}
+
+/* x_k = D_k^-1 s. */
+static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
+{
+    const double *S = L->dinv + WS_SYM * (size_t)k;
+    double *X = L->x + 3 * (size_t)k;
+    X[0] = X[1] = X[2] = 0.0;
+    ws_sym_madd(S, s[0], s[1], s[2], X);
+}
+
+/* The sweeps of block Gauss-Seidel on a coarse level L. Forward from x = 0: a node meets only
+ * the nodes before it (those after are still zero), and the sweep leaves the residual r - A x
  * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
- * as that node is solved, with the block its own solve has just read); or backward from the x
- * there is. */
-static void gauss_seidel(mg_level *L, int backward)
+ * as that node is solved, with the block its own solve has just read). */
+static void gauss_seidel_forward(mg_level *L)
 {
-    const int nx = L->nx, ny = L->ny;
-    int64_t j[9];
-    if (!backward)
-        memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
-    for (int q = 0; q < nx * ny; q++) {
-        const int k = backward ? nx * ny - 1 - q : q;
-        neighbours(L, k % nx, k / nx, j);
-        const double *R = L->r + 3 * (size_t)k;
-        double s[3] = {R[0], R[1], R[2]};
-        if (backward) {
-            row_times(L, (size_t)k, j, 0, s);
-        } else {
-            /* A_kj for the nodes j before k: the transpose of j's forward block, or k's own
-             * forward block across a band's seam. */
-            const double *B[9];
-            int tr[9];
-            for (int o = 0; o < 9; o++) {
-                B[o] = NULL;
-                if (j[o] < 0 || o == CENTRE || j[o] > k)
-                    continue;
-                tr[o] = o < CENTRE;
-                B[o] = tr[o] ? AT(L, j[o], 8 - o) : AT(L, k, o);
-                const double *X = L->x + 3 * (size_t)j[o], *M = B[o];
-                block_sub(M, tr[o], X, s);
-            }
-            const double *S = L->dinv + WS_SYM * (size_t)k;
-            double *X = L->x + 3 * (size_t)k;
-            X[0] = X[1] = X[2] = 0.0;
-            ws_sym_madd(S, s[0], s[1], s[2], X);
-            for (int o = 0; o < 9; o++) { /* t_j -= A_jk x_k, A_jk = A_kj^T */
-                if (!B[o])
-                    continue;
-                const double *M = B[o];
-                double *T = L->t + 3 * (size_t)j[o];
-                block_sub(M, !tr[o], X, T);
-            }
-            continue;
+    memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
+    for (int iy = 0; iy < L->ny; iy++)
+        for (int ix = 0; ix < L->nx; ix++) {
+            const int64_t k = ix + (int64_t)L->nx * iy;
+            int64_t j[9];
+            neighbours(L, ix, iy, j);
+            const double *R = L->r + 3 * (size_t)k;
+            double s[3] = {R[0], R[1], R[2]};
+            const float *B[9];
+            for (int o = 0; o < 9; o++)
+                if (o != CENTRE)
+                    gs_take(L, k, o, j[o], &B[o], s);
+            gs_solve(L, k, s);
+            const double *X = L->x + 3 * (size_t)k;
+            for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
+                if (o != CENTRE && B[o])
+                    fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
         }
-        const double *S = L->dinv + WS_SYM * (size_t)k;
-        double *X = L->x + 3 * (size_t)k;
-        X[0] = X[1] = X[2] = 0.0;
-        ws_sym_madd(S, s[0], s[1], s[2], X);
+}
+
+/* Backward from the x there is: node k meets every neighbour. */
+static void gauss_seidel_backward(mg_level *L)
+{
+    for (int iy = L->ny - 1; iy >= 0; iy--)
+        for (int ix = L->nx - 1; ix >= 0; ix--) {
+            const int64_t k = ix + (int64_t)L->nx * iy;
+            int64_t j[9];
+            neighbours(L, ix, iy, j);
+            const double *R = L->r + 3 * (size_t)k;
+            double s[3] = {R[0], R[1], R[2]};
+            for (int o = 0; o < 9; o++)
+                if (o != CENTRE && j[o] >= 0)
+                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
+            gs_solve(L, k, s);
+        }
+}
+
+/* Whether fine node i of level k is left out of P (a pinned film node: its dv is zero). */
+static inline int left_out(const ws_web *web, int k, uint32_t i)
+{
+    return k == 0 && !web->same_inv_m && web->inv_m[i] == 0.0;
+}
+
+/* c->r = P^T t (t a level-k vector; the film's pinned nodes left out). P is a map along x
+ * times one along y: each fine row is restricted along x into mg->row, which is added to the
+ * coarse rows it maps to. */
+static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *t)
+{
+    const mg_level *f = &mg->lv[k];
+    const mg_level *c = &mg->lv[k + 1];
+    double *u = mg->row;
+    memset(c->r, 0, 3 * (size_t)c->n * sizeof(double));
+    for (int iy = 0; iy < f->ny; iy++) {
+        memset(u, 0, 3 * (size_t)c->nx * sizeof(double));
+        for (int ix = 0; ix < f->nx; ix++) {
+            const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
+            if (left_out(web, k, i))
+                continue;
+            const map1d *mx = &f->mx[ix];
+            const double *T = t + 3 * (size_t)i;
+            for (int a = 0; a < mx->n; a++) {
+                double *U = u + 3 * (size_t)mx->c[a];
+                const double w = mx->w[a];
+                U[0] += w * T[0];
+                U[1] += w * T[1];
+                U[2] += w * T[2];
+            }
+        }
+        const map1d *my = &f->my[iy];
+        for (int b = 0; b < my->n; b++) {
+            double *R = c->r + 3 * (size_t)c->nx * (size_t)my->c[b];
+            const double w = my->w[b];
+            for (size_t q = 0; q < 3 * (size_t)c->nx; q++)
+                R[q] += w * u[q];
+        }
     }
 }
 
-/* c->r = P^T (r - t), or P^T t when r is NULL (r, t level-f vectors; f the film's when web is
- * given, its pinned nodes then left out), and prolongation x += P c->x. */
-static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *r,
-                        const double *t)
+/* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
+ * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
+ * of the product that follows is taken on the way: t = r - N x. */
+static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
+                        double *t)
 {
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
-    memset(c->r, 0, 3 * (size_t)c->n * sizeof(double));
-    pmap p;
-    for (int iy = 0; iy < f->ny; iy++)
-        for (int ix = 0; ix < f->nx; ix++) {
-            const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-            if (web && web->inv_m[i] == 0.0)
-                continue;
-            pmap_of(f, c, ix, iy, &p);
-            const double *T = t + 3 * (size_t)i;
-            double d[3] = {T[0], T[1], T[2]};
-            if (r) {
-                const double *F = r + 3 * (size_t)i;
-                d[0] = F[0] - d[0], d[1] = F[1] - d[1], d[2] = F[2] - d[2];
-            }
-            for (int q = 0; q < p.n; q++) {
-                double *R = c->r + 3 * (size_t)p.idx[q];
-                R[0] += p.w[q] * d[0];
-                R[1] += p.w[q] * d[1];
-                R[2] += p.w[q] * d[2];
-            }
+    double *u = mg->row;
+    for (int iy = 0; iy < f->ny; iy++) {
+        const map1d *my = &f->my[iy];
+        const double *C0 = c->x + 3 * (size_t)c->nx * (size_t)my->c[0];
+        if (my->n == 1) {
+            memcpy(u, C0, 3 * (size_t)c->nx * sizeof(double));
+        } else {
+            const double *C1 = c->x + 3 * (size_t)c->nx * (size_t)my->c[1];
+            const double w0 = my->w[0], w1 = my->w[1];
+            for (size_t q = 0; q < 3 * (size_t)c->nx; q++)
+                u[q] = w0 * C0[q] + w1 * C1[q];
         }
-}
-
-static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x)
-{
-    const mg_level *f = &mg->lv[k];
-    const mg_level *c = &mg->lv[k + 1];
-    pmap p;
-    for (int iy = 0; iy < f->ny; iy++)
         for (int ix = 0; ix < f->nx; ix++) {
             const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-            if (web && web->inv_m[i] == 0.0)
-                continue;
-            pmap_of(f, c, ix, iy, &p);
             double *X = x + 3 * (size_t)i;
-            for (int q = 0; q < p.n; q++) {
-                const double *C = c->x + 3 * (size_t)p.idx[q];
-                X[0] += p.w[q] * C[0];
-                X[1] += p.w[q] * C[1];
-                X[2] += p.w[q] * C[2];
+            if (!left_out(web, k, i)) {
+                const map1d *mx = &f->mx[ix];
+                for (int a = 0; a < mx->n; a++) {
+                    const double *U = u + 3 * (size_t)mx->c[a];
+                    const double w = mx->w[a];
+                    X[0] += w * U[0];
+                    X[1] += w * U[1];
+                    X[2] += w * U[2];
+                }
+            }
+            if (r) {
+                const double *R = r + 3 * (size_t)i;
+                double *T = t + 3 * (size_t)i;
+                T[0] = R[0], T[1] = R[1], T[2] = R[2];
+                fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
             }
         }
+    }
 }
 
 /* x = L^-T L^-1 r on the coarsest level. */
@@ -470,60 +606,101 @@ static void solve_coarsest(ws_mg *mg)
 
 /* x_k = B_k r_k on coarse level k: Gauss-Seidel forward, the coarser correction, Gauss-Seidel
  * backward (the two sweeps each other's transpose, so B_k is symmetric). */
-static void cycle(ws_mg *mg, int k)
+static void cycle(ws_mg *mg, const ws_web *web, int k)
 {
     if (k == mg->nlev - 1) {
         solve_coarsest(mg);
         return;
     }
     mg_level *L = &mg->lv[k];
-    gauss_seidel(L, 0);
-    restrict_to(mg, NULL, k, NULL, L->t);
-    cycle(mg, k + 1);
-    prolong_add(mg, NULL, k, L->x);
-    gauss_seidel(L, 1);
+    gauss_seidel_forward(L);
+    restrict_to(mg, web, k, L->t);
+    cycle(mg, web, k + 1);
+    prolong_add(mg, web, k, L->x, NULL, NULL);
+    gauss_seidel_backward(L);
 }
 
-/* z += w P^-1 (r - t) with the film's block-Jacobi inverses (t NULL: z = w P^-1 r). */
-static void jacobi(const ws_web *web, const double *r, const double *t, double *z)
+/* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
+ * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
+ * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
+ * them (single precision). Returns r . z. */
+enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
+
+static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
+                                double *restrict t, double *restrict z, int how, int residual)
 {
-    const double *pinv = web->imp->pinv;
-    for (uint32_t i = 0; i < web->n; i++) {
-        const double *R = r + 3 * (size_t)i, *S = pinv + WS_SYM * (size_t)i;
-        double *Z = z + 3 * (size_t)i;
-        double d[3] = {R[0], R[1], R[2]};
-        if (t) {
-            const double *T = t + 3 * (size_t)i;
-            d[0] -= T[0], d[1] -= T[1], d[2] -= T[2];
-        } else {
-            Z[0] = Z[1] = Z[2] = 0.0;
+    double rz = 0.0;
+    for (uint32_t i = 0; i < n; i++) {
+        const double *R = r + 3 * (size_t)i;
+        double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
+        if (how != JACOBI_NONE) {
+            const float *J = mg->fpinv + WS_SYM * (size_t)i;
+            const double *D = how == JACOBI_SET ? R : T;
+            const double xx = J[WS_SYM_XX], yy = J[WS_SYM_YY], zz = J[WS_SYM_ZZ],
+                         xy = J[WS_SYM_XY], xz = J[WS_SYM_XZ], yz = J[WS_SYM_YZ];
+            const double u0 = xx * D[0] + xy * D[1] + xz * D[2],
+                         u1 = xy * D[0] + yy * D[1] + yz * D[2],
+                         u2 = xz * D[0] + yz * D[1] + zz * D[2];
+            if (how == JACOBI_SET)
+                Z[0] = u0, Z[1] = u1, Z[2] = u2;
+            else
+                Z[0] += u0, Z[1] += u1, Z[2] += u2;
         }
-        d[0] *= MG_OMEGA, d[1] *= MG_OMEGA, d[2] *= MG_OMEGA;
-        ws_sym_madd(S, d[0], d[1], d[2], Z);
+        if (residual) {
+            T[0] = R[0], T[1] = R[1], T[2] = R[2];
+            fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
+        } else {
+            rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
+        }
+    }
+    return rz;
+}
+
+/* t -= the springs' part of A z, with the springs' blocks as the level keeps them (e, a, b in
+ * single precision). */
+static void film_springs(const ws_mg *mg, const ws_web *web, const double *restrict z,
+                         double *restrict t)
+{
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const float *q = mg->fop + 5 * (size_t)s; /* ex ey ez a b */
+        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
+        const double *A = z + 3 * (size_t)sa[s], *B = z + 3 * (size_t)sb[s];
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double ed = a * (ex * dx + ey * dy + ez * dz);
+        const double tx = ed * ex + b * dx, ty = ed * ey + b * dy, tz = ed * ez + b * dz;
+        double *TA = t + 3 * (size_t)sa[s], *TB = t + 3 * (size_t)sb[s];
+        TA[0] -= tx;
+        TA[1] -= ty;
+        TA[2] -= tz;
+        TB[0] += tx;
+        TB[1] += ty;
+        TB[2] += tz;
     }
 }
 
+/* z = B r: on the film's level MG_SWEEPS Jacobi sweeps from zero, the residual restricted, the
+ * coarse cycle, its correction interpolated, MG_SWEEPS sweeps more. Each sweep's product is
+ * the node pass (which also finishes the sweep before) and the springs' pass. */
 double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
 {
     double *t = mg->lv[0].t;
-    const size_t m = 3 * (size_t)web->n;
-    jacobi(web, r, NULL, z);
+    const uint32_t n = web->n;
+    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1);
+    film_springs(mg, web, z, t);
+    for (int s = 1; s < MG_SWEEPS; s++) { /* after it, t = r - A z */
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
+        film_springs(mg, web, z, t);
+    }
+    restrict_to(mg, web, 0, t);
+    cycle(mg, web, 1);
+    prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
+    film_springs(mg, web, z, t);
     for (int s = 1; s < MG_SWEEPS; s++) {
-        (void)ws_implicit_apply_op(web, z, t);
-        jacobi(web, r, t, z);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
+        film_springs(mg, web, z, t);
     }
-    (void)ws_implicit_apply_op(web, z, t);
-    restrict_to(mg, web, 0, r, t);
-    cycle(mg, 1);
-    prolong_add(mg, web, 0, z);
-    for (int s = 0; s < MG_SWEEPS; s++) {
-        (void)ws_implicit_apply_op(web, z, t);
-        jacobi(web, r, t, z);
-    }
-    double rz = 0.0;
-    for (size_t j = 0; j < m; j++)
-        rz += r[j] * z[j];
-    return rz;
+    return film_nodes(mg, n, r, t, z, JACOBI_ADD, 0);
 }
 
 int ws_mg_levels(const ws_mg *mg)
@@ -548,14 +725,14 @@ static int springs_on_grid(const ws_web *web)
     return 1;
 }
 
-int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
+/* The levels' sizes of a web into lv; their number, or 0 when the multigrid cannot serve it
+ * (ws_mg_grid). */
+static int plan_levels(const ws_web *web, mg_level *lv)
 {
-    *out = NULL;
     if (web->nx <= 0 || web->ny <= 0 || (uint64_t)web->nx * (uint64_t)web->ny != web->n ||
         (web->closed && web->nx < 3) || !springs_on_grid(web))
         return 0;
-    mg_level lv[MG_LEVELS];
-    memset(lv, 0, sizeof lv);
+    memset(lv, 0, MG_LEVELS * sizeof *lv);
     lv[0] = (mg_level){.nx = web->nx, .ny = web->ny, .closed = web->closed, .n = web->n};
     int k = 0;
     while (k + 1 < MG_LEVELS && lv[k].n > MG_COARSEST) {
@@ -569,20 +746,50 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
                                .n = (uint32_t)nx * (uint32_t)ny};
         k++;
     }
-    const int nlev = k + 1;
-    if (nlev < 2 || lv[k].n > MG_DENSE)
+    return k < 1 || lv[k].n > WS_MG_COARSEST_MAX ? 0 : k + 1;
+}
+
+int ws_mg_grid(const ws_web *web)
+{
+    mg_level lv[MG_LEVELS];
+    return plan_levels(web, lv) > 0;
+}
+
+int ws_mg_chosen(const ws_web *web)
+{
+    if (web->precond == WS_WEB_PRECONDITIONER_BLOCK_JACOBI ||
+        (web->precond == WS_WEB_PRECONDITIONER_AUTO && web->n < WS_WEB_MULTIGRID_AUTO_NODES))
         return 0;
+    return ws_mg_grid(web);
+}
+
+int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
+{
+    *out = NULL;
+    mg_level lv[MG_LEVELS];
+    const int nlev = ws_mg_chosen(web) ? plan_levels(web, lv) : 0;
+    if (nlev < 2)
+        return 0;
+    const int k = nlev - 1;
     const uint32_t m = 3 * lv[k].n;
-    size_t doubles = 3 * (size_t)web->n + (size_t)m * m;
-    for (int i = 1; i < nlev; i++)
-        doubles += (STEN + WS_SYM + 9) * (size_t)lv[i].n;
+    size_t doubles = 3 * (size_t)web->n + (size_t)m * m + 2 * STEN * (size_t)lv[1].n +
+                     3 * (size_t)lv[1].nx,
+           floats = 0;
+    for (int i = 1; i < nlev; i++) {
+        doubles += (WS_SYM + 9) * (size_t)lv[i].n;
+        floats += STEN * (size_t)lv[i].n;
+    }
+    floats += 5 * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
     size_t nmaps = 0;
     for (int i = 0; i + 1 < nlev; i++)
         nmaps += (size_t)lv[i].nx + (size_t)lv[i].ny;
     ws_mg *mg = ws_mem_calloc(mem, 1, sizeof *mg);
     double *blk = mg ? ws_mem_calloc(mem, doubles, sizeof(double)) : NULL;
-    map1d *maps = blk ? ws_mem_calloc(mem, nmaps, sizeof(map1d)) : NULL;
+    float *fblk = blk ? ws_mem_calloc(mem, floats, sizeof(float)) : NULL;
+    map1d *maps = fblk ? ws_mem_calloc(mem, nmaps, sizeof(map1d)) : NULL;
     if (!maps) {
+        if (fblk)
+            ws_mem_free(mem, fblk, floats * sizeof(float));
         if (blk)
             ws_mem_free(mem, blk, doubles * sizeof(double));
         if (mg)
@@ -605,13 +812,22 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     mg->m = m;
     mg->blk = blk;
     mg->doubles = doubles;
+    mg->fblk = fblk;
+    mg->floats = floats;
     memcpy(mg->lv, lv, sizeof lv);
     double *q = blk;
+    float *fq = fblk;
+    mg->fop = fq, fq += 5 * (size_t)(web->ns ? web->ns : 1);
+    mg->fnd = fq, fq += WS_SYM * (size_t)web->n;
+    mg->fpinv = fq, fq += WS_SYM * (size_t)web->n;
     mg->lv[0].t = q, q += 3 * (size_t)web->n;
     mg->chol = q, q += (size_t)m * m;
+    mg->acc = q, q += STEN * (size_t)lv[1].n;
+    mg->sacc = q, q += STEN * (size_t)lv[1].n;
+    mg->row = q, q += 3 * (size_t)lv[1].nx;
     for (int i = 1; i < nlev; i++) {
         mg_level *L = &mg->lv[i];
-        L->a = q, q += STEN * (size_t)L->n;
+        L->a = fq, fq += STEN * (size_t)L->n;
         L->dinv = q, q += WS_SYM * (size_t)L->n;
         L->x = q, q += 3 * (size_t)L->n;
         L->r = q, q += 3 * (size_t)L->n;
@@ -627,5 +843,6 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg)
         return;
     ws_mem_free(mem, mg->maps, mg->nmaps * sizeof(map1d));
     ws_mem_free(mem, mg->blk, mg->doubles * sizeof(double));
+    ws_mem_free(mem, mg->fblk, mg->floats * sizeof(float));
     ws_mem_free(mem, mg, sizeof *mg);
 }

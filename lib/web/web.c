@@ -127,6 +127,20 @@ static double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
     return l * il0 - 1.0;
 }
 
+/* The histories of the springs whose law keeps one, advanced at their strains and rates at
+ * (x, v), time t, over dt. */
+static void commit_laws(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
+{
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const ws_law *L = web->law[web->kind[s]];
+        if (!L->nstate)
+            continue;
+        v3 d;
+        double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
+        ws_law_commit(L, web->hist + (size_t)s * web->nstate, &eps, &epsd, t, dt);
+    }
+}
+
 int ws_web_law_state(ws_mem *mem, ws_web *web)
 {
     uint32_t most = 0;
@@ -142,16 +156,9 @@ int ws_web_law_state(ws_mem *mem, ws_web *web)
     /* The film was stretched to its pre-stretch when it was put on: each spring starts with the
      * history of a strain step to where it is now (committed over no time), from which a
      * relaxation law relaxes. */
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_law *L = web->law[web->kind[s]];
-        double *h = web->hist + (size_t)s * most;
-        ws_law_state_init(L, h);
-        if (!L->nstate)
-            continue;
-        v3 d;
-        double epsd, il, eps = strain_of(web, web->x[0], web->v[0], s, &d, &epsd, &il);
-        ws_law_commit(L, h, &eps, &epsd, 0.0, 0.0);
-    }
+    for (uint32_t s = 0; s < web->ns; s++)
+        ws_law_state_init(web->law[web->kind[s]], web->hist + (size_t)s * most);
+    commit_laws(web, web->x[0], web->v[0], 0.0, 0.0);
     return 0;
 }
 
@@ -160,16 +167,8 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
     web->nbroken_step = 0;
     if (web->rupture > 0.0)
         ws_web_rupture_check(web, x, t);
-    if (!web->nstate)
-        return;
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const ws_law *L = web->law[web->kind[s]];
-        if (!L->nstate)
-            continue;
-        v3 d;
-        double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
-        ws_law_commit(L, web->hist + (size_t)s * web->nstate, &eps, &epsd, t, dt);
-    }
+    if (web->nstate)
+        commit_laws(web, x, v, t, dt);
 }
 
 /* Tension / length of a spring of film form p whose second end is at d from its first and moves
@@ -285,12 +284,6 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, a, fu);
     if (b >= lo && b < hi)
         nodes_add(web->f, b, v3_scale(fu, -1.0));
-}
-
-/* The same onto both ends. */
-static void spring_one(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s)
-{
-    spring_one_in(web, x, v, s, 0, UINT32_MAX);
 }
 
 /* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
@@ -491,7 +484,7 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, int lane_f
     if (p->gen || !web->law[WS_SPRING_AROUND] || nx < 2) {
         base_forces(web, v, nx * r, nx * (r + 1));
         for (size_t s = cols * r; p->gen && nx >= 2 && s < cols * (r + 1); s++)
-            spring_one(web, x, v, (uint32_t)s);
+            spring_one_in(web, x, v, (uint32_t)s, 0, UINT32_MAX);
         return;
     }
     if (web->closed && (r % WS_WEB_WRAPS == 0 || lane_first))
@@ -578,7 +571,7 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
     if (web->nx == 0) {
         base_forces(web, v, 0, web->n);
         for (uint32_t s = 0; s < web->ns; s++)
-            spring_one(web, x, v, s);
+            spring_one_in(web, x, v, s, 0, UINT32_MAX);
         *n0 = 0;
         *n1 = web->n;
         return;
@@ -684,10 +677,16 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v)
     return most;
 }
 
-/* Per free node, into the force scratch (not state; no step is running when this is asked):
- * f.x = 2 sum of its springs' largest stiffness / l0 -- the Gershgorin bound of its row of the
- * stiffness matrix -- and f.y = 2 sum of their damping / l0. */
-static void node_bounds(const ws_web *web)
+/* What the free nodes can bear: from the Gershgorin bound of each node's row of the stiffness
+ * matrix, k = kc + 2 sum of its springs' largest stiffness / l0, and its damping c = cc + 2 sum
+ * of theirs / l0 + the node drag (summed in the force scratch: not state, no step is running
+ * when this is asked), the least stable step, the least mass stable at sub-step h, the least
+ * mass and the largest k. */
+typedef struct node_limits {
+    double dt, mass, min_mass, max_k;
+} node_limits;
+
+static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
 {
     ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
@@ -702,58 +701,45 @@ static void node_bounds(const ws_web *web)
         acc.y[web->sa[s]] += c;
         acc.y[web->sb[s]] += c;
     }
+    node_limits o = {INFINITY, 0.0, INFINITY, 0.0};
+    for (uint32_t i = 0; i < web->n; i++) {
+        if (web->inv_m[i] == 0.0)
+            continue;
+        const double k = acc.x[i] + kc, c = acc.y[i] + cc + web->damping;
+        /* Symplectic Euler on m x'' + c x' + k x = 0 is stable for
+         * dt < 2/omega (sqrt(1 + z^2) - z), omega^2 = k/m, z = c/(2 m omega). */
+        const double om = sqrt(k * web->inv_m[i]);
+        if (om > 0.0) {
+            double z = c * web->inv_m[i] / (2.0 * om);
+            double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
+            o.dt = dt < o.dt ? dt : o.dt;
+        }
+        /* The same bound in closed form: 2/omega (sqrt(1 + z^2) - z) = (sqrt(c^2 + 4 m k) - c)
+         * / k, which is >= h exactly when m >= h^2 k / 4 + h c / 2. A light node is held by its
+         * damping (the h c / 2 term), not by its stiffness. */
+        const double m = 0.25 * h * h * k + 0.5 * h * c;
+        o.mass = m <= o.mass ? o.mass : m; /* NaN wins */
+        o.min_mass = fmin(o.min_mass, web->m[i]);
+        o.max_k = fmax(o.max_k, k);
+    }
+    return o;
 }
 
 double ws_web_stable_dt(const ws_web *web, double kc, double cc)
 {
-    /* Symplectic Euler on m x'' + c x' + k x = 0 is stable for
-     * dt < 2/omega (sqrt(1 + z^2) - z), omega^2 = k/m, z = c/(2 m omega). */
-    double best = INFINITY;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
-        double om = sqrt(k * web->inv_m[i]);
-        if (!(om > 0.0))
-            continue;
-        double z = c * web->inv_m[i] / (2.0 * om);
-        double dt = 2.0 / om * (sqrt(1.0 + z * z) - z);
-        if (dt < best)
-            best = dt;
-    }
-    return best;
+    return limits_of(web, kc, cc, 0.0).dt;
 }
 
 double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h)
 {
-    /* ws_web_stable_dt's bound in closed form: 2/omega (sqrt(1 + z^2) - z) = (sqrt(c^2 + 4 m k)
-     * - c) / k, which is >= h exactly when m >= h^2 k / 4 + h c / 2. A light node is held by
-     * its damping (the h c / 2 term), not by its stiffness. */
-    double most = 0.0;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        double k = web->f.x[i] + kc, c = web->f.y[i] + cc + web->damping;
-        double m = 0.25 * h * h * k + 0.5 * h * c;
-        most = m <= most ? most : m; /* NaN wins */
-    }
-    return most;
+    return limits_of(web, kc, cc, h).mass;
 }
 
 void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k)
 {
-    double mm = INFINITY, mk = 0.0;
-    node_bounds(web);
-    for (uint32_t i = 0; i < web->n; i++) {
-        if (web->inv_m[i] == 0.0)
-            continue;
-        mm = fmin(mm, web->m[i]);
-        mk = fmax(mk, web->f.x[i] + kc);
-    }
-    *min_mass = mm;
-    *max_k = mk;
+    const node_limits o = limits_of(web, kc, 0.0, 0.0);
+    *min_mass = o.min_mass;
+    *max_k = o.max_k;
 }
 
 double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)
@@ -788,108 +774,4 @@ double ws_web_elastic_energy(const ws_web *web, ws_nodes3 x)
         e += q * ws_law_elastic_energy(web->law[web->kind[s]], h, &eps) / web->inv_l0[s];
     }
     return e;
-}
-
-int ws_web_rupture_alloc(ws_mem *mem, ws_web *web)
-{
-    if (web->broken)
-        return 0;
-    web->broken = ws_mem_calloc(mem, (size_t)web->ns + WS_WEB_PAD, 1);
-    return web->broken ? 0 : -1;
-}
-
-/* The rupture check's pass over the springs: springs broken so far in it, and the most
- * strained of them. q is a little under (1 + limit)^2: a spring whose squared stretch
- * (l / l0)^2 is not above it cannot have a strain above the limit, whatever the rounding, and
- * needs no square root. */
-typedef struct rupture_pass {
-    double lim, q;
-    uint32_t most;
-    double most_eps;
-} rupture_pass;
-
-/* Springs [s0, s1): each intact one strained past the limit breaks. */
-static void break_range(ws_web *web, ws_nodes3 x, uint32_t s0, uint32_t s1, rupture_pass *r)
-{
-    for (uint32_t s = s0; s < s1; s++) {
-        if (web->broken[s])
-            continue;
-        const uint32_t a = web->sa[s], b = web->sb[s];
-        const double dx = x.x[b] - x.x[a], dy = x.y[b] - x.y[a], dz = x.z[b] - x.z[a];
-        const double il0 = web->inv_l0[s];
-        if (!((dx * dx + dy * dy + dz * dz) * il0 * il0 > r->q))
-            continue;
-        /* The strain as every read-out gives it decides. */
-        double eps = ws_web_spring_strain(web, x, s);
-        if (!(eps > r->lim))
-            continue;
-        web->broken[s] = 1;
-        web->nbroken++;
-        web->nbroken_step++;
-        if (r->most == UINT32_MAX || eps > r->most_eps) {
-            r->most = s;
-            r->most_eps = eps;
-        }
-    }
-}
-
-/* How many of the springs from node i to node i + stride, i in [0, m), rest lengths
- * 1 / il0[i], have a squared stretch above q: a count, so the loop runs on vectors. */
-WS_VECTOR_LOOP
-static size_t stretched(const double *restrict x, const double *restrict y,
-                        const double *restrict z, size_t stride, size_t m,
-                        const double *restrict il0, double q)
-{
-    size_t hits = 0;
-    for (size_t i = 0; i < m; i++) {
-        double dx = x[i + stride] - x[i], dy = y[i + stride] - y[i], dz = z[i + stride] - z[i];
-        hits += (dx * dx + dy * dy + dz * dz) * il0[i] * il0[i] > q;
-    }
-    return hits;
-}
-
-void ws_web_rupture_check(ws_web *web, ws_nodes3 x, double t)
-{
-    /* Strains at the end of the step, as the state will be read: a spring breaks once its
-     * committed strain passes the limit (a strain above it inside the sub-steps of one step
-     * and back below at its end does not break it). NaN never breaks one: the step's health
-     * check reports that. A grid web's around- and up-springs are first screened a row at a
-     * time on vectors; only a row with a spring near the limit (or a broken one) is gone
-     * through spring by spring. */
-    const double lim = web->rupture, one = 1.0 + lim;
-    rupture_pass r = {lim, one * one * (1.0 - 1e-9), UINT32_MAX, 0.0};
-    if (web->nx > 0 && web->ny > 0) {
-        const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
-        const size_t cols = web->closed ? nx : nx - 1;
-        for (size_t j = 0; j < ny; j++) {
-            const size_t a = nx * j, s = cols * j;
-            if (nx >= 2 && stretched(x.x + a, x.y + a, x.z + a, 1, nx - 1, web->inv_l0 + s, r.q))
-                break_range(web, x, (uint32_t)s, (uint32_t)(s + nx - 1), &r);
-            if (web->closed)
-                break_range(web, x, (uint32_t)(s + nx - 1), (uint32_t)(s + nx), &r);
-        }
-        for (size_t j = 0; j + 1 < ny; j++) {
-            const size_t a = nx * j, s = cols * ny + nx * j;
-            if (stretched(x.x + a, x.y + a, x.z + a, nx, nx, web->inv_l0 + s, r.q))
-                break_range(web, x, (uint32_t)s, (uint32_t)(s + nx), &r);
-        }
-        break_range(web, x, (uint32_t)(cols * ny + nx * (ny - 1)), web->ns, &r); /* shear */
-    } else {
-        break_range(web, x, 0, web->ns, &r);
-    }
-    if (r.most == UINT32_MAX || web->first_spring != UINT32_MAX)
-        return;
-    web->first_spring = r.most;
-    web->first_time = t;
-    web->first_strain = r.most_eps;
-    web->first_at =
-        v3_scale(v3_add(nodes_get(x, web->sa[r.most]), nodes_get(x, web->sb[r.most])), 0.5);
-}
-
-void ws_web_rupture_recount(ws_web *web)
-{
-    uint32_t n = 0;
-    for (uint32_t s = 0; web->broken && s < web->ns; s++)
-        n += web->broken[s] != 0;
-    web->nbroken = n;
 }

@@ -65,7 +65,7 @@ typedef struct ws_web {
     ws_nodes3 x[2], v[2];    /* state, double-buffered like the bodies' */
     ws_nodes3 f;             /* force accumulator (scratch): in a sweep, the velocities it
                                 writes (ws_web_sweep_begin), else fmem */
-    ws_nodes3 fmem;          /* scratch of n nodes' vectors (node_bounds, writers) */
+    ws_nodes3 fmem;          /* scratch of n nodes' vectors (limits_of, writers) */
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
@@ -128,6 +128,7 @@ typedef struct ws_web {
     int integrator;
     double solver_tol;
     int solver_maxit;
+    int precond; /* ws_web_preconditioner (web/multigrid.c's ws_mg_reserve takes it) */
     int hold_bodies; /* ws_web_def.hold_bodies: the bodies held during the solve */
     struct ws_implicit *imp;
 } ws_web;

@@ -1,6 +1,7 @@
 /* Public calls on laws and webs: validation, id lookup, generators, read-out. */
 #include "world/world_internal.h"
 #include "contact/node_jacobian.h"
+#include "web/multigrid.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -104,6 +105,13 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': solver_tolerance must be in (0, 0.1], got %g", c->label,
                        d->solver_tolerance);
+    if (d->preconditioner != WS_WEB_PRECONDITIONER_AUTO &&
+        d->preconditioner != WS_WEB_PRECONDITIONER_BLOCK_JACOBI &&
+        d->preconditioner != WS_WEB_PRECONDITIONER_MULTIGRID)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': preconditioner must be WS_WEB_PRECONDITIONER_AUTO (0), "
+                       "_BLOCK_JACOBI (1) or _MULTIGRID (2), got %d",
+                       c->label, d->preconditioner);
     if (d->solver_max_iterations < 1 || d->solver_max_iterations > 100000)
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': solver_max_iterations must be 1..100000, got %d", c->label,
@@ -210,6 +218,14 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
     web->integrator = c->d.integrator;
     web->solver_tol = c->d.solver_tolerance;
     web->solver_maxit = c->d.solver_max_iterations;
+    web->precond = c->d.preconditioner;
+    if (web->precond == WS_WEB_PRECONDITIONER_MULTIGRID && !ws_mg_grid(web))
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': preconditioner WS_WEB_PRECONDITIONER_MULTIGRID needs a grid "
+                       "web (sheet or band) of at least %d nodes whose springs all join grid "
+                       "neighbours, coarsening to at most %d nodes; this one is not (use "
+                       "_AUTO or _BLOCK_JACOBI)",
+                       c->label, WS_MG_MIN_NODES, WS_MG_COARSEST_MAX);
     web->hold_bodies = c->d.hold_bodies;
     if (!(web->contact = ws_node_contact_new(&w->mem, web->n)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);

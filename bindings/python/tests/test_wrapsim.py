@@ -454,6 +454,16 @@ def test_implicit_web_sags_like_a_string():
         with pytest.raises(ws.WrapsimError):
             w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
                         integrator="implicit", solver_tolerance=0.5)
+        # the multigrid needs a grid of at least 17 nodes: a string of 3 is refused by name
+        with pytest.raises(ws.WrapsimError, match="MULTIGRID"):
+            w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                        integrator="implicit", preconditioner="multigrid")
+        with pytest.raises(ValueError):
+            w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                        integrator="implicit", preconditioner="lines")
+        jac = w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                          integrator="implicit", preconditioner="block_jacobi")
+        assert jac.solver_stats()["solves"] == 0
         with pytest.raises(ws.WrapsimError, match="hold_bodies"):
             w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
                         integrator="implicit", hold_bodies=2)

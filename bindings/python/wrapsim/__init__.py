@@ -87,6 +87,7 @@ _ENUMS = {
     (L.WorldDef, "integrator"): {"symplectic_euler": 0, "paper_explicit": 1},
     (L.ContactDef, "friction_model"): {"regularized": 0, "stick": 1},
     (L.WebDef, "integrator"): {"explicit": 0, "implicit": 1},
+    (L.WebDef, "preconditioner"): {"auto": 0, "block_jacobi": 1, "multigrid": 2},
     (L.BodyDef, "type"): {"dynamic": 0, "kinematic": 1},
     (L.DriveDef, "type"): {"static": 0, "tilt": 1, "sine": 2, "callback": 3, "pulse": 4,
                            "impact": 5, "table": 6, "random": 7, "sweep": 8},
@@ -847,7 +848,7 @@ class World:
         """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
         areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain,
         integrator ("explicit" or "implicit"), solver_tolerance, solver_max_iterations,
-        hold_bodies) and
+        preconditioner ("auto", "block_jacobi" or "multigrid"), hold_bodies) and
         ws_sheet_def
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
         prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""

@@ -387,6 +387,7 @@ class WebDef(Structure):
         ("integrator", c_int),
         ("solver_tolerance", c_double),
         ("solver_max_iterations", c_int),
+        ("preconditioner", c_int),
         ("hold_bodies", c_int),
     ]
 
