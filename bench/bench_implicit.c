@@ -6,7 +6,7 @@
  * bottom one, wall time, CG iterations a step and node-updates a second per CG iteration.
  * Never fails on time.
  * Usage: bench_implicit [what] [duration s]: what = ref (the three films at dt 0.25 ms,
- * default), dt (the implicit film at dt 0.25, 1, 2.4 and 2.5 ms; dt1 from 1 ms on; dt1sub:
+ * default), dt (the implicit film at dt 0.25, 1, 1.6, 2.4 and 2.5 ms; dt1 from 1 ms on; dt1sub:
  * dt 1 ms with the film in 1 and in 4 sub-steps), ratio (the three films' times
  * in interleaved rounds of a short run), refine (the implicit film's band refined 1, 2 and 4
  * times in each direction, short runs: cost per simulated second and containment; `refine
@@ -14,7 +14,10 @@
  * tolerance, with that ws_web_preconditioner: 1 block Jacobi, 2 multigrid, 0 AUTO), rigid (the
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
  * crossing (drums of the real film from 10 x 10 to 96 x 96 nodes, block Jacobi and multigrid
- * in turn: CPU time a step and CG iterations, where the multigrid starts to pay). */
+ * in turn: CPU time a step and CG iterations, where the multigrid starts to pay),
+ * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
+ * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
+ * alone). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -168,9 +171,10 @@ int main(int argc, char **argv)
         const int first_dt = !strcmp(what, "dt1"); /* dt1: from 1 ms on */
         /* 2.5 ms is refused by the box-box pair's bound (2.45 ms: 2e5 N/m on an effective 2.5
          * kg over 8 contacts) and 2.4 ms by the stack's own highest mode (1.86 ms: the boxes
-         * rocking against each other, docs/theory.md section 8): both print the refusal. */
-        const double dts[4] = {2.5e-4, 1e-3, 2.4e-3, 2.5e-3};
-        for (int k = first_dt; k < 4; k++) {
+         * rocking against each other, docs/theory.md section 8): both print the refusal. 1.6
+         * ms is below both. */
+        const double dts[5] = {2.5e-4, 1e-3, 1.6e-3, 2.4e-3, 2.5e-3};
+        for (int k = first_dt; k < 5; k++) {
             tilt_options a = o;
             a.film_mass = 1.6e-6;
             a.implicit = 1;
@@ -309,6 +313,37 @@ int main(int argc, char **argv)
                    sides[k], sides[k], sides[k] * sides[k], 1e6 * cpu[0], its[0], 1e6 * cpu[1],
                    its[1], cpu[1] / cpu[0]);
             fflush(stdout);
+        }
+    } else if (!strcmp(what, "why")) {
+        /* What limits dt 1 ms, one cause at a time (`why [duration] [case]`, case alone or
+         * all): the implicit film at 1 ms with the boxes held during its solve (the explicit
+         * coupling) or in it (the default), each with the box-box friction regularised (the
+         * paper's law) and with the stick model; then both couplings at 0.25 and 0.125 ms
+         * (which answer the step converges to). */
+        static const struct {
+            const char *name;
+            double dt;
+            int hold, stick;
+        } cases[8] = {{"1 ms, held, regularised", 1e-3, 1, 0},
+                      {"1 ms, held, stick", 1e-3, 1, 1},
+                      {"1 ms, in the solve, regularised", 1e-3, 0, 0},
+                      {"1 ms, in the solve, stick", 1e-3, 0, 1},
+                      {"0.25 ms, in the solve, regularised", 2.5e-4, 0, 0},
+                      {"0.25 ms, held, regularised", 2.5e-4, 1, 0},
+                      {"0.125 ms, held, regularised", 1.25e-4, 1, 0},
+                      {"0.125 ms, in the solve, regularised", 1.25e-4, 0, 0}};
+        const int only = argc > 3 ? atoi(argv[3]) : -1;
+        for (int k = 0; k < 8; k++) {
+            if (only >= 0 && k != only)
+                continue;
+            tilt_options a = o;
+            a.film_mass = 1.6e-6;
+            a.implicit = 1;
+            a.substeps = 1;
+            a.dt = cases[k].dt;
+            a.hold_bodies = cases[k].hold;
+            a.stick = cases[k].stick;
+            line(cases[k].name, &a);
         }
     } else if (!strcmp(what, "rigid")) {
         /* The rigid contacts' share of the step limit, without the film: the top box's slide

@@ -76,6 +76,7 @@ typedef struct tilt_options {
     double solver_tolerance; /* implicit film: the solve's tolerance; 0 = the default */
     int preconditioner;   /* implicit film: ws_web_preconditioner; 0 = AUTO */
     double dt;            /* s; 0 = 0.25 ms */
+    int hold_bodies;      /* implicit film: 1 holds the boxes during its solve (ws_web_def) */
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -193,6 +194,7 @@ static ws_status tilt_wrap(const tilt_options *o, tilt_scene *sc, ws_material_id
     if (o->solver_tolerance > 0)
         wd.solver_tolerance = o->solver_tolerance;
     wd.preconditioner = o->preconditioner;
+    wd.hold_bodies = o->hold_bodies;
     wd.contact_layer = layer;
     wd.material = film_mat;
     wd.law = around;

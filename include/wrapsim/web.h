@@ -99,6 +99,13 @@ typedef struct ws_web_def {
     int preconditioner;     /**< implicit webs: ws_web_preconditioner; default
                                  WS_WEB_PRECONDITIONER_AUTO. A trailing field: older callers
                                  get AUTO */
+    /** Implicit webs: how the dynamic bodies the film touches take part in its solve. 0, the
+     *  default: their velocities are unknowns of the film's linear system beside the nodes',
+     *  so the film's loads on them are those of the end of the step (docs/theory.md, section
+     *  8b). 1: they are held at their state at t during the solve and take its loads as
+     *  given forces (an explicit coupling, as for an explicit web; the scheme of earlier
+     *  versions). Explicit webs ignore it. A trailing field: older callers get 0. */
+    int hold_bodies;
 } ws_web_def;
 
 /** A rectangular sheet: nx x ny nodes at origin + i spacing_x axis_x + j spacing_y axis_y. */

@@ -2,6 +2,7 @@
  * (web/implicit.h says the scheme; docs/theory.md, "The implicit film", why this one). */
 #include "web/implicit.h"
 
+#include "web/coupled.h"
 #include "web/multigrid.h"
 
 #include <float.h>
@@ -410,6 +411,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     const uint32_t n = web->n;
     const size_t m = VEC(n);
     double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
+    ws_rigid *R = im->rig && im->rig->nb ? im->rig : NULL; /* bodies in the solve */
     im->solves++;
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; the scale of the residual: the larger of |b| and
@@ -430,20 +432,29 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         weight2 += web->m[i] * web->m[i];
     }
     /* The weight scale takes standard gravity whatever the world's: a tolerance of momentum. */
+    /* The film's alone, with bodies in the solve too: their loads' impulse (a box's weight)
+     * would loosen the film's tolerance by orders; their rows' residual is held to it. */
     const double scale = fmax(sqrt(dot(b, b, m)), h * 9.81 * sqrt(weight2));
     const double goal = web->solver_tol * scale;
-    if (preconditioner(web, h) != 0) {
+    if (preconditioner(web, h) != 0 || (R && ws_rigid_factor(R) != 0)) {
         im->warm = 0;
         im->last_residual = NAN;
         return -1;
     }
     operator_for(web, h);
+    if (R && R->coarse && ws_rigid_coarse(R, web) != 0) {
+        im->warm = 0;
+        im->last_residual = NAN;
+        return -1;
+    }
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
     (void)ws_implicit_apply_op(web, x, q);
+    if (R)
+        (void)ws_rigid_apply(R, web, x, R->x, q, R->q);
     for (size_t j = 0; j < m; j++)
         r[j] = b[j] - q[j];
     double rr = dot(r, r, m);
@@ -454,25 +465,37 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
                     ? im->mg
                     : NULL;
     double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+    if (R) { /* after the film's part, which its coarse correction adds to */
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->r[j] = R->b[j] - R->q[j];
+        rr += ws_rigid_dot(R, R->r, R->r);
+        rz += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
+    }
     memcpy(p, z, m * sizeof(double));
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
-        const double pq = ws_implicit_apply_op(web, p, q);
+        const double pq = ws_implicit_apply_op(web, p, q) +
+                          (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
         const double alpha = rz / pq;
-        rr = 0.0;
+        rr = R ? ws_rigid_step(R, alpha) : 0.0;
         for (size_t j = 0; j < m; j++) {
             x[j] += alpha * p[j];
             r[j] -= alpha * q[j];
             rr += r[j] * r[j];
         }
         it++;
-        const double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z),
-                     beta = rz1 / rz;
+        double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+        if (R)
+            rz1 += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+        const double beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)
             p[j] = z[j] + beta * p[j];
+        if (R)
+            ws_rigid_direction(R, beta);
     }
     im->iterations += (uint64_t)it;
     im->last_iterations = it;

@@ -46,9 +46,13 @@ typedef struct ws_implicit {
     uint64_t begun;  /* steps begun (ws_implicit_begin): the springs' blocks change with it */
     /* The preconditioner: multigrid (web/multigrid.h; NULL when the web's Def chooses block
      * Jacobi, ws_mg_chosen), block Jacobi otherwise or when jacobi_only is set (a test's
-     * comparison). */
+     * comparison; the bodies in the solve then go without their coarse space,
+     * web/coupled.h). */
     struct ws_mg *mg;
     int jacobi_only;
+    /* Rigid bodies in the solve beside the nodes (web/coupled.h), set by the caller around a
+     * solve; NULL: none (the bodies held). */
+    struct ws_rigid *rig;
     /* Counts (ws_web_get_solver_stats). */
     uint64_t solves, iterations;
     int last_iterations;
@@ -73,8 +77,10 @@ void ws_implicit_add(ws_implicit *im, uint32_t i, v3 f, const double K[WS_SYM],
                      const double D[WS_SYM]);
 
 /* Solve for dv over the step h at (x, v) (the state begin took) to web->solver_tol, at most
- * web->solver_maxit iterations. 0 when it converged, else -1 (dv then holds the last iterate).
- * The iterations and the residual over its scale are kept in the counts. */
+ * web->solver_maxit iterations; with imp->rig set, its bodies' velocity changes too (their
+ * rows, right-hand side and start in it: web/coupled.h), the residual over both parts, its
+ * scale the film's. 0 when it converged, else -1 (dv then holds the last iterate). The iterations and the
+ * residual over its scale are kept in the counts. */
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h);
 
 /* The new velocities alone, vd = v + dv. */

@@ -129,6 +129,7 @@ typedef struct ws_web {
     double solver_tol;
     int solver_maxit;
     int precond; /* ws_web_preconditioner (web/multigrid.c's ws_mg_reserve takes it) */
+    int hold_bodies; /* ws_web_def.hold_bodies: the bodies held during the solve */
     struct ws_implicit *imp;
 } ws_web;
 

@@ -1,12 +1,16 @@
 /* An implicit web's part of the step (web/implicit.h, contact/node_jacobian.h): per sub-step,
  * the springs and the node contacts at its start, one linear solve, the new node state and the
- * contacts' loads on the bodies, which are held at their state at t as for the explicit film
- * (deviation (h) of docs/design.md). */
+ * contacts' loads on the bodies. The dynamic bodies the film touches are unknowns of the solve
+ * beside its nodes (web/coupled.h, docs/theory.md section 8b), their other loads (gravity, body
+ * contacts, elements, webs stepped before) known; with hold_bodies they are held at their
+ * state at t as for the explicit film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
+#include "web/coupled.h"
 #include "world/world_internal.h"
 
 #include <float.h>
 #include <stdio.h>
+#include <string.h>
 
 /* Solves a sub-step at most, as its contacts come in and go (the active set). */
 #define WS_IMPLICIT_PASSES 6
@@ -14,6 +18,145 @@
 static const char *label(const ws_web *web)
 {
     return web->name ? web->name : "(unnamed)";
+}
+
+/* The solve's bodies for the contacts L[0, nl): every dynamic body one of them touches gets
+ * an index (slot[body], UINT32_MAX for the others) and its mass and global inertia; the
+ * scratch (with the coarse space's, for a web of `nodes` nodes) from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
+ * with *fail 1 when out of memory. */
+static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
+                            size_t nl, uint32_t nodes, uint32_t **slot_out, int *fail)
+{
+    *fail = 1;
+    uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
+    ws_rigid *R = ws_arena_alloc(arena, sizeof *R);
+    if (!slot || !R)
+        return NULL;
+    for (size_t i = 0; i < b->slots; i++)
+        slot[i] = UINT32_MAX;
+    uint32_t nb = 0;
+    for (size_t k = 0; k < nl; k++)
+        if (b->type[L[k].body] == WS_BODY_DYNAMIC && slot[L[k].body] == UINT32_MAX)
+            slot[L[k].body] = nb++;
+    *fail = 0;
+    if (nb == 0)
+        return NULL;
+    memset(R, 0, sizeof *R);
+    R->nb = nb;
+    R->cap = nl;
+    const size_t v6 = 6 * (size_t)nb, m = 3 * (size_t)nodes;
+    R->link = ws_arena_alloc(arena, (nl + 1) * sizeof *R->link);
+    double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 2 * m) *
+                                          sizeof(double));
+    if (!R->link || !d) {
+        *fail = 1;
+        return NULL;
+    }
+    memset(d, 0, 6 * v6 * sizeof(double));
+    R->b = d, R->x = d + v6, R->r = d + 2 * v6, R->z = d + 3 * v6, R->p = d + 4 * v6;
+    R->q = d + 5 * v6;
+    R->mass = d + 6 * v6;
+    R->inertia = R->mass + nb;
+    R->fac = R->inertia + WS_SYM * (size_t)nb;
+    R->cb = R->fac + 36 * (size_t)nb;
+    R->cq = R->cb + v6;
+    R->coarse = R->cq + v6;
+    R->fa = R->coarse + v6 * v6;
+    R->fb = R->fa + m;
+    for (size_t i = 0; i < b->slots; i++) {
+        const uint32_t j = slot[i];
+        if (j == UINT32_MAX)
+            continue;
+        R->mass[j] = b->mass[i];
+        /* The global inertia A J A^T. */
+        const m3 At = m3_transpose(&b->A[i]), JA = m3_mul(&b->J[i], &At);
+        const m3 I = m3_mul(&b->A[i], &JA);
+        double *S = R->inertia + WS_SYM * (size_t)j;
+        S[WS_SYM_XX] = I.m[0], S[WS_SYM_YY] = I.m[4], S[WS_SYM_ZZ] = I.m[8];
+        S[WS_SYM_XY] = 0.5 * (I.m[1] + I.m[3]);
+        S[WS_SYM_XZ] = 0.5 * (I.m[2] + I.m[6]);
+        S[WS_SYM_YZ] = 0.5 * (I.m[5] + I.m[7]);
+    }
+    *slot_out = slot;
+    return R;
+}
+
+/* The velocity of body bi's point at lever r at t. */
+static v3 point_velocity(const ws_body_store *b, int cur, uint32_t bi, v3 r)
+{
+    return v3_add(b->st[cur].v[bi], v3_cross(b->wg[bi], r));
+}
+
+/* The contacts L into the film's matrix for step h (ws_implicit_add), and, for those with a
+ * body of the solve (slot), into R: the link, the body's right-hand side h (F + sum J^T (-(f0 +
+ * h K J U0) + h K v0)) with F its known load, and the node's force f0 + h K J U0, so that both
+ * see the contact's relative motion over the step (docs/theory.md, section 8b). */
+static void links_into(ws_implicit *im, ws_rigid *R, const uint32_t *slot, const ws_body_store *b,
+                       int cur, const ws_node_link *L, size_t nl, ws_nodes3 v, double h)
+{
+    if (R) {
+        R->nl = 0;
+        for (size_t i = 0; i < b->slots; i++) {
+            const uint32_t j = slot[i];
+            if (j == UINT32_MAX)
+                continue;
+            double *B = R->b + 6 * (size_t)j;
+            B[0] = h * b->f[i].x, B[1] = h * b->f[i].y, B[2] = h * b->f[i].z;
+            B[3] = h * b->m[i].x, B[4] = h * b->m[i].y, B[5] = h * b->m[i].z;
+        }
+    }
+    for (size_t k = 0; k < nl; k++) {
+        const ws_node_link *c = &L[k];
+        if (!c->active)
+            continue;
+        const uint32_t j = R ? slot[c->body] : UINT32_MAX;
+        if (j == UINT32_MAX) {
+            ws_implicit_add(im, c->node, c->f, c->K, c->D);
+            continue;
+        }
+        const v3 u0 = point_velocity(b, cur, c->body, c->lever), u = nodes_get(v, c->node);
+        double ku[3] = {0.0, 0.0, 0.0}, kv[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(c->K, h * u0.x, h * u0.y, h * u0.z, ku);
+        ws_sym_madd(c->K, h * u.x, h * u.y, h * u.z, kv);
+        const v3 f = v3_add(c->f, v3_make(ku[0], ku[1], ku[2]));
+        ws_implicit_add(im, c->node, f, c->K, c->D);
+        ws_rigid_link *q = &R->link[R->nl++];
+        q->node = c->node;
+        q->body = j;
+        q->lever = c->lever;
+        for (int s = 0; s < WS_SYM; s++)
+            q->C[s] = h * h * c->K[s] + h * c->D[s];
+        const v3 g = v3_sub(f, v3_make(kv[0], kv[1], kv[2])), m = v3_cross(c->lever, g);
+        double *B = R->b + 6 * (size_t)j;
+        B[0] -= h * g.x, B[1] -= h * g.y, B[2] -= h * g.z;
+        B[3] -= h * m.x, B[4] -= h * m.y, B[5] -= h * m.z;
+    }
+}
+
+/* The loads of the contacts with a body of the solve, as ws_node_link_loads wrote them (the
+ * body held), made those of the solve: + h K J U0 + (h K + D) J dU, into the node's record and,
+ * opposite, its body's. */
+static void loads_moved(const ws_rigid *R, const uint32_t *slot, const ws_body_store *b, int cur,
+                        const ws_node_link *L, size_t nl, double h, double share, v3 *fc,
+                        v3 *bforce, v3 *bmoment)
+{
+    for (size_t k = 0; k < nl; k++) {
+        const ws_node_link *c = &L[k];
+        const uint32_t j = slot[c->body];
+        if (!c->active || j == UINT32_MAX)
+            continue;
+        const double *dU = R->x + 6 * (size_t)j;
+        const v3 u0 = point_velocity(b, cur, c->body, c->lever),
+                 du = v3_add(v3_make(dU[0], dU[1], dU[2]),
+                             v3_cross(v3_make(dU[3], dU[4], dU[5]), c->lever));
+        double o[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(c->K, h * (u0.x + du.x), h * (u0.y + du.y), h * (u0.z + du.z), o);
+        ws_sym_madd(c->D, du.x, du.y, du.z, o);
+        const v3 d = v3_scale(v3_make(o[0], o[1], o[2]), share);
+        fc[c->node] = v3_add(fc[c->node], d);
+        bforce[c->body] = v3_sub(bforce[c->body], d);
+        bmoment[c->body] = v3_sub(bmoment[c->body], v3_cross(c->lever, d));
+    }
 }
 
 ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
@@ -46,6 +189,16 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
                                         S->contact.margin, links);
+        uint32_t *slot = NULL;
+        int nomem = 0;
+        ws_rigid *R = web->hold_bodies
+                          ? NULL
+                          : rigid_make(S->arena, b, links, nl, web->n, &slot, &nomem);
+        if (nomem)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
+                           label(web));
+        if (R && im->jacobi_only)
+            R->coarse = NULL; /* a test's comparison: the plain block-diagonal preconditioner */
         /* The active set: a solve with the contacts that push, then with those whose linear
          * model pushes at the end of the step, until no contact changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
@@ -53,10 +206,11 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         for (int pass = 0; pass < WS_IMPLICIT_PASSES; pass++) {
             if (pass > 0)
                 ws_implicit_reset(im);
-            for (size_t k = 0; k < nl; k++)
-                if (links[k].active)
-                    ws_implicit_add(im, links[k].node, links[k].f, links[k].K, links[k].D);
-            if ((ok = ws_implicit_solve(web, vs, h) == 0) == 0)
+            links_into(im, R, slot, b, cur, links, nl, vs, h);
+            im->rig = R;
+            ok = ws_implicit_solve(web, vs, h) == 0;
+            im->rig = NULL;
+            if (!ok)
                 break;
             ws_implicit_velocities(web, vs, vd);
             if (pass + 1 == WS_IMPLICIT_PASSES ||
@@ -88,6 +242,9 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         web->nfct[nxt] +=
             ws_node_link_loads(links, nl, im->dv, vd, h, share, web->fc[nxt], web->fct[nxt] + nt,
                                web->bforce[nxt], web->bmoment[nxt]);
+        if (R)
+            loads_moved(R, slot, b, cur, links, nl, h, share, web->fc[nxt], web->bforce[nxt],
+                        web->bmoment[nxt]);
         xs = xd;
         vs = vd;
     }

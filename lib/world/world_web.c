@@ -116,6 +116,11 @@ static ws_status take_common(ws_world *w, const ws_web_def *def, web_common *c, 
         return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
                        "web '%s': solver_max_iterations must be 1..100000, got %d", c->label,
                        d->solver_max_iterations);
+    if (d->hold_bodies != 0 && d->hold_bodies != 1)
+        return ws_fail(w, WS_ERR_INVALID_ARGUMENT,
+                       "web '%s': hold_bodies must be 0 (bodies in the implicit solve) or 1 "
+                       "(held), got %d",
+                       c->label, d->hold_bodies);
     c->material = 0;
     if (d->material.bits && (s = ws_lookup_material(w, d->material, &c->material)) != WS_OK)
         return s;
@@ -221,6 +226,7 @@ static ws_status finish_web(ws_world *w, web_common *c, ws_web *web, const uint3
                        "neighbours, coarsening to at most %d nodes; this one is not (use "
                        "_AUTO or _BLOCK_JACOBI)",
                        c->label, WS_MG_MIN_NODES, WS_MG_COARSEST_MAX);
+    web->hold_bodies = c->d.hold_bodies;
     if (!(web->contact = ws_node_contact_new(&w->mem, web->n)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c->label);
     web->contact->list = 0;

@@ -464,6 +464,12 @@ def test_implicit_web_sags_like_a_string():
         jac = w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
                           integrator="implicit", preconditioner="block_jacobi")
         assert jac.solver_stats()["solves"] == 0
+        with pytest.raises(ws.WrapsimError, match="hold_bodies"):
+            w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                        integrator="implicit", hold_bodies=2)
+        held = w.web_sheet(law, nx=3, ny=1, spacing_x=sp, spacing_y=sp, node_mass=m,
+                           integrator="implicit", hold_bodies=1)
+        assert held is not None
 
 
 def test_drive_callback_and_its_errors():

@@ -848,7 +848,7 @@ class World:
         """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
         areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain,
         integrator ("explicit" or "implicit"), solver_tolerance, solver_max_iterations,
-        preconditioner ("auto", "block_jacobi" or "multigrid")) and
+        preconditioner ("auto", "block_jacobi" or "multigrid"), hold_bodies) and
         ws_sheet_def
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
         prestretch_y, shear); `pinned` a sequence of node indices i + nx j."""

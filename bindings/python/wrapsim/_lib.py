@@ -388,6 +388,7 @@ class WebDef(Structure):
         ("solver_tolerance", c_double),
         ("solver_max_iterations", c_int),
         ("preconditioner", c_int),
+        ("hold_bodies", c_int),
     ]
 
 

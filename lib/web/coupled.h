@@ -1,0 +1,77 @@
+/* Rigid bodies in an implicit web's solve (web module): the six velocity unknowns of each body
+ * the film touches beside its nodes' (docs/theory.md, section 8b). A contact between node i and
+ * body j at lever r from the body's centre of mass couples them through the contact point's
+ * velocity J U = V + W x r (J = [I, -[r]x], U = (V, W) the body's velocity and spin, global):
+ * with C = h^2 K + h D the contact's block of the film's matrix A (K = -df/dx, D = -df/dv over
+ * the relative motion), the coupled matrix is
+ *
+ *     [ A          -C J           ]
+ *     [ -J^T C     M_j + J^T C J  ]     summed over the contacts,
+ *
+ * M_j = diag(m I, I_w) the body's mass and global inertia: symmetric positive definite
+ * whenever A is (its energy is the film's plus (dv - J dU)^T C (dv - J dU) + dU^T M dU). The
+ * solve's vectors keep their film part as before (3 doubles a node) and put the bodies' in the
+ * arrays here (6 a body: velocity change, then spin change). The module knows no body: the
+ * world fills a body's mass, inertia and right-hand side and the contacts' levers and blocks. */
+#ifndef WS_WEB_COUPLED_H
+#define WS_WEB_COUPLED_H
+
+#include "web/implicit.h"
+
+/* A node-body contact of the solve: node, body (its index among the solve's bodies, not a
+ * body slot), lever from the body's centre of mass to the contact point (global, m), and its
+ * block C = h^2 K + h D (symmetric). */
+typedef struct ws_rigid_link {
+    uint32_t node, body;
+    v3 lever;
+    double C[WS_SYM];
+} ws_rigid_link;
+
+typedef struct ws_rigid {
+    uint32_t nb;    /* bodies in the solve */
+    size_t nl, cap; /* contacts in the solve, room for them */
+    ws_rigid_link *link;
+    double *mass;                  /* per body: its mass, kg */
+    double *inertia;               /* per body: its global inertia, symmetric (WS_SYM doubles) */
+    double *fac;                   /* per body: the Cholesky factor of its diagonal block of the
+                                      coupled matrix (36 doubles, lower triangle row-major) */
+    double *b, *x, *r, *z, *p, *q; /* the solve's vectors, 6 a body (x: dU, kept between
+                                      the solves of one step) */
+    /* The coarse space of the preconditioner: a column per body and direction, the body
+     * moving (or turning) by one unit and every node it touches with the contact point, Phi.
+     * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles;
+     * fa, fb: 3 doubles a film node (scratch). NULL coarse: none. */
+    double *coarse, *cb, *cq, *fa, *fb;
+} ws_rigid;
+
+/* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
+ * a block is not positive definite (a NaN, a body of no mass). */
+int ws_rigid_factor(ws_rigid *R);
+
+/* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr, and the coupling's
+ * -C J pr added into the film part y (y untouched at pinned nodes). Returns the dot product
+ * these add: p . (what it added to y) + pr . yr. */
+double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
+                      double *y, double *yr);
+
+/* Phi^T A Phi for the operator the running solve set (its film part by ws_implicit_apply_op),
+ * factored into R->coarse. 0, or -1 when it is not positive definite. */
+int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
+
+/* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
+ * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
+ * Phi c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
+ * r . z. */
+double ws_rigid_precondition(const ws_rigid *R, const ws_web *web, const double *rf, double *zf,
+                             const double *rr, double *zr);
+
+/* The CG's update of the bodies' part: x += alpha p, r -= alpha q; returns r . r. */
+double ws_rigid_step(ws_rigid *R, double alpha);
+
+/* The CG's new direction of the bodies' part: p = z + beta p. */
+void ws_rigid_direction(ws_rigid *R, double beta);
+
+/* a . b over the bodies' part. */
+double ws_rigid_dot(const ws_rigid *R, const double *a, const double *b);
+
+#endif
