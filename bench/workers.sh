@@ -24,6 +24,10 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 subs=$("$w" 1 P 1 | sed -n 's/.* x \([0-9]*\) sub-step.*/\1/p')
 echo "load before: $(uptime); the wrapped case's film takes ${subs:=1} sub-step(s) a step"
+# The hand-over price between the two cores (bench_pingpong.c): it moves the 1->2 figure, and on
+# a virtual machine it changes with where the host puts the cores.
+pp=$dir/bench/bench_pingpong
+if [ -x "$pp" ]; then echo "before: $("$pp" 500000)"; fi
 r=1
 while [ "$r" -le "$rounds" ]; do
     /usr/bin/time -f %e -o "$tmp/1" "$w" "$steps" P 1 >/dev/null
@@ -45,3 +49,4 @@ done | awk -v subs="$subs" '{ printf "round %d: 1 worker %.2f s, 2 workers %.2f 
                   printf "per node-update: 2 workers / plain %.3f, 1 worker / plain %.3f\n",
                          med(q) / subs, med(o) / subs }'
 echo "load after: $(uptime)"
+if [ -x "$pp" ]; then echo "after: $("$pp" 500000)"; fi
