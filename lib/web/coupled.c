@@ -122,9 +122,10 @@ double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, con
             const double cj[3] = {sym_row(L->C, 0, jp.x, jp.y, jp.z),
                                   sym_row(L->C, 1, jp.x, jp.y, jp.z),
                                   sym_row(L->C, 2, jp.x, jp.y, jp.z)};
+            /* g = C (p_node - J P) */
             const double g[3] = {sym_row(L->C, 0, pn[0], pn[1], pn[2]) - cj[0],
                                  sym_row(L->C, 1, pn[0], pn[1], pn[2]) - cj[1],
-                                 sym_row(L->C, 2, pn[0], pn[1], pn[2]) - cj[2]}; /* C (p_node - J P) */
+                                 sym_row(L->C, 2, pn[0], pn[1], pn[2]) - cj[2]};
             const v3 m = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
             y0 -= g[0], y1 -= g[1], y2 -= g[2];
             y3 -= m.x, y4 -= m.y, y5 -= m.z;
