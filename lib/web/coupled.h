@@ -42,6 +42,11 @@ typedef struct ws_rigid {
      * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles;
      * fa, fb: 3 doubles a film node (scratch). NULL coarse: none. */
     double *coarse, *cb, *cq, *fa, *fb;
+    /* The coarse space's contacts (room for cap), set by ws_rigid_coarse: the first link of
+     * each node-body pair at an unpinned node, as node, body and lever (3 doubles). */
+    size_t nphi;
+    uint32_t *phi_node, *phi_body;
+    double *phi_lever;
 } ws_rigid;
 
 /* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
@@ -62,8 +67,8 @@ int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
  * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
  * Phi c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
  * r . z. */
-double ws_rigid_precondition(const ws_rigid *R, const ws_web *web, const double *rf, double *zf,
-                             const double *rr, double *zr);
+double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
+                             double *zr);
 
 /* The CG's update of the bodies' part: x += alpha p, r -= alpha q; returns r . r. */
 double ws_rigid_step(ws_rigid *R, double alpha);

@@ -469,7 +469,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
             R->r[j] = R->b[j] - R->q[j];
         rr += ws_rigid_dot(R, R->r, R->r);
-        rz += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+        rz += ws_rigid_precondition(R, r, z, R->r, R->z);
         memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
     }
     memcpy(p, z, m * sizeof(double));
@@ -489,7 +489,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         it++;
         double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
         if (R)
-            rz1 += ws_rigid_precondition(R, web, r, z, R->r, R->z);
+            rz1 += ws_rigid_precondition(R, r, z, R->r, R->z);
         const double beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)

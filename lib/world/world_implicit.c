@@ -48,7 +48,10 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->link = ws_arena_alloc(arena, (nl + 1) * sizeof *R->link);
     double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 2 * m) *
                                           sizeof(double));
-    if (!R->link || !d) {
+    R->phi_node = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_node);
+    R->phi_body = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_body);
+    R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
+    if (!R->link || !d || !R->phi_node || !R->phi_body || !R->phi_lever) {
         *fail = 1;
         return NULL;
     }
