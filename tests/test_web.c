@@ -2462,6 +2462,61 @@ START_TEST(test_steady_step_allocates_nothing)
 }
 END_TEST
 
+/* The bytes a world holds (its allocator's count) after 40 steps of an nx by ny sheet on
+ * `workers`, lying flat on the ground (every node a candidate: its nodes 0.5 mm above the
+ * touching layers) or, `lifted`, 1 m above it (no candidate at all). */
+static long long sheet_world_bytes(int nx, int ny, int workers, int lifted)
+{
+    test_alloc a = {0};
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 1e-4;
+    d.worker_count = workers;
+    a.track = 1;
+    a.allocs_left = -1;
+    test_alloc_install(&d, &a);
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    add_ground(w, 1.0, no_material());
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 0.01;
+    wd.law = make_law(w, WS_LAW_TENSION_COMPRESSION, 100.0, 1.0, 0.01, 0.0);
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = nx;
+    sd.ny = ny;
+    sd.spacing_x = sd.spacing_y = 0.02;
+    sd.origin = (ws_vec3){-0.01 * (nx - 1), -0.01 * (ny - 1), (lifted ? 1.0 : 0.0) + 2.5e-3};
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    ck_ok(w, ws_world_step_n(w, 40));
+    const long long bytes = a.bytes;
+    ws_world_destroy(w);
+    test_alloc_done(&a);
+    return bytes;
+}
+
+/* The node-contact memory of a film swept in lanes is that of one lane plus a margin: each
+ * lane keeps room for the candidates of its own rows, not for every candidate of the web (which
+ * tripled the world at two workers). A 48 x 64 sheet flat on the ground (3072 candidates, eight
+ * sweep blocks of 8 rows, so four lanes on two workers) against the same sheet 1 m up (none): the
+ * difference is what the candidates cost. At two workers it must stay within 1.3 times that of
+ * one: the lanes' rooms sum to the candidates, each grown by half at most past its own, and
+ * rooms sized for the whole web would make it about 1 + lanes - 1 = 4 times. */
+START_TEST(test_lanes_contact_memory)
+{
+    const long long one = sheet_world_bytes(48, 64, 1, 0) - sheet_world_bytes(48, 64, 1, 1);
+    const long long two = sheet_world_bytes(48, 64, 2, 0) - sheet_world_bytes(48, 64, 2, 1);
+    report("node-contact memory of a 48 x 64 sheet on the ground: %lld B on one worker, %lld B "
+           "on two (%.2f times)",
+           one, two, (double)two / (double)one);
+    ck_assert_int_gt(one, 3072 * 100); /* the candidates' room is there to measure */
+    ck_assert_msg((double)two <= 1.3 * (double)one, "two workers take %lld B, one %lld B", two,
+                  one);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("web");
@@ -2494,6 +2549,7 @@ int main(void)
     add_case(s, "oom_film_step_sizes", test_oom_film_step_sizes, 60);
     add_case(s, "oom_film_step_lanes", test_oom_film_step_lanes, 120);
     add_case(s, "steady_step_allocates_nothing", test_steady_step_allocates_nothing, 30);
+    add_case(s, "lanes_contact_memory", test_lanes_contact_memory, 60);
     add_case(s, "springs_checked_before_law_histories", test_springs_checked_before_law_histories,
              10);
     return run_suite(s);

@@ -1203,7 +1203,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
         } else {
             bad = search_moved(S, web, (size_t)moved, old, &list);
         }
-        if (bad || ws_node_scratch(S->mem, nc, nc->cand[list].n) != 0)
+        if (bad)
             return -1;
     }
     nc->next_list = list;

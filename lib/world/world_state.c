@@ -512,10 +512,8 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
     size_t nc = C->cand[C->list].n;
     count(k, &nc, SIZE_MAX / sizeof(ws_ncand) / 2, 4 * 4, "node candidates");
     room(k, (void **)&C->cand[list].c, &C->cand[list].cap, nc + 1, sizeof(ws_ncand));
-    /* The contacts' room for that many candidates: a step that does not search takes it as
-     * it is. */
-    if (k->mode == WS_WALK_CHECK && !failed(k) && ws_node_scratch(&w->mem, web->contact, nc) != 0)
-        fail(k, WS_ERR_OUT_OF_MEMORY, "out of memory for %zu node candidates", nc);
+    /* The contacts' room the step takes, for the candidates of each of its lanes
+     * (world_step.c). */
     uint32_t prev = 0;
     ws_ncand last[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}; /* the last three read */
     for (size_t q = 0; q < nc && !failed(k); q++) {

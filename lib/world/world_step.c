@@ -334,10 +334,25 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     J[lanes - 1].r1 = ny;
 }
 
-/* The scratch of each of the lanes ready for ncand candidates: the spring chunk and the list
- * of touched nodes from the step's arena, here on the calling thread before the lanes start
- * (they never share the arena's bump pointer), and every lane's marks of where its rows' loads
- * start (a block's rows); the contact scratch the lanes keep. The chunk
+/* The candidates lane i sweeps, from its rows' stretches (cut in candidate order, so those of
+ * rows [r0, r1) lie between the first stretch of row r0 and that of row r1): the whole list for
+ * one lane. */
+static size_t lane_cands(const ws_web *web, const ws_lane_job *J, uint32_t lanes, size_t ncand)
+{
+    const ws_node_contact *nc = web->contact;
+    if (lanes == 1)
+        return ncand;
+    const size_t k0 = ws_node_first_segment(nc, (uint32_t)web->nx * J->r0),
+                 k1 = ws_node_first_segment(nc, (uint32_t)web->nx * J->r1);
+    return (k1 < nc->nseg ? nc->seg[k1].c0 : ncand) - (k0 < nc->nseg ? nc->seg[k0].c0 : ncand);
+}
+
+/* The scratch of each of the lanes (cut, lanes_cut) ready for the ncand candidates of the web:
+ * the spring chunk and the list of touched nodes from the step's arena, here on the calling
+ * thread before the lanes start (they never share the arena's bump pointer), and every lane's
+ * marks of where its rows' loads start (a block's rows); the contact room the lanes keep (lane
+ * 0's the web's own), each for the candidates of its own rows (lane_cands), so that the rooms
+ * of all lanes together hold about the web's candidates, whatever the worker count. The chunk
  * is not cleared: the springs write it before they read it (lane 0's, the web's own, holds
  * the last sub-step's values), and clearing it cost the calling thread 20 kB a step. 0 when
  * out of memory. */
@@ -345,11 +360,13 @@ static int lanes_ready(ws_step *S, ws_web *web, uint32_t lanes, size_t ncand)
 {
     for (uint32_t i = 0; i < lanes; i++) {
         ws_lane_job *J = &S->w->lane_job[i];
+        const size_t own = lane_cands(web, J, lanes, ncand);
         if (!(J->marks = ws_arena_alloc(S->arena, (ws_web_block_rows(web) + 1) * sizeof(size_t))))
             return 0;
-        if (i > 0 && (!(J->tmp = ws_arena_alloc(S->arena, WS_WEB_TMP * sizeof(double))) ||
-                      !(J->fct = ws_arena_alloc(S->arena, (ncand + 1) * sizeof(uint32_t))) ||
-                      ws_node_lane_scratch(&S->w->mem, &J->own, web->contact, web->n, ncand) != 0))
+        if (i == 0 ? ws_node_scratch(&S->w->mem, web->contact, own) != 0
+                   : (!(J->tmp = ws_arena_alloc(S->arena, WS_WEB_TMP * sizeof(double))) ||
+                      !(J->fct = ws_arena_alloc(S->arena, (own + 1) * sizeof(uint32_t))) ||
+                      ws_node_lane_scratch(&S->w->mem, &J->own, web->contact, web->n, own) != 0))
             return 0;
     }
     return 1;
@@ -641,13 +658,13 @@ static ws_status step_webs(ws_step *S)
         const int list = nc->next_list;
         if (ws_world_node_params(w, web->material) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        lanes_cut(w, web, lanes);
         /* Room to list every contact of every sub-step, before anything changes. */
         if (ws_array_reserve(&w->mem, (void **)&web->fct[nxt], &web->fct_cap[nxt],
                              (size_t)web->substeps * nc->cand[list].n + 1, sizeof(uint32_t)) != 0 ||
             !lanes_ready(S, web, lanes, nc->cand[list].n))
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
-        lanes_cut(w, web, lanes);
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
         /* The node contact forces this step writes: zero where they were not (the nodes that
