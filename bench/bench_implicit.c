@@ -15,6 +15,7 @@
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
  * crossing (drums of the real film from 10 x 10 to 96 x 96 nodes, block Jacobi and multigrid
  * in turn: CPU time a step and CG iterations, where the multigrid starts to pay),
+ * solve (`solve [duration] [dt ms] [preconditioner] [tolerance]`: one implicit run of case R),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -184,6 +185,22 @@ int main(int argc, char **argv)
             snprintf(name, sizeof name, "implicit, 1.6 mg nodes, dt %.2f ms", 1e3 * dts[k]);
             line(name, &a);
         }
+    } else if (!strcmp(what, "solve")) {
+        /* `solve [duration] [dt ms] [preconditioner] [tolerance]`: the implicit film at one
+         * dt with one ws_web_preconditioner (0 AUTO, 1 block Jacobi, 2 multigrid) and solve
+         * tolerance (0: the default 1e-6): whether the answers are the solve's and not its
+         * preconditioner's, which a tighter tolerance must leave where they are. */
+        tilt_options a = o;
+        a.film_mass = 1.6e-6;
+        a.implicit = 1;
+        a.substeps = 1;
+        a.dt = 1e-3 * (argc > 3 ? atof(argv[3]) : 1.0);
+        a.preconditioner = argc > 4 ? atoi(argv[4]) : 0;
+        a.solver_tolerance = argc > 5 ? atof(argv[5]) : 0.0;
+        char name[96];
+        snprintf(name, sizeof name, "implicit, dt %.2f ms, preconditioner %d, tolerance %g",
+                 1e3 * a.dt, a.preconditioner, a.solver_tolerance > 0 ? a.solver_tolerance : 1e-6);
+        line(name, &a);
     } else if (!strcmp(what, "dt1sub")) {
         /* What limits dt 1 ms: the world (bodies and their contacts) at 1 ms with the film at
          * 4 sub-steps of 0.25 ms each, beside both at 1 ms (dt1's first line). When the film's
