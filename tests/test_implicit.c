@@ -247,17 +247,12 @@ static void contact_fd(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_nod
     }
 }
 
-START_TEST(test_contact_jacobian)
+/* The scene of the contact Jacobians: a 0.2 m box of 1 kg moving at (10, 20, 0) mm/s without
+ * spin, and a web of two nodes (one spring, implicit): node 0 over its top face 1.5 mm up (the
+ * window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along y, 1.41 mm from
+ * it; stepped once, so the candidates are found and the faces prepared. x: the nodes' places. */
+static ws_world *box_two_nodes(ws_web **web, ws_nodes3 *x)
 {
-    /* A 0.2 m box moving at (10, 20, 0) mm/s without spin, two nodes: node 0 over its top face
-     * 1.5 mm up (the window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along
-     * y, 1.41 mm from it. Each slips on the box: node 0 at 5 mm/s (half of v_lim: the
-     * polynomial part of eq. 13), node 1 at 20 mm/s (beyond v_lim: mu N), and each approaches
-     * it at 1 mm/s. The exact derivatives of their contact forces (normal force, damping,
-     * friction; for the rim its turning normal) equal central differences to 1e-6 of their
-     * size (steps 1e-8 m and 1e-8 m/s: truncation (1e-8 / 1e-3)^2, round-off 1e-16 N / 1e-8
-     * ~ 1e-8 against 1e3 N/m; see below for the rate at rest). At rest on the box (no slip, no approach), the matrix's blocks
-     * of the face contact (k n n^T, c n n^T + mu N phi across n) equal them too. */
     ws_world *w = world_g(1e-5, NO_G);
     ws_shape_id box;
     ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &box));
@@ -278,8 +273,7 @@ START_TEST(test_contact_jacobian)
     bd.shape = box;
     bd.mass = 1.0;
     bd.material = box_mat;
-    const v3 vb = v3_make(0.01, 0.02, 0.0);
-    bd.velocity = vb;
+    bd.velocity = v3_make(0.01, 0.02, 0.0);
     ws_body_id body;
     ck_ok(w, ws_body_create(w, &bd, &body));
     ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
@@ -294,17 +288,34 @@ START_TEST(test_contact_jacobian)
     const uint32_t pair[2] = {0, 1};
     const double rest = 0.2;
     ws_web_id id = mesh_web(w, &wd, 2, pos, pair, 1, &rest, NULL, 0);
-    ws_web *web = web_of(w, id);
+    *web = web_of(w, id);
     ck_ok(w, ws_world_step(w)); /* candidates found, faces prepared */
+    *x = nodes_new(2);
+    for (int i = 0; i < 2; i++) {
+        x->x[i] = pos[3 * i];
+        x->y[i] = pos[3 * i + 1];
+        x->z[i] = pos[3 * i + 2];
+    }
+    return w;
+}
+
+START_TEST(test_contact_jacobian)
+{
+    /* A 0.2 m box moving at (10, 20, 0) mm/s without spin, two nodes: node 0 over its top face
+     * 1.5 mm up (the window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along
+     * y, 1.41 mm from it. Each slips on the box: node 0 at 5 mm/s (half of v_lim: the
+     * polynomial part of eq. 13), node 1 at 20 mm/s (beyond v_lim: mu N), and each approaches
+     * it at 1 mm/s. The exact derivatives of their contact forces (normal force, damping,
+     * friction; for the rim its turning normal) equal central differences to 1e-6 of their
+     * size (steps 1e-8 m and 1e-8 m/s: truncation (1e-8 / 1e-3)^2, round-off 1e-16 N / 1e-8
+     * ~ 1e-8 against 1e3 N/m; see below for the rate at rest). At rest on the box (no slip, no approach), the matrix's blocks
+     * of the face contact (k n n^T, c n n^T + mu N phi across n) equal them too. */
+    ws_web *web;
+    ws_nodes3 x, v = nodes_new(2);
+    ws_world *w = box_two_nodes(&web, &x);
     const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
     ck_assert_uint_ge(cl->n, 2);
     ws_node_link *L = calloc(cl->n, sizeof *L);
-    ws_nodes3 x = nodes_new(2), v = nodes_new(2);
-    for (int i = 0; i < 2; i++) {
-        x.x[i] = pos[3 * i];
-        x.y[i] = pos[3 * i + 1];
-        x.z[i] = pos[3 * i + 2];
-    }
     const ws_body_state *st = &w->bodies.st[w->cur];
     const v3 vbody = st->v[0];
     for (int rest_case = 0; rest_case < 2; rest_case++) {
@@ -1358,51 +1369,11 @@ START_TEST(test_coupled_jacobian)
      * equals -(h df/dU + h^2 df/dr_b) column by column (the spin's position column by the
      * contact point's displacement e x r: the face turning with the body is left out, docs),
      * and its body-node block is its transpose to round-off. */
-    ws_world *w = world_g(1e-5, NO_G);
-    ws_shape_id box;
-    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &box));
-    ws_material_def md;
-    ws_material_def_init(&md);
-    ws_material_id film_mat, box_mat;
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_material_create(w, &md, &box_mat));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    cd.friction_vlim = 0.01;
-    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.shape = box;
-    bd.mass = 1.0;
-    bd.material = box_mat;
-    bd.velocity = v3_make(0.01, 0.02, 0.0);
-    ws_body_id body;
-    ck_ok(w, ws_body_create(w, &bd, &body));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
-    const double r = 1e-3 / sqrt(2.0);
-    const double pos[6] = {0.03, -0.02, 0.1 + 1.5e-3, 0.1 + r, 0.05, 0.1 + r};
-    const uint32_t pair[2] = {0, 1};
-    const double rest = 0.2;
-    ws_web_id id = mesh_web(w, &wd, 2, pos, pair, 1, &rest, NULL, 0);
-    ws_web *web = web_of(w, id);
-    ck_ok(w, ws_world_step(w));
+    ws_web *web;
+    ws_nodes3 x, v = nodes_new(2);
+    ws_world *w = box_two_nodes(&web, &x);
     const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
     ws_node_link *L = calloc(cl->n + 1, sizeof *L);
-    ws_nodes3 x = nodes_new(2), v = nodes_new(2);
-    for (int i = 0; i < 2; i++) {
-        x.x[i] = pos[3 * i];
-        x.y[i] = pos[3 * i + 1];
-        x.z[i] = pos[3 * i + 2];
-    }
     ws_body_state *st = &w->bodies.st[w->cur];
     const v3 r0 = st->r[0], vb = st->v[0], wb0 = v3_make(0, 0, 0);
     const v3 slip[2] = {v3_make(0, 0, 0), v3_make(-7e-4, 0.02, -7e-4)};
