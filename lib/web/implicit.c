@@ -405,9 +405,6 @@ static double precondition(const ws_implicit *im, uint32_t n, const double *rest
     return rz;
 }
 
-/* The delay of the error estimate, in iterations: a few are enough (the terms fall fast). */
-#define ERR_DELAY 4
-
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
 {
     ws_implicit *im = web->imp;
@@ -439,16 +436,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
      * would loosen the film's tolerance by orders; their rows' residual is held to it. */
     const double scale = fmax(sqrt(dot(b, b, m)), h * 9.81 * sqrt(weight2));
     const double goal = web->solver_tol * scale;
-    /* The error test: the estimate of the error's energy ||x* - x||_A^2 (mass times speed
-     * squared) over the film's free mass, an rms speed error, against tol times the speed
-     * gravity gives in the step. The residual alone bounds the error only up to the system's
-     * condition: a small residual leaves error in the slow modes, which the energy sees. */
-    double mass = 0.0;
-    for (uint32_t i = 0; i < n; i++)
-        if (web->inv_m[i] != 0.0)
-            mass += web->m[i];
-    const double egoal = web->solver_tol * h * 9.81;
-    const double egoal2 = egoal * egoal * mass;
     if (preconditioner(web, h) != 0 || (R && ws_rigid_factor(R) != 0)) {
         im->warm = 0;
         im->last_residual = NAN;
@@ -487,24 +474,12 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     }
     memcpy(p, z, m * sizeof(double));
     int it = 0;
-    /* The last ERR_DELAY terms alpha_j r_j.z_j of the error's energy (Hestenes-Stiefel): their
-     * sum after iteration k + d estimates (from below, closely for a small d) the energy of the
-     * error at k; the iterate k + d is no worse, so stopping there is safe. A solve that does
-     * not iterate (the warm start meets the residual) is held to the residual only. */
-    double ering[ERR_DELAY] = {0.0};
-    double esum = INFINITY;
-    while (!(sqrt(rr) <= goal && (it == 0 || esum <= egoal2)) && it < web->solver_maxit) {
+    while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
         const double pq = ws_implicit_apply_op(web, p, q) +
                           (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
         const double alpha = rz / pq;
-        ering[it % ERR_DELAY] = alpha * rz;
-        if (it + 1 >= ERR_DELAY) {
-            esum = 0.0;
-            for (int k = 0; k < ERR_DELAY; k++)
-                esum += ering[k];
-        }
         rr = R ? ws_rigid_step(R, alpha) : 0.0;
         for (size_t j = 0; j < m; j++) {
             x[j] += alpha * p[j];
@@ -525,8 +500,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     im->iterations += (uint64_t)it;
     im->last_iterations = it;
     im->last_residual = scale > 0.0 ? sqrt(rr) / scale : 0.0;
-    /* Met on the residual: a solve stopped by the iteration limit with the residual met but
-     * the error estimate not is a slower one, not a failed one. */
     const int ok = sqrt(rr) <= goal;
     im->warm = ok;
     return ok ? 0 : -1;
