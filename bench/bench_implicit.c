@@ -301,9 +301,11 @@ int main(int argc, char **argv)
             if (r == 1)
                 base = el / T;
             printf("  refine %d (%u nodes): %.1f s CPU (%.1f s wall) per simulated s (%.2f x "
-                   "unrefined), CG %.1f it/step; line load %.2f N/m, contact force %.2f N\n",
+                   "unrefined), CG %.1f it/step (%.2f solves/step); line load %.2f N/m, contact force "
+                   "%.2f N\n",
                    r, info.node_count, el / T, wall / T, el / T / base,
                    (double)(ss.iterations - s0.iterations) / steps,
+                   (double)(ss.solves - s0.solves) / steps,
                    band.line_load, band.contact_force);
             fflush(stdout);
             ws_world_destroy(sc.world);
