@@ -2,8 +2,6 @@
  * section 8b, why). */
 #include "web/coupled.h"
 
-#include "web/multigrid.h"
-
 #include <string.h>
 
 /* J^T C J of a contact at lever r into the 6x6 block B (row-major): column k is J^T C J e_k,
@@ -205,90 +203,21 @@ static void phi_transpose(const ws_rigid *R, const double *rf, const double *rr,
     }
 }
 
-/* out = W^T (rf, rr) for the extended columns (interleaved, wf[nc k + c]): a pass over the
- * film's unknowns summing every column's product at once. */
-static void w_transpose(const ws_rigid *R, size_t m, const double *wf, const double *rf,
-                        const double *rr, double *out)
-{
-    const size_t nc = 6 * (size_t)R->nb;
-    memcpy(out, rr, nc * sizeof(double));
-    for (size_t k = 0; k < m; k++) {
-        const double *w = wf + nc * k, f = rf[k];
-        for (size_t c = 0; c < nc; c++)
-            out[c] += w[c] * f;
-    }
-}
-
-/* yf += W c's film part (interleaved columns). */
-static void w_apply(const ws_rigid *R, size_t m, const double *wf, const double *c, double *yf)
-{
-    const size_t nc = 6 * (size_t)R->nb;
-    for (size_t k = 0; k < m; k++) {
-        const double *w = wf + nc * k;
-        double s = 0.0;
-        for (size_t d = 0; d < nc; d++)
-            s += w[d] * c[d];
-        yf[k] += s;
-    }
-}
-
-/* Column c of W into fa (film part; its bodies' part is the unit vector cb): Phi's, then
- * R->extend cycles of the film's multigrid on the film's rows of A (fa, cb) = 0, the motion
- * the film makes when the body moves by one unit and the film's nodes are free to follow
- * (docs/theory.md 8b). fb, tf: scratch. */
-static void extended_column(ws_rigid *R, const ws_web *web, struct ws_mg *mg, size_t m)
-{
-    memset(R->fa, 0, m * sizeof(double));
-    phi_apply(R, R->cb, R->fa);
-    for (int s = 0; s < R->extend; s++) {
-        (void)ws_implicit_apply_op(web, R->fa, R->fb);
-        (void)ws_rigid_apply(R, web, R->fa, R->cb, R->fb, R->cq);
-        for (size_t k = 0; k < m; k++)
-            R->fb[k] = -R->fb[k];
-        (void)ws_mg_apply(mg, web, R->fb, R->tf);
-        for (size_t k = 0; k < m; k++)
-            R->fa[k] += R->tf[k];
-    }
-}
-
-int ws_rigid_coarse(ws_rigid *R, const ws_web *web, struct ws_mg *mg)
+int ws_rigid_coarse(ws_rigid *R, const ws_web *web)
 {
     const size_t nc = 6 * (size_t)R->nb, m = 3 * (size_t)web->n;
     double *A = R->coarse;
     phi_list(R, web);
-    R->wide = mg && R->wf;
     for (size_t c = 0; c < nc; c++) {
         memset(R->cb, 0, nc * sizeof(double));
+        memset(R->fa, 0, m * sizeof(double));
         R->cb[c] = 1.0;
-        if (R->wide) {
-            extended_column(R, web, mg, m);
-            for (size_t k = 0; k < m; k++)
-                R->wf[nc * k + c] = R->fa[k];
-        } else {
-            memset(R->fa, 0, m * sizeof(double));
-            phi_apply(R, R->cb, R->fa);
-        }
+        phi_apply(R, R->cb, R->fa);
         (void)ws_implicit_apply_op(web, R->fa, R->fb);
         (void)ws_rigid_apply(R, web, R->fa, R->cb, R->fb, R->cq);
-        if (R->wide) { /* A W kept: the coarse matrix below, and the balanced form's */
-            for (size_t k = 0; k < m; k++)
-                R->awf[nc * k + c] = R->fb[k];
-            memcpy(R->awr + nc * c, R->cq, nc * sizeof(double));
-            continue;
-        }
         phi_transpose(R, R->fb, R->cq, R->cb);
         for (size_t d = 0; d < nc; d++)
             A[nc * d + c] = R->cb[d];
-    }
-    if (R->wide) { /* W^T A W: entry (d, c) = w_d . (A w_c)'s film part + (A w_c)'s body d */
-        for (size_t c = 0; c < nc; c++)
-            memcpy(A + nc * c, R->awr + nc * c, nc * sizeof(double));
-        for (size_t k = 0; k < m; k++) {
-            const double *w = R->wf + nc * k, *aw = R->awf + nc * k;
-            for (size_t c = 0; c < nc; c++)
-                for (size_t d = 0; d < nc; d++)
-                    A[nc * c + d] += w[d] * aw[c];
-        }
     }
     for (size_t c = 0; c < nc; c++) /* symmetric to round-off: its mean */
         for (size_t d = c + 1; d < nc; d++)
@@ -296,8 +225,8 @@ int ws_rigid_coarse(ws_rigid *R, const ws_web *web, struct ws_mg *mg)
     return cholesky(A, nc);
 }
 
-/* zr = B^-1 rr per body; returns rr . zr. */
-static double blocks_solve(const ws_rigid *R, const double *rr, double *zr)
+double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
+                             double *zr)
 {
     double rz = 0.0;
     for (uint32_t j = 0; j < R->nb; j++) {
@@ -307,92 +236,20 @@ static double blocks_solve(const ws_rigid *R, const double *rr, double *zr)
         for (int i = 0; i < 6; i++)
             rz += rv[i] * zv[i];
     }
-    return rz;
-}
-
-/* The film's unknowns of the solve (3 a node): the length of W's film part. */
-static size_t film_unknowns(const ws_rigid *R)
-{
-    return R->nfilm;
-}
-
-double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
-                             double *zr)
-{
-    double rz = blocks_solve(R, rr, zr);
     if (!R->coarse)
         return rz;
     /* The coarse correction, added (two-level additive Schwarz: a sum of symmetric positive
      * (semi-)definite parts, so CG stays valid). */
     const size_t nc = 6 * (size_t)R->nb;
     double *c = R->cq; /* free while the CG runs */
-    if (R->wide)
-        w_transpose(R, film_unknowns(R), R->wf, rf, rr, c);
-    else
-        phi_transpose(R, rf, rr, c);
+    phi_transpose(R, rf, rr, c);
     double *g = R->cb;
     cholesky_solve(R->coarse, nc, c, g);
     for (size_t k = 0; k < nc; k++) {
         rz += c[k] * g[k];
         zr[k] += g[k];
     }
-    if (R->wide)
-        w_apply(R, film_unknowns(R), R->wf, g, zf);
-    else
-        phi_apply(R, g, zf);
-    return rz;
-}
-
-void ws_rigid_balance_pre(ws_rigid *R, const double *rf, const double *rr)
-{
-    const size_t nc = 6 * (size_t)R->nb, m = film_unknowns(R);
-    w_transpose(R, m, R->wf, rf, rr, R->c1);
-    cholesky_solve(R->coarse, nc, R->c1, R->c0);
-    memcpy(R->tf, rf, m * sizeof(double));
-    for (size_t k = 0; k < m; k++) {
-        const double *aw = R->awf + nc * k;
-        double s = 0.0;
-        for (size_t c = 0; c < nc; c++)
-            s += aw[c] * R->c0[c];
-        R->tf[k] -= s;
-    }
-    for (size_t d = 0; d < nc; d++) {
-        double s = rr[d];
-        for (size_t c = 0; c < nc; c++)
-            s -= R->awr[nc * c + d] * R->c0[c];
-        R->tr[d] = s;
-    }
-}
-
-double ws_rigid_balance_post(ws_rigid *R, const ws_web *web, const double *rf, double *zf,
-                             const double *rr, double *zr)
-{
-    (void)web;
-    const size_t nc = 6 * (size_t)R->nb, m = film_unknowns(R);
-    (void)blocks_solve(R, R->tr, zr);
-    /* g = (A W)^T z: A W's film part interleaved, its bodies' part by column. */
-    double *g = R->c1;
-    memset(g, 0, nc * sizeof(double));
-    for (size_t k = 0; k < m; k++) {
-        const double *aw = R->awf + nc * k, f = zf[k];
-        for (size_t c = 0; c < nc; c++)
-            g[c] += aw[c] * f;
-    }
-    for (size_t c = 0; c < nc; c++)
-        for (size_t d = 0; d < nc; d++)
-            g[c] += R->awr[nc * c + d] * zr[d];
-    double *e = R->cq; /* free while the CG runs */
-    cholesky_solve(R->coarse, nc, g, e);
-    for (size_t c = 0; c < nc; c++)
-        e[c] = R->c0[c] - e[c];
-    w_apply(R, m, R->wf, e, zf);
-    double rz = 0.0;
-    for (size_t c = 0; c < nc; c++) {
-        zr[c] += e[c];
-        rz += rr[c] * zr[c];
-    }
-    for (size_t k = 0; k < m; k++)
-        rz += rf[k] * zf[k];
+    phi_apply(R, g, zf);
     return rz;
 }
 
@@ -419,45 +276,4 @@ double ws_rigid_dot(const ws_rigid *R, const double *a, const double *b)
     for (size_t k = 0; k < 6 * (size_t)R->nb; k++)
         s += a[k] * b[k];
     return s;
-}
-
-double ws_rigid_sgs(ws_rigid *R, const ws_web *web, const double *rf, double *zf, void *mg,
-                    const void *im)
-{
-    const size_t nc = 6 * (size_t)R->nb, m = R->nfilm;
-    double *y = R->c0, *t = R->tf, *u = R->tr, *zr = R->z;
-    (void)blocks_solve(R, R->r, y);
-    memset(R->fb, 0, m * sizeof(double));
-    memset(t, 0, m * sizeof(double));
-    (void)ws_rigid_apply(R, web, R->fb, y, t, u); /* t = A_fb y */
-    for (size_t k = 0; k < m; k++)
-        t[k] = rf[k] - t[k];
-    (void)ws_film_pre(web, mg, im, t, zf);
-    memset(R->c1, 0, nc * sizeof(double));
-    (void)ws_rigid_apply(R, web, zf, R->c1, t, u); /* u = A_bf zf */
-    for (size_t k = 0; k < nc; k++)
-        u[k] = R->r[k] - u[k];
-    (void)blocks_solve(R, u, zr);
-    double rz = 0.0;
-    for (size_t k = 0; k < m; k++)
-        rz += rf[k] * zf[k];
-    for (size_t k = 0; k < nc; k++)
-        rz += R->r[k] * zr[k];
-    if (!R->coarse)
-        return rz;
-    double *c = R->cq, *g = R->cb;
-    if (R->wide)
-        w_transpose(R, m, R->wf, rf, R->r, c);
-    else
-        phi_transpose(R, rf, R->r, c);
-    cholesky_solve(R->coarse, nc, c, g);
-    for (size_t k = 0; k < nc; k++) {
-        rz += c[k] * g[k];
-        zr[k] += g[k];
-    }
-    if (R->wide)
-        w_apply(R, m, R->wf, g, zf);
-    else
-        phi_apply(R, g, zf);
-    return rz;
 }

@@ -29,7 +29,6 @@ typedef struct ws_rigid_link {
 
 typedef struct ws_rigid {
     uint32_t nb;    /* bodies in the solve */
-    size_t nfilm;   /* the film's unknowns in the solve (3 a node) */
     size_t nl, cap; /* contacts in the solve, room for them */
     ws_rigid_link *link;
     double *mass;                  /* per body: its mass, kg */
@@ -48,16 +47,6 @@ typedef struct ws_rigid {
     size_t nphi;
     uint32_t *phi_node, *phi_body;
     double *phi_lever;
-    /* The coarse columns extended into the film by the film's multigrid (docs/theory.md 8b),
-     * with room for them: W, each column's film part (3 doubles a film node, interleaved:
-     * unknown k's 6 nb values together, wf[6 nb k + c]), A W likewise (awf) and A W's bodies'
-     * part (awr[6 nb c + d]); tf: 3 doubles a film node, tr, c0, c1: 6 nb (scratch). NULL wf:
-     * no room (the columns stay Phi, sparse). extend: the multigrid's cycles of the
-     * extension; balanced: the coarse correction is taken before and after the film's
-     * preconditioner instead of beside it. wide: set by ws_rigid_coarse, whether the running
-     * solve uses W (with a multigrid) rather than Phi. */
-    double *wf, *awf, *awr, *tf, *tr, *c0, *c1;
-    int extend, balanced, wide, sgs;
 } ws_rigid;
 
 /* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
@@ -70,30 +59,16 @@ int ws_rigid_factor(ws_rigid *R);
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
                       double *y, double *yr);
 
-/* The coarse columns for the operator the running solve set (its film part by
- * ws_implicit_apply_op): Phi, or with mg (the film's multigrid, set up for this solve) and
- * room for them (R->wf) W = Phi extended into the film by R->extend cycles of mg
- * (docs/theory.md 8b); W^T A W factored into R->coarse. 0, or -1 when it is not positive
- * definite. */
-int ws_rigid_coarse(ws_rigid *R, const ws_web *web, struct ws_mg *mg);
+/* Phi^T A Phi for the operator the running solve set (its film part by ws_implicit_apply_op),
+ * factored into R->coarse. 0, or -1 when it is not positive definite. */
+int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
 
-/* The bodies' part of the preconditioner and the coarse correction added: zr = B^-1 rr per
- * body (B its factored block), then, with R->coarse, c = (W^T A W)^-1 W^T (rf, rr) added as
- * W c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
+/* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
+ * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
+ * Phi c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
  * r . z. */
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
                              double *zr);
-
-/* The balanced form's first half (R->wide and R->balanced): c0 = (W^T A W)^-1 W^T (rf, rr)
- * kept in R->c0, and (tf, tr) = (rf, rr) - A W c0 into R->tf, R->tr: the residual the film's
- * and the bodies' preconditioners then take. */
-void ws_rigid_balance_pre(ws_rigid *R, const double *rf, const double *rr);
-
-/* The balanced form's second half: zr = B^-1 tr per body, then (zf, zr) += W (c0 - (W^T A
- * W)^-1 (A W)^T (zf, zr)), zf the film's preconditioner applied to R->tf. Returns r . z over
- * both parts. */
-double ws_rigid_balance_post(ws_rigid *R, const ws_web *web, const double *rf, double *zf,
-                             const double *rr, double *zr);
 
 /* The CG's update of the bodies' part: x += alpha p, r -= alpha q; returns r . r. */
 double ws_rigid_step(ws_rigid *R, double alpha);
@@ -103,9 +78,5 @@ void ws_rigid_direction(ws_rigid *R, double beta);
 
 /* a . b over the bodies' part. */
 double ws_rigid_dot(const ws_rigid *R, const double *a, const double *b);
-
-double ws_rigid_sgs(ws_rigid *R, const ws_web *web, const double *rf, double *zf, void *mg,
-                    const void *im);
-double ws_film_pre(const ws_web *web, void *mg, const void *im, const double *r, double *z);
 
 #endif

@@ -11,9 +11,6 @@
 #include <float.h>
 #include <stdio.h>
 #include <string.h>
-#include <stdlib.h>
-
-#define WS_RIGID_WIDE_MAX ((size_t)1 << 24)
 
 /* Solves a sub-step at most, as its contacts come in and go (the active set). */
 #define WS_IMPLICIT_PASSES 6
@@ -28,7 +25,7 @@ static const char *label(const ws_web *web)
  * scratch (with the coarse space's, for a web of `nodes` nodes) from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
  * with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
-                            size_t nl, uint32_t nodes, int wide, uint32_t **slot_out, int *fail)
+                            size_t nl, uint32_t nodes, uint32_t **slot_out, int *fail)
 {
     *fail = 1;
     uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
@@ -69,24 +66,6 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->coarse = R->cq + v6;
     R->fa = R->coarse + v6 * v6;
     R->fb = R->fa + m;
-    R->nfilm = m;
-    if (wide && v6 * m <= WS_RIGID_WIDE_MAX && getenv("WS_EXT")) {
-        double *e = ws_arena_alloc(arena, (2 * v6 * m + v6 * v6 + m + 3 * v6) * sizeof(double));
-        if (!e) {
-            *fail = 1;
-            return NULL;
-        }
-        R->wf = e, e += v6 * m;
-        R->awf = e, e += v6 * m;
-        R->awr = e, e += v6 * v6;
-        R->tf = e, e += m;
-        R->tr = e, e += v6;
-        R->c0 = e, e += v6;
-        R->c1 = e;
-        R->extend = atoi(getenv("WS_EXT"));
-        R->balanced = getenv("WS_BAL") ? atoi(getenv("WS_BAL")) : 0;
-    }
-    R->sgs = R->wf && getenv("WS_SGS") ? atoi(getenv("WS_SGS")) : 0;
     for (size_t i = 0; i < b->slots; i++) {
         const uint32_t j = slot[i];
         if (j == UINT32_MAX)
@@ -215,10 +194,9 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                                         S->contact.margin, links);
         uint32_t *slot = NULL;
         int nomem = 0;
-        ws_rigid *R = web->hold_bodies || getenv("WS_HOLD")
+        ws_rigid *R = web->hold_bodies
                           ? NULL
-                          : rigid_make(S->arena, b, links, nl, web->n, im->mg != NULL, &slot,
-                                       &nomem);
+                          : rigid_make(S->arena, b, links, nl, web->n, &slot, &nomem);
         if (nomem)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
