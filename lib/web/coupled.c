@@ -82,12 +82,6 @@ int ws_rigid_factor(ws_rigid *R)
     return 0;
 }
 
-void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z)
-{
-    for (uint32_t j = 0; j < R->nb; j++)
-        cholesky_solve(R->fac + 36 * (size_t)j, 6, r + 6 * (size_t)j, z + 6 * (size_t)j);
-}
-
 /* Row i of the symmetric S times (x, y, z): what ws_sym_madd adds, without the add to a
  * zero the product loop would otherwise pay twice a contact. */
 static inline double sym_row(const double *S, int i, double x, double y, double z)
@@ -250,23 +244,6 @@ double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, co
     double *c = R->cq; /* free while the CG runs */
     phi_transpose(R, rf, rr, c);
     double *g = R->cb;
-    cholesky_solve(R->coarse, nc, c, g);
-    for (size_t k = 0; k < nc; k++) {
-        rz += c[k] * g[k];
-        zr[k] += g[k];
-    }
-    phi_apply(R, g, zf);
-    return rz;
-}
-
-double ws_rigid_coarse_add(const ws_rigid *R, const double *rf, double *zf, const double *rr,
-                           double *zr)
-{
-    if (!R->coarse)
-        return 0.0;
-    const size_t nc = 6 * (size_t)R->nb;
-    double *c = R->cq, *g = R->cb, rz = 0.0;
-    phi_transpose(R, rf, rr, c);
     cholesky_solve(R->coarse, nc, c, g);
     for (size_t k = 0; k < nc; k++) {
         rz += c[k] * g[k];

@@ -42,8 +42,6 @@ typedef struct ws_rigid {
      * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles;
      * fa, fb: 3 doubles a film node (scratch). NULL coarse: none. */
     double *coarse, *cb, *cq, *fa, *fb;
-    double *mgbuf; /* scratch of the film's multigrid with the bodies nested in it (or NULL) */
-    int nest_phi;  /* with them nested: the coarse correction added too */
     /* The coarse space's contacts (room for cap), set by ws_rigid_coarse: the first link of
      * each node-body pair at an unpinned node, as node, body and lever (3 doubles). */
     size_t nphi;
@@ -54,9 +52,6 @@ typedef struct ws_rigid {
 /* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
  * a block is not positive definite (a NaN, a body of no mass). */
 int ws_rigid_factor(ws_rigid *R);
-
-/* z = B^-1 r per body, B its factored block (6 doubles a body; z may be r). */
-void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z);
 
 /* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr, and the coupling's
  * -C J pr added into the film part y (y untouched at pinned nodes). Returns the dot product
@@ -74,11 +69,6 @@ int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
  * r . z. */
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
                              double *zr);
-
-/* The coarse correction alone added into (zf, zr): c = (Phi^T A Phi)^-1 Phi^T (rf, rr), Phi c.
- * Returns what it adds to r . z. */
-double ws_rigid_coarse_add(const ws_rigid *R, const double *rf, double *zf, const double *rr,
-                           double *zr);
 
 /* The CG's update of the bodies' part: x += alpha p, r -= alpha q; returns r . r. */
 double ws_rigid_step(ws_rigid *R, double alpha);

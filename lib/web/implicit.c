@@ -405,25 +405,6 @@ static double precondition(const ws_implicit *im, uint32_t n, const double *rest
     return rz;
 }
 
-/* z = P r over the film's part (r, z) and the bodies' (R->r, R->z; R NULL when none): with
- * the multigrid and the bodies nested in it, its cycle over both; otherwise the film's
- * preconditioner (the multigrid or block Jacobi), each body's block and the coarse correction
- * added (docs/theory.md 8b). Returns r . z over both parts. */
-static double precondition_all(const ws_implicit *im, const ws_web *web, ws_mg *mg,
-                               const ws_rigid *R, const double *r, double *z)
-{
-    if (R && mg && R->mgbuf) {
-        double rz = ws_mg_apply_bodies(mg, web, r, z, R->r, R->z);
-        if (R->nest_phi == 1)
-            rz += ws_rigid_coarse_add(R, r, z, R->r, R->z);
-        return rz;
-    }
-    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, web->n, r, z);
-    if (R) /* after the film's part, which its coarse correction adds to */
-        rz += ws_rigid_precondition(R, r, z, R->r, R->z);
-    return rz;
-}
-
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
 {
     ws_implicit *im = web->imp;
@@ -461,6 +442,11 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         return -1;
     }
     operator_for(web, h);
+    if (R && R->coarse && ws_rigid_coarse(R, web) != 0) {
+        im->warm = 0;
+        im->last_residual = NAN;
+        return -1;
+    }
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
@@ -474,27 +460,18 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     double rr = dot(r, r, m);
     /* The multigrid's coarse levels only for a solve that iterates: a calm film's warm start
      * often meets the tolerance already. */
-    if (im->mg) /* the bodies nested in the multigrid when it has room for them */
-        ws_mg_bodies(im->mg, R, R ? R->mgbuf : NULL);
     ws_mg *mg = im->mg && !im->jacobi_only && !(sqrt(rr) <= goal) &&
                         ws_mg_setup(im->mg, web, im->begun, h) == 0
                     ? im->mg
                     : NULL;
-    /* The bodies' coarse space, unless they are nested in the multigrid (which resolves
-     * their modes on every level). */
-    if (R && R->coarse && !(mg && R->mgbuf && R->nest_phi != 1) && ws_rigid_coarse(R, web) != 0) {
-        im->warm = 0;
-        im->last_residual = NAN;
-        return -1;
-    }
-    if (R) {
+    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+    if (R) { /* after the film's part, which its coarse correction adds to */
         for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
             R->r[j] = R->b[j] - R->q[j];
         rr += ws_rigid_dot(R, R->r, R->r);
-    }
-    double rz = precondition_all(im, web, mg, R, r, z);
-    if (R)
+        rz += ws_rigid_precondition(R, r, z, R->r, R->z);
         memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
+    }
     memcpy(p, z, m * sizeof(double));
     int it = 0;
     while (!(sqrt(rr) <= goal) && it < web->solver_maxit) {
@@ -510,7 +487,9 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
             rr += r[j] * r[j];
         }
         it++;
-        const double rz1 = precondition_all(im, web, mg, R, r, z);
+        double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
+        if (R)
+            rz1 += ws_rigid_precondition(R, r, z, R->r, R->z);
         const double beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)

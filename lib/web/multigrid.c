@@ -2,7 +2,6 @@
  * docs/theory.md, "The implicit film", why it is this one). */
 #include "web/multigrid.h"
 
-#include "web/coupled.h"
 #include "web/implicit.h"
 
 #include <string.h>
@@ -44,10 +43,6 @@ typedef struct mg_level {
     double *dinv;           /* WS_SYM n: inverse of each node's own block (coarse levels) */
     double *x, *r, *t;      /* 3 n each: the level's solution, right-hand side, scratch (the
                                film's level has t alone) */
-    double *G;              /* with bodies (coarse levels): each node's coupling to each body,
-                               P^T (-C J) restricted level by level, 3x6 row-major, 18 nb a
-                               node */
-    double *xb, *rb;        /* with bodies: their solution and right-hand side (6 nb each) */
 } mg_level;
 
 struct ws_mg {
@@ -71,14 +66,6 @@ struct ws_mg {
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
-    /* The bodies of the running solve nested in the hierarchy (ws_mg_bodies; nb 0: none):
-     * their six unknowns ride along every level, coupled to its nodes by G. bchol: the
-     * coarsest level's factor with them ((m + 6 nb)^2), bsc: its right-hand side (m + 6 nb),
-     * fr: the film's right-hand side less the bodies' coupling (3 n). */
-    uint32_t nb;
-    int smooth_bodies; /* the bodies smoothed on the film's level too */
-    const ws_rigid *rig;
-    double *bchol, *bsc, *fr;
 };
 
 /* Interpolation from a coarse level to the finer one, along one direction: fine index i of n
@@ -364,33 +351,9 @@ static int own_inverse(const float *B, double *S)
 static int factor_coarsest(ws_mg *mg)
 {
     const mg_level *L = &mg->lv[mg->nlev - 1];
-    const uint32_t m0 = mg->m, m = m0 + 6 * mg->nb;
-    double *D = mg->nb ? mg->bchol : mg->chol;
+    const uint32_t m = mg->m;
+    double *D = mg->chol;
     memset(D, 0, (size_t)m * m * sizeof(double));
-    if (mg->nb) { /* the bodies' rows: their blocks L L^T and the nodes' coupling G */
-        const uint32_t nb = mg->nb;
-        for (uint32_t j = 0; j < nb; j++) {
-            const double *F = mg->rig->fac + 36 * (size_t)j;
-            const size_t o = m0 + 6 * (size_t)j;
-            for (int a = 0; a < 6; a++)
-                for (int b = 0; b < 6; b++) {
-                    double v = 0.0;
-                    for (int q = 0; q <= (a < b ? a : b); q++)
-                        v += F[6 * a + q] * F[6 * b + q];
-                    D[(o + a) * m + o + b] = v;
-                }
-        }
-        for (uint32_t i = 0; i < L->n; i++)
-            for (uint32_t j = 0; j < nb; j++) {
-                const double *G = L->G + 18 * ((size_t)i * nb + j);
-                const size_t o = m0 + 6 * (size_t)j;
-                for (int r = 0; r < 3; r++)
-                    for (int c = 0; c < 6; c++) {
-                        D[(3 * (size_t)i + r) * m + o + c] = G[6 * r + c];
-                        D[(o + c) * m + 3 * (size_t)i + r] = G[6 * r + c];
-                    }
-            }
-    }
     int64_t nb[9];
     for (int iy = 0; iy < L->ny; iy++)
         for (int ix = 0; ix < L->nx; ix++) {
@@ -438,92 +401,6 @@ static int factor_coarsest(ws_mg *mg)
     return 0;
 }
 
-/* A contact's coupling -C J (3x6 row-major, J = [I, -[r]x]: column 3 + k is -C (e_k x r)). */
-static void link_coupling(const ws_rigid_link *L, double *G)
-{
-    const v3 r = L->lever;
-    const v3 e[3] = {v3_make(0.0, -r.z, r.y), v3_make(r.z, 0.0, -r.x), v3_make(-r.y, r.x, 0.0)};
-    for (int c = 0; c < 6; c++) {
-        const v3 a = c < 3 ? v3_make(c == 0, c == 1, c == 2) : e[c - 3];
-        double g[3] = {0.0, 0.0, 0.0};
-        ws_sym_madd(L->C, a.x, a.y, a.z, g);
-        for (int q = 0; q < 3; q++)
-            G[6 * q + c] = -g[q];
-    }
-}
-
-/* The bodies' coupling on every coarse level: G_1 = P^T (the contacts' -C J), G_k+1 = P^T G_k
- * (P acts on the nodes' rows alone: the bodies' unknowns are the same on every level). */
-static void galerkin_bodies(ws_mg *mg, const ws_web *web)
-{
-    const uint32_t nb = mg->nb;
-    const ws_rigid *R = mg->rig;
-    mg_level *c = &mg->lv[1];
-    memset(c->G, 0, 18 * (size_t)nb * c->n * sizeof(double));
-    pmap p;
-    double G0[18];
-    for (size_t l = 0; l < R->nl; l++) {
-        const ws_rigid_link *L = &R->link[l];
-        film_pmap(mg, web, L->node, &p);
-        if (!p.n)
-            continue;
-        link_coupling(L, G0);
-        for (int i = 0; i < p.n; i++) {
-            double *G = c->G + 18 * ((size_t)p.idx[i] * nb + L->body);
-            for (int q = 0; q < 18; q++)
-                G[q] += p.w[i] * G0[q];
-        }
-    }
-    for (int k = 1; k + 1 < mg->nlev; k++) {
-        const mg_level *f = &mg->lv[k];
-        c = &mg->lv[k + 1];
-        memset(c->G, 0, 18 * (size_t)nb * c->n * sizeof(double));
-        for (int iy = 0; iy < f->ny; iy++)
-            for (int ix = 0; ix < f->nx; ix++) {
-                const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-                pmap_of(f, c, ix, iy, &p);
-                const double *Gf = f->G + 18 * (size_t)i * nb;
-                for (int a = 0; a < p.n; a++) {
-                    double *Gc = c->G + 18 * (size_t)p.idx[a] * nb;
-                    for (size_t q = 0; q < 18 * (size_t)nb; q++)
-                        Gc[q] += p.w[a] * Gf[q];
-                }
-            }
-    }
-}
-
-size_t ws_mg_body_doubles(const ws_mg *mg, uint32_t nb)
-{
-    if (!mg || !nb)
-        return 0;
-    const size_t m = mg->m + 6 * (size_t)nb;
-    size_t d = m * m + m + 3 * (size_t)mg->lv[0].n;
-    for (int k = 1; k < mg->nlev; k++)
-        d += 18 * (size_t)nb * mg->lv[k].n + 12 * (size_t)nb;
-    return d;
-}
-
-void ws_mg_bodies(ws_mg *mg, const ws_rigid *R, double *buf)
-{
-    mg->nb = R && buf ? R->nb : 0;
-    mg->smooth_bodies = R && R->nest_phi >= 2;
-    mg->rig = mg->nb ? R : NULL;
-    if (!mg->nb)
-        return;
-    const uint32_t nb = mg->nb;
-    const size_t m = mg->m + 6 * (size_t)nb;
-    double *q = buf;
-    mg->bchol = q, q += m * m;
-    mg->bsc = q, q += m;
-    mg->fr = q, q += 3 * (size_t)mg->lv[0].n;
-    for (int k = 1; k < mg->nlev; k++) {
-        mg_level *L = &mg->lv[k];
-        L->G = q, q += 18 * (size_t)nb * L->n;
-        L->xb = q, q += 6 * (size_t)nb;
-        L->rb = q, q += 6 * (size_t)nb;
-    }
-}
-
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
@@ -549,8 +426,6 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
             if (own_inverse(AT(L, i, CENTRE), L->dinv + WS_SYM * (size_t)i) != 0)
                 return -1;
     }
-    if (mg->nb)
-        galerkin_bodies(mg, web);
     return factor_coarsest(mg);
 }
 
@@ -581,49 +456,11 @@ static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
     ws_sym_madd(S, s[0], s[1], s[2], X);
 }
 
-/* s -= sum over the bodies of G_kj xb_j, node k's coupling on level L. */
-static inline void node_coupling_sub(const ws_mg *mg, const mg_level *L, size_t k,
-                                     const double *xb, double *s)
-{
-    const uint32_t nb = mg->nb;
-    const double *G = L->G + 18 * k * nb;
-    for (uint32_t j = 0; j < nb; j++, G += 18) {
-        const double *X = xb + 6 * (size_t)j;
-        for (int r = 0; r < 3; r++) {
-            const double *g = G + 6 * r;
-            s[r] -= g[0] * X[0] + g[1] * X[1] + g[2] * X[2] + g[3] * X[3] + g[4] * X[4] +
-                    g[5] * X[5];
-        }
-    }
-}
-
-/* t -= G xb over level L's nodes. */
-static void coupling_sub(const ws_mg *mg, const mg_level *L, const double *xb, double *t)
-{
-    for (uint32_t k = 0; k < L->n; k++)
-        node_coupling_sub(mg, L, k, xb, t + 3 * (size_t)k);
-}
-
-/* The bodies' Gauss-Seidel step on level L: xb = A_bb^-1 (rb - G^T x). */
-static void bodies_solve(const ws_mg *mg, mg_level *L)
-{
-    const uint32_t nb = mg->nb;
-    double *s = L->xb; /* summed in place, then solved in place */
-    memcpy(s, L->rb, 6 * (size_t)nb * sizeof(double));
-    for (uint32_t k = 0; k < L->n; k++) {
-        const double *X = L->x + 3 * (size_t)k, *G = L->G + 18 * (size_t)k * nb;
-        for (uint32_t j = 0; j < nb; j++, G += 18)
-            for (int c = 0; c < 6; c++)
-                s[6 * j + c] -= G[c] * X[0] + G[6 + c] * X[1] + G[12 + c] * X[2];
-    }
-    ws_rigid_block_solve(mg->rig, s, s);
-}
-
 /* The sweeps of block Gauss-Seidel on a coarse level L. Forward from x = 0: a node meets only
  * the nodes before it (those after are still zero), and the sweep leaves the residual r - A x
  * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
  * as that node is solved, with the block its own solve has just read). */
-static void gauss_seidel_forward(const ws_mg *mg, mg_level *L)
+static void gauss_seidel_forward(mg_level *L)
 {
     memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
     for (int iy = 0; iy < L->ny; iy++)
@@ -643,17 +480,11 @@ static void gauss_seidel_forward(const ws_mg *mg, mg_level *L)
                 if (o != CENTRE && B[o])
                     fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
         }
-    if (mg->nb) { /* the bodies after the nodes, and the nodes' residual with them */
-        bodies_solve(mg, L);
-        coupling_sub(mg, L, L->xb, L->t);
-    }
 }
 
 /* Backward from the x there is: node k meets every neighbour. */
-static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
+static void gauss_seidel_backward(mg_level *L)
 {
-    if (mg->nb)
-        bodies_solve(mg, L); /* the bodies first, from the nodes' x */
     for (int iy = L->ny - 1; iy >= 0; iy--)
         for (int ix = L->nx - 1; ix >= 0; ix--) {
             const int64_t k = ix + (int64_t)L->nx * iy;
@@ -664,8 +495,6 @@ static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
             for (int o = 0; o < 9; o++)
                 if (o != CENTRE && j[o] >= 0)
                     fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
-            if (mg->nb)
-                node_coupling_sub(mg, L, (size_t)k, L->xb, s);
             gs_solve(L, k, s);
         }
 }
@@ -757,18 +586,12 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
 /* x = L^-T L^-1 r on the coarsest level. */
 static void solve_coarsest(ws_mg *mg)
 {
-    mg_level *L = &mg->lv[mg->nlev - 1];
-    const uint32_t m = mg->m + 6 * mg->nb;
-    const double *F = mg->nb ? mg->bchol : mg->chol;
-    double *x = mg->nb ? mg->bsc : L->x;
-    const double *rhs = L->r;
-    if (mg->nb) { /* film and bodies as one vector */
-        memcpy(x, L->r, mg->m * sizeof(double));
-        memcpy(x + mg->m, L->rb, 6 * (size_t)mg->nb * sizeof(double));
-        rhs = x;
-    }
+    const mg_level *L = &mg->lv[mg->nlev - 1];
+    const uint32_t m = mg->m;
+    const double *F = mg->chol;
+    double *x = L->x;
     for (uint32_t i = 0; i < m; i++) {
-        double s = rhs[i];
+        double s = L->r[i];
         for (uint32_t k = 0; k < i; k++)
             s -= F[(size_t)i * m + k] * x[k];
         x[i] = s / F[(size_t)i * m + i];
@@ -778,10 +601,6 @@ static void solve_coarsest(ws_mg *mg)
         for (uint32_t k = i + 1; k < m; k++)
             s -= F[(size_t)k * m + i] * x[k];
         x[i] = s / F[(size_t)i * m + i];
-    }
-    if (mg->nb) {
-        memcpy(L->x, x, mg->m * sizeof(double));
-        memcpy(L->xb, x + mg->m, 6 * (size_t)mg->nb * sizeof(double));
     }
 }
 
@@ -794,16 +613,11 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
         return;
     }
     mg_level *L = &mg->lv[k];
-    gauss_seidel_forward(mg, L);
+    gauss_seidel_forward(L);
     restrict_to(mg, web, k, L->t);
-    if (mg->nb) /* the bodies' residual after the forward sweep: zero (they came last) */
-        memset(mg->lv[k + 1].rb, 0, 6 * (size_t)mg->nb * sizeof(double));
     cycle(mg, web, k + 1);
     prolong_add(mg, web, k, L->x, NULL, NULL);
-    if (mg->nb)
-        for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
-            L->xb[q] += mg->lv[k + 1].xb[q];
-    gauss_seidel_backward(mg, L);
+    gauss_seidel_backward(L);
 }
 
 /* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
@@ -868,47 +682,7 @@ static void film_springs(const ws_mg *mg, const ws_web *web, const double *restr
 /* z = B r: on the film's level MG_SWEEPS Jacobi sweeps from zero, the residual restricted, the
  * coarse cycle, its correction interpolated, MG_SWEEPS sweeps more. Each sweep's product is
  * the node pass (which also finishes the sweep before) and the springs' pass. */
-/* The bodies' part of the film level's cycle: rb1 = rb - A_bf z = rb + sum over the contacts
- * of J^T C z_node (the bodies' residual after the pre-sweeps, which leave them at zero), into
- * level 1's right-hand side. */
-static void bodies_residual(const ws_mg *mg, const double *z, const double *rb, double *out)
-{
-    const ws_rigid *R = mg->rig;
-    memcpy(out, rb, 6 * (size_t)mg->nb * sizeof(double));
-    for (size_t l = 0; l < R->nl; l++) {
-        const ws_rigid_link *L = &R->link[l];
-        const double *Z = z + 3 * (size_t)L->node;
-        double g[3] = {0.0, 0.0, 0.0};
-        ws_sym_madd(L->C, Z[0], Z[1], Z[2], g);
-        const v3 gv = v3_make(g[0], g[1], g[2]), m = v3_cross(L->lever, gv);
-        double *o = out + 6 * (size_t)L->body;
-        o[0] += g[0], o[1] += g[1], o[2] += g[2];
-        o[3] += m.x, o[4] += m.y, o[5] += m.z;
-    }
-}
-
-/* fr = r - A_fb zb = r + C J zb at each contact's (unpinned) node: the film's right-hand side
- * with the bodies' correction held, for the post-sweeps. */
-static void film_less_bodies(const ws_mg *mg, const ws_web *web, const double *r,
-                             const double *zb, double *fr, int same)
-{
-    const ws_rigid *R = mg->rig;
-    if (!same) /* fr is r itself when same */
-        memcpy(fr, r, 3 * (size_t)web->n * sizeof(double));
-    for (size_t l = 0; l < R->nl; l++) {
-        const ws_rigid_link *L = &R->link[l];
-        if (web->inv_m[L->node] == 0.0)
-            continue;
-        const double *U = zb + 6 * (size_t)L->body;
-        const v3 u = v3_add(v3_make(U[0], U[1], U[2]),
-                            v3_cross(v3_make(U[3], U[4], U[5]), L->lever));
-        ws_sym_madd(L->C, u.x, u.y, u.z, fr + 3 * (size_t)L->node);
-    }
-}
-
-/* The cycle over the film (r, z) and, with bodies nested (mg->nb), the bodies (rb, zb). */
-static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, const double *rb,
-                    double *zb)
+double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
 {
     double *t = mg->lv[0].t;
     const uint32_t n = web->n;
@@ -918,72 +692,15 @@ static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, co
         (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
         film_springs(mg, web, z, t);
     }
-    const size_t nb6 = 6 * (size_t)mg->nb;
-    if (mg->nb && mg->smooth_bodies) {
-        /* the bodies after the film's sweeps: zb = A_bb^-1 (rb - A_bf z), and the film's
-         * residual with them; their own residual is then zero */
-        bodies_residual(mg, z, rb, zb);
-        ws_rigid_block_solve(mg->rig, zb, zb);
-        film_less_bodies(mg, web, t, zb, t, 1);
-        restrict_to(mg, web, 0, t);
-        memset(mg->lv[1].rb, 0, nb6 * sizeof(double));
-    } else {
-        restrict_to(mg, web, 0, t);
-        if (mg->nb)
-            bodies_residual(mg, z, rb, mg->lv[1].rb);
-        if (mg->nb)
-            memset(zb, 0, nb6 * sizeof(double));
-    }
+    restrict_to(mg, web, 0, t);
     cycle(mg, web, 1);
-    const double *fr = r;
-    if (mg->nb) {
-        for (size_t q = 0; q < nb6; q++)
-            zb[q] += mg->lv[1].xb[q];
-    }
-    if (mg->nb && mg->smooth_bodies) {
-        /* the bodies before the film's sweeps, from the film's z after the correction */
-        prolong_add(mg, web, 0, z, NULL, NULL);
-        bodies_residual(mg, z, rb, zb);
-        ws_rigid_block_solve(mg->rig, zb, zb);
-    }
-    if (mg->nb) {
-        film_less_bodies(mg, web, r, zb, mg->fr, 0);
-        fr = mg->fr;
-    }
-    if (mg->nb && mg->smooth_bodies) {
-        (void)film_nodes(mg, n, fr, t, z, JACOBI_NONE, 1);
-    } else {
-        prolong_add(mg, web, 0, z, fr, t); /* and t = fr - N z */
-    }
+    prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
     film_springs(mg, web, z, t);
     for (int s = 1; s < MG_SWEEPS; s++) {
-        (void)film_nodes(mg, n, fr, t, z, JACOBI_ADD, 1);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
         film_springs(mg, web, z, t);
     }
-    const double rz = film_nodes(mg, n, fr, t, z, JACOBI_ADD, 0);
-    if (!mg->nb)
-        return rz;
-    double s = 0.0;
-    for (size_t q = 0; q < 3 * (size_t)n; q++)
-        s += r[q] * z[q];
-    for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
-        s += rb[q] * zb[q];
-    return s;
-}
-
-double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
-{
-    const uint32_t nb = mg->nb;
-    mg->nb = 0; /* the film alone */
-    const double rz = apply(mg, web, r, z, NULL, NULL);
-    mg->nb = nb;
-    return rz;
-}
-
-double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double *z,
-                          const double *rb, double *zb)
-{
-    return apply(mg, web, r, z, rb, zb);
+    return film_nodes(mg, n, r, t, z, JACOBI_ADD, 0);
 }
 
 int ws_mg_levels(const ws_mg *mg)

@@ -45,24 +45,8 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg);
  * not positive definite (then the solve keeps block Jacobi). */
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h);
 
-/* z = B r, one V-cycle of the film alone; r and z xyz per node, zero at pinned nodes. Returns
- * r . z. */
+/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. */
 double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z);
-
-/* The bodies of the running solve nested into the hierarchy (docs/theory.md 8b): their six
- * unknowns ride along every level, coupled to its nodes by the contacts' -C J restricted with
- * the levels' products, smoothed after the nodes (before them on the way back) and solved with
- * the coarsest level. ws_mg_body_doubles: the scratch it needs for nb bodies (0 without a
- * multigrid or bodies); ws_mg_bodies: R's bodies (its links, blocks and factors, set for the
- * solve before ws_mg_setup) with that scratch, or none (R or buf NULL). */
-struct ws_rigid;
-size_t ws_mg_body_doubles(const ws_mg *mg, uint32_t nb);
-void ws_mg_bodies(ws_mg *mg, const struct ws_rigid *R, double *buf);
-
-/* z = B r and zb = B rb over the film and the nested bodies (ws_mg_bodies set): one V-cycle
- * of the coupled matrix. Returns r . z + rb . zb. */
-double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double *z,
-                          const double *rb, double *zb);
 
 /* The number of levels (the film's own one included), for the counts. */
 int ws_mg_levels(const ws_mg *mg);

@@ -6,13 +6,11 @@
  * state at t as for the explicit film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
 #include "web/coupled.h"
-#include "web/multigrid.h"
 #include "world/world_internal.h"
 
 #include <float.h>
 #include <stdio.h>
 #include <string.h>
-#include <stdlib.h>
 
 /* Solves a sub-step at most, as its contacts come in and go (the active set). */
 #define WS_IMPLICIT_PASSES 6
@@ -27,8 +25,7 @@ static const char *label(const ws_web *web)
  * scratch (with the coarse space's, for a web of `nodes` nodes) from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
  * with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
-                            size_t nl, uint32_t nodes, const ws_mg *mg, uint32_t **slot_out,
-                            int *fail)
+                            size_t nl, uint32_t nodes, uint32_t **slot_out, int *fail)
 {
     *fail = 1;
     uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
@@ -69,12 +66,6 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->coarse = R->cq + v6;
     R->fa = R->coarse + v6 * v6;
     R->fb = R->fa + m;
-    const size_t mgd = getenv("WS_NEST") ? ws_mg_body_doubles(mg, nb) : 0;
-    if (mgd && !(R->mgbuf = ws_arena_alloc(arena, mgd * sizeof(double)))) {
-        *fail = 1;
-        return NULL;
-    }
-    R->nest_phi = getenv("WS_NEST") ? atoi(getenv("WS_NEST")) - 1 : 0;
     for (size_t i = 0; i < b->slots; i++) {
         const uint32_t j = slot[i];
         if (j == UINT32_MAX)
@@ -205,7 +196,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
                           ? NULL
-                          : rigid_make(S->arena, b, links, nl, web->n, im->mg, &slot, &nomem);
+                          : rigid_make(S->arena, b, links, nl, web->n, &slot, &nomem);
         if (nomem)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
