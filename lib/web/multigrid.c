@@ -5,8 +5,6 @@
 #include "web/implicit.h"
 
 #include <string.h>
-#include <stdlib.h>
-#include <stdio.h>
 
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
 #define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
@@ -68,8 +66,6 @@ struct ws_mg {
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
-    double *wop;  /* EXPERIMENT: film level's interpolation weights by node (4 a node) */
-    int opdep;
 };
 
 /* Interpolation from a coarse level to the finer one, along one direction: fine index i of n
@@ -199,63 +195,7 @@ static void film_pmap(const ws_mg *mg, const ws_web *web, uint32_t i, pmap *p)
         p->n = 0;
         return;
     }
-    const int ix = (int)(i % (uint32_t)f->nx), iy = (int)(i / (uint32_t)f->nx);
-    pmap_of(f, &mg->lv[1], ix, iy, p);
-    if (!mg->opdep)
-        return;
-    const map1d *mx = &f->mx[ix], *my = &f->my[iy];
-    const double *W = mg->wop + 4 * (size_t)i;
-    int k = 0;
-    for (int b = 0; b < my->n; b++)
-        for (int a = 0; a < mx->n; a++, k++)
-            p->w[k] = (mx->n == 2 ? W[a] : 1.0) * (my->n == 2 ? W[2 + b] : 1.0);
-}
-
-/* EXPERIMENT: weights from the springs' stiffness a + 3 b toward each side. */
-static void op_weights(ws_mg *mg, const ws_web *web)
-{
-    const ws_implicit *im = web->imp;
-    const uint32_t n = web->n, nx = (uint32_t)web->nx;
-    double *W = mg->wop; /* first the four sides' stiffness: left right down up */
-    memset(W, 0, 4 * (size_t)n * sizeof(double));
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const uint32_t a = web->sa[s], b = web->sb[s];
-        int dx = (int)(b % nx) - (int)(a % nx);
-        const int dy = (int)(b / nx) - (int)(a / nx);
-        if (web->closed && (dx == (int)nx - 1 || dx == 1 - (int)nx))
-            dx = dx > 0 ? -1 : 1;
-        const double k = im->sp[s].a + 3.0 * im->sp[s].b;
-        if (dy == 0 && dx != 0) {
-            const uint32_t l = dx > 0 ? a : b, r = dx > 0 ? b : a; /* l left of r */
-            W[4 * (size_t)l + 1] += k;
-            W[4 * (size_t)r + 0] += k;
-        } else if (dx == 0 && dy != 0) {
-            const uint32_t d = dy > 0 ? a : b, u = dy > 0 ? b : a;
-            W[4 * (size_t)d + 3] += k;
-            W[4 * (size_t)u + 2] += k;
-        }
-    }
-    if (getenv("WS_STATS")) {
-        double sum[3] = {0, 0, 0}, sa[3] = {0, 0, 0}, sb[3] = {0, 0, 0}; size_t cnt[3] = {0, 0, 0}, slack[3] = {0, 0, 0};
-        for (uint32_t s2 = 0; s2 < web->ns; s2++) {
-            const uint32_t a = web->sa[s2], b = web->sb[s2];
-            int dx = (int)(b % nx) - (int)(a % nx);
-            const int dy = (int)(b / nx) - (int)(a / nx);
-            if (web->closed && (dx == (int)nx - 1 || dx == 1 - (int)nx)) dx = dx > 0 ? -1 : 1;
-            const int d = dy == 0 ? 0 : dx == 0 ? 1 : 2;
-            sum[d] += im->sp[s2].a + 3 * im->sp[s2].b; sa[d] += im->sp[s2].a; sb[d] += im->sp[s2].b; cnt[d]++;
-            slack[d] += im->sp[s2].kb == 0.0;
-        }
-        for (int d = 0; d < 3; d++)
-            fprintf(stderr, "STATS dir %d: n %zu mean a %.3g mean b %.3g slack %.3f\n", d, cnt[d], sa[d] / cnt[d], sb[d] / cnt[d], (double)slack[d] / cnt[d]);
-    }
-    for (uint32_t i = 0; i < n; i++) {
-        double *w = W + 4 * (size_t)i;
-        const double sx = w[0] + w[1], sy = w[2] + w[3];
-        const double l = w[0], r = w[1], d = w[2], u = w[3];
-        w[0] = sx > 0.0 ? l / sx : 0.5, w[1] = sx > 0.0 ? r / sx : 0.5;
-        w[2] = sy > 0.0 ? d / sy : 0.5, w[3] = sy > 0.0 ? u / sy : 0.5;
-    }
+    pmap_of(f, &mg->lv[1], (int)(i % (uint32_t)f->nx), (int)(i / (uint32_t)f->nx), p);
 }
 
 /* d = p - q as one list (a spring's E P from its ends' rows), zero weights dropped. */
@@ -464,8 +404,6 @@ static int factor_coarsest(ws_mg *mg)
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
-        if (mg->opdep)
-            op_weights(mg, web);
         galerkin_springs(mg, web, h);
         mg->springs_kept = 1;
         mg->kept_begun = begun;
@@ -576,18 +514,6 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
     const mg_level *c = &mg->lv[k + 1];
     double *u = mg->row;
     memset(c->r, 0, 3 * (size_t)c->n * sizeof(double));
-    if (k == 0 && mg->opdep) {
-        pmap p;
-        for (uint32_t i = 0; i < web->n; i++) {
-            film_pmap(mg, web, i, &p);
-            const double *T = t + 3 * (size_t)i;
-            for (int a = 0; a < p.n; a++) {
-                double *R = c->r + 3 * (size_t)p.idx[a];
-                R[0] += p.w[a] * T[0], R[1] += p.w[a] * T[1], R[2] += p.w[a] * T[2];
-            }
-        }
-        return;
-    }
     for (int iy = 0; iy < f->ny; iy++) {
         memset(u, 0, 3 * (size_t)c->nx * sizeof(double));
         for (int ix = 0; ix < f->nx; ix++) {
@@ -623,24 +549,6 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
     double *u = mg->row;
-    if (k == 0 && mg->opdep) {
-        pmap p;
-        for (uint32_t i = 0; i < web->n; i++) {
-            film_pmap(mg, web, i, &p);
-            double *X = x + 3 * (size_t)i;
-            for (int a = 0; a < p.n; a++) {
-                const double *C = c->x + 3 * (size_t)p.idx[a];
-                X[0] += p.w[a] * C[0], X[1] += p.w[a] * C[1], X[2] += p.w[a] * C[2];
-            }
-            if (r) {
-                const double *R = r + 3 * (size_t)i;
-                double *T = t + 3 * (size_t)i;
-                T[0] = R[0], T[1] = R[1], T[2] = R[2];
-                fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
-            }
-        }
-        return;
-    }
     for (int iy = 0; iy < f->ny; iy++) {
         const map1d *my = &f->my[iy];
         const double *C0 = c->x + 3 * (size_t)c->nx * (size_t)my->c[0];
@@ -864,7 +772,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         return 0;
     const int k = nlev - 1;
     const uint32_t m = 3 * lv[k].n;
-    size_t doubles = 7 * (size_t)web->n + (size_t)m * m + 2 * STEN * (size_t)lv[1].n +
+    size_t doubles = 3 * (size_t)web->n + (size_t)m * m + 2 * STEN * (size_t)lv[1].n +
                      3 * (size_t)lv[1].nx,
            floats = 0;
     for (int i = 1; i < nlev; i++) {
@@ -917,8 +825,6 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     mg->acc = q, q += STEN * (size_t)lv[1].n;
     mg->sacc = q, q += STEN * (size_t)lv[1].n;
     mg->row = q, q += 3 * (size_t)lv[1].nx;
-    mg->wop = q, q += 4 * (size_t)web->n;
-    mg->opdep = getenv("WS_OPDEP") != NULL;
     for (int i = 1; i < nlev; i++) {
         mg_level *L = &mg->lv[i];
         L->a = fq, fq += STEN * (size_t)L->n;
