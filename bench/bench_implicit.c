@@ -14,7 +14,8 @@
  * tolerance, with that ws_web_preconditioner: 1 block Jacobi, 2 multigrid, 0 AUTO), rigid (the
  * unwrapped stack, no film, at dt 0.25 to 2.4 ms: the rigid contacts' own share of the limit),
  * crossing (drums of the real film from 10 x 10 to 96 x 96 nodes, block Jacobi and multigrid
- * in turn: CPU time a step and CG iterations, where the multigrid starts to pay),
+ * in turn: CPU time a step and CG iterations, where the multigrid starts to pay; `crossing 0 1`
+ * with a 1 kg box on each drum's middle, in the film's solve),
  * solve (`solve [duration] [dt ms] [preconditioner] [tolerance]`: one implicit run of case R),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
@@ -88,7 +89,40 @@ static void settle_motion(double dt, double *kmax, double *rise, char *why, size
  * 20 % as the reference band, its laws (2000 N/m a spring, 1 % in compression) and areal
  * density, sagging under gravity at dt 0.25 ms from flat: after 40 steps untimed, CPU seconds
  * a step and CG iterations a step over 200 more, with preconditioner pre. */
-static ws_status drum_run(int n, int pre, double *cpu_per_step, double *iterations)
+/* A box resting on the drum's middle (half its side each way, 1 kg, in the film's solve):
+ * the crossing with a body in the solve. */
+static ws_status drum_box(ws_world *w, int n, ws_web_def *wd)
+{
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film_mat, box_mat;
+    ws_status s;
+    if ((s = ws_material_create(w, &md, &film_mat)) != WS_OK ||
+        (s = ws_material_create(w, &md, &box_mat)) != WS_OK)
+        return s;
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    if ((s = ws_world_set_contact(w, film_mat, box_mat, &cd)) != WS_OK)
+        return s;
+    const double a = 0.005 * n; /* the box's side: half the drum's */
+    ws_shape_id cube;
+    if ((s = ws_shape_create_box(w, a, a, a, &cube)) != WS_OK)
+        return s;
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = cube;
+    bd.mass = 1.0;
+    bd.material = box_mat;
+    bd.position = (ws_vec3){0.0, 0.0, a / 2 + 1.9e-3}; /* its layer just on the film's */
+    ws_body_id body;
+    wd->material = film_mat;
+    return ws_body_create(w, &bd, &body);
+}
+
+static ws_status drum_run(int n, int pre, int box, double *cpu_per_step, double *iterations)
 {
     ws_world_def d;
     ws_world_def_init(&d);
@@ -109,9 +143,14 @@ static ws_status drum_run(int n, int pre, double *cpu_per_step, double *iteratio
     wd.areal_density = 0.018;
     wd.integrator = WS_WEB_IMPLICIT;
     wd.preconditioner = pre;
+    if (box && (s = drum_box(w, n, &wd)) != WS_OK) {
+        ws_world_destroy(w);
+        return s;
+    }
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
     sd.nx = sd.ny = n;
+    sd.origin = (ws_vec3){-0.005 * (n - 1), -0.005 * (n - 1), 0.0}; /* centred */
     sd.spacing_x = sd.spacing_y = 0.01;
     sd.prestretch_x = 0.4;
     sd.prestretch_y = 0.2;
@@ -301,15 +340,18 @@ int main(int argc, char **argv)
             if (r == 1)
                 base = el / T;
             printf("  refine %d (%u nodes): %.1f s CPU (%.1f s wall) per simulated s (%.2f x "
-                   "unrefined), CG %.1f it/step; line load %.2f N/m, contact force %.2f N\n",
+                   "unrefined), CG %.1f it/step (%.2f solves/step); line load %.2f N/m, contact force "
+                   "%.2f N\n",
                    r, info.node_count, el / T, wall / T, el / T / base,
                    (double)(ss.iterations - s0.iterations) / steps,
+                   (double)(ss.solves - s0.solves) / steps,
                    band.line_load, band.contact_force);
             fflush(stdout);
             ws_world_destroy(sc.world);
         }
     } else if (!strcmp(what, "crossing")) {
         const int sides[] = {10, 12, 16, 24, 32, 40, 48, 64, 96};
+        const int box = argc > 3 ? atoi(argv[3]) : 0; /* a box on the drum, in its solve */
         for (size_t k = 0; k < sizeof sides / sizeof sides[0]; k++) {
             double cpu[2], its[2];
             for (int round = 0; round < 3; round++) /* interleaved; the least of 3 kept */
@@ -317,7 +359,7 @@ int main(int argc, char **argv)
                     double c, it;
                     if (drum_run(sides[k], m ? WS_WEB_PRECONDITIONER_MULTIGRID
                                              : WS_WEB_PRECONDITIONER_BLOCK_JACOBI,
-                                 &c, &it) != WS_OK) {
+                                 box, &c, &it) != WS_OK) {
                         printf("  drum %d: failed\n", sides[k]);
                         return 1;
                     }
