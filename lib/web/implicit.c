@@ -507,46 +507,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         double *skc = malloc(2 * SYMS(n) * sizeof(double));
         ws_ispring *ssp = malloc((web->ns ? web->ns : 1) * sizeof(ws_ispring));
         memcpy(ssp, im->sp, web->ns * sizeof(ws_ispring));
-        if (getenv("WS_MAP") && im->begun % 20 == 0) { /* where the springs' stiffness spreads */
-            const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny;
-            for (int d = 0; d < 2; d++) {
-                for (int w2 = 0; w2 < 2; w2++) {
-                    double *v = malloc(web->ns * sizeof(double)); size_t c = 0;
-                    for (uint32_t s = 0; s < web->ns; s++) {
-                        const int dd = web->sa[s] / nx == web->sb[s] / nx ? 0 : 1;
-                        if (dd == d) v[c++] = w2 ? im->sp[s].kb : im->sp[s].ka;
-                    }
-                    for (size_t i2 = 1; i2 < c; i2++) { double t2 = v[i2]; size_t j2 = i2; while (j2 > 0 && v[j2-1] > t2) { v[j2] = v[j2-1]; j2--; } v[j2] = t2; }
-                    const double med = v[c / 2];
-                    fprintf(stderr, "MAP step %llu dir %s %s n %zu min %.3g q05 %.3g q25 %.3g med %.3g q75 %.3g q95 %.3g max %.3g\n",
-                            (unsigned long long)im->begun, d ? "up" : "around", w2 ? "kb" : "ka", c, v[0]/med, v[c/20]/med, v[c/4]/med, med, v[3*c/4]/med, v[19*c/20]/med, v[c-1]/med);
-                    /* the far springs (ratio > 3 or < 1/3) by place: band edge rows, contact nodes, other */
-                    size_t cls[3][2] = {{0}};
-                    long prof[16] = {0}; double profs[16] = {0}; long yprof[16] = {0}; double yprofs[16] = {0};
-                    for (uint32_t s = 0; s < web->ns; s++) {
-                        const int dd = web->sa[s] / nx == web->sb[s] / nx ? 0 : 1;
-                        if (dd != d) continue;
-                        const double k2 = w2 ? im->sp[s].kb : im->sp[s].ka, rat = k2 / med;
-                        const uint32_t ia = web->sa[s], ib = web->sb[s];
-                        const uint32_t ya = ia / nx, yb = ib / nx;
-                        const double *ka2 = im->kc + 6 * (size_t)ia, *kb2 = im->kc + 6 * (size_t)ib;
-                        const int cont = ka2[0] + ka2[1] + ka2[2] > 0 || kb2[0] + kb2[1] + kb2[2] > 0;
-                        const int edge = ya < 2 || yb < 2 || ya + 3 > ny || yb + 3 > ny;
-                        const int cl = edge ? 0 : cont ? 1 : 2;
-                        cls[cl][rat > 3 || rat < 1.0 / 3] ++;
-                        if (!edge) { prof[16 * (ia % nx) / nx]++; profs[16 * (ia % nx) / nx] += rat; }
-                        yprof[16 * ya / ny]++; yprofs[16 * ya / ny] += rat;
-                    }
-                    fprintf(stderr, "MAP  far/all: edge %zu/%zu contact %zu/%zu other %zu/%zu\n  x-profile (mean ratio):",
-                            cls[0][1], cls[0][0] + cls[0][1], cls[1][1], cls[1][0] + cls[1][1], cls[2][1], cls[2][0] + cls[2][1]);
-                    for (int b2 = 0; b2 < 16; b2++) fprintf(stderr, " %.2f", prof[b2] ? profs[b2] / prof[b2] : 0);
-                    fprintf(stderr, "\n  y-profile:");
-                    for (int b2 = 0; b2 < 16; b2++) fprintf(stderr, " %.2f", yprof[b2] ? yprofs[b2] / yprof[b2] : 0);
-                    fprintf(stderr, "\n");
-                    free(v);
-                }
-            }
-        }
         for (int mode = 0; mode < 5; mode++) {
             if (mode == 4) { /* each direction's springs their direction's mean */
                 memcpy(im->sp, ssp, web->ns * sizeof(ws_ispring));

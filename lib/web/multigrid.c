@@ -5,7 +5,6 @@
 #include "web/implicit.h"
 
 #include <string.h>
-#include <stdlib.h>
 
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
 #define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
@@ -14,7 +13,7 @@
  * (A = N + sum over springs of E^T K E with E = e_a - e_b, and 2 D - A = N + sum (e_a + e_b)^T
  * K (e_a + e_b) >= 0), so any weight below 1 contracts in A's norm and the cycle stays positive
  * definite; 2/3 is the weight that damps the grid's upper half of frequencies best. */
-#define MG_SWEEPS (getenv("WS_SW") ? atoi(getenv("WS_SW")) : 2)
+#define MG_SWEEPS 2
 #define MG_OMEGA (2.0 / 3.0)
 /* A coarse node's row holds its own block and those of its forward neighbours (slots 4 to 8 of
  * the 9 with dx, dy in -1..1, slot 3 (dy + 1) + dx + 1); a backward neighbour's block is that
@@ -740,11 +739,6 @@ static int plan_levels(const ws_web *web, mg_level *lv)
         mg_level *L = &lv[k];
         L->cx = L->closed ? L->nx >= 5 : L->nx >= 3;
         L->cy = L->ny >= 3;
-        {
-            const char *e = getenv("WS_SEMI");
-            if (e && k < atoi(e) && L->cx)
-                L->cy = 0;
-        }
         if (!L->cx && !L->cy)
             break;
         const int nx = L->cx ? (L->nx + 1) / 2 : L->nx, ny = L->cy ? (L->ny + 1) / 2 : L->ny;
