@@ -7,8 +7,6 @@
 
 #include <float.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 /* Doubles of each per-node array: xyz vectors and symmetric blocks. */
 #define VEC(n) (3 * (size_t)(n))
@@ -498,94 +496,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
             p[j] = z[j] + beta * p[j];
         if (R)
             ws_rigid_direction(R, beta);
-    }
-    if (getenv("WS_AUX") && mg && R) { /* same state: coupled from zero, film alone from zero */
-        double *sx = malloc(m * sizeof(double)), *sxr = malloc(6 * R->nb * sizeof(double));
-        memcpy(sx, x, m * sizeof(double));
-        memcpy(sxr, R->x, 6 * R->nb * sizeof(double));
-        int its[5], bad[5];
-        double *skc = malloc(2 * SYMS(n) * sizeof(double));
-        ws_ispring *ssp = malloc((web->ns ? web->ns : 1) * sizeof(ws_ispring));
-        memcpy(ssp, im->sp, web->ns * sizeof(ws_ispring));
-        for (int mode = 0; mode < 5; mode++) {
-            if (mode == 4) { /* each direction's springs their direction's mean */
-                memcpy(im->sp, ssp, web->ns * sizeof(ws_ispring));
-                double sa[2] = {0, 0}, sb[2] = {0, 0}, sc[2] = {0, 0}; size_t cnt[2] = {0, 0};
-                const uint32_t nx = (uint32_t)web->nx;
-                for (int pass = 0; pass < 2; pass++)
-                    for (uint32_t q2 = 0; q2 < web->ns; q2++) {
-                        const int d = web->sa[q2] / nx == web->sb[q2] / nx ? 0 : 1;
-                        ws_ispring *sp2 = &im->sp[q2];
-                        if (pass == 0 && sp2->kb > 0) { sa[d] += sp2->ka; sb[d] += sp2->kb; sc[d] += sp2->cs; cnt[d]++; }
-                        if (pass == 1 && (sp2->ex != 0 || sp2->ey != 0 || sp2->ez != 0) && cnt[d]) {
-                            sp2->ka = sa[d] / cnt[d]; sp2->kb = sb[d] / cnt[d]; sp2->cs = sc[d] / cnt[d]; }
-                    }
-                (void)preconditioner(web, h);
-                operator_for(web, h);
-                im->begun++;
-                (void)ws_mg_setup(mg, web, im->begun, h);
-                im->begun--; /* one step up in all from mode 3's */
-            }
-            if (mode == 3) { /* a uniform film: every spring the mean of the pulling ones */
-                double sa = 0, sb = 0, sc = 0; size_t cnt = 0;
-                for (uint32_t q2 = 0; q2 < web->ns; q2++)
-                    if (im->sp[q2].kb > 0) { sa += im->sp[q2].ka; sb += im->sp[q2].kb; sc += im->sp[q2].cs; cnt++; }
-                for (uint32_t q2 = 0; q2 < web->ns; q2++)
-                    if (im->sp[q2].ex != 0 || im->sp[q2].ey != 0 || im->sp[q2].ez != 0) {
-                        im->sp[q2].ka = sa / cnt; im->sp[q2].kb = sb / cnt; im->sp[q2].cs = sc / cnt; }
-                (void)preconditioner(web, h);
-                operator_for(web, h);
-                im->begun++;
-                (void)ws_mg_setup(mg, web, im->begun, h);
-            }
-            ws_rigid *RR = mode ? NULL : R;
-            if (mode == 2) { /* the film without its contacts: A_ff's springs and masses */
-                memcpy(skc, im->kc, SYMS(n) * sizeof(double));
-                memcpy(skc + SYMS(n), im->dc, SYMS(n) * sizeof(double));
-                memset(im->kc, 0, SYMS(n) * sizeof(double));
-                memset(im->dc, 0, SYMS(n) * sizeof(double));
-                (void)preconditioner(web, h);
-                operator_for(web, h);
-                (void)ws_mg_setup(mg, web, im->begun, h);
-            }
-            memset(x, 0, m * sizeof(double));
-            memcpy(r, b, m * sizeof(double));
-            double rr2 = dot(r, r, m), rz2;
-            if (RR) { memset(R->x, 0, 6 * R->nb * sizeof(double)); memcpy(R->r, R->b, 6 * R->nb * sizeof(double)); rr2 += ws_rigid_dot(R, R->r, R->r); }
-            rz2 = mg ? ws_mg_apply(mg, web, r, z) : 0.0;
-            if (RR) rz2 += ws_rigid_precondition(R, r, z, R->r, R->z);
-            memcpy(p, z, m * sizeof(double));
-            if (RR) memcpy(R->p, R->z, 6 * R->nb * sizeof(double));
-            int k = 0; bad[mode] = 0;
-            while (!(sqrt(rr2) <= goal) && k < 500) {
-                const double pq = ws_implicit_apply_op(web, p, q) + (RR ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
-                if (!(pq > 0.0)) { bad[mode] = 1; break; }
-                const double al = rz2 / pq;
-                rr2 = RR ? ws_rigid_step(R, al) : 0.0;
-                for (size_t j = 0; j < m; j++) { x[j] += al * p[j]; r[j] -= al * q[j]; rr2 += r[j] * r[j]; }
-                k++;
-                double rz3 = ws_mg_apply(mg, web, r, z);
-                if (RR) rz3 += ws_rigid_precondition(R, r, z, R->r, R->z);
-                const double be = rz3 / rz2; rz2 = rz3;
-                for (size_t j = 0; j < m; j++) p[j] = z[j] + be * p[j];
-                if (RR) ws_rigid_direction(R, be);
-            }
-            its[mode] = k;
-        }
-        memcpy(im->sp, ssp, web->ns * sizeof(ws_ispring));
-        im->begun--;
-        free(ssp);
-        memcpy(im->kc, skc, SYMS(n) * sizeof(double));
-        memcpy(im->dc, skc + SYMS(n), SYMS(n) * sizeof(double));
-        (void)preconditioner(web, h);
-        operator_for(web, h);
-        (void)ws_mg_setup(mg, web, im->begun, h);
-        free(skc);
-        fprintf(stderr, "AUX %d %d %d %d %d %d %d %d\n", it, its[0], its[1], its[2], its[3], its[4], bad[2], bad[3]);
-        memcpy(x, sx, m * sizeof(double));
-        memcpy(R->x, sxr, 6 * R->nb * sizeof(double));
-        free(sx);
-        free(sxr);
     }
     im->iterations += (uint64_t)it;
     im->last_iterations = it;
