@@ -15,6 +15,11 @@
  * definite; 2/3 is the weight that damps the grid's upper half of frequencies best. */
 #define MG_SWEEPS 2
 #define MG_OMEGA (2.0 / 3.0)
+/* A band's film level halves around only (plan_levels says why) and then takes one sweep
+ * before and one after: the coarse level it hands on, twice as fine, does what the second
+ * sweep was for (bench/NOTES.md, session 13: 19.6 iterations a step at one sweep on the
+ * unrefined band, 18.1 at two, for 10 % less time an iteration). */
+#define MG_SWEEPS_SEMI 1
 /* A coarse node's row holds its own block and those of its forward neighbours (slots 4 to 8 of
  * the 9 with dx, dy in -1..1, slot 3 (dy + 1) + dx + 1); a backward neighbour's block is that
  * neighbour's forward one (every block is symmetric: P is a scalar weight times the 3x3
@@ -47,6 +52,7 @@ typedef struct mg_level {
 
 struct ws_mg {
     int nlev;
+    int sweeps;   /* the film level's sweeps before and after: MG_SWEEPS, or MG_SWEEPS_SEMI */
     mg_level lv[MG_LEVELS];
     uint32_t m;   /* unknowns of the coarsest level */
     double *chol; /* its Cholesky factor, lower, m x m */
@@ -679,8 +685,8 @@ static void film_springs(const ws_mg *mg, const ws_web *web, const double *restr
     }
 }
 
-/* z = B r: on the film's level MG_SWEEPS Jacobi sweeps from zero, the residual restricted, the
- * coarse cycle, its correction interpolated, MG_SWEEPS sweeps more. Each sweep's product is
+/* z = B r: on the film's level mg->sweeps Jacobi sweeps from zero, the residual restricted,
+ * the coarse cycle, its correction interpolated, mg->sweeps sweeps more. Each sweep's product is
  * the node pass (which also finishes the sweep before) and the springs' pass. */
 double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
 {
@@ -688,7 +694,7 @@ double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
     const uint32_t n = web->n;
     (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1);
     film_springs(mg, web, z, t);
-    for (int s = 1; s < MG_SWEEPS; s++) { /* after it, t = r - A z */
+    for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
         (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
         film_springs(mg, web, z, t);
     }
@@ -696,7 +702,7 @@ double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
     cycle(mg, web, 1);
     prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
     film_springs(mg, web, z, t);
-    for (int s = 1; s < MG_SWEEPS; s++) {
+    for (int s = 1; s < mg->sweeps; s++) {
         (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
         film_springs(mg, web, z, t);
     }
@@ -738,7 +744,17 @@ static int plan_levels(const ws_web *web, mg_level *lv)
     while (k + 1 < MG_LEVELS && lv[k].n > MG_COARSEST) {
         mg_level *L = &lv[k];
         L->cx = L->closed ? L->nx >= 5 : L->nx >= 3;
-        L->cy = L->ny >= 3;
+        /* A band's film level halves around only. Its up springs' tension falls toward
+         * nothing at the band's free edges (their transverse stiffness in the edge rows a
+         * quarter of its median, 5 % at the least; the around springs' and every axial one
+         * within 15 % of their median everywhere), so near the edges a node is held around
+         * far more strongly than up (out of the film's plane and along it), and a point smoother
+         * leaves the error that is smooth around and rough up: only a level that keeps every
+         * row can take it. Halving both there made the iterations grow with refinement (the
+         * rows of weak coupling grow in number); halving around once makes the next level's
+         * around couplings 4x weaker against its up ones, about even, and the levels after
+         * halve both (bench/NOTES.md, session 13). */
+        L->cy = L->ny >= 3 && !(k == 0 && L->closed && L->cx);
         if (!L->cx && !L->cy)
             break;
         const int nx = L->cx ? (L->nx + 1) / 2 : L->nx, ny = L->cy ? (L->ny + 1) / 2 : L->ny;
@@ -809,6 +825,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
             lv[i].my[y].n = map1(y, lv[i].ny, 0, lv[i].cy, lv[i].my[y].c, lv[i].my[y].w);
     }
     mg->nlev = nlev;
+    mg->sweeps = lv[0].cy ? MG_SWEEPS : MG_SWEEPS_SEMI;
     mg->m = m;
     mg->blk = blk;
     mg->doubles = doubles;

@@ -1,7 +1,7 @@
 /* A geometric multigrid preconditioner for the implicit film's solve on grid webs (web module,
  * used by web/implicit.c; docs/theory.md, "The implicit film", says why). The film's grid
  * (node i + nx j, closed around when it is a band) is coarsened by two in each direction, level
- * after level, to at most 16 nodes; each coarser matrix is the Galerkin product P^T A P of the
+ * after level (a band's film level around only), to at most 16 nodes; each coarser matrix is the Galerkin product P^T A P of the
  * finer one with bilinear interpolation P, so it stays symmetric positive definite and needs no
  * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
  * matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
