@@ -227,7 +227,7 @@ int main(int argc, char **argv)
     } else if (!strcmp(what, "solve")) {
         /* `solve [duration] [dt ms] [preconditioner] [tolerance]`: the implicit film at one
          * dt with one ws_web_preconditioner (0 AUTO, 1 block Jacobi, 2 multigrid) and solve
-         * tolerance (0: the default 1e-6): whether the answers are the solve's and not its
+         * tolerance (0: the default): whether the answers are the solve's and not its
          * preconditioner's, which a tighter tolerance must leave where they are. */
         tilt_options a = o;
         a.film_mass = 1.6e-6;
@@ -236,9 +236,12 @@ int main(int argc, char **argv)
         a.dt = 1e-3 * (argc > 3 ? atof(argv[3]) : 1.0);
         a.preconditioner = argc > 4 ? atoi(argv[4]) : 0;
         a.solver_tolerance = argc > 5 ? atof(argv[5]) : 0.0;
+        ws_web_def dw;
+        ws_web_def_init(&dw);
         char name[96];
         snprintf(name, sizeof name, "implicit, dt %.2f ms, preconditioner %d, tolerance %g",
-                 1e3 * a.dt, a.preconditioner, a.solver_tolerance > 0 ? a.solver_tolerance : 1e-6);
+                 1e3 * a.dt, a.preconditioner,
+                 a.solver_tolerance > 0 ? a.solver_tolerance : dw.solver_tolerance);
         line(name, &a);
     } else if (!strcmp(what, "dt1sub")) {
         /* What limits dt 1 ms: the world (bodies and their contacts) at 1 ms with the film at
@@ -300,7 +303,7 @@ int main(int argc, char **argv)
          * film, N), which refinement must leave alone. */
         const double T = duration > 0 ? duration : 0.05;
         const int only = argc > 3 ? atoi(argv[3]) : 0; /* one refinement alone */
-        const double tol = argc > 4 ? atof(argv[4]) : 0.0; /* the solve's tolerance; 0: 1e-6 */
+        const double tol = argc > 4 ? atof(argv[4]) : 0.0; /* the solve's tolerance; 0: the default */
         const int pre = argc > 5 ? atoi(argv[5]) : 0; /* ws_web_preconditioner; 0: AUTO */
         double base = 0;
         for (int r = 1; r <= 4; r *= 2) {

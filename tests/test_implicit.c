@@ -1797,6 +1797,133 @@ START_TEST(test_film_body_momentum)
 }
 END_TEST
 
+/* A drum of the real film (31 x 31 nodes 1 cm apart, 0.018 kg/m^2: 1.8 mg a node, pre-stretched
+ * 40 % and 20 %, its edge pinned, the film's law of bench_implicit's drums) over a box whose
+ * top face starts 0.5 mm under it, inside the nodes' 1 mm contact layer, and rises 5 mm into it
+ * at 2 Hz (a kinematic drive), at dt 1 ms, block Jacobi, the solve's tolerance tol and its
+ * stopping test (relative: the earlier one). The film tents over the box's edges as a wrap
+ * over a load's corners, its pressed nodes held between the pretension and the contacts'
+ * forces, 1e4 of their weight. After `steps` steps: the last solve's residual recomputed from
+ * its matrix, b - A dv (not the CG's running residual), each row's over its own weight impulse
+ * m g h: the largest over the nodes without contacts (worst[0]) and with (worst[1]). */
+static void pressed_drum(double tol, int relative, int steps, double worst[2])
+{
+    const double dt = 1e-3;
+    ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &cube));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film_mat, box_mat;
+    ck_ok(w, ws_material_create(w, &md, &film_mat));
+    ck_ok(w, ws_material_create(w, &md, &box_mat));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.type = WS_BODY_KINEMATIC;
+    bd.shape = cube;
+    bd.material = box_mat;
+    bd.position = v3_make(0.0, 0.0, -0.05 - 0.5e-3);
+    ws_body_id box;
+    ck_ok(w, ws_body_create(w, &bd, &box));
+    ws_drive_def dd; /* the box rises into the film: 5 mm at 2 Hz */
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_SINE;
+    dd.direction = v3_make(0.0, 0.0, 1.0);
+    dd.amplitude = 5e-3;
+    dd.frequency = 2.0;
+    dd.ramp_time = 0.0;
+    ck_ok(w, ws_body_set_drive(w, box, &dd));
+    ws_law_id law = make_law(w, WS_LAW_TENSION_COMPRESSION, 2000.0 * 0.01 / 1.4,
+                             0.01 * 2000.0 * 0.01 / 1.4, 0.1 * 0.01 / 1.4, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.areal_density = 0.018;
+    wd.law = wd.law_shear = law;
+    wd.material = film_mat;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = tol;
+    wd.solver_max_iterations = 20000;
+    wd.preconditioner = WS_WEB_PRECONDITIONER_BLOCK_JACOBI;
+    enum { N = 31 };
+    uint32_t pins[4 * N];
+    size_t np = 0;
+    for (uint32_t j = 0; j < N; j++)
+        for (uint32_t i = 0; i < N; i++)
+            if (i == 0 || j == 0 || i == N - 1 || j == N - 1)
+                pins[np++] = i + N * j;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = N;
+    sd.origin = v3_make(-0.15, -0.15, 0.0);
+    sd.spacing_x = sd.spacing_y = 0.01;
+    sd.prestretch_x = 0.4;
+    sd.prestretch_y = 0.2;
+    sd.shear = 1;
+    sd.pinned = pins;
+    sd.pinned_count = np;
+    ws_web_id id;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &id));
+    ws_web *web = web_of(w, id);
+    ck_assert_int_eq(ws_implicit_reserve(&w->mem, web), 0);
+    web->imp->stop_relative = relative;
+    ck_ok(w, ws_world_step_n(w, steps));
+    const ws_implicit *im = web->imp;
+    double *y = malloc(3 * (size_t)web->n * sizeof *y);
+    ck_assert(y);
+    ws_implicit_apply(web, dt, im->dv, y);
+    worst[0] = worst[1] = 0.0;
+    for (uint32_t i = 0; i < web->n; i++) {
+        int pressed = 0;
+        for (int k = 0; k < WS_SYM; k++)
+            pressed |= im->kc[WS_SYM * (size_t)i + k] != 0.0;
+        double s = 0.0;
+        for (int k = 0; k < 3; k++) {
+            const double r = im->b[3 * i + k] - y[3 * i + k];
+            s += r * r;
+        }
+        worst[pressed] = fmax(worst[pressed], sqrt(s) * web->inv_m[i] / (G0 * dt));
+    }
+    free(y);
+    ws_world_destroy(w);
+}
+
+START_TEST(test_stop_on_rows)
+{
+    /* The solve stops when every row's residual is at most tol m g h, its own weight impulse
+     * over the step, tol the default 1e-3: recomputed from the matrix, no row, a light
+     * pressed node's as a free one's, is left above it. The bound is 1.5 tol, not tol: the
+     * CG's running residual, which the solve reads, drifts from b - A dv by round-off, eps
+     * times the rows' forces times the iterations (the pressed nodes' 1e4 of their weight,
+     * a few hundred iterations: under 1e-9 of it), and 0.5 tol leaves room for that. The
+     * earlier test, the residual's norm at most 1e-6 of the right-hand side's, whose norm is
+     * the pretension's and contacts' forces (2e4 of the film's weight impulse here), leaves
+     * the pressed rows at some 50 times the new bound: asserted above 10 times, so that the
+     * case goes on telling the two tests apart. */
+    double rows[2], old[2];
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    const double tol = wd.solver_tolerance;
+    ck_assert(tol == 1e-3);
+    pressed_drum(tol, 0, 60, rows);
+    pressed_drum(1e-6, 1, 60, old);
+    report("real film over a rising box, dt 1 ms, after 60 steps: worst row residual over m g h: "
+           "rows test at %g: free %.3g, pressed %.3g; relative test at 1e-6: free %.3g, "
+           "pressed %.3g",
+           tol, rows[0], rows[1], old[0], old[1]);
+    ck_assert_msg(rows[1] > 0.0, "no node pressed the box");
+    ck_assert_msg(rows[0] <= 1.5 * tol && rows[1] <= 1.5 * tol, "rows %g %g over %g", rows[0],
+                  rows[1], tol);
+    ck_assert_msg(old[1] > 10.0 * tol, "the relative test left %g: no longer shows the rows' need",
+                  old[1]);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("implicit");
@@ -1819,5 +1946,6 @@ int main(void)
     add_case(s, "preconditioners_agree", test_preconditioners_agree, 20);
     add_case(s, "refined_band_pressure", test_refined_band_pressure, 60);
     add_case(s, "band_multigrid_refined", test_band_multigrid_refined, 60);
+    add_case(s, "stop_on_rows", test_stop_on_rows, 30);
     return run_suite(s);
 }

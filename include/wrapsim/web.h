@@ -89,10 +89,19 @@ typedef struct ws_web_def {
      *  of it. A trailing field: older callers get 0. */
     double rupture_strain;
     int integrator;         /**< ws_web_integrator; default WS_WEB_EXPLICIT */
-    double solver_tolerance; /**< implicit webs: the linear solve stops when its residual is
-                                  at most this times the larger of the right-hand side's norm
-                                  and the film's weight times the step (momentum, N s);
-                                  (0, 0.1]; default 1e-6 */
+    double solver_tolerance; /**< implicit webs: the linear solve stops when every row's
+                                  residual (a momentum, N s) is at most this fraction of its
+                                  own weight over the step, m g h (g = 9.81 m/s^2 whatever
+                                  the world's gravity): each node's with its mass m_i, each
+                                  body in the solve's with its mass m_j, a body's turning
+                                  rows as the speed, rms over its mass, of the spin change
+                                  they would give it. Equivalently, the velocity change each
+                                  row's residual would give its own mass is at most this
+                                  times g h; the solve's velocities are then within this
+                                  times g h of the exact ones, rms over the film's and the
+                                  bodies' mass (docs/theory.md, section 8). (0, 0.1];
+                                  default 1e-3. Earlier versions bounded the residual's
+                                  norm by the right-hand side's (default 1e-6) */
     int solver_max_iterations; /**< implicit webs: conjugate-gradient iterations at most per
                                     solve (1..100000); default 1000. A solve that does not
                                     converge fails the step with WS_ERR_NUMERICAL */
@@ -272,8 +281,8 @@ typedef struct ws_web_solver_stats {
     uint64_t solves;          /**< linear solves since the web was made (one per sub-step) */
     uint64_t iterations;      /**< conjugate-gradient iterations of all of them */
     int last_iterations;      /**< iterations of the last solve */
-    double last_residual;     /**< its residual over its scale (<= the tolerance when it
-                                   converged) */
+    double last_residual;     /**< its worst row's residual over that row's weight over
+                                   the step, m g h (<= solver_tolerance when it converged) */
 } ws_web_solver_stats;
 
 /** The implicit solver's counts of a web. @return WS_OK, WS_ERR_STALE_HANDLE,

@@ -224,8 +224,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
             S->stats->numerical_errors++;
             return ws_fail(w, WS_ERR_NUMERICAL,
                            "web '%s': the implicit step's linear solve did not converge at t = "
-                           "%.6g s: residual %.3g of its scale after %d iterations (tolerance "
-                           "%.3g, at most %d); the step was undone. Raise "
+                           "%.6g s: a row's residual %.3g of its weight impulse after %d "
+                           "iterations (tolerance %.3g, at most %d); the step was undone. Raise "
                            "solver_max_iterations or solver_tolerance, or take a smaller dt",
                            label(web), w->time, im->last_residual, im->last_iterations,
                            web->solver_tol, web->solver_maxit);

@@ -26,7 +26,7 @@ static void web_defaults(ws_web_def *def)
     def->contact_layer = 1e-3;
     def->substeps = 1;
     def->integrator = WS_WEB_EXPLICIT;
-    def->solver_tolerance = 1e-6;
+    def->solver_tolerance = 1e-3; /* of each row's weight impulse (docs/theory.md 8) */
     def->solver_max_iterations = 1000;
 }
 WS_DEF_INITS(ws_web_def, web_defaults, name)

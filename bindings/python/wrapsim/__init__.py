@@ -847,7 +847,8 @@ class World:
     def web_sheet(self, law, pinned=None, **kwargs):
         """A rectangular sheet: ws_web_def fields (law, law_cross, law_shear, node_mass,
         areal_density, contact_layer, material, node_damping, substeps, name, rupture_strain,
-        integrator ("explicit" or "implicit"), solver_tolerance, solver_max_iterations,
+        integrator ("explicit" or "implicit"), solver_tolerance (each row's residual over its
+        own weight m g h, default 1e-3), solver_max_iterations,
         preconditioner ("auto", "block_jacobi" or "multigrid"), hold_bodies) and
         ws_sheet_def
         fields (nx, ny, origin, axis_x, axis_y, spacing_x, spacing_y, prestretch_x,
