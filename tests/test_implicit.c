@@ -1559,6 +1559,21 @@ START_TEST(test_coupled_jacobian)
 }
 END_TEST
 
+/* A film's and a box's materials in w, their contact 4000 N/m, 1 N s/m, friction 0.5. */
+static void film_and_box(ws_world *w, ws_material_id *film, ws_material_id *box)
+{
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ck_ok(w, ws_material_create(w, &md, film));
+    ck_ok(w, ws_material_create(w, &md, box));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    ck_ok(w, ws_world_set_contact(w, *film, *box, &cd));
+}
+
 /* A box of `mass` kg, 0.1 m a side, dropped from rest just touching the middle of a square
  * implicit sheet (0.4 m, 21 x 21 nodes, its border pinned, pre-stretched 5 %) under gravity,
  * at step dt, the box held during the film's solve or in it; after T s: the box's speed, the
@@ -1575,17 +1590,8 @@ static sling box_on_sheet(double dt, double mass, int hold, int plain, double T)
     ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
     ws_shape_id box;
     ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &box));
-    ws_material_def md;
-    ws_material_def_init(&md);
     ws_material_id film_mat, box_mat;
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_material_create(w, &md, &box_mat));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    film_and_box(w, &film_mat, &box_mat);
     ws_body_def bd;
     ws_body_def_init(&bd);
     bd.shape = box;
@@ -1706,17 +1712,8 @@ START_TEST(test_film_body_momentum)
     ws_world *w = world_g(1e-3, NO_G);
     ws_shape_id box;
     ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &box));
-    ws_material_def md;
-    ws_material_def_init(&md);
     ws_material_id film_mat, box_mat;
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_material_create(w, &md, &box_mat));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    film_and_box(w, &film_mat, &box_mat);
     const double mb = 0.2, mn = 1e-4;
     ws_body_def bd;
     ws_body_def_init(&bd);
@@ -1792,17 +1789,8 @@ static void pressed_drum(double tol, int relative, int steps, double worst[2])
     ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
     ws_shape_id cube;
     ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &cube));
-    ws_material_def md;
-    ws_material_def_init(&md);
     ws_material_id film_mat, box_mat;
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_material_create(w, &md, &box_mat));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    film_and_box(w, &film_mat, &box_mat);
     ws_body_def bd;
     ws_body_def_init(&bd);
     bd.type = WS_BODY_KINEMATIC;
