@@ -192,6 +192,18 @@ static void spring_case(ws_law_type type, double kc, double tr, double eps, int 
     ws_world_destroy(w);
 }
 
+/* The nodes on the edge of an nx x ny sheet (row by row) into pins (room for 2 (nx + ny)): a
+ * drum's pinned rim. Returns their count. */
+static size_t edge_pins(int nx, int ny, uint32_t *pins)
+{
+    size_t np = 0;
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++)
+            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
+                pins[np++] = (uint32_t)(i + nx * j);
+    return np;
+}
+
 START_TEST(test_spring_jacobian)
 {
     /* Tolerance 1e-6 relative: central differences at a step of 1e-8 m on a 2 cm spring err
@@ -830,11 +842,7 @@ START_TEST(test_failed_solve_with_body)
     wd.name = "sheet under a box";
     enum { N = 9 };
     uint32_t pins[4 * N];
-    size_t np = 0;
-    for (uint32_t j = 0; j < N; j++)
-        for (uint32_t i = 0; i < N; i++)
-            if (i == 0 || j == 0 || i == N - 1 || j == N - 1)
-                pins[np++] = i + N * j;
+    const size_t np = edge_pins(N, N, pins);
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
     sd.nx = sd.ny = N;
@@ -962,11 +970,7 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
     uint32_t pins[2 * (161 + 89)]; /* the whole edge: a drum */
     ck_assert_int_le(nx, 161);
     ck_assert_int_le(ny, 89);
-    size_t np = 0;
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++)
-            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
-                pins[np++] = (uint32_t)(i + nx * j);
+    const size_t np = edge_pins(nx, ny, pins);
     sd.pinned = pins;
     sd.pinned_count = np;
     ws_web_id id;
@@ -1292,11 +1296,7 @@ static ws_world *choice_drum(int nx, int ny, int pre, double tol, ws_web_id *id,
     sd.shear = 1;
     uint32_t *pins = malloc(2 * (size_t)(nx + ny) * sizeof *pins);
     ck_assert(pins);
-    size_t np = 0;
-    for (int j = 0; j < ny; j++)
-        for (int i = 0; i < nx; i++)
-            if (i == 0 || j == 0 || i == nx - 1 || j == ny - 1)
-                pins[np++] = (uint32_t)(i + nx * j);
+    const size_t np = edge_pins(nx, ny, pins);
     sd.pinned = pins;
     sd.pinned_count = np;
     *st = ws_web_create_sheet(w, &wd, &sd, id);
@@ -1612,11 +1612,7 @@ static sling box_on_sheet(double dt, double mass, int hold, int plain, double T)
     wd.hold_bodies = hold;
     enum { N = 21 };
     uint32_t pins[4 * N];
-    size_t np = 0;
-    for (uint32_t j = 0; j < N; j++)
-        for (uint32_t i = 0; i < N; i++)
-            if (i == 0 || j == 0 || i == N - 1 || j == N - 1)
-                pins[np++] = i + N * j;
+    const size_t np = edge_pins(N, N, pins);
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
     sd.nx = N;
@@ -1820,11 +1816,7 @@ static void pressed_drum(double tol, int relative, int steps, double worst[2])
     wd.preconditioner = WS_WEB_PRECONDITIONER_BLOCK_JACOBI;
     enum { N = 31 };
     uint32_t pins[4 * N];
-    size_t np = 0;
-    for (uint32_t j = 0; j < N; j++)
-        for (uint32_t i = 0; i < N; i++)
-            if (i == 0 || j == 0 || i == N - 1 || j == N - 1)
-                pins[np++] = i + N * j;
+    const size_t np = edge_pins(N, N, pins);
     ws_sheet_def sd;
     ws_sheet_def_init(&sd);
     sd.nx = sd.ny = N;
