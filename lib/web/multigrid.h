@@ -45,8 +45,28 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg);
  * not positive definite (then the solve keeps block Jacobi). */
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h);
 
-/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. */
+/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. With
+ * bodies nested (ws_mg_bodies), the film's block of ws_mg_apply_bodies: their residual zero,
+ * their answer dropped. */
 double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z);
+
+/* The bodies of the running solve nested in the hierarchy (docs/theory.md 8b): their six
+ * unknowns ride along every coarse level, coupled to its nodes by the contacts' -C J restricted
+ * with the levels' interpolation and kept only for the (coarse node, body) pairs that have one,
+ * smoothed after the nodes in the forward Gauss-Seidel sweep (before them in the backward one)
+ * and solved with the coarsest level; the film's level smooths its nodes alone and hands the
+ * bodies' residual down with the nodes'. ws_mg_body_bytes: the scratch this needs for nb
+ * bodies (0 without a multigrid or bodies); ws_mg_bodies: R's bodies (its links and factored
+ * blocks, set for the solve before ws_mg_setup, which restricts the coupling) with that
+ * scratch, or none (R or buf NULL). */
+struct ws_rigid;
+size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb);
+void ws_mg_bodies(ws_mg *mg, const struct ws_rigid *R, void *buf);
+
+/* z = B r and zb = B rb over the film and the nested bodies: one V-cycle of the coupled matrix,
+ * symmetric positive definite (docs/theory.md 8b). rb, zb 6 a body. Returns r . z + rb . zb. */
+double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double *z,
+                          const double *rb, double *zb);
 
 /* The number of levels (the film's own one included), for the counts. */
 int ws_mg_levels(const ws_mg *mg);
