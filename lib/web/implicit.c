@@ -546,13 +546,12 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     /* The multigrid's coarse levels only for a solve that iterates: a calm film's warm start
      * often meets the tolerance already. The bodies of the solve nested in it when the world
      * gave it room for them. */
-    if (im->mg)
-        ws_mg_bodies(im->mg, R, R ? R->mgbuf : NULL);
+    const int nests = im->mg && ws_mg_bodies(im->mg, R, R ? R->mgbuf : NULL);
     ws_mg *mg = im->mg && !im->jacobi_only && !(meas <= lim) &&
                         ws_mg_setup(im->mg, web, im->begun, h) == 0
                     ? im->mg
                     : NULL;
-    const int nested = R && mg && R->mgbuf;
+    const int nested = mg && nests;
     /* The bodies' coarse space, unless they are nested in the multigrid (which resolves their
      * modes on every level). */
     if (R && R->coarse && !nested && ws_rigid_coarse(R, web) != 0) {

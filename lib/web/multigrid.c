@@ -567,12 +567,17 @@ size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb)
     return d * sizeof(double) + u * sizeof(uint32_t) + sizeof(double);
 }
 
-void ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
+int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
 {
-    mg->nb = R && buf ? R->nb : 0;
-    mg->rig = mg->nb ? R : NULL;
-    if (!mg->nb)
-        return;
+    mg->nb = 0;
+    mg->rig = NULL;
+    if (!R || !buf || !R->nb)
+        return 0;
+    for (size_t l = 1; l < R->nl; l++) /* the film level walks them in node order */
+        if (R->link[l].node < R->link[l - 1].node)
+            return 0;
+    mg->nb = R->nb;
+    mg->rig = R;
     const uint32_t nb = mg->nb;
     const size_t m = mg->m + 6 * (size_t)nb;
     /* doubles first, from the buffer's first 8-aligned byte; then the indices */
@@ -599,6 +604,7 @@ void ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
         L->gn = u, u += L->gcap;
         L->gb = u, u += L->gcap;
     }
+    return 1;
 }
 
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
@@ -788,12 +794,45 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
     }
 }
 
+/* The film level's coupling to the nested bodies, taken inside its node passes: the solve's
+ * contacts are sorted by node (ws_mg_bodies checks it), so a pass over the nodes walks them
+ * with a cursor *l and meets node i's contacts when it is at node i, its z or t in hand. */
+/* rbo += J^T C Z over node i's contacts (the bodies' residual takes -A_bf z). */
+static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
+                                  double *rbo)
+{
+    for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
+        const ws_rigid_link *L = &R->link[*l];
+        double g[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(L->C, Z[0], Z[1], Z[2], g);
+        const v3 m = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
+        double *o = rbo + 6 * (size_t)L->body;
+        o[0] += g[0], o[1] += g[1], o[2] += g[2];
+        o[3] += m.x, o[4] += m.y, o[5] += m.z;
+    }
+}
+
+/* T += C J zb over node i's contacts (T, the film's residual, takes -A_fb zb). */
+static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
+                                  double *T)
+{
+    for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
+        const ws_rigid_link *L = &R->link[*l];
+        const double *U = zb + 6 * (size_t)L->body;
+        const v3 u = v3_add(v3_make(U[0], U[1], U[2]),
+                            v3_cross(v3_make(U[3], U[4], U[5]), L->lever));
+        ws_sym_madd(L->C, u.x, u.y, u.z, T);
+    }
+}
+
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
  * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
- * of the product that follows is taken on the way: t = r - N x. */
+ * of the product that follows is taken on the way: t = r - N x, and with the bodies nested
+ * (zb given) t -= A_fb zb. */
 static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
-                        double *t)
+                        double *t, const double *zb)
 {
+    size_t l = 0;
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
     double *u = mg->row;
@@ -826,6 +865,8 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
                 double *T = t + 3 * (size_t)i;
                 T[0] = R[0], T[1] = R[1], T[2] = R[2];
                 fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
+                if (zb)
+                    bodies_to_node(mg->rig, &l, i, zb, T);
             }
         }
     }
@@ -874,7 +915,7 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
     gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
-    prolong_add(mg, web, k, L->x, NULL, NULL);
+    prolong_add(mg, web, k, L->x, NULL, NULL, NULL);
     for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
         L->xb[q] += mg->lv[k + 1].xb[q];
     gauss_seidel_backward(mg, L);
@@ -883,13 +924,16 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
 /* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
  * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
  * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
- * them (single precision). Returns r . z. */
+ * them (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo
+ * given: rbo -= A_bf z with the new z (never both). Returns r . z. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
 static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
-                                double *restrict t, double *restrict z, int how, int residual)
+                                double *restrict t, double *restrict z, int how, int residual,
+                                const double *zb, double *rbo)
 {
     double rz = 0.0;
+    size_t l = 0;
     for (uint32_t i = 0; i < n; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
@@ -906,9 +950,13 @@ static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restr
             else
                 Z[0] += u0, Z[1] += u1, Z[2] += u2;
         }
+        if (rbo)
+            node_to_bodies(mg->rig, &l, i, Z, rbo);
         if (residual) {
             T[0] = R[0], T[1] = R[1], T[2] = R[2];
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
+            if (zb)
+                bodies_to_node(mg->rig, &l, i, zb, T);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
@@ -939,40 +987,6 @@ static void film_springs(const ws_mg *mg, const ws_web *web, const double *restr
     }
 }
 
-/* The bodies' right-hand side for level 1 after the film level's pre-sweeps (which leave
- * them at zero): out = rb - A_bf z = rb + sum over the contacts of J^T C z_node. */
-static void bodies_residual(const ws_mg *mg, const double *z, const double *rb, double *out)
-{
-    const ws_rigid *R = mg->rig;
-    memcpy(out, rb, 6 * (size_t)mg->nb * sizeof(double));
-    for (size_t l = 0; l < R->nl; l++) {
-        const ws_rigid_link *L = &R->link[l];
-        const double *Z = z + 3 * (size_t)L->node;
-        double g[3] = {0.0, 0.0, 0.0};
-        ws_sym_madd(L->C, Z[0], Z[1], Z[2], g);
-        const v3 m = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
-        double *o = out + 6 * (size_t)L->body;
-        o[0] += g[0], o[1] += g[1], o[2] += g[2];
-        o[3] += m.x, o[4] += m.y, o[5] += m.z;
-    }
-}
-
-/* t -= A_fb zb = t + C J zb at each contact's unpinned node: the film's residual with the
- * bodies' correction, for the post-sweeps. */
-static void film_less_bodies(const ws_mg *mg, const ws_web *web, const double *zb, double *t)
-{
-    const ws_rigid *R = mg->rig;
-    for (size_t l = 0; l < R->nl; l++) {
-        const ws_rigid_link *L = &R->link[l];
-        if (web->inv_m[L->node] == 0.0)
-            continue;
-        const double *U = zb + 6 * (size_t)L->body;
-        const v3 u = v3_add(v3_make(U[0], U[1], U[2]),
-                            v3_cross(v3_make(U[3], U[4], U[5]), L->lever));
-        ws_sym_madd(L->C, u.x, u.y, u.z, t + 3 * (size_t)L->node);
-    }
-}
-
 /* z = B r (and zb = B rb with bodies nested): on the film's level mg->sweeps Jacobi sweeps
  * from zero (the bodies held at zero), the residual restricted (the bodies' with it), the
  * coarse cycle, its correction interpolated, mg->sweeps sweeps more against the bodies'
@@ -983,30 +997,29 @@ static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, co
 {
     double *t = mg->lv[0].t;
     const uint32_t n = web->n;
-    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1);
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    /* The bodies' right-hand side for level 1, rb - A_bf z, taken with the last pre-sweep's z. */
+    double *rbo = nb6 ? mg->lv[1].rb : NULL;
+    if (nb6)
+        memcpy(rbo, rb, nb6 * sizeof(double));
+    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
         film_springs(mg, web, z, t);
     }
     restrict_to(mg, web, 0, t);
-    if (mg->nb)
-        bodies_residual(mg, z, rb, mg->lv[1].rb);
     cycle(mg, web, 1);
-    prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
-    if (mg->nb) {
-        memcpy(zb, mg->lv[1].xb, 6 * (size_t)mg->nb * sizeof(double));
-        film_less_bodies(mg, web, zb, t);
-    }
+    if (nb6)
+        memcpy(zb, mg->lv[1].xb, nb6 * sizeof(double));
+    prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL); /* and t = r - N z - A_fb zb */
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) {
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
-        if (mg->nb)
-            film_less_bodies(mg, web, zb, t);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
         film_springs(mg, web, z, t);
     }
-    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0);
-    for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
+    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0, NULL, NULL);
+    for (size_t q = 0; q < nb6; q++)
         rz += rb[q] * zb[q];
     return rz;
 }

@@ -58,10 +58,11 @@ double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z);
  * bodies' residual down with the nodes'. ws_mg_body_bytes: the scratch this needs for nb
  * bodies (0 without a multigrid or bodies); ws_mg_bodies: R's bodies (its links and factored
  * blocks, set for the solve before ws_mg_setup, which restricts the coupling) with that
- * scratch, or none (R or buf NULL). */
+ * scratch, or none (R or buf NULL); it returns whether they are nested (1), 0 when none are
+ * or R's contacts are not sorted by node (the film level walks them in node order). */
 struct ws_rigid;
 size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb);
-void ws_mg_bodies(ws_mg *mg, const struct ws_rigid *R, void *buf);
+int ws_mg_bodies(ws_mg *mg, const struct ws_rigid *R, void *buf);
 
 /* z = B r and zb = B rb over the film and the nested bodies: one V-cycle of the coupled matrix,
  * symmetric positive definite (docs/theory.md 8b). rb, zb 6 a body. Returns r . z + rb . zb. */
