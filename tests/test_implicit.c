@@ -1329,7 +1329,7 @@ static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, pres
     }
     o->mgbuf = NULL;
     if (nest) {
-        const size_t bytes = ws_mg_body_bytes(im->mg, 1);
+        const size_t bytes = ws_mg_body_bytes(im->mg, 1, R->cap);
         ck_assert(bytes > 0);
         o->mgbuf = malloc(bytes);
         ck_assert(o->mgbuf);

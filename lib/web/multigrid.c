@@ -504,9 +504,9 @@ static inline void g_axpy(double *G, double w, const double *S)
 /* The bodies' coupling on every coarse level, kept for the (node, body) pairs that have one:
  * level 1's is P^T (-C J) over the contacts, level k + 1's P^T of level k's (P acts on the
  * nodes alone: a body's unknowns are the same on every level). Each level is gathered in two
- * passes, the pairs marked, then the blocks summed; a level's pairs are at most its nodes
- * times the bodies (the room ws_mg_body_bytes gives), and on a wrapped band about its nodes,
- * each near one box. */
+ * passes, the pairs marked, then the blocks summed; a level's pairs fit the room
+ * ws_mg_body_bytes gives (pairs_room), and on a wrapped band they are about its nodes, each
+ * near one box. */
 static void galerkin_bodies(ws_mg *mg, const ws_web *web)
 {
     const uint32_t nb = mg->nb;
@@ -553,14 +553,27 @@ static void galerkin_bodies(ws_mg *mg, const ws_web *web)
     }
 }
 
-size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb)
+/* The room for level k's (node, body) pairs with nb bodies and nl contacts: at most its nodes
+ * times the bodies, and at most 4 a pair of the level above (a row of P has at most four
+ * coarse nodes), level 1's 4 a contact. */
+static size_t pairs_room(const ws_mg *mg, int k, uint32_t nb, size_t nl)
 {
-    if (!mg || !nb)
+    size_t room = nl;
+    for (int i = 1; i <= k; i++) {
+        const size_t all = (size_t)mg->lv[i].n * nb;
+        room = 4 * room < all ? 4 * room : all;
+    }
+    return room;
+}
+
+size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb, size_t nl)
+{
+    if (!mg || !nb || nb > WS_MG_NEST_BODIES_MAX)
         return 0;
-    const size_t m = mg->m + 6 * (size_t)nb, pairs1 = (size_t)mg->lv[1].n * nb;
-    size_t d = m * m + m + 18 * (size_t)nb, u = pairs1;
+    const size_t m = mg->m + 6 * (size_t)nb;
+    size_t d = m * m + m + 18 * (size_t)nb, u = (size_t)mg->lv[1].n * nb;
     for (int k = 1; k < mg->nlev; k++) {
-        const size_t pairs = (size_t)mg->lv[k].n * nb;
+        const size_t pairs = pairs_room(mg, k, nb, nl);
         d += 12 * (size_t)nb + 18 * pairs;
         u += (size_t)mg->lv[k].n + 1 + 2 * pairs;
     }
@@ -571,7 +584,7 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
 {
     mg->nb = 0;
     mg->rig = NULL;
-    if (!R || !buf || !R->nb)
+    if (!R || !buf || !R->nb || R->nb > WS_MG_NEST_BODIES_MAX || R->nl > R->cap)
         return 0;
     for (size_t l = 1; l < R->nl; l++) /* the film level walks them in node order */
         if (R->link[l].node < R->link[l - 1].node)
@@ -593,7 +606,7 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
     }
     for (int k = 1; k < mg->nlev; k++) {
         mg_level *L = &mg->lv[k];
-        L->gcap = (size_t)L->n * nb;
+        L->gcap = pairs_room(mg, k, nb, R->cap);
         L->G = q, q += 18 * L->gcap;
     }
     uint32_t *u = (uint32_t *)q;

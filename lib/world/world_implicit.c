@@ -69,7 +69,7 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->fa = R->coarse + v6 * v6;
     R->fb = R->fa + m;
     /* Room for the film's multigrid to nest the bodies in (none without one). */
-    const size_t mgb = ws_mg_body_bytes(mg, nb);
+    const size_t mgb = ws_mg_body_bytes(mg, nb, nl);
     if (mgb && !(R->mgbuf = ws_arena_alloc(arena, mgb))) {
         *fail = 1;
         return NULL;
