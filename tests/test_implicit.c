@@ -225,7 +225,7 @@ static v3 contact_force(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_no
 {
     const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
                             x,          v,      0.0,           1.0,         NULL};
-    size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L);
+    size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L, NULL);
     v3 f = v3_make(0, 0, 0);
     *count = 0;
     for (size_t k = 0; k < n; k++)
@@ -327,7 +327,8 @@ START_TEST(test_contact_jacobian)
     ws_world *w = box_two_nodes(&web, &x);
     const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
     ck_assert_uint_ge(cl->n, 2);
-    ws_node_link *L = calloc(cl->n, sizeof *L);
+    ws_node_link *L = calloc(cl->n, sizeof *L), *L2 = calloc(cl->n, sizeof *L2);
+    ws_node_exact *E = calloc(cl->n, sizeof *E);
     const ws_body_state *st = &w->bodies.st[w->cur];
     const v3 vbody = st->v[0];
     for (int rest_case = 0; rest_case < 2; rest_case++) {
@@ -342,12 +343,19 @@ START_TEST(test_contact_jacobian)
             (void)contact_force(w, web, cl, x, v, L, i, &cnt);
             ck_assert_int_eq(cnt, 1);
             ws_node_link link;
+            ws_node_exact exact;
             const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
                                     x,          v,      0.0,           1.0,         NULL};
-            size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L);
+            size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L, E);
             for (size_t k = 0; k < n; k++)
-                if (L[k].node == i && L[k].active)
+                if (L[k].node == i && L[k].active) {
                     link = L[k];
+                    exact = E[k];
+                }
+            /* The step asks for no exact derivatives: its contacts must be the same to the
+             * bit as those computed with them. */
+            ck_assert_uint_eq(ws_node_links(&P, web, cl->n, NULL, 0.0, L2, NULL), n);
+            ck_assert_int_eq(memcmp(L, L2, n * sizeof *L), 0);
             double Fx[9], Fv[9];
             contact_fd(w, web, cl, x, v, L, i, 0, 1e-8, Fx);
             /* At rest eq. 13 bends as |t| t / v_lim^2 about zero slip: central differences
@@ -358,8 +366,8 @@ START_TEST(test_contact_jacobian)
             const int sym[9] = {WS_SYM_XX, WS_SYM_XY, WS_SYM_XZ, WS_SYM_XY, WS_SYM_YY,
                                 WS_SYM_YZ, WS_SYM_XZ, WS_SYM_YZ, WS_SYM_ZZ};
             for (int k = 0; k < 9; k++) {
-                ex = fmax(ex, fabs(link.Jx[k] - Fx[k]));
-                ev = fmax(ev, fabs(link.Jv[k] - Fv[k]));
+                ex = fmax(ex, fabs(exact.Jx[k] - Fx[k]));
+                ev = fmax(ev, fabs(exact.Jv[k] - Fv[k]));
                 mx = fmax(mx, fabs(-link.K[sym[k]] - Fx[k]));
                 mv = fmax(mv, fabs(-link.D[sym[k]] - Fv[k]));
             }
@@ -376,6 +384,8 @@ START_TEST(test_contact_jacobian)
         }
     }
     free(L);
+    free(L2);
+    free(E);
     free(x.x);
     free(v.x);
     ws_world_destroy(w);
@@ -1443,6 +1453,7 @@ START_TEST(test_coupled_jacobian)
     ws_world *w = box_two_nodes(&web, &x);
     const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
     ws_node_link *L = calloc(cl->n + 1, sizeof *L);
+    ws_node_exact *E = calloc(cl->n + 1, sizeof *E);
     ws_body_state *st = &w->bodies.st[w->cur];
     const v3 r0 = st->r[0], vb = st->v[0], wb0 = v3_make(0, 0, 0);
     const v3 slip[2] = {v3_make(0, 0, 0), v3_make(-7e-4, 0.02, -7e-4)};
@@ -1454,12 +1465,16 @@ START_TEST(test_coupled_jacobian)
         (void)force_with_body(w, web, cl, x, v, L, i, r0, vb, wb0);
         const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
                                 x,          v,      0.0,           1.0,         NULL};
-        const size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L);
+        ws_node_exact exact;
+        const size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L, E);
         ws_node_link link;
         memset(&link, 0, sizeof link);
+        memset(&exact, 0, sizeof exact);
         for (size_t k = 0; k < n; k++)
-            if (L[k].node == i && L[k].active)
+            if (L[k].node == i && L[k].active) {
                 link = L[k];
+                exact = E[k];
+            }
         ck_assert(link.active);
         /* df/dU (3 x 6, velocity then spin) and df/dr_b (3 x 3) by central differences. */
         double FU[18], Fr[9];
@@ -1488,11 +1503,11 @@ START_TEST(test_coupled_jacobian)
             const v3 e = v3_make(k % 3 == 0, k % 3 == 1, k % 3 == 2);
             const v3 a = k < 3 ? e : v3_cross(e, link.lever);
             for (int row = 0; row < 3; row++) {
-                const double want = -(link.Jv[3 * row] * a.x + link.Jv[3 * row + 1] * a.y +
-                                      link.Jv[3 * row + 2] * a.z);
+                const double want = -(exact.Jv[3 * row] * a.x + exact.Jv[3 * row + 1] * a.y +
+                                      exact.Jv[3 * row + 2] * a.z);
                 eU = fmax(eU, fabs(FU[6 * row + k] - want));
                 if (k < 3)
-                    er = fmax(er, fabs(Fr[3 * row + k] + link.Jx[3 * row + k]));
+                    er = fmax(er, fabs(Fr[3 * row + k] + exact.Jx[3 * row + k]));
             }
         }
         const double nU = max_abs(FU, 18), nr = max_abs(Fr, 9);
@@ -1553,6 +1568,7 @@ START_TEST(test_coupled_jacobian)
         ck_assert_msg(eT <= 1e-14 * nA, "blocks not each other's transpose: %g", eT);
     }
     free(L);
+    free(E);
     free(x.x);
     free(v.x);
     ws_world_destroy(w);

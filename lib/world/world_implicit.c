@@ -191,7 +191,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
          * window's top, bounded by the margin the candidates cover. */
         const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
-                                        S->contact.margin, links);
+                                        S->contact.margin, links, NULL);
         uint32_t *slot = NULL;
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
