@@ -2007,7 +2007,7 @@ START_TEST(test_coarse_setup)
         R.phi_body = calloc(cap + 1, sizeof *R.phi_body);
         R.phi_lever = calloc(3 * (cap + 1), sizeof *R.phi_lever);
         R.crow = calloc(n + 1, sizeof *R.crow);
-        R.cphi = calloc(cap + 1, sizeof *R.cphi);
+        R.cphi = calloc(2 * (cap + 1), sizeof *R.cphi);
         ck_assert(d && R.phi_node && R.phi_body && R.phi_lever && R.crow && R.cphi);
         R.fac = d;
         R.b = d + 72, R.x = R.b + v6, R.r = R.x + v6, R.z = R.r + v6, R.p = R.z + v6;

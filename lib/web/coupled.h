@@ -41,8 +41,8 @@ typedef struct ws_rigid {
      * moving (or turning) by one unit and every node it touches with the contact point, Phi.
      * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles.
      * Scratch of its set-up: crow, a film node's row among Phi's nodes (a uint32_t a film
-     * node); cphi, a row's entry (cap + 1); cy, 18 doubles a row (cap + 1); cyr, 36 nb
-     * doubles. NULL coarse: none. */
+     * node); cphi, a row's entry and a flag (2 (cap + 1)); cy, 18 doubles a row (cap + 1);
+     * cyr, 36 nb doubles. NULL coarse: none. */
     double *coarse, *cb, *cq, *cy, *cyr;
     uint32_t *crow, *cphi;
     /* The coarse space's contacts (room for cap), set by ws_rigid_coarse: the first link of

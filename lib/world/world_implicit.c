@@ -53,7 +53,7 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->phi_body = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_body);
     R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
     R->crow = ws_arena_alloc(arena, ((size_t)nodes + 1) * sizeof *R->crow);
-    R->cphi = ws_arena_alloc(arena, (nl + 1) * sizeof *R->cphi);
+    R->cphi = ws_arena_alloc(arena, 2 * (nl + 1) * sizeof *R->cphi);
     if (!R->link || !d || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow ||
         !R->cphi) {
         *fail = 1;
