@@ -249,7 +249,7 @@ static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t 
 {
     const ws_implicit *im = web->imp;
     const size_t nc = 6 * (size_t)R->nb;
-    uint32_t *at = R->cphi;           /* a row's entry of Phi with body j, UINT32_MAX: none */
+    uint32_t *at = R->cphi;             /* a row's entry of Phi with body j, UINT32_MAX: none */
     uint32_t *reached = R->cphi + rows; /* whether a term of body j's columns reaches a row */
     double *Y = R->cy;
     for (uint32_t r = 0; r < rows; r++)
