@@ -1998,8 +1998,9 @@ START_TEST(test_coarse_setup)
         R.cap = cap;
         R.link = link;
         const size_t v6 = 12;
-        double mass[2] = {1.0, 2.5},
-               inertia[2 * WS_SYM] = {0.01, 0.02, 0.015, 1e-3, 0, -2e-3, 0.03, 0.02, 0.04, 0, 1e-3, 0};
+        double mass[2] = {1.0, 2.5};
+        double inertia[2 * WS_SYM] = {0.01, 0.02, 0.015, 1e-3, 0, -2e-3,
+                                      0.03, 0.02,  0.04,  0,    1e-3, 0};
         R.mass = mass;
         R.inertia = inertia;
         double *d = calloc(72 + 8 * v6 + v6 * v6 + 6 * v6 + 18 * (cap + 1), sizeof(double));
