@@ -343,15 +343,17 @@ int main(int argc, char **argv)
             ws_web_get_info(sc.world, sc.film, &info);
             ws_web_solver_stats ss;
             ws_web_get_solver_stats(sc.world, sc.film, &ss);
+            uint64_t hash = 0;
+            ws_world_get_state_hash(sc.world, &hash);
             if (r == 1)
                 base = el / T;
             printf("  refine %d (%u nodes): %.1f s CPU (%.1f s wall) per simulated s (%.2f x "
                    "unrefined), CG %.1f it/step (%.2f solves/step); line load %.2f N/m, contact force "
-                   "%.2f N\n",
+                   "%.2f N; state %016llx\n",
                    r, info.node_count, el / T, wall / T, el / T / base,
                    (double)(ss.iterations - s0.iterations) / steps,
                    (double)(ss.solves - s0.solves) / steps,
-                   band.line_load, band.contact_force);
+                   band.line_load, band.contact_force, (unsigned long long)hash);
             fflush(stdout);
             ws_world_destroy(sc.world);
         }

@@ -46,18 +46,66 @@ static void link_slip(ws_node_link *L, v3 t, double vlim)
     }
 }
 
-/* One contact, its force and derivatives (see ws_node_link), for the node at x (velocity u, a
- * pinned one without friction) touching a body of motion b at `at`, the contact's parameters p.
- * G: dn/dx (zero for a face, (P_e - n n^T) / d for an edge's rim, P_e the projection across the
- * edge). The force is the contact laws' (penalty.h), as the explicit film's. */
+/* The exact derivatives of an active contact L's force (ws_node_exact) with the normal force f,
+ * the relative velocity vr and its normal part vn, the contact's parameters p, G as link_of's.
+ * df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
+ * df/du = -c n^T; friction's through its slip and through f. */
+static void exact_of(const ws_node_params *p, const ws_node_link *L, v3 vr, double vn, double f,
+                     const double G[9], int pinned, ws_node_exact *J)
+{
+    const v3 n = L->n;
+    memset(J, 0, sizeof *J);
+    double dfx[3] = {-p->k * n.x, -p->k * n.y, -p->k * n.z};
+    const double vrv[3] = {vr.x, vr.y, vr.z};
+    for (int k = 0; k < 3; k++)
+        for (int q = 0; q < 3; q++)
+            dfx[k] -= p->c * vrv[q] * G[3 * q + k];
+    const v3 dfxv = v3_make(dfx[0], dfx[1], dfx[2]);
+    outer_add(J->Jx, 1.0, n, dfxv);
+    for (int k = 0; k < 9; k++)
+        J->Jx[k] += f * G[k];
+    outer_add(J->Jv, -p->c, n, n);
+    if (!(p->mu > 0.0) || pinned)
+        return;
+    /* Eq. 13 over the tangential slip t: F_t = -mu f phi t (link_slip) and dF_t/dt = -mu f
+     * (phi I + (p'/v_lim - phi) tt^T), tt = t / |t|. */
+    const v3 t = L->t, tt = L->tt;
+    const double phi = L->phi, dp = L->dp, mf = p->mu * f;
+    double T[9] = {0}; /* dF_t/dt at fixed f */
+    for (int i = 0; i < 3; i++)
+        T[4 * i] = -mf * phi;
+    outer_add(T, -mf * (dp - phi), tt, tt);
+    /* dt/du = I - n n^T; dt/dx = -(vn G + n vr^T G). */
+    double Pn[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Tx[9];
+    outer_add(Pn, -1.0, n, n);
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            double s2 = 0.0;
+            for (int q = 0; q < 3; q++)
+                s2 += vrv[q] * G[3 * q + k];
+            const double nv[3] = {n.x, n.y, n.z};
+            Tx[3 * i + k] = -(vn * G[3 * i + k] + nv[i] * s2);
+        }
+    mul_add(J->Jx, 1.0, T, Tx);
+    mul_add(J->Jv, 1.0, T, Pn);
+    /* Through the normal force: F_t is proportional to f. */
+    outer_add(J->Jx, -p->mu * phi, t, dfxv);
+    outer_add(J->Jv, p->mu * phi * p->c, t, n);
+}
+
+/* One contact, its force and the matrix's blocks (see ws_node_link), for the node at x (velocity
+ * u, a pinned one without friction) touching a body of motion b at `at`, the contact's
+ * parameters p; with J not NULL its exact derivatives too (exact_of; zero when it does not
+ * push). G: dn/dx (zero for a face, (P_e - n n^T) / d for an edge's rim, P_e the projection
+ * across the edge), read for J alone. The force is the contact laws' (penalty.h), as the
+ * explicit film's. */
 static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_node_touch_at *at,
-                    const double G[9], int pinned, ws_node_link *L)
+                    const double G[9], int pinned, ws_node_link *L, ws_node_exact *J)
 {
     const v3 n = at->n;
     const ws_node_kin kin = ws_node_kinematics(n, at->d, x, u, b);
     const ws_normal law = ws_normal_law(n, kin.vr, at->hi - at->d, p->k, p->c);
-    const v3 vr = kin.vr;
-    const double vn = law.vn, f = law.fn;
+    const double f = law.fn;
     memset(L, 0, sizeof *L);
     L->lever = kin.lever;
     L->n = n;
@@ -73,71 +121,39 @@ static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_n
     L->active = f > 0.0;
     L->mu = pinned ? 0.0 : p->mu;
     link_slip(L, law.t, p->vlim);
+    if (J) {
+        if (L->active)
+            exact_of(p, L, kin.vr, law.vn, f, G, pinned, J);
+        else
+            memset(J, 0, sizeof *J);
+    }
+    ws_sym_add_outer(L->K, p->k, n);
+    ws_sym_add_outer(L->D, p->c, n);
     if (!L->active) {
         /* Not pushing now: the penalty's linear model alone, for the step to take if it
          * brings the node in (ws_node_link_update, which adds the friction then). */
         L->f = v3_scale(n, f);
-        ws_sym_add_outer(L->K, p->k, n);
-        ws_sym_add_outer(L->D, p->c, n);
         return;
     }
-    /* df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
-     * df/du = -c n^T. */
-    double dfx[3] = {-p->k * n.x, -p->k * n.y, -p->k * n.z};
-    const double vrv[3] = {vr.x, vr.y, vr.z};
-    for (int k = 0; k < 3; k++)
-        for (int q = 0; q < 3; q++)
-            dfx[k] -= p->c * vrv[q] * G[3 * q + k];
-    const v3 dfxv = v3_make(dfx[0], dfx[1], dfx[2]);
-    outer_add(L->Jx, 1.0, n, dfxv);
-    for (int k = 0; k < 9; k++)
-        L->Jx[k] += f * G[k];
-    outer_add(L->Jv, -p->c, n, n);
-    ws_sym_add_outer(L->K, p->k, n);
-    ws_sym_add_outer(L->D, p->c, n);
     v3 F = v3_scale(n, f);
     if (p->mu > 0.0 && !pinned) {
-        /* Eq. 13 over the tangential slip t: F_t = -mu f phi t (link_slip) and
-         * dF_t/dt = -mu f (phi I + (p'/v_lim - phi) tt^T), tt = t / |t|, which is positive
-         * semi-definite across the normal (p' >= 0, phi + p'/v_lim - phi >= 0). */
-        const v3 t = L->t, tt = L->tt;
-        const double phi = L->phi, dp = L->dp;
-        const double mf = p->mu * f;
-        F = v3_madd(F, t, -mf * phi);
-        double T[9] = {0}; /* dF_t/dt at fixed f */
-        for (int i = 0; i < 3; i++)
-            T[4 * i] = -mf * phi;
-        outer_add(T, -mf * (dp - phi), tt, tt);
-        /* dt/du = I - n n^T; dt/dx = -(vn G + n vr^T G). */
-        double Pn[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, Tx[9];
-        outer_add(Pn, -1.0, n, n);
-        for (int i = 0; i < 3; i++)
-            for (int k = 0; k < 3; k++) {
-                double s2 = 0.0;
-                for (int q = 0; q < 3; q++)
-                    s2 += vrv[q] * G[3 * q + k];
-                const double nv[3] = {n.x, n.y, n.z};
-                Tx[3 * i + k] = -(vn * G[3 * i + k] + nv[i] * s2);
-            }
-        mul_add(L->Jx, 1.0, T, Tx);
-        mul_add(L->Jv, 1.0, T, Pn);
-        /* Through the normal force: F_t is proportional to f. */
-        outer_add(L->Jx, -p->mu * phi, t, dfxv);
-        outer_add(L->Jv, p->mu * phi * p->c, t, n);
-        /* The matrix takes friction as the damper its own force is over the slip, mu f phi
-         * across the normal (the secant, not the tangent): at rest they are the same (phi =
-         * p'(0) / v_lim), but a sliding node's tangent has no damping along the slip (Coulomb's
-         * force does not grow with speed), and one linear step would carry the node past the
+        /* Eq. 13 over the tangential slip t: F_t = -mu f phi t (link_slip). The matrix takes
+         * friction as the damper its own force is over the slip, mu f phi across the normal
+         * (the secant, not the tangent, exact_of's): at rest they are the same (phi = p'(0) /
+         * v_lim), but a sliding node's tangent has no damping along the slip (Coulomb's force
+         * does not grow with speed), and one linear step would carry the node past the
          * reversal of its slip with nothing to stop it. As a damper, backward Euler ends the
          * step with the force -mu f phi t1 against the slip it ends with, which cannot
          * overshoot. The coupling through f (t n^T) is not symmetric and vanishes at rest. */
+        const double mf = p->mu * f;
+        F = v3_madd(F, L->t, -mf * L->phi);
         double Dn[WS_SYM] = {0};
         ws_sym_add_outer(Dn, -1.0, n);
         Dn[WS_SYM_XX] += 1.0;
         Dn[WS_SYM_YY] += 1.0;
         Dn[WS_SYM_ZZ] += 1.0;
         for (int k = 0; k < WS_SYM; k++)
-            L->D[k] += mf * phi * Dn[k];
+            L->D[k] += mf * L->phi * Dn[k];
     }
     L->f = F;
 }
@@ -161,7 +177,7 @@ static void bring_in(ws_node_link *c, double fe)
 }
 
 size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, const double *guess,
-                     double reach, ws_node_link *out)
+                     double reach, ws_node_link *out, ws_node_exact *exact)
 {
     size_t m = 0;
     const ws_body_store *b = P->b;
@@ -173,8 +189,8 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
         ws_node_touch_at at;
         if (!ws_node_touch(P, web, c, xi, reach, &at))
             continue;
-        double G[9] = {0};
-        if (c->local & WS_NCAND_EDGE) {
+        double G[9] = {0}; /* the exact derivatives' alone */
+        if (exact && (c->local & WS_NCAND_EDGE)) {
             /* The rim's normal turns with the node: dn/dx = (I - e e^T - n n^T) / d. */
             const ws_wedge *E = &P->g->edge[c->feat];
             const v3 e = v3_scale(E->e, sqrt(E->inv_e2));
@@ -183,10 +199,11 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
                 for (int q = 0; q < 3; q++)
                     G[3 * r + q] = ((r == q) - ev[r] * ev[q] - nv[r] * nv[q]) / at.d;
         }
+        ws_node_exact *J = exact ? &exact[m] : NULL;
         ws_node_link *L = &out[m++];
         const ws_motion mb = {st->r[bi], st->v[bi], b->wg[bi]};
         link_of(&P->pp[b->material[bi]], xi, nodes_get(P->v, i), mb, &at, G, web->inv_m[i] == 0.0,
-                L);
+                L, J);
         L->node = i;
         L->body = bi;
         /* One that the node reaches within the step at its present velocity, plus the guess of

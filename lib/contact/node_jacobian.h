@@ -8,9 +8,9 @@
 #include "web/implicit.h"
 
 /* A pushing contact of node `node` and body `body` at the start of a step: the force on the node
- * f (normal force and friction), the lever from the body's CoG to the contact point, the
- * symmetric blocks the matrix takes (K = -df/dx, D = -df/dv, positive semi-definite) and the
- * exact derivatives Jx = df/dx, Jv = df/dv (row-major) for a body that does not spin. */
+ * f (normal force and friction), the lever from the body's CoG to the contact point and the
+ * symmetric blocks the matrix takes (K = -df/dx, D = -df/dv, positive semi-definite). The exact
+ * derivatives are ws_node_exact's, apart: the step never reads them. */
 typedef struct ws_node_link {
     uint32_t node, body;
     int active;  /* in the step's matrix and forces (ws_node_link_update) */
@@ -25,8 +25,14 @@ typedef struct ws_node_link {
     v3 t, tt;    /* the tangential slip at the start and its direction (zero at rest) */
     double phi, dp; /* eq. 13 over the slip: F_t = -mu N phi t; dp = p'(s) / v_lim */
     double K[WS_SYM], D[WS_SYM];
-    double Jx[9], Jv[9];
 } ws_node_link;
+
+/* A contact's exact derivatives of its force at the start of the step, Jx = df/dx and Jv =
+ * df/dv (row-major), for a body that does not spin: what the matrix's K and D approximate (the
+ * tests compare both with finite differences). */
+typedef struct ws_node_exact {
+    double Jx[9], Jv[9];
+} ws_node_exact;
 
 /* The contacts of the candidates P->cand[0, count) (sorted by node) with the node state (P->x,
  * P->v) and the bodies at state P->cur (features prepared in P->g), parameters P->pp by body
@@ -35,9 +41,10 @@ typedef struct ws_node_link {
  * node reaches within the step P->h at its present velocity plus `guess` (xyz per node; NULL:
  * none) (with the normal force it would end with); any other (beyond the window, or leaving
  * it) starts inactive with its normal force's linear model alone (f = fn n, K, D along n),
- * which ws_node_link_update may bring in. P's share and fc are not read. */
+ * which ws_node_link_update may bring in. P's share and fc are not read. exact (room for count,
+ * or NULL: not computed) receives each contact's exact derivatives, in the order of out. */
 size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, const double *guess,
-                     double reach, ws_node_link *out);
+                     double reach, ws_node_link *out, ws_node_exact *exact);
 
 /* After a solve over step h (dv; new velocities v1): each contact's normal force at the end of
  * the step by its linear model, fn - k h n.v1 - c n.dv; an inactive contact becomes active

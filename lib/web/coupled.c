@@ -209,26 +209,212 @@ static void phi_transpose(const ws_rigid *R, const double *rf, const double *rr,
     }
 }
 
-int ws_rigid_coarse(ws_rigid *R, const ws_web *web)
+/* The film part of Phi's unit column q (< 6) at a node of lever r: e_q for a velocity, e_(q-3) x
+ * r for a spin, written out. phi_apply's cross product multiplies by exact zeros and ones, so
+ * these are its values (the sign of a zero aside). */
+static inline v3 phi_unit(int q, const double *r)
 {
-    const size_t nc = 6 * (size_t)R->nb, m = 3 * (size_t)web->n;
+    switch (q) {
+    case 0:
+        return v3_make(1.0, 0.0, 0.0);
+    case 1:
+        return v3_make(0.0, 1.0, 0.0);
+    case 2:
+        return v3_make(0.0, 0.0, 1.0);
+    case 3:
+        return v3_make(0.0, -r[2], r[1]);
+    case 4:
+        return v3_make(r[2], 0.0, -r[0]);
+    default:
+        return v3_make(-r[1], r[0], 0.0);
+    }
+}
+
+/* The coarse space's rows: every node of Phi (any body) gets one, in crow (UINT32_MAX for the
+ * others); their number returned. */
+static uint32_t coarse_rows(ws_rigid *R, const ws_web *web)
+{
+    memset(R->crow, 0xff, (size_t)web->n * sizeof *R->crow);
+    uint32_t rows = 0;
+    for (size_t k = 0; k < R->nphi; k++)
+        if (R->crow[R->phi_node[k]] == UINT32_MAX)
+            R->crow[R->phi_node[k]] = rows++;
+    return rows;
+}
+
+/* The six columns of body j of Phi^T A Phi into A (nc x nc, row-major), A the coupled matrix of
+ * the running solve: what ws_implicit_apply_op, ws_rigid_apply and phi_transpose give column by
+ * column for Phi e_c, computed for the six at once and only where they are not zero: the rows
+ * of Phi's nodes (cy, 18 doubles a row: column, then xyz), the springs with an end that moves
+ * with body j (for a velocity column, only those with one end: both ends moving alike do not
+ * stretch it), the contacts of body j or of a node that moves with it (a contact at the point
+ * Phi moves its node with adds nothing to the body's row), Phi^T over the rows these reach.
+ * Each entry takes the same terms in the same order as the column-by-column product and leaves
+ * out only exact zeros, so the matrix is the same to the bit (the sign of a zero aside). */
+static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t j, double *A)
+{
+    const ws_implicit *im = web->imp;
+    const size_t nc = 6 * (size_t)R->nb;
+    uint32_t *at = R->cphi;             /* a row's entry of Phi with body j, UINT32_MAX: none */
+    uint32_t *reached = R->cphi + rows; /* whether a term of body j's columns reaches a row */
+    double *Y = R->cy;
+    for (uint32_t r = 0; r < rows; r++)
+        at[r] = UINT32_MAX, reached[r] = 0;
+    for (size_t k = 0; k < R->nphi; k++)
+        if (R->phi_body[k] == j) {
+            const uint32_t r = R->crow[R->phi_node[k]];
+            at[r] = (uint32_t)k;
+            reached[r] = 1;
+        }
+    /* The film's own blocks (ws_implicit_apply_op's first loop), each row at its node's first
+     * entry (coarse_rows numbered them in that order). */
+    uint32_t next = 0;
+    for (size_t k = 0; k < R->nphi; k++) {
+        const uint32_t i = R->phi_node[k], r = R->crow[i];
+        if (r != next)
+            continue; /* the node's row is done */
+        next++;
+        const double *S = im->nd + WS_SYM * (size_t)i;
+        for (int q = 0; q < 6; q++) {
+            const v3 u = at[r] == UINT32_MAX ? v3_make(0.0, 0.0, 0.0)
+                                             : phi_unit(q, R->phi_lever + 3 * (size_t)at[r]);
+            double *y = Y + 18 * (size_t)r + 3 * (size_t)q;
+            y[0] = S[WS_SYM_XX] * u.x + S[WS_SYM_XY] * u.y + S[WS_SYM_XZ] * u.z;
+            y[1] = S[WS_SYM_XY] * u.x + S[WS_SYM_YY] * u.y + S[WS_SYM_YZ] * u.z;
+            y[2] = S[WS_SYM_XZ] * u.x + S[WS_SYM_YZ] * u.y + S[WS_SYM_ZZ] * u.z;
+        }
+    }
+    /* The springs, in their order (its second loop). */
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const uint32_t ra = R->crow[web->sa[s]], rb = R->crow[web->sb[s]];
+        const uint32_t ka = ra == UINT32_MAX ? UINT32_MAX : at[ra],
+                       kb = rb == UINT32_MAX ? UINT32_MAX : at[rb];
+        if (ka == UINT32_MAX && kb == UINT32_MAX)
+            continue;
+        const double *o = im->op + 5 * (size_t)s; /* ex ey ez a b */
+        const double *la = ka == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)ka,
+                     *lb = kb == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)kb;
+        if (ra != UINT32_MAX)
+            reached[ra] = 1;
+        if (rb != UINT32_MAX)
+            reached[rb] = 1;
+        for (int q = la && lb ? 3 : 0; q < 6; q++) {
+            const v3 a = la ? phi_unit(q, la) : v3_make(0.0, 0.0, 0.0);
+            const v3 b = lb ? phi_unit(q, lb) : v3_make(0.0, 0.0, 0.0);
+            const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+            const double ed = o[3] * (o[0] * dx + o[1] * dy + o[2] * dz);
+            const double tx = ed * o[0] + o[4] * dx, ty = ed * o[1] + o[4] * dy,
+                         tz = ed * o[2] + o[4] * dz;
+            if (ra != UINT32_MAX) {
+                double *y = Y + 18 * (size_t)ra + 3 * (size_t)q;
+                y[0] += tx, y[1] += ty, y[2] += tz;
+            }
+            if (rb != UINT32_MAX) {
+                double *y = Y + 18 * (size_t)rb + 3 * (size_t)q;
+                y[0] -= tx, y[1] -= ty, y[2] -= tz;
+            }
+        }
+    }
+    /* The bodies' rows and the contacts' coupling (ws_rigid_apply), yr of column q in
+     * cyr + q nc. */
+    double *yr = R->cyr;
+    for (int q = 0; q < 6; q++)
+        for (uint32_t k = 0; k < R->nb; k++) {
+            double P[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            if (k == j)
+                P[q] = 1.0;
+            const double *I = R->inertia + WS_SYM * (size_t)k, m = R->mass[k];
+            double *Yb = yr + nc * (size_t)q + 6 * (size_t)k;
+            Yb[0] = m * P[0], Yb[1] = m * P[1], Yb[2] = m * P[2];
+            Yb[3] = Yb[4] = Yb[5] = 0.0;
+            ws_sym_madd(I, P[3], P[4], P[5], Yb + 3);
+        }
+    size_t l = 0;
+    while (l < R->nl) {
+        const uint32_t k = R->link[l].body;
+        size_t end = l;
+        while (end < R->nl && R->link[end].body == k)
+            end++;
+        for (int q = 0; q < 6; q++) {
+            double *Yb = yr + nc * (size_t)q + 6 * (size_t)k;
+            double y0 = Yb[0], y1 = Yb[1], y2 = Yb[2], y3 = Yb[3], y4 = Yb[4], y5 = Yb[5];
+            for (size_t c = l; c < end; c++) {
+                const ws_rigid_link *L = &R->link[c];
+                const uint32_t rn = R->crow[L->node];
+                const uint32_t kn = rn == UINT32_MAX ? UINT32_MAX : at[rn];
+                if (k != j && kn == UINT32_MAX)
+                    continue; /* neither end moves */
+                const double lv[3] = {L->lever.x, L->lever.y, L->lever.z};
+                const double *ln = kn == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)kn;
+                const v3 jp = k == j ? phi_unit(q, lv) : v3_make(0.0, 0.0, 0.0);
+                const double cj[3] = {sym_row(L->C, 0, jp.x, jp.y, jp.z),
+                                      sym_row(L->C, 1, jp.x, jp.y, jp.z),
+                                      sym_row(L->C, 2, jp.x, jp.y, jp.z)};
+                /* g = C (p_node - J P): zero when Phi moves the node with this very contact
+                 * point (the same operations on the same numbers). */
+                if (!(k == j && ln && ln[0] == lv[0] && ln[1] == lv[1] && ln[2] == lv[2])) {
+                    const v3 pn = ln ? phi_unit(q, ln) : v3_make(0.0, 0.0, 0.0);
+                    const double g[3] = {sym_row(L->C, 0, pn.x, pn.y, pn.z) - cj[0],
+                                         sym_row(L->C, 1, pn.x, pn.y, pn.z) - cj[1],
+                                         sym_row(L->C, 2, pn.x, pn.y, pn.z) - cj[2]};
+                    const v3 mo = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
+                    y0 -= g[0], y1 -= g[1], y2 -= g[2];
+                    y3 -= mo.x, y4 -= mo.y, y5 -= mo.z;
+                }
+                if (web->inv_m[L->node] == 0.0 || rn == UINT32_MAX)
+                    continue; /* a pinned node's row stays zero; no other is outside Phi */
+                double *y = Y + 18 * (size_t)rn + 3 * (size_t)q;
+                y[0] -= cj[0], y[1] -= cj[1], y[2] -= cj[2];
+                reached[rn] = 1;
+            }
+            Yb[0] = y0, Yb[1] = y1, Yb[2] = y2, Yb[3] = y3, Yb[4] = y4, Yb[5] = y5;
+        }
+        l = end;
+    }
+    /* Phi^T of each column (phi_transpose) over the rows reached, into A's columns 6 j + q. */
+    for (int q = 0; q < 6; q++) {
+        double *out = R->cb;
+        memcpy(out, yr + nc * (size_t)q, nc * sizeof(double));
+        size_t k = 0;
+        while (k < R->nphi) {
+            const uint32_t b = R->phi_body[k];
+            double *o = out + 6 * (size_t)b;
+            double o0 = o[0], o1 = o[1], o2 = o[2], o3 = o[3], o4 = o[4], o5 = o[5];
+            for (; k < R->nphi && R->phi_body[k] == b; k++) {
+                const uint32_t r = R->crow[R->phi_node[k]];
+                if (!reached[r])
+                    continue;
+                const double *f = Y + 18 * (size_t)r + 3 * (size_t)q, *lk = R->phi_lever + 3 * k;
+                const v3 fv = v3_make(f[0], f[1], f[2]),
+                         mo = v3_cross(v3_make(lk[0], lk[1], lk[2]), fv);
+                o0 += f[0], o1 += f[1], o2 += f[2];
+                o3 += mo.x, o4 += mo.y, o5 += mo.z;
+            }
+            o[0] = o0, o[1] = o1, o[2] = o2, o[3] = o3, o[4] = o4, o[5] = o5;
+        }
+        const size_t c = 6 * (size_t)j + (size_t)q;
+        for (size_t d = 0; d < nc; d++)
+            A[nc * d + c] = out[d];
+    }
+}
+
+void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
+{
+    const size_t nc = 6 * (size_t)R->nb;
     double *A = R->coarse;
     phi_list(R, web);
-    for (size_t c = 0; c < nc; c++) {
-        memset(R->cb, 0, nc * sizeof(double));
-        memset(R->fa, 0, m * sizeof(double));
-        R->cb[c] = 1.0;
-        phi_apply(R, R->cb, R->fa);
-        (void)ws_implicit_apply_op(web, R->fa, R->fb);
-        (void)ws_rigid_apply(R, web, R->fa, R->cb, R->fb, R->cq);
-        phi_transpose(R, R->fb, R->cq, R->cb);
-        for (size_t d = 0; d < nc; d++)
-            A[nc * d + c] = R->cb[d];
-    }
+    const uint32_t rows = coarse_rows(R, web);
+    for (uint32_t j = 0; j < R->nb; j++)
+        coarse_body(R, web, rows, j, A);
     for (size_t c = 0; c < nc; c++) /* symmetric to round-off: its mean */
         for (size_t d = c + 1; d < nc; d++)
             A[nc * d + c] = A[nc * c + d] = 0.5 * (A[nc * d + c] + A[nc * c + d]);
-    return cholesky(A, nc);
+}
+
+int ws_rigid_coarse(ws_rigid *R, const ws_web *web)
+{
+    ws_rigid_coarse_matrix(R, web);
+    return cholesky(R->coarse, 6 * (size_t)R->nb);
 }
 
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,

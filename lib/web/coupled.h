@@ -39,9 +39,12 @@ typedef struct ws_rigid {
                                       the solves of one step) */
     /* The coarse space of the preconditioner: a column per body and direction, the body
      * moving (or turning) by one unit and every node it touches with the contact point, Phi.
-     * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles;
-     * fa, fb: 3 doubles a film node (scratch). NULL coarse: none. */
-    double *coarse, *cb, *cq, *fa, *fb;
+     * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles.
+     * Scratch of its set-up: crow, a film node's row among Phi's nodes (a uint32_t a film
+     * node); cphi, a row's entry and a flag (2 (cap + 1)); cy, 18 doubles a row (cap + 1);
+     * cyr, 36 nb doubles. NULL coarse: none. */
+    double *coarse, *cb, *cq, *cy, *cyr;
+    uint32_t *crow, *cphi;
     /* The coarse space's contacts (room for cap), set by ws_rigid_coarse: the first link of
      * each node-body pair at an unpinned node, as node, body and lever (3 doubles). */
     size_t nphi;
@@ -68,6 +71,12 @@ double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, con
 /* Phi^T A Phi for the operator the running solve set (its film part by ws_implicit_apply_op),
  * factored into R->coarse. 0, or -1 when it is not positive definite. */
 int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
+
+/* Phi^T A Phi (symmetrised: the mean of it and its transpose) into R->coarse, not factored: the
+ * same to the bit (a zero's sign aside) as Phi^T (A (Phi e_c)) column by column with
+ * ws_implicit_apply_op and ws_rigid_apply, at two passes over the springs instead of 6 nb
+ * over the film (a test compares them). */
+void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web);
 
 /* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
  * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as

@@ -23,8 +23,8 @@ static const char *label(const ws_web *web)
 
 /* The solve's bodies for the contacts L[0, nl): every dynamic body one of them touches gets
  * an index (slot[body], UINT32_MAX for the others) and its mass and global inertia; the
- * scratch (with the coarse space's, for a web of `nodes` nodes) from the step's arena. NULL (and *fail 0) when no dynamic body is touched, NULL
- * with *fail 1 when out of memory. */
+ * scratch (with the coarse space's set-up's, for a web of `nodes` nodes) from the step's arena.
+ * NULL (and *fail 0) when no dynamic body is touched, NULL with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
                             size_t nl, uint32_t nodes, const ws_mg *mg, uint32_t **slot_out,
                             int *fail)
@@ -46,14 +46,17 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     memset(R, 0, sizeof *R);
     R->nb = nb;
     R->cap = nl;
-    const size_t v6 = 6 * (size_t)nb, m = 3 * (size_t)nodes;
+    const size_t v6 = 6 * (size_t)nb;
     R->link = ws_arena_alloc(arena, (nl + 1) * sizeof *R->link);
-    double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 2 * m) *
-                                          sizeof(double));
+    double *d =
+        ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 6 * v6 + 18 * (nl + 1)) *
+                                  sizeof(double));
     R->phi_node = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_node);
     R->phi_body = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_body);
     R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
-    if (!R->link || !d || !R->phi_node || !R->phi_body || !R->phi_lever) {
+    R->crow = ws_arena_alloc(arena, ((size_t)nodes + 1) * sizeof *R->crow);
+    R->cphi = ws_arena_alloc(arena, 2 * (nl + 1) * sizeof *R->cphi);
+    if (!R->link || !d || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow || !R->cphi) {
         *fail = 1;
         return NULL;
     }
@@ -66,8 +69,8 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->cb = R->fac + 36 * (size_t)nb;
     R->cq = R->cb + v6;
     R->coarse = R->cq + v6;
-    R->fa = R->coarse + v6 * v6;
-    R->fb = R->fa + m;
+    R->cyr = R->coarse + v6 * v6;
+    R->cy = R->cyr + 6 * v6;
     /* Room for the film's multigrid to nest the bodies in (none without one). */
     const size_t mgb = ws_mg_body_bytes(mg, nb, nl);
     if (mgb && !(R->mgbuf = ws_arena_alloc(arena, mgb))) {
@@ -199,7 +202,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
          * window's top, bounded by the margin the candidates cover. */
         const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
-                                        S->contact.margin, links);
+                                        S->contact.margin, links, NULL);
         uint32_t *slot = NULL;
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
