@@ -1399,7 +1399,8 @@ static int band_pressed(int r, int nest, int checks)
         double *u = malloc(3 * n * sizeof(double)), *y = malloc(3 * n * sizeof(double)),
                *Bu = malloc(3 * n * sizeof(double)), *By = malloc(3 * n * sizeof(double));
         ck_assert(u && y && Bu && By);
-        double ub[6] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2}, yb[6] = {-0.1, 0.25, 0.3, -0.2, 0.1, 0.15};
+        double ub[6] = {0.3, -0.2, 0.1, 0.05, -0.4, 0.2},
+               yb[6] = {-0.1, 0.25, 0.3, -0.2, 0.1, 0.15};
         double Bub[6], Byb[6];
         random_vector(web, 7, u);
         random_vector(web, 8, y);

@@ -53,7 +53,8 @@ typedef struct mg_level {
      * (node, body) pairs that have one: entries gs[i] .. gs[i + 1] - 1 are node i's, sorted by
      * node; entry e couples node gn[e] to body gb[e] by the 3x6 block G + 18 e (row-major; in
      * double precision: converting single-precision blocks cost more time than their halved
-     * reading saved, bench/NOTES.md session 14). ng entries, room for gcap. xb, rb: the bodies' solution and right-hand side (6 nb). */
+     * reading saved, bench/NOTES.md session 14). ng entries, room for gcap. xb, rb: the
+     * bodies' solution and right-hand side (6 nb). */
     uint32_t *gs, *gn, *gb;
     double *G;
     size_t ng, gcap;
