@@ -82,6 +82,12 @@ int ws_rigid_factor(ws_rigid *R)
     return 0;
 }
 
+void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z)
+{
+    for (uint32_t j = 0; j < R->nb; j++)
+        cholesky_solve(R->fac + 36 * (size_t)j, 6, r + 6 * (size_t)j, z + 6 * (size_t)j);
+}
+
 /* Row i of the symmetric S times (x, y, z): what ws_sym_madd adds, without the add to a
  * zero the product loop would otherwise pay twice a contact. */
 static inline double sym_row(const double *S, int i, double x, double y, double z)

@@ -50,11 +50,17 @@ typedef struct ws_rigid {
     size_t nphi;
     uint32_t *phi_node, *phi_body;
     double *phi_lever;
+    /* Scratch for the film's multigrid to nest the bodies in (ws_mg_body_bytes; NULL: none,
+     * then the preconditioner is the block one with the coarse space). */
+    void *mgbuf;
 } ws_rigid;
 
 /* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
  * a block is not positive definite (a NaN, a body of no mass). */
 int ws_rigid_factor(ws_rigid *R);
+
+/* z = B^-1 r per body, B its factored block (6 doubles a body; z may be r). */
+void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z);
 
 /* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr, and the coupling's
  * -C J pr added into the film part y (y untouched at pinned nodes). Returns the dot product

@@ -468,6 +468,21 @@ static void residual_sites(ws_implicit *im, const ws_web *web, const ws_rigid *R
     }
 }
 
+/* z = P r over the film's part (r, z) and the bodies' (R->r, R->z; R NULL when none): the
+ * multigrid's cycle over both when the bodies are nested in it (nest); otherwise the film's
+ * preconditioner (the multigrid mg, or block Jacobi when NULL), then each body's block and the
+ * coarse correction added (docs/theory.md 8b). Returns r . z over both parts. */
+static double precondition_all(const ws_implicit *im, const ws_web *web, ws_mg *nest, ws_mg *mg,
+                               const ws_rigid *R, const double *r, double *z)
+{
+    if (nest)
+        return ws_mg_apply_bodies(nest, web, r, z, R->r, R->z);
+    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, web->n, r, z);
+    if (R) /* after the film's part, which its coarse correction adds to */
+        rz += ws_rigid_precondition(R, r, z, R->r, R->z);
+    return rz;
+}
+
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
 {
     ws_implicit *im = web->imp;
@@ -511,11 +526,6 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         return -1;
     }
     operator_for(web, h);
-    if (R && R->coarse && ws_rigid_coarse(R, web) != 0) {
-        im->warm = 0;
-        im->last_residual = NAN;
-        return -1;
-    }
     if (!im->warm)
         memset(x, 0, m * sizeof(double));
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
@@ -534,19 +544,29 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         meas = fmax(meas, bodies_worst2(R, R->r));
     }
     /* The multigrid's coarse levels only for a solve that iterates: a calm film's warm start
-     * often meets the tolerance already. */
+     * often meets the tolerance already. The bodies of the solve nested in it when the world
+     * gave it room for them. */
+    const int nests = im->mg && ws_mg_bodies(im->mg, R, R ? R->mgbuf : NULL);
     ws_mg *mg = im->mg && !im->jacobi_only && !(meas <= lim) &&
                         ws_mg_setup(im->mg, web, im->begun, h) == 0
                     ? im->mg
                     : NULL;
-    double rz = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
-    if (R) { /* after the film's part, which its coarse correction adds to */
+    const int nested = mg && nests;
+    /* The bodies' coarse space, unless they are nested in the multigrid (which resolves their
+     * modes on every level). */
+    if (R && R->coarse && !nested && ws_rigid_coarse(R, web) != 0) {
+        im->warm = 0;
+        im->last_residual = NAN;
+        return -1;
+    }
+    if (R) {
         for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
             R->r[j] = R->b[j] - R->q[j];
         rr += ws_rigid_dot(R, R->r, R->r);
-        rz += ws_rigid_precondition(R, r, z, R->r, R->z);
-        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
     }
+    double rz = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
+    if (R)
+        memcpy(R->p, R->z, 6 * (size_t)R->nb * sizeof(double));
     if (im->stop_relative)
         meas = rr;
     if (!isfinite(rr))
@@ -573,9 +593,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         }
         meas = !isfinite(rr) ? NAN : im->stop_relative ? rr : w2;
         it++;
-        double rz1 = mg ? ws_mg_apply(mg, web, r, z) : precondition(im, n, r, z);
-        if (R)
-            rz1 += ws_rigid_precondition(R, r, z, R->r, R->z);
+        const double rz1 = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
         const double beta = rz1 / rz;
         rz = rz1;
         for (size_t j = 0; j < m; j++)

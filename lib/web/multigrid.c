@@ -2,6 +2,7 @@
  * docs/theory.md, "The implicit film", why it is this one). */
 #include "web/multigrid.h"
 
+#include "web/coupled.h"
 #include "web/implicit.h"
 
 #include <string.h>
@@ -48,6 +49,16 @@ typedef struct mg_level {
     double *dinv;           /* WS_SYM n: inverse of each node's own block (coarse levels) */
     double *x, *r, *t;      /* 3 n each: the level's solution, right-hand side, scratch (the
                                film's level has t alone) */
+    /* With bodies nested (coarse levels): the coupling of the nodes to them, kept only for the
+     * (node, body) pairs that have one: entries gs[i] .. gs[i + 1] - 1 are node i's, sorted by
+     * node; entry e couples node gn[e] to body gb[e] by the 3x6 block G + 18 e (row-major; in
+     * double precision: converting single-precision blocks cost more time than their halved
+     * reading saved, bench/NOTES.md session 14). ng entries, room for gcap. xb, rb: the
+     * bodies' solution and right-hand side (6 nb). */
+    uint32_t *gs, *gn, *gb;
+    double *G;
+    size_t ng, gcap;
+    double *xb, *rb;
 } mg_level;
 
 struct ws_mg {
@@ -72,6 +83,17 @@ struct ws_mg {
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
+    /* The bodies of the running solve nested in the hierarchy (ws_mg_bodies; nb 0: none):
+     * their six unknowns ride along every coarse level, coupled to its nodes by the levels'
+     * entries. bchol: the coarsest level's factor with them ((m + 6 nb)^2), bsc: its vector
+     * (m + 6 nb); mark: (node, body) -> entry + 1 while a level's entries are gathered (level
+     * 1's n nb). All in the scratch ws_mg_bodies was given. */
+    uint32_t nb;
+    const ws_rigid *rig;
+    double *bchol, *bsc;
+    double *brz;  /* a zero residual and an answer for the bodies (12 nb: ws_mg_apply) */
+    double *bsum; /* the bodies' right-hand side in a backward sweep (6 nb) */
+    uint32_t *mark;
 };
 
 /* Interpolation from a coarse level to the finer one, along one direction: fine index i of n
@@ -352,14 +374,44 @@ static int own_inverse(const float *B, double *S)
     return ws_sym_invert(sym, S);
 }
 
+/* The bodies' rows of the coarsest level's dense matrix D (m unknowns, the bodies' after the
+ * nodes'): each body's block M_j + sum J^T C J (from its factor L L^T) and the nodes' coupling
+ * entries in both triangles. */
+static void coarsest_bodies(const ws_mg *mg, const mg_level *L, double *D, uint32_t m)
+{
+    const uint32_t m0 = mg->m;
+    for (uint32_t j = 0; j < mg->nb; j++) {
+        const double *F = mg->rig->fac + 36 * (size_t)j;
+        const size_t o = m0 + 6 * (size_t)j;
+        for (int a = 0; a < 6; a++)
+            for (int b = 0; b < 6; b++) {
+                double v = 0.0;
+                for (int q = 0; q <= (a < b ? a : b); q++)
+                    v += F[6 * a + q] * F[6 * b + q];
+                D[(o + (size_t)a) * m + o + (size_t)b] = v;
+            }
+    }
+    for (size_t e = 0; e < L->ng; e++) {
+        const double *G = L->G + 18 * e;
+        const size_t i = 3 * (size_t)L->gn[e], o = m0 + 6 * (size_t)L->gb[e];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 6; c++) {
+                D[(i + (size_t)r) * m + o + (size_t)c] = G[6 * r + c];
+                D[(o + (size_t)c) * m + i + (size_t)r] = G[6 * r + c];
+            }
+    }
+}
+
 /* The coarsest level's dense matrix and its Cholesky factor. 0, or -1 when it is not positive
  * definite. */
 static int factor_coarsest(ws_mg *mg)
 {
     const mg_level *L = &mg->lv[mg->nlev - 1];
-    const uint32_t m = mg->m;
-    double *D = mg->chol;
+    const uint32_t m = mg->m + 6 * mg->nb;
+    double *D = mg->nb ? mg->bchol : mg->chol;
     memset(D, 0, (size_t)m * m * sizeof(double));
+    if (mg->nb)
+        coarsest_bodies(mg, L, D, m);
     int64_t nb[9];
     for (int iy = 0; iy < L->ny; iy++)
         for (int ix = 0; ix < L->nx; ix++) {
@@ -407,6 +459,168 @@ static int factor_coarsest(ws_mg *mg)
     return 0;
 }
 
+/* A contact's coupling -C J (3x6 row-major; J = [I, -[r]x], so column 3 + k is -C (e_k x r)). */
+static void link_coupling(const ws_rigid_link *L, double *G)
+{
+    const v3 r = L->lever;
+    for (int c = 0; c < 6; c++) {
+        const v3 e = v3_make(c % 3 == 0, c % 3 == 1, c % 3 == 2);
+        const v3 a = c < 3 ? e : v3_cross(e, r);
+        double g[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(L->C, a.x, a.y, a.z, g);
+        for (int q = 0; q < 3; q++)
+            G[6 * q + c] = -g[q];
+    }
+}
+
+/* Level c's entries from the pairs marked in mg->mark (node-major, bodies in order), their
+ * blocks zeroed; mark then holds each pair's entry + 1. */
+static void entries_of_marks(const ws_mg *mg, mg_level *c)
+{
+    const uint32_t nb = mg->nb;
+    uint32_t e = 0;
+    for (uint32_t i = 0; i < c->n; i++) {
+        c->gs[i] = e;
+        for (uint32_t j = 0; j < nb; j++) {
+            uint32_t *k = &mg->mark[(size_t)i * nb + j];
+            if (!*k)
+                continue;
+            c->gn[e] = i;
+            c->gb[e] = j;
+            *k = ++e;
+        }
+    }
+    c->gs[c->n] = e;
+    c->ng = e;
+    memset(c->G, 0, 18 * (size_t)e * sizeof(double));
+}
+
+/* G += w S for 3x6 blocks. */
+static inline void g_axpy(double *G, double w, const double *S)
+{
+    for (int q = 0; q < 18; q++)
+        G[q] += w * S[q];
+}
+
+/* The bodies' coupling on every coarse level, kept for the (node, body) pairs that have one:
+ * level 1's is P^T (-C J) over the contacts, level k + 1's P^T of level k's (P acts on the
+ * nodes alone: a body's unknowns are the same on every level). Each level is gathered in two
+ * passes, the pairs marked, then the blocks summed; a level's pairs fit the room
+ * ws_mg_body_bytes gives (pairs_room), and on a wrapped band they are about its nodes, each
+ * near one box. */
+static void galerkin_bodies(ws_mg *mg, const ws_web *web)
+{
+    const uint32_t nb = mg->nb;
+    const ws_rigid *R = mg->rig;
+    mg_level *c = &mg->lv[1];
+    pmap p;
+    double G0[18];
+    memset(mg->mark, 0, (size_t)c->n * nb * sizeof(uint32_t));
+    for (size_t l = 0; l < R->nl; l++) {
+        film_pmap(mg, web, R->link[l].node, &p);
+        for (int i = 0; i < p.n; i++)
+            mg->mark[(size_t)p.idx[i] * nb + R->link[l].body] = 1;
+    }
+    entries_of_marks(mg, c);
+    for (size_t l = 0; l < R->nl; l++) {
+        const ws_rigid_link *L = &R->link[l];
+        film_pmap(mg, web, L->node, &p);
+        if (!p.n)
+            continue;
+        link_coupling(L, G0);
+        for (int i = 0; i < p.n; i++)
+            g_axpy(c->G + 18 * ((size_t)mg->mark[(size_t)p.idx[i] * nb + L->body] - 1),
+                   p.w[i], G0);
+    }
+    for (int k = 1; k + 1 < mg->nlev; k++) {
+        const mg_level *f = &mg->lv[k];
+        c = &mg->lv[k + 1];
+        memset(mg->mark, 0, (size_t)c->n * nb * sizeof(uint32_t));
+        for (int pass = 0; pass < 2; pass++) {
+            for (size_t e = 0; e < f->ng; e++) {
+                const uint32_t i = f->gn[e], j = f->gb[e];
+                pmap_of(f, c, (int)(i % (uint32_t)f->nx), (int)(i / (uint32_t)f->nx), &p);
+                for (int a = 0; a < p.n; a++) {
+                    uint32_t *mk = &mg->mark[(size_t)p.idx[a] * nb + j];
+                    if (pass == 0)
+                        *mk = 1;
+                    else
+                        g_axpy(c->G + 18 * ((size_t)*mk - 1), p.w[a], f->G + 18 * e);
+                }
+            }
+            if (pass == 0)
+                entries_of_marks(mg, c);
+        }
+    }
+}
+
+/* The room for level k's (node, body) pairs with nb bodies and nl contacts: at most its nodes
+ * times the bodies, and at most 4 a pair of the level above (a row of P has at most four
+ * coarse nodes), level 1's 4 a contact. */
+static size_t pairs_room(const ws_mg *mg, int k, uint32_t nb, size_t nl)
+{
+    size_t room = nl;
+    for (int i = 1; i <= k; i++) {
+        const size_t all = (size_t)mg->lv[i].n * nb;
+        room = 4 * room < all ? 4 * room : all;
+    }
+    return room;
+}
+
+size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb, size_t nl)
+{
+    if (!mg || !nb || nb > WS_MG_NEST_BODIES_MAX)
+        return 0;
+    const size_t m = mg->m + 6 * (size_t)nb;
+    size_t d = m * m + m + 18 * (size_t)nb, u = (size_t)mg->lv[1].n * nb;
+    for (int k = 1; k < mg->nlev; k++) {
+        const size_t pairs = pairs_room(mg, k, nb, nl);
+        d += 12 * (size_t)nb + 18 * pairs;
+        u += (size_t)mg->lv[k].n + 1 + 2 * pairs;
+    }
+    return d * sizeof(double) + u * sizeof(uint32_t) + sizeof(double);
+}
+
+int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
+{
+    mg->nb = 0;
+    mg->rig = NULL;
+    if (!R || !buf || !R->nb || R->nb > WS_MG_NEST_BODIES_MAX || R->nl > R->cap)
+        return 0;
+    for (size_t l = 1; l < R->nl; l++) /* the film level walks them in node order */
+        if (R->link[l].node < R->link[l - 1].node)
+            return 0;
+    mg->nb = R->nb;
+    mg->rig = R;
+    const uint32_t nb = mg->nb;
+    const size_t m = mg->m + 6 * (size_t)nb;
+    /* doubles first, from the buffer's first 8-aligned byte; then the indices */
+    double *q = (double *)(((uintptr_t)buf + 7) & ~(uintptr_t)7);
+    mg->bchol = q, q += m * m;
+    mg->bsc = q, q += m;
+    mg->brz = q, q += 12 * (size_t)nb;
+    mg->bsum = q, q += 6 * (size_t)nb;
+    for (int k = 1; k < mg->nlev; k++) {
+        mg_level *L = &mg->lv[k];
+        L->xb = q, q += 6 * (size_t)nb;
+        L->rb = q, q += 6 * (size_t)nb;
+    }
+    for (int k = 1; k < mg->nlev; k++) {
+        mg_level *L = &mg->lv[k];
+        L->gcap = pairs_room(mg, k, nb, R->cap);
+        L->G = q, q += 18 * L->gcap;
+    }
+    uint32_t *u = (uint32_t *)q;
+    mg->mark = u, u += (size_t)mg->lv[1].n * nb;
+    for (int k = 1; k < mg->nlev; k++) {
+        mg_level *L = &mg->lv[k];
+        L->gs = u, u += L->n + 1;
+        L->gn = u, u += L->gcap;
+        L->gb = u, u += L->gcap;
+    }
+    return 1;
+}
+
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
@@ -432,6 +646,8 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
             if (own_inverse(AT(L, i, CENTRE), L->dinv + WS_SYM * (size_t)i) != 0)
                 return -1;
     }
+    if (mg->nb)
+        galerkin_bodies(mg, web);
     return factor_coarsest(mg);
 }
 
@@ -462,13 +678,40 @@ static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
     ws_sym_madd(S, s[0], s[1], s[2], X);
 }
 
-/* The sweeps of block Gauss-Seidel on a coarse level L. Forward from x = 0: a node meets only
- * the nodes before it (those after are still zero), and the sweep leaves the residual r - A x
- * in t (at node k, what the nodes after it add since: -sum over them of A_kj x_j, each added
- * as that node is solved, with the block its own solve has just read). */
-static void gauss_seidel_forward(mg_level *L)
+/* s -= G u for a coupling block G (3x6 row-major) and a body's u (6). */
+static inline void g_sub(const double *G, const double *u, double *s)
 {
+    for (int r = 0; r < 3; r++) {
+        const double *g = G + 6 * r;
+        s[r] -= g[0] * u[0] + g[1] * u[1] + g[2] * u[2] + g[3] * u[3] + g[4] * u[4] +
+                g[5] * u[5];
+    }
+}
+
+/* s -= G^T x for a coupling block G and a node's x (3) into a body's s (6). */
+static inline void gt_sub(const double *G, const double *x, double *s)
+{
+    for (int c = 0; c < 6; c++)
+        s[c] -= G[c] * x[0] + G[6 + c] * x[1] + G[12 + c] * x[2];
+}
+
+/* The sweeps of block Gauss-Seidel on a coarse level L, with the bodies nested (mg->nb) first
+ * in the forward sweep and last in the backward one, so that the two mirror each other (B_k
+ * symmetric) and every coupling term is taken in the node loops, where the node's x is at
+ * hand. Forward from x = 0: the bodies from their right-hand side alone, then a node meets
+ * only the nodes before it (those after are still zero) and the bodies; the sweep leaves the
+ * residual r - A x in t (at node k, what the nodes after it add since: -sum over them of
+ * A_kj x_j, each added as that node is solved, with the block its own solve has just read)
+ * and the bodies' residual, rb - A_bb xb - G^T x = -G^T x, in rbn (the next level's: the
+ * bodies are the same unknowns there). */
+static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
     memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
+    if (nb6) {
+        ws_rigid_block_solve(mg->rig, L->rb, L->xb);
+        memset(rbn, 0, nb6 * sizeof(double));
+    }
     for (int iy = 0; iy < L->ny; iy++)
         for (int ix = 0; ix < L->nx; ix++) {
             const int64_t k = ix + (int64_t)L->nx * iy;
@@ -480,17 +723,28 @@ static void gauss_seidel_forward(mg_level *L)
             for (int o = 0; o < 9; o++)
                 if (o != CENTRE)
                     gs_take(L, k, o, j[o], &B[o], s);
+            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+            for (uint32_t e = e0; e < e1; e++)
+                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
             gs_solve(L, k, s);
             const double *X = L->x + 3 * (size_t)k;
             for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
                 if (o != CENTRE && B[o])
                     fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
+            for (uint32_t e = e0; e < e1; e++)
+                gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
         }
 }
 
-/* Backward from the x there is: node k meets every neighbour. */
-static void gauss_seidel_backward(mg_level *L)
+/* Backward from the x and xb there are: node k meets every neighbour and the bodies, and its
+ * new x is taken off the bodies' right-hand side (in mg->bsum), which they are solved with at
+ * the end. */
+static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
 {
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    double *sb = mg->bsum;
+    if (nb6)
+        memcpy(sb, L->rb, nb6 * sizeof(double));
     for (int iy = L->ny - 1; iy >= 0; iy--)
         for (int ix = L->nx - 1; ix >= 0; ix--) {
             const int64_t k = ix + (int64_t)L->nx * iy;
@@ -501,8 +755,16 @@ static void gauss_seidel_backward(mg_level *L)
             for (int o = 0; o < 9; o++)
                 if (o != CENTRE && j[o] >= 0)
                     fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
+            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+            for (uint32_t e = e0; e < e1; e++)
+                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
             gs_solve(L, k, s);
+            const double *X = L->x + 3 * (size_t)k;
+            for (uint32_t e = e0; e < e1; e++)
+                gt_sub(L->G + 18 * (size_t)e, X, sb + 6 * (size_t)L->gb[e]);
         }
+    if (nb6) /* the bodies last: xb = A_bb^-1 (rb - G^T x) */
+        ws_rigid_block_solve(mg->rig, sb, L->xb);
 }
 
 /* Whether fine node i of level k is left out of P (a pinned film node: its dv is zero). */
@@ -546,12 +808,45 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
     }
 }
 
+/* The film level's coupling to the nested bodies, taken inside its node passes: the solve's
+ * contacts are sorted by node (ws_mg_bodies checks it), so a pass over the nodes walks them
+ * with a cursor *l and meets node i's contacts when it is at node i, its z or t in hand. */
+/* rbo += J^T C Z over node i's contacts (the bodies' residual takes -A_bf z). */
+static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
+                                  double *rbo)
+{
+    for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
+        const ws_rigid_link *L = &R->link[*l];
+        double g[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(L->C, Z[0], Z[1], Z[2], g);
+        const v3 m = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
+        double *o = rbo + 6 * (size_t)L->body;
+        o[0] += g[0], o[1] += g[1], o[2] += g[2];
+        o[3] += m.x, o[4] += m.y, o[5] += m.z;
+    }
+}
+
+/* T += C J zb over node i's contacts (T, the film's residual, takes -A_fb zb). */
+static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
+                                  double *T)
+{
+    for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
+        const ws_rigid_link *L = &R->link[*l];
+        const double *U = zb + 6 * (size_t)L->body;
+        const v3 u = v3_add(v3_make(U[0], U[1], U[2]),
+                            v3_cross(v3_make(U[3], U[4], U[5]), L->lever));
+        ws_sym_madd(L->C, u.x, u.y, u.z, T);
+    }
+}
+
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
  * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
- * of the product that follows is taken on the way: t = r - N x. */
+ * of the product that follows is taken on the way: t = r - N x, and with the bodies nested
+ * (zb given) t -= A_fb zb. */
 static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
-                        double *t)
+                        double *t, const double *zb)
 {
+    size_t l = 0;
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
     double *u = mg->row;
@@ -584,6 +879,8 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
                 double *T = t + 3 * (size_t)i;
                 T[0] = R[0], T[1] = R[1], T[2] = R[2];
                 fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
+                if (zb)
+                    bodies_to_node(mg->rig, &l, i, zb, T);
             }
         }
     }
@@ -592,12 +889,18 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
 /* x = L^-T L^-1 r on the coarsest level. */
 static void solve_coarsest(ws_mg *mg)
 {
-    const mg_level *L = &mg->lv[mg->nlev - 1];
-    const uint32_t m = mg->m;
-    const double *F = mg->chol;
-    double *x = L->x;
+    mg_level *L = &mg->lv[mg->nlev - 1];
+    const uint32_t m = mg->m + 6 * mg->nb;
+    const double *F = mg->nb ? mg->bchol : mg->chol;
+    double *x = mg->nb ? mg->bsc : L->x;
+    const double *rhs = L->r;
+    if (mg->nb) { /* nodes and bodies as one vector */
+        memcpy(x, L->r, mg->m * sizeof(double));
+        memcpy(x + mg->m, L->rb, 6 * (size_t)mg->nb * sizeof(double));
+        rhs = x;
+    }
     for (uint32_t i = 0; i < m; i++) {
-        double s = L->r[i];
+        double s = rhs[i];
         for (uint32_t k = 0; k < i; k++)
             s -= F[(size_t)i * m + k] * x[k];
         x[i] = s / F[(size_t)i * m + i];
@@ -607,6 +910,10 @@ static void solve_coarsest(ws_mg *mg)
         for (uint32_t k = i + 1; k < m; k++)
             s -= F[(size_t)k * m + i] * x[k];
         x[i] = s / F[(size_t)i * m + i];
+    }
+    if (mg->nb) {
+        memcpy(L->x, x, mg->m * sizeof(double));
+        memcpy(L->xb, x + mg->m, 6 * (size_t)mg->nb * sizeof(double));
     }
 }
 
@@ -619,23 +926,28 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
         return;
     }
     mg_level *L = &mg->lv[k];
-    gauss_seidel_forward(L);
+    gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
-    prolong_add(mg, web, k, L->x, NULL, NULL);
-    gauss_seidel_backward(L);
+    prolong_add(mg, web, k, L->x, NULL, NULL, NULL);
+    for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
+        L->xb[q] += mg->lv[k + 1].xb[q];
+    gauss_seidel_backward(mg, L);
 }
 
 /* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
  * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
  * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
- * them (single precision). Returns r . z. */
+ * them (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo
+ * given: rbo -= A_bf z with the new z (never both). Returns r . z. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
 static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
-                                double *restrict t, double *restrict z, int how, int residual)
+                                double *restrict t, double *restrict z, int how, int residual,
+                                const double *zb, double *rbo)
 {
     double rz = 0.0;
+    size_t l = 0;
     for (uint32_t i = 0; i < n; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
@@ -652,9 +964,13 @@ static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restr
             else
                 Z[0] += u0, Z[1] += u1, Z[2] += u2;
         }
+        if (rbo)
+            node_to_bodies(mg->rig, &l, i, Z, rbo);
         if (residual) {
             T[0] = R[0], T[1] = R[1], T[2] = R[2];
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
+            if (zb)
+                bodies_to_node(mg->rig, &l, i, zb, T);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
@@ -685,28 +1001,57 @@ static void film_springs(const ws_mg *mg, const ws_web *web, const double *restr
     }
 }
 
-/* z = B r: on the film's level mg->sweeps Jacobi sweeps from zero, the residual restricted,
- * the coarse cycle, its correction interpolated, mg->sweeps sweeps more. Each sweep's product is
- * the node pass (which also finishes the sweep before) and the springs' pass. */
-double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
+/* z = B r (and zb = B rb with bodies nested): on the film's level mg->sweeps Jacobi sweeps
+ * from zero (the bodies held at zero), the residual restricted (the bodies' with it), the
+ * coarse cycle, its correction interpolated, mg->sweeps sweeps more against the bodies'
+ * correction. Each sweep's product is the node pass (which also finishes the sweep before)
+ * and the springs' pass. */
+static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, const double *rb,
+                    double *zb)
 {
     double *t = mg->lv[0].t;
     const uint32_t n = web->n;
-    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1);
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    /* The bodies' right-hand side for level 1, rb - A_bf z, taken with the last pre-sweep's z. */
+    double *rbo = nb6 ? mg->lv[1].rb : NULL;
+    if (nb6)
+        memcpy(rbo, rb, nb6 * sizeof(double));
+    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
         film_springs(mg, web, z, t);
     }
     restrict_to(mg, web, 0, t);
     cycle(mg, web, 1);
-    prolong_add(mg, web, 0, z, r, t); /* and t = r - N z */
+    if (nb6)
+        memcpy(zb, mg->lv[1].xb, nb6 * sizeof(double));
+    prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL); /* and t = r - N z - A_fb zb */
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) {
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
         film_springs(mg, web, z, t);
     }
-    return film_nodes(mg, n, r, t, z, JACOBI_ADD, 0);
+    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0, NULL, NULL);
+    for (size_t q = 0; q < nb6; q++)
+        rz += rb[q] * zb[q];
+    return rz;
+}
+
+double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z)
+{
+    if (!mg->nb)
+        return apply(mg, web, r, z, NULL, NULL);
+    /* With bodies nested, the film's block of the cycle: their residual zero, their part of
+     * the answer dropped (a principal block of a symmetric positive definite map is one). */
+    memset(mg->brz, 0, 6 * (size_t)mg->nb * sizeof(double));
+    return apply(mg, web, r, z, mg->brz, mg->brz + 6 * (size_t)mg->nb);
+}
+
+double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double *z,
+                          const double *rb, double *zb)
+{
+    return apply(mg, web, r, z, rb, zb);
 }
 
 int ws_mg_levels(const ws_mg *mg)

@@ -45,8 +45,37 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg);
  * not positive definite (then the solve keeps block Jacobi). */
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h);
 
-/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. */
+/* z = B r, one V-cycle; r and z xyz per node, zero at pinned nodes. Returns r . z. With
+ * bodies nested (ws_mg_bodies), the film's block of ws_mg_apply_bodies: their residual zero,
+ * their answer dropped. */
 double ws_mg_apply(ws_mg *mg, const ws_web *web, const double *r, double *z);
+
+/* The bodies of the running solve nested in the hierarchy (docs/theory.md 8b): their six
+ * unknowns ride along every coarse level, coupled to its nodes by the contacts' -C J restricted
+ * with the levels' interpolation and kept only for the (coarse node, body) pairs that have one,
+ * smoothed before the nodes in the forward Gauss-Seidel sweep (after them in the backward one)
+ * and solved with the coarsest level; the film's level smooths its nodes alone and hands the
+ * bodies' residual down with the nodes'. ws_mg_body_bytes: the scratch this needs for nb
+ * bodies and at most nl contacts (0 without a multigrid or bodies, or with more than
+ * WS_MG_NEST_BODIES_MAX bodies); ws_mg_bodies: R's bodies (its links, at most R->cap, and
+ * factored blocks, set for the solve before ws_mg_setup, which restricts the coupling) with
+ * that scratch, or none (R or buf NULL); it returns whether they are nested (1), 0 when none
+ * are, there are too many or R's contacts are not sorted by node (the film level walks them
+ * in node order). Then the solve keeps the bodies' blocks and coarse space beside the
+ * multigrid. */
+/* The most bodies nested: the pairs are gathered through a (coarse node, body) table of the
+ * first coarse level's nodes times the bodies, and the coarsest factor grows with the cube of
+ * its unknowns plus 6 nb; 32 boxes on a band of 92544 nodes take 6 MB of table and a factor of
+ * at most 576 unknowns (WS_MG_COARSEST_MAX nodes and the bodies). */
+#define WS_MG_NEST_BODIES_MAX 32
+struct ws_rigid;
+size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb, size_t nl);
+int ws_mg_bodies(ws_mg *mg, const struct ws_rigid *R, void *buf);
+
+/* z = B r and zb = B rb over the film and the nested bodies: one V-cycle of the coupled matrix,
+ * symmetric positive definite (docs/theory.md 8b). rb, zb 6 a body. Returns r . z + rb . zb. */
+double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double *z,
+                          const double *rb, double *zb);
 
 /* The number of levels (the film's own one included), for the counts. */
 int ws_mg_levels(const ws_mg *mg);

@@ -6,6 +6,7 @@
  * state at t as for the explicit film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
 #include "web/coupled.h"
+#include "web/multigrid.h"
 #include "world/world_internal.h"
 
 #include <float.h>
@@ -25,7 +26,8 @@ static const char *label(const ws_web *web)
  * scratch (with the coarse space's set-up's, for a web of `nodes` nodes) from the step's arena.
  * NULL (and *fail 0) when no dynamic body is touched, NULL with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
-                            size_t nl, uint32_t nodes, uint32_t **slot_out, int *fail)
+                            size_t nl, uint32_t nodes, const ws_mg *mg, uint32_t **slot_out,
+                            int *fail)
 {
     *fail = 1;
     uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
@@ -69,6 +71,12 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->coarse = R->cq + v6;
     R->cyr = R->coarse + v6 * v6;
     R->cy = R->cyr + 6 * v6;
+    /* Room for the film's multigrid to nest the bodies in (none without one). */
+    const size_t mgb = ws_mg_body_bytes(mg, nb, nl);
+    if (mgb && !(R->mgbuf = ws_arena_alloc(arena, mgb))) {
+        *fail = 1;
+        return NULL;
+    }
     for (size_t i = 0; i < b->slots; i++) {
         const uint32_t j = slot[i];
         if (j == UINT32_MAX)
@@ -199,7 +207,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
                           ? NULL
-                          : rigid_make(S->arena, b, links, nl, web->n, &slot, &nomem);
+                          : rigid_make(S->arena, b, links, nl, web->n, im->mg, &slot, &nomem);
         if (nomem)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
