@@ -370,7 +370,7 @@ static void probe_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
 /* Every item of every task runs exactly once, on a worker below the pool's count, one item a
  * call, whatever the task's size: 20000 tasks back to back (a thread that wakes late for one
  * must not take an item of the next), of 1 to 48 items (more than the pool was made for: then
- * all on the caller). The bookkeeping of each task is exact, so any miss is a failure. And the
+ * all on the caller), 0 to 3 of them shared (no worker's own share, up to all of them). The bookkeeping of each task is exact, so any miss is a failure. And the
  * pool is made and joined with its bytes back to zero. */
 START_TEST(test_pool_runs_each_item_once)
 {
@@ -388,7 +388,9 @@ START_TEST(test_pool_runs_each_item_once)
         const int32_t count = 1 + (int32_t)((t * 7919u) % 48u);
         for (int32_t i = 0; i < count; i++)
             atomic_store(&P->runs[i], 0);
-        ws_pool_run(pool, probe_items, count, P);
+        const int32_t shared = (int32_t)((t * 31u) % 4u) < count ? (int32_t)((t * 31u) % 4u)
+                                                                  : count;
+        ws_pool_run(pool, probe_items, count, shared, P);
         for (int32_t i = 0; i < count; i++) {
             if (atomic_load(&P->runs[i]) != 1)
                 ck_abort_msg("task %d of %d items: item %d ran %d times", t, count, i,
