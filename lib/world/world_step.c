@@ -4,7 +4,9 @@
  *   (2) contact detection: full (broad phase, optional libccd gate, candidate feature pairs) or
  *       the cached candidates carried over;
  *   (3) forces: gravity, then every candidate evaluated (penalty + friction on both bodies),
- *       then the deformable elements (rods, springs, bushings: world_element.c);
+ *       then the deformable elements (rods, springs, bushings: world_element.c), then the
+ *       webs' (with workers and only explicit webs the candidates are evaluated beside the
+ *       film's first sub-step and the elements follow the film: the same sums, step_once);
  *   (4) integration into the other state buffer; world elements from their drives at t + dt;
  *   (5) health check; (6) commit by swapping buffers and t += dt.
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
