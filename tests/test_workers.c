@@ -272,13 +272,13 @@ static int failing_law(void *user, int dim, const double *u, const double *ud, d
 /* On workers the body contacts run beside the film's first sub-step, and the elements and the
  * bodies' stable-step check after the film: a step that an element's law refuses there has
  * swept the film already, and must still leave the world as it was. The sheet on 2 workers
- * with a soft spring from the world to the box, whose law fails at steps 150 and 151 (after
- * the sheet lands: contacts, runs, searches): each refused step leaves the state hash as it
+ * with a soft spring from the world to the box, whose law fails at steps 80 and 81 (the sheet
+ * lands at step 65 and lifts off at 105: contacts, runs, searches): each refused step leaves the state hash as it
  * was, and the world then steps on to the hash of a twin that was never refused, to the bit
  * (the film's contact cache, lists and anchors undone too). */
 START_TEST(test_refused_after_the_film)
 {
-    const long steps = short_run() ? 160 : 400, fail_at = 150;
+    const long steps = short_run() ? 120 : 400, fail_at = 80;
     uint64_t h[2];
     long refused = 0;
     for (int twin = 0; twin < 2; twin++) {
@@ -321,10 +321,15 @@ START_TEST(test_refused_after_the_film)
             }
             fail = 0;
         }
-        ck_ok(w, ws_world_step_n(w, steps - fail_at));
-        ws_vec3 f;
-        ck_ok(w, ws_web_get_body_force(w, web, box, &f, NULL));
-        ck_assert_msg(f.z < 0.0, "the sheet does not press on the box");
+        /* The film touches the box after the refused steps. */
+        double press = 0.0;
+        for (long k = fail_at; k < steps; k++) {
+            ck_ok(w, ws_world_step(w));
+            ws_vec3 f;
+            ck_ok(w, ws_web_get_body_force(w, web, box, &f, NULL));
+            press = fmax(press, -f.z);
+        }
+        ck_assert_msg(press > 0.0, "the sheet never pressed on the box");
         ck_ok(w, ws_world_get_state_hash(w, &h[twin]));
         ws_world_destroy(w);
     }
