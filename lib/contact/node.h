@@ -33,9 +33,6 @@ _Static_assert(3ull * WS_MESH_MAX_ITEMS / 2 < WS_NCAND_CORNER, "feature numbers 
 typedef struct ws_nseg {
     uint32_t n0, n1, c0, c1;
     int run;
-    /* A run's nodes in the contact window at its last sub-step: the cost its lane's sweep
-     * gives it beyond its nodes (the world's cut of the lanes, lanes_cut). */
-    uint32_t window;
 } ws_nseg;
 
 /* A growable list of candidates: c[0, n), room for cap. */

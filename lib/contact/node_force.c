@@ -744,12 +744,10 @@ static const uint8_t run_count4[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3,
  * places in the list of loads, in node order: the run passes take them with the arithmetic of
  * contacts_general for a node whose only candidate is a face it lies well inside of, without
  * its look-ups (the face, body and contact are the run's). A chunk with a node below the face's
- * plane (d < 0), where another face may lie shallower, goes to contacts_general. Returns how
- * many of its nodes the batch took (in the window). */
-static uint32_t contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand,
-                             const ws_nseg *sg, double h, double share, v3 *fc)
+ * plane (d < 0), where another face may lie shallower, goes to contacts_general. */
+static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, const ws_nseg *sg,
+                         double h, double share, v3 *fc)
 {
-    uint32_t window = 0;
     ws_web *web = E->web;
     ws_node_contact *nc = web->contact;
     const ws_nodes3 x = E->x;
@@ -795,10 +793,8 @@ static uint32_t contacts_run(const node_env *E, run_batch *B, const ws_ncand *ca
             B->grp[B->n++] = (run_group){rf, start, slot, bits << (o + e - start)};
             slot += run_count4[bits];
         }
-        window += slot - (uint32_t)L->nl;
         L->nl = slot;
     }
-    return window;
 }
 
 /* The stretches being cut into seg, which has room for one per candidate (none is empty): a
@@ -822,7 +818,7 @@ static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
     if (c0 != c1)
         seg_put(sc, (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0,
-                              (uint32_t)c1, run, 0});
+                              (uint32_t)c1, run});
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -1022,8 +1018,8 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
         tried += sg->c1 - sg->c0;
         if (nc->row_mark && sg->n0 / (uint32_t)web->nx != row) /* a row's first stretch */
             nc->row_mark[nc->nrow_mark++] = L.nl, row = sg->n0 / (uint32_t)web->nx;
-        if (sg->run) /* its window noted for the lanes' cut (the lane's own stretch) */
-            nc->seg[k].window = contacts_run(&E, &B, cand, sg, h, share, fc);
+        if (sg->run)
+            contacts_run(&E, &B, cand, sg, h, share, fc);
         else
             contacts_general(&E, cand + sg->c0, sg->c1 - sg->c0);
     }

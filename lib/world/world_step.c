@@ -301,18 +301,9 @@ static int lanes_cover(const ws_lane_job *J, uint32_t lanes, uint32_t ny)
 
 enum { LANES_CUT_EVERY = 16 };
 
-/* A stretch's cost in lanes_cut's units (a node: 5) beyond its nodes. */
-static uint64_t seg_cost(const ws_nseg *sg)
-{
-    return 4ull * (sg->run ? sg->window : sg->c1 - sg->c0);
-}
-
 /* The rows of each of the lanes (r0, r1), cut so that their work is about equal: a row costs
- * its nodes (springs, integration, the depth of each in a run), 0.8 of a node for each node of
- * a run in the contact window at its last sub-step (the run passes) and as much for each
- * candidate it takes one by one (a fit of the four lanes' thread CPU times on the wrapped
- * reference case; the window left out, the first two lanes there, the world's thread's,
- * took 8 % more than the last two).
+ * its nodes (springs, integration, a contact each in a run) and 0.6 of a node for each
+ * candidate it takes one by one (a fit of the lanes' times on the wrapped reference case).
  * Every lane but the last holds a block's rows at least, the last a row: the run kernel's
  * groups, which may start up to three nodes before a node of the lane's end, stay within it.
  * The results do not depend on the cut. (A cut between blocks, tried, left the two workers'
@@ -338,23 +329,17 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     const int segs = nc->seg_list == nc->next_list;
     uint64_t total = 5ull * nx * ny, acc = 0;
     for (size_t s = 0; segs && s < nc->nseg; s++)
-        total += seg_cost(&nc->seg[s]);
+        total += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
     uint32_t i = 1;
     J[0].r0 = 0;
     for (uint32_t j = 0, s = 0; j < ny && i < lanes; j++) {
-        const uint64_t before = acc;
         acc += 5ull * nx; /* row j, with its stretches */
         for (; segs && s < nc->nseg && nc->seg[s].n0 < nx * (j + 1); s++)
-            acc += seg_cost(&nc->seg[s]);
-        /* Lane i starts after row j once the lanes before have their share, within room, or
-         * at row j when that leaves them nearer their share: a row is some 3 % of a worker's
-         * share of the wrapped case, and cutting always after it gave the first lanes the
-         * surplus. */
+            acc += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
+        /* Lane i starts after row j once the lanes before have their share, within room. */
         const uint32_t lo = J[i - 1].r0 + r, hi = ny - (lanes - i - 1) * r - 1;
         if ((acc * lanes >= total * i && j + 1 >= lo) || j + 1 == hi) {
-            const int sooner = j + 1 < hi && j >= lo &&
-                               total * i - before * lanes < acc * lanes - total * i;
-            J[i - 1].r1 = J[i].r0 = sooner ? j : j + 1;
+            J[i - 1].r1 = J[i].r0 = j + 1;
             i++;
         }
     }
