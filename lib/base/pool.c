@@ -16,8 +16,8 @@
  * - a share's next item is a counter in its owner's line, tagged with the task's number: a
  *   worker takes an item by raising the counter of the task it read, which a thread that woke
  *   late for an older task cannot do (it finds a newer number, or a share used up);
- * - each worker adds the items it ran to its own count once it finds nothing more to take,
- *   and the caller waits until the counts add up to every item published.
+ * - each worker counts the items it ran on its own line, and the caller waits until the
+ *   counts add up to every item published.
  * (Before: the task read under the mutex, one claim word per item side by side, and a shared
  * count of items done raised after each item: several lines moved per task, about 1.2 us of a
  * task of four items, and the same again on a busy machine's bad state.)
@@ -200,9 +200,12 @@ static void share_items(const pool_task *T, uint32_t q, uint32_t workers, int32_
 }
 
 /* Run what worker `worker` of `workers` may take of task T: its own share, the shared items,
- * then what is left of the others' shares; then its count of items run, raised once. */
+ * then what is left of the others' shares. Its count of items run is raised after each item
+ * (its own line: only the caller reads it), so that a worker that loses its core while it
+ * looks for more does not hold up a task whose items are all done. */
 static void run_items(ws_pool *p, const pool_task *T, uint32_t worker, uint32_t workers)
 {
+    _Atomic uint64_t *done = &p->share[worker].done;
     uint64_t ran = 0;
     for (uint32_t k = 0; k <= workers; k++) {
         /* Its own share, then the shared one (index workers), then the next worker's on. */
@@ -216,11 +219,12 @@ static void run_items(ws_pool *p, const pool_task *T, uint32_t worker, uint32_t 
         while ((i = take(&p->share[q], T->number, i0, i1)) >= 0) {
             T->task(i, i + 1, worker, T->ctx);
             ran++;
+            atomic_store_explicit(done, atomic_load_explicit(done, memory_order_relaxed) + 1,
+                                  memory_order_seq_cst);
         }
     }
     if (!ran)
         return;
-    atomic_fetch_add_explicit(&p->share[worker].done, ran, memory_order_seq_cst);
     if (worker && atomic_load_explicit(&p->post.caller_asleep, memory_order_seq_cst)) {
         pthread_mutex_lock(&p->lock);
         pthread_cond_signal(&p->done);
