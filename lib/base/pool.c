@@ -1,26 +1,14 @@
 #define _POSIX_C_SOURCE 200809L /* clock_gettime for the bounded spin */
 /* The world's own threads (pool.h).
  *
- * A task's items are cut into as many consecutive shares as there are workers (the caller is
- * worker 0), and the last `shared` items form a share of no worker's own: each worker runs its
- * own share first, so the same items, and with them the same rows of a film, go to the same
- * worker from task to task and stay in its core's cache; then the shared items, then what is
- * left of the others' shares, so that a worker waiting for its core on a busy machine costs at
- * most what one worker would.
- *
- * What a task costs beyond its items is the cache lines that move between the cores, some
- * 200-700 ns each on this kind of machine (bench_pingpong), so each worker's claims and count
- * of items done lie on a line of their own, which only the others' stealing reads:
- * - the task is published in one line, its fields under a sequence count (odd while they are
- *   written), which a thread reads without a lock;
- * - a share's next item is a counter in its owner's line, tagged with the task's number: a
- *   worker takes an item by raising the counter of the task it read, which a thread that woke
- *   late for an older task cannot do (it finds a newer number, or a share used up);
- * - each worker counts the items it ran on its own line, and the caller waits until the
- *   counts add up to every item published.
- * (Before: the task read under the mutex, one claim word per item side by side, and a shared
- * count of items done raised after each item: several lines moved per task, about 1.2 us of a
- * task of four items, and the same again on a busy machine's bad state.)
+ * A task is published under the mutex with a new generation. Its items are cut into as many
+ * consecutive shares as there are workers (the caller is worker 0): each worker runs its own
+ * share first, so the same items, and with them the same rows of a film, go to the same
+ * worker from task to task and stay in its core's cache; then it takes what is left of the
+ * others' shares, so that a worker waiting for its core on a busy machine costs at most what
+ * one worker would. An item is taken by writing the task's generation into its claim, which
+ * only a worker of that generation can do: a thread that woke late for an older task finds
+ * nothing to take.
  *
  * A step publishes tasks a few microseconds to a few tens of microseconds apart (the move
  * test, each sub-step). Waking a sleeping thread costs about as much CPU on both sides (some
@@ -44,11 +32,6 @@
 #define PAUSE_NS 5000
 /* Pause rounds between two looks at the clock. */
 #define SPIN_ROUNDS 64
-/* A cache line, and the bits of a share's counter that hold the next item (the rest: the
- * task's number). */
-#define LINE 64
-#define ITEM_BITS 24
-#define ITEM_MASK ((UINT64_C(1) << ITEM_BITS) - 1)
 
 typedef struct pool_thread {
     ws_pool *pool;
@@ -56,47 +39,24 @@ typedef struct pool_thread {
     uint32_t index; /* worker index, 1.. */
 } pool_thread;
 
-/* A worker's own line: the next item of its share (task number << ITEM_BITS | item), and the
- * items it has run over all tasks. The last one (index workers) is the shared items'. */
-typedef struct pool_share {
-    _Atomic uint64_t next;
-    _Atomic uint64_t done;
-    char pad[LINE - 2 * sizeof(uint64_t)];
-} pool_share;
-
-/* The task published last, read without a lock: seq is odd while the caller writes it, and
- * seq / 2 is the task's number. */
-typedef struct pool_post {
-    _Atomic uint64_t seq;
-    _Atomic(ws_task_fn *) task;
-    _Atomic(void *) ctx;
-    atomic_int count, shared;
-    atomic_int stop;
-    atomic_int caller_asleep; /* the caller sleeps on done */
-    char pad[LINE];
-} pool_post;
-
 struct ws_pool {
-    pool_post post;
     pthread_mutex_t lock;
     pthread_cond_t go, done;
-    int sleepers;   /* threads asleep on go (under the lock) */
-    uint64_t total; /* items published over all tasks (the caller's) */
-    int32_t items;  /* the most items of a task run on the threads */
-    uint32_t threads; /* threads made */
-    uint32_t cap;     /* room in thread */
-    pool_thread *thread;
-    char pad[LINE];
-    pool_share share[]; /* threads + 2: the workers', then the shared items' */
-};
-
-/* What a thread read of a task. */
-typedef struct pool_task {
-    uint64_t number;
+    _Atomic uint64_t generation; /* of the task published last */
+    atomic_int stop;
+    /* The task published last: written under the lock, read under it by the threads. */
     ws_task_fn *task;
     void *ctx;
     int32_t count, shared;
-} pool_task;
+    atomic_int_least32_t finished; /* items of the task done */
+    int sleepers;                  /* threads asleep on go (under the lock) */
+    atomic_int caller_asleep;      /* the caller sleeps on done */
+    _Atomic uint64_t *claim;       /* per item: the generation that took it last */
+    int32_t claim_cap;
+    uint32_t threads; /* threads made */
+    uint32_t cap;     /* room in thread */
+    pool_thread *thread;
+};
 
 static void cpu_pause(void)
 {
@@ -132,103 +92,50 @@ static int spin_until(int (*ready)(ws_pool *, uint64_t), ws_pool *p, uint64_t ar
 
 static int new_task(ws_pool *p, uint64_t seen)
 {
-    return atomic_load_explicit(&p->post.seq, memory_order_acquire) / 2 != seen ||
-           atomic_load_explicit(&p->post.stop, memory_order_relaxed);
+    return atomic_load_explicit(&p->generation, memory_order_acquire) != seen ||
+           atomic_load_explicit(&p->stop, memory_order_relaxed);
 }
 
-/* The items run over all tasks, by every worker. */
-static uint64_t items_done(const ws_pool *p)
+static int task_done(ws_pool *p, uint64_t count)
 {
-    uint64_t n = 0;
-    for (uint32_t k = 0; k <= p->threads; k++)
-        n += atomic_load_explicit(&p->share[k].done, memory_order_acquire);
-    return n;
+    return (uint64_t)atomic_load_explicit(&p->finished, memory_order_acquire) == count;
 }
 
-static int task_done(ws_pool *p, uint64_t total)
+/* Take item i for generation gen: 1 when this worker takes it. */
+static int take(ws_pool *p, int32_t i, uint64_t gen)
 {
-    return items_done(p) == total;
+    uint64_t c = atomic_load_explicit(&p->claim[i], memory_order_relaxed);
+    return c < gen && atomic_compare_exchange_strong(&p->claim[i], &c, gen);
 }
 
-/* The task published last, read consistently (its fields between two equal even counts). */
-static pool_task read_task(ws_pool *p)
+static void item_done(ws_pool *p, int32_t count)
 {
-    for (;;) {
-        const uint64_t s = atomic_load_explicit(&p->post.seq, memory_order_acquire);
-        if (s & 1) {
-            cpu_pause();
-            continue;
-        }
-        pool_task t = {s / 2,
-                       atomic_load_explicit(&p->post.task, memory_order_relaxed),
-                       atomic_load_explicit(&p->post.ctx, memory_order_relaxed),
-                       atomic_load_explicit(&p->post.count, memory_order_relaxed),
-                       atomic_load_explicit(&p->post.shared, memory_order_relaxed)};
-        atomic_thread_fence(memory_order_acquire);
-        if (atomic_load_explicit(&p->post.seq, memory_order_relaxed) == s)
-            return t;
-    }
-}
-
-/* Take the next item of share q, items [i0, i1) of task t: the item, or -1 when none is left
- * (or the share has gone on to a newer task). */
-static int32_t take(pool_share *q, uint64_t t, int32_t i0, int32_t i1)
-{
-    uint64_t v = atomic_load_explicit(&q->next, memory_order_relaxed);
-    for (;;) {
-        const uint64_t vt = v >> ITEM_BITS;
-        if (vt > t)
-            return -1;
-        const int32_t i = vt == t ? (int32_t)(v & ITEM_MASK) : i0;
-        if (i >= i1)
-            return -1;
-        if (atomic_compare_exchange_weak_explicit(&q->next, &v,
-                                                  t << ITEM_BITS | (uint64_t)(i + 1),
-                                                  memory_order_acq_rel, memory_order_relaxed))
-            return i;
-    }
-}
-
-/* The items of share q of task T on `workers` workers: worker q's own, or (q == workers) the
- * shared ones. */
-static void share_items(const pool_task *T, uint32_t q, uint32_t workers, int32_t *i0,
-                        int32_t *i1)
-{
-    const int64_t owned = T->count - T->shared;
-    *i0 = q == workers ? (int32_t)owned : (int32_t)((int64_t)q * owned / workers);
-    *i1 = q == workers ? T->count : (int32_t)((int64_t)(q + 1) * owned / workers);
-}
-
-/* Run what worker `worker` of `workers` may take of task T: its own share, the shared items,
- * then what is left of the others' shares. Its count of items run is raised after each item
- * (its own line: only the caller reads it), so that a worker that loses its core while it
- * looks for more does not hold up a task whose items are all done. */
-static void run_items(ws_pool *p, const pool_task *T, uint32_t worker, uint32_t workers)
-{
-    _Atomic uint64_t *done = &p->share[worker].done;
-    uint64_t ran = 0;
-    for (uint32_t k = 0; k <= workers; k++) {
-        /* Its own share, then the shared one (index workers), then the next worker's on. */
-        const uint32_t q = k == 0 ? worker : k == 1 ? workers : (worker + k - 1) % workers;
-        if (k > 1 && q == worker)
-            continue;
-        int32_t i0, i1, i;
-        share_items(T, q, workers, &i0, &i1);
-        if (i0 >= i1)
-            continue;
-        while ((i = take(&p->share[q], T->number, i0, i1)) >= 0) {
-            T->task(i, i + 1, worker, T->ctx);
-            ran++;
-            atomic_store_explicit(done, atomic_load_explicit(done, memory_order_relaxed) + 1,
-                                  memory_order_seq_cst);
-        }
-    }
-    if (!ran)
-        return;
-    if (worker && atomic_load_explicit(&p->post.caller_asleep, memory_order_seq_cst)) {
+    if (atomic_fetch_add(&p->finished, 1) + 1 == count && atomic_load(&p->caller_asleep)) {
         pthread_mutex_lock(&p->lock);
         pthread_cond_signal(&p->done);
         pthread_mutex_unlock(&p->lock);
+    }
+}
+
+/* Run what worker `worker` of `workers` may take of task generation gen: its own share of the
+ * first count - shared items, then what is left of the others' and the shared ones. */
+static void run_items(ws_pool *p, ws_task_fn *task, void *ctx, int32_t count, int32_t shared,
+                      uint64_t gen, uint32_t worker, uint32_t workers)
+{
+    const int64_t owned = count - shared;
+    const int32_t i0 = (int32_t)((int64_t)worker * owned / workers),
+                  i1 = (int32_t)((int64_t)(worker + 1) * owned / workers);
+    for (int32_t i = i0; i < i1; i++)
+        if (take(p, i, gen)) {
+            task(i, i + 1, worker, ctx);
+            item_done(p, count);
+        }
+    for (int32_t k = 0; k < count; k++) {
+        const int32_t i = (i1 + k) % count;
+        if (take(p, i, gen)) {
+            task(i, i + 1, worker, ctx);
+            item_done(p, count);
+        }
     }
 }
 
@@ -246,41 +153,41 @@ static void *pool_main(void *arg)
             p->sleepers--;
             pthread_mutex_unlock(&p->lock);
         }
-        if (atomic_load(&p->post.stop))
+        if (atomic_load(&p->stop))
             break;
-        const pool_task T = read_task(p);
-        seen = T.number;
-        run_items(p, &T, t->index, p->threads + 1);
+        pthread_mutex_lock(&p->lock);
+        seen = atomic_load_explicit(&p->generation, memory_order_relaxed);
+        ws_task_fn *task = p->task;
+        void *ctx = p->ctx;
+        const int32_t count = p->count, shared = p->shared;
+        pthread_mutex_unlock(&p->lock);
+        run_items(p, task, ctx, count, shared, seen, t->index, p->threads + 1);
     }
     return NULL;
 }
 
 ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads, int32_t items)
 {
-    const size_t bytes = sizeof(ws_pool) + (threads + 2) * sizeof(pool_share);
-    ws_pool *p = ws_mem_calloc(mem, 1, bytes);
+    ws_pool *p = ws_mem_calloc(mem, 1, sizeof *p);
     if (!p)
         return NULL;
     p->cap = threads;
-    p->items = items;
+    p->claim_cap = items;
     p->thread = ws_mem_calloc(mem, threads, sizeof *p->thread);
-    int ok = p->thread && pthread_mutex_init(&p->lock, NULL) == 0;
+    p->claim = ws_mem_calloc(mem, (size_t)items, sizeof *p->claim);
+    int ok = p->thread && p->claim && pthread_mutex_init(&p->lock, NULL) == 0;
     if (!ok) {
         ws_mem_free(mem, p->thread, p->thread ? threads * sizeof *p->thread : 0);
-        ws_mem_free(mem, p, bytes);
+        ws_mem_free(mem, (void *)p->claim, p->claim ? (size_t)items * sizeof *p->claim : 0);
+        ws_mem_free(mem, p, sizeof *p);
         return NULL;
     }
-    for (uint32_t k = 0; k < threads + 2; k++) {
-        atomic_init(&p->share[k].next, 0);
-        atomic_init(&p->share[k].done, 0);
-    }
-    atomic_init(&p->post.seq, 0);
-    atomic_init(&p->post.task, NULL);
-    atomic_init(&p->post.ctx, NULL);
-    atomic_init(&p->post.count, 0);
-    atomic_init(&p->post.shared, 0);
-    atomic_init(&p->post.stop, 0);
-    atomic_init(&p->post.caller_asleep, 0);
+    for (int32_t i = 0; i < items; i++)
+        atomic_init(&p->claim[i], 0);
+    atomic_init(&p->generation, 0);
+    atomic_init(&p->stop, 0);
+    atomic_init(&p->finished, 0);
+    atomic_init(&p->caller_asleep, 0);
     ok = pthread_cond_init(&p->go, NULL) == 0;
     if (ok && pthread_cond_init(&p->done, NULL) != 0) {
         pthread_cond_destroy(&p->go);
@@ -289,7 +196,8 @@ ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads, int32_t items)
     if (!ok) {
         pthread_mutex_destroy(&p->lock);
         ws_mem_free(mem, p->thread, threads * sizeof *p->thread);
-        ws_mem_free(mem, p, bytes);
+        ws_mem_free(mem, (void *)p->claim, (size_t)items * sizeof *p->claim);
+        ws_mem_free(mem, p, sizeof *p);
         return NULL;
     }
     for (uint32_t i = 0; i < threads; i++) {
@@ -308,7 +216,7 @@ void ws_pool_destroy(ws_mem *mem, ws_pool *p)
     if (!p)
         return;
     pthread_mutex_lock(&p->lock);
-    atomic_store(&p->post.stop, 1);
+    atomic_store(&p->stop, 1);
     pthread_cond_broadcast(&p->go);
     pthread_mutex_unlock(&p->lock);
     for (uint32_t i = 0; i < p->threads; i++)
@@ -317,43 +225,35 @@ void ws_pool_destroy(ws_mem *mem, ws_pool *p)
     pthread_cond_destroy(&p->go);
     pthread_mutex_destroy(&p->lock);
     ws_mem_free(mem, p->thread, p->cap * sizeof *p->thread);
-    ws_mem_free(mem, p, sizeof(ws_pool) + (p->cap + 2) * sizeof(pool_share));
+    ws_mem_free(mem, (void *)p->claim, (size_t)p->claim_cap * sizeof *p->claim);
+    ws_mem_free(mem, p, sizeof *p);
 }
 
 void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, int32_t shared, void *ctx)
 {
-    if (count > p->items) { /* more items than the pool was made for: run them here */
+    if (count > p->claim_cap) { /* more items than the pool was made for: run them here */
         for (int32_t i = 0; i < count; i++)
             task(i, i + 1, 0, ctx);
         return;
     }
-    /* Published: the count odd while the fields change, even again after. */
-    const uint64_t s = atomic_load_explicit(&p->post.seq, memory_order_relaxed);
-    atomic_store_explicit(&p->post.seq, s + 1, memory_order_relaxed);
-    atomic_thread_fence(memory_order_release);
-    atomic_store_explicit(&p->post.task, task, memory_order_relaxed);
-    atomic_store_explicit(&p->post.ctx, ctx, memory_order_relaxed);
-    atomic_store_explicit(&p->post.count, count, memory_order_relaxed);
-    atomic_store_explicit(&p->post.shared, shared, memory_order_relaxed);
-    atomic_store_explicit(&p->post.seq, s + 2, memory_order_release);
-    p->total += (uint64_t)count;
-    /* A thread that checked for a task under the lock before this one was published sleeps,
-     * or is about to: wake it. */
     pthread_mutex_lock(&p->lock);
+    p->task = task;
+    p->ctx = ctx;
+    p->count = count;
+    p->shared = shared;
+    atomic_store(&p->finished, 0);
+    const uint64_t gen = atomic_load_explicit(&p->generation, memory_order_relaxed) + 1;
+    atomic_store_explicit(&p->generation, gen, memory_order_release);
     if (p->sleepers)
         pthread_cond_broadcast(&p->go);
     pthread_mutex_unlock(&p->lock);
-    const pool_task T = {(s + 2) / 2, task, ctx, count, shared};
-    run_items(p, &T, 0, p->threads + 1);
-    if (spin_until(task_done, p, p->total))
+    run_items(p, task, ctx, count, shared, gen, 0, p->threads + 1);
+    if (spin_until(task_done, p, (uint64_t)count))
         return;
     pthread_mutex_lock(&p->lock);
-    atomic_store_explicit(&p->post.caller_asleep, 1, memory_order_seq_cst);
-    /* Against a worker's count raised then the flag read (run_items): one of the two sees
-     * the other's write. */
-    atomic_thread_fence(memory_order_seq_cst);
-    while (!task_done(p, p->total))
+    atomic_store(&p->caller_asleep, 1);
+    while (!task_done(p, (uint64_t)count))
         pthread_cond_wait(&p->done, &p->lock);
-    atomic_store(&p->post.caller_asleep, 0);
+    atomic_store(&p->caller_asleep, 0);
     pthread_mutex_unlock(&p->lock);
 }
