@@ -1226,11 +1226,13 @@ static ws_status step_once(ws_world *w)
         S.stats->seconds_web += clock_now(w) - t_web;
     }
     if (S.loads_later) {
+        const double t_late = clock_now(w);
         if (S.body_later) /* no web was swept in lanes */
             body_contacts(&S);
         if ((s = contacts_ready(&S)) != WS_OK ||
             (s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK)
             return s;
+        S.stats->seconds_contacts += clock_now(w) - t_late;
         for (size_t k = 0; k < w->web_slots.slot_count; k++)
             if (w->web_slots.dense[k] != UINT32_MAX)
                 web_loads(&S, w->webs[k]);
