@@ -129,32 +129,18 @@ typedef struct sheet_run {
     uint64_t *reruns; /* where to put how many did (may be NULL) */
 } sheet_run;
 
-/* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, dropped from
- * 3 mm onto a box on the ground so that it drapes over the edges: contacts on faces, edges and
- * corners, runs and one by one, with friction. Its state hash after `steps` steps. */
-static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
+/* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, 3 mm above a
+ * box on the ground, so that dropped it drapes over the edges: contacts on faces, edges and
+ * corners, runs and one by one, with friction. The world is made with d (its workers and
+ * scheduler set); the box and the web into *box and *web. */
+static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_id *box,
+                             ws_web_id *web)
 {
-    ws_world_def d;
-    ws_world_def_init(&d);
-    d.dt = 2.5e-4;
-    d.worker_count = (uint32_t)r->workers;
-    int calls = 0;
-    thread_task tt;
-    if (r->host == 1) {
-        d.enqueue_task = enqueue_reverse;
-        d.finish_task = finish_never;
-        d.task_context = &calls;
-    } else if (r->host == 2) {
-        d.enqueue_task = enqueue_threads;
-        d.finish_task = finish_threads;
-        d.task_context = &tt;
-    }
     ws_world *w = NULL;
-    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ck_assert_int_eq(ws_world_create(d, &w), WS_OK);
     w->search_tight = r->tight;
     add_ground(w, 2.0, no_material());
-    ws_body_id box =
-        add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
+    *box = add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
     ws_law_def ld;
     ws_law_def_init(&ld);
     ld.type = (ws_law_type)r->law_type;
@@ -177,14 +163,37 @@ static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
     sd.origin = (ws_vec3){-0.2975, -0.24375, 0.303};
     sd.prestretch_x = sd.prestretch_y = 0.02;
     sd.shear = 1;
-    ws_web_id web;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, web));
     double S;
-    ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+    ck_ok(w, ws_web_get_stable_dt(w, *web, &S));
     /* Sub-steps for half the stable sub-step, with 5 % to spare (the world's default
      * stable_fraction is 0.5). */
-    int n = (int)ceil(2.1 * d.dt / S);
-    ck_ok(w, ws_web_set_substeps(w, web, n < 1 ? 1 : n));
+    int n = (int)ceil(2.1 * d->dt / S);
+    ck_ok(w, ws_web_set_substeps(w, *web, n < 1 ? 1 : n));
+    return w;
+}
+
+/* The sheet of sheet_world on r's workers and scheduler: its state hash after `steps` steps. */
+static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = 2.5e-4;
+    d.worker_count = (uint32_t)r->workers;
+    int calls = 0;
+    thread_task tt;
+    if (r->host == 1) {
+        d.enqueue_task = enqueue_reverse;
+        d.finish_task = finish_never;
+        d.task_context = &calls;
+    } else if (r->host == 2) {
+        d.enqueue_task = enqueue_threads;
+        d.finish_task = finish_threads;
+        d.task_context = &tt;
+    }
+    ws_body_id box;
+    ws_web_id web;
+    ws_world *w = sheet_world(&d, r, &box, &web);
     /* The film touches the box: a sheet in free fall would test no contact. */
     double press = 0.0;
     for (long k = 0; k < steps; k += 20) {
@@ -245,6 +254,88 @@ START_TEST(test_sheet_same_for_any_workers)
     report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers, both schedulers and %llu "
            "pieces of searches run again",
            steps, (unsigned long long)one, short_run() ? 2 : 4, (unsigned long long)reruns);
+}
+END_TEST
+
+/* A linear spring's law that fails while *user is not 0. */
+static int failing_law(void *user, int dim, const double *u, const double *ud, double t,
+                       double *F, double *dFdu, double *dFdud)
+{
+    (void)ud, (void)t, (void)dFdud;
+    for (int i = 0; i < dim; i++) {
+        F[i] = 10.0 * u[i];
+        dFdu[i * dim + i] = 10.0;
+    }
+    return *(int *)user;
+}
+
+/* On workers the body contacts run beside the film's first sub-step, and the elements and the
+ * bodies' stable-step check after the film: a step that an element's law refuses there has
+ * swept the film already, and must still leave the world as it was. The sheet on 2 workers
+ * with a soft spring from the world to the box, whose law fails at steps 80 and 81 (the sheet
+ * lands at step 65 and lifts off at 105: contacts, runs, searches): each refused step leaves the state hash as it
+ * was, and the world then steps on to the hash of a twin that was never refused, to the bit
+ * (the film's contact cache, lists and anchors undone too). */
+START_TEST(test_refused_after_the_film)
+{
+    const long steps = short_run() ? 120 : 400, fail_at = 80;
+    uint64_t h[2];
+    long refused = 0;
+    for (int twin = 0; twin < 2; twin++) {
+        ws_world_def d;
+        ws_world_def_init(&d);
+        d.dt = 2.5e-4;
+        d.worker_count = 2;
+        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
+        ws_body_id box;
+        ws_web_id web;
+        ws_world *w = sheet_world(&d, &r, &box, &web);
+        int fail = 0;
+        ws_law_def ld;
+        ws_law_def_init(&ld);
+        ld.type = WS_LAW_USER;
+        ld.dim = 3;
+        ld.stiffness = 10.0;
+        ld.user_fn = failing_law;
+        ld.user_data = &fail;
+        ws_law_id law;
+        ck_ok(w, ws_law_create(w, &ld, &law));
+        ws_element_def ed;
+        ws_element_def_init(&ed);
+        ed.type = WS_ELEMENT_LINEAR_SPRING;
+        ed.body2 = box;
+        ed.law = law;
+        ed.point1 = (ws_vec3){0.0, 0.0, 0.15};
+        ws_element_id e;
+        ck_ok(w, ws_element_create(w, &ed, &e));
+        ck_ok(w, ws_world_step_n(w, fail_at));
+        if (twin == 1) {
+            uint64_t before, after;
+            ck_ok(w, ws_world_get_state_hash(w, &before));
+            fail = 1;
+            for (int k = 0; k < 2; k++) {
+                ck_assert_int_eq(ws_world_step(w), WS_ERR_CALLBACK);
+                ck_ok(w, ws_world_get_state_hash(w, &after));
+                ck_assert_msg(after == before, "refused step %d changed the state hash", k);
+                refused++;
+            }
+            fail = 0;
+        }
+        /* The film touches the box after the refused steps. */
+        double press = 0.0;
+        for (long k = fail_at; k < steps; k++) {
+            ck_ok(w, ws_world_step(w));
+            ws_vec3 f;
+            ck_ok(w, ws_web_get_body_force(w, web, box, &f, NULL));
+            press = fmax(press, -f.z);
+        }
+        ck_assert_msg(press > 0.0, "the sheet never pressed on the box");
+        ck_ok(w, ws_world_get_state_hash(w, &h[twin]));
+        ws_world_destroy(w);
+    }
+    ck_assert_int_eq(refused, 2);
+    ck_assert_msg(h[1] == h[0], "refused twice: 0x%016llx, never: 0x%016llx",
+                  (unsigned long long)h[1], (unsigned long long)h[0]);
 }
 END_TEST
 
@@ -370,7 +461,7 @@ static void probe_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
 /* Every item of every task runs exactly once, on a worker below the pool's count, one item a
  * call, whatever the task's size: 20000 tasks back to back (a thread that wakes late for one
  * must not take an item of the next), of 1 to 48 items (more than the pool was made for: then
- * all on the caller). The bookkeeping of each task is exact, so any miss is a failure. And the
+ * all on the caller), 0 to 3 of them shared (no worker's own share, up to all of them). The bookkeeping of each task is exact, so any miss is a failure. And the
  * pool is made and joined with its bytes back to zero. */
 START_TEST(test_pool_runs_each_item_once)
 {
@@ -388,7 +479,9 @@ START_TEST(test_pool_runs_each_item_once)
         const int32_t count = 1 + (int32_t)((t * 7919u) % 48u);
         for (int32_t i = 0; i < count; i++)
             atomic_store(&P->runs[i], 0);
-        ws_pool_run(pool, probe_items, count, P);
+        const int32_t shared = (int32_t)((t * 31u) % 4u) < count ? (int32_t)((t * 31u) % 4u)
+                                                                  : count;
+        ws_pool_run(pool, probe_items, count, shared, P);
         for (int32_t i = 0; i < count; i++) {
             if (atomic_load(&P->runs[i]) != 1)
                 ck_abort_msg("task %d of %d items: item %d ran %d times", t, count, i,
@@ -413,6 +506,7 @@ int main(void)
     Suite *s = suite_create("workers");
     add_case(s, "wrapped_same_for_any_workers", test_wrapped_same_for_any_workers, 300);
     add_case(s, "sheet_same_for_any_workers", test_sheet_same_for_any_workers, 300);
+    add_case(s, "refused_after_the_film", test_refused_after_the_film, 300);
     add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
     add_case(s, "oom_in_a_parallel_step", test_oom_in_a_parallel_step, 300);
     add_case(s, "bad_worker_defs", test_bad_worker_defs, 60);

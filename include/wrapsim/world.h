@@ -142,7 +142,9 @@ typedef struct ws_world_stats {
     uint64_t bodies;           /**< bodies alive */
     /* With ws_world_def.profile = 1, wall-clock seconds spent in, over all steps: */
     double seconds_detection;  /**< finding candidate pairs (bodies and film nodes) */
-    double seconds_contacts;   /**< evaluating body-body contacts */
+    /** evaluating body-body contacts (with worker_count > 1 and only explicit webs they are
+     *  evaluated beside the film's first sub-step, and that part counts in seconds_web) */
+    double seconds_contacts;
     double seconds_web;        /**< film: springs, node contacts, node integration */
     double seconds_total;      /**< whole steps */
     /** The largest fraction of an explicit web's stable sub-step that dt / substeps uses (0

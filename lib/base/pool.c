@@ -47,7 +47,7 @@ struct ws_pool {
     /* The task published last: written under the lock, read under it by the threads. */
     ws_task_fn *task;
     void *ctx;
-    int32_t count;
+    int32_t count, shared;
     atomic_int_least32_t finished; /* items of the task done */
     int sleepers;                  /* threads asleep on go (under the lock) */
     atomic_int caller_asleep;      /* the caller sleeps on done */
@@ -117,13 +117,14 @@ static void item_done(ws_pool *p, int32_t count)
     }
 }
 
-/* Run what worker `worker` of `workers` may take of task generation gen: its own share, then
- * what is left of the others'. */
-static void run_items(ws_pool *p, ws_task_fn *task, void *ctx, int32_t count, uint64_t gen,
-                      uint32_t worker, uint32_t workers)
+/* Run what worker `worker` of `workers` may take of task generation gen: its own share of the
+ * first count - shared items, then what is left of the others' and the shared ones. */
+static void run_items(ws_pool *p, ws_task_fn *task, void *ctx, int32_t count, int32_t shared,
+                      uint64_t gen, uint32_t worker, uint32_t workers)
 {
-    const int32_t i0 = (int32_t)((int64_t)worker * count / workers),
-                  i1 = (int32_t)((int64_t)(worker + 1) * count / workers);
+    const int64_t owned = count - shared;
+    const int32_t i0 = (int32_t)((int64_t)worker * owned / workers),
+                  i1 = (int32_t)((int64_t)(worker + 1) * owned / workers);
     for (int32_t i = i0; i < i1; i++)
         if (take(p, i, gen)) {
             task(i, i + 1, worker, ctx);
@@ -158,9 +159,9 @@ static void *pool_main(void *arg)
         seen = atomic_load_explicit(&p->generation, memory_order_relaxed);
         ws_task_fn *task = p->task;
         void *ctx = p->ctx;
-        const int32_t count = p->count;
+        const int32_t count = p->count, shared = p->shared;
         pthread_mutex_unlock(&p->lock);
-        run_items(p, task, ctx, count, seen, t->index, p->threads + 1);
+        run_items(p, task, ctx, count, shared, seen, t->index, p->threads + 1);
     }
     return NULL;
 }
@@ -228,7 +229,7 @@ void ws_pool_destroy(ws_mem *mem, ws_pool *p)
     ws_mem_free(mem, p, sizeof *p);
 }
 
-void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, void *ctx)
+void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, int32_t shared, void *ctx)
 {
     if (count > p->claim_cap) { /* more items than the pool was made for: run them here */
         for (int32_t i = 0; i < count; i++)
@@ -239,13 +240,14 @@ void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, void *ctx)
     p->task = task;
     p->ctx = ctx;
     p->count = count;
+    p->shared = shared;
     atomic_store(&p->finished, 0);
     const uint64_t gen = atomic_load_explicit(&p->generation, memory_order_relaxed) + 1;
     atomic_store_explicit(&p->generation, gen, memory_order_release);
     if (p->sleepers)
         pthread_cond_broadcast(&p->go);
     pthread_mutex_unlock(&p->lock);
-    run_items(p, task, ctx, count, gen, 0, p->threads + 1);
+    run_items(p, task, ctx, count, shared, gen, 0, p->threads + 1);
     if (spin_until(task_done, p, (uint64_t)count))
         return;
     pthread_mutex_lock(&p->lock);

@@ -17,8 +17,10 @@ ws_pool *ws_pool_create(ws_mem *mem, uint32_t threads, int32_t items);
 /* Stop and join the threads, free the pool (NULL: nothing). */
 void ws_pool_destroy(ws_mem *mem, ws_pool *pool);
 /* Run items [0, count) of `task`, one item a call, on the threads and the caller (worker 0),
- * and return when all have run. Worker k of n runs its share, items [k count / n, (k + 1)
- * count / n), first, then takes what is left of the others'. */
-void ws_pool_run(ws_pool *pool, ws_task_fn *task, int32_t count, void *ctx);
+ * and return when all have run. The first count - shared items are cut into shares: worker k
+ * of n runs its share, items [k c / n, (k + 1) c / n) with c = count - shared, first, then
+ * takes what is left of the others' and of the last `shared` items, which are no worker's own
+ * and go to whichever is free first (0 <= shared <= count). */
+void ws_pool_run(ws_pool *pool, ws_task_fn *task, int32_t count, int32_t shared, void *ctx);
 
 #endif

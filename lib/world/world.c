@@ -194,9 +194,10 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         return WS_ERR_OUT_OF_MEMORY;
     }
     w->params_cap = 4;
+    /* A task's items: the lanes, and the body contacts after them (world_step.c). */
     if (d.worker_count > 1 && !d.enqueue_task &&
         !(w->pool = ws_pool_create(&w->mem, d.worker_count - 1,
-                                            WS_LANES_PER_WORKER * (int32_t)d.worker_count))) {
+                                   WS_LANES_PER_WORKER * (int32_t)d.worker_count + 1))) {
         ws_world_destroy(w);
         return WS_ERR_OUT_OF_MEMORY;
     }

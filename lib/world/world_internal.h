@@ -170,6 +170,9 @@ typedef struct ws_step {
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
     double pair_dt; /* the bodies' per-pair stable step (ws_world_contact_limit), s */
+    /* The body contacts still to run (in the film's first sub-step in lanes, or after it),
+     * and the webs' loads to add after the elements' (world_step.c, step_once). */
+    int body_later, loads_later;
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that

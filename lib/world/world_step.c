@@ -4,7 +4,9 @@
  *   (2) contact detection: full (broad phase, optional libccd gate, candidate feature pairs) or
  *       the cached candidates carried over;
  *   (3) forces: gravity, then every candidate evaluated (penalty + friction on both bodies),
- *       then the deformable elements (rods, springs, bushings: world_element.c);
+ *       then the deformable elements (rods, springs, bushings: world_element.c), then the
+ *       webs' (with workers and only explicit webs the candidates are evaluated beside the
+ *       film's first sub-step and the elements follow the film: the same sums, step_once);
  *   (4) integration into the other state buffer; world elements from their drives at t + dt;
  *   (5) health check; (6) commit by swapping buffers and t += dt.
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
@@ -204,6 +206,8 @@ static ws_status webs_ready(ws_world *w)
     return WS_OK;
 }
 
+static void body_contacts(ws_step *S);
+
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
     ws_world *w;
@@ -213,6 +217,9 @@ typedef struct lane_task {
      * the next state in its own rows before it adds to them, so that those rows stay in its
      * core's cache. */
     int zero;
+    uint32_t lanes;
+    /* The body contacts of the step, item `lanes` of the task (NULL: not in this one). */
+    ws_step *body;
 } lane_task;
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
@@ -251,13 +258,18 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     ws_web_sweep_end(web);
 }
 
-/* Items [start, end) of a sub-step's lanes (ws_task_fn). */
+/* Items [start, end) of a sub-step's lanes (ws_task_fn), and after them the body contacts
+ * when the task carries them. */
 static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
 {
     (void)worker; /* a lane's scratch is its own, whichever worker takes it */
     const lane_task *T = ctx;
-    for (int32_t i = start; i < end; i++)
-        sweep_lane(T, &T->w->lane_job[i]);
+    for (int32_t i = start; i < end; i++) {
+        if ((uint32_t)i < T->lanes)
+            sweep_lane(T, &T->w->lane_job[i]);
+        else
+            body_contacts(T->body);
+    }
 }
 
 /* The lanes a web's sweep is cut into: one unless the world has workers and the web can be
@@ -373,8 +385,9 @@ static int lanes_ready(ws_step *S, ws_web *web, uint32_t lanes, size_t ncand)
 }
 
 /* Run items [0, count) of task on the host's scheduler, the world's threads or, for one item,
- * right here. */
-static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, void *ctx)
+ * right here; the last `shared` items are no worker's own share on the world's threads
+ * (ws_pool_run). */
+static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, uint32_t shared, void *ctx)
 {
     if (count == 1) {
         task(0, 1, 0, ctx);
@@ -383,7 +396,7 @@ static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, void *ctx)
         if (h)
             w->def.finish_task(h, w->def.task_context);
     } else {
-        ws_pool_run(w->pool, task, (int32_t)count, ctx);
+        ws_pool_run(w->pool, task, (int32_t)count, (int32_t)shared, ctx);
     }
 }
 
@@ -422,7 +435,7 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
         J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
     }
     flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
-    run_task(w, flag_items, lanes, &T);
+    run_task(w, flag_items, lanes, 0, &T);
     size_t flagged = 0;
     for (uint32_t i = 0; i < lanes; i++)
         flagged += w->lane_job[i].flagged;
@@ -504,7 +517,7 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
             return -1;
     }
     const search_task T = {w, S, web, nodes, count, pieces};
-    run_task(w, search_items, pieces, (void *)&T);
+    run_task(w, search_items, pieces, 0, (void *)&T);
     size_t total = 0;
     for (uint32_t i = 0; i < pieces; i++) {
         ws_lane_job *J = &w->lane_job[i];
@@ -610,11 +623,37 @@ static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *
 {
     for (uint32_t i = 0; i < lanes; i++)
         lane_open(w, web, lanes, i);
-    run_task(w, lane_items, lanes, T);
+    const uint32_t body = T->body != NULL;
+    run_task(w, lane_items, lanes + body, body, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
         fast += lane_close(w, web, i, bforce, bmoment);
     return fast;
+}
+
+/* The film's pull on each body, its sub-steps averaged, into the body's accumulators. */
+static void web_loads(ws_step *S, const ws_web *web)
+{
+    ws_body_store *b = S->b;
+    for (size_t i = 0; i < web->bcap && i < b->slots; i++) {
+        b->f[i] = v3_add(b->f[i], web->bforce[S->nxt][i]);
+        b->m[i] = v3_add(b->m[i], web->bmoment[S->nxt][i]);
+    }
+}
+
+/* Whether the body contacts may wait for the film (step_once): with workers, when every web is
+ * explicit (an implicit web's solve reads the bodies' loads) and there is one. */
+static int bodies_beside_film(const ws_world *w)
+{
+    int webs = 0;
+    for (size_t k = 0; k < w->web_slots.slot_count; k++) {
+        if (w->web_slots.dense[k] == UINT32_MAX)
+            continue;
+        if (w->webs[k]->integrator != WS_WEB_EXPLICIT)
+            return 0;
+        webs = 1;
+    }
+    return webs && w->def.worker_count > 1;
 }
 
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
@@ -695,7 +734,13 @@ static ws_status step_webs(ws_step *S)
                             web->fc[nxt]},
                            xd,
                            vd,
-                           s == 0 && lanes > 1};
+                           s == 0 && lanes > 1,
+                           lanes,
+                           NULL};
+            if (S->body_later && lanes > 1) { /* the body contacts, beside the lanes */
+                T.body = S;
+                S->body_later = 0;
+            }
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
@@ -722,11 +767,8 @@ static ws_status step_webs(ws_step *S)
                 return web_unstable(w, web, h, ws_world_web_stable_dt(w, web), what);
             }
         }
-        /* The film's pull on each body, its sub-steps averaged, into the body's accumulators. */
-        for (size_t i = 0; i < web->bcap && i < b->slots; i++) {
-            b->f[i] = v3_add(b->f[i], web->bforce[nxt][i]);
-            b->m[i] = v3_add(b->m[i], web->bmoment[nxt][i]);
-        }
+        if (!S->loads_later)
+            web_loads(S, web);
     }
     return WS_OK;
 }
@@ -1161,11 +1203,20 @@ static ws_status step_once(ws_world *w)
         return s;
     double t_eval = clock_now(w);
     S.stats->seconds_detection += t_eval - t_mark;
-    body_contacts(&S);
-    if ((s = contacts_ready(&S)) != WS_OK)
-        return s;
-    if ((s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK) /* rods, springs, bushings */
-        return s;
+    /* The body contacts read only the bodies' state at t, and the film does not read the
+     * bodies' loads: with workers and only explicit webs they run as one more item of the
+     * film's first sub-step in lanes, on whichever worker is free first, and their check
+     * and the elements follow the film (the loads summed as before: contacts, elements,
+     * webs). A step they refuse then leaves the world as it was all the same: the film
+     * wrote only the next state and its scratch. */
+    S.body_later = S.loads_later = bodies_beside_film(w);
+    if (!S.body_later) {
+        body_contacts(&S);
+        if ((s = contacts_ready(&S)) != WS_OK)
+            return s;
+        if ((s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK) /* rods, springs, bushings */
+            return s;
+    }
 
     double t_web = clock_now(w);
     S.stats->seconds_contacts += t_web - t_eval;
@@ -1173,6 +1224,18 @@ static ws_status step_once(ws_world *w)
         if ((s = webs_ready(w)) != WS_OK || (s = step_webs(&S)) != WS_OK)
             return s;
         S.stats->seconds_web += clock_now(w) - t_web;
+    }
+    if (S.loads_later) {
+        const double t_late = clock_now(w);
+        if (S.body_later) /* no web was swept in lanes */
+            body_contacts(&S);
+        if ((s = contacts_ready(&S)) != WS_OK ||
+            (s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK)
+            return s;
+        S.stats->seconds_contacts += clock_now(w) - t_late;
+        for (size_t k = 0; k < w->web_slots.slot_count; k++)
+            if (w->web_slots.dense[k] != UINT32_MAX)
+                web_loads(&S, w->webs[k]);
     }
     if ((s = integrate(&S)) != WS_OK)
         return s;
