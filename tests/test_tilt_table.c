@@ -37,6 +37,11 @@ START_TEST(variant_r_unwrapped_regularised)
     ck_assert_msg(fabs(r.final_slip[0]) < 2e-3, "bottom slip %.4f m", r.final_slip[0]);
     /* The top box leaves the bottom one: it slid off by more than its own width. */
     ck_assert_msg(r.final_slip[1] > 0.25, "top slip %.4f m", r.final_slip[1]);
+    /* The record of its move on the bottom box goes on through the slide: it slid past half its
+     * width (0.125 m) before it tipped off the edge. (A record that stopped when the slide was
+     * confirmed, 0.2 s after its onset, would read a few mm and hide the slide.) */
+    ck_assert_msg(r.max_relative_slip > 0.1, "top box on the bottom one: %.4f m",
+                  r.max_relative_slip);
     /* It then leaves the platform (the world has no floor) and the run stops there, before the
      * 7 s, with the box's CoG just below the platform's surface, not 19 m below. */
     ck_assert_msg(!isnan(r.off_time[1]) && r.end_time == r.off_time[1] && r.end_time < 7.0,
