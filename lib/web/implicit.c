@@ -18,69 +18,6 @@ static size_t scratch_doubles(uint32_t n)
     return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
 }
 
-/* Whether web is a grid whose rows a plan can take: nx ny nodes. */
-static int rows_grid(const ws_web *web)
-{
-    return web->nx > 0 && web->ny > 0 && (uint64_t)web->nx * (uint64_t)web->ny == web->n;
-}
-
-static size_t rows_room(const ws_web *web)
-{
-    return WS_ROW_RUNS * ((size_t)(rows_grid(web) ? web->ny : 1) + 1);
-}
-
-/* P's runs and rows for web's spring list (ws_rows says what they are), start having room for
- * rows_room. */
-static void rows_plan(const ws_web *web, ws_rows *P)
-{
-    const uint32_t ns = web->ns;
-    uint32_t b[WS_ROW_RUNS + 1], runs = ns ? 1 : 0;
-    b[0] = 0;
-    if (rows_grid(web)) {
-        const uint32_t nx = (uint32_t)web->nx;
-        uint32_t last = 0;
-        for (uint32_t s = 0; s < ns && runs <= WS_ROW_RUNS; s++) {
-            const uint32_t ka = web->sa[s] / nx, kb = web->sb[s] / nx;
-            const uint32_t key = ka > kb ? ka : kb;
-            if (s > 0 && key < last) {
-                if (runs < WS_ROW_RUNS)
-                    b[runs] = s;
-                runs++;
-            }
-            last = key;
-        }
-    }
-    if (!rows_grid(web) || runs > WS_ROW_RUNS) { /* one row, one run */
-        P->nrows = 1;
-        P->row_nodes = web->n;
-        P->nruns = 1;
-        P->block = 1;
-        P->start[0] = 0;
-        P->start[1] = ns;
-        return;
-    }
-    const uint32_t nx = (uint32_t)web->nx, nr = (uint32_t)web->ny;
-    P->nrows = nr;
-    P->row_nodes = nx;
-    P->nruns = runs;
-    P->block = nx < WS_ROW_BLOCK_NODES ? WS_ROW_BLOCK_NODES / nx : 1;
-    b[runs] = ns;
-    for (uint32_t g = 0; g < runs; g++) {
-        uint32_t *st = P->start + (size_t)g * (nr + 1);
-        uint32_t s = b[g];
-        for (uint32_t j = 0; j <= nr; j++) { /* the first of the run with key >= j */
-            while (s < b[g + 1]) {
-                const uint32_t ka = web->sa[s] / nx, kb = web->sb[s] / nx;
-                if ((ka > kb ? ka : kb) >= j)
-                    break;
-                s++;
-            }
-            st[j] = s;
-        }
-        st[nr] = b[g + 1];
-    }
-}
-
 int ws_implicit_reserve(ws_mem *mem, ws_web *web)
 {
     if (web->imp)
@@ -92,9 +29,7 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
     ws_ispring *sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
     double *op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
-    uint32_t *rows = ws_mem_calloc(mem, rows_room(web), sizeof(uint32_t));
-    if (!blk || !sp || !op || !rows) {
-        ws_mem_free(mem, rows, rows ? rows_room(web) * sizeof(uint32_t) : 0);
+    if (!blk || !sp || !op) {
         ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
         ws_mem_free(mem, sp, sp ? (ns ? ns : 1) * sizeof(ws_ispring) : 0);
         ws_mem_free(mem, op, op ? OPS(ns) * sizeof(double) : 0);
@@ -105,9 +40,6 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->ns = ns;
     im->sp = sp;
     im->op = op;
-    im->rows.start = rows;
-    im->rows.room = rows_room(web);
-    rows_plan(web, &im->rows);
     double *q = blk;
     im->f = q, q += VEC(n);
     im->b = q, q += VEC(n);
@@ -125,7 +57,6 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
         ws_mem_free(mem, blk, scratch_doubles(n) * sizeof(double));
         ws_mem_free(mem, sp, (ns ? ns : 1) * sizeof(ws_ispring));
         ws_mem_free(mem, op, OPS(ns) * sizeof(double));
-        ws_mem_free(mem, rows, im->rows.room * sizeof(uint32_t));
         ws_mem_free(mem, im, sizeof *im);
         return -1;
     }
@@ -142,7 +73,6 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
     ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
     ws_mem_free(mem, im->op, OPS(im->ns) * sizeof(double));
-    ws_mem_free(mem, im->rows.start, im->rows.room * sizeof(uint32_t));
     ws_mem_free(mem, im, sizeof *im);
     web->imp = NULL;
 }
@@ -345,13 +275,16 @@ static void operator_for(const ws_web *web, double h)
     }
 }
 
-/* y_i = N_i p_i, node i's own block, for nodes i0 .. i1 - 1; with z given, p_i = z_i + beta
- * p_i first (CG's new direction, made where its product reads it). */
-static inline void op_nodes(const ws_implicit *im, uint32_t i0, uint32_t i1,
-                            const double *restrict z, double beta, double *restrict p,
-                            double *restrict y)
+/* The product's own passes: the nodes' blocks (with p = z + beta p made there, CG's direction
+ * where the product reads it first, one pass over z and p the fewer), the springs, y . p. A
+ * pinned node's p is zero (its preconditioner is), so its y is not needed: it is set to
+ * zero. */
+double ws_implicit_direction_apply(const ws_web *web, const double *restrict z, double beta,
+                                   double *restrict p, double *restrict y)
 {
-    for (uint32_t i = i0; i < i1; i++) {
+    const ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    for (uint32_t i = 0; i < n; i++) {
         const double *S = im->nd + WS_SYM * (size_t)i;
         double *P = p + 3 * (size_t)i, *Y = y + 3 * (size_t)i;
         if (z) {
@@ -364,16 +297,9 @@ static inline void op_nodes(const ws_implicit *im, uint32_t i0, uint32_t i1,
         Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
         Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
     }
-}
-
-/* y += springs s0 .. s1 - 1's part of A p. */
-static inline void op_springs(const ws_web *web, uint32_t s0, uint32_t s1,
-                              const double *restrict p, double *restrict y)
-{
     const uint32_t *sa = web->sa, *sb = web->sb;
-    const double *op = web->imp->op;
-    for (uint32_t s = s0; s < s1; s++) {
-        const double *q = op + 5 * (size_t)s; /* ex ey ez a b */
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
         const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
         const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
         const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
@@ -387,18 +313,13 @@ static inline void op_springs(const ws_web *web, uint32_t s0, uint32_t s1,
         YB[1] -= ty;
         YB[2] -= tz;
     }
-}
-
-/* Nodes i0 .. i1 - 1 of y = A p finished (a pinned node's y zero): py plus their p . y. */
-static inline double op_finish(const ws_web *web, uint32_t i0, uint32_t i1,
-                               const double *restrict p, double *restrict y, double py)
-{
+    double py = 0.0;
     if (web->same_inv_m) { /* no pinned node */
-        for (size_t j = VEC(i0); j < VEC(i1); j++)
+        for (size_t j = 0; j < VEC(n); j++)
             py += p[j] * y[j];
         return py;
     }
-    for (uint32_t i = i0; i < i1; i++) {
+    for (uint32_t i = 0; i < n; i++) {
         double *Y = y + 3 * (size_t)i;
         if (web->inv_m[i] == 0.0)
             Y[0] = Y[1] = Y[2] = 0.0;
@@ -407,40 +328,9 @@ static inline double op_finish(const ws_web *web, uint32_t i0, uint32_t i1,
     return py;
 }
 
-/* p = z + beta p when z is given (p left when NULL), then y = A p with the parts operator_for
- * set, and p . y returned. A pinned node's p is zero (its preconditioner is), so its y is not
- * needed: it is set to zero. One pass over the rows (ws_rows) a block of them at a time: the
- * block's own blocks (and its p), then the springs whose upper end is in the block (the rows
- * they reach have their new p), then the rows no spring still to come reaches (all but the
- * block's last) finished and summed into p . y. The springs' terms may reach a node in another
- * order than the spring list's (A the same; y to rounding; the same order on a grid without
- * shear springs). */
-static double direction_product(const ws_web *web, const double *restrict z, double beta,
-                                double *restrict p, double *restrict y)
-{
-    const ws_implicit *im = web->imp;
-    const ws_rows *P = &im->rows;
-    const uint32_t n = web->n, nr = P->nrows;
-    const uint32_t nb = P->block;
-    double py = 0.0;
-    uint32_t done = 0; /* nodes finished */
-    for (uint32_t j0 = 0; j0 < nr; j0 += nb) {
-        const uint32_t j1 = j0 + nb < nr ? j0 + nb : nr;
-        op_nodes(im, ws_row_first(P, j0, n), ws_row_first(P, j1, n), z, beta, p, y);
-        for (uint32_t g = 0; g < P->nruns; g++) {
-            const uint32_t *st = P->start + (size_t)g * (nr + 1);
-            op_springs(web, st[j0], st[j1], p, y);
-        }
-        const uint32_t i1 = ws_row_first(P, j1 - 1, n); /* the rows before j1 - 1 are done */
-        py = op_finish(web, done, i1, p, y, py);
-        done = i1;
-    }
-    return op_finish(web, done, n, p, y, py);
-}
-
 double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
 {
-    return direction_product(web, NULL, 0.0, (double *)p, y);
+    return ws_implicit_direction_apply(web, NULL, 0.0, (double *)p, y); /* p only read */
 }
 
 /* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
@@ -699,7 +589,7 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     int it = 0;
     double beta = 0.0; /* p = z + beta p is made in the next product (none before the first) */
     while (!(meas <= lim) && it < web->solver_maxit) {
-        const double pq = direction_product(web, it ? z : NULL, beta, p, q) +
+        const double pq = ws_implicit_direction_apply(web, it ? z : NULL, beta, p, q) +
                           (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */

@@ -30,30 +30,8 @@ typedef struct ws_ispring {
                     b = h^2 kb), set by ws_implicit_solve */
 } ws_ispring;
 
-/* The springs a row of a grid web at a time (ws_implicit_rows): a grid's spring list falls into
- * a few runs (the builder's: around, up, shear), each sorted by the upper row its springs
- * reach (key: the larger of its ends' rows). Row j's springs of run g are start[g (nrows + 1)
- * + j] .. start[g (nrows + 1) + j + 1] - 1, and row j's nodes row_nodes j .. row_nodes (j + 1)
- * - 1 (the last row's up to n). A pass that takes row j's nodes and then row j's springs of
- * every run has, after row j, every spring with an end in a row before j done: the passes over
- * the nodes and over the springs are one pass over the rows, a row's vectors still in the
- * cache when its springs and the next row's read them. A web that is no grid, or whose list
- * falls into more than WS_ROW_RUNS runs, is one row of one run (the passes as separate ones). */
-#define WS_ROW_RUNS 4
-#define WS_ROW_BLOCK_NODES 2048
-typedef struct ws_rows {
-    uint32_t nrows, nruns, row_nodes;
-    uint32_t block;  /* rows a block: a pass takes a block's nodes and then its springs, each of
-                        its streams (vectors, blocks, runs) read a block at a time, long enough
-                        for the prefetch to run ahead, the block's vectors still in the cache
-                        when its springs read them (WS_ROW_BLOCK_NODES nodes, at least a row) */
-    uint32_t *start; /* room entries */
-    size_t room;
-} ws_rows;
-
 typedef struct ws_implicit {
     uint32_t n, ns;
-    ws_rows rows;    /* the springs by row (ws_implicit_rows) */
     double *f;       /* force on each node at (x0, v0): springs, drag, gravity, contacts */
     double *fs;      /* the same without the contacts (ws_implicit_reset) */
     double *kc, *dc; /* per node, symmetric: -df/dx and -df/dv of its contacts */
@@ -129,15 +107,15 @@ size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, w
  * nodes. */
 void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y);
 
-/* Row j's first node under plan P (j = P->nrows: n). */
-static inline uint32_t ws_row_first(const ws_rows *P, uint32_t j, uint32_t n)
-{
-    return j >= P->nrows ? n : j * P->row_nodes;
-}
-
 /* y = A p with the parts the running solve set (its springs' and nodes' blocks), p and y xyz
  * per node, y zero at pinned nodes; returns p . y. */
 double ws_implicit_apply_op(const ws_web *web, const double *p, double *y);
+
+/* p = z + beta p when z is given (p left when NULL: ws_implicit_apply_op), then y = A p as
+ * ws_implicit_apply_op makes it, p . y returned: CG's new direction made in the product's pass
+ * over the nodes, each p_i the same number the update alone gives. */
+double ws_implicit_direction_apply(const ws_web *web, const double *z, double beta, double *p,
+                                   double *y);
 
 /* The exact derivatives of spring s's force on its end a at (x, v), the law taken at (t,
  * since): Jx = df_a/dx_b (= -df_a/dx_a) and Jv = df_a/dv_b, row-major. They hold the terms

@@ -935,29 +935,20 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
     gauss_seidel_backward(mg, L);
 }
 
-/* The film level's node pass of a Jacobi sweep over nodes i0 .. i1 - 1: z_i = J_i r_i (how
- * JACOBI_SET), z_i += J_i t_i (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual,
- * t_i = r_i - N_i z_i (the springs' part follows in film_springs). J = w D^-1 and N, the
- * nodes' own blocks, as the level keeps them (single precision). With the bodies nested, zb
- * given: t_i -= (A_fb zb)_i too; rbo given: rbo -= A_bf z with the new z (never both); *l is
- * the cursor in the node-sorted contacts. Returns rz plus r . z over the nodes. */
+/* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
+ * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
+ * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
+ * them (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo
+ * given: rbo -= A_bf z with the new z (never both). Returns r . z. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
-typedef struct film_pass {
-    const double *r;
-    double *t, *z;
-    int how, residual;
-    const double *zb;
-    double *rbo;
-} film_pass;
-
-static inline double film_nodes(const ws_mg *mg, uint32_t i0, uint32_t i1, const film_pass *f,
-                                size_t *l, double rz)
+static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
+                                double *restrict t, double *restrict z, int how, int residual,
+                                const double *zb, double *rbo)
 {
-    const double *restrict r = f->r;
-    double *restrict t = f->t, *restrict z = f->z;
-    const int how = f->how;
-    for (uint32_t i = i0; i < i1; i++) {
+    double rz = 0.0;
+    size_t l = 0;
+    for (uint32_t i = 0; i < n; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
         if (how != JACOBI_NONE) {
@@ -973,13 +964,13 @@ static inline double film_nodes(const ws_mg *mg, uint32_t i0, uint32_t i1, const
             else
                 Z[0] += u0, Z[1] += u1, Z[2] += u2;
         }
-        if (f->rbo)
-            node_to_bodies(mg->rig, l, i, Z, f->rbo);
-        if (f->residual) {
+        if (rbo)
+            node_to_bodies(mg->rig, &l, i, Z, rbo);
+        if (residual) {
             T[0] = R[0], T[1] = R[1], T[2] = R[2];
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
-            if (f->zb)
-                bodies_to_node(mg->rig, l, i, f->zb, T);
+            if (zb)
+                bodies_to_node(mg->rig, &l, i, zb, T);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
@@ -987,13 +978,13 @@ static inline double film_nodes(const ws_mg *mg, uint32_t i0, uint32_t i1, const
     return rz;
 }
 
-/* t -= springs s0 .. s1 - 1's part of A z, with the springs' blocks as the level keeps them
- * (e, a, b in single precision). */
-static inline void film_springs(const ws_mg *mg, const ws_web *web, uint32_t s0, uint32_t s1,
-                                const double *restrict z, double *restrict t)
+/* t -= the springs' part of A z, with the springs' blocks as the level keeps them (e, a, b in
+ * single precision). */
+static void film_springs(const ws_mg *mg, const ws_web *web, const double *restrict z,
+                         double *restrict t)
 {
     const uint32_t *sa = web->sa, *sb = web->sb;
-    for (uint32_t s = s0; s < s1; s++) {
+    for (uint32_t s = 0; s < web->ns; s++) {
         const float *q = mg->fop + 5 * (size_t)s; /* ex ey ez a b */
         const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
         const double *A = z + 3 * (size_t)sa[s], *B = z + 3 * (size_t)sb[s];
@@ -1010,89 +1001,38 @@ static inline void film_springs(const ws_mg *mg, const ws_web *web, uint32_t s0,
     }
 }
 
-/* Rows j0 .. j1 - 1's springs of every run of plan P (implicit.h's ws_rows): t -= their part
- * of A z. */
-static inline void film_row_springs(const ws_mg *mg, const ws_web *web, const ws_rows *P,
-                                    uint32_t j0, uint32_t j1, const double *z, double *t)
-{
-    for (uint32_t g = 0; g < P->nruns; g++) {
-        const uint32_t *st = P->start + (size_t)g * (P->nrows + 1);
-        film_springs(mg, web, st[j0], st[j1], z, t);
-    }
-}
-
-/* A node pass and then the springs' pass on the z it leaves (a sweep, its residual t = r - A z
- * for the next), as one pass over the rows a block at a time (ws_rows): the block's nodes,
- * then its springs (the rows before have their new z; each term reads the z the two passes
- * would). Returns r . z when f has no residual. */
-static double film_nodes_springs(const ws_mg *mg, const ws_web *web, const film_pass *f)
-{
-    const ws_rows *P = &web->imp->rows;
-    const uint32_t n = web->n, nr = P->nrows, nb = P->block;
-    size_t l = 0;
-    double rz = 0.0;
-    for (uint32_t j0 = 0; j0 < nr; j0 += nb) {
-        const uint32_t j1 = j0 + nb < nr ? j0 + nb : nr;
-        rz = film_nodes(mg, ws_row_first(P, j0, n), ws_row_first(P, j1, n), f, &l, rz);
-        if (f->residual)
-            film_row_springs(mg, web, P, j0, j1, f->z, f->t);
-    }
-    return rz;
-}
-
-/* The springs' pass on the z there is (t -= their part of A z, t holding r - N z already), then
- * a node pass on the t it leaves, as one pass over the rows a block at a time: the block's
- * springs, then the nodes no spring still to come reaches (up to the block's last row: a
- * node's z changes only after every spring at it has read it). Returns r . z when f has no
- * residual. */
-static double film_springs_nodes(const ws_mg *mg, const ws_web *web, const film_pass *f)
-{
-    const ws_rows *P = &web->imp->rows;
-    const uint32_t n = web->n, nr = P->nrows, nb = P->block;
-    size_t l = 0;
-    double rz = 0.0;
-    uint32_t done = 0;
-    for (uint32_t j0 = 0; j0 < nr; j0 += nb) {
-        const uint32_t j1 = j0 + nb < nr ? j0 + nb : nr;
-        film_row_springs(mg, web, P, j0, j1, f->z, f->t);
-        const uint32_t i1 = ws_row_first(P, j1 - 1, n);
-        rz = film_nodes(mg, done, i1, f, &l, rz);
-        done = i1;
-    }
-    return film_nodes(mg, done, n, f, &l, rz);
-}
-
 /* z = B r (and zb = B rb with bodies nested): on the film's level mg->sweeps Jacobi sweeps
  * from zero (the bodies held at zero), the residual restricted (the bodies' with it), the
  * coarse cycle, its correction interpolated, mg->sweeps sweeps more against the bodies'
  * correction. Each sweep's product is the node pass (which also finishes the sweep before)
- * and the springs' pass, taken together a row at a time (film_nodes_springs before the coarse
- * correction, film_springs_nodes after it). */
+ * and the springs' pass. */
 static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, const double *rb,
                     double *zb)
 {
     double *t = mg->lv[0].t;
+    const uint32_t n = web->n;
     const size_t nb6 = 6 * (size_t)mg->nb;
     /* The bodies' right-hand side for level 1, rb - A_bf z, taken with the last pre-sweep's z. */
     double *rbo = nb6 ? mg->lv[1].rb : NULL;
     if (nb6)
         memcpy(rbo, rb, nb6 * sizeof(double));
-    for (int s = 0; s < mg->sweeps; s++) { /* after them, t = r - A z */
-        const film_pass f = {r, t, z, s == 0 ? JACOBI_SET : JACOBI_ADD, 1, NULL,
-                             s + 1 == mg->sweeps ? rbo : NULL};
-        (void)film_nodes_springs(mg, web, &f);
+    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
+    film_springs(mg, web, z, t);
+    for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
+        film_springs(mg, web, z, t);
     }
     restrict_to(mg, web, 0, t);
     cycle(mg, web, 1);
     if (nb6)
         memcpy(zb, mg->lv[1].xb, nb6 * sizeof(double));
     prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL); /* and t = r - N z - A_fb zb */
+    film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) {
-        const film_pass f = {r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL};
-        (void)film_springs_nodes(mg, web, &f);
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
+        film_springs(mg, web, z, t);
     }
-    const film_pass f = {r, t, z, JACOBI_ADD, 0, NULL, NULL};
-    double rz = film_springs_nodes(mg, web, &f);
+    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0, NULL, NULL);
     for (size_t q = 0; q < nb6; q++)
         rz += rb[q] * zb[q];
     return rz;
