@@ -275,24 +275,15 @@ static void operator_for(const ws_web *web, double h)
     }
 }
 
-/* The product's own passes: the nodes' blocks (with p = z + beta p made there, CG's direction
- * where the product reads it first, one pass over z and p the fewer), the springs, y . p. A
- * pinned node's p is zero (its preconditioner is), so its y is not needed: it is set to
- * zero. */
-double ws_implicit_direction_apply(const ws_web *web, const double *restrict z, double beta,
-                                   double *restrict p, double *restrict y)
+/* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
+ * preconditioner is), so its y is not needed: it is set to zero. */
+double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
     const uint32_t n = web->n;
     for (uint32_t i = 0; i < n; i++) {
-        const double *S = im->nd + WS_SYM * (size_t)i;
-        double *P = p + 3 * (size_t)i, *Y = y + 3 * (size_t)i;
-        if (z) {
-            const double *Z = z + 3 * (size_t)i;
-            P[0] = Z[0] + beta * P[0];
-            P[1] = Z[1] + beta * P[1];
-            P[2] = Z[2] + beta * P[2];
-        }
+        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
+        double *Y = y + 3 * (size_t)i;
         Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
         Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
         Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
@@ -326,11 +317,6 @@ double ws_implicit_direction_apply(const ws_web *web, const double *restrict z, 
         py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
     }
     return py;
-}
-
-double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
-{
-    return ws_implicit_direction_apply(web, NULL, 0.0, (double *)p, y); /* p only read */
 }
 
 /* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
@@ -587,9 +573,8 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         meas = NAN; /* a NaN row is never met */
     memcpy(p, z, m * sizeof(double));
     int it = 0;
-    double beta = 0.0; /* p = z + beta p is made in the next product (none before the first) */
     while (!(meas <= lim) && it < web->solver_maxit) {
-        const double pq = ws_implicit_direction_apply(web, it ? z : NULL, beta, p, q) +
+        const double pq = ws_implicit_apply_op(web, p, q) +
                           (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
@@ -609,8 +594,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         meas = !isfinite(rr) ? NAN : im->stop_relative ? rr : w2;
         it++;
         const double rz1 = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
-        beta = rz1 / rz;
+        const double beta = rz1 / rz;
         rz = rz1;
+        for (size_t j = 0; j < m; j++)
+            p[j] = z[j] + beta * p[j];
         if (R)
             ws_rigid_direction(R, beta);
     }

@@ -111,12 +111,6 @@ void ws_implicit_apply(const ws_web *web, double h, const double *p, double *y);
  * per node, y zero at pinned nodes; returns p . y. */
 double ws_implicit_apply_op(const ws_web *web, const double *p, double *y);
 
-/* p = z + beta p when z is given (p left when NULL: ws_implicit_apply_op), then y = A p as
- * ws_implicit_apply_op makes it, p . y returned: CG's new direction made in the product's pass
- * over the nodes, each p_i the same number the update alone gives. */
-double ws_implicit_direction_apply(const ws_web *web, const double *z, double beta, double *p,
-                                   double *y);
-
 /* The exact derivatives of spring s's force on its end a at (x, v), the law taken at (t,
  * since): Jx = df_a/dx_b (= -df_a/dx_a) and Jv = df_a/dv_b, row-major. They hold the terms
  * the matrix leaves out (compression's negative transverse stiffness, the rate's dependence
