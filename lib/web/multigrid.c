@@ -30,6 +30,9 @@
  * the cycle stays symmetric positive definite); they are summed in double (`acc`) and rounded
  * once. */
 #define CENTRE 4
+#define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
+#define FOP_A 5
+#define FOP_B 6
 #define STEN (5 * WS_SYM)
 #define AT(L, k, o) ((L)->a + STEN * (size_t)(k) + WS_SYM * (size_t)((o) - CENTRE))
 #define ACC(acc, k, o) ((acc) + STEN * (size_t)(k) + WS_SYM * (size_t)((o) - CENTRE))
@@ -75,7 +78,9 @@ struct ws_mg {
     uint64_t kept_begun;
     double kept_h;
     double *blk;  /* every array above but the levels' blocks, in one allocation of `doubles` */
-    float *fop;   /* the film's springs for the sweeps: e, a, b (5 a spring; with sacc) */
+    float *fop;   /* the film's springs for the sweeps, FOP words a spring: e, a, b (with
+                     sacc), then its ends a and b (uint32_t, set at reserve) in words FOP_A
+                     and FOP_B: one record a spring, one stream for the springs' pass */
     float *fnd;   /* the film's nodes' own blocks N (WS_SYM a node; at every setup) */
     float *fpinv; /* w times the inverse of the film's diagonal blocks D (likewise) */
     float *fblk;  /* every float array above, `floats` */
@@ -260,7 +265,7 @@ static void galerkin_springs(ws_mg *mg, const ws_web *web, double h)
     pmap p, q, d;
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_ispring *k = &im->sp[s];
-        float *o = mg->fop + 5 * (size_t)s;
+        float *o = mg->fop + FOP * (size_t)s;
         o[0] = (float)k->ex, o[1] = (float)k->ey, o[2] = (float)k->ez;
         o[3] = (float)k->a, o[4] = (float)k->b;
         if (k->a == 0.0 && k->b == 0.0)
@@ -983,15 +988,17 @@ static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restr
 static void film_springs(const ws_mg *mg, const ws_web *web, const double *restrict z,
                          double *restrict t)
 {
-    const uint32_t *sa = web->sa, *sb = web->sb;
     for (uint32_t s = 0; s < web->ns; s++) {
-        const float *q = mg->fop + 5 * (size_t)s; /* ex ey ez a b */
+        const float *q = mg->fop + FOP * (size_t)s; /* ex ey ez a b, ends */
         const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
-        const double *A = z + 3 * (size_t)sa[s], *B = z + 3 * (size_t)sb[s];
+        uint32_t ia, ib;
+        memcpy(&ia, q + FOP_A, sizeof ia);
+        memcpy(&ib, q + FOP_B, sizeof ib);
+        const double *A = z + 3 * (size_t)ia, *B = z + 3 * (size_t)ib;
         const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
         const double ed = a * (ex * dx + ey * dy + ez * dz);
         const double tx = ed * ex + b * dx, ty = ed * ey + b * dy, tz = ed * ez + b * dz;
-        double *TA = t + 3 * (size_t)sa[s], *TB = t + 3 * (size_t)sb[s];
+        double *TA = t + 3 * (size_t)ia, *TB = t + 3 * (size_t)ib;
         TA[0] -= tx;
         TA[1] -= ty;
         TA[2] -= tz;
@@ -1140,7 +1147,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         doubles += (WS_SYM + 9) * (size_t)lv[i].n;
         floats += STEN * (size_t)lv[i].n;
     }
-    floats += 5 * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
+    floats += FOP * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
     size_t nmaps = 0;
     for (int i = 0; i + 1 < nlev; i++)
         nmaps += (size_t)lv[i].nx + (size_t)lv[i].ny;
@@ -1179,7 +1186,11 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     memcpy(mg->lv, lv, sizeof lv);
     double *q = blk;
     float *fq = fblk;
-    mg->fop = fq, fq += 5 * (size_t)(web->ns ? web->ns : 1);
+    mg->fop = fq, fq += FOP * (size_t)(web->ns ? web->ns : 1);
+    for (uint32_t s = 0; s < web->ns; s++) { /* the ends, fixed for the web */
+        memcpy(mg->fop + FOP * (size_t)s + FOP_A, &web->sa[s], sizeof(uint32_t));
+        memcpy(mg->fop + FOP * (size_t)s + FOP_B, &web->sb[s], sizeof(uint32_t));
+    }
     mg->fnd = fq, fq += WS_SYM * (size_t)web->n;
     mg->fpinv = fq, fq += WS_SYM * (size_t)web->n;
     mg->lv[0].t = q, q += 3 * (size_t)web->n;
