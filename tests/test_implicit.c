@@ -1230,11 +1230,11 @@ START_TEST(test_refined_band_pressure)
 END_TEST
 
 /* The band of cylinder_band at 64 r x (16 r + 1) nodes, 0.16 m tall, stretched 20 % around
- * and pre_up up, 20 steps of 1 ms with the multigrid: the film solve of the next step from
- * zero to 1e-10 of each row's weight, its iterations (the levels into *levels). */
-static int band_from_zero(int r, double pre_up, int *levels)
+ * and pre_up up, solved with the multigrid to 1e-10 of each row's weight, after 20 steps of
+ * BAND_DT with its next step begun (ws_implicit_begin): the world, its web into *out. */
+#define BAND_DT 1e-3
+static ws_world *band_begun(int r, double pre_up, ws_web **out)
 {
-    const double dt = 1e-3;
     ws_web_def solve;
     ws_web_def_init(&solve);
     solve.solver_tolerance = 1e-10;
@@ -1244,11 +1244,22 @@ static int band_from_zero(int r, double pre_up, int *levels)
     ws_world *w = cylinder_band(r, 0.16, 16 * r + 1, pre_up, &solve, &id);
     ck_ok(w, ws_world_step_n(w, 20));
     ws_web *web = web_of(w, id);
-    ws_implicit *im = web->imp;
-    ck_assert_msg(im && im->mg, "the band takes the multigrid");
+    ck_assert_msg(web->imp && web->imp->mg, "the band takes the multigrid");
     const int cur = w->cur;
-    ws_nodes3 x = web->x[cur], v = web->v[cur];
-    ck_assert_int_eq(ws_implicit_begin(web, x, v, NO_G, w->time, 0.0), 0);
+    ck_assert_int_eq(ws_implicit_begin(web, web->x[cur], web->v[cur], NO_G, w->time, 0.0), 0);
+    *out = web;
+    return w;
+}
+
+/* The film solve of band_begun's next step from zero: its iterations (the levels into
+ * *levels). */
+static int band_from_zero(int r, double pre_up, int *levels)
+{
+    const double dt = BAND_DT;
+    ws_web *web;
+    ws_world *w = band_begun(r, pre_up, &web);
+    ws_implicit *im = web->imp;
+    ws_nodes3 v = web->v[w->cur];
     im->warm = 0;
     ck_assert_int_eq(ws_implicit_solve(web, v, dt), 0);
     const int it = im->last_iterations;
@@ -1372,21 +1383,11 @@ static double coupled_apply(const ws_web *web, const ws_rigid *R, const double *
  * film and body. */
 static int band_pressed(int r, int nest, int checks)
 {
-    const double dt = 1e-3;
-    ws_web_def solve;
-    ws_web_def_init(&solve);
-    solve.solver_tolerance = 1e-10;
-    solve.solver_max_iterations = 5000;
-    solve.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
-    ws_web_id id;
-    ws_world *w = cylinder_band(r, 0.16, 16 * r + 1, 0.02, &solve, &id);
-    ck_ok(w, ws_world_step_n(w, 20));
-    ws_web *web = web_of(w, id);
+    const double dt = BAND_DT;
+    ws_web *web;
+    ws_world *w = band_begun(r, 0.02, &web);
     ws_implicit *im = web->imp;
-    ck_assert_msg(im && im->mg, "the band takes the multigrid");
-    const int cur = w->cur;
-    ws_nodes3 x = web->x[cur], v = web->v[cur];
-    ck_assert_int_eq(ws_implicit_begin(web, x, v, NO_G, w->time, 0.0), 0);
+    ws_nodes3 x = web->x[w->cur], v = web->v[w->cur];
     press_case pb;
     press_body(web, x, r, dt, nest, &pb);
     ws_rigid *R = &pb.R;

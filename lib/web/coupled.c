@@ -98,18 +98,21 @@ static inline double sym_row(const double *S, int i, double x, double y, double 
     return S[ix[i][0]] * x + S[ix[i][1]] * y + S[ix[i][2]] * z;
 }
 
+/* Y = M_j P: body j's mass and inertia times its six velocities P. */
+static void body_mass_apply(const ws_rigid *R, uint32_t j, const double *P, double *Y)
+{
+    const double m = R->mass[j];
+    Y[0] = m * P[0], Y[1] = m * P[1], Y[2] = m * P[2];
+    Y[3] = Y[4] = Y[5] = 0.0;
+    ws_sym_madd(R->inertia + WS_SYM * (size_t)j, P[3], P[4], P[5], Y + 3);
+}
+
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
                       double *y, double *yr)
 {
     double added = 0.0;
-    for (uint32_t j = 0; j < R->nb; j++) {
-        const double *P = pr + 6 * (size_t)j, *I = R->inertia + WS_SYM * (size_t)j;
-        double *Y = yr + 6 * (size_t)j;
-        const double m = R->mass[j];
-        Y[0] = m * P[0], Y[1] = m * P[1], Y[2] = m * P[2];
-        Y[3] = Y[4] = Y[5] = 0.0;
-        ws_sym_madd(I, P[3], P[4], P[5], Y + 3);
-    }
+    for (uint32_t j = 0; j < R->nb; j++)
+        body_mass_apply(R, j, pr + 6 * (size_t)j, yr + 6 * (size_t)j);
     /* A run of links on one body (a node's neighbours mostly press on the same box) sums its
      * body's row in registers, stored once at the run's end: the same sums in the same order
      * as adding into yr link by link, without a chain of loads and stores through memory. */
@@ -323,11 +326,7 @@ static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t 
             double P[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
             if (k == j)
                 P[q] = 1.0;
-            const double *I = R->inertia + WS_SYM * (size_t)k, m = R->mass[k];
-            double *Yb = yr + nc * (size_t)q + 6 * (size_t)k;
-            Yb[0] = m * P[0], Yb[1] = m * P[1], Yb[2] = m * P[2];
-            Yb[3] = Yb[4] = Yb[5] = 0.0;
-            ws_sym_madd(I, P[3], P[4], P[5], Yb + 3);
+            body_mass_apply(R, k, P, yr + nc * (size_t)q + 6 * (size_t)k);
         }
     size_t l = 0;
     while (l < R->nl) {
