@@ -1795,6 +1795,19 @@ static void film_and_box(ws_world *w, ws_material_id *film, ws_material_id *box)
     ck_ok(w, ws_world_set_contact(w, *film, *box, &cd));
 }
 
+/* A body def of a 0.1 m cube of the box's material of film_and_box (made here, the film's
+ * into *film), at rest at the origin: the caller sets its type, mass and place. */
+static void cube_and_film(ws_world *w, ws_material_id *film, ws_body_def *bd)
+{
+    ws_shape_id cube;
+    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &cube));
+    ws_material_id box_mat;
+    film_and_box(w, film, &box_mat);
+    ws_body_def_init(bd);
+    bd->shape = cube;
+    bd->material = box_mat;
+}
+
 /* A box of `mass` kg, 0.1 m a side, dropped from rest just touching the middle of a square
  * implicit sheet (0.4 m, 21 x 21 nodes, its border pinned, pre-stretched 5 %) under gravity,
  * at step dt, the box held during the film's solve or in it; after T s: the box's speed, the
@@ -1809,15 +1822,10 @@ static sling box_on_sheet(double dt, double mass, int hold, int plain, double T)
 {
     sling o = {WS_OK, NAN, NAN, 0.0, NAN};
     ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
-    ws_shape_id box;
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &box));
-    ws_material_id film_mat, box_mat;
-    film_and_box(w, &film_mat, &box_mat);
+    ws_material_id film_mat;
     ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.shape = box;
+    cube_and_film(w, &film_mat, &bd);
     bd.mass = mass;
-    bd.material = box_mat;
     bd.position = v3_make(0.0, 0.0, 0.05 + 1.9e-3);
     ws_body_id body;
     ck_ok(w, ws_body_create(w, &bd, &body));
@@ -1927,16 +1935,11 @@ START_TEST(test_film_body_momentum)
      * momentum stays that of the start, to 1e-9 of it over 0.3 s at dt 1 ms (the solve's
      * tolerance 1e-11 bounds each step's residual impulse; 300 steps of it). */
     ws_world *w = world_g(1e-3, NO_G);
-    ws_shape_id box;
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &box));
-    ws_material_id film_mat, box_mat;
-    film_and_box(w, &film_mat, &box_mat);
-    const double mb = 0.2, mn = 1e-4;
+    ws_material_id film_mat;
     ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.shape = box;
+    cube_and_film(w, &film_mat, &bd);
+    const double mb = 0.2, mn = 1e-4;
     bd.mass = mb;
-    bd.material = box_mat;
     bd.position = v3_make(0.02, -0.01, 0.053);
     bd.velocity = v3_make(0.1, 0.05, -0.4);
     bd.angular_velocity = v3_make(0.0, 0.0, 2.0);
@@ -2004,15 +2007,10 @@ static void pressed_drum(double tol, int relative, int steps, double worst[2])
 {
     const double dt = 1e-3;
     ws_world *w = world_g(dt, (ws_vec3){0, 0, -G0});
-    ws_shape_id cube;
-    ck_ok(w, ws_shape_create_box(w, 0.1, 0.1, 0.1, &cube));
-    ws_material_id film_mat, box_mat;
-    film_and_box(w, &film_mat, &box_mat);
+    ws_material_id film_mat;
     ws_body_def bd;
-    ws_body_def_init(&bd);
+    cube_and_film(w, &film_mat, &bd);
     bd.type = WS_BODY_KINEMATIC;
-    bd.shape = cube;
-    bd.material = box_mat;
     bd.position = v3_make(0.0, 0.0, -0.05 - 0.5e-3);
     ws_body_id box;
     ck_ok(w, ws_body_create(w, &bd, &box));
