@@ -11,8 +11,10 @@
  * M_j = diag(m I, I_w) the body's mass and global inertia: symmetric positive definite
  * whenever A is (its energy is the film's plus (dv - J dU)^T C (dv - J dU) + dU^T M dU). The
  * solve's vectors keep their film part as before (3 doubles a node) and put the bodies' in the
- * arrays here (6 a body: velocity change, then spin change). The module knows no body: the
- * world fills a body's mass, inertia and right-hand side and the contacts' levers and blocks. */
+ * arrays here (6 a body: velocity change, then spin change). Body contacts whose friction is
+ * in the solve (ws_rigid_pair) add (J_b dU_b - J_a dU_a)^T C (J_b dU_b - J_a dU_a) between two
+ * bodies' rows. The module knows no body: the world fills a body's mass, inertia and
+ * right-hand side and the contacts' levers and blocks. */
 #ifndef WS_WEB_COUPLED_H
 #define WS_WEB_COUPLED_H
 

@@ -2,8 +2,10 @@
  * the springs and the node contacts at its start, one linear solve, the new node state and the
  * contacts' loads on the bodies. The dynamic bodies the film touches are unknowns of the solve
  * beside its nodes (web/coupled.h, docs/theory.md section 8b), their other loads (gravity, body
- * contacts, elements, webs stepped before) known; with hold_bodies they are held at their
- * state at t as for the explicit film (deviation (h) of docs/design.md). */
+ * contacts, elements, webs stepped before) known, but for their contacts' regularised
+ * friction, which goes into the solve with them (pairs_make; explicit, it chatters past 0.33 ms
+ * on a wrapped stack); with hold_bodies they are held at their state at t as for the explicit
+ * film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
 #include "contact/penalty.h"
 #include "web/coupled.h"
