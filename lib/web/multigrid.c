@@ -403,21 +403,25 @@ static void sym_sub_full(double *S, const double *U)
     S[WS_SYM_YZ] -= 0.5 * (U[5] + U[7]);
 }
 
-/* A node's line factor: its pivot's inverse (WS_SYM), its multiplier to the next node along the
- * row C (9) and, on a closed row, to the row's last node F (9); LF floats. */
+/* A node's line factor: its pivot's inverse D^-1 (WS_SYM) and, on a closed row, its multiplier
+ * to the row's last node F (9); LF doubles. The multiplier to the next node along the row, C =
+ * A_{i+1,i} D^-1, is not kept: the sweeps take it as the coupling block (which the level
+ * keeps) times D^-1, for less to read. */
 #define LF_D 0
-#define LF_C WS_SYM
-#define LF_F (WS_SYM + 9)
-#define LF (WS_SYM + 18)
+#define LF_F WS_SYM
+#define LF (WS_SYM + 9)
 
 /* Each row's line block T on coarse level L (the row's nodes and their couplings along it,
  * closed around on a band) as T = L D L^T by block elimination along the row, into L->lf: node
- * i's pivot inverse D_i^-1, its multiplier C_i = A_{i+1,i} D_i^-1 and, on a closed row, F_i,
- * the row's last node's (eliminated last: an arrow, no fill but that row). Kept in single
- * precision: whatever the rounding, the solve L^-T D^-1 L^-1 is symmetric, and positive
- * definite as long as the rounded D^-1 is (docs/theory.md 8a). A node no fine node reaches has
- * a zero block and no couplings: its pivot is the identity (its right-hand side is always
- * zero). 0, or -1 when a pivot is not positive definite. */
+ * i's pivot inverse D_i^-1 and, on a closed row, F_i, the row's last node's multiplier (that
+ * node eliminated last: an arrow, no fill but its row); the multiplier along the row, C_i =
+ * A_{i+1,i} D_i^-1, is taken from the same numbers in the sweeps, so whatever the rounding the
+ * solve L^-T D^-1 L^-1 is symmetric, and positive definite with D^-1 (docs/theory.md 8a). In
+ * double precision: a ring's smooth mode around is held only by the mass and the weak
+ * couplings up (T's condition 1e6 and more), and single precision lost it (bench/NOTES.md,
+ * session 14). A node no fine node reaches has a zero block and no couplings: its pivot is the
+ * identity (its right-hand side is always zero). 0, or -1 when a pivot is not positive
+ * definite. */
 static int line_factor(mg_level *L)
 {
     const int n = L->nx, m = L->closed ? n - 1 : n; /* m: the nodes of the chain */
@@ -454,8 +458,6 @@ static int line_factor(mg_level *L)
                 full_of(AT(L, k, CENTRE + 1), Bf);
                 mat_mul(Bf, Pf, 0, Cp);
                 memcpy(Bp, Bf, sizeof Bf);
-                for (int q = 0; q < 9; q++)
-                    o[LF_C + q] = Cp[q];
             }
             if (!L->closed)
                 continue;
@@ -848,8 +850,8 @@ static inline void fmat_sub(const double *M, int tr, const double *x, double *o)
 }
 
 /* The line solve's forward step at node ix of a row (X: the row's x, holding its right-hand
- * side s up to ix): g_ix = s_ix - C_{ix-1} g_{ix-1}, and on a closed row the last node's
- * g_m = s_m - sum F_i g_i (the sum gathered in acc as the row goes). */
+ * side s up to ix): g_ix = s_ix - A_{ix,ix-1} D_{ix-1}^-1 g_{ix-1}, and on a closed row the
+ * last node's g_m = s_m - sum F_i g_i (the sum gathered in acc as the row goes). */
 static inline void line_down(const mg_level *L, size_t k0, int ix, double *X, double *acc)
 {
     const int m = L->closed ? L->nx - 1 : L->nx;
@@ -858,30 +860,32 @@ static inline void line_down(const mg_level *L, size_t k0, int ix, double *X, do
         Xi[0] += acc[0], Xi[1] += acc[1], Xi[2] += acc[2];
         return;
     }
-    if (ix > 0)
-        fmat_sub(L->lf + LF * (k0 + (size_t)ix - 1) + LF_C, 0, Xi - 3, Xi);
+    if (ix > 0) {
+        double u[3] = {0.0, 0.0, 0.0};
+        const double *D = L->lf + LF * (k0 + (size_t)ix - 1) + LF_D;
+        ws_sym_madd(D, Xi[-3], Xi[-2], Xi[-1], u);
+        fsym_sub(AT(L, k0 + (size_t)ix - 1, CENTRE + 1), u, Xi);
+    }
     if (L->closed)
         fmat_sub(L->lf + LF * (k0 + (size_t)ix) + LF_F, 0, Xi, acc);
 }
 
 /* The line solve's backward step at node ix (the nodes after it, and the last, solved):
- * x_ix = D^-1 g_ix - C_ix^T x_{ix+1} - F_ix^T x_m. */
+ * x_ix = D^-1 (g_ix - A_{ix,ix+1} x_{ix+1}) - F_ix^T x_m. */
 static inline void line_up(const mg_level *L, size_t k0, int ix, double *X)
 {
     const int m = L->closed ? L->nx - 1 : L->nx;
     const double *o = L->lf + LF * (k0 + (size_t)ix);
     double *Xi = X + 3 * (size_t)ix;
-    const double g[3] = {Xi[0], Xi[1], Xi[2]};
+    double g[3] = {Xi[0], Xi[1], Xi[2]};
+    if (ix + 1 < m)
+        fsym_sub(AT(L, k0 + (size_t)ix, CENTRE + 1), Xi + 3, g);
     const double xx = o[WS_SYM_XX], yy = o[WS_SYM_YY], zz = o[WS_SYM_ZZ], xy = o[WS_SYM_XY],
                  xz = o[WS_SYM_XZ], yz = o[WS_SYM_YZ];
     Xi[0] = xx * g[0] + xy * g[1] + xz * g[2];
     Xi[1] = xy * g[0] + yy * g[1] + yz * g[2];
     Xi[2] = xz * g[0] + yz * g[1] + zz * g[2];
-    if (ix == m)
-        return;
-    if (ix + 1 < m)
-        fmat_sub(o + LF_C, 1, Xi + 3, Xi);
-    if (L->closed)
+    if (ix < m && L->closed)
         fmat_sub(o + LF_F, 1, X + 3 * (size_t)m, Xi);
 }
 
