@@ -889,6 +889,21 @@ static inline void line_up(const mg_level *L, size_t k0, int ix, double *X)
         fmat_sub(o + LF_F, 1, X + 3 * (size_t)m, Xi);
 }
 
+/* The neighbours of (ix, iy) on level L in the row iy + dy (dy -1 or 1), by dx = -1, 0, 1
+ * (slots 3 (dy + 1) + dx + 1); -1 beyond the grid's edge. */
+static inline void row_beside(const mg_level *L, int ix, int iy, int dy, int64_t *j)
+{
+    const int jy = iy + dy;
+    if (jy < 0 || jy >= L->ny) {
+        j[0] = j[1] = j[2] = -1;
+        return;
+    }
+    const int64_t b = (int64_t)L->nx * jy;
+    j[0] = ix > 0 ? b + ix - 1 : L->closed ? b + L->nx - 1 : -1;
+    j[1] = b + ix;
+    j[2] = ix + 1 < L->nx ? b + ix + 1 : L->closed ? b : -1;
+}
+
 /* The line sweeps of block Gauss-Seidel on a coarse level L: each row (along x, around a
  * band) solved whole against the rows beside it (its factor from line_factor), the rows in
  * order, and the bodies nested first in the forward sweep and last in the backward one, so
@@ -910,13 +925,13 @@ static void line_forward(const ws_mg *mg, mg_level *L, double *rbn)
         double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
         for (int ix = 0; ix < L->nx; ix++) {
             const int64_t k = (int64_t)k0 + ix;
-            neighbours(L, ix, iy, j);
+            row_beside(L, ix, iy, -1, j);
             const double *R = L->r + 3 * (size_t)k;
             double *X = L->x + 3 * (size_t)k;
             X[0] = R[0], X[1] = R[1], X[2] = R[2];
             for (int o = 0; o < 3; o++)
                 if (j[o] >= 0)
-                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], X);
+                    fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
             const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
             for (uint32_t e = e0; e < e1; e++)
                 g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
@@ -925,11 +940,11 @@ static void line_forward(const ws_mg *mg, mg_level *L, double *rbn)
         for (int ix = L->nx - 1; ix >= 0; ix--) {
             const int64_t k = (int64_t)k0 + ix;
             line_up(L, k0, ix, Xr);
-            neighbours(L, ix, iy, j);
+            row_beside(L, ix, iy, -1, j);
             const double *X = L->x + 3 * (size_t)k;
             for (int o = 0; o < 3; o++) /* t_j -= A_jk x_k for the row before */
                 if (j[o] >= 0)
-                    fsym_sub(off_block(L, (size_t)k, o, j[o]), X, L->t + 3 * (size_t)j[o]);
+                    fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
             const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
             for (uint32_t e = e0; e < e1; e++)
                 gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
@@ -952,13 +967,17 @@ static void line_backward(const ws_mg *mg, mg_level *L)
         double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
         for (int ix = 0; ix < L->nx; ix++) {
             const int64_t k = (int64_t)k0 + ix;
-            neighbours(L, ix, iy, j);
+            row_beside(L, ix, iy, -1, j);
+            row_beside(L, ix, iy, 1, j + 6);
             const double *R = L->r + 3 * (size_t)k;
             double *X = L->x + 3 * (size_t)k;
             X[0] = R[0], X[1] = R[1], X[2] = R[2];
-            for (int o = 0; o < 9; o++)
-                if ((o < 3 || o > 5) && j[o] >= 0)
-                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], X);
+            for (int o = 0; o < 3; o++) {
+                if (j[o] >= 0)
+                    fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+                if (j[6 + o] >= 0)
+                    fsym_sub(AT(L, (size_t)k, 6 + o), L->x + 3 * (size_t)j[6 + o], X);
+            }
             const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
             for (uint32_t e = e0; e < e1; e++)
                 g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
