@@ -418,10 +418,9 @@ static void sym_sub_full(double *S, const double *U)
  * A_{i+1,i} D_i^-1, is taken from the same numbers in the sweeps, so whatever the rounding the
  * solve L^-T D^-1 L^-1 is symmetric, and positive definite with D^-1 (docs/theory.md 8a). In
  * double precision: a ring's smooth mode around is held only by the mass and the weak
- * couplings up (T's condition 1e6 and more), and single precision lost it (bench/NOTES.md,
- * session 14). A node no fine node reaches has a zero block and no couplings: its pivot is the
- * identity (its right-hand side is always zero). 0, or -1 when a pivot is not positive
- * definite. */
+ * couplings up, and single precision lost it (bench/NOTES.md, session 14). A node no fine
+ * node reaches has a zero block and no couplings: its pivot is the identity (its right-hand
+ * side is always zero). 0, or -1 when a pivot is not positive definite. */
 static int line_factor(mg_level *L)
 {
     const int n = L->nx, m = L->closed ? n - 1 : n; /* m: the nodes of the chain */
