@@ -6,7 +6,9 @@
  * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
  * matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
  * Gauss-Seidel (forward before, backward after the coarse correction) on the coarse levels
- * (their blocks in single precision too), a dense Cholesky factor on the coarsest. The cycle is
+ * (their blocks in single precision too; a level held more strongly along x than along y
+ * solves its rows along x whole, a band's closed around), a dense Cholesky factor on the
+ * coarsest. The cycle is
  * the same linear, symmetric positive definite map on every call of a solve, so conjugate
  * gradients stay valid with it (docs/theory.md 8a: why the rounding keeps it so).
  *
