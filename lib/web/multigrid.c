@@ -29,10 +29,13 @@
  * preconditioner's, and halving them halves what a cycle streams (docs/theory.md 8a says why
  * the cycle stays symmetric positive definite); they are summed in double (`acc`) and rounded
  * once. */
-/* A coarse level held along x (around a band) this many times more strongly than along y is
- * swept by rows along x, solved whole (held_along_x; bench/NOTES.md, session 14: the band's
- * first coarse level is held 7-40x more strongly around, the next ones 0.3-2x). */
-#define MG_LINE_RATIO 1.5
+/* A coarse level's row along x (around a band) is solved whole in its sweeps where point
+ * Jacobi would take less than this share off the error constant along the row and alternating
+ * up (row_held_along): (1 - 0.45)^2 = 0.30 a symmetric sweep is what a V-cycle takes off the
+ * rest (I - B A's factor 0.25-0.32). Measured on the refined reference band (bench/NOTES.md,
+ * session 15): its first coarse level's edge rows 0.76-0.83 at 1x, 0.37-0.45 at 2x, 0.20-0.33
+ * at 4x, its middle rows 0.65-0.9. */
+#define MG_LINE_RHO 0.45
 #define CENTRE 4
 #define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
 #define FOP_A 5
@@ -50,7 +53,8 @@ typedef struct map1d {
 typedef struct mg_level {
     int nx, ny, closed; /* grid: node ix + nx iy, closed around (a band) */
     int cx, cy;         /* whether x and y are halved for the next level */
-    int lines;          /* its sweeps solve rows along x whole (coarse levels; held_along_x) */
+    int lines;          /* how many of its rows its sweeps solve whole (coarse levels) */
+    unsigned char *whole; /* ny: whether each row is solved whole (row_held_along) */
     map1d *mx, *my;     /* interpolation from the next level, by ix and by iy */
     uint32_t n;
     float *a;               /* STEN n: each node's row of blocks (coarse levels) */
@@ -93,6 +97,8 @@ struct ws_mg {
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
+    unsigned char *whole; /* every coarse level's rows' kind (mg_level.whole), rows of them */
+    size_t rows;
     /* The bodies of the running solve nested in the hierarchy (ws_mg_bodies; nb 0: none):
      * their six unknowns ride along every coarse level, coupled to its nodes by the levels'
      * entries. bchol: the coarsest level's factor with them ((m + 6 nb)^2), bsc: its vector
@@ -426,10 +432,10 @@ static void sym_sub_full(double *S, const double *U)
  * couplings up, and single precision lost it (bench/NOTES.md, session 14). A node no fine
  * node reaches has a zero block and no couplings: its pivot is the identity (its right-hand
  * side is always zero). 0, or -1 when a pivot is not positive definite. */
-static int line_factor(mg_level *L)
+static int line_factor(mg_level *L, int iy)
 {
     const int n = L->nx, m = L->closed ? n - 1 : n; /* m: the nodes of the chain */
-    for (int iy = 0; iy < L->ny; iy++) {
+    {
         const size_t k0 = (size_t)n * (size_t)iy;
         double Pf[9], Bf[9], Cp[9], Bp[9], f[9], Ff[9], U[9], Pl[WS_SYM];
         if (L->closed) { /* the last node's row: its block and its coupling to node 0 */
@@ -482,13 +488,13 @@ static int line_factor(mg_level *L)
             }
         }
         if (!L->closed)
-            continue;
+            return 0;
         double *o = L->lf + LF * (k0 + (size_t)m);
         memset(o, 0, LF * sizeof(double));
         double Pinv[WS_SYM];
         if (Pl[WS_SYM_XX] == 0.0 && Pl[WS_SYM_YY] == 0.0 && Pl[WS_SYM_ZZ] == 0.0) {
             o[LF_D + WS_SYM_XX] = o[LF_D + WS_SYM_YY] = o[LF_D + WS_SYM_ZZ] = 1.0;
-            continue;
+            return 0;
         }
         if (ws_sym_invert(Pl, Pinv) != 0)
             return -1;
@@ -498,35 +504,57 @@ static int line_factor(mg_level *L)
     return 0;
 }
 
-/* Whether coarse level L is held along x (around a band) at least MG_LINE_RATIO times as
- * strongly as along y in some direction of motion, by its own blocks: for each of x, y and z
- * motion, the sums over the nodes of the size of that diagonal entry of the block to the next
- * node along x and of the block to the next along y. By direction, since what is weak is the
- * up springs' transverse stiffness (the tension's), which the blocks' traces hide under the
- * axial one. Such a level's error that is smooth along x and rough along y is what a point
- * sweep leaves and its coarser level cannot carry. */
-static int held_along_x(const mg_level *L)
+/* Whether row iy of coarse level L is to be solved whole. For each node and each direction of
+ * motion q, the quotient v^T A v / v^T D v of the error that is constant along the row about
+ * the node and alternates from row to row: the node's diagonal entry q q and its couplings
+ * along the row, less those to the rows beside it (the mode's sign flips there), over the
+ * diagonal entry: point Jacobi takes 1 - that off such an error a sweep. Where the row is held
+ * along itself far more strongly than by its mass and the rows beside it the quotient is
+ * small; docs/theory.md 8a derives why it falls under refinement in the rows weakly held up.
+ * The row is solved whole when the mean over its nodes of their least quotient (over q: the
+ * faces of a band turn its directions) is under MG_LINE_RHO. */
+static int row_held_along(const mg_level *L, int iy)
 {
-    double ax[3] = {0.0, 0.0, 0.0}, ay[3] = {0.0, 0.0, 0.0};
-    for (uint32_t i = 0; i < L->n; i++) {
-        const float *X = AT(L, i, CENTRE + 1), *Y = AT(L, i, 7);
+    const int nx = L->nx;
+    double sum = 0.0;
+    for (int ix = 0; ix < nx; ix++) {
+        const size_t k = (size_t)nx * (size_t)iy + (size_t)ix;
+        const int xl = ix > 0 ? ix - 1 : L->closed ? nx - 1 : -1;
+        const int xr = ix + 1 < nx ? ix + 1 : L->closed ? 0 : -1;
+        double least = 1.0;
         for (int q = 0; q < 3; q++) { /* WS_SYM_XX, YY, ZZ */
-            ax[q] += fabs((double)X[q]);
-            ay[q] += fabs((double)Y[q]);
+            const double d = AT(L, k, CENTRE)[q];
+            double a = d;
+            if (xr >= 0)
+                a += AT(L, k, CENTRE + 1)[q];
+            if (xl >= 0)
+                a += AT(L, k - (size_t)ix + (size_t)xl, CENTRE + 1)[q];
+            if (iy + 1 < L->ny)
+                for (int o = 6; o < 9; o++)
+                    a -= AT(L, k, o)[q];
+            if (iy > 0) {
+                const size_t b = k - (size_t)nx;
+                a -= AT(L, b, 7)[q];
+                if (xl >= 0)
+                    a -= AT(L, b - (size_t)ix + (size_t)xl, 8)[q];
+                if (xr >= 0)
+                    a -= AT(L, b - (size_t)ix + (size_t)xr, 6)[q];
+            }
+            if (d > 0.0 && a < least * d)
+                least = a / d;
         }
+        sum += least;
     }
-    int lines = 0;
-    for (int q = 0; q < 3; q++)
-        lines |= ax[q] > MG_LINE_RATIO * ay[q];
-    return lines;
+    return sum < MG_LINE_RHO * nx;
 }
 
-/* The point sweeps' factor of coarse level L: each node's own block's inverse, or the
- * identity for a node no fine node reaches (its right-hand side is always zero). 0, or -1 when
- * a block is not positive definite. */
-static int point_factor(mg_level *L)
+/* The point sweeps' factor of row iy of coarse level L: each node's own block's inverse, or
+ * the identity for a node no fine node reaches (its right-hand side is always zero). 0, or -1
+ * when a block is not positive definite. */
+static int point_factor(mg_level *L, int iy)
 {
-    for (uint32_t i = 0; i < L->n; i++) {
+    for (uint32_t i = (uint32_t)L->nx * (uint32_t)iy; i < (uint32_t)L->nx * (uint32_t)(iy + 1);
+         i++) {
         double *o = L->lf + LF * (size_t)i, S[WS_SYM];
         block_of(AT(L, i, CENTRE), S);
         if (S[WS_SYM_XX] == 0.0 && S[WS_SYM_YY] == 0.0 && S[WS_SYM_ZZ] == 0.0) {
@@ -786,6 +814,8 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
     return 1;
 }
 
+
+
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
@@ -807,9 +837,13 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
     }
     for (int k = 1; k + 1 < mg->nlev; k++) {
         mg_level *L = &mg->lv[k];
-        L->lines = held_along_x(L);
-        if ((L->lines ? line_factor(L) : point_factor(L)) != 0)
-            return -1;
+        L->lines = 0;
+        for (int iy = 0; iy < L->ny; iy++) {
+            L->whole[iy] = (unsigned char)row_held_along(L, iy);
+            L->lines += L->whole[iy];
+            if ((L->whole[iy] ? line_factor(L, iy) : point_factor(L, iy)) != 0)
+                return -1;
+        }
     }
     if (mg->nb)
         galerkin_bodies(mg, web);
@@ -908,95 +942,77 @@ static inline void row_beside(const mg_level *L, int ix, int iy, int dy, int64_t
     j[2] = ix + 1 < L->nx ? b + ix + 1 : L->closed ? b : -1;
 }
 
-/* The line sweeps of block Gauss-Seidel on a coarse level L: each row (along x, around a
- * band) solved whole against the rows beside it (its factor from line_factor), the rows in
- * order, and the bodies nested first in the forward sweep and last in the backward one, so
- * that the two mirror each other (B_k symmetric). Forward from x = 0: a row meets only the row
- * before it (those after are still zero) and the bodies; the sweep leaves the residual r - A x
- * in t (in a row, what the row after it adds since: -A_{row,row+1} x_{row+1}, added as that
- * row is solved) and the bodies' residual -G^T x in rbn (the next level's). */
-static void line_forward(const ws_mg *mg, mg_level *L, double *rbn)
+/* Forward, row iy solved whole (its factor from line_factor) against the row before it (those
+ * after are still zero) and the bodies: then the row before takes -A_{row-1,row} x_row into t
+ * (the row itself is solved exactly: its own couplings leave nothing), and the bodies -G^T x
+ * into rbn. */
+static void line_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
-    memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
-    if (nb6) {
-        ws_rigid_block_solve(mg->rig, L->rb, L->xb);
-        memset(rbn, 0, nb6 * sizeof(double));
+    const size_t k0 = (size_t)L->nx * (size_t)iy;
+    double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
+    int64_t j[3];
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = (int64_t)k0 + ix;
+        row_beside(L, ix, iy, -1, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double *X = L->x + 3 * (size_t)k;
+        X[0] = R[0], X[1] = R[1], X[2] = R[2];
+        for (int o = 0; o < 3; o++)
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
+        line_down(L, k0, ix, Xr, acc);
     }
-    int64_t j[9];
-    for (int iy = 0; iy < L->ny; iy++) {
-        const size_t k0 = (size_t)L->nx * (size_t)iy;
-        double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
-        for (int ix = 0; ix < L->nx; ix++) {
-            const int64_t k = (int64_t)k0 + ix;
-            row_beside(L, ix, iy, -1, j);
-            const double *R = L->r + 3 * (size_t)k;
-            double *X = L->x + 3 * (size_t)k;
-            X[0] = R[0], X[1] = R[1], X[2] = R[2];
-            for (int o = 0; o < 3; o++)
-                if (j[o] >= 0)
-                    fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
-            line_down(L, k0, ix, Xr, acc);
-        }
-        for (int ix = L->nx - 1; ix >= 0; ix--) {
-            const int64_t k = (int64_t)k0 + ix;
-            line_up(L, k0, ix, Xr);
-            row_beside(L, ix, iy, -1, j);
-            const double *X = L->x + 3 * (size_t)k;
-            for (int o = 0; o < 3; o++) /* t_j -= A_jk x_k for the row before */
-                if (j[o] >= 0)
-                    fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
-        }
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = (int64_t)k0 + ix;
+        line_up(L, k0, ix, Xr);
+        row_beside(L, ix, iy, -1, j);
+        const double *X = L->x + 3 * (size_t)k;
+        for (int o = 0; o < 3; o++) /* t_j -= A_jk x_k for the row before */
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
     }
 }
 
-/* Backward from the x and xb there are: the rows in reverse, each against both rows beside
- * it and the bodies; its new x is taken off the bodies' right-hand side (mg->bsum), which they
- * are solved with at the end. */
-static void line_backward(const ws_mg *mg, mg_level *L)
+/* Backward, row iy solved whole against both rows beside it and the bodies; its new x taken
+ * off the bodies' right-hand side sb. */
+static void line_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
-    double *sb = mg->bsum;
-    if (nb6)
-        memcpy(sb, L->rb, nb6 * sizeof(double));
+    const size_t k0 = (size_t)L->nx * (size_t)iy;
+    double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
     int64_t j[9];
-    for (int iy = L->ny - 1; iy >= 0; iy--) {
-        const size_t k0 = (size_t)L->nx * (size_t)iy;
-        double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
-        for (int ix = 0; ix < L->nx; ix++) {
-            const int64_t k = (int64_t)k0 + ix;
-            row_beside(L, ix, iy, -1, j);
-            row_beside(L, ix, iy, 1, j + 6);
-            const double *R = L->r + 3 * (size_t)k;
-            double *X = L->x + 3 * (size_t)k;
-            X[0] = R[0], X[1] = R[1], X[2] = R[2];
-            for (int o = 0; o < 3; o++) {
-                if (j[o] >= 0)
-                    fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
-                if (j[6 + o] >= 0)
-                    fsym_sub(AT(L, (size_t)k, 6 + o), L->x + 3 * (size_t)j[6 + o], X);
-            }
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
-            line_down(L, k0, ix, Xr, acc);
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = (int64_t)k0 + ix;
+        row_beside(L, ix, iy, -1, j);
+        row_beside(L, ix, iy, 1, j + 6);
+        const double *R = L->r + 3 * (size_t)k;
+        double *X = L->x + 3 * (size_t)k;
+        X[0] = R[0], X[1] = R[1], X[2] = R[2];
+        for (int o = 0; o < 3; o++) {
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+            if (j[6 + o] >= 0)
+                fsym_sub(AT(L, (size_t)k, 6 + o), L->x + 3 * (size_t)j[6 + o], X);
         }
-        for (int ix = L->nx - 1; ix >= 0; ix--) {
-            const int64_t k = (int64_t)k0 + ix;
-            line_up(L, k0, ix, Xr);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, L->x + 3 * (size_t)k, sb + 6 * (size_t)L->gb[e]);
-        }
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
+        line_down(L, k0, ix, Xr, acc);
     }
-    if (nb6)
-        ws_rigid_block_solve(mg->rig, sb, L->xb);
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = (int64_t)k0 + ix;
+        line_up(L, k0, ix, Xr);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, L->x + 3 * (size_t)k, sb + 6 * (size_t)L->gb[e]);
+    }
 }
 
 /* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
@@ -1020,15 +1036,69 @@ static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
     ws_sym_madd(S, s[0], s[1], s[2], X);
 }
 
-/* The point sweeps of block Gauss-Seidel on a coarse level L (held alike both ways), with the bodies nested (mg->nb) first
- * in the forward sweep and last in the backward one, so that the two mirror each other (B_k
- * symmetric) and every coupling term is taken in the node loops, where the node's x is at
- * hand. Forward from x = 0: the bodies from their right-hand side alone, then a node meets
- * only the nodes before it (those after are still zero) and the bodies; the sweep leaves the
- * residual r - A x in t (at node k, what the nodes after it add since: -sum over them of
- * A_kj x_j, each added as that node is solved, with the block its own solve has just read)
- * and the bodies' residual, rb - A_bb xb - G^T x = -G^T x, in rbn (the next level's: the
- * bodies are the same unknowns there). */
+/* Forward, row iy node by node: a node meets only the nodes before it (those after are still
+ * zero) and the bodies, and each node before it that it meets takes -A_jk x_k into t (with the
+ * block its own solve has just read), the bodies -G^T x_k into rbn. */
+static void point_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = ix + (int64_t)L->nx * iy;
+        int64_t j[9];
+        neighbours(L, ix, iy, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double s[3] = {R[0], R[1], R[2]};
+        const float *B[9];
+        for (int o = 0; o < 9; o++)
+            if (o != CENTRE)
+                gs_take(L, k, o, j[o], &B[o], s);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
+        gs_solve(L, k, s);
+        const double *X = L->x + 3 * (size_t)k;
+        for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
+            if (o != CENTRE && B[o])
+                fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* Backward, row iy node by node in reverse: a node meets every neighbour and the bodies, and
+ * its new x is taken off the bodies' right-hand side sb. */
+static void point_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = ix + (int64_t)L->nx * iy;
+        int64_t j[9];
+        neighbours(L, ix, iy, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double s[3] = {R[0], R[1], R[2]};
+        for (int o = 0; o < 9; o++)
+            if (o != CENTRE && j[o] >= 0)
+                fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
+        gs_solve(L, k, s);
+        const double *X = L->x + 3 * (size_t)k;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, sb + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* The sweeps of symmetric block Gauss-Seidel on a coarse level L, the blocks a level's rows
+ * solved whole (L->whole) and its other nodes one by one, taken in the grid's order: the
+ * bodies nested (mg->nb) first in the forward sweep and last in the backward one, which takes
+ * the same blocks in reverse, so that the two mirror each other (B_k symmetric) and every
+ * coupling term is taken in the node loops, where the node's x is at hand. Forward from x = 0:
+ * the bodies from their right-hand side alone, then each block meets only the blocks before it
+ * (those after are still zero) and the bodies; the sweep leaves the residual r - A x in t (each
+ * block's own couplings are solved exactly, so what is left at a node is what the blocks after
+ * it add since, added as each is solved) and the bodies' residual, rb - A_bb xb - G^T x =
+ * -G^T x, in rbn (the next level's: the bodies are the same unknowns there). */
 static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
@@ -1037,60 +1107,33 @@ static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
         ws_rigid_block_solve(mg->rig, L->rb, L->xb);
         memset(rbn, 0, nb6 * sizeof(double));
     }
-    for (int iy = 0; iy < L->ny; iy++)
-        for (int ix = 0; ix < L->nx; ix++) {
-            const int64_t k = ix + (int64_t)L->nx * iy;
-            int64_t j[9];
-            neighbours(L, ix, iy, j);
-            const double *R = L->r + 3 * (size_t)k;
-            double s[3] = {R[0], R[1], R[2]};
-            const float *B[9];
-            for (int o = 0; o < 9; o++)
-                if (o != CENTRE)
-                    gs_take(L, k, o, j[o], &B[o], s);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
-            gs_solve(L, k, s);
-            const double *X = L->x + 3 * (size_t)k;
-            for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
-                if (o != CENTRE && B[o])
-                    fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
-        }
+    for (int iy = 0; iy < L->ny; iy++) {
+        if (L->whole[iy])
+            line_row_forward(mg, L, iy, rbn);
+        else
+            point_row_forward(mg, L, iy, rbn);
+    }
 }
 
-/* Backward from the x and xb there are: node k meets every neighbour and the bodies, and its
- * new x is taken off the bodies' right-hand side (in mg->bsum), which they are solved with at
- * the end. */
+/* Backward from the x and xb there are: the blocks in reverse, each against every neighbour
+ * and the bodies, its new x taken off the bodies' right-hand side (in mg->bsum), which they
+ * are solved with at the end. */
 static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
     double *sb = mg->bsum;
     if (nb6)
         memcpy(sb, L->rb, nb6 * sizeof(double));
-    for (int iy = L->ny - 1; iy >= 0; iy--)
-        for (int ix = L->nx - 1; ix >= 0; ix--) {
-            const int64_t k = ix + (int64_t)L->nx * iy;
-            int64_t j[9];
-            neighbours(L, ix, iy, j);
-            const double *R = L->r + 3 * (size_t)k;
-            double s[3] = {R[0], R[1], R[2]};
-            for (int o = 0; o < 9; o++)
-                if (o != CENTRE && j[o] >= 0)
-                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
-            gs_solve(L, k, s);
-            const double *X = L->x + 3 * (size_t)k;
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, X, sb + 6 * (size_t)L->gb[e]);
-        }
+    for (int iy = L->ny - 1; iy >= 0; iy--) {
+        if (L->whole[iy])
+            line_row_backward(mg, L, iy, sb);
+        else
+            point_row_backward(mg, L, iy, sb);
+    }
     if (nb6) /* the bodies last: xb = A_bb^-1 (rb - G^T x) */
         ws_rigid_block_solve(mg->rig, sb, L->xb);
 }
+
 /* Whether fine node i of level k is left out of P (a pinned film node: its dv is zero). */
 static inline int left_out(const ws_web *web, int k, uint32_t i)
 {
@@ -1250,19 +1293,13 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
         return;
     }
     mg_level *L = &mg->lv[k];
-    if (L->lines)
-        line_forward(mg, L, mg->lv[k + 1].rb);
-    else
-        gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
+    gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
     prolong_add(mg, web, k, L->x, NULL, NULL, NULL);
     for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
         L->xb[q] += mg->lv[k + 1].xb[q];
-    if (L->lines)
-        line_backward(mg, L);
-    else
-        gauss_seidel_backward(mg, L);
+    gauss_seidel_backward(mg, L);
 }
 
 /* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
@@ -1386,6 +1423,25 @@ double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double 
     return apply(mg, web, r, z, rb, zb);
 }
 
+int ws_mg_rows(const ws_mg *mg, int k, int *whole)
+{
+    *whole = 0;
+    if (k < 1 || k + 1 >= mg->nlev)
+        return 0;
+    *whole = mg->lv[k].lines;
+    return mg->lv[k].ny;
+}
+
+int ws_mg_set_row(ws_mg *mg, int k, int iy, int whole)
+{
+    if (k < 1 || k + 1 >= mg->nlev || iy < 0 || iy >= mg->lv[k].ny)
+        return -1;
+    mg_level *L = &mg->lv[k];
+    L->lines += (whole != 0) - L->whole[iy];
+    L->whole[iy] = whole != 0;
+    return whole ? line_factor(L, iy) : point_factor(L, iy);
+}
+
 int ws_mg_levels(const ws_mg *mg)
 {
     return mg ? mg->nlev : 1;
@@ -1473,14 +1529,19 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         floats += STEN * (size_t)lv[i].n;
     }
     floats += FOP * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
-    size_t nmaps = 0;
+    size_t nmaps = 0, rows = 0;
     for (int i = 0; i + 1 < nlev; i++)
         nmaps += (size_t)lv[i].nx + (size_t)lv[i].ny;
+    for (int i = 1; i < nlev; i++)
+        rows += (size_t)lv[i].ny;
     ws_mg *mg = ws_mem_calloc(mem, 1, sizeof *mg);
     double *blk = mg ? ws_mem_calloc(mem, doubles, sizeof(double)) : NULL;
     float *fblk = blk ? ws_mem_calloc(mem, floats, sizeof(float)) : NULL;
     map1d *maps = fblk ? ws_mem_calloc(mem, nmaps, sizeof(map1d)) : NULL;
-    if (!maps) {
+    unsigned char *whole = maps ? ws_mem_calloc(mem, rows, 1) : NULL;
+    if (!whole) {
+        if (maps)
+            ws_mem_free(mem, maps, nmaps * sizeof(map1d));
         if (fblk)
             ws_mem_free(mem, fblk, floats * sizeof(float));
         if (blk)
@@ -1491,6 +1552,8 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     }
     mg->maps = maps;
     mg->nmaps = nmaps;
+    mg->whole = whole;
+    mg->rows = rows;
     map1d *mp = maps;
     for (int i = 0; i + 1 < nlev; i++) {
         lv[i].mx = mp, mp += lv[i].nx;
@@ -1530,6 +1593,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         L->x = q, q += 3 * (size_t)L->n;
         L->r = q, q += 3 * (size_t)L->n;
         L->t = q, q += 3 * (size_t)L->n;
+        L->whole = whole, whole += L->ny;
     }
     *out = mg;
     return 0;
@@ -1539,6 +1603,7 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg)
 {
     if (!mg)
         return;
+    ws_mem_free(mem, mg->whole, mg->rows);
     ws_mem_free(mem, mg->maps, mg->nmaps * sizeof(map1d));
     ws_mem_free(mem, mg->blk, mg->doubles * sizeof(double));
     ws_mem_free(mem, mg->fblk, mg->floats * sizeof(float));
