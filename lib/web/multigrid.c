@@ -58,7 +58,10 @@ typedef struct mg_level {
     map1d *mx, *my;     /* interpolation from the next level, by ix and by iy */
     uint32_t n;
     float *a;               /* STEN n: each node's row of blocks (coarse levels) */
-    double *lf;             /* LF n: each row's line factor (coarse levels; line_factor) */
+    double *dinv;           /* WS_SYM n: each node's pivot's inverse, of its own block
+                               (point_factor) or of its row's factor (line_factor) */
+    double *lff;            /* 9 n: a closed row's multipliers to its last node (line_factor;
+                               apart from dinv, which the point sweeps stream alone) */
     double *x, *r, *t;      /* 3 n each: the level's solution, right-hand side, scratch (the
                                film's level has t alone) */
     /* With bodies nested (coarse levels): the coupling of the nodes to them, kept only for the
@@ -414,18 +417,16 @@ static void sym_sub_full(double *S, const double *U)
     S[WS_SYM_YZ] -= 0.5 * (U[5] + U[7]);
 }
 
-/* A node's line factor: its pivot's inverse D^-1 (WS_SYM) and, on a closed row, its multiplier
- * to the row's last node F (9); LF doubles. The multiplier to the next node along the row, C =
- * A_{i+1,i} D^-1, is not kept: the sweeps take it as the coupling block (which the level
+/* A node's line factor: its pivot's inverse D^-1 (in dinv) and, on a closed row, its
+ * multiplier to the row's last node F (in lff). The multiplier to the next node along the row,
+ * C = A_{i+1,i} D^-1, is not kept: the sweeps take it as the coupling block (which the level
  * keeps) times D^-1, for less to read. */
-#define LF_D 0
-#define LF_F WS_SYM
-#define LF (WS_SYM + 9)
 
-/* Each row's line block T on coarse level L (the row's nodes and their couplings along it,
- * closed around on a band) as T = L D L^T by block elimination along the row, into L->lf: node
- * i's pivot inverse D_i^-1 and, on a closed row, F_i, the row's last node's multiplier (that
- * node eliminated last: an arrow, no fill but its row); the multiplier along the row, C_i =
+/* Row iy's line block T on coarse level L (the row's nodes and their couplings along it,
+ * closed around on a band) as T = L D L^T by block elimination along the row: node i's pivot
+ * inverse D_i^-1 into L->dinv and, on a closed row, F_i, the row's last node's multiplier (that
+ * node eliminated last: an arrow, no fill but its row), into L->lff; the multiplier along the
+ * row, C_i =
  * A_{i+1,i} D_i^-1, is taken from the same numbers in the sweeps, so whatever the rounding the
  * solve L^-T D^-1 L^-1 is symmetric, and positive definite with D^-1 (docs/theory.md 8a). In
  * double precision: a ring's smooth mode around is held only by the mass and the weak
@@ -444,12 +445,13 @@ static int line_factor(mg_level *L, int iy)
         }
         for (int i = 0; i < m; i++) {
             const size_t k = k0 + (size_t)i;
-            double *o = L->lf + LF * k;
+            double *o = L->dinv + WS_SYM * k, *oF = L->lff + 9 * k;
             double P[WS_SYM], Pinv[WS_SYM];
-            memset(o, 0, LF * sizeof(double));
+            memset(o, 0, WS_SYM * sizeof(double));
+            memset(oF, 0, 9 * sizeof(double));
             block_of(AT(L, k, CENTRE), P);
             if (P[WS_SYM_XX] == 0.0 && P[WS_SYM_YY] == 0.0 && P[WS_SYM_ZZ] == 0.0) {
-                o[LF_D + WS_SYM_XX] = o[LF_D + WS_SYM_YY] = o[LF_D + WS_SYM_ZZ] = 1.0;
+                o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
                 memset(Cp, 0, sizeof Cp);
                 memset(f, 0, sizeof f); /* no coupling: nor any fill */
                 continue;
@@ -461,7 +463,7 @@ static int line_factor(mg_level *L, int iy)
             if (ws_sym_invert(P, Pinv) != 0)
                 return -1;
             for (int q = 0; q < WS_SYM; q++)
-                o[LF_D + q] = Pinv[q];
+                o[q] = Pinv[q];
             full_of_sym(Pinv, Pf);
             memset(Cp, 0, sizeof Cp);
             if (i + 1 < m) {
@@ -478,7 +480,7 @@ static int line_factor(mg_level *L, int iy)
             }
             mat_mul(f, Pf, 0, Ff); /* F_i = f_i D_i^-1; the last pivot loses F_i f_i^T */
             for (int q = 0; q < 9; q++)
-                o[LF_F + q] = Ff[q];
+                oF[q] = Ff[q];
             mat_mul(Ff, f, 1, U);
             sym_sub_full(Pl, U);
             if (i + 1 < m) { /* the last node's coupling to node i + 1: -F_i A_{i,i+1} */
@@ -489,17 +491,18 @@ static int line_factor(mg_level *L, int iy)
         }
         if (!L->closed)
             return 0;
-        double *o = L->lf + LF * (k0 + (size_t)m);
-        memset(o, 0, LF * sizeof(double));
+        double *o = L->dinv + WS_SYM * (k0 + (size_t)m);
+        memset(o, 0, WS_SYM * sizeof(double));
+        memset(L->lff + 9 * (k0 + (size_t)m), 0, 9 * sizeof(double));
         double Pinv[WS_SYM];
         if (Pl[WS_SYM_XX] == 0.0 && Pl[WS_SYM_YY] == 0.0 && Pl[WS_SYM_ZZ] == 0.0) {
-            o[LF_D + WS_SYM_XX] = o[LF_D + WS_SYM_YY] = o[LF_D + WS_SYM_ZZ] = 1.0;
+            o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
             return 0;
         }
         if (ws_sym_invert(Pl, Pinv) != 0)
             return -1;
         for (int q = 0; q < WS_SYM; q++)
-            o[LF_D + q] = Pinv[q];
+            o[q] = Pinv[q];
     }
     return 0;
 }
@@ -555,12 +558,12 @@ static int point_factor(mg_level *L, int iy)
 {
     for (uint32_t i = (uint32_t)L->nx * (uint32_t)iy; i < (uint32_t)L->nx * (uint32_t)(iy + 1);
          i++) {
-        double *o = L->lf + LF * (size_t)i, S[WS_SYM];
+        double *o = L->dinv + WS_SYM * (size_t)i, S[WS_SYM];
         block_of(AT(L, i, CENTRE), S);
         if (S[WS_SYM_XX] == 0.0 && S[WS_SYM_YY] == 0.0 && S[WS_SYM_ZZ] == 0.0) {
             memset(o, 0, WS_SYM * sizeof(double));
             o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
-        } else if (ws_sym_invert(S, o + LF_D) != 0) {
+        } else if (ws_sym_invert(S, o) != 0) {
             return -1;
         }
     }
@@ -900,12 +903,12 @@ static inline void line_down(const mg_level *L, size_t k0, int ix, double *X, do
     }
     if (ix > 0) {
         double u[3] = {0.0, 0.0, 0.0};
-        const double *D = L->lf + LF * (k0 + (size_t)ix - 1) + LF_D;
+        const double *D = L->dinv + WS_SYM * (k0 + (size_t)ix - 1);
         ws_sym_madd(D, Xi[-3], Xi[-2], Xi[-1], u);
         fsym_sub(AT(L, k0 + (size_t)ix - 1, CENTRE + 1), u, Xi);
     }
     if (L->closed)
-        fmat_sub(L->lf + LF * (k0 + (size_t)ix) + LF_F, 0, Xi, acc);
+        fmat_sub(L->lff + 9 * (k0 + (size_t)ix), 0, Xi, acc);
 }
 
 /* The line solve's backward step at node ix (the nodes after it, and the last, solved):
@@ -913,7 +916,7 @@ static inline void line_down(const mg_level *L, size_t k0, int ix, double *X, do
 static inline void line_up(const mg_level *L, size_t k0, int ix, double *X)
 {
     const int m = L->closed ? L->nx - 1 : L->nx;
-    const double *o = L->lf + LF * (k0 + (size_t)ix);
+    const double *o = L->dinv + WS_SYM * (k0 + (size_t)ix);
     double *Xi = X + 3 * (size_t)ix;
     double g[3] = {Xi[0], Xi[1], Xi[2]};
     if (ix + 1 < m)
@@ -924,7 +927,7 @@ static inline void line_up(const mg_level *L, size_t k0, int ix, double *X)
     Xi[1] = xy * g[0] + yy * g[1] + yz * g[2];
     Xi[2] = xz * g[0] + yz * g[1] + zz * g[2];
     if (ix < m && L->closed)
-        fmat_sub(o + LF_F, 1, X + 3 * (size_t)m, Xi);
+        fmat_sub(L->lff + 9 * (k0 + (size_t)ix), 1, X + 3 * (size_t)m, Xi);
 }
 
 /* The neighbours of (ix, iy) on level L in the row iy + dy (dy -1 or 1), by dx = -1, 0, 1
@@ -1030,7 +1033,7 @@ static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const
 /* x_k = D_k^-1 s (the inverse of the node's own block, point_factor). */
 static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
 {
-    const double *S = L->lf + LF * (size_t)k + LF_D;
+    const double *S = L->dinv + WS_SYM * (size_t)k;
     double *X = L->x + 3 * (size_t)k;
     X[0] = X[1] = X[2] = 0.0;
     ws_sym_madd(S, s[0], s[1], s[2], X);
@@ -1525,7 +1528,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
                      3 * (size_t)lv[1].nx,
            floats = 0;
     for (int i = 1; i < nlev; i++) {
-        doubles += (9 + LF) * (size_t)lv[i].n;
+        doubles += (9 + WS_SYM + 9) * (size_t)lv[i].n;
         floats += STEN * (size_t)lv[i].n;
     }
     floats += FOP * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
@@ -1589,7 +1592,8 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     for (int i = 1; i < nlev; i++) {
         mg_level *L = &mg->lv[i];
         L->a = fq, fq += STEN * (size_t)L->n;
-        L->lf = q, q += LF * (size_t)L->n;
+        L->dinv = q, q += WS_SYM * (size_t)L->n;
+        L->lff = q, q += 9 * (size_t)L->n;
         L->x = q, q += 3 * (size_t)L->n;
         L->r = q, q += 3 * (size_t)L->n;
         L->t = q, q += 3 * (size_t)L->n;
