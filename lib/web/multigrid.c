@@ -31,11 +31,11 @@
  * once. */
 /* A coarse level's row along x (around a band) is solved whole in its sweeps where point
  * Jacobi would take less than this share off the error constant along the row and alternating
- * up (row_held_along): (1 - 0.45)^2 = 0.30 a symmetric sweep is what a V-cycle takes off the
- * rest (I - B A's factor 0.25-0.32). Measured on the refined reference band (bench/NOTES.md,
- * session 15): its first coarse level's edge rows 0.76-0.83 at 1x, 0.37-0.45 at 2x, 0.20-0.33
- * at 4x, its middle rows 0.65-0.9. */
-#define MG_LINE_RHO 0.45
+ * up (row_held_along). Measured on the refined reference band's first coarse level (bench/
+ * NOTES.md, session 15): its edge rows 0.76-0.83 at 1x, 0.37-0.45 at 2x (solving them whole
+ * saved no iteration there), 0.20-0.33 at 4x (it saved a quarter), its middle rows 0.65-0.9;
+ * at 4x 0.35 and 0.45 gave the same iterations, 0.3 4 % more. */
+#define MG_LINE_RHO 0.35
 #define CENTRE 4
 #define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
 #define FOP_A 5
@@ -515,7 +515,8 @@ static int line_factor(mg_level *L, int iy)
  * along itself far more strongly than by its mass and the rows beside it the quotient is
  * small; docs/theory.md 8a derives why it falls under refinement in the rows weakly held up.
  * The row is solved whole when the mean over its nodes of their least quotient (over q: the
- * faces of a band turn its directions) is under MG_LINE_RHO. */
+ * faces of a band turn its directions; at most 1, a node cleared in one sweep) is under
+ * MG_LINE_RHO. */
 static int row_held_along(const mg_level *L, int iy)
 {
     const int nx = L->nx;
