@@ -32,9 +32,9 @@
 /* A coarse level's row along x (around a band) is solved whole in its sweeps where point
  * Jacobi would take less than this share off the error constant along the row and alternating
  * up (row_held_along). Measured on the refined reference band's first coarse level (bench/
- * NOTES.md, session 15): its edge rows 0.76-0.83 at 1x, 0.37-0.45 at 2x (solving them whole
- * saved no iteration there), 0.20-0.33 at 4x (it saved a quarter), its middle rows 0.65-0.9;
- * at 4x 0.35 and 0.45 gave the same iterations, 0.3 4 % more. */
+ * NOTES.md, session 15): its six outer rows at each edge 0.76-0.92 at 1x, 0.37-0.50 at 2x
+ * (solving them whole saved no iteration there), 0.20-0.33 at 4x (it saved a quarter), its
+ * middle rows 0.65-0.92; at 4x 0.35 and 0.45 gave the same iterations, 0.3 4 % more. */
 #define MG_LINE_RHO 0.35
 #define CENTRE 4
 #define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
