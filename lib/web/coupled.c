@@ -76,6 +76,13 @@ int ws_rigid_factor(ws_rigid *R)
     }
     for (size_t l = 0; l < R->nl; l++)
         add_block(R->fac + 36 * (size_t)R->link[l].body, R->link[l].C, R->link[l].lever);
+    for (size_t q = 0; q < R->npair; q++) {
+        const ws_rigid_pair *P = &R->pair[q];
+        if (P->a != UINT32_MAX)
+            add_block(R->fac + 36 * (size_t)P->a, P->C, P->ra);
+        if (P->b != UINT32_MAX)
+            add_block(R->fac + 36 * (size_t)P->b, P->C, P->rb);
+    }
     for (uint32_t j = 0; j < R->nb; j++)
         if (cholesky(R->fac + 36 * (size_t)j, 6) != 0)
             return -1;
@@ -105,6 +112,43 @@ static void body_mass_apply(const ws_rigid *R, uint32_t j, const double *P, doub
     Y[0] = m * P[0], Y[1] = m * P[1], Y[2] = m * P[2];
     Y[3] = Y[4] = Y[5] = 0.0;
     ws_sym_madd(R->inertia + WS_SYM * (size_t)j, P[3], P[4], P[5], Y + 3);
+}
+
+/* The motion J u of the point at lever r of body j for the six velocities u of each body (6
+ * a body); zero for a side not in the solve (j UINT32_MAX). */
+static v3 point_move(const double *u, uint32_t j, v3 r)
+{
+    if (j == UINT32_MAX)
+        return v3_make(0.0, 0.0, 0.0);
+    const double *P = u + 6 * (size_t)j;
+    return v3_add(v3_make(P[0], P[1], P[2]), v3_cross(v3_make(P[3], P[4], P[5]), r));
+}
+
+/* J^T g at lever r into body j's six rows Y (6 a body), times sign; nothing for a side not in
+ * the solve. */
+static void point_load(double *Y, uint32_t j, v3 r, v3 g, double sign)
+{
+    if (j == UINT32_MAX)
+        return;
+    double *o = Y + 6 * (size_t)j;
+    const v3 m = v3_cross(r, g);
+    o[0] += sign * g.x, o[1] += sign * g.y, o[2] += sign * g.z;
+    o[3] += sign * m.x, o[4] += sign * m.y, o[5] += sign * m.z;
+}
+
+/* The pairs' terms of yr = A pr: g = C (J_b p_b - J_a p_a), J_b^T g into b's rows, -J_a^T g
+ * into a's. */
+static void pairs_apply(const ws_rigid *R, const double *pr, double *yr)
+{
+    for (size_t q = 0; q < R->npair; q++) {
+        const ws_rigid_pair *P = &R->pair[q];
+        const v3 d = ws_rigid_pair_slip(R, q, pr);
+        double g[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(P->C, d.x, d.y, d.z, g);
+        const v3 gv = v3_make(g[0], g[1], g[2]);
+        point_load(yr, P->b, P->rb, gv, 1.0);
+        point_load(yr, P->a, P->ra, gv, -1.0);
+    }
 }
 
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
@@ -146,7 +190,14 @@ double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, con
         }
         Y[0] = y0, Y[1] = y1, Y[2] = y2, Y[3] = y3, Y[4] = y4, Y[5] = y5;
     }
+    pairs_apply(R, pr, yr);
     return added + ws_rigid_dot(R, pr, yr);
+}
+
+v3 ws_rigid_pair_slip(const ws_rigid *R, size_t q, const double *dU)
+{
+    const ws_rigid_pair *P = &R->pair[q];
+    return v3_sub(point_move(dU, P->b, P->rb), point_move(dU, P->a, P->ra));
 }
 
 /* Whether link l is the first of its node's links with its body: a node on two faces of one
@@ -405,6 +456,17 @@ void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
     const uint32_t rows = coarse_rows(R, web);
     for (uint32_t j = 0; j < R->nb; j++)
         coarse_body(R, web, rows, j, A);
+    /* The pairs' terms, Phi's body columns being unit motions of the bodies: column c of body
+     * j and direction k gets pairs_apply's rows for that unit motion. */
+    for (size_t c = 0; c < nc && R->npair; c++) {
+        double *e = R->cq, *col = R->cb; /* free until the solve runs */
+        memset(e, 0, nc * sizeof(double));
+        memset(col, 0, nc * sizeof(double));
+        e[c] = 1.0;
+        pairs_apply(R, e, col);
+        for (size_t d = 0; d < nc; d++)
+            A[nc * d + c] += col[d];
+    }
     for (size_t c = 0; c < nc; c++) /* symmetric to round-off: its mean */
         for (size_t d = c + 1; d < nc; d++)
             A[nc * d + c] = A[nc * c + d] = 0.5 * (A[nc * d + c] + A[nc * c + d]);

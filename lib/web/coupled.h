@@ -11,8 +11,10 @@
  * M_j = diag(m I, I_w) the body's mass and global inertia: symmetric positive definite
  * whenever A is (its energy is the film's plus (dv - J dU)^T C (dv - J dU) + dU^T M dU). The
  * solve's vectors keep their film part as before (3 doubles a node) and put the bodies' in the
- * arrays here (6 a body: velocity change, then spin change). The module knows no body: the
- * world fills a body's mass, inertia and right-hand side and the contacts' levers and blocks. */
+ * arrays here (6 a body: velocity change, then spin change). Body contacts whose friction is
+ * in the solve (ws_rigid_pair) add (J_b dU_b - J_a dU_a)^T C (J_b dU_b - J_a dU_a) between two
+ * bodies' rows. The module knows no body: the world fills a body's mass, inertia and
+ * right-hand side and the contacts' levers and blocks. */
 #ifndef WS_WEB_COUPLED_H
 #define WS_WEB_COUPLED_H
 
@@ -27,10 +29,26 @@ typedef struct ws_rigid_link {
     double C[WS_SYM];
 } ws_rigid_link;
 
+/* A contact of two bodies (a body contact of the world) whose friction is in the solve: its
+ * eq. 13 as the damper it is over the slip, c (I - n n^T) with c = mu N p(s) / |t| at the
+ * start (2 mu N / v_lim at rest), between the contact points of its two bodies (a, b: indices
+ * among the solve's bodies, UINT32_MAX for a world element, whose motion is given), levers
+ * ra, rb from their centres of mass (global, m); C = h c (I - n n^T). */
+typedef struct ws_rigid_pair {
+    uint32_t a, b;
+    uint32_t tag; /* the caller's: which of its contacts this is */
+    v3 ra, rb;
+    double C[WS_SYM];
+} ws_rigid_pair;
+
 typedef struct ws_rigid {
     uint32_t nb;    /* bodies in the solve */
     size_t nl, cap; /* contacts in the solve, room for them */
     ws_rigid_link *link;
+    /* The body-body contacts whose friction is in the solve (docs/theory.md section 8b): they
+     * add (J_b dU_b - J_a dU_a)^T C (J_b dU_b - J_a dU_a) to the energy of the matrix. */
+    ws_rigid_pair *pair;
+    size_t npair;
     double *mass;                  /* per body: its mass, kg */
     double *inertia;               /* per body: its global inertia, symmetric (WS_SYM doubles) */
     double *fac;                   /* per body: the Cholesky factor of its diagonal block of the
@@ -55,14 +73,20 @@ typedef struct ws_rigid {
     void *mgbuf;
 } ws_rigid;
 
-/* Each body's diagonal block M_j + sum J^T C J factored for the preconditioner. 0, or -1 when
+/* The velocity change over the step of pair q's contact point on body b relative to a's,
+ * J_b dU_b - J_a dU_a, for the bodies' velocity changes dU (6 a body). */
+v3 ws_rigid_pair_slip(const ws_rigid *R, size_t q, const double *dU);
+
+/* Each body's diagonal block M_j + sum J^T C J (the film's contacts and the pairs' ends)
+ * factored for the preconditioner. 0, or -1 when
  * a block is not positive definite (a NaN, a body of no mass). */
 int ws_rigid_factor(ws_rigid *R);
 
 /* z = B^-1 r per body, B its factored block (6 doubles a body; z may be r). */
 void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z);
 
-/* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr, and the coupling's
+/* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr (the film's contacts'
+ * and the body-body pairs'), and the coupling's
  * -C J pr added into the film part y (y untouched at pinned nodes). Returns the dot product
  * these add: p . (what it added to y) + pr . yr. */
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
@@ -75,7 +99,8 @@ int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
 /* Phi^T A Phi (symmetrised: the mean of it and its transpose) into R->coarse, not factored: the
  * same to the bit (a zero's sign aside) as Phi^T (A (Phi e_c)) column by column with
  * ws_implicit_apply_op and ws_rigid_apply, at two passes over the springs instead of 6 nb
- * over the film (a test compares them). */
+ * over the film (a test compares them); the body-body pairs' terms (none in that test) added
+ * after the film's, the same to round-off. */
 void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web);
 
 /* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
