@@ -29,6 +29,13 @@
  * preconditioner's, and halving them halves what a cycle streams (docs/theory.md 8a says why
  * the cycle stays symmetric positive definite); they are summed in double (`acc`) and rounded
  * once. */
+/* A coarse level's row along x (around a band) is solved whole in its sweeps where point
+ * Jacobi would take less than this share off the error constant along the row and alternating
+ * up (row_held_along). Measured on the refined reference band's first coarse level (bench/
+ * NOTES.md, session 15): its six outer rows at each edge 0.76-0.92 at 1x, 0.37-0.50 at 2x
+ * (solving them whole saved no iteration there), 0.20-0.33 at 4x (it saved a quarter), its
+ * middle rows 0.65-0.92; at 4x 0.35 and 0.45 gave the same iterations, 0.3 4 % more. */
+#define MG_LINE_RHO 0.35
 #define CENTRE 4
 #define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
 #define FOP_A 5
@@ -46,10 +53,15 @@ typedef struct map1d {
 typedef struct mg_level {
     int nx, ny, closed; /* grid: node ix + nx iy, closed around (a band) */
     int cx, cy;         /* whether x and y are halved for the next level */
+    int lines;          /* how many of its rows its sweeps solve whole (coarse levels) */
+    unsigned char *whole; /* ny: whether each row is solved whole (row_held_along) */
     map1d *mx, *my;     /* interpolation from the next level, by ix and by iy */
     uint32_t n;
     float *a;               /* STEN n: each node's row of blocks (coarse levels) */
-    double *dinv;           /* WS_SYM n: inverse of each node's own block (coarse levels) */
+    double *dinv;           /* WS_SYM n: each node's pivot's inverse, of its own block
+                               (point_factor) or of its row's factor (line_factor) */
+    double *lff;            /* 9 n: a closed row's multipliers to its last node (line_factor;
+                               apart from dinv, which the point sweeps stream alone) */
     double *x, *r, *t;      /* 3 n each: the level's solution, right-hand side, scratch (the
                                film's level has t alone) */
     /* With bodies nested (coarse levels): the coupling of the nodes to them, kept only for the
@@ -88,6 +100,8 @@ struct ws_mg {
     size_t doubles;
     map1d *maps;  /* every level's mx and my, nmaps of them */
     size_t nmaps;
+    unsigned char *whole; /* every coarse level's rows' kind (mg_level.whole), rows of them */
+    size_t rows;
     /* The bodies of the running solve nested in the hierarchy (ws_mg_bodies; nb 0: none):
      * their six unknowns ride along every coarse level, coupled to its nodes by the levels'
      * entries. bchol: the coarsest level's factor with them ((m + 6 nb)^2), bsc: its vector
@@ -365,18 +379,196 @@ static inline void fsym_sub(const float *S, const double *x, double *o)
     o[2] -= xz * x[0] + yz * x[1] + zz * x[2];
 }
 
-/* The inverse of a node's own block, or zeros for a node no fine node reaches (all of its
- * fine nodes pinned: its right-hand side is always zero). 0, or -1 when the block is not
- * positive definite. */
-static int own_inverse(const float *B, double *S)
+/* A symmetric block (float, or double) as a full 3x3, row-major. */
+static void full_of(const float *S, double *F)
 {
-    double sym[WS_SYM];
-    block_of(B, sym);
-    if (sym[WS_SYM_XX] == 0.0 && sym[WS_SYM_YY] == 0.0 && sym[WS_SYM_ZZ] == 0.0) {
-        memset(S, 0, WS_SYM * sizeof(double));
-        return 0;
+    F[0] = S[WS_SYM_XX], F[1] = S[WS_SYM_XY], F[2] = S[WS_SYM_XZ];
+    F[3] = S[WS_SYM_XY], F[4] = S[WS_SYM_YY], F[5] = S[WS_SYM_YZ];
+    F[6] = S[WS_SYM_XZ], F[7] = S[WS_SYM_YZ], F[8] = S[WS_SYM_ZZ];
+}
+
+static void full_of_sym(const double *S, double *F)
+{
+    F[0] = S[WS_SYM_XX], F[1] = S[WS_SYM_XY], F[2] = S[WS_SYM_XZ];
+    F[3] = S[WS_SYM_XY], F[4] = S[WS_SYM_YY], F[5] = S[WS_SYM_YZ];
+    F[6] = S[WS_SYM_XZ], F[7] = S[WS_SYM_YZ], F[8] = S[WS_SYM_ZZ];
+}
+
+/* C = A B, or C = A B^T (bt), for full 3x3 blocks. */
+static void mat_mul(const double *A, const double *B, int bt, double *C)
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) {
+            double s = 0.0;
+            for (int q = 0; q < 3; q++)
+                s += A[3 * r + q] * (bt ? B[3 * c + q] : B[3 * q + c]);
+            C[3 * r + c] = s;
+        }
+}
+
+/* S -= the symmetric part of a full block U (U is symmetric but for rounding). */
+static void sym_sub_full(double *S, const double *U)
+{
+    S[WS_SYM_XX] -= U[0];
+    S[WS_SYM_YY] -= U[4];
+    S[WS_SYM_ZZ] -= U[8];
+    S[WS_SYM_XY] -= 0.5 * (U[1] + U[3]);
+    S[WS_SYM_XZ] -= 0.5 * (U[2] + U[6]);
+    S[WS_SYM_YZ] -= 0.5 * (U[5] + U[7]);
+}
+
+/* A node's line factor: its pivot's inverse D^-1 (in dinv) and, on a closed row, its
+ * multiplier to the row's last node F (in lff). The multiplier to the next node along the row,
+ * C = A_{i+1,i} D^-1, is not kept: the sweeps take it as the coupling block (which the level
+ * keeps) times D^-1, for less to read. */
+
+/* Row iy's line block T on coarse level L (the row's nodes and their couplings along it,
+ * closed around on a band) as T = L D L^T by block elimination along the row: node i's pivot
+ * inverse D_i^-1 into L->dinv and, on a closed row, F_i, the row's last node's multiplier (that
+ * node eliminated last: an arrow, no fill but its row), into L->lff; the multiplier along the
+ * row, C_i =
+ * A_{i+1,i} D_i^-1, is taken from the same numbers in the sweeps, so whatever the rounding the
+ * solve L^-T D^-1 L^-1 is symmetric, and positive definite with D^-1 (docs/theory.md 8a). In
+ * double precision: a ring's smooth mode around is held only by the mass and the weak
+ * couplings up, and single precision lost it (bench/NOTES.md, session 14). A node no fine
+ * node reaches has a zero block and no couplings: its pivot is the identity (its right-hand
+ * side is always zero). 0, or -1 when a pivot is not positive definite. */
+static int line_factor(mg_level *L, int iy)
+{
+    const int n = L->nx, m = L->closed ? n - 1 : n; /* m: the nodes of the chain */
+    {
+        const size_t k0 = (size_t)n * (size_t)iy;
+        double Pf[9], Bf[9], Cp[9], Bp[9], f[9], Ff[9], U[9], Pl[WS_SYM];
+        if (L->closed) { /* the last node's row: its block and its coupling to node 0 */
+            block_of(AT(L, k0 + (size_t)m, CENTRE), Pl);
+            full_of(AT(L, k0 + (size_t)m, CENTRE + 1), f);
+        }
+        for (int i = 0; i < m; i++) {
+            const size_t k = k0 + (size_t)i;
+            double *o = L->dinv + WS_SYM * k, *oF = L->lff + 9 * k;
+            double P[WS_SYM], Pinv[WS_SYM];
+            memset(o, 0, WS_SYM * sizeof(double));
+            memset(oF, 0, 9 * sizeof(double));
+            block_of(AT(L, k, CENTRE), P);
+            if (P[WS_SYM_XX] == 0.0 && P[WS_SYM_YY] == 0.0 && P[WS_SYM_ZZ] == 0.0) {
+                o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
+                memset(Cp, 0, sizeof Cp);
+                memset(f, 0, sizeof f); /* no coupling: nor any fill */
+                continue;
+            }
+            if (i > 0) { /* P_i = A_i - C_{i-1} A_{i-1,i} */
+                mat_mul(Cp, Bp, 0, U);
+                sym_sub_full(P, U);
+            }
+            if (ws_sym_invert(P, Pinv) != 0)
+                return -1;
+            for (int q = 0; q < WS_SYM; q++)
+                o[q] = Pinv[q];
+            full_of_sym(Pinv, Pf);
+            memset(Cp, 0, sizeof Cp);
+            if (i + 1 < m) {
+                full_of(AT(L, k, CENTRE + 1), Bf);
+                mat_mul(Bf, Pf, 0, Cp);
+                memcpy(Bp, Bf, sizeof Bf);
+            }
+            if (!L->closed)
+                continue;
+            if (i == m - 1) { /* node m - 1 meets the last node along the row */
+                full_of(AT(L, k, CENTRE + 1), Bf);
+                for (int q = 0; q < 9; q++)
+                    f[q] += Bf[q];
+            }
+            mat_mul(f, Pf, 0, Ff); /* F_i = f_i D_i^-1; the last pivot loses F_i f_i^T */
+            for (int q = 0; q < 9; q++)
+                oF[q] = Ff[q];
+            mat_mul(Ff, f, 1, U);
+            sym_sub_full(Pl, U);
+            if (i + 1 < m) { /* the last node's coupling to node i + 1: -F_i A_{i,i+1} */
+                mat_mul(Ff, Bp, 0, U);
+                for (int q = 0; q < 9; q++)
+                    f[q] = -U[q];
+            }
+        }
+        if (!L->closed)
+            return 0;
+        double *o = L->dinv + WS_SYM * (k0 + (size_t)m);
+        memset(o, 0, WS_SYM * sizeof(double));
+        memset(L->lff + 9 * (k0 + (size_t)m), 0, 9 * sizeof(double));
+        double Pinv[WS_SYM];
+        if (Pl[WS_SYM_XX] == 0.0 && Pl[WS_SYM_YY] == 0.0 && Pl[WS_SYM_ZZ] == 0.0) {
+            o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
+            return 0;
+        }
+        if (ws_sym_invert(Pl, Pinv) != 0)
+            return -1;
+        for (int q = 0; q < WS_SYM; q++)
+            o[q] = Pinv[q];
     }
-    return ws_sym_invert(sym, S);
+    return 0;
+}
+
+/* Whether row iy of coarse level L is to be solved whole. For each node and each direction of
+ * motion q, the quotient v^T A v / v^T D v of the error that is constant along the row about
+ * the node and alternates from row to row: the node's diagonal entry q q and its couplings
+ * along the row, less those to the rows beside it (the mode's sign flips there), over the
+ * diagonal entry: point Jacobi takes 1 - that off such an error a sweep. Where the row is held
+ * along itself far more strongly than by its mass and the rows beside it the quotient is
+ * small; docs/theory.md 8a derives why it falls under refinement in the rows weakly held up.
+ * The row is solved whole when the mean over its nodes of their least quotient (over q: the
+ * faces of a band turn its directions; at most 1, a node cleared in one sweep) is under
+ * MG_LINE_RHO. */
+static int row_held_along(const mg_level *L, int iy)
+{
+    const int nx = L->nx;
+    double sum = 0.0;
+    for (int ix = 0; ix < nx; ix++) {
+        const size_t k = (size_t)nx * (size_t)iy + (size_t)ix;
+        const int xl = ix > 0 ? ix - 1 : L->closed ? nx - 1 : -1;
+        const int xr = ix + 1 < nx ? ix + 1 : L->closed ? 0 : -1;
+        double least = 1.0;
+        for (int q = 0; q < 3; q++) { /* WS_SYM_XX, YY, ZZ */
+            const double d = AT(L, k, CENTRE)[q];
+            double a = d;
+            if (xr >= 0)
+                a += AT(L, k, CENTRE + 1)[q];
+            if (xl >= 0)
+                a += AT(L, k - (size_t)ix + (size_t)xl, CENTRE + 1)[q];
+            if (iy + 1 < L->ny)
+                for (int o = 6; o < 9; o++)
+                    a -= AT(L, k, o)[q];
+            if (iy > 0) {
+                const size_t b = k - (size_t)nx;
+                a -= AT(L, b, 7)[q];
+                if (xl >= 0)
+                    a -= AT(L, b - (size_t)ix + (size_t)xl, 8)[q];
+                if (xr >= 0)
+                    a -= AT(L, b - (size_t)ix + (size_t)xr, 6)[q];
+            }
+            if (d > 0.0 && a < least * d)
+                least = a / d;
+        }
+        sum += least;
+    }
+    return sum < MG_LINE_RHO * nx;
+}
+
+/* The point sweeps' factor of row iy of coarse level L: each node's own block's inverse, or
+ * the identity for a node no fine node reaches (its right-hand side is always zero). 0, or -1
+ * when a block is not positive definite. */
+static int point_factor(mg_level *L, int iy)
+{
+    for (uint32_t i = (uint32_t)L->nx * (uint32_t)iy; i < (uint32_t)L->nx * (uint32_t)(iy + 1);
+         i++) {
+        double *o = L->dinv + WS_SYM * (size_t)i, S[WS_SYM];
+        block_of(AT(L, i, CENTRE), S);
+        if (S[WS_SYM_XX] == 0.0 && S[WS_SYM_YY] == 0.0 && S[WS_SYM_ZZ] == 0.0) {
+            memset(o, 0, WS_SYM * sizeof(double));
+            o[WS_SYM_XX] = o[WS_SYM_YY] = o[WS_SYM_ZZ] = 1.0;
+        } else if (ws_sym_invert(S, o) != 0) {
+            return -1;
+        }
+    }
+    return 0;
 }
 
 /* The bodies' rows of the coarsest level's dense matrix D (m unknowns, the bodies' after the
@@ -626,6 +818,8 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
     return 1;
 }
 
+
+
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
@@ -646,10 +840,14 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
         store_level(mg, k + 1);
     }
     for (int k = 1; k + 1 < mg->nlev; k++) {
-        const mg_level *L = &mg->lv[k];
-        for (uint32_t i = 0; i < L->n; i++)
-            if (own_inverse(AT(L, i, CENTRE), L->dinv + WS_SYM * (size_t)i) != 0)
+        mg_level *L = &mg->lv[k];
+        L->lines = 0;
+        for (int iy = 0; iy < L->ny; iy++) {
+            L->whole[iy] = (unsigned char)row_held_along(L, iy);
+            L->lines += L->whole[iy];
+            if ((L->whole[iy] ? line_factor(L, iy) : point_factor(L, iy)) != 0)
                 return -1;
+        }
     }
     if (mg->nb)
         galerkin_bodies(mg, web);
@@ -660,27 +858,6 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 static inline const float *off_block(const mg_level *L, size_t k, int o, int64_t j)
 {
     return o > CENTRE ? AT(L, k, o) : AT(L, (size_t)j, 8 - o);
-}
-
-/* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
- * k (the nodes after are still zero), its block into *B (NULL when not). */
-static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const float **B,
-                           double *s)
-{
-    *B = NULL;
-    if (j < 0 || j > k)
-        return;
-    *B = off_block(L, (size_t)k, o, j);
-    fsym_sub(*B, L->x + 3 * (size_t)j, s);
-}
-
-/* x_k = D_k^-1 s. */
-static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
-{
-    const double *S = L->dinv + WS_SYM * (size_t)k;
-    double *X = L->x + 3 * (size_t)k;
-    X[0] = X[1] = X[2] = 0.0;
-    ws_sym_madd(S, s[0], s[1], s[2], X);
 }
 
 /* s -= G u for a coupling block G (3x6 row-major) and a body's u (6). */
@@ -700,15 +877,232 @@ static inline void gt_sub(const double *G, const double *x, double *s)
         s[c] -= G[c] * x[0] + G[6 + c] * x[1] + G[12 + c] * x[2];
 }
 
-/* The sweeps of block Gauss-Seidel on a coarse level L, with the bodies nested (mg->nb) first
- * in the forward sweep and last in the backward one, so that the two mirror each other (B_k
- * symmetric) and every coupling term is taken in the node loops, where the node's x is at
- * hand. Forward from x = 0: the bodies from their right-hand side alone, then a node meets
- * only the nodes before it (those after are still zero) and the bodies; the sweep leaves the
- * residual r - A x in t (at node k, what the nodes after it add since: -sum over them of
- * A_kj x_j, each added as that node is solved, with the block its own solve has just read)
- * and the bodies' residual, rb - A_bb xb - G^T x = -G^T x, in rbn (the next level's: the
- * bodies are the same unknowns there). */
+/* o -= M x (tr: M^T x) for a full 3x3 block M. */
+static inline void fmat_sub(const double *M, int tr, const double *x, double *o)
+{
+    if (tr) {
+        o[0] -= M[0] * x[0] + M[3] * x[1] + M[6] * x[2];
+        o[1] -= M[1] * x[0] + M[4] * x[1] + M[7] * x[2];
+        o[2] -= M[2] * x[0] + M[5] * x[1] + M[8] * x[2];
+    } else {
+        o[0] -= M[0] * x[0] + M[1] * x[1] + M[2] * x[2];
+        o[1] -= M[3] * x[0] + M[4] * x[1] + M[5] * x[2];
+        o[2] -= M[6] * x[0] + M[7] * x[1] + M[8] * x[2];
+    }
+}
+
+/* The line solve's forward step at node ix of a row (X: the row's x, holding its right-hand
+ * side s up to ix): g_ix = s_ix - A_{ix,ix-1} D_{ix-1}^-1 g_{ix-1}, and on a closed row the
+ * last node's g_m = s_m - sum F_i g_i (the sum gathered in acc as the row goes). */
+static inline void line_down(const mg_level *L, size_t k0, int ix, double *X, double *acc)
+{
+    const int m = L->closed ? L->nx - 1 : L->nx;
+    double *Xi = X + 3 * (size_t)ix;
+    if (ix == m) { /* the closed row's last node */
+        Xi[0] += acc[0], Xi[1] += acc[1], Xi[2] += acc[2];
+        return;
+    }
+    if (ix > 0) {
+        double u[3] = {0.0, 0.0, 0.0};
+        const double *D = L->dinv + WS_SYM * (k0 + (size_t)ix - 1);
+        ws_sym_madd(D, Xi[-3], Xi[-2], Xi[-1], u);
+        fsym_sub(AT(L, k0 + (size_t)ix - 1, CENTRE + 1), u, Xi);
+    }
+    if (L->closed)
+        fmat_sub(L->lff + 9 * (k0 + (size_t)ix), 0, Xi, acc);
+}
+
+/* The line solve's backward step at node ix (the nodes after it, and the last, solved):
+ * x_ix = D^-1 (g_ix - A_{ix,ix+1} x_{ix+1}) - F_ix^T x_m. */
+static inline void line_up(const mg_level *L, size_t k0, int ix, double *X)
+{
+    const int m = L->closed ? L->nx - 1 : L->nx;
+    const double *o = L->dinv + WS_SYM * (k0 + (size_t)ix);
+    double *Xi = X + 3 * (size_t)ix;
+    double g[3] = {Xi[0], Xi[1], Xi[2]};
+    if (ix + 1 < m)
+        fsym_sub(AT(L, k0 + (size_t)ix, CENTRE + 1), Xi + 3, g);
+    const double xx = o[WS_SYM_XX], yy = o[WS_SYM_YY], zz = o[WS_SYM_ZZ], xy = o[WS_SYM_XY],
+                 xz = o[WS_SYM_XZ], yz = o[WS_SYM_YZ];
+    Xi[0] = xx * g[0] + xy * g[1] + xz * g[2];
+    Xi[1] = xy * g[0] + yy * g[1] + yz * g[2];
+    Xi[2] = xz * g[0] + yz * g[1] + zz * g[2];
+    if (ix < m && L->closed)
+        fmat_sub(L->lff + 9 * (k0 + (size_t)ix), 1, X + 3 * (size_t)m, Xi);
+}
+
+/* The neighbours of (ix, iy) on level L in the row iy + dy (dy -1 or 1), by dx = -1, 0, 1
+ * (slots 3 (dy + 1) + dx + 1); -1 beyond the grid's edge. */
+static inline void row_beside(const mg_level *L, int ix, int iy, int dy, int64_t *j)
+{
+    const int jy = iy + dy;
+    if (jy < 0 || jy >= L->ny) {
+        j[0] = j[1] = j[2] = -1;
+        return;
+    }
+    const int64_t b = (int64_t)L->nx * jy;
+    j[0] = ix > 0 ? b + ix - 1 : L->closed ? b + L->nx - 1 : -1;
+    j[1] = b + ix;
+    j[2] = ix + 1 < L->nx ? b + ix + 1 : L->closed ? b : -1;
+}
+
+/* Forward, row iy solved whole (its factor from line_factor) against the row before it (those
+ * after are still zero) and the bodies: then the row before takes -A_{row-1,row} x_row into t
+ * (the row itself is solved exactly: its own couplings leave nothing), and the bodies -G^T x
+ * into rbn. */
+static void line_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    const size_t k0 = (size_t)L->nx * (size_t)iy;
+    double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
+    int64_t j[3];
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = (int64_t)k0 + ix;
+        row_beside(L, ix, iy, -1, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double *X = L->x + 3 * (size_t)k;
+        X[0] = R[0], X[1] = R[1], X[2] = R[2];
+        for (int o = 0; o < 3; o++)
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
+        line_down(L, k0, ix, Xr, acc);
+    }
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = (int64_t)k0 + ix;
+        line_up(L, k0, ix, Xr);
+        row_beside(L, ix, iy, -1, j);
+        const double *X = L->x + 3 * (size_t)k;
+        for (int o = 0; o < 3; o++) /* t_j -= A_jk x_k for the row before */
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* Backward, row iy solved whole against both rows beside it and the bodies; its new x taken
+ * off the bodies' right-hand side sb. */
+static void line_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    const size_t k0 = (size_t)L->nx * (size_t)iy;
+    double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
+    int64_t j[9];
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = (int64_t)k0 + ix;
+        row_beside(L, ix, iy, -1, j);
+        row_beside(L, ix, iy, 1, j + 6);
+        const double *R = L->r + 3 * (size_t)k;
+        double *X = L->x + 3 * (size_t)k;
+        X[0] = R[0], X[1] = R[1], X[2] = R[2];
+        for (int o = 0; o < 3; o++) {
+            if (j[o] >= 0)
+                fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+            if (j[6 + o] >= 0)
+                fsym_sub(AT(L, (size_t)k, 6 + o), L->x + 3 * (size_t)j[6 + o], X);
+        }
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
+        line_down(L, k0, ix, Xr, acc);
+    }
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = (int64_t)k0 + ix;
+        line_up(L, k0, ix, Xr);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, L->x + 3 * (size_t)k, sb + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
+ * k (the nodes after are still zero), its block into *B (NULL when not). */
+static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const float **B,
+                           double *s)
+{
+    *B = NULL;
+    if (j < 0 || j > k)
+        return;
+    *B = off_block(L, (size_t)k, o, j);
+    fsym_sub(*B, L->x + 3 * (size_t)j, s);
+}
+
+/* x_k = D_k^-1 s (the inverse of the node's own block, point_factor). */
+static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
+{
+    const double *S = L->dinv + WS_SYM * (size_t)k;
+    double *X = L->x + 3 * (size_t)k;
+    X[0] = X[1] = X[2] = 0.0;
+    ws_sym_madd(S, s[0], s[1], s[2], X);
+}
+
+/* Forward, row iy node by node: a node meets only the nodes before it (those after are still
+ * zero) and the bodies, and each node before it that it meets takes -A_jk x_k into t (with the
+ * block its own solve has just read), the bodies -G^T x_k into rbn. */
+static void point_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    for (int ix = 0; ix < L->nx; ix++) {
+        const int64_t k = ix + (int64_t)L->nx * iy;
+        int64_t j[9];
+        neighbours(L, ix, iy, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double s[3] = {R[0], R[1], R[2]};
+        const float *B[9];
+        for (int o = 0; o < 9; o++)
+            if (o != CENTRE)
+                gs_take(L, k, o, j[o], &B[o], s);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
+        gs_solve(L, k, s);
+        const double *X = L->x + 3 * (size_t)k;
+        for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
+            if (o != CENTRE && B[o])
+                fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* Backward, row iy node by node in reverse: a node meets every neighbour and the bodies, and
+ * its new x is taken off the bodies' right-hand side sb. */
+static void point_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
+{
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    for (int ix = L->nx - 1; ix >= 0; ix--) {
+        const int64_t k = ix + (int64_t)L->nx * iy;
+        int64_t j[9];
+        neighbours(L, ix, iy, j);
+        const double *R = L->r + 3 * (size_t)k;
+        double s[3] = {R[0], R[1], R[2]};
+        for (int o = 0; o < 9; o++)
+            if (o != CENTRE && j[o] >= 0)
+                fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
+        const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
+        for (uint32_t e = e0; e < e1; e++)
+            g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
+        gs_solve(L, k, s);
+        const double *X = L->x + 3 * (size_t)k;
+        for (uint32_t e = e0; e < e1; e++)
+            gt_sub(L->G + 18 * (size_t)e, X, sb + 6 * (size_t)L->gb[e]);
+    }
+}
+
+/* The sweeps of symmetric block Gauss-Seidel on a coarse level L, the blocks a level's rows
+ * solved whole (L->whole) and its other nodes one by one, taken in the grid's order: the
+ * bodies nested (mg->nb) first in the forward sweep and last in the backward one, which takes
+ * the same blocks in reverse, so that the two mirror each other (B_k symmetric) and every
+ * coupling term is taken in the node loops, where the node's x is at hand. Forward from x = 0:
+ * the bodies from their right-hand side alone, then each block meets only the blocks before it
+ * (those after are still zero) and the bodies; the sweep leaves the residual r - A x in t (each
+ * block's own couplings are solved exactly, so what is left at a node is what the blocks after
+ * it add since, added as each is solved) and the bodies' residual, rb - A_bb xb - G^T x =
+ * -G^T x, in rbn (the next level's: the bodies are the same unknowns there). */
 static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
@@ -717,57 +1111,29 @@ static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
         ws_rigid_block_solve(mg->rig, L->rb, L->xb);
         memset(rbn, 0, nb6 * sizeof(double));
     }
-    for (int iy = 0; iy < L->ny; iy++)
-        for (int ix = 0; ix < L->nx; ix++) {
-            const int64_t k = ix + (int64_t)L->nx * iy;
-            int64_t j[9];
-            neighbours(L, ix, iy, j);
-            const double *R = L->r + 3 * (size_t)k;
-            double s[3] = {R[0], R[1], R[2]};
-            const float *B[9];
-            for (int o = 0; o < 9; o++)
-                if (o != CENTRE)
-                    gs_take(L, k, o, j[o], &B[o], s);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
-            gs_solve(L, k, s);
-            const double *X = L->x + 3 * (size_t)k;
-            for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
-                if (o != CENTRE && B[o])
-                    fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
-        }
+    for (int iy = 0; iy < L->ny; iy++) {
+        if (L->whole[iy])
+            line_row_forward(mg, L, iy, rbn);
+        else
+            point_row_forward(mg, L, iy, rbn);
+    }
 }
 
-/* Backward from the x and xb there are: node k meets every neighbour and the bodies, and its
- * new x is taken off the bodies' right-hand side (in mg->bsum), which they are solved with at
- * the end. */
+/* Backward from the x and xb there are: the blocks in reverse, each against every neighbour
+ * and the bodies, its new x taken off the bodies' right-hand side (in mg->bsum), which they
+ * are solved with at the end. */
 static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
     double *sb = mg->bsum;
     if (nb6)
         memcpy(sb, L->rb, nb6 * sizeof(double));
-    for (int iy = L->ny - 1; iy >= 0; iy--)
-        for (int ix = L->nx - 1; ix >= 0; ix--) {
-            const int64_t k = ix + (int64_t)L->nx * iy;
-            int64_t j[9];
-            neighbours(L, ix, iy, j);
-            const double *R = L->r + 3 * (size_t)k;
-            double s[3] = {R[0], R[1], R[2]};
-            for (int o = 0; o < 9; o++)
-                if (o != CENTRE && j[o] >= 0)
-                    fsym_sub(off_block(L, (size_t)k, o, j[o]), L->x + 3 * (size_t)j[o], s);
-            const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
-            for (uint32_t e = e0; e < e1; e++)
-                g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
-            gs_solve(L, k, s);
-            const double *X = L->x + 3 * (size_t)k;
-            for (uint32_t e = e0; e < e1; e++)
-                gt_sub(L->G + 18 * (size_t)e, X, sb + 6 * (size_t)L->gb[e]);
-        }
+    for (int iy = L->ny - 1; iy >= 0; iy--) {
+        if (L->whole[iy])
+            line_row_backward(mg, L, iy, sb);
+        else
+            point_row_backward(mg, L, iy, sb);
+    }
     if (nb6) /* the bodies last: xb = A_bb^-1 (rb - G^T x) */
         ws_rigid_block_solve(mg->rig, sb, L->xb);
 }
@@ -1061,6 +1427,25 @@ double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double 
     return apply(mg, web, r, z, rb, zb);
 }
 
+int ws_mg_rows(const ws_mg *mg, int k, int *whole)
+{
+    *whole = 0;
+    if (k < 1 || k + 1 >= mg->nlev)
+        return 0;
+    *whole = mg->lv[k].lines;
+    return mg->lv[k].ny;
+}
+
+int ws_mg_set_row(ws_mg *mg, int k, int iy, int whole)
+{
+    if (k < 1 || k + 1 >= mg->nlev || iy < 0 || iy >= mg->lv[k].ny)
+        return -1;
+    mg_level *L = &mg->lv[k];
+    L->lines += (whole != 0) - L->whole[iy];
+    L->whole[iy] = whole != 0;
+    return whole ? line_factor(L, iy) : point_factor(L, iy);
+}
+
 int ws_mg_levels(const ws_mg *mg)
 {
     return mg ? mg->nlev : 1;
@@ -1144,18 +1529,23 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
                      3 * (size_t)lv[1].nx,
            floats = 0;
     for (int i = 1; i < nlev; i++) {
-        doubles += (WS_SYM + 9) * (size_t)lv[i].n;
+        doubles += (9 + WS_SYM + 9) * (size_t)lv[i].n;
         floats += STEN * (size_t)lv[i].n;
     }
     floats += FOP * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
-    size_t nmaps = 0;
+    size_t nmaps = 0, rows = 0;
     for (int i = 0; i + 1 < nlev; i++)
         nmaps += (size_t)lv[i].nx + (size_t)lv[i].ny;
+    for (int i = 1; i < nlev; i++)
+        rows += (size_t)lv[i].ny;
     ws_mg *mg = ws_mem_calloc(mem, 1, sizeof *mg);
     double *blk = mg ? ws_mem_calloc(mem, doubles, sizeof(double)) : NULL;
     float *fblk = blk ? ws_mem_calloc(mem, floats, sizeof(float)) : NULL;
     map1d *maps = fblk ? ws_mem_calloc(mem, nmaps, sizeof(map1d)) : NULL;
-    if (!maps) {
+    unsigned char *whole = maps ? ws_mem_calloc(mem, rows, 1) : NULL;
+    if (!whole) {
+        if (maps)
+            ws_mem_free(mem, maps, nmaps * sizeof(map1d));
         if (fblk)
             ws_mem_free(mem, fblk, floats * sizeof(float));
         if (blk)
@@ -1166,6 +1556,8 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     }
     mg->maps = maps;
     mg->nmaps = nmaps;
+    mg->whole = whole;
+    mg->rows = rows;
     map1d *mp = maps;
     for (int i = 0; i + 1 < nlev; i++) {
         lv[i].mx = mp, mp += lv[i].nx;
@@ -1202,9 +1594,11 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         mg_level *L = &mg->lv[i];
         L->a = fq, fq += STEN * (size_t)L->n;
         L->dinv = q, q += WS_SYM * (size_t)L->n;
+        L->lff = q, q += 9 * (size_t)L->n;
         L->x = q, q += 3 * (size_t)L->n;
         L->r = q, q += 3 * (size_t)L->n;
         L->t = q, q += 3 * (size_t)L->n;
+        L->whole = whole, whole += L->ny;
     }
     *out = mg;
     return 0;
@@ -1214,6 +1608,7 @@ void ws_mg_free(ws_mem *mem, ws_mg *mg)
 {
     if (!mg)
         return;
+    ws_mem_free(mem, mg->whole, mg->rows);
     ws_mem_free(mem, mg->maps, mg->nmaps * sizeof(map1d));
     ws_mem_free(mem, mg->blk, mg->doubles * sizeof(double));
     ws_mem_free(mem, mg->fblk, mg->floats * sizeof(float));

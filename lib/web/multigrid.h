@@ -6,7 +6,9 @@
  * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
  * matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
  * Gauss-Seidel (forward before, backward after the coarse correction) on the coarse levels
- * (their blocks in single precision too), a dense Cholesky factor on the coarsest. The cycle is
+ * (their blocks in single precision too; the rows along x where a point sweep would leave
+ * the error constant along the row and alternating up are solved whole, a band's closed
+ * around, the others node by node), a dense Cholesky factor on the coarsest. The cycle is
  * the same linear, symmetric positive definite map on every call of a solve, so conjugate
  * gradients stay valid with it (docs/theory.md 8a: why the rounding keeps it so).
  *
@@ -79,5 +81,14 @@ double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double 
 
 /* The number of levels (the film's own one included), for the counts. */
 int ws_mg_levels(const ws_mg *mg);
+
+/* Coarse level k's rows (along x) and, into *whole, how many of them its sweeps solve whole
+ * (chosen at each set-up); 0 when k is not a coarse level swept (1 .. levels - 2). */
+int ws_mg_rows(const ws_mg *mg, int k, int *whole);
+
+/* For tests: row iy of coarse level k solved whole (whole != 0) or node by node, until the
+ * next set-up chooses again; its factor made anew. 0, or -1 when k or iy is out of range or a
+ * pivot is not positive definite. */
+int ws_mg_set_row(ws_mg *mg, int k, int iy, int whole);
 
 #endif
