@@ -404,6 +404,21 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
     return count;
 }
 
+/* The least distance of the listed nodes beyond far body t->body's box (grown by the layers)
+ * along its axis, at state cur: INFINITY for none. */
+static double far_least(const ws_body_store *b, int cur, const ws_track *t, const ws_web *web,
+                        ws_nodes3 x, const uint32_t *nodes, size_t count)
+{
+    const axis_span S = body_span(b, cur, t->body, web, t->axis);
+    double least = INFINITY;
+    for (size_t m = 0; m < count; m++) {
+        const double c = v3_dot(S.a, nodes_get(x, nodes[m])) - S.o, lo = c - S.hi, hi = S.lo - c;
+        const double g = fmax(lo, hi);
+        least = g < least ? g : least;
+    }
+    return least;
+}
+
 /* Flag (1 in `flag`) the nodes whose coordinates in body k's frame at state cur, A^T (x - r),
  * lie in its box grown by e. Straight-line code, on vectors, FLAG_CHUNK nodes at a time (those
  * of a group with none in the box are left as they are). */
@@ -549,8 +564,24 @@ size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t
     return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
 }
 
+size_t ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                         ws_node_lane *L)
+{
+    ws_node_contact *nc = web->contact;
+    const size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    uint32_t *moved = nc->moved + L->n0;
+    L->count = flagged ? collect_flagged(nc->redo + L->n0, L->n1 - L->n0, moved) : 0;
+    for (size_t m = 0; m < L->count; m++)
+        moved[m] += L->n0;
+    for (size_t q = 0; q < nc->ntrack; q++)
+        L->least[q] = nc->track[q].near || !L->count
+                          ? INFINITY
+                          : far_least(b, cur, &nc->track[q], web, x, moved, L->count);
+    return flagged;
+}
+
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
-                       size_t flagged)
+                       const ws_node_lane *lanes, uint32_t nlanes, size_t flagged)
 {
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
@@ -558,30 +589,42 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_body(b, cur, &nc->track[q], web, x, margin);
-    /* Most steps flag no node. */
-    long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
+    /* The lanes' flagged nodes joined in lane order, which is node order, unless a re-based
+     * body flagged more since. Most steps flag no node. */
+    const int joined = lanes && !M->rebase;
+    long count = 0;
+    for (uint32_t i = 0; joined && i < nlanes; i++) {
+        if (lanes[i].count && (size_t)count != lanes[i].n0)
+            memmove(nc->moved + count, nc->moved + lanes[i].n0, lanes[i].count * sizeof(uint32_t));
+        count += (long)lanes[i].count;
+    }
+    if (!joined && (flagged || M->rebase))
+        count = (long)collect_flagged(nc->redo, web->n, nc->moved);
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
-     * the least of what it was and their distances beyond its box now, less its move so far. */
+     * the least of what it was and their distances beyond its box now, less its move so far
+     * (the lanes' least distances, the least of them: the same number, found in pieces). */
     for (size_t q = 0; count && q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         if (t->near)
             continue;
-        const axis_span S = body_span(b, cur, t->body, web, t->axis);
         double least = INFINITY;
-        for (long m = 0; m < count; m++) {
-            double c = v3_dot(S.a, nodes_get(x, nc->moved[m])) - S.o;
-            double g = fmax(c - S.hi, S.lo - c);
-            least = g < least ? g : least;
-        }
+        if (joined)
+            for (uint32_t i = 0; i < nlanes; i++)
+                least = lanes[i].least[q] < least ? lanes[i].least[q] : least;
+        else
+            least = far_least(b, cur, t, web, x, nc->moved, (size_t)count);
         const double d = body_move(t, st, M, M->reach);
         if (least - d < t->gap)
             t->gap = least - d;
         if (may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Found again now: their moves count from here. */
-    to_ref(web, x, M, nc->moved, (size_t)count);
     return count;
+}
+
+void ws_node_to_ref(ws_web *web, ws_nodes3 x, const uint32_t *nodes, size_t count)
+{
+    to_ref(web, x, &web->contact->move, nodes, count);
 }
 
 /* The end of node m's candidates in the list c (n of them, sorted by node), from f on. */
@@ -1018,6 +1061,8 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
     count = nodes ? count : web->n;
     if (S->search && count)
         return S->search(S, web, nodes, count, L);
+    if (nodes) /* found again now: their moves count from here */
+        ws_node_to_ref(web, web->x[S->cur], nodes, count);
     return count && ws_node_find_scratch(S->b, S->g) ? -1
                                                      : ws_node_find(S, web, nodes, 0, count, L);
 }
@@ -1184,7 +1229,8 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
     int list = nc->list, all = nc->search_all;
     long moved = 0;
     if (!all &&
-        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, flagged)) < 0)
+        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, S->lanes,
+                                   S->nlanes, flagged)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {

@@ -189,15 +189,27 @@ typedef struct ws_node_geom {
 struct ws_node_step;
 /* A search of node candidates as ws_node_find does it from first = 0, for the nodes listed
  * (0 .. count - 1 when nodes is NULL), into L (empty): the world's, in pieces on its threads.
+ * Listed nodes are found again now: it also moves them to the reference frame (ws_node_to_ref),
+ * in its pieces.
  * 0, or 1 when the nodes are listed and their candidates found are those the committed list
  * holds for them (ws_node_same, which it may leave undone: then 0), or -1 when out of memory. */
 typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const uint32_t *nodes,
                               size_t count, ws_ncand_list *L);
 
+/* A lane's part of the move test (ws_node_flag_lane): its nodes [n0, n1) and what it found
+ * there: the flagged ones, in order, at web->contact->moved + n0 (count of them), and for each
+ * track the least distance of those beyond the far body's box (ws_node_moved_end; INFINITY for
+ * a near body or none flagged; room for every track). */
+typedef struct ws_node_lane {
+    uint32_t n0, n1;
+    size_t count;
+    double *least;
+} ws_node_lane;
+
 /* What a step's search of node candidates reads and counts: the world's allocator, the bodies
  * at state cur with their features (g, whose scratch the search uses), the contact margin,
  * where feature checks are counted, and who searches (search; NULL: ws_node_find, here), with
- * its context. */
+ * its context; the lanes that ran the move test (NULL: it ran whole). */
 typedef struct ws_node_step {
     ws_mem *mem;
     const ws_body_store *b;
@@ -207,6 +219,8 @@ typedef struct ws_node_step {
     uint64_t *checks;
     ws_node_search_fn *search;
     void *search_ctx;
+    const ws_node_lane *lanes;
+    uint32_t nlanes;
 } ws_node_step;
 
 /* The search's scratch in g, from its arena (g->arena), at its most for a group of nodes: for
@@ -261,20 +275,35 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
  * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
  * node.c. */
 
-/* ws_node_moved in three parts, so that the per-node test runs in pieces (a lane's nodes):
- * the bodies' part, -1 when every node must be found again, else 0 with the test set up in
+/* ws_node_moved in parts, so that the per-node test runs in pieces (a lane's nodes): the
+ * bodies' part, -1 when every node must be found again, else 0 with the test set up in
  * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
- * distinct nodes); the rest, given the pieces' total, as ws_node_moved returns. */
+ * distinct nodes), or, by ws_node_flag_lane, also listed and measured against the far bodies
+ * in the lane (L->n0, L->n1; the lanes covering the nodes in order); the rest, given the
+ * lanes (NULL: none) and the pieces' total, as ws_node_moved returns, but with the listed
+ * nodes not yet moved to the reference frame: the search of their candidates does that
+ * (ws_node_to_ref, in its pieces when it has any). */
 int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin);
 size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
+size_t ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                         ws_node_lane *L);
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
-                       size_t flagged);
+                       const ws_node_lane *lanes, uint32_t nlanes, size_t flagged);
+/* The listed nodes (count of them) to the reference frame of this step's move test: their
+ * record (xdet, xep) from where they are, x; web->contact->lever2 grows to hold them. Distinct
+ * nodes may be moved at once through views of one contact, each its own lever2 (the largest
+ * of them is the whole's). */
+void ws_node_to_ref(ws_web *web, ws_nodes3 x, const uint32_t *nodes, size_t count);
 static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
                                  ws_nodes3 v, double dt, double margin)
 {
     if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
         return -1;
-    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
+    const long count =
+        ws_node_moved_end(b, cur, web, x, margin, NULL, 0, ws_node_flag(web, x, v, 0, web->n));
+    if (count > 0)
+        ws_node_to_ref(web, x, web->contact->moved, (size_t)count);
+    return count;
 }
 
 /* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]

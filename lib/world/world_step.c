@@ -401,12 +401,17 @@ static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, uint32_t sha
 }
 
 /* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
- * them): the count flagged in each lane's job. */
+ * them): each lane flags its nodes, lists the flagged ones and measures them against the far
+ * bodies (ws_node_flag_lane, into fl[i]); and, as one item more that is no worker's own, the
+ * bodies' features the web's committed candidates name (ws_node_prepare), which only the sweep
+ * reads: a body that the search finds near later is prepared after it. */
 typedef struct flag_task {
     ws_world *w;
     ws_web *web;
     uint32_t lanes;
+    int cur;
     ws_nodes3 x, v;
+    ws_node_lane *fl;
 } flag_task;
 
 static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
@@ -414,19 +419,24 @@ static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
     (void)worker;
     const flag_task *T = ctx;
     for (int32_t i = start; i < end; i++) {
-        const ws_lane_job *J = &T->w->lane_job[i];
-        const uint32_t nx = T->lanes > 1 ? (uint32_t)T->web->nx : 0; /* 0: the whole web */
-        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, nx ? nx * J->r0 : 0,
-                                                 nx ? nx * J->r1 : T->web->n);
+        if ((uint32_t)i == T->lanes) {
+            ws_node_prepare(&T->w->bodies, T->cur, &T->w->node_geom, T->web);
+            continue;
+        }
+        T->w->lane_job[i].flagged =
+            ws_node_flag_lane(&T->w->bodies, T->cur, T->web, T->x, T->v, &T->fl[i]);
     }
 }
 
 /* The flags in the lanes of the last cut when it cuts this web's rows (the nodes stay on
- * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. */
-static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
+ * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. The
+ * lanes' findings in *fl (from the arena; NULL when out of memory, and nothing flagged). */
+static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane **fl)
 {
+    ws_world *w = S->w;
     ws_lane_job *J = w->lane_job;
-    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
+    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1, nx = web->nx > 0 ? (uint32_t)web->nx : 0;
+    const size_t ntrack = web->contact->ntrack;
     const int cut = lanes_cover(J, lanes, ny);
     if (!cut)
         w->cut_web = NULL; /* not lanes_cut's */
@@ -434,8 +444,15 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
         J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
         J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
     }
-    flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
-    run_task(w, flag_items, lanes, 0, &T);
+    ws_node_lane *L = ws_arena_alloc(S->arena, lanes * sizeof *L);
+    double *least = ws_arena_alloc(S->arena, (lanes * ntrack + 1) * sizeof *least);
+    if (!(*fl = L) || !least)
+        return *fl = NULL, 0;
+    for (uint32_t i = 0; i < lanes; i++)
+        L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n, 0,
+                              least + i * ntrack};
+    flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
+    run_task(w, flag_items, lanes > 1 ? lanes + 1 : 1, lanes > 1, &T);
     size_t flagged = 0;
     for (uint32_t i = 0; i < lanes; i++)
         flagged += w->lane_job[i].flagged;
@@ -477,6 +494,8 @@ static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
     J->found.n = 0;
     J->found_checks = 0;
     const uint32_t *nodes = T->nodes ? T->nodes + q0 : NULL;
+    if (nodes) /* found again now: their record from here, J->cview.lever2 for the whole's */
+        ws_node_to_ref(&J->view, J->view.x[T->S->cur], nodes, q1 - q0);
     J->found_bad = ws_node_find(&s, &J->view, nodes, (uint32_t)q0, q1 - q0, &J->found) != 0;
     const ws_node_contact *nc = T->web->contact;
     const ws_node_found F = {nodes, q1 - q0, &J->found};
@@ -500,6 +519,8 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
     if (pieces < 2) {
         ws_node_step s = *S;
         s.search = NULL;
+        if (nodes)
+            ws_node_to_ref(web, web->x[S->cur], nodes, count);
         return ws_node_find_scratch(S->b, S->g) ? -1 : ws_node_find(&s, web, nodes, 0, count, L);
     }
     const size_t slots = S->b->slots + 1, room = w->search_tight ? 8 : 2 * (count / pieces) + 64;
@@ -542,6 +563,9 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
         *S->checks += J->found_checks;
         for (size_t k = 0; k + 1 < slots; k++)
             web->contact->cbody[k] |= J->cview.cbody[k];
+        /* The largest |xdet|^2 of the pieces' nodes: as one pass over them all would keep. */
+        if (J->cview.lever2 > web->contact->lever2)
+            web->contact->lever2 = J->cview.lever2;
     }
     return same;
 }
@@ -676,8 +700,12 @@ static ws_status step_webs(ws_step *S)
         int searched = 0;
         const uint32_t lanes = web_lanes(w, web);
         size_t flagged = 0;
-        if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
-            flagged = flag_lanes(w, web, lanes, cur);
+        ws_node_lane *fl = NULL;
+        if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid) &&
+            (flagged = flag_lanes(S, web, lanes, &fl), !fl)) {
+            nc->refresh = 1; /* the move test's record is not to be trusted: all found again */
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        }
         const double t0 = clock_now(w);
         const ws_node_step ns = {&w->mem,
                                  b,
@@ -686,7 +714,9 @@ static ws_status step_webs(ws_step *S)
                                  S->contact.margin,
                                  &S->stats->narrow_checks,
                                  lanes > 1 ? search_lanes : NULL,
-                                 w};
+                                 w,
+                                 fl,
+                                 fl ? lanes : 0};
         if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
