@@ -73,26 +73,65 @@ static double max_step_travel(const ws_world *w, int k)
     return most * w->def.dt;
 }
 
-static ws_status detect_full(ws_step *S)
+/* A full detection's narrow phase over the broad phase's pairs (S->pairs): the candidates of
+ * each pair into cand[nxt], sorted, the stick anchors carried over. With mem NULL (beside the
+ * film, on a worker) the list does not grow: -1 when its room runs out, as when out of
+ * memory. */
+static int detect_narrow(ws_step *S, ws_mem *mem)
 {
     ws_world *w = S->w;
     const int nxt = S->nxt;
-    if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
+    /* The room a worker may fill (a test's, tighter), and the pairs counted when it is done. */
+    size_t room = w->capcand[nxt], gated = 0, tested = 0;
+    if (!mem && w->narrow_tight && room > 2)
+        room = 2;
     w->ncand[nxt] = 0;
     for (size_t k = 0; k < S->npairs; k++) {
         uint32_t i = S->pairs[2 * k], j = S->pairs[2 * k + 1];
         if (w->def.use_ccd && !ws_ccd_may_touch_at(S->b, S->cur, i, j, S->contact.margin)) {
-            S->stats->body_pairs_gated++;
+            gated++;
             continue;
         }
-        S->stats->body_pairs_tested++;
-        if (ws_contact_candidates(&w->mem, &S->contact, i, j, &w->cand[nxt], &w->ncand[nxt],
-                                  &w->capcand[nxt]) != 0)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+        tested++;
+        if (ws_contact_candidates(mem, &S->contact, i, j, &w->cand[nxt], &w->ncand[nxt],
+                                  mem ? &w->capcand[nxt] : &room) != 0)
+            return -1;
     }
+    S->stats->body_pairs_gated += gated;
+    S->stats->body_pairs_tested += tested;
     ws_contact_sort(w->cand[nxt], w->ncand[nxt]);
     ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[S->cur], w->ncand[S->cur]);
+    return 0;
+}
+
+/* Room for the candidates and records of a narrow phase beside the film: twice the last
+ * list's and some, so that it rarely runs out (then it runs again here, with the room grown:
+ * step_once). 0, or -1 when out of memory. */
+static int narrow_room(ws_step *S)
+{
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    return ws_array_reserve(&w->mem, (void **)&w->cand[nxt], &w->capcand[nxt],
+                            2 * w->ncand[S->cur] + 64, sizeof *w->cand[nxt]) ||
+                   ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt],
+                                    w->capcand[nxt] + 1, sizeof *w->rec[nxt])
+               ? -1
+               : 0;
+}
+
+static ws_status detect_full(ws_step *S)
+{
+    ws_world *w = S->w;
+    if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
+    if (S->body_later) { /* the narrow phase beside the film, with the body contacts */
+        S->narrow_later = 1;
+        if (narrow_room(S) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+        return WS_OK;
+    }
+    if (detect_narrow(S, &w->mem) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
     return WS_OK;
 }
 
@@ -435,7 +474,8 @@ static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane *
 {
     ws_world *w = S->w;
     ws_lane_job *J = w->lane_job;
-    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1, nx = web->nx > 0 ? (uint32_t)web->nx : 0;
+    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1,
+                   nx = web->nx > 0 ? (uint32_t)web->nx : 0;
     const size_t ntrack = web->contact->ntrack;
     const int cut = lanes_cover(J, lanes, ny);
     if (!cut)
@@ -980,7 +1020,8 @@ static ws_status detect(ws_step *S)
             memcpy(w->cand[nxt], w->cand[cur], w->ncand[cur] * sizeof *w->cand[nxt]);
         w->ncand[nxt] = w->ncand[cur];
     }
-    if (ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
+    if (!S->narrow_later &&
+        ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
                          sizeof *w->rec[nxt]) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact records");
     return WS_OK;
@@ -993,6 +1034,10 @@ static void body_contacts(ws_step *S)
     ws_world *w = S->w;
     const ws_body_store *b = S->b;
     const int nxt = S->nxt;
+    /* A full detection's narrow phase first, when it waits here (detect_full): out of room,
+     * both run again on the calling thread (step_once). */
+    if (S->narrow_later && (S->narrow_bad = detect_narrow(S, NULL) != 0))
+        return;
     size_t nrec = 0;
     for (size_t k = 0; k < w->ncand[nxt]; k++)
         if (ws_contact_eval(&S->contact, &w->cand[nxt][k], &w->rec[nxt][nrec]))
@@ -1228,18 +1273,18 @@ static ws_status step_once(ws_world *w)
     S.guard_m = S.guard_f + b->slots + 1;
 
     prepare(w);
+    /* The body contacts read only the bodies' state at t, and the film does not read the
+     * bodies' loads: with workers and only explicit webs they run as one more item of the
+     * film's first sub-step in lanes, on whichever worker is free first, with a full
+     * detection's narrow phase before them, and their check and the elements follow the film
+     * (the loads summed as before: contacts, elements, webs). A step they refuse then leaves
+     * the world as it was all the same: the film wrote only the next state and its scratch. */
+    S.body_later = S.loads_later = bodies_beside_film(w);
     double t_mark = clock_now(w);
     if ((s = detect(&S)) != WS_OK)
         return s;
     double t_eval = clock_now(w);
     S.stats->seconds_detection += t_eval - t_mark;
-    /* The body contacts read only the bodies' state at t, and the film does not read the
-     * bodies' loads: with workers and only explicit webs they run as one more item of the
-     * film's first sub-step in lanes, on whichever worker is free first, and their check
-     * and the elements follow the film (the loads summed as before: contacts, elements,
-     * webs). A step they refuse then leaves the world as it was all the same: the film
-     * wrote only the next state and its scratch. */
-    S.body_later = S.loads_later = bodies_beside_film(w);
     if (!S.body_later) {
         body_contacts(&S);
         if ((s = contacts_ready(&S)) != WS_OK)
@@ -1259,6 +1304,16 @@ static ws_status step_once(ws_world *w)
         const double t_late = clock_now(w);
         if (S.body_later) /* no web was swept in lanes */
             body_contacts(&S);
+        if (S.narrow_bad) { /* its room ran out beside the film: again here, growing it */
+            S.narrow_later = S.narrow_bad = 0;
+            w->narrow_reruns++;
+            if (detect_narrow(&S, &w->mem) != 0 ||
+                ws_array_reserve(&w->mem, (void **)&w->rec[S.nxt], &w->caprec[S.nxt],
+                                 w->ncand[S.nxt] + 1, sizeof *w->rec[S.nxt]) != 0)
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY,
+                               "step: out of memory for contact candidates");
+            body_contacts(&S);
+        }
         if ((s = contacts_ready(&S)) != WS_OK ||
             (s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK)
             return s;
