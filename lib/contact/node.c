@@ -1167,15 +1167,21 @@ static void prepare_body(const ws_body_store *b, int cur, ws_node_geom *g, uint3
     }
 }
 
-void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
+void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web,
+                          uint32_t first, uint32_t stride)
 {
     ws_node_contact *nc = web->contact;
     const size_t m = nc->cbody_cap < b->slots ? nc->cbody_cap : b->slots;
-    for (uint32_t k = 0; k < m; k++)
+    for (uint32_t k = first; k < m; k += stride)
         if (nc->cbody[k] && !g->ready[k] && b->alive[k]) {
             prepare_body(b, cur, g, k);
             g->ready[k] = 1;
         }
+}
+
+void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
+{
+    ws_node_prepare_some(b, cur, g, web, 0, 1);
 }
 
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)

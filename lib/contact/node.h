@@ -260,6 +260,10 @@ int ws_node_geometry(const ws_body_store *b, ws_node_geom *g);
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
  * (web->cbody) and that are not prepared yet in this step. */
 void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
+/* The same for the body slots first, first + stride, ...: pieces with the same stride and
+ * distinct firsts may run at once (each body's tables are its own). */
+void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web,
+                          uint32_t first, uint32_t stride);
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a

@@ -257,9 +257,25 @@ typedef struct lane_task {
      * core's cache. */
     int zero;
     uint32_t lanes;
-    /* The body contacts of the step, item `lanes` of the task (NULL: not in this one). */
+    /* The body part of the step, item `lanes` of the task (NULL: none in this one), and
+     * which: a full detection's narrow phase (BODY_NARROW, the first sub-step's), the body
+     * contacts (BODY_CONTACTS, the last's), each where its sub-step's lanes leave room. */
     ws_step *body;
+    int body_part;
 } lane_task;
+
+enum { BODY_NARROW = 1, BODY_CONTACTS = 2 };
+
+/* The body part of a sub-step's task: the narrow phase, the contacts or both (lane_task). */
+static void body_item(ws_step *S, int part)
+{
+    if ((part & BODY_NARROW) && S->narrow_later) {
+        S->narrow_bad = detect_narrow(S, NULL) != 0;
+        S->narrow_later = 0;
+    }
+    if (part & BODY_CONTACTS)
+        body_contacts(S);
+}
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
 static void sweep_lane(const lane_task *T, ws_lane_job *J)
@@ -307,7 +323,7 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         if ((uint32_t)i < T->lanes)
             sweep_lane(T, &T->w->lane_job[i]);
         else
-            body_contacts(T->body);
+            body_item(T->body, T->body_part);
     }
 }
 
@@ -441,9 +457,11 @@ static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, uint32_t sha
 
 /* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
  * them): each lane flags its nodes, lists the flagged ones and measures them against the far
- * bodies (ws_node_flag_lane, into fl[i]); and, as one item more that is no worker's own, the
- * bodies' features the web's committed candidates name (ws_node_prepare), which only the sweep
- * reads: a body that the search finds near later is prepared after it. */
+ * bodies (ws_node_flag_lane, into fl[i]); and prepares the features of every lanes-th body
+ * from slot i on that the web's committed candidates name (ws_node_prepare_some), which only
+ * the sweep reads: a body that the search finds near later is prepared after it. (As one
+ * item that is no worker's own, tried first, they lengthened the task by their whole cost:
+ * the flags' shares are even.) */
 typedef struct flag_task {
     ws_world *w;
     ws_web *web;
@@ -458,12 +476,10 @@ static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
     (void)worker;
     const flag_task *T = ctx;
     for (int32_t i = start; i < end; i++) {
-        if ((uint32_t)i == T->lanes) {
-            ws_node_prepare(&T->w->bodies, T->cur, &T->w->node_geom, T->web);
-            continue;
-        }
         T->w->lane_job[i].flagged =
             ws_node_flag_lane(&T->w->bodies, T->cur, T->web, T->x, T->v, &T->fl[i]);
+        ws_node_prepare_some(&T->w->bodies, T->cur, &T->w->node_geom, T->web, (uint32_t)i,
+                             T->lanes);
     }
 }
 
@@ -492,7 +508,7 @@ static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane *
         L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n, 0,
                               least + i * ntrack};
     flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
-    run_task(w, flag_items, lanes > 1 ? lanes + 1 : 1, lanes > 1, &T);
+    run_task(w, flag_items, lanes, 0, &T);
     size_t flagged = 0;
     for (uint32_t i = 0; i < lanes; i++)
         flagged += w->lane_job[i].flagged;
@@ -806,11 +822,17 @@ static ws_status step_webs(ws_step *S)
                            vd,
                            s == 0 && lanes > 1,
                            lanes,
-                           NULL};
-            if (S->body_later && lanes > 1) { /* the body contacts, beside the lanes */
-                T.body = S;
+                           NULL,
+                           0};
+            /* The body part beside the lanes: the narrow phase in the first sub-step, the
+             * contacts in the last, so that each fills a sub-step's slack. */
+            if (lanes > 1 && s == 0 && S->narrow_later)
+                T.body_part |= BODY_NARROW;
+            if (lanes > 1 && s == n - 1 && S->body_later) {
+                T.body_part |= BODY_CONTACTS;
                 S->body_later = 0;
             }
+            T.body = T.body_part ? S : NULL;
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
@@ -1034,9 +1056,13 @@ static void body_contacts(ws_step *S)
     ws_world *w = S->w;
     const ws_body_store *b = S->b;
     const int nxt = S->nxt;
-    /* A full detection's narrow phase first, when it waits here (detect_full): out of room,
-     * both run again on the calling thread (step_once). */
-    if (S->narrow_later && (S->narrow_bad = detect_narrow(S, NULL) != 0))
+    /* A full detection's narrow phase first, when it still waits (detect_full); when it
+     * ran out of room beside the film, both run again on the calling thread (step_once). */
+    if (S->narrow_later) {
+        S->narrow_bad = detect_narrow(S, NULL) != 0;
+        S->narrow_later = 0;
+    }
+    if (S->narrow_bad)
         return;
     size_t nrec = 0;
     for (size_t k = 0; k < w->ncand[nxt]; k++)
@@ -1305,7 +1331,7 @@ static ws_status step_once(ws_world *w)
         if (S.body_later) /* no web was swept in lanes */
             body_contacts(&S);
         if (S.narrow_bad) { /* its room ran out beside the film: again here, growing it */
-            S.narrow_later = S.narrow_bad = 0;
+            S.narrow_bad = 0;
             w->narrow_reruns++;
             if (detect_narrow(&S, &w->mem) != 0 ||
                 ws_array_reserve(&w->mem, (void **)&w->rec[S.nxt], &w->caprec[S.nxt],
