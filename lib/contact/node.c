@@ -445,15 +445,36 @@ static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const ws_body_stor
     }
 }
 
-/* Re-base near body t->body (see ws_node_moved) at state cur: its record in the reference frame
- * (nc->move) and its lever from now, and the nodes it may meet flagged in nc->redo: those in
- * its box grown by the reach (layers + margin), in its frame now, and those that hold a
- * candidate of it in the committed list. */
-static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
-                        double margin)
+/* The nodes [n0, n1) that re-based body t->body may meet flagged in nc->redo (rebase_body): in
+ * its box grown by the reach, in its frame at state cur, or holding a candidate of it in the
+ * committed list (whose nodes' candidates start at cstart). Lanes of distinct nodes may run it
+ * at once. */
+static void rebase_flags(const ws_body_store *b, int cur, const ws_track *t, ws_web *web,
+                         ws_nodes3 x, double margin, uint32_t n0, uint32_t n1)
 {
     ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
+    const ws_nodes3 xs = {x.x + n0, x.y + n0, x.z + n0};
+    flag_in_box(nc->redo + n0, xs, n1 - n0, b, cur, k, b->layer[k] + web->layer + margin);
+    const ws_ncand *c = nc->cand[nc->list].c;
+    for (size_t q = nc->cstart[n0]; q < nc->cstart[n1]; q++)
+        nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+}
+
+/* Re-base near body t->body (see ws_node_moved) at state cur: its record in the reference frame
+ * (nc->move) and its lever from now, and, unless lanes did it (`flagged`), the nodes it may
+ * meet flagged in nc->redo: those in its box grown by the reach (layers + margin), in its frame
+ * now, and those that hold a candidate of it in the committed list. */
+static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
+                        double margin, int flagged)
+{
+    ws_node_contact *nc = web->contact;
+    const uint32_t k = t->body;
+    if (flagged) {
+        record_body(t, &b->st[cur], &nc->move);
+        t->lever = sphere_lever(b, k, web, margin);
+        return;
+    }
     flag_in_box(nc->redo, x, web->n, b, cur, k, b->layer[k] + web->layer + margin);
     const ws_ncand *c = nc->cand[nc->list].c;
     if (nc->seg_list == nc->list) {
@@ -568,7 +589,12 @@ size_t ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3
                          ws_node_lane *L)
 {
     ws_node_contact *nc = web->contact;
-    const size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    for (size_t q = 0; nc->move.rebase && q < nc->ntrack; q++)
+        if (nc->track[q].rebase) {
+            rebase_flags(b, cur, &nc->track[q], web, x, L->margin, L->n0, L->n1);
+            flagged = 1; /* a count no longer: some may be */
+        }
     uint32_t *moved = nc->moved + L->n0;
     L->count = flagged ? collect_flagged(nc->redo + L->n0, L->n1 - L->n0, moved) : 0;
     for (size_t m = 0; m < L->count; m++)
@@ -586,12 +612,13 @@ long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
     const ws_move_test *M = &nc->move;
+    /* With lanes, they flagged and listed the nodes re-based bodies may meet too. */
+    const int joined = lanes != NULL;
     for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
-            rebase_body(b, cur, &nc->track[q], web, x, margin);
-    /* The lanes' flagged nodes joined in lane order, which is node order, unless a re-based
-     * body flagged more since. Most steps flag no node. */
-    const int joined = lanes && !M->rebase;
+            rebase_body(b, cur, &nc->track[q], web, x, margin, joined);
+    /* The lanes' flagged nodes joined in lane order, which is node order. Most steps flag no
+     * node. */
     long count = 0;
     for (uint32_t i = 0; joined && i < nlanes; i++) {
         if (lanes[i].count && (size_t)count != lanes[i].n0)

@@ -202,6 +202,7 @@ typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const u
  * a near body or none flagged; room for every track). */
 typedef struct ws_node_lane {
     uint32_t n0, n1;
+    double margin; /* the contact margin, m: the reach of a re-based body */
     size_t count;
     double *least;
 } ws_node_lane;
@@ -283,7 +284,8 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
  * bodies' part, -1 when every node must be found again, else 0 with the test set up in
  * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
  * distinct nodes), or, by ws_node_flag_lane, also listed and measured against the far bodies
- * in the lane (L->n0, L->n1; the lanes covering the nodes in order); the rest, given the
+ * in the lane (L->n0, L->n1; the lanes covering the nodes in order), with the nodes that a
+ * re-based near body may meet; the rest, given the
  * lanes (NULL: none) and the pieces' total, as ws_node_moved returns, but with the listed
  * nodes not yet moved to the reference frame: the search of their candidates does that
  * (ws_node_to_ref, in its pieces when it has any). */

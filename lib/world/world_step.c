@@ -250,6 +250,7 @@ static void body_contacts(ws_step *S);
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
     ws_world *w;
+    ws_web *web; /* read only while the lanes run: each opens its views from it (lane_open) */
     ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
     ws_nodes3 xd, vd;  /* the state written */
     /* The first sub-step of a step swept in lanes: each lane zeroes the contact forces of
@@ -278,8 +279,11 @@ static void body_item(ws_step *S, int part)
 }
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
+static void lane_open(ws_world *w, ws_web *web, uint32_t i);
+
 static void sweep_lane(const lane_task *T, ws_lane_job *J)
 {
+    lane_open(T->w, T->web, (uint32_t)(J - T->w->lane_job));
     ws_world *w = T->w;
     ws_web *web = &J->view;
     const uint32_t rows = web->nx > 0 ? (uint32_t)web->ny : 1, r = ws_web_block_rows(web);
@@ -505,8 +509,8 @@ static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane *
     if (!(*fl = L) || !least)
         return *fl = NULL, 0;
     for (uint32_t i = 0; i < lanes; i++)
-        L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n, 0,
-                              least + i * ntrack};
+        L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n,
+                              S->contact.margin, 0, least + i * ntrack};
     flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
     run_task(w, flag_items, lanes, 0, &T);
     size_t flagged = 0;
@@ -640,11 +644,11 @@ void ws_world_lanes_free(ws_world *w)
 }
 
 /* Lane i's copies of the web and its contact: their state shared, their scratch the lane's own
- * (lane 0: the web's), the nodes the lane ends at. */
-static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
+ * (lane 0: the web's), the nodes the lane ends at. Made by the lane at the start of its sweep
+ * (sweep_lane), on its worker: the web and its contact are only read while the lanes run. */
+static void lane_open(ws_world *w, ws_web *web, uint32_t i)
 {
     ws_lane_job *J = &w->lane_job[i];
-    (void)lanes;
     J->view = *web;
     J->cview = *web->contact;
     J->view.contact = &J->cview;
@@ -701,8 +705,6 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *b
  * lane, right here. Returns how many nodes ended too fast. */
 static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
 {
-    for (uint32_t i = 0; i < lanes; i++)
-        lane_open(w, web, lanes, i);
     const uint32_t body = T->body != NULL;
     run_task(w, lane_items, lanes + body, body, T);
     size_t fast = 0;
@@ -816,6 +818,7 @@ static ws_status step_webs(ws_step *S)
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
             ws_web_sweep_laws(web, w->def.gravity, S->t + s * h, s * h);
             lane_task T = {w,
+                           web,
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
                             web->fc[nxt]},
                            xd,
