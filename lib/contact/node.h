@@ -182,7 +182,7 @@ typedef struct ws_node_geom {
     double *find_val;
     uint64_t *find_mask;
     uint32_t *find_node;
-    /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
+    /* ready[k]: body k's features are prepared for this step (ws_node_prepare_some). */
     uint8_t *ready;
 } ws_node_geom;
 
@@ -243,28 +243,32 @@ int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
                           int all);
 /* The second: the candidates brought up to date at state cur (all found again, or those of
- * the nodes that moved merged in; `flagged`: the sum of ws_node_flag's counts), the bodies'
- * features prepared (g) and the list cut into stretches, with the room its evaluation needs.
+ * the nodes that moved merged in; S->lanes: the move test's), the bodies' features prepared (g)
+ * and the list cut into stretches, with the room its evaluation needs.
  * The list to evaluate is nc->next_list, nc->cand[next_list]; *searched says whether nodes
  * were searched. Feature checks are counted in *checks. 0, or -1 when out of memory (nothing
  * committed changed; the next step searches every node). */
-int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, int *searched);
+int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched);
 /* After an accepted step: its list becomes the committed one. */
 void ws_node_contact_commit(ws_node_contact *nc);
 
 /* Room in g, from its arena (g->arena, the step's), and the numbers of the bodies' features
  * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
- * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
+ * some web's candidates may name (ws_node_prepare_some). The tables last until the arena's next
  * reset. 0, or -1 when out of memory. */
 int ws_node_geometry(const ws_body_store *b, ws_node_geom *g);
 
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
- * (web->cbody) and that are not prepared yet in this step. */
-void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
-/* The same for the body slots first, first + stride, ...: pieces with the same stride and
- * distinct firsts may run at once (each body's tables are its own). */
+ * (web->cbody) and that are not prepared yet in this step: of the body slots first, first +
+ * stride, ... (pieces with the same stride and distinct firsts may run at once: each body's
+ * tables are its own), or of all (ws_node_prepare). */
 void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web,
                           uint32_t first, uint32_t stride);
+static inline void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g,
+                                   const ws_web *web)
+{
+    ws_node_prepare_some(b, cur, g, web, 0, 1);
+}
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
@@ -283,30 +287,36 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 /* ws_node_moved in parts, so that the per-node test runs in pieces (a lane's nodes): the
  * bodies' part, -1 when every node must be found again, else 0 with the test set up in
  * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
- * distinct nodes), or, by ws_node_flag_lane, also listed and measured against the far bodies
- * in the lane (L->n0, L->n1; the lanes covering the nodes in order), with the nodes that a
- * re-based near body may meet; the rest, given the
- * lanes (NULL: none) and the pieces' total, as ws_node_moved returns, but with the listed
- * nodes not yet moved to the reference frame: the search of their candidates does that
+ * distinct nodes), or, by ws_node_flag_lane, with those a re-based near body may meet, listed
+ * and measured against the far bodies (L: the lanes cover the nodes in order, whole rows of a
+ * grid web); the rest, given the lanes, as ws_node_moved returns, but with the listed nodes
+ * not yet moved to the reference frame: the search of their candidates does that
  * (ws_node_to_ref, in its pieces when it has any). */
 int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin);
 size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
-size_t ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
-                         ws_node_lane *L);
+void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                       ws_node_lane *L);
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
-                       const ws_node_lane *lanes, uint32_t nlanes, size_t flagged);
-/* The listed nodes (count of them) to the reference frame of this step's move test: their
- * record (xdet, xep) from where they are, x; web->contact->lever2 grows to hold them. Distinct
- * nodes may be moved at once through views of one contact, each its own lever2 (the largest
- * of them is the whole's). */
-void ws_node_to_ref(ws_web *web, ws_nodes3 x, const uint32_t *nodes, size_t count);
+                       const ws_node_lane *lanes, uint32_t nlanes);
+/* The listed nodes (count of them; all when only is NULL) to the reference frame M (of this
+ * step's move test: ws_node_to_ref): their record (xdet, xep) from where they are, x;
+ * web->contact->lever2 grows to hold them. Distinct nodes may be moved at once through views of
+ * one contact, each its own lever2 (the largest of them is the whole's). */
+void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
+                       size_t count);
+static inline void ws_node_to_ref(ws_web *web, ws_nodes3 x, const uint32_t *nodes, size_t count)
+{
+    ws_node_ref_nodes(web, x, &web->contact->move, nodes, count);
+}
+/* The whole of it in one lane; least: room for a double a track (web->contact->ntrack). */
 static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
-                                 ws_nodes3 v, double dt, double margin)
+                                 ws_nodes3 v, double dt, double margin, double *least)
 {
     if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
         return -1;
-    const long count =
-        ws_node_moved_end(b, cur, web, x, margin, NULL, 0, ws_node_flag(web, x, v, 0, web->n));
+    ws_node_lane L = {0, web->n, margin, 0, least};
+    ws_node_flag_lane(b, cur, web, x, v, &L);
+    const long count = ws_node_moved_end(b, cur, web, x, margin, &L, 1);
     if (count > 0)
         ws_node_to_ref(web, x, web->contact->moved, (size_t)count);
     return count;

@@ -34,7 +34,7 @@ typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
     uint32_t r0, r1;
-    size_t fast, flagged; /* nodes too fast; nodes the move test flagged */
+    size_t fast; /* nodes too fast */
     uint64_t checks;
     double *tmp;
     uint32_t *fct;

@@ -480,17 +480,16 @@ static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
     (void)worker;
     const flag_task *T = ctx;
     for (int32_t i = start; i < end; i++) {
-        T->w->lane_job[i].flagged =
-            ws_node_flag_lane(&T->w->bodies, T->cur, T->web, T->x, T->v, &T->fl[i]);
+        ws_node_flag_lane(&T->w->bodies, T->cur, T->web, T->x, T->v, &T->fl[i]);
         ws_node_prepare_some(&T->w->bodies, T->cur, &T->w->node_geom, T->web, (uint32_t)i,
                              T->lanes);
     }
 }
 
 /* The flags in the lanes of the last cut when it cuts this web's rows (the nodes stay on
- * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. The
- * lanes' findings in *fl (from the arena; NULL when out of memory, and nothing flagged). */
-static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane **fl)
+ * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. Returns
+ * the lanes' findings (from the arena; NULL when out of memory). */
+static ws_node_lane *flag_lanes(ws_step *S, ws_web *web, uint32_t lanes)
 {
     ws_world *w = S->w;
     ws_lane_job *J = w->lane_job;
@@ -506,17 +505,14 @@ static size_t flag_lanes(ws_step *S, ws_web *web, uint32_t lanes, ws_node_lane *
     }
     ws_node_lane *L = ws_arena_alloc(S->arena, lanes * sizeof *L);
     double *least = ws_arena_alloc(S->arena, (lanes * ntrack + 1) * sizeof *least);
-    if (!(*fl = L) || !least)
-        return *fl = NULL, 0;
+    if (!L || !least)
+        return NULL;
     for (uint32_t i = 0; i < lanes; i++)
         L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n,
                               S->contact.margin, 0, least + i * ntrack};
     flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
     run_task(w, flag_items, lanes, 0, &T);
-    size_t flagged = 0;
-    for (uint32_t i = 0; i < lanes; i++)
-        flagged += w->lane_job[i].flagged;
-    return flagged;
+    return L;
 }
 
 /* The search of node candidates in pieces on the world's threads (ws_node_search_fn, its
@@ -757,10 +753,9 @@ static ws_status step_webs(ws_step *S)
         ws_node_contact *nc = web->contact;
         int searched = 0;
         const uint32_t lanes = web_lanes(w, web);
-        size_t flagged = 0;
         ws_node_lane *fl = NULL;
         if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid) &&
-            (flagged = flag_lanes(S, web, lanes, &fl), !fl)) {
+            !(fl = flag_lanes(S, web, lanes))) {
             nc->refresh = 1; /* the move test's record is not to be trusted: all found again */
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         }
@@ -775,7 +770,7 @@ static ws_status step_webs(ws_step *S)
                                  w,
                                  fl,
                                  fl ? lanes : 0};
-        if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
+        if (ws_node_contact_update(&ns, web, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
