@@ -124,7 +124,7 @@ static ws_status detect_full(ws_step *S)
     ws_world *w = S->w;
     if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
-    if (S->body_later) { /* the narrow phase beside the film, with the body contacts */
+    if (S->body_later) { /* the narrow phase beside the film, before the body contacts */
         S->narrow_later = 1;
         if (narrow_room(S) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
@@ -278,9 +278,9 @@ static void body_item(ws_step *S, int part)
         body_contacts(S);
 }
 
-/* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
 static void lane_open(ws_world *w, ws_web *web, uint32_t i);
 
+/* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
 static void sweep_lane(const lane_task *T, ws_lane_job *J)
 {
     lane_open(T->w, T->web, (uint32_t)(J - T->w->lane_job));
