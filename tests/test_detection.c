@@ -1209,7 +1209,9 @@ START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
             s0[3 * q + 2] = web->contact->xdet.z[q];
         }
         const v3 e0 = web->contact->epoch_r;
-        long moved = ws_node_moved(b, cur, web, x, web->v[cur], w->def.dt, margin);
+        double least[16]; /* a double a tracked body */
+        ck_assert_uint_le(web->contact->ntrack, 16);
+        long moved = ws_node_moved(b, cur, web, x, web->v[cur], w->def.dt, margin, least);
         if (moved < 0)
             ck_abort_msg("step %d: every node to be found again", step);
         epochs += e0.x != web->contact->epoch_r.x || e0.y != web->contact->epoch_r.y ||

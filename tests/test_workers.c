@@ -127,6 +127,9 @@ typedef struct sheet_run {
     int law_type;
     int tight; /* the pieces of a search start with little room, so that some run again */
     uint64_t *reruns; /* where to put how many did (may be NULL) */
+    int interval;     /* the bodies' full detection every this many steps (0: the default) */
+    int narrow_tight; /* the narrow phase beside the film has little room: it runs again */
+    uint64_t *narrow_reruns, *full; /* how many did, and the full detections (may be NULL) */
 } sheet_run;
 
 /* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, 3 mm above a
@@ -139,6 +142,7 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     ws_world *w = NULL;
     ck_assert_int_eq(ws_world_create(d, &w), WS_OK);
     w->search_tight = r->tight;
+    w->narrow_tight = r->narrow_tight;
     add_ground(w, 2.0, no_material());
     *box = add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
     ws_law_def ld;
@@ -180,6 +184,8 @@ static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
     ws_world_def_init(&d);
     d.dt = 2.5e-4;
     d.worker_count = (uint32_t)r->workers;
+    if (r->interval)
+        d.detection_interval = r->interval;
     int calls = 0;
     thread_task tt;
     if (r->host == 1) {
@@ -207,6 +213,13 @@ static uint64_t sheet_hash(const sheet_run *r, long steps, int *enqueued)
     ck_ok(w, ws_world_get_state_hash(w, &h));
     if (r->reruns)
         *r->reruns = w->search_reruns;
+    if (r->narrow_reruns)
+        *r->narrow_reruns = w->narrow_reruns;
+    if (r->full) {
+        ws_world_stats st;
+        ck_ok(w, ws_world_get_stats(w, &st));
+        *r->full = st.full_detections;
+    }
     ws_world_destroy(w);
     if (enqueued)
         *enqueued = calls;
@@ -223,7 +236,7 @@ static long sheet_steps(void)
 START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
         r.workers = k;
@@ -233,12 +246,12 @@ START_TEST(test_sheet_same_for_any_workers)
     }
     /* A host's scheduler: the pieces last first, then each on a thread of its own. */
     int calls = 0;
-    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
+    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL};
     uint64_t h = sheet_hash(&r, steps, &calls);
     ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
     ck_assert_msg(calls > 0, "the host's scheduler was never called");
-    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
+    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL};
     h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -246,7 +259,7 @@ START_TEST(test_sheet_same_for_any_workers)
      * pieces that run out are searched again on the world's thread, and the list is the
      * same. */
     uint64_t reruns = 0;
-    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns};
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL};
     h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "pieces searched again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -254,6 +267,38 @@ START_TEST(test_sheet_same_for_any_workers)
     report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers, both schedulers and %llu "
            "pieces of searches run again",
            steps, (unsigned long long)one, short_run() ? 2 : 4, (unsigned long long)reruns);
+}
+END_TEST
+
+/* The bodies' full detection: its narrow phase runs beside the film's first sub-step on
+ * workers, with the body contacts. Every fifth step (as on the reference case after 0.5 s),
+ * on 1, 2 and 3 workers, the state hash is the same to the bit; and with the room of the
+ * narrow phase beside the film made tight, so that it runs out and runs again on the world's
+ * thread, too. */
+START_TEST(test_detection_beside_the_film)
+{
+    const long steps = sheet_steps();
+    uint64_t full = 0, reruns = 0;
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full};
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    /* ceil(steps / 5) full detections, the first of them at step 0. */
+    ck_assert_msg(full == (uint64_t)(steps + 4) / 5, "%llu full detections in %ld steps",
+                  (unsigned long long)full, steps);
+    for (int k = 2; k <= 3; k++) {
+        r.workers = k;
+        const uint64_t h = sheet_hash(&r, steps, NULL);
+        ck_assert_msg(h == one,
+                      "%d workers, a full detection every 5th step: 0x%016llx, 1 worker 0x%016llx",
+                      k, (unsigned long long)h, (unsigned long long)one);
+    }
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL};
+    const uint64_t h = sheet_hash(&r, steps, NULL);
+    ck_assert_msg(h == one, "narrow phases run again: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    ck_assert_msg(reruns > 0, "no narrow phase beside the film ran out of room");
+    report("workers: sheet, full detection every 5th step (%llu), %ld steps: 0x%016llx for 1-3 "
+           "workers, %llu narrow phases run again",
+           (unsigned long long)full, steps, (unsigned long long)one, (unsigned long long)reruns);
 }
 END_TEST
 
@@ -286,7 +331,7 @@ START_TEST(test_refused_after_the_film)
         ws_world_def_init(&d);
         d.dt = 2.5e-4;
         d.worker_count = 2;
-        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL};
+        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL};
         ws_body_id box;
         ws_web_id web;
         ws_world *w = sheet_world(&d, &r, &box, &web);
@@ -345,14 +390,14 @@ START_TEST(test_sheet_law_with_history)
      * history or a user's function would be) sweeps in one lane whatever the workers: the
      * same hash, and the host's scheduler never called. */
     const long steps = short_run() ? 120 : 500;
-    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL};
+    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     int calls = 0;
-    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL};
+    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL};
     ck_assert(sheet_hash(&r, steps, &calls) == one);
     ck_assert_int_eq(calls, 0);
     if (!short_run()) {
-        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL};
+        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL};
         ck_assert(sheet_hash(&r, steps, NULL) == one);
     }
 }
@@ -506,6 +551,7 @@ int main(void)
     Suite *s = suite_create("workers");
     add_case(s, "wrapped_same_for_any_workers", test_wrapped_same_for_any_workers, 300);
     add_case(s, "sheet_same_for_any_workers", test_sheet_same_for_any_workers, 300);
+    add_case(s, "detection_beside_the_film", test_detection_beside_the_film, 300);
     add_case(s, "refused_after_the_film", test_refused_after_the_film, 300);
     add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
     add_case(s, "oom_in_a_parallel_step", test_oom_in_a_parallel_step, 300);

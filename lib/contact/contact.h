@@ -85,7 +85,8 @@ static inline const ws_pair_params *ws_contact_params(const ws_contact_ctx *x, u
     return &x->params[x->pair_index[x->b->material[a] * x->nmat + x->b->material[b]]];
 }
 
-/* Candidates of one body pair (i, j), appended to *cand. Returns 0, or -1 out of memory. */
+/* Candidates of one body pair (i, j), appended to *cand. Returns 0, or -1 out of memory; with
+ * mem NULL the list does not grow (a call on a worker): -1 when its room runs out. */
 int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j, ws_cand **cand,
                           size_t *n, size_t *cap);
 

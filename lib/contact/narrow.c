@@ -96,7 +96,8 @@ static void relative(const ws_body_store *b, int cur, uint32_t ia, uint32_t ib, 
 static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a, uint32_t b,
                 uint32_t fa, uint32_t fb, uint32_t kind)
 {
-    if (ws_array_reserve(mem, (void **)cand, cap, *n + 1, sizeof **cand) != 0)
+    /* Without an allocator (a worker's call) the list cannot grow: out of room. */
+    if (mem ? ws_array_reserve(mem, (void **)cand, cap, *n + 1, sizeof **cand) != 0 : *n >= *cap)
         return -1;
     ws_cand *c = &(*cand)[(*n)++];
     c->a = a;

@@ -215,8 +215,8 @@ static void ref_chunk(size_t m, const ws_move_test *M, const ws_node_contact *nc
  * epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the listed
  * ones when `only` is set. Gathered REF_CHUNK at a time, turned on vectors, put back: the
  * gather costs little beside the search that follows every call. */
-static void to_ref(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
-                   size_t count)
+void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
+                       size_t count)
 {
     ws_node_contact *nc = web->contact;
     double t[T_ROWS][REF_CHUNK], lever2 = nc->lever2;
@@ -289,7 +289,7 @@ static int track_bodies(const ws_node_step *S, ws_web *web)
     nc->epoch_r = M.r;
     nc->epoch_q = qt_conj(M.pc);
     nc->lever2 = 0.0;
-    to_ref(web, x, &M, NULL, 0);
+    ws_node_ref_nodes(web, x, &M, NULL, 0);
     return 0;
 }
 
@@ -372,12 +372,12 @@ static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
     return count;
 }
 
-/* The flagged nodes (flags 0 or 1) into `moved`, in order; how many. Thirty-two flags at a
- * time, then eight: most steps flag few nodes, and those in runs. */
-static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
+/* The flagged nodes of [n0, n1) (flags 0 or 1) into `moved`, in order; how many. Thirty-two
+ * flags at a time, then eight: most steps flag few nodes, and those in runs. */
+static size_t collect_flagged(const uint8_t *flag, size_t n0, size_t n1, uint32_t *moved)
 {
-    size_t count = 0, i = 0;
-    for (; i + 32 <= n; i += 32) {
+    size_t count = 0, i = n0;
+    for (; i + 32 <= n1; i += 32) {
         uint64_t word[4];
         memcpy(word, flag + i, sizeof word);
         if (!(word[0] | word[1] | word[2] | word[3]))
@@ -397,7 +397,7 @@ static size_t collect_flagged(const uint8_t *flag, size_t n, uint32_t *moved)
 #endif
         }
     }
-    for (; i < n; i++) {
+    for (; i < n1; i++) {
         moved[count] = (uint32_t)i;
         count += flag[i];
     }
@@ -430,35 +430,31 @@ static void flag_in_box(uint8_t *flag, ws_nodes3 x, size_t n, const ws_body_stor
     }
 }
 
-/* Re-base near body t->body (see ws_node_moved) at state cur: its record in the reference frame
- * (nc->move) and its lever from now, and the nodes it may meet flagged in nc->redo: those in
- * its box grown by the reach (layers + margin), in its frame now, and those that hold a
- * candidate of it in the committed list. */
-static void rebase_body(const ws_body_store *b, int cur, ws_track *t, ws_web *web, ws_nodes3 x,
-                        double margin)
+/* Flag in nc->redo the nodes [n0, n1) (whole rows: a stretch lies in a row) that re-based body
+ * t->body may meet: in its box grown by layers + margin now, or holding a candidate of it. */
+static void rebase_flags(const ws_body_store *b, int cur, const ws_track *t, ws_web *web,
+                         ws_nodes3 x, double margin, uint32_t n0, uint32_t n1)
 {
     ws_node_contact *nc = web->contact;
     const uint32_t k = t->body;
-    flag_in_box(nc->redo, x, web->n, b, cur, k, b->layer[k] + web->layer + margin);
     const ws_ncand *c = nc->cand[nc->list].c;
-    if (nc->seg_list == nc->list) {
-        /* The list's stretches: a run's candidates are of one face, so of one body, and its
-         * nodes are flagged at once. The reference case re-bases a body often enough that a
-         * pass over every candidate costs it about 2 % of its step. */
-        for (size_t s = 0; s < nc->nseg; s++) {
-            const ws_nseg *sg = &nc->seg[s];
-            if (sg->run && c[sg->c0].body == k)
-                memset(nc->redo + sg->n0, 1, sg->n1 - sg->n0);
-            else if (!sg->run)
-                for (size_t q = sg->c0; q < sg->c1; q++)
-                    nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
-        }
-    } else {
-        for (size_t q = 0; q < nc->cand[nc->list].n; q++)
+    flag_in_box(nc->redo + n0, (ws_nodes3){x.x + n0, x.y + n0, x.z + n0}, n1 - n0, b, cur, k,
+                b->layer[k] + web->layer + margin);
+    if (nc->seg_list != nc->list) {
+        for (size_t q = nc->cstart[n0]; q < nc->cstart[n1]; q++)
             nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+        return;
     }
-    record_body(t, &b->st[cur], &nc->move);
-    t->lever = sphere_lever(b, k, web, margin);
+    /* By stretches: a run's candidates are of one body, its nodes flagged at once (a pass over
+     * every candidate cost the reference case about 2 % of its step). */
+    for (size_t s = ws_node_first_segment(nc, n0); s < nc->nseg && nc->seg[s].n0 < n1; s++) {
+        const ws_nseg *sg = &nc->seg[s];
+        if (sg->run && c[sg->c0].body == k)
+            memset(nc->redo + sg->n0, 1, sg->n1 - sg->n0);
+        else if (!sg->run)
+            for (size_t q = sg->c0; q < sg->c1; q++)
+                nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
+    }
 }
 
 int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin)
@@ -503,6 +499,10 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
         const double d = body_move(t, st, M, t->near ? 0.0 : M->reach);
         t->rebase = t->near && d >= MOVE_PART(MOVE_BODY) * margin;
         M->rebase |= t->rebase;
+        if (t->rebase) { /* its record and lever from now (the lanes flag its nodes) */
+            record_body(t, st, M);
+            t->lever = sphere_lever(b, t->body, web, margin);
+        }
         if (!t->near && may_reach(d, t->gap, margin))
             return -1;
     }
@@ -549,38 +549,57 @@ size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t
     return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
 }
 
+void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                       ws_node_lane *L)
+{
+    ws_node_contact *nc = web->contact;
+    const size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    for (size_t q = 0; nc->move.rebase && q < nc->ntrack; q++)
+        if (nc->track[q].rebase)
+            rebase_flags(b, cur, &nc->track[q], web, x, L->margin, L->n0, L->n1);
+    const int any = flagged || nc->move.rebase; /* a re-based body's nodes are not counted */
+    L->count = any ? collect_flagged(nc->redo, L->n0, L->n1, nc->moved + L->n0) : 0;
+    /* Each far body's least distance to them beyond its grown box, on its axis (body_gap). */
+    for (size_t q = 0; q < nc->ntrack; q++) {
+        const ws_track *t = &nc->track[q];
+        const axis_span S = body_span(b, cur, t->body, web, t->axis);
+        L->least[q] = INFINITY;
+        for (size_t m = L->n0; !t->near && m < L->n0 + L->count; m++) {
+            const double c = v3_dot(S.a, nodes_get(x, nc->moved[m])) - S.o;
+            const double g = fmax(c - S.hi, S.lo - c);
+            L->least[q] = g < L->least[q] ? g : L->least[q];
+        }
+    }
+}
+
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
-                       size_t flagged)
+                       const ws_node_lane *lanes, uint32_t nlanes)
 {
     ws_node_contact *nc = web->contact;
     const ws_body_state *st = &b->st[cur];
     const ws_move_test *M = &nc->move;
-    for (size_t q = 0; M->rebase && q < nc->ntrack; q++)
-        if (nc->track[q].rebase)
-            rebase_body(b, cur, &nc->track[q], web, x, margin);
-    /* Most steps flag no node. */
-    long count = flagged || M->rebase ? (long)collect_flagged(nc->redo, web->n, nc->moved) : 0;
+    /* The lanes' flagged nodes joined in lane order, which is node order. */
+    long count = 0;
+    for (uint32_t i = 0; i < nlanes; i++) {
+        memmove(nc->moved + count, nc->moved + lanes[i].n0, lanes[i].count * sizeof(uint32_t));
+        count += (long)lanes[i].count;
+    }
     /* The moved nodes are found again now, from where they are: each far body's gap becomes
-     * the least of what it was and their distances beyond its box now, less its move so far. */
+     * the least of what it was and their distances beyond its box now (the lanes'), less its
+     * move so far. */
     for (size_t q = 0; count && q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         if (t->near)
             continue;
-        const axis_span S = body_span(b, cur, t->body, web, t->axis);
         double least = INFINITY;
-        for (long m = 0; m < count; m++) {
-            double c = v3_dot(S.a, nodes_get(x, nc->moved[m])) - S.o;
-            double g = fmax(c - S.hi, S.lo - c);
-            least = g < least ? g : least;
-        }
+        for (uint32_t i = 0; i < nlanes; i++)
+            least = lanes[i].least[q] < least ? lanes[i].least[q] : least;
         const double d = body_move(t, st, M, M->reach);
         if (least - d < t->gap)
             t->gap = least - d;
         if (may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Found again now: their moves count from here. */
-    to_ref(web, x, M, nc->moved, (size_t)count);
     return count;
 }
 
@@ -1018,6 +1037,8 @@ static int find_candidates(const ws_node_step *S, ws_web *web, const uint32_t *n
     count = nodes ? count : web->n;
     if (S->search && count)
         return S->search(S, web, nodes, count, L);
+    if (nodes) /* found again now: their moves count from here */
+        ws_node_to_ref(web, web->x[S->cur], nodes, count);
     return count && ws_node_find_scratch(S->b, S->g) ? -1
                                                      : ws_node_find(S, web, nodes, 0, count, L);
 }
@@ -1122,11 +1143,12 @@ static void prepare_body(const ws_body_store *b, int cur, ws_node_geom *g, uint3
     }
 }
 
-void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web)
+void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web,
+                          uint32_t first, uint32_t stride)
 {
     ws_node_contact *nc = web->contact;
     const size_t m = nc->cbody_cap < b->slots ? nc->cbody_cap : b->slots;
-    for (uint32_t k = 0; k < m; k++)
+    for (uint32_t k = first; k < m; k += stride)
         if (nc->cbody[k] && !g->ready[k] && b->alive[k]) {
             prepare_body(b, cur, g, k);
             g->ready[k] = 1;
@@ -1172,7 +1194,7 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
                : 0;
 }
 
-int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, int *searched)
+int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
 {
     ws_node_contact *nc = web->contact;
     /* Node candidates: all found again when asked, when the record is invalid or when a body
@@ -1184,7 +1206,8 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
     int list = nc->list, all = nc->search_all;
     long moved = 0;
     if (!all &&
-        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, flagged)) < 0)
+        (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, S->lanes,
+                                   S->nlanes)) < 0)
         all = 1;
     *searched = all || moved > 0;
     if (*searched) {
@@ -1207,7 +1230,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, i
             return -1;
     }
     nc->next_list = list;
-    ws_node_prepare(S->b, S->cur, S->g, web);
+    ws_node_prepare_some(S->b, S->cur, S->g, web, 0, 1);
     /* The list cut into stretches for the evaluation: again whenever it changed (a list that
      * serves again keeps its stretches). */
     if (nc->seg_list != list &&

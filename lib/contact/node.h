@@ -182,22 +182,35 @@ typedef struct ws_node_geom {
     double *find_val;
     uint64_t *find_mask;
     uint32_t *find_node;
-    /* ready[k]: body k's features are prepared for this step (ws_node_prepare). */
+    /* ready[k]: body k's features are prepared for this step (ws_node_prepare_some). */
     uint8_t *ready;
 } ws_node_geom;
 
 struct ws_node_step;
 /* A search of node candidates as ws_node_find does it from first = 0, for the nodes listed
  * (0 .. count - 1 when nodes is NULL), into L (empty): the world's, in pieces on its threads.
+ * Listed nodes are found again now: it also moves them to the reference frame (ws_node_to_ref),
+ * in its pieces.
  * 0, or 1 when the nodes are listed and their candidates found are those the committed list
  * holds for them (ws_node_same, which it may leave undone: then 0), or -1 when out of memory. */
 typedef int ws_node_search_fn(const struct ws_node_step *S, ws_web *web, const uint32_t *nodes,
                               size_t count, ws_ncand_list *L);
 
+/* A lane's part of the move test (ws_node_flag_lane): its nodes [n0, n1) and what it found
+ * there: the flagged ones, in order, at web->contact->moved + n0 (count of them), and for each
+ * track the least distance of those beyond the far body's box (ws_node_moved_end; INFINITY for
+ * a near body or none flagged; room for every track). */
+typedef struct ws_node_lane {
+    uint32_t n0, n1;
+    double margin; /* the contact margin, m: the reach of a re-based body */
+    size_t count;
+    double *least;
+} ws_node_lane;
+
 /* What a step's search of node candidates reads and counts: the world's allocator, the bodies
  * at state cur with their features (g, whose scratch the search uses), the contact margin,
  * where feature checks are counted, and who searches (search; NULL: ws_node_find, here), with
- * its context. */
+ * its context; the lanes that ran the move test (NULL: it ran whole). */
 typedef struct ws_node_step {
     ws_mem *mem;
     const ws_body_store *b;
@@ -207,6 +220,8 @@ typedef struct ws_node_step {
     uint64_t *checks;
     ws_node_search_fn *search;
     void *search_ctx;
+    const ws_node_lane *lanes;
+    uint32_t nlanes;
 } ws_node_step;
 
 /* The search's scratch in g, from its arena (g->arena), at its most for a group of nodes: for
@@ -228,24 +243,32 @@ int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
                           int all);
 /* The second: the candidates brought up to date at state cur (all found again, or those of
- * the nodes that moved merged in; `flagged`: the sum of ws_node_flag's counts), the bodies'
- * features prepared (g) and the list cut into stretches, with the room its evaluation needs.
+ * the nodes that moved merged in; S->lanes: the move test's), the bodies' features prepared (g)
+ * and the list cut into stretches, with the room its evaluation needs.
  * The list to evaluate is nc->next_list, nc->cand[next_list]; *searched says whether nodes
  * were searched. Feature checks are counted in *checks. 0, or -1 when out of memory (nothing
  * committed changed; the next step searches every node). */
-int ws_node_contact_update(const ws_node_step *S, ws_web *web, size_t flagged, int *searched);
+int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched);
 /* After an accepted step: its list becomes the committed one. */
 void ws_node_contact_commit(ws_node_contact *nc);
 
 /* Room in g, from its arena (g->arena, the step's), and the numbers of the bodies' features
  * (face_base, tri_base, edge_base), with no body prepared yet: a step prepares only the bodies
- * some web's candidates may name (ws_node_prepare). The tables last until the arena's next
+ * some web's candidates may name (ws_node_prepare_some). The tables last until the arena's next
  * reset. 0, or -1 when out of memory. */
 int ws_node_geometry(const ws_body_store *b, ws_node_geom *g);
 
 /* The features, in the global frame at state cur, of the bodies whose candidates web may hold
- * (web->cbody) and that are not prepared yet in this step. */
-void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web);
+ * (web->cbody) and that are not prepared yet in this step: of the body slots first, first +
+ * stride, ... (pieces with the same stride and distinct firsts may run at once: each body's
+ * tables are its own), or of all (ws_node_prepare). */
+void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, const ws_web *web,
+                          uint32_t first, uint32_t stride);
+static inline void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom *g,
+                                   const ws_web *web)
+{
+    ws_node_prepare_some(b, cur, g, web, 0, 1);
+}
 void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
@@ -261,20 +284,42 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
  * candidate list is built to cover, and a body it holds no candidate of cannot touch it: see
  * node.c. */
 
-/* ws_node_moved in three parts, so that the per-node test runs in pieces (a lane's nodes):
- * the bodies' part, -1 when every node must be found again, else 0 with the test set up in
+/* ws_node_moved in parts, so that the per-node test runs in pieces (a lane's nodes): the
+ * bodies' part, -1 when every node must be found again, else 0 with the test set up in
  * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
- * distinct nodes); the rest, given the pieces' total, as ws_node_moved returns. */
+ * distinct nodes), or, by ws_node_flag_lane, with those a re-based near body may meet, listed
+ * and measured against the far bodies (L: the lanes cover the nodes in order, whole rows of a
+ * grid web); the rest, given the lanes, as ws_node_moved returns, but with the listed nodes
+ * not yet moved to the reference frame: the search of their candidates does that
+ * (ws_node_to_ref, in its pieces when it has any). */
 int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin);
 size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
+void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
+                       ws_node_lane *L);
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,
-                       size_t flagged);
+                       const ws_node_lane *lanes, uint32_t nlanes);
+/* The listed nodes (count of them; all when only is NULL) to the reference frame M (of this
+ * step's move test: ws_node_to_ref): their record (xdet, xep) from where they are, x;
+ * web->contact->lever2 grows to hold them. Distinct nodes may be moved at once through views of
+ * one contact, each its own lever2 (the largest of them is the whole's). */
+void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
+                       size_t count);
+static inline void ws_node_to_ref(ws_web *web, ws_nodes3 x, const uint32_t *nodes, size_t count)
+{
+    ws_node_ref_nodes(web, x, &web->contact->move, nodes, count);
+}
+/* The whole of it in one lane; least: room for a double a track (web->contact->ntrack). */
 static inline long ws_node_moved(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x,
-                                 ws_nodes3 v, double dt, double margin)
+                                 ws_nodes3 v, double dt, double margin, double *least)
 {
     if (ws_node_moved_begin(b, cur, web, dt, margin) < 0)
         return -1;
-    return ws_node_moved_end(b, cur, web, x, margin, ws_node_flag(web, x, v, 0, web->n));
+    ws_node_lane L = {0, web->n, margin, 0, least};
+    ws_node_flag_lane(b, cur, web, x, v, &L);
+    const long count = ws_node_moved_end(b, cur, web, x, margin, &L, 1);
+    if (count > 0)
+        ws_node_to_ref(web, x, web->contact->moved, (size_t)count);
+    return count;
 }
 
 /* Where each of n nodes' candidates start in the list c (nc of them, sorted by node): start[i]

@@ -34,7 +34,7 @@ typedef struct ws_lane_job {
     ws_web view;
     ws_node_contact cview;
     uint32_t r0, r1;
-    size_t fast, flagged; /* nodes too fast; nodes the move test flagged */
+    size_t fast; /* nodes too fast */
     uint64_t checks;
     double *tmp;
     uint32_t *fct;
@@ -134,6 +134,8 @@ struct ws_world {
     uint64_t cut_step;            /* cut_step (world_step.c, lanes_cut) */
     int search_tight;       /* tests: the pieces of a search start with room for 8 candidates */
     uint64_t search_reruns; /* pieces of a search searched again, their room run out */
+    int narrow_tight;       /* tests: a narrow phase beside the film has room for 2 candidates */
+    uint64_t narrow_reruns; /* narrow phases beside the film run again, their room run out */
     size_t node_par_cap;
 
     ws_element **elements; /* by id slot (world_element.c) */
@@ -173,6 +175,10 @@ typedef struct ws_step {
     /* The body contacts still to run (in the film's first sub-step in lanes, or after it),
      * and the webs' loads to add after the elements' (world_step.c, step_once). */
     int body_later, loads_later;
+    /* A full detection's narrow phase still to run, before the body contacts and beside the
+     * film like them (the broad phase's pairs found); and whether it ran out of the room
+     * reserved for it there (then it runs again on the calling thread). */
+    int narrow_later, narrow_bad;
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that

@@ -73,26 +73,65 @@ static double max_step_travel(const ws_world *w, int k)
     return most * w->def.dt;
 }
 
-static ws_status detect_full(ws_step *S)
+/* A full detection's narrow phase over the broad phase's pairs (S->pairs): the candidates of
+ * each pair into cand[nxt], sorted, the stick anchors carried over. With mem NULL (beside the
+ * film, on a worker) the list does not grow: -1 when its room runs out, as when out of
+ * memory. */
+static int detect_narrow(ws_step *S, ws_mem *mem)
 {
     ws_world *w = S->w;
     const int nxt = S->nxt;
-    if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
-        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
+    /* The room a worker may fill (a test's, tighter), and the pairs counted when it is done. */
+    size_t room = w->capcand[nxt], gated = 0, tested = 0;
+    if (!mem && w->narrow_tight && room > 2)
+        room = 2;
     w->ncand[nxt] = 0;
     for (size_t k = 0; k < S->npairs; k++) {
         uint32_t i = S->pairs[2 * k], j = S->pairs[2 * k + 1];
         if (w->def.use_ccd && !ws_ccd_may_touch_at(S->b, S->cur, i, j, S->contact.margin)) {
-            S->stats->body_pairs_gated++;
+            gated++;
             continue;
         }
-        S->stats->body_pairs_tested++;
-        if (ws_contact_candidates(&w->mem, &S->contact, i, j, &w->cand[nxt], &w->ncand[nxt],
-                                  &w->capcand[nxt]) != 0)
-            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+        tested++;
+        if (ws_contact_candidates(mem, &S->contact, i, j, &w->cand[nxt], &w->ncand[nxt],
+                                  mem ? &w->capcand[nxt] : &room) != 0)
+            return -1;
     }
+    S->stats->body_pairs_gated += gated;
+    S->stats->body_pairs_tested += tested;
     ws_contact_sort(w->cand[nxt], w->ncand[nxt]);
     ws_contact_carry_anchors(w->cand[nxt], w->ncand[nxt], w->cand[S->cur], w->ncand[S->cur]);
+    return 0;
+}
+
+/* Room for the candidates and records of a narrow phase beside the film: twice the last
+ * list's and some, so that it rarely runs out (then it runs again here, with the room grown:
+ * step_once). 0, or -1 when out of memory. */
+static int narrow_room(ws_step *S)
+{
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    return ws_array_reserve(&w->mem, (void **)&w->cand[nxt], &w->capcand[nxt],
+                            2 * w->ncand[S->cur] + 64, sizeof *w->cand[nxt]) ||
+                   ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt],
+                                    w->capcand[nxt] + 1, sizeof *w->rec[nxt])
+               ? -1
+               : 0;
+}
+
+static ws_status detect_full(ws_step *S)
+{
+    ws_world *w = S->w;
+    if (ws_broad_pairs(S->arena, S->b, &S->pairs, &S->npairs) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory in the broad phase");
+    if (S->body_later) { /* the narrow phase beside the film, before the body contacts */
+        S->narrow_later = 1;
+        if (narrow_room(S) != 0)
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
+        return WS_OK;
+    }
+    if (detect_narrow(S, &w->mem) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact candidates");
     return WS_OK;
 }
 
@@ -211,6 +250,7 @@ static void body_contacts(ws_step *S);
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
     ws_world *w;
+    ws_web *web; /* read only while the lanes run: each opens its views from it (lane_open) */
     ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
     ws_nodes3 xd, vd;  /* the state written */
     /* The first sub-step of a step swept in lanes: each lane zeroes the contact forces of
@@ -218,13 +258,32 @@ typedef struct lane_task {
      * core's cache. */
     int zero;
     uint32_t lanes;
-    /* The body contacts of the step, item `lanes` of the task (NULL: not in this one). */
+    /* The body part of the step, item `lanes` of the task (NULL: none in this one), and
+     * which: a full detection's narrow phase (BODY_NARROW, the first sub-step's), the body
+     * contacts (BODY_CONTACTS, the last's), each where its sub-step's lanes leave room. */
     ws_step *body;
+    int body_part;
 } lane_task;
+
+enum { BODY_NARROW = 1, BODY_CONTACTS = 2 };
+
+/* The body part of a sub-step's task: the narrow phase, the contacts or both (lane_task). */
+static void body_item(ws_step *S, int part)
+{
+    if ((part & BODY_NARROW) && S->narrow_later) {
+        S->narrow_bad = detect_narrow(S, NULL) != 0;
+        S->narrow_later = 0;
+    }
+    if (part & BODY_CONTACTS)
+        body_contacts(S);
+}
+
+static void lane_open(ws_world *w, ws_web *web, uint32_t i);
 
 /* One lane's blocks of a sub-step: forces, node contacts, integration, block by block. */
 static void sweep_lane(const lane_task *T, ws_lane_job *J)
 {
+    lane_open(T->w, T->web, (uint32_t)(J - T->w->lane_job));
     ws_world *w = T->w;
     ws_web *web = &J->view;
     const uint32_t rows = web->nx > 0 ? (uint32_t)web->ny : 1, r = ws_web_block_rows(web);
@@ -268,7 +327,7 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         if ((uint32_t)i < T->lanes)
             sweep_lane(T, &T->w->lane_job[i]);
         else
-            body_contacts(T->body);
+            body_item(T->body, T->body_part);
     }
 }
 
@@ -401,12 +460,19 @@ static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, uint32_t sha
 }
 
 /* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
- * them): the count flagged in each lane's job. */
+ * them): each lane flags its nodes, lists the flagged ones and measures them against the far
+ * bodies (ws_node_flag_lane, into fl[i]); and prepares the features of every lanes-th body
+ * from slot i on that the web's committed candidates name (ws_node_prepare_some), which only
+ * the sweep reads: a body that the search finds near later is prepared after it. (As one
+ * item that is no worker's own, tried first, they lengthened the task by their whole cost:
+ * the flags' shares are even.) */
 typedef struct flag_task {
     ws_world *w;
     ws_web *web;
     uint32_t lanes;
+    int cur;
     ws_nodes3 x, v;
+    ws_node_lane *fl;
 } flag_task;
 
 static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
@@ -414,19 +480,22 @@ static void flag_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
     (void)worker;
     const flag_task *T = ctx;
     for (int32_t i = start; i < end; i++) {
-        const ws_lane_job *J = &T->w->lane_job[i];
-        const uint32_t nx = T->lanes > 1 ? (uint32_t)T->web->nx : 0; /* 0: the whole web */
-        T->w->lane_job[i].flagged = ws_node_flag(T->web, T->x, T->v, nx ? nx * J->r0 : 0,
-                                                 nx ? nx * J->r1 : T->web->n);
+        ws_node_flag_lane(&T->w->bodies, T->cur, T->web, T->x, T->v, &T->fl[i]);
+        ws_node_prepare_some(&T->w->bodies, T->cur, &T->w->node_geom, T->web, (uint32_t)i,
+                             T->lanes);
     }
 }
 
 /* The flags in the lanes of the last cut when it cuts this web's rows (the nodes stay on
- * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. */
-static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
+ * their cores), else in lanes of equal rows: a node's flag costs the same everywhere. Returns
+ * the lanes' findings (from the arena; NULL when out of memory). */
+static ws_node_lane *flag_lanes(ws_step *S, ws_web *web, uint32_t lanes)
 {
+    ws_world *w = S->w;
     ws_lane_job *J = w->lane_job;
-    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1;
+    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1,
+                   nx = web->nx > 0 ? (uint32_t)web->nx : 0;
+    const size_t ntrack = web->contact->ntrack;
     const int cut = lanes_cover(J, lanes, ny);
     if (!cut)
         w->cut_web = NULL; /* not lanes_cut's */
@@ -434,12 +503,16 @@ static size_t flag_lanes(ws_world *w, ws_web *web, uint32_t lanes, int cur)
         J[i].r0 = (uint32_t)((uint64_t)i * ny / lanes);
         J[i].r1 = (uint32_t)((uint64_t)(i + 1) * ny / lanes);
     }
-    flag_task T = {w, web, lanes, web->x[cur], web->v[cur]};
-    run_task(w, flag_items, lanes, 0, &T);
-    size_t flagged = 0;
+    ws_node_lane *L = ws_arena_alloc(S->arena, lanes * sizeof *L);
+    double *least = ws_arena_alloc(S->arena, (lanes * ntrack + 1) * sizeof *least);
+    if (!L || !least)
+        return NULL;
     for (uint32_t i = 0; i < lanes; i++)
-        flagged += w->lane_job[i].flagged;
-    return flagged;
+        L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n,
+                              S->contact.margin, 0, least + i * ntrack};
+    flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
+    run_task(w, flag_items, lanes, 0, &T);
+    return L;
 }
 
 /* The search of node candidates in pieces on the world's threads (ws_node_search_fn, its
@@ -477,6 +550,8 @@ static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
     J->found.n = 0;
     J->found_checks = 0;
     const uint32_t *nodes = T->nodes ? T->nodes + q0 : NULL;
+    if (nodes) /* found again now: their record from here, J->cview.lever2 for the whole's */
+        ws_node_to_ref(&J->view, J->view.x[T->S->cur], nodes, q1 - q0);
     J->found_bad = ws_node_find(&s, &J->view, nodes, (uint32_t)q0, q1 - q0, &J->found) != 0;
     const ws_node_contact *nc = T->web->contact;
     const ws_node_found F = {nodes, q1 - q0, &J->found};
@@ -500,6 +575,8 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
     if (pieces < 2) {
         ws_node_step s = *S;
         s.search = NULL;
+        if (nodes)
+            ws_node_to_ref(web, web->x[S->cur], nodes, count);
         return ws_node_find_scratch(S->b, S->g) ? -1 : ws_node_find(&s, web, nodes, 0, count, L);
     }
     const size_t slots = S->b->slots + 1, room = w->search_tight ? 8 : 2 * (count / pieces) + 64;
@@ -542,6 +619,9 @@ static int search_lanes(const ws_node_step *S, ws_web *web, const uint32_t *node
         *S->checks += J->found_checks;
         for (size_t k = 0; k + 1 < slots; k++)
             web->contact->cbody[k] |= J->cview.cbody[k];
+        /* The largest |xdet|^2 of the pieces' nodes: as one pass over them all would keep. */
+        if (J->cview.lever2 > web->contact->lever2)
+            web->contact->lever2 = J->cview.lever2;
     }
     return same;
 }
@@ -560,11 +640,11 @@ void ws_world_lanes_free(ws_world *w)
 }
 
 /* Lane i's copies of the web and its contact: their state shared, their scratch the lane's own
- * (lane 0: the web's), the nodes the lane ends at. */
-static void lane_open(ws_world *w, ws_web *web, uint32_t lanes, uint32_t i)
+ * (lane 0: the web's), the nodes the lane ends at. Made by the lane at the start of its sweep
+ * (sweep_lane), on its worker: the web and its contact are only read while the lanes run. */
+static void lane_open(ws_world *w, ws_web *web, uint32_t i)
 {
     ws_lane_job *J = &w->lane_job[i];
-    (void)lanes;
     J->view = *web;
     J->cview = *web->contact;
     J->view.contact = &J->cview;
@@ -621,8 +701,6 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *b
  * lane, right here. Returns how many nodes ended too fast. */
 static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
 {
-    for (uint32_t i = 0; i < lanes; i++)
-        lane_open(w, web, lanes, i);
     const uint32_t body = T->body != NULL;
     run_task(w, lane_items, lanes + body, body, T);
     size_t fast = 0;
@@ -675,9 +753,12 @@ static ws_status step_webs(ws_step *S)
         ws_node_contact *nc = web->contact;
         int searched = 0;
         const uint32_t lanes = web_lanes(w, web);
-        size_t flagged = 0;
-        if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid))
-            flagged = flag_lanes(w, web, lanes, cur);
+        ws_node_lane *fl = NULL;
+        if (ws_node_contact_begin(b, cur, web, S->dt, S->contact.margin, !w->cand_valid) &&
+            !(fl = flag_lanes(S, web, lanes))) {
+            nc->refresh = 1; /* the move test's record is not to be trusted: all found again */
+            return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        }
         const double t0 = clock_now(w);
         const ws_node_step ns = {&w->mem,
                                  b,
@@ -686,8 +767,10 @@ static ws_status step_webs(ws_step *S)
                                  S->contact.margin,
                                  &S->stats->narrow_checks,
                                  lanes > 1 ? search_lanes : NULL,
-                                 w};
-        if (ws_node_contact_update(&ns, web, flagged, &searched) != 0)
+                                 w,
+                                 fl,
+                                 fl ? lanes : 0};
+        if (ws_node_contact_update(&ns, web, &searched) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            web_label(web));
         if (searched) { /* counted as detection, not film */
@@ -730,17 +813,24 @@ static ws_status step_webs(ws_step *S)
             ws_nodes3 vd = last_parity ? web->v[nxt] : web->vsub;
             ws_web_sweep_laws(web, w->def.gravity, S->t + s * h, s * h);
             lane_task T = {w,
+                           web,
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
                             web->fc[nxt]},
                            xd,
                            vd,
                            s == 0 && lanes > 1,
                            lanes,
-                           NULL};
-            if (S->body_later && lanes > 1) { /* the body contacts, beside the lanes */
-                T.body = S;
+                           NULL,
+                           0};
+            /* The body part beside the lanes: the narrow phase in the first sub-step, the
+             * contacts in the last, so that each fills a sub-step's slack. */
+            if (lanes > 1 && s == 0 && S->narrow_later)
+                T.body_part |= BODY_NARROW;
+            if (lanes > 1 && s == n - 1 && S->body_later) {
+                T.body_part |= BODY_CONTACTS;
                 S->body_later = 0;
             }
+            T.body = T.body_part ? S : NULL;
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
             xs = xd;
             vs = vd;
@@ -950,7 +1040,8 @@ static ws_status detect(ws_step *S)
             memcpy(w->cand[nxt], w->cand[cur], w->ncand[cur] * sizeof *w->cand[nxt]);
         w->ncand[nxt] = w->ncand[cur];
     }
-    if (ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
+    if (!S->narrow_later &&
+        ws_array_reserve(&w->mem, (void **)&w->rec[nxt], &w->caprec[nxt], w->ncand[nxt] + 1,
                          sizeof *w->rec[nxt]) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for contact records");
     return WS_OK;
@@ -963,6 +1054,14 @@ static void body_contacts(ws_step *S)
     ws_world *w = S->w;
     const ws_body_store *b = S->b;
     const int nxt = S->nxt;
+    /* A full detection's narrow phase first, when it still waits (detect_full); when it
+     * ran out of room beside the film, both run again on the calling thread (step_once). */
+    if (S->narrow_later) {
+        S->narrow_bad = detect_narrow(S, NULL) != 0;
+        S->narrow_later = 0;
+    }
+    if (S->narrow_bad)
+        return;
     size_t nrec = 0;
     for (size_t k = 0; k < w->ncand[nxt]; k++)
         if (ws_contact_eval(&S->contact, &w->cand[nxt][k], &w->rec[nxt][nrec]))
@@ -1198,18 +1297,18 @@ static ws_status step_once(ws_world *w)
     S.guard_m = S.guard_f + b->slots + 1;
 
     prepare(w);
+    /* The body contacts read only the bodies' state at t, and the film does not read the
+     * bodies' loads: with workers and only explicit webs they run as one more item of the
+     * film's first sub-step in lanes, on whichever worker is free first, with a full
+     * detection's narrow phase before them, and their check and the elements follow the film
+     * (the loads summed as before: contacts, elements, webs). A step they refuse then leaves
+     * the world as it was all the same: the film wrote only the next state and its scratch. */
+    S.body_later = S.loads_later = bodies_beside_film(w);
     double t_mark = clock_now(w);
     if ((s = detect(&S)) != WS_OK)
         return s;
     double t_eval = clock_now(w);
     S.stats->seconds_detection += t_eval - t_mark;
-    /* The body contacts read only the bodies' state at t, and the film does not read the
-     * bodies' loads: with workers and only explicit webs they run as one more item of the
-     * film's first sub-step in lanes, on whichever worker is free first, and their check
-     * and the elements follow the film (the loads summed as before: contacts, elements,
-     * webs). A step they refuse then leaves the world as it was all the same: the film
-     * wrote only the next state and its scratch. */
-    S.body_later = S.loads_later = bodies_beside_film(w);
     if (!S.body_later) {
         body_contacts(&S);
         if ((s = contacts_ready(&S)) != WS_OK)
@@ -1229,6 +1328,16 @@ static ws_status step_once(ws_world *w)
         const double t_late = clock_now(w);
         if (S.body_later) /* no web was swept in lanes */
             body_contacts(&S);
+        if (S.narrow_bad) { /* its room ran out beside the film: again here, growing it */
+            S.narrow_bad = 0;
+            w->narrow_reruns++;
+            if (detect_narrow(&S, &w->mem) != 0 ||
+                ws_array_reserve(&w->mem, (void **)&w->rec[S.nxt], &w->caprec[S.nxt],
+                                 w->ncand[S.nxt] + 1, sizeof *w->rec[S.nxt]) != 0)
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY,
+                               "step: out of memory for contact candidates");
+            body_contacts(&S);
+        }
         if ((s = contacts_ready(&S)) != WS_OK ||
             (s = ws_world_element_forces(w, S.cur, S.t)) != WS_OK)
             return s;
