@@ -56,8 +56,17 @@ static int near_face(const ws_shape *sa, uint32_t g, v3 s, double lo, double hi,
 {
     if (ws_point_in_face(sa, g, s, lo, hi, d))
         return 1;
-    *d = v3_dot(sa->faces[g].normal, s) - sa->faces[g].offset;
-    return *d > lo && *d < hi && outside_face(sa, g, s) < WS_OUTLINE_TOL;
+    const ws_face *fc = &sa->faces[g];
+    *d = v3_dot(fc->normal, s) - fc->offset;
+    if (!(*d > lo && *d < hi))
+        return 0;
+    /* The face's box first: most points out of the face are far out. */
+    v3 x = v3_madd(s, fc->normal, -*d);
+    const double e = WS_OUTLINE_TOL;
+    if (x.x < fc->lo.x - e || x.x > fc->hi.x + e || x.y < fc->lo.y - e || x.y > fc->hi.y + e ||
+        x.z < fc->lo.z - e || x.z > fc->hi.z + e)
+        return 0;
+    return outside_face(sa, g, s) < WS_OUTLINE_TOL;
 }
 
 int ws_point_on_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist)
