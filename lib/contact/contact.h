@@ -114,9 +114,10 @@ int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi,
 
 /* ws_point_in_face for another body's point, with the rim widened by WS_OUTLINE_TOL: a point
  * whose projection lies outside the face but within that of its outline counts on it if it is
- * above the face's plane (or less than the tolerance below it), and no other face holding it lies
- * farther below it (over the rim, the face whose normal is nearer the direction from the rim to
- * the point takes it: one face per point). Contacts between bodies use this; film nodes do not. */
+ * above the face's plane (or less than the tolerance below it), and no other face holding it
+ * has a greater height over its plane (over the rim, the face whose normal is nearer the
+ * direction from the rim to the point takes it: one face per point). Contacts between bodies
+ * use this; film nodes do not. */
 int ws_point_on_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist);
 
 /* A point inside the solid (d < 0 under face f): 1 if f is the face it is least deep under among
