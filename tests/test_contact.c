@@ -742,58 +742,64 @@ START_TEST(test_edge_edge_support)
 END_TEST
 
 /* Two equal cubes side by side, pressed face to face with a layer overlap of 0.1 mm, as the
- * cartons of a wrapped load are: each of the four corners of the shared face carries one
- * contact, k x 0.1 mm, whichever feature holds it (a corner of one cube in the other's face,
- * or, where neither corner is inside, the edges that cross there). Shifting the second cube
- * along the face by a micrometre either way and turning it by a micro-radian about any axis
- * must not change that: 4 contacts, the total k (4 x 0.1 mm) within the tilt's change of the
- * overlaps (1e-6 rad x 0.25 m = 0.25 um on 100 um: 0.25 % a corner, and the total cancels to
- * first order: asserted to 0.5 %). With the cone test exact, a crossing whose edge tilts the
- * wrong way by a micro-radian was dropped and that corner carried nothing. */
+ * cartons of a wrapped load are. Aligned, each corner of the shared face carries two springs
+ * (either cube's corner lies on the other's face: test_interface_stiffness), k x 0.1 mm each.
+ * Shifting the second cube along the face by 0.1 um either way and turning it by a micro-radian
+ * about any axis moves its corners by at most 0.23 um, within the rim tolerance of the
+ * point-face test (WS_OUTLINE_TOL, 1 um): the corners are still on the rims, 8 contacts.
+ * Shifted by 10 um (past the tolerance), each corner carries one contact, whichever feature
+ * holds it (a corner of one cube in the other's face, or, where neither corner is inside, the
+ * edges that cross there): 4. In both the total is k times the count times 0.1 mm within the
+ * tilt's change of the overlaps (1e-6 rad x 0.25 m = 0.25 um on 100 um: 0.25 % a corner, and
+ * the total cancels to first order: asserted to 0.5 %). With the cone test exact, a crossing
+ * whose edge tilts the wrong way by a micro-radian was dropped and that corner carried nothing;
+ * with the rim exact, a corner 0.1 um past it lost its second spring. */
 START_TEST(test_side_by_side_corners_hold)
 {
-    const double a = 0.25, k = 2e5, ov = 1e-4, e = 1e-6, tilt = 1e-6;
+    const double a = 0.25, k = 2e5, ov = 1e-4, tilt = 1e-6;
+    const double shifts[2] = {1e-7, 1e-5};
+    const int expect[2] = {8, 4};
     ws_contact_def cd = contact_params(k, 0.0, 0.0, WS_FRICTION_REGULARIZED);
-    int cases = 0, worst_n = 4;
+    int cases = 0;
     double worst = 0.0;
-    for (int sy = -1; sy <= 1; sy += 2)
-        for (int sz = -1; sz <= 1; sz += 2)
-            for (int axis = 0; axis < 3; axis++)
-                for (int st = -1; st <= 1; st += 2) {
-                    ws_world_def wd;
-                    ws_world_def_init(&wd);
-                    wd.gravity = v3(0, 0, 0);
-                    ws_world *w = NULL;
-                    ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
-                    ck_ok(w, ws_world_set_default_contact(w, &cd));
-                    ws_body_id fixed = make_box(w, WS_BODY_KINEMATIC, a, a, a, 0, v3(0, 0, 0),
-                                                Q_ID, v3(0, 0, 0), "fixed");
-                    ws_vec3 ax = v3(axis == 0, axis == 1, axis == 2);
-                    ws_body_id side = make_box(w, WS_BODY_DYNAMIC, a, a, a, 10.0,
-                                               v3(a + 2 * DELTA - ov, sy * e, sz * e),
-                                               quat_axis(ax, st * tilt), v3(0, 0, 0), "side");
-                    ck_ok(w, ws_world_step(w));
-                    contacts cs;
-                    get_contacts(w, &cs);
-                    int n;
-                    unsigned kinds;
-                    double f = normal_force_between(&cs, fixed, side, &n, &kinds);
-                    double rel = fabs(f - 4 * k * ov) / (4 * k * ov);
-                    if (n != 4 || rel > worst) {
+    for (int se = 0; se < 2; se++)
+        for (int sy = -1; sy <= 1; sy += 2)
+            for (int sz = -1; sz <= 1; sz += 2)
+                for (int axis = 0; axis < 3; axis++)
+                    for (int st = -1; st <= 1; st += 2) {
+                        const double e = shifts[se];
+                        ws_world_def wd;
+                        ws_world_def_init(&wd);
+                        wd.gravity = v3(0, 0, 0);
+                        ws_world *w = NULL;
+                        ck_assert_int_eq(ws_world_create(&wd, &w), WS_OK);
+                        ck_ok(w, ws_world_set_default_contact(w, &cd));
+                        ws_body_id fixed = make_box(w, WS_BODY_KINEMATIC, a, a, a, 0,
+                                                    v3(0, 0, 0), Q_ID, v3(0, 0, 0), "fixed");
+                        ws_vec3 ax = v3(axis == 0, axis == 1, axis == 2);
+                        ws_body_id side = make_box(w, WS_BODY_DYNAMIC, a, a, a, 10.0,
+                                                   v3(a + 2 * DELTA - ov, sy * e, sz * e),
+                                                   quat_axis(ax, st * tilt), v3(0, 0, 0),
+                                                   "side");
+                        ck_ok(w, ws_world_step(w));
+                        contacts cs;
+                        get_contacts(w, &cs);
+                        int n;
+                        unsigned kinds;
+                        double f = normal_force_between(&cs, fixed, side, &n, &kinds);
+                        double want = expect[se] * k * ov;
+                        double rel = fabs(f - want) / want;
                         worst = fmax(worst, rel);
-                        if (n != 4)
-                            worst_n = n;
+                        ck_assert_msg(n == expect[se] && rel < 5e-3,
+                                      "shift (%d, %d) x %g m, tilt %d urad about axis %d: %d "
+                                      "contacts (kinds 0x%x), %.6g N (%d k ov = %.6g N)",
+                                      sy, sz, e, st, axis, n, kinds, f, expect[se], want);
+                        cases++;
+                        ws_world_destroy(w);
                     }
-                    ck_assert_msg(n == 4 && rel < 5e-3,
-                                  "shift (%d, %d) um, tilt %d urad about axis %d: %d contacts "
-                                  "(kinds 0x%x), %.6g N (4 k ov = %.6g N)",
-                                  sy, sz, st, axis, n, kinds, f, 4 * k * ov);
-                    cases++;
-                    ws_world_destroy(w);
-                }
-    report("side by side cubes: %d shifts and tilts, 4 contacts in each (%d), total force within "
-           "%.3g %% of 4 k overlap",
-           cases, worst_n, 100 * worst);
+    report("side by side cubes: %d shifts and tilts, 8 contacts within the rim tolerance, 4 "
+           "past it, total force within %.3g %% of k overlap per contact",
+           cases, 100 * worst);
 }
 END_TEST
 
@@ -1428,6 +1434,79 @@ START_TEST(test_reference_stack_layer_geometry)
 }
 END_TEST
 
+/* Two equal, aligned boxes stacked: each box's corners lie on the edges of the other's face,
+ * and the interface carries 8 point-face springs, two at each corner (test_interface_stiffness).
+ * A resting load's compliance, a film's pull or round-off turn the top box by micro-radians and
+ * shift it by fractions of a micrometre; its corners then lie ~1e-7 m inside or outside the
+ * other face's outline, and the support must not depend on which side: a corner moved by
+ * 0.1 um is still a corner of the interface. The bottom box is kinematic; the top one (m = 5 kg)
+ * starts at rest at the resting gap 2 delta - m g / (8 k), turned by +-1e-6 rad about either
+ * horizontal diagonal or about z and shifted by +-1e-7 m, and takes one step. The springs then
+ * carry the resting overlap ov0 = m g / (8 k) = 3.07e-5 m plus the tilt's theta (n . r) at each
+ * corner (at most theta a / sqrt(2) = 1.8e-7 m), so
+ *  - all 8 springs are there, each corner's pair carrying m g / 4 within the tilt's share,
+ *    theta a / sqrt(2) / ov0 = 0.6 %: asserted 2 %;
+ *  - they sum to m g: the tilt's overlap changes cancel over the symmetric corners, the
+ *    velocity is zero (no damping force): asserted 1e-6 relative;
+ *  - their centre lies within theta (a/2)^2 / ov0 = 0.51 mm (the tilt's overlap difference
+ *    over the corners' levers) + the shift of the axis: asserted 1 mm.
+ * A corner lost shifts the centre by ~a/8 = 31 mm and a quarter of the load. */
+START_TEST(test_equal_boxes_keep_corners)
+{
+    const double a = 0.25, m = 5.0, k = 2e5, th = 1e-6, sh = 1e-7;
+    const ws_vec3 axes[3] = {v3(sqrt(0.5), sqrt(0.5), 0), v3(sqrt(0.5), -sqrt(0.5), 0),
+                             v3(0, 0, 1)};
+    const double shifts[4][2] = {{0, 0}, {sh, sh}, {sh, -sh}, {-sh, 0}};
+    ws_contact_def cd = contact_params(k, 100.0, 0.3, WS_FRICTION_REGULARIZED);
+    int failed = 0;
+    double worst_share = 0.0, worst_centre = 0.0, worst_sum = 0.0;
+    for (int ax = 0; ax < 3; ax++)
+        for (int sg = -1; sg <= 1; sg += 2)
+            for (int si = 0; si < 4; si++) {
+                ws_world *w = contact_world(2.5e-4, &cd);
+                ws_body_id bot = make_box(w, WS_BODY_KINEMATIC, a, a, a, 0, v3(0, 0, 0), Q_ID,
+                                          v3(0, 0, 0), "bottom");
+                ws_vec3 c = v3(shifts[si][0], shifts[si][1], a + 2 * DELTA - m * G0 / (8 * k));
+                ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, c,
+                                          quat_axis(axes[ax], sg * th), v3(0, 0, 0), "top");
+                OK(w, ws_world_step_n(w, 1));
+                ws_contact_info ci[32];
+                size_t n;
+                OK(w, ws_world_copy_contacts_between(w, bot, top, ci, 32, &n));
+                double quarter[4] = {0, 0, 0, 0}, f = 0.0, mx = 0.0, my = 0.0;
+                for (size_t i = 0; i < n; i++) {
+                    double fz = ci[i].normal_force * ci[i].normal.z;
+                    int q = (ci[i].point.x > c.x) + 2 * (ci[i].point.y > c.y);
+                    quarter[q] += fz;
+                    f += fz;
+                    mx += fz * (ci[i].point.x - c.x);
+                    my += fz * (ci[i].point.y - c.y);
+                }
+                double share = 0.0;
+                for (int q = 0; q < 4; q++)
+                    share = fmax(share, fabs(quarter[q] / (0.25 * m * G0) - 1.0));
+                double centre = f > 0.0 ? hypot(mx, my) / f : 1.0;
+                double rel = fabs(f / (m * G0) - 1.0);
+                worst_share = fmax(worst_share, share);
+                worst_centre = fmax(worst_centre, centre);
+                worst_sum = fmax(worst_sum, rel);
+                if (n != 8 || share > 0.02 || centre > 1e-3 || rel > 1e-6) {
+                    failed++;
+                    fprintf(stderr,
+                            "axis %d sign %+d shift %d: %zu contacts, quarters %.3f %.3f %.3f "
+                            "%.3f N, sum %.6f N, centre %.3g m\n",
+                            ax, sg, si, n, quarter[0], quarter[1], quarter[2], quarter[3], f,
+                            centre);
+                }
+                ws_world_destroy(w);
+            }
+    report("equal boxes tilted 1e-6 rad, shifted 1e-7 m (24 cases): worst corner share off "
+           "%.4f %%, force sum off %.2g, centre %.4f mm from the axis",
+           100 * worst_share, worst_sum, 1e3 * worst_centre);
+    ck_assert_msg(failed == 0, "%d of 24 cases lose corner support", failed);
+}
+END_TEST
+
 static Suite *contact_suite(void)
 {
     Suite *s = suite_create("contact");
@@ -1462,6 +1541,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_interface_stiffness);
     tcase_add_test(tc, test_contacts_between_normal_convention);
     tcase_add_test(tc, test_reference_stack_layer_geometry);
+    tcase_add_test(tc, test_equal_boxes_keep_corners);
     suite_add_tcase(s, tc);
 
     tc = tcase_create("impact");

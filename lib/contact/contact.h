@@ -27,6 +27,25 @@
  * faces of 0.3 m: 1e-4 to 1e-3), and small beside any edge that truly turns away. */
 #define WS_CONE_TOL 1e-2
 
+/* How far past a face's outline (m, in the face's plane) a point of another body still counts on
+ * the face, when it lies over the face's half of the rim (ws_point_on_face); edge pairs whose
+ * closest points lie that near an edge's end are left to those point-face contacts. Two equal,
+ * aligned boxes stacked (or a box flush against one of its own size) have each box's corners on
+ * the other face's rim: 8 springs, two a corner. A moment of ~1 N m (a film's uneven pull)
+ * turns the boxes by ~1e-6 rad and moves the corners 1.25e-7 m (over a 0.25 m box's
+ * half-height) to either side of the rim; the barycentric tolerance (WS_FEATURE_TOL: 0.25 nm on
+ * such a face) made the support follow those signs: half its springs gone, or all on one edge,
+ * where the squeeze rocks the stack. Past this tolerance a corner hands over (it loses its
+ * second spring, or an edge pair takes it) in one step, so the tolerance must exceed the
+ * micro-radian offsets (5e-7 m: 4 times them, with a 1e-7 m shift besides) and stay well below
+ * the creep of a stuck interface under load (the stick law's mu N / k_t: 9-18 um for the
+ * reference boxes): there a hand-over jolts the anchors (at 1e-6 m a stuck stack on a tilting
+ * plane slips at its corners, test_stick_stack_settles_on_tilt; at 1e-5-1e-4 m a sliding box's
+ * onset is seen 2 deg late, its anchors reset mid-slide). A corner counted past the rim moves
+ * the force's line by 2e-6 of a 0.25 m face. Not the resting tilts of WS_CONE_TOL (1e-4 to
+ * 1e-3 rad, 12-125 um at the corners): those are real offsets, which the edge pairs carry. */
+#define WS_OUTLINE_TOL 5e-7
+
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
@@ -93,6 +112,14 @@ int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j
 /* Point s (frame of shape sa) against face f: 1 and the signed distance if its projection lies in
  * the face and the distance is within (lo, hi). */
 int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist);
+
+/* ws_point_in_face for another body's point, with the rim widened by WS_OUTLINE_TOL: a point
+ * whose projection lies outside the face but within that of its outline counts on it if it is
+ * above the face's plane (or less than the tolerance below it), and no other face holding it
+ * has a greater height over its plane (over the rim, the face whose normal is nearer the
+ * direction from the rim to the point takes it: one face per point). Contacts between bodies
+ * use this; film nodes do not. */
+int ws_point_on_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist);
 
 /* A point inside the solid (d < 0 under face f): 1 if f is the face it is least deep under among
  * the faces it projects into, so only that face pushes it out. */

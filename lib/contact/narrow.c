@@ -24,6 +24,70 @@ int ws_point_in_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi,
     return 0;
 }
 
+/* Distance from x to the segment a + t d, t in [0, 1]. */
+static double point_segment(v3 x, v3 a, v3 d)
+{
+    double t = v3_dot(v3_sub(x, a), d) / v3_dot(d, d);
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    return v3_norm(v3_sub(x, v3_madd(a, d, t)));
+}
+
+/* How far the projection of s on face f's plane lies outside the face (0 inside): the least
+ * distance to its triangles, each measured in the plane. */
+static double outside_face(const ws_shape *sa, uint32_t f, v3 s)
+{
+    const ws_face *fc = &sa->faces[f];
+    double best = INFINITY;
+    for (uint32_t t = fc->first_tri; t < fc->first_tri + fc->tri_count; t++) {
+        const ws_tri *q = &sa->tris[t];
+        v3 r = v3_sub(s, q->p);
+        r = v3_madd(r, fc->normal, -v3_dot(r, fc->normal));
+        v3 x = v3_add(q->p, r);
+        double e = fmin(fmin(point_segment(x, q->p, q->w), point_segment(x, q->p, q->v)),
+                        point_segment(x, v3_add(q->p, q->w), v3_sub(q->v, q->w)));
+        best = fmin(best, e);
+    }
+    return best;
+}
+
+/* s in face g or less than WS_OUTLINE_TOL outside its outline, at a height *d over its plane
+ * within (lo, hi). */
+static int near_face(const ws_shape *sa, uint32_t g, v3 s, double lo, double hi, double *d)
+{
+    if (ws_point_in_face(sa, g, s, lo, hi, d))
+        return 1;
+    const ws_face *fc = &sa->faces[g];
+    *d = v3_dot(fc->normal, s) - fc->offset;
+    if (!(*d > lo && *d < hi))
+        return 0;
+    /* The face's box first: most points out of the face are far out. */
+    v3 x = v3_madd(s, fc->normal, -*d);
+    const double e = WS_OUTLINE_TOL;
+    if (x.x < fc->lo.x - e || x.x > fc->hi.x + e || x.y < fc->lo.y - e || x.y > fc->hi.y + e ||
+        x.z < fc->lo.z - e || x.z > fc->hi.z + e)
+        return 0;
+    return outside_face(sa, g, s) < WS_OUTLINE_TOL;
+}
+
+int ws_point_on_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi, double *dist)
+{
+    if (ws_point_in_face(sa, f, s, lo, hi, dist))
+        return 1;
+    /* Widened only a tolerance below the plane: deeper, a point past the rim is outside the
+     * solid through a side face, not through this one. */
+    double d, e;
+    if (!near_face(sa, f, s, fmax(lo, -WS_OUTLINE_TOL), hi, &d))
+        return 0;
+    /* Over the rim, the face with the greater height takes the point: at a rim between faces
+     * of outward normals n_f, n_g, a point at angle phi from n_f about the rim has heights
+     * rho cos(phi) and rho cos(alpha - phi), the first greater on f's side of the bisector. */
+    for (uint32_t g = 0; g < sa->face_count; g++)
+        if (g != f && near_face(sa, g, s, d, hi, &e))
+            return 0;
+    *dist = d;
+    return 1;
+}
+
 /* n in the normal cone of an edge whose faces have outward normals n1, n2 (all orthogonal to the
  * edge): n = a n1 + b n2 with a, b >= 0, up to WS_CONE_TOL. */
 static int in_cone(v3 n, v3 n1, v3 n2)
@@ -53,8 +117,12 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     v3 r = v3_sub(pj, pi);
     double ru = v3_dot(r, u), rw = v3_dot(r, w);
     double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
-    double lo = WS_FEATURE_TOL, hi = 1.0 - WS_FEATURE_TOL;
-    if (!(s > lo && s < hi && t > lo && t < hi))
+    /* Closest points within WS_OUTLINE_TOL of an edge's end lie within that of the end's point
+     * and of the other body's face rim: the point-face contact carries them (ws_point_on_face),
+     * once, and not with the sign of a sub-micrometre offset. */
+    double ls = fmax(WS_FEATURE_TOL, WS_OUTLINE_TOL / sqrt(uu));
+    double lt = fmax(WS_FEATURE_TOL, WS_OUTLINE_TOL / sqrt(ww));
+    if (!(s > ls && s < 1.0 - ls && t > lt && t < 1.0 - lt))
         return 0;
     n = v3_scale(n, 1.0 / sqrt(nn));
     if (!in_cone(n, n1i, n2i)) {
@@ -128,7 +196,7 @@ static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb
     relative(b, x->cur, pa, pb, &R, &t);
     for (uint32_t k = 0; k < sb->vertex_count; k++) {
         v3 s = v3_add(m3_mul_v(&R, sb->vertices[k]), t);
-        if (!inside_box(s, sa->lo, sa->hi, reach))
+        if (!inside_box(s, sa->lo, sa->hi, reach + WS_OUTLINE_TOL))
             continue;
         for (uint32_t f = 0; f < sa->face_count; f++) {
             const ws_face *fc = &sa->faces[f];
@@ -137,20 +205,12 @@ static int points_faces(ws_mem *mem, ws_contact_ctx *x, uint32_t pa, uint32_t pb
             /* Depth counts along the normal only: the point's projection on the face's plane
              * must lie within reach of the face (its box is flat along the normal). */
             if (d > -reach - sa->inner && d < reach &&
-                inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach))
+                inside_box(v3_madd(s, fc->normal, -d), fc->lo, fc->hi, reach + WS_OUTLINE_TOL))
                 if (push(mem, cand, n, cap, pa, pb, f, k, WS_CONTACT_POINT_FACE) != 0)
                     return -1;
         }
     }
     return 0;
-}
-
-/* Distance from x to the segment a + t d, t in [0, 1]. */
-static double point_segment(v3 x, v3 a, v3 d)
-{
-    double t = v3_dot(v3_sub(x, a), d) / v3_dot(d, d);
-    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-    return v3_norm(v3_sub(x, v3_madd(a, d, t)));
 }
 
 /* The distance between the segments p + s u and q + t w (s, t in [0, 1]); for nearly parallel
@@ -246,7 +306,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         v3 pg = v3_add(st->r[ib], m3_mul_v(Ab, sb->vertices[c->fb]));
         v3 s = m3_tmul_v(Aa, v3_sub(pg, st->r[ia]));
         double d;
-        if (!ws_point_in_face(sa, c->fa, s, -reach - sa->inner, reach, &d))
+        if (!ws_point_on_face(sa, c->fa, s, -reach - sa->inner, reach, &d))
             return 0;
         if (d < 0.0 && !ws_shallowest_face(sa, c->fa, s, d))
             return 0;
