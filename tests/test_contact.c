@@ -746,7 +746,7 @@ END_TEST
  * (either cube's corner lies on the other's face: test_interface_stiffness), k x 0.1 mm each.
  * Shifting the second cube along the face by 0.1 um either way and turning it by a micro-radian
  * about any axis moves its corners by at most 0.23 um, within the rim tolerance of the
- * point-face test (WS_OUTLINE_TOL, 1 um): the corners are still on the rims, 8 contacts.
+ * point-face test (WS_OUTLINE_TOL, 0.5 um): the corners are still on the rims, 8 contacts.
  * Shifted by 10 um (past the tolerance), each corner carries one contact, whichever feature
  * holds it (a corner of one cube in the other's face, or, where neither corner is inside, the
  * edges that cross there): 4. In both the total is k times the count times 0.1 mm within the
