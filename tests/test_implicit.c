@@ -1400,6 +1400,8 @@ static void rows_mixed_checks(ws_web *web, const char *what)
     free(u), free(y), free(Bu), free(By), free(e), free(Ae), free(BAe);
 }
 
+static ws_world *choice_drum(int nx, int ny, int pre, double tol, ws_web_id *id, ws_status *st);
+
 START_TEST(test_rows_mixed)
 {
     /* A level whose rows are partly solved whole and partly node by node: the blocks of its
@@ -1416,31 +1418,10 @@ START_TEST(test_rows_mixed)
     rows_mixed_checks(web, "band");
     ws_world_destroy(w);
 
-    const int nx = 41, ny = 23;
-    w = world_g(2e-3, (ws_vec3){0, 0, -G0});
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 20.0, 0.0, 0.01, 0.0);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-4;
-    wd.law = law;
-    wd.law_shear = law;
-    wd.integrator = WS_WEB_IMPLICIT;
-    wd.solver_tolerance = 1e-11;
-    wd.solver_max_iterations = 5000;
-    wd.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = nx;
-    sd.ny = ny;
-    sd.spacing_x = sd.spacing_y = 0.01;
-    sd.prestretch_x = 0.4;
-    sd.prestretch_y = 0.2;
-    sd.shear = 1;
-    uint32_t pins[2 * (41 + 23)];
-    sd.pinned = pins;
-    sd.pinned_count = edge_pins(nx, ny, pins);
     ws_web_id id;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &id));
+    ws_status st;
+    w = choice_drum(41, 23, WS_WEB_PRECONDITIONER_MULTIGRID, 1e-11, &id, &st);
+    ck_assert_msg(w, "the drum is made");
     ck_ok(w, ws_world_step_n(w, 5));
     web = web_of(w, id);
     ck_assert_msg(web->imp && web->imp->mg, "the drum takes the multigrid");
