@@ -21,9 +21,8 @@ static size_t scratch_doubles(uint32_t n)
     return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
 }
 
-uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *upto, uint32_t *ord)
+uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *cnt, uint32_t *ord)
 {
-    uint32_t *cnt = upto;
     const uint32_t n = web->n, ns = web->ns;
     uint32_t lag = 0;
     memset(cnt, 0, ((size_t)n + 1) * sizeof *cnt);
@@ -38,7 +37,7 @@ uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *upto, uint32_t *or
         cnt[i + 1] += cnt[i];
     for (uint32_t s = 0; s < ns; s++) {
         const uint32_t a = web->sa[s], b = web->sb[s];
-        ord[cnt[a > b ? a : b]++] = s; /* cnt[i] ends as the first place past node i's */
+        ord[cnt[a > b ? a : b]++] = s;
     }
     return lag;
 }
@@ -52,7 +51,6 @@ static void scratch_free(ws_mem *mem, ws_implicit *im, double *blk)
     ws_mem_free(mem, im->op, im->op ? OPS(ns) * sizeof(double) : 0);
     ws_mem_free(mem, im->ops, im->ops ? RECS(ns) * sizeof(double) : 0);
     ws_mem_free(mem, im->sord, im->sord ? SPRINGS(ns) * sizeof(uint32_t) : 0);
-    ws_mem_free(mem, im->supto, im->supto ? ((size_t)n + 1) * sizeof(uint32_t) : 0);
     ws_mem_free(mem, im, sizeof *im);
 }
 
@@ -71,12 +69,14 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
     im->ops = ws_mem_calloc(mem, RECS(ns), sizeof(double));
     im->sord = ws_mem_calloc(mem, SPRINGS(ns), sizeof(uint32_t));
-    im->supto = ws_mem_calloc(mem, (size_t)n + 1, sizeof(uint32_t));
-    if (!blk || !im->sp || !im->op || !im->ops || !im->sord || !im->supto) {
+    uint32_t *cnt = ws_mem_calloc(mem, (size_t)n + 1, sizeof(uint32_t));
+    if (!blk || !im->sp || !im->op || !im->ops || !im->sord || !cnt) {
+        ws_mem_free(mem, cnt, cnt ? ((size_t)n + 1) * sizeof(uint32_t) : 0);
         scratch_free(mem, im, blk);
         return -1;
     }
-    im->slag = ws_springs_by_later_end(web, im->supto, im->sord);
+    im->slag = ws_springs_by_later_end(web, cnt, im->sord);
+    ws_mem_free(mem, cnt, ((size_t)n + 1) * sizeof(uint32_t));
     for (uint32_t k = 0; k < ns; k++) { /* the ends, fixed for the web */
         const uint32_t s = im->sord[k], ends[2] = {web->sa[s], web->sb[s]};
         memcpy(im->ops + REC * (size_t)k + 5, ends, sizeof ends);
@@ -327,38 +327,36 @@ static inline double op_node_done(const ws_web *web, const double *restrict p, d
     return P[0] * Y[0] + P[1] * Y[1] + P[2] * Y[2];
 }
 
-/* y = A p with the parts operator_for set, and p . y returned, in one pass over the nodes
- * a chunk at a time (WS_IMPLICIT_CHUNK): the chunk's nodes' own blocks, then the springs
- * whose later end is in the chunk (ops, in that order), then the nodes the gap (slag) behind
- * the chunk's last, which no spring meets any more, finished. The springs' records are one
- * stream and each spring's ends are at most a chunk and the gap back, so a refined film's
- * product reads its arrays once from memory instead of three times (nodes, springs, the dot
- * product). With z given, p is CG's direction made in the same pass, p_i = z_i + beta p_i as
- * the node is reached (pd and p the same array then): a spring meets its ends' new p. */
+/* y = A p with the parts operator_for set, and p . y returned, in one pass over the nodes:
+ * node i's own block, then the springs whose later end is i (ops, in that order), then node
+ * i - slag, which no spring meets any more, finished. The springs' records are one stream
+ * and each spring's second end is at most slag nodes back, so a refined film's product reads
+ * its arrays once from memory instead of three times (nodes, springs, the dot product). With
+ * z given, p is CG's direction made in the same pass, p_i = z_i + beta p_i as the node is
+ * reached (pd and p the same array then): a spring meets its ends' new p, both at or before
+ * node i. */
 static inline double op_pass(const ws_web *web, const double *z, double beta, double *pd,
                              const double *p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
-    const uint32_t n = web->n, lag = im->slag;
-    const double *restrict nd = im->nd;
-    uint32_t k = 0, done = 0;
+    const uint32_t n = web->n, ns = web->ns, lag = im->slag;
+    const double *restrict nd = im->nd, *restrict q = im->ops;
+    uint32_t k = 0;
     double py = 0.0;
-    for (uint32_t i0 = 0; i0 < n; i0 += WS_IMPLICIT_CHUNK) {
-        const uint32_t i1 = n - i0 > WS_IMPLICIT_CHUNK ? i0 + WS_IMPLICIT_CHUNK : n;
+    for (uint32_t i = 0; i < n; i++) {
         if (z)
-            for (size_t c = 3 * (size_t)i0; c < 3 * (size_t)i1; c++)
+            for (size_t c = 3 * (size_t)i; c < 3 * (size_t)i + 3; c++)
                 pd[c] = z[c] + beta * pd[c];
-        for (uint32_t i = i0; i < i1; i++) {
-            const double *P = p + 3 * (size_t)i, *S = nd + WS_SYM * (size_t)i;
-            double *Y = y + 3 * (size_t)i;
-            Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
-            Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
-            Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
-        }
-        for (const uint32_t k1 = im->supto[i1 - 1]; k < k1; k++) {
-            const double *q = im->ops + REC * (size_t)k;
+        const double *P = p + 3 * (size_t)i, *S = nd + WS_SYM * (size_t)i;
+        double *Y = y + 3 * (size_t)i;
+        Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
+        Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
+        Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
+        for (; k < ns; k++, q += REC) {
             uint32_t e[2];
             memcpy(e, q + 5, sizeof e);
+            if (e[0] > i || e[1] > i)
+                break;
             const double *A = p + 3 * (size_t)e[0], *B = p + 3 * (size_t)e[1];
             const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
             const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
@@ -372,9 +370,11 @@ static inline double op_pass(const ws_web *web, const double *z, double beta, do
             YB[1] -= ty;
             YB[2] -= tz;
         }
-        for (const uint32_t j1 = i1 == n ? n : i1 > lag ? i1 - lag : 0; done < j1; done++)
-            py += op_node_done(web, p, y, done);
+        if (i >= lag)
+            py += op_node_done(web, p, y, i - lag);
     }
+    for (uint32_t j = n > lag ? n - lag : 0; j < n; j++)
+        py += op_node_done(web, p, y, j);
     return py;
 }
 

@@ -39,12 +39,11 @@ typedef struct ws_implicit {
     double *op;      /* per spring, the solve's A block, packed: e and a, b of ws_ispring (5
                         doubles a spring, in the web's order; web/coupled.c reads it) */
     /* The springs in the order of their later end (ws_springs_by_later_end, made at reserve):
-     * sord[k] is the k-th spring, supto[i] the number whose later end is at most i (n + 1),
-     * slag the largest gap between a spring's two ends. ops: the solve's A block of spring
-     * sord[k] at record k, e, a, b and then its two ends (uint32_t, in the sixth double), so
-     * that ws_implicit_apply_op reads one stream a pass and finishes each node's product
-     * while its rows are still in the cache. */
-    uint32_t *sord, *supto;
+     * sord[k] is the k-th spring, slag the largest gap between a spring's two ends. ops: the
+     * solve's A block of spring sord[k] at record k, e, a, b and then its two ends (uint32_t,
+     * in the sixth double), so that ws_implicit_apply_op reads one stream a pass and finishes
+     * each node's product while its rows are still in the cache. */
+    uint32_t *sord;
     uint32_t slag;
     double *ops;
     double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
@@ -78,17 +77,11 @@ typedef struct ws_implicit {
 } ws_implicit;
 
 /* The web's springs ordered by their later end, max(sa, sb), ascending (ties in the web's
- * order) into ord (ns entries), and into upto (n + 1) how many of them end at or before each
- * node (upto[n] = ns); returns the largest gap between a spring's two ends (0 with no
- * springs). A pass over the nodes in order that takes, after node i, the springs whose later
- * end is i has then met every spring of node j once it is past node j + the gap. */
-uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *upto, uint32_t *ord);
-
-/* Nodes a chunk of the one-pass products (ws_implicit_apply_op, the multigrid's film level):
- * a chunk's nodes, then its springs, then the nodes the gap behind finished, each as a plain
- * loop; a test a spring costs more than the passes it saves on a film whose arrays stay in
- * the cache. */
-#define WS_IMPLICIT_CHUNK 256
+ * order) into ord (ns entries); returns the largest gap between a spring's two ends (0 with
+ * no springs). A pass over the nodes in order that takes, after node i, the springs whose
+ * later end is i has then met every spring of node j once it is past node j + the gap. cnt:
+ * scratch of n + 1 counts. */
+uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *cnt, uint32_t *ord);
 
 /* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
 int ws_implicit_reserve(ws_mem *mem, ws_web *web);

@@ -1215,19 +1215,21 @@ static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, cons
     }
 }
 
-/* t -= the springs' part of A z for the film level's springs from record *k up to (not
- * including) k1, the cursor left at k1: the records in the order of their later ends
- * (web/implicit.h's sord), so that a node pass takes a chunk's springs right after its nodes,
- * reads the records as one stream and meets z and t while their rows are in the cache. The
- * blocks as the level keeps them (e, a, b in single precision). */
-static inline void film_springs_upto(const ws_mg *mg, uint32_t *k, uint32_t k1,
+/* t -= the springs' part of A z for the film level's springs from record *k on whose later
+ * end is at most i (the records in the order of their later ends, web/implicit.h's sord),
+ * the cursor *k left at the first spring past i. The blocks as the level keeps them (e, a, b
+ * in single precision). Taken by the node passes right after node i, so that a pass reads
+ * the springs' records as one stream and meets z and t while their rows are in the cache. */
+static inline void film_springs_upto(const ws_mg *mg, uint32_t ns, uint32_t i, uint32_t *k,
                                      const double *restrict z, double *restrict t)
 {
-    for (; *k < k1; (*k)++) {
+    for (; *k < ns; (*k)++) {
         const float *q = mg->fop + FOP * (size_t)*k; /* ex ey ez a b, ends */
         uint32_t ia, ib;
         memcpy(&ia, q + FOP_A, sizeof ia);
         memcpy(&ib, q + FOP_B, sizeof ib);
+        if (ia > i || ib > i)
+            return;
         const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
         const double *A = z + 3 * (size_t)ia, *B = z + 3 * (size_t)ib;
         const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
@@ -1268,7 +1270,7 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
                         double *t, const double *zb, double *rz)
 {
     size_t l = 0;
-    uint32_t sk = 0, done = 0;
+    uint32_t sk = 0;
     const uint32_t lag = r ? web->imp->slag : 0;
     double sum = 0.0;
     const mg_level *f = &mg->lv[k];
@@ -1305,20 +1307,17 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
                 fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
                 if (zb)
                     bodies_to_node(mg->rig, &l, i, zb, T);
+                film_springs_upto(mg, web->ns, i, &sk, x, t);
+                if (rz && i >= lag)
+                    sum += film_last(mg, i - lag, r, t, x);
             }
         }
-        if (r) { /* the row's springs, then the nodes the gap behind its end */
-            const uint32_t i1 = (uint32_t)f->nx * (uint32_t)(iy + 1);
-            film_springs_upto(mg, &sk, web->imp->supto[i1 - 1], x, t);
-            for (const uint32_t j1 = iy + 1 == f->ny ? i1
-                                     : i1 > lag      ? i1 - lag
-                                                     : 0;
-                 rz && done < j1; done++)
-                sum += film_last(mg, done, r, t, x);
-        }
     }
-    if (rz)
+    if (rz) {
+        for (uint32_t j = web->n > lag ? web->n - lag : 0; j < web->n; j++)
+            sum += film_last(mg, j, r, t, x);
         *rz = sum;
+    }
 }
 
 /* x = L^-T L^-1 r on the coarsest level. */
@@ -1372,12 +1371,11 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
 
 /* The film level's pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
  * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i and the
- * springs' part of A z, a chunk's springs (WS_IMPLICIT_CHUNK nodes) right after its nodes
- * (film_springs_upto). J = w D^-1 and N, the nodes' own blocks, as the level keeps them
- * (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo given:
- * rbo -= A_bf z with the new z (never both). Returns r . z. A node's t_i is read
- * (JACOBI_ADD) before any spring of this pass meets it: a spring comes after the chunk of
- * its later end. */
+ * springs' part of A z, node i's springs right after it (film_springs_upto). J = w D^-1 and
+ * N, the nodes' own blocks, as the level keeps them (single precision). With the bodies
+ * nested, zb given: t_i -= (A_fb zb)_i too; rbo given: rbo -= A_bf z with the new z (never
+ * both). Returns r . z. A node's t_i is read (JACOBI_ADD) before any spring of this pass
+ * meets it: its springs come after the node that is the later end of each. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
 static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double *restrict r,
@@ -1389,8 +1387,6 @@ static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double
     size_t l = 0;
     uint32_t sk = 0;
     for (uint32_t i = 0; i < n; i++) {
-        if (residual && i > 0 && i % WS_IMPLICIT_CHUNK == 0) /* the chunk before's springs */
-            film_springs_upto(mg, &sk, web->imp->supto[i - 1], z, t);
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
         if (how != JACOBI_NONE) {
@@ -1413,12 +1409,11 @@ static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
             if (zb)
                 bodies_to_node(mg->rig, &l, i, zb, T);
+            film_springs_upto(mg, web->ns, i, &sk, z, t);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
     }
-    if (residual)
-        film_springs_upto(mg, &sk, web->ns, z, t);
     return rz;
 }
 
