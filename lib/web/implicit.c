@@ -331,12 +331,8 @@ static inline double op_node_done(const ws_web *web, const double *restrict p, d
  * node i's own block, then the springs whose later end is i (ops, in that order), then node
  * i - slag, which no spring meets any more, finished. The springs' records are one stream
  * and each spring's second end is at most slag nodes back, so a refined film's product reads
- * its arrays once from memory instead of three times (nodes, springs, the dot product). With
- * z given, p is CG's direction made in the same pass, p_i = z_i + beta p_i as the node is
- * reached (pd and p the same array then): a spring meets its ends' new p, both at or before
- * node i. */
-static inline double op_pass(const ws_web *web, const double *z, double beta, double *pd,
-                             const double *p, double *restrict y)
+ * its arrays once from memory instead of three times (nodes, springs, the dot product). */
+double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
     const uint32_t n = web->n, ns = web->ns, lag = im->slag;
@@ -344,9 +340,6 @@ static inline double op_pass(const ws_web *web, const double *z, double beta, do
     uint32_t k = 0;
     double py = 0.0;
     for (uint32_t i = 0; i < n; i++) {
-        if (z)
-            for (size_t c = 3 * (size_t)i; c < 3 * (size_t)i + 3; c++)
-                pd[c] = z[c] + beta * pd[c];
         const double *P = p + 3 * (size_t)i, *S = nd + WS_SYM * (size_t)i;
         double *Y = y + 3 * (size_t)i;
         Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
@@ -376,11 +369,6 @@ static inline double op_pass(const ws_web *web, const double *z, double beta, do
     for (uint32_t j = n > lag ? n - lag : 0; j < n; j++)
         py += op_node_done(web, p, y, j);
     return py;
-}
-
-double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
-{
-    return op_pass(web, NULL, 0.0, NULL, p, y);
 }
 
 /* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
@@ -637,9 +625,8 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         meas = NAN; /* a NaN row is never met */
     memcpy(p, z, m * sizeof(double));
     int it = 0;
-    double beta = 0.0; /* after the first iteration, the film's p = z + beta p is made in A p */
     while (!(meas <= lim) && it < web->solver_maxit) {
-        const double pq = op_pass(web, it ? z : NULL, beta, p, p, q) +
+        const double pq = ws_implicit_apply_op(web, p, q) +
                           (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
             break; /* not positive definite along p, or NaN: no progress possible */
@@ -659,8 +646,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         meas = !isfinite(rr) ? NAN : im->stop_relative ? rr : w2;
         it++;
         const double rz1 = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
-        beta = rz1 / rz;
+        const double beta = rz1 / rz;
         rz = rz1;
+        for (size_t j = 0; j < m; j++)
+            p[j] = z[j] + beta * p[j];
         if (R)
             ws_rigid_direction(R, beta);
     }
