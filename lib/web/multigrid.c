@@ -277,16 +277,11 @@ static void galerkin_springs(ws_mg *mg, const ws_web *web, double h)
     const mg_level *c = &mg->lv[1];
     memset(mg->sacc, 0, STEN * (size_t)c->n * sizeof(double));
     pmap p, q, d;
-    for (uint32_t k = 0; k < web->ns; k++) { /* the film level's records, in im->sord's order */
-        const uint32_t s = im->sord[k], ends[2] = {web->sa[s], web->sb[s]};
-        const ws_ispring *sp = &im->sp[s];
-        float *o = mg->fop + FOP * (size_t)k;
-        o[0] = (float)sp->ex, o[1] = (float)sp->ey, o[2] = (float)sp->ez;
-        o[3] = (float)sp->a, o[4] = (float)sp->b;
-        memcpy(o + FOP_A, ends, sizeof ends);
-    }
     for (uint32_t s = 0; s < web->ns; s++) {
         const ws_ispring *k = &im->sp[s];
+        float *o = mg->fop + FOP * (size_t)s;
+        o[0] = (float)k->ex, o[1] = (float)k->ey, o[2] = (float)k->ez;
+        o[3] = (float)k->a, o[4] = (float)k->b;
         if (k->a == 0.0 && k->b == 0.0)
             continue;
         const double S[WS_SYM] = {[WS_SYM_XX] = k->a * k->ex * k->ex + k->b,
@@ -1215,64 +1210,14 @@ static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, cons
     }
 }
 
-/* t -= the springs' part of A z for the film level's springs from record *k on whose later
- * end is at most i (the records in the order of their later ends, web/implicit.h's sord),
- * the cursor *k left at the first spring past i. The blocks as the level keeps them (e, a, b
- * in single precision). Taken by the node passes right after node i, so that a pass reads
- * the springs' records as one stream and meets z and t while their rows are in the cache. */
-static inline void film_springs_upto(const ws_mg *mg, uint32_t ns, uint32_t i, uint32_t *k,
-                                     const double *restrict z, double *restrict t)
-{
-    for (; *k < ns; (*k)++) {
-        const float *q = mg->fop + FOP * (size_t)*k; /* ex ey ez a b, ends */
-        uint32_t ia, ib;
-        memcpy(&ia, q + FOP_A, sizeof ia);
-        memcpy(&ib, q + FOP_B, sizeof ib);
-        if (ia > i || ib > i)
-            return;
-        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
-        const double *A = z + 3 * (size_t)ia, *B = z + 3 * (size_t)ib;
-        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
-        const double ed = a * (ex * dx + ey * dy + ez * dz);
-        const double tx = ed * ex + b * dx, ty = ed * ey + b * dy, tz = ed * ez + b * dz;
-        double *TA = t + 3 * (size_t)ia, *TB = t + 3 * (size_t)ib;
-        TA[0] -= tx;
-        TA[1] -= ty;
-        TA[2] -= tz;
-        TB[0] += tx;
-        TB[1] += ty;
-        TB[2] += tz;
-    }
-}
-
-/* The last half-sweep at film node j, once t_j = (r - A z)_j is whole: z_j += w D_j^-1 t_j;
- * returns r_j . z_j. */
-static inline double film_last(const ws_mg *mg, uint32_t j, const double *restrict r,
-                               const double *restrict t, double *restrict z)
-{
-    const float *J = mg->fpinv + WS_SYM * (size_t)j;
-    const double *T = t + 3 * (size_t)j, *R = r + 3 * (size_t)j;
-    double *Z = z + 3 * (size_t)j;
-    const double xx = J[WS_SYM_XX], yy = J[WS_SYM_YY], zz = J[WS_SYM_ZZ], xy = J[WS_SYM_XY],
-                 xz = J[WS_SYM_XZ], yz = J[WS_SYM_YZ];
-    Z[0] += xx * T[0] + xy * T[1] + xz * T[2];
-    Z[1] += xy * T[0] + yy * T[1] + yz * T[2];
-    Z[2] += xz * T[0] + yz * T[1] + zz * T[2];
-    return R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
-}
-
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
- * interpolated along y into mg->row, then along x. On the film's level (r given) the product
- * that follows is taken on the way, t = r - A x (with the bodies nested, zb given, t -= A_fb
- * zb too), each node's springs after it; with rz given, the last half-sweep too, z += w D^-1
- * t, at each node that no spring meets any more, and r . z into *rz. */
+ * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
+ * of the product that follows is taken on the way: t = r - N x, and with the bodies nested
+ * (zb given) t -= A_fb zb. */
 static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
-                        double *t, const double *zb, double *rz)
+                        double *t, const double *zb)
 {
     size_t l = 0;
-    uint32_t sk = 0;
-    const uint32_t lag = r ? web->imp->slag : 0;
-    double sum = 0.0;
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
     double *u = mg->row;
@@ -1307,16 +1252,8 @@ static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, co
                 fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
                 if (zb)
                     bodies_to_node(mg->rig, &l, i, zb, T);
-                film_springs_upto(mg, web->ns, i, &sk, x, t);
-                if (rz && i >= lag)
-                    sum += film_last(mg, i - lag, r, t, x);
             }
         }
-    }
-    if (rz) {
-        for (uint32_t j = web->n > lag ? web->n - lag : 0; j < web->n; j++)
-            sum += film_last(mg, j, r, t, x);
-        *rz = sum;
     }
 }
 
@@ -1363,29 +1300,25 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
     gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
-    prolong_add(mg, web, k, L->x, NULL, NULL, NULL, NULL);
+    prolong_add(mg, web, k, L->x, NULL, NULL, NULL);
     for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
         L->xb[q] += mg->lv[k + 1].xb[q];
     gauss_seidel_backward(mg, L);
 }
 
-/* The film level's pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
- * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i and the
- * springs' part of A z, node i's springs right after it (film_springs_upto). J = w D^-1 and
- * N, the nodes' own blocks, as the level keeps them (single precision). With the bodies
- * nested, zb given: t_i -= (A_fb zb)_i too; rbo given: rbo -= A_bf z with the new z (never
- * both). Returns r . z. A node's t_i is read (JACOBI_ADD) before any spring of this pass
- * meets it: its springs come after the node that is the later end of each. */
+/* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
+ * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
+ * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
+ * them (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo
+ * given: rbo -= A_bf z with the new z (never both). Returns r . z. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
-static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double *restrict r,
+static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
                                 double *restrict t, double *restrict z, int how, int residual,
                                 const double *zb, double *rbo)
 {
-    const uint32_t n = web->n;
     double rz = 0.0;
     size_t l = 0;
-    uint32_t sk = 0;
     for (uint32_t i = 0; i < n; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
@@ -1409,7 +1342,6 @@ static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
             if (zb)
                 bodies_to_node(mg->rig, &l, i, zb, T);
-            film_springs_upto(mg, web->ns, i, &sk, z, t);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
@@ -1417,35 +1349,63 @@ static inline double film_nodes(const ws_mg *mg, const ws_web *web, const double
     return rz;
 }
 
+/* t -= the springs' part of A z, with the springs' blocks as the level keeps them (e, a, b in
+ * single precision). */
+static void film_springs(const ws_mg *mg, const ws_web *web, const double *restrict z,
+                         double *restrict t)
+{
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const float *q = mg->fop + FOP * (size_t)s; /* ex ey ez a b, ends */
+        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
+        uint32_t ia, ib;
+        memcpy(&ia, q + FOP_A, sizeof ia);
+        memcpy(&ib, q + FOP_B, sizeof ib);
+        const double *A = z + 3 * (size_t)ia, *B = z + 3 * (size_t)ib;
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double ed = a * (ex * dx + ey * dy + ez * dz);
+        const double tx = ed * ex + b * dx, ty = ed * ey + b * dy, tz = ed * ez + b * dz;
+        double *TA = t + 3 * (size_t)ia, *TB = t + 3 * (size_t)ib;
+        TA[0] -= tx;
+        TA[1] -= ty;
+        TA[2] -= tz;
+        TB[0] += tx;
+        TB[1] += ty;
+        TB[2] += tz;
+    }
+}
+
 /* z = B r (and zb = B rb with bodies nested): on the film's level mg->sweeps Jacobi sweeps
  * from zero (the bodies held at zero), the residual restricted (the bodies' with it), the
  * coarse cycle, its correction interpolated, mg->sweeps sweeps more against the bodies'
- * correction. Each sweep's product is one pass over the nodes with their springs (which
- * also finishes the sweep before). */
+ * correction. Each sweep's product is the node pass (which also finishes the sweep before)
+ * and the springs' pass. */
 static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, const double *rb,
                     double *zb)
 {
     double *t = mg->lv[0].t;
+    const uint32_t n = web->n;
     const size_t nb6 = 6 * (size_t)mg->nb;
     /* The bodies' right-hand side for level 1, rb - A_bf z, taken with the last pre-sweep's z. */
     double *rbo = nb6 ? mg->lv[1].rb : NULL;
     if (nb6)
         memcpy(rbo, rb, nb6 * sizeof(double));
-    (void)film_nodes(mg, web, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
-    for (int s = 1; s < mg->sweeps; s++) /* after it, t = r - A z */
-        (void)film_nodes(mg, web, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
+    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
+    film_springs(mg, web, z, t);
+    for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
+        film_springs(mg, web, z, t);
+    }
     restrict_to(mg, web, 0, t);
     cycle(mg, web, 1);
     if (nb6)
         memcpy(zb, mg->lv[1].xb, nb6 * sizeof(double));
-    /* and t = r - A z - A_fb zb; with one sweep, the last half-sweep and r . z in the same
-     * pass */
-    double rz = 0.0;
-    prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL, mg->sweeps == 1 ? &rz : NULL);
-    for (int s = 1; s < mg->sweeps; s++)
-        (void)film_nodes(mg, web, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
-    if (mg->sweeps > 1)
-        rz = film_nodes(mg, web, r, t, z, JACOBI_ADD, 0, NULL, NULL);
+    prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL); /* and t = r - N z - A_fb zb */
+    film_springs(mg, web, z, t);
+    for (int s = 1; s < mg->sweeps; s++) {
+        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
+        film_springs(mg, web, z, t);
+    }
+    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0, NULL, NULL);
     for (size_t q = 0; q < nb6; q++)
         rz += rb[q] * zb[q];
     return rz;
@@ -1619,6 +1579,10 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     double *q = blk;
     float *fq = fblk;
     mg->fop = fq, fq += FOP * (size_t)(web->ns ? web->ns : 1);
+    for (uint32_t s = 0; s < web->ns; s++) { /* the ends, fixed for the web */
+        memcpy(mg->fop + FOP * (size_t)s + FOP_A, &web->sa[s], sizeof(uint32_t));
+        memcpy(mg->fop + FOP * (size_t)s + FOP_B, &web->sb[s], sizeof(uint32_t));
+    }
     mg->fnd = fq, fq += WS_SYM * (size_t)web->n;
     mg->fpinv = fq, fq += WS_SYM * (size_t)web->n;
     mg->lv[0].t = q, q += 3 * (size_t)web->n;
