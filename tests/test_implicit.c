@@ -2247,137 +2247,9 @@ START_TEST(test_stop_on_rows)
 }
 END_TEST
 
-/* y = A p, the film's operator of the running solve, its springs taken in the web's order
- * (im->op) after every node's own block, as the coarse set-up (web/coupled.c) sums them:
- * ws_implicit_apply_op takes the same terms in the order of the springs' later ends, which
- * rounds differently. */
-static void apply_op_web_order(const ws_web *web, const double *p, double *y)
-{
-    const ws_implicit *im = web->imp;
-    for (uint32_t i = 0; i < web->n; i++) {
-        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
-        double *Y = y + 3 * (size_t)i;
-        Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
-        Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
-        Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
-    }
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const double *q = im->op + 5 * (size_t)s;
-        const double *A = p + 3 * (size_t)web->sa[s], *B = p + 3 * (size_t)web->sb[s];
-        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
-        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
-        const double t[3] = {ed * q[0] + q[4] * dx, ed * q[1] + q[4] * dy, ed * q[2] + q[4] * dz};
-        double *YA = y + 3 * (size_t)web->sa[s], *YB = y + 3 * (size_t)web->sb[s];
-        for (int c = 0; c < 3; c++) {
-            YA[c] += t[c];
-            YB[c] -= t[c];
-        }
-    }
-    for (uint32_t i = 0; i < web->n; i++)
-        if (web->inv_m[i] == 0.0)
-            y[3 * i] = y[3 * i + 1] = y[3 * i + 2] = 0.0;
-}
-
-/* The size of every term apply_op_web_order sums into y, node by node: |N_i| |p_i| and each
- * spring's |t| at both ends (the bound of a reordered sum's rounding). Into a (n). */
-static void apply_op_terms(const ws_web *web, const double *p, double *a)
-{
-    const ws_implicit *im = web->imp;
-    for (uint32_t i = 0; i < web->n; i++) {
-        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
-        a[i] = (fabs(S[WS_SYM_XX]) + fabs(S[WS_SYM_XY]) + fabs(S[WS_SYM_XZ]) + fabs(S[WS_SYM_YY]) +
-                fabs(S[WS_SYM_YZ]) + fabs(S[WS_SYM_ZZ])) *
-               (fabs(P[0]) + fabs(P[1]) + fabs(P[2]));
-    }
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const double *q = im->op + 5 * (size_t)s;
-        const double *A = p + 3 * (size_t)web->sa[s], *B = p + 3 * (size_t)web->sb[s];
-        const double d = fabs(A[0] - B[0]) + fabs(A[1] - B[1]) + fabs(A[2] - B[2]);
-        const double t = (fabs(q[3]) + fabs(q[4])) * d;
-        a[web->sa[s]] += t;
-        a[web->sb[s]] += t;
-    }
-}
-
-/* ws_implicit_apply_op against the product in the web's order on web's running operator:
- * the springs' order (ws_springs_by_later_end: each spring once, later ends ascending, the
- * gap `lag`), then y and p . y for a random p. */
-static void operator_one_pass(const ws_web *web, uint32_t lag, const char *what)
-{
-    const ws_implicit *im = web->imp;
-    const uint32_t n = web->n, ns = web->ns;
-    unsigned char *seen = calloc(ns, 1);
-    ck_assert(seen);
-    uint32_t prev = 0;
-    for (uint32_t k = 0; k < ns; k++) {
-        const uint32_t s = im->sord[k], a = web->sa[s], b = web->sb[s];
-        const uint32_t hi = a > b ? a : b;
-        ck_assert_msg(s < ns && !seen[s], "%s: spring %u twice in the order", what, s);
-        seen[s] = 1;
-        ck_assert_msg(hi >= prev, "%s: later ends not ascending at %u", what, k);
-        prev = hi;
-    }
-    free(seen);
-    ck_assert_msg(im->slag == lag, "%s: gap %u, expected %u", what, im->slag, lag);
-    double *p = malloc(3 * (size_t)n * sizeof(double)), *y = malloc(3 * (size_t)n * sizeof(double));
-    double *yw = malloc(3 * (size_t)n * sizeof(double)), *a = malloc(n * sizeof(double));
-    ck_assert(p && y && yw && a);
-    random_vector(web, 17, p);
-    const double py = ws_implicit_apply_op(web, p, y);
-    apply_op_web_order(web, p, yw);
-    apply_op_terms(web, p, a);
-    double worst = 0.0, pa = 0.0;
-    uint32_t pinned = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        pa += a[i] * (fabs(p[3 * i]) + fabs(p[3 * i + 1]) + fabs(p[3 * i + 2]));
-        if (web->inv_m[i] == 0.0) {
-            pinned++;
-            for (int c = 0; c < 3; c++)
-                ck_assert_msg(y[3 * i + c] == 0.0, "%s: pinned node %u's y not zero", what, i);
-            continue;
-        }
-        for (int c = 0; c < 3; c++)
-            worst = fmax(worst, fabs(y[3 * i + c] - yw[3 * i + c]) / (DBL_EPSILON * a[i]));
-    }
-    const double pyw = dot3(p, yw, n);
-    report("operator in one pass, %s: %u nodes (%u pinned), %u springs, gap %u: y within %.2f "
-           "eps of its terms' sizes, p.y %.17g against %.17g",
-           what, n, pinned, ns, im->slag, worst, py, pyw);
-    ck_assert_msg(worst <= 16.0, "%s: y differs by %g eps of its terms", what, worst);
-    ck_assert_msg(fabs(py - pyw) <= 16.0 * DBL_EPSILON * pa, "%s: p.y %.17g against %.17g", what,
-                  py, pyw);
-    free(p);
-    free(y);
-    free(yw);
-    free(a);
-}
-
-START_TEST(test_operator_one_pass)
-{
-    /* The film's product A p in one pass over the nodes (each node's springs taken after its
-     * later end, the node finished once no spring meets it) sums the terms of the product in
-     * the web's order, only in another order: every row within a few roundings of its terms'
-     * sizes (at most 9 terms a row, a spring's sum rounded once; 16 eps is room for twice
-     * that), pinned rows exactly zero, p . y to the same measure. On a sheet with shear
-     * springs and a pinned edge (gap nx + 1: a diagonal spring) and on a closed band (gap nx:
-     * an up spring; the spring closing a row around spans nx - 1). */
-    ws_web_id id;
-    ws_status st;
-    ws_world *w = choice_drum(14, 11, WS_WEB_PRECONDITIONER_BLOCK_JACOBI, 1e-3, &id, &st);
-    ck_assert_ptr_nonnull(w);
-    ck_ok(w, ws_world_step_n(w, 4));
-    operator_one_pass(web_of(w, id), 14 + 1, "sheet 14 x 11");
-    ws_world_destroy(w);
-    ws_web *web;
-    w = band_begun(1, 0.02, &web);
-    operator_one_pass(web, (uint32_t)web->nx, "band");
-    ws_world_destroy(w);
-}
-END_TEST
-
 /* Phi^T A Phi column by column, as the coarse space's set-up computed it before it took the
  * columns of a body at once: Phi e_c into the film (each node once a body), the coupled
- * operator (apply_op_web_order, ws_rigid_apply), Phi^T of the result; symmetrised by the
+ * operator (ws_implicit_apply_op, ws_rigid_apply), Phi^T of the result; symmetrised by the
  * mean. Into A (nc x nc). */
 static void coarse_by_columns(const ws_rigid *R, const ws_web *web, double *A)
 {
@@ -2396,7 +2268,7 @@ static void coarse_by_columns(const ws_rigid *R, const ws_web *web, double *A)
             double *y = fa + 3 * (size_t)R->phi_node[k];
             y[0] += u.x, y[1] += u.y, y[2] += u.z;
         }
-        apply_op_web_order(web, fa, fb);
+        (void)ws_implicit_apply_op(web, fa, fb);
         (void)ws_rigid_apply(R, web, fa, cb, fb, cq);
         for (size_t k = 0; k < R->nphi; k++) {
             const double *f = fb + 3 * (size_t)R->phi_node[k], *r = R->phi_lever + 3 * k;
@@ -2754,7 +2626,6 @@ int main(void)
     add_case(s, "band_bodies_nested", test_band_bodies_nested, 60);
     add_case(s, "stop_on_rows", test_stop_on_rows, 30);
     add_case(s, "coarse_setup", test_coarse_setup, 20);
-    add_case(s, "operator_one_pass", test_operator_one_pass, 20);
     add_case(s, "body_friction_in_solve", test_body_friction_in_solve, 20);
     add_case(s, "body_friction_dissipates", test_body_friction_dissipates, 20);
     return run_suite(s);

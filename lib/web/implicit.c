@@ -12,46 +12,10 @@
 #define VEC(n) (3 * (size_t)(n))
 #define SYMS(n) (WS_SYM * (size_t)(n))
 #define OPS(ns) (5 * (size_t)((ns) ? (ns) : 1))
-#define REC 6 /* doubles of a spring's record in ops: ex ey ez a b, then its ends */
-#define RECS(ns) (REC * (size_t)((ns) ? (ns) : 1))
-#define SPRINGS(ns) ((size_t)((ns) ? (ns) : 1))
 
 static size_t scratch_doubles(uint32_t n)
 {
     return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
-}
-
-uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *cnt, uint32_t *ord)
-{
-    const uint32_t n = web->n, ns = web->ns;
-    uint32_t lag = 0;
-    memset(cnt, 0, ((size_t)n + 1) * sizeof *cnt);
-    for (uint32_t s = 0; s < ns; s++) {
-        const uint32_t a = web->sa[s], b = web->sb[s];
-        const uint32_t hi = a > b ? a : b, lo = a > b ? b : a;
-        cnt[hi + 1]++;
-        if (hi - lo > lag)
-            lag = hi - lo;
-    }
-    for (uint32_t i = 0; i < n; i++) /* cnt[i]: the first place of the springs ending at i */
-        cnt[i + 1] += cnt[i];
-    for (uint32_t s = 0; s < ns; s++) {
-        const uint32_t a = web->sa[s], b = web->sb[s];
-        ord[cnt[a > b ? a : b]++] = s;
-    }
-    return lag;
-}
-
-/* The implicit scratch's own arrays freed (each may be NULL), then im. */
-static void scratch_free(ws_mem *mem, ws_implicit *im, double *blk)
-{
-    const uint32_t n = im->n, ns = im->ns;
-    ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
-    ws_mem_free(mem, im->sp, im->sp ? SPRINGS(ns) * sizeof(ws_ispring) : 0);
-    ws_mem_free(mem, im->op, im->op ? OPS(ns) * sizeof(double) : 0);
-    ws_mem_free(mem, im->ops, im->ops ? RECS(ns) * sizeof(double) : 0);
-    ws_mem_free(mem, im->sord, im->sord ? SPRINGS(ns) * sizeof(uint32_t) : 0);
-    ws_mem_free(mem, im, sizeof *im);
 }
 
 int ws_implicit_reserve(ws_mem *mem, ws_web *web)
@@ -62,25 +26,20 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     if (!im)
         return -1;
     const uint32_t n = web->n, ns = web->ns;
-    im->n = n;
-    im->ns = ns;
     double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
-    im->sp = ws_mem_calloc(mem, SPRINGS(ns), sizeof(ws_ispring));
-    im->op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
-    im->ops = ws_mem_calloc(mem, RECS(ns), sizeof(double));
-    im->sord = ws_mem_calloc(mem, SPRINGS(ns), sizeof(uint32_t));
-    uint32_t *cnt = ws_mem_calloc(mem, (size_t)n + 1, sizeof(uint32_t));
-    if (!blk || !im->sp || !im->op || !im->ops || !im->sord || !cnt) {
-        ws_mem_free(mem, cnt, cnt ? ((size_t)n + 1) * sizeof(uint32_t) : 0);
-        scratch_free(mem, im, blk);
+    ws_ispring *sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
+    double *op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
+    if (!blk || !sp || !op) {
+        ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
+        ws_mem_free(mem, sp, sp ? (ns ? ns : 1) * sizeof(ws_ispring) : 0);
+        ws_mem_free(mem, op, op ? OPS(ns) * sizeof(double) : 0);
+        ws_mem_free(mem, im, sizeof *im);
         return -1;
     }
-    im->slag = ws_springs_by_later_end(web, cnt, im->sord);
-    ws_mem_free(mem, cnt, ((size_t)n + 1) * sizeof(uint32_t));
-    for (uint32_t k = 0; k < ns; k++) { /* the ends, fixed for the web */
-        const uint32_t s = im->sord[k], ends[2] = {web->sa[s], web->sb[s]};
-        memcpy(im->ops + REC * (size_t)k + 5, ends, sizeof ends);
-    }
+    im->n = n;
+    im->ns = ns;
+    im->sp = sp;
+    im->op = op;
     double *q = blk;
     im->f = q, q += VEC(n);
     im->b = q, q += VEC(n);
@@ -95,7 +54,10 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->pinv = q, q += SYMS(n);
     im->nd = q;
     if (ws_mg_reserve(mem, web, &im->mg) != 0) {
-        scratch_free(mem, im, blk);
+        ws_mem_free(mem, blk, scratch_doubles(n) * sizeof(double));
+        ws_mem_free(mem, sp, (ns ? ns : 1) * sizeof(ws_ispring));
+        ws_mem_free(mem, op, OPS(ns) * sizeof(double));
+        ws_mem_free(mem, im, sizeof *im);
         return -1;
     }
     web->imp = im;
@@ -108,7 +70,10 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     if (!im)
         return;
     ws_mg_free(mem, im->mg);
-    scratch_free(mem, im, im->f);
+    ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
+    ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
+    ws_mem_free(mem, im->op, OPS(im->ns) * sizeof(double));
+    ws_mem_free(mem, im, sizeof *im);
     web->imp = NULL;
 }
 
@@ -298,11 +263,6 @@ static void operator_for(const ws_web *web, double h)
         double *o = im->op + 5 * (size_t)s;
         o[0] = q->ex, o[1] = q->ey, o[2] = q->ez, o[3] = q->a, o[4] = q->b;
     }
-    for (uint32_t k = 0; k < web->ns; k++) {
-        const ws_ispring *q = &im->sp[im->sord[k]];
-        double *o = im->ops + REC * (size_t)k;
-        o[0] = q->ex, o[1] = q->ey, o[2] = q->ez, o[3] = q->a, o[4] = q->b;
-    }
     for (uint32_t i = 0; i < web->n; i++) {
         double *S = im->nd + WS_SYM * (size_t)i;
         const double *kc = im->kc + WS_SYM * (size_t)i, *dc = im->dc + WS_SYM * (size_t)i;
@@ -315,59 +275,47 @@ static void operator_for(const ws_web *web, double h)
     }
 }
 
-/* Node j's product finished: zero at a pinned node (its p is zero, the preconditioner's
- * is), and p_j . y_j returned. */
-static inline double op_node_done(const ws_web *web, const double *restrict p, double *restrict y,
-                                  uint32_t j)
-{
-    double *Y = y + 3 * (size_t)j;
-    const double *P = p + 3 * (size_t)j;
-    if (!web->same_inv_m && web->inv_m[j] == 0.0)
-        Y[0] = Y[1] = Y[2] = 0.0;
-    return P[0] * Y[0] + P[1] * Y[1] + P[2] * Y[2];
-}
-
-/* y = A p with the parts operator_for set, and p . y returned, in one pass over the nodes:
- * node i's own block, then the springs whose later end is i (ops, in that order), then node
- * i - slag, which no spring meets any more, finished. The springs' records are one stream
- * and each spring's second end is at most slag nodes back, so a refined film's product reads
- * its arrays once from memory instead of three times (nodes, springs, the dot product). */
+/* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
+ * preconditioner is), so its y is not needed: it is set to zero. */
 double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
-    const uint32_t n = web->n, ns = web->ns, lag = im->slag;
-    const double *restrict nd = im->nd, *restrict q = im->ops;
-    uint32_t k = 0;
-    double py = 0.0;
+    const uint32_t n = web->n;
     for (uint32_t i = 0; i < n; i++) {
-        const double *P = p + 3 * (size_t)i, *S = nd + WS_SYM * (size_t)i;
+        const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
         double *Y = y + 3 * (size_t)i;
         Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
         Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
         Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
-        for (; k < ns; k++, q += REC) {
-            uint32_t e[2];
-            memcpy(e, q + 5, sizeof e);
-            if (e[0] > i || e[1] > i)
-                break;
-            const double *A = p + 3 * (size_t)e[0], *B = p + 3 * (size_t)e[1];
-            const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
-            const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
-            const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
-                         tz = ed * q[2] + q[4] * dz;
-            double *YA = y + 3 * (size_t)e[0], *YB = y + 3 * (size_t)e[1];
-            YA[0] += tx;
-            YA[1] += ty;
-            YA[2] += tz;
-            YB[0] -= tx;
-            YB[1] -= ty;
-            YB[2] -= tz;
-        }
-        if (i >= lag)
-            py += op_node_done(web, p, y, i - lag);
     }
-    for (uint32_t j = n > lag ? n - lag : 0; j < n; j++)
-        py += op_node_done(web, p, y, j);
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
+        const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
+        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
+        const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
+                     tz = ed * q[2] + q[4] * dz;
+        double *YA = y + 3 * (size_t)sa[s], *YB = y + 3 * (size_t)sb[s];
+        YA[0] += tx;
+        YA[1] += ty;
+        YA[2] += tz;
+        YB[0] -= tx;
+        YB[1] -= ty;
+        YB[2] -= tz;
+    }
+    double py = 0.0;
+    if (web->same_inv_m) { /* no pinned node */
+        for (size_t j = 0; j < VEC(n); j++)
+            py += p[j] * y[j];
+        return py;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        double *Y = y + 3 * (size_t)i;
+        if (web->inv_m[i] == 0.0)
+            Y[0] = Y[1] = Y[2] = 0.0;
+        py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
+    }
     return py;
 }
 

@@ -36,16 +36,8 @@ typedef struct ws_implicit {
     double *fs;      /* the same without the contacts (ws_implicit_reset) */
     double *kc, *dc; /* per node, symmetric: -df/dx and -df/dv of its contacts */
     ws_ispring *sp;  /* per spring */
-    double *op;      /* per spring, the solve's A block, packed: e and a, b of ws_ispring (5
-                        doubles a spring, in the web's order; web/coupled.c reads it) */
-    /* The springs in the order of their later end (ws_springs_by_later_end, made at reserve):
-     * sord[k] is the k-th spring, slag the largest gap between a spring's two ends. ops: the
-     * solve's A block of spring sord[k] at record k, e, a, b and then its two ends (uint32_t,
-     * in the sixth double), so that ws_implicit_apply_op reads one stream a pass and finishes
-     * each node's product while its rows are still in the cache. */
-    uint32_t *sord;
-    uint32_t slag;
-    double *ops;
+    double *op;      /* per spring, the solve's A block as its products read it, packed: e and
+                        a, b of ws_ispring (5 doubles a spring; ws_implicit_apply_op) */
     double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
     double *pinv;    /* per node: the inverse of A's diagonal block (symmetric) */
     double *nd;      /* per node: A's own part of the node, M + h (drag + dc) + h^2 kc (the
@@ -75,13 +67,6 @@ typedef struct ws_implicit {
      * turning rows in N^2 m^2 s^2). Filled at the end of every solve, for a bench. */
     double last_worst[3], last_rr[3];
 } ws_implicit;
-
-/* The web's springs ordered by their later end, max(sa, sb), ascending (ties in the web's
- * order) into ord (ns entries); returns the largest gap between a spring's two ends (0 with
- * no springs). A pass over the nodes in order that takes, after node i, the springs whose
- * later end is i has then met every spring of node j once it is past node j + the gap. cnt:
- * scratch of n + 1 counts. */
-uint32_t ws_springs_by_later_end(const ws_web *web, uint32_t *cnt, uint32_t *ord);
 
 /* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
 int ws_implicit_reserve(ws_mem *mem, ws_web *web);
