@@ -1324,6 +1324,73 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
 }
 END_TEST
 
+/* The report of the node contact forces holds the last step's contacts alone: a sheet pressed
+ * on a box, the box then taken away (10 m aside, between steps), and the sheet's nodes in free
+ * fall for two steps, which write each of the report's two buffers once: every node's
+ * contact force must then be zero exactly (a force left from the steps on the box, in either
+ * buffer, is up to some N). On 1 and 2 workers (one sweep lane, or four). */
+START_TEST(contact_forces_end_with_the_contacts)
+{
+    for (int workers = 1; workers <= 2; workers++) {
+        ws_world_def d;
+        ws_world_def_init(&d);
+        d.dt = 2.5e-4;
+        d.worker_count = (uint32_t)workers;
+        ws_world *w = NULL;
+        ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+        const ws_body_id box =
+            add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.5}, no_material(), "box");
+        ws_pose held = {{0.0, 0.0, 0.5}, {1.0, 0.0, 0.0, 0.0}};
+        ws_web_def wd;
+        soft_film(w, &wd);
+        ws_sheet_def sd;
+        ws_sheet_def_init(&sd);
+        sd.nx = 48;
+        sd.ny = 40; /* 5 sweep blocks of 8 rows */
+        sd.spacing_x = sd.spacing_y = 0.0125;
+        sd.origin = (ws_vec3){-0.2975, -0.24375, 0.653};
+        ws_web_id web;
+        ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+        double S;
+        ck_ok(w, ws_web_get_stable_dt(w, web, &S));
+        const int n = (int)ceil(2.1 * d.dt / S);
+        ck_ok(w, ws_web_set_substeps(w, web, n < 1 ? 1 : n));
+        const size_t nn = 48 * 40;
+        double *fc = malloc(3 * nn * sizeof *fc);
+        ck_assert(fc);
+        size_t got;
+        double most = 0.0;
+        for (int k = 0; k < 200; k++) { /* the box held still, the sheet dropped on it */
+            ck_ok(w, ws_body_set_pose(w, box, &held));
+            ck_ok(w, ws_body_set_velocity(w, box, &(ws_vec3){0, 0, 0}, &(ws_vec3){0, 0, 0}));
+            ck_ok(w, ws_world_step(w));
+        }
+        ck_ok(w, ws_web_copy_contact_forces(w, web, fc, nn, &got));
+        for (size_t i = 0; i < 3 * nn; i++)
+            most = fmax(most, fabs(fc[i]));
+        ck_assert_msg(most > 1e-3, "the sheet never pressed on the box (%g N)", most);
+        const ws_pose away = {{10.0, 0.0, 0.5}, {1.0, 0.0, 0.0, 0.0}};
+        ck_ok(w, ws_body_set_pose(w, box, &away));
+        for (int k = 0; k < 2; k++) {
+            ck_ok(w, ws_world_step(w));
+            ck_ok(w, ws_web_copy_contact_forces(w, web, fc, nn, &got));
+            size_t left = 0;
+            for (size_t i = 0; i < 3 * nn; i++)
+                left += fc[i] != 0.0;
+            ck_assert_msg(left == 0,
+                          "%d workers, step %d after the box left: %zu components of the "
+                          "node contact forces not zero (before: up to %g N)",
+                          workers, k + 1, left, most);
+        }
+        report("contact forces end with the contacts (%d workers): up to %.3g N on the box, "
+               "all zero after it left",
+               workers, most);
+        free(fc);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("detection");
@@ -1345,6 +1412,7 @@ int main(void)
     tcase_add_test(tc, well_inside_takes_the_projection);
     tcase_add_test(tc, nodes_moved_relative_to_the_reference_are_flagged);
     tcase_add_test(tc, merged_candidates_equal_the_list_they_stand_for);
+    tcase_add_test(tc, contact_forces_end_with_the_contacts);
     suite_add_tcase(s, tc);
     return run_suite(s);
 }

@@ -344,8 +344,6 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
             ws_lane_set(&G[(j - 1) >> 2].k, (j - 1) & 3, k);
     }
     act_friction(ng, h, share, G);
-    uint32_t *touched = web->fct[web->fck];
-    size_t nt = web->nfct[web->fck];
     for (size_t q = 0; q < m; q++) {
         const act_group *e = &G[q >> 2];
         const size_t l = q & 3;
@@ -353,11 +351,9 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
         const v3 Fb = ws_lane(&e->b, l);
         nodes_add(f, i, ws_lane(&e->a, l));
         fc[i] = v3_sub(fc[i], Fb); /* the share of the contact force: -Fb, to the bit */
-        touched[nt++] = i;
         L->load[at] = (act_load){Fb, ws_lane(&e->mm, l)};
         L->lbody[at] = L->body[q];
     }
-    web->nfct[web->fck] = nt;
     L->n = 0;
 }
 
@@ -694,8 +690,7 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
     run_apply(B->n, B->grp, f.x, f.y, f.z, share, T);
     act_list *L = E->L;
     act_load *load = L->load;
-    uint32_t *touched = web->fct[web->fck], *lbody = L->lbody;
-    size_t nt = web->nfct[web->fck];
+    uint32_t *lbody = L->lbody;
     for (size_t g = 0; g < B->n; g++) {
         const run_group *G = &B->grp[g];
         /* Read here: as far as the compiler knows, the stores below could change them. */
@@ -706,12 +701,10 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
             const size_t e = 4 * g + l;
             const v3 Fb = tmp_get(T->b, e);
             fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
-            touched[nt++] = i;
             load[s] = (act_load){Fb, tmp_get(T->m, e)};
             lbody[s] = body;
         }
     }
-    web->nfct[web->fck] = nt;
     B->n = 0;
 }
 

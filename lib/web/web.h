@@ -77,7 +77,9 @@ typedef struct ws_web {
     int no_drag;
     v3 *fc[2];               /* contact force on each node, mean over the sub-steps */
     uint32_t *fct[2];        /* the nodes whose fc[k] may be non-zero (some more than once):
-                                zeroed at the start of a step that writes fc[k] */
+                                zeroed at the start of a step that writes fc[k]; an implicit
+                                web's (a swept web zeroes fc[k] block by block in its first
+                                sub-step, world_step.c, and lists none) */
     size_t nfct[2], fct_cap[2];
     int fck;                 /* the fc the contacts of the running step add to (scratch) */
     double *m, *inv_m;       /* inv_m = 0: pinned */

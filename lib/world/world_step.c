@@ -253,9 +253,9 @@ typedef struct lane_task {
     ws_web *web; /* read only while the lanes run: each opens its views from it (lane_open) */
     ws_node_pass pass; /* the node contacts' part (pass.x, pass.v: the state read) */
     ws_nodes3 xd, vd;  /* the state written */
-    /* The first sub-step of a step swept in lanes: each lane zeroes the contact forces of
-     * the next state in its own rows before it adds to them, so that those rows stay in its
-     * core's cache. */
+    /* The first sub-step of a step: each lane zeroes the contact forces of the next state in
+     * its own rows, a block before its contacts add to them, so that they are in its core's
+     * cache (and no list of the nodes touched is kept). */
     int zero;
     uint32_t lanes;
     /* The body part of the step, item `lanes` of the task (NULL: none in this one), and
@@ -289,8 +289,6 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     const uint32_t rows = web->nx > 0 ? (uint32_t)web->ny : 1, r = ws_web_block_rows(web);
     uint32_t n0 = web->nx > 0 ? (uint32_t)web->nx * J->r0 : 0, n1;
     size_t next = J->r0 ? ws_node_first_segment(&J->cview, n0) : 0;
-    if (T->zero)
-        memset(T->pass.fc + n0, 0, (J->cview.lane_end - n0) * sizeof(v3));
     ws_node_substep(&J->cview);
     const ws_web_pass P = {T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, w->def.max_speed};
     ws_web_sweep_begin(web, &P);
@@ -300,6 +298,8 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
         const int edges = (j == J->r0 && j > 0 ? WS_WEB_LANE_FIRST : 0) |
                           (j1 == J->r1 && j1 < rows ? WS_WEB_LANE_LAST : 0);
         ws_web_forces_rows(web, &P, j, j1, edges, &n0, &n1);
+        if (T->zero) /* where the block's contacts add first: in the cache when they do */
+            memset(T->pass.fc + n0, 0, (n1 - n0) * sizeof(v3));
         /* Each row's loads on the bodies folded apart (a mesh web's all together): rows,
          * unlike lanes, do not depend on the worker count, so neither do the totals
          * (lane_close). */
@@ -789,9 +789,9 @@ static ws_status step_webs(ws_step *S)
                            web_label(web));
         for (size_t i = 0; i < web->bcap; i++)
             web->bforce[nxt][i] = web->bmoment[nxt][i] = v3_make(0, 0, 0);
-        /* The node contact forces this step writes: zero where they were not (the nodes that
-         * had contacts when fc[nxt] was last written), or, in lanes, every one by the lane of
-         * its row (the others are zero already). */
+        /* The node contact forces this step writes: zero where they were not (an implicit
+         * web's nodes that had contacts when fc[nxt] was last written), or, swept, every one
+         * by the lane of its row in the first sub-step. */
         for (size_t q = 0; lanes == 1 && q < web->nfct[nxt]; q++)
             web->fc[nxt][web->fct[nxt][q]] = v3_make(0, 0, 0);
         web->nfct[nxt] = 0;
@@ -818,7 +818,7 @@ static ws_status step_webs(ws_step *S)
                             web->fc[nxt]},
                            xd,
                            vd,
-                           s == 0 && lanes > 1,
+                           s == 0,
                            lanes,
                            NULL,
                            0};
