@@ -4,38 +4,46 @@
 
 #include <string.h>
 
-/* J^T C J of a contact at lever r into the 6x6 block B (row-major): column k is J^T C J e_k,
- * with J e_k the contact point's velocity for a unit velocity (k < 3) or spin (k >= 3) and
- * J^T g = (g, r x g). */
-static void add_block(double *B, const double *C, v3 r)
+/* sign J_i^T C J_j into the block of bodies i (rows) and j (columns) of the n x n A (row-major):
+ * column k is J_i^T C J_j e_k, with J_j e_k body j's point at lever rj moving for a unit
+ * velocity (k < 3) or spin (k >= 3) and J_i^T g = (g, ri x g). */
+static void add_coupling(double *A, size_t n, uint32_t i, v3 ri, uint32_t j, v3 rj,
+                         const double *C, double sign)
 {
+    double *B = A + 6 * (size_t)i * n + 6 * (size_t)j;
     for (int k = 0; k < 6; k++) {
         v3 e = v3_make(k % 3 == 0, k % 3 == 1, k % 3 == 2);
-        const v3 a = k < 3 ? e : v3_cross(e, r);
+        const v3 a = k < 3 ? e : v3_cross(e, rj);
         double g[3] = {0.0, 0.0, 0.0};
         ws_sym_madd(C, a.x, a.y, a.z, g);
-        const v3 gv = v3_make(g[0], g[1], g[2]), m = v3_cross(r, gv);
+        const v3 gv = v3_make(g[0], g[1], g[2]), m = v3_cross(ri, gv);
         const double col[6] = {g[0], g[1], g[2], m.x, m.y, m.z};
-        for (int i = 0; i < 6; i++)
-            B[6 * i + k] += col[i];
+        for (int q = 0; q < 6; q++)
+            B[n * (size_t)q + (size_t)k] += sign * col[q];
     }
 }
 
-/* The lower Cholesky factor of the symmetric n x n B (row-major), in place. 0, or -1 when not
+/* The lower Cholesky factor of the symmetric n x n B (row-major), in place, over the envelope
+ * env (row i's entries before column env[i] are zero, and stay zero in the factor; NULL: all
+ * of each row): the products of zeros a dense factor would add are left out. 0, or -1 when not
  * positive definite. */
-static int cholesky(double *B, size_t n)
+static int cholesky(double *B, size_t n, const uint32_t *env)
 {
     for (size_t j = 0; j < n; j++) {
+        const size_t fj = env ? env[j] : 0;
         double d = B[n * j + j];
-        for (size_t k = 0; k < j; k++)
+        for (size_t k = fj; k < j; k++)
             d -= B[n * j + k] * B[n * j + k];
         if (!(d > 0.0) || !isfinite(d))
             return -1;
         const double l = sqrt(d);
         B[n * j + j] = l;
         for (size_t i = j + 1; i < n; i++) {
+            const size_t fi = env ? env[i] : 0;
+            if (fi > j)
+                continue; /* outside the envelope: zero */
             double s = B[n * i + j];
-            for (size_t k = 0; k < j; k++)
+            for (size_t k = fi > fj ? fi : fj; k < j; k++)
                 s -= B[n * i + k] * B[n * j + k];
             B[n * i + j] = s / l;
         }
@@ -43,56 +51,75 @@ static int cholesky(double *B, size_t n)
     return 0;
 }
 
-/* z = (L L^T)^-1 r for the factor L of cholesky (z may be r). */
-static void cholesky_solve(const double *L, size_t n, const double *r, double *z)
+/* z = (L L^T)^-1 r for the factor L of cholesky over the envelope env (NULL: none; z may be
+ * r). */
+static void cholesky_solve(const double *L, size_t n, const uint32_t *env, const double *r,
+                           double *z)
 {
     for (size_t i = 0; i < n; i++) {
         double s = r[i];
-        for (size_t k = 0; k < i; k++)
+        for (size_t k = env ? env[i] : 0; k < i; k++)
             s -= L[n * i + k] * z[k];
         z[i] = s / L[n * i + i];
     }
     for (size_t i = n; i-- > 0;) {
         double s = z[i];
         for (size_t k = i + 1; k < n; k++)
-            s -= L[n * k + i] * z[k];
+            if (!env || env[k] <= i)
+                s -= L[n * k + i] * z[k];
         z[i] = s / L[n * i + i];
     }
 }
 
 int ws_rigid_factor(ws_rigid *R)
 {
+    const size_t n = 6 * (size_t)R->nb;
+    double *A = R->abb;
+    memset(A, 0, n * n * sizeof(double));
+    const int ix[3][3] = {{WS_SYM_XX, WS_SYM_XY, WS_SYM_XZ},
+                          {WS_SYM_XY, WS_SYM_YY, WS_SYM_YZ},
+                          {WS_SYM_XZ, WS_SYM_YZ, WS_SYM_ZZ}};
     for (uint32_t j = 0; j < R->nb; j++) {
-        double *B = R->fac + 36 * (size_t)j;
+        double *B = A + 6 * (size_t)j * (n + 1);
         const double *I = R->inertia + WS_SYM * (size_t)j;
-        memset(B, 0, 36 * sizeof(double));
-        B[0] = B[7] = B[14] = R->mass[j];
-        const int ix[3][3] = {{WS_SYM_XX, WS_SYM_XY, WS_SYM_XZ},
-                              {WS_SYM_XY, WS_SYM_YY, WS_SYM_YZ},
-                              {WS_SYM_XZ, WS_SYM_YZ, WS_SYM_ZZ}};
+        B[0] = B[n + 1] = B[2 * n + 2] = R->mass[j];
         for (int i = 0; i < 3; i++)
             for (int k = 0; k < 3; k++)
-                B[6 * (3 + i) + 3 + k] = I[ix[i][k]];
+                B[n * (size_t)(3 + i) + 3 + (size_t)k] = I[ix[i][k]];
     }
-    for (size_t l = 0; l < R->nl; l++)
-        add_block(R->fac + 36 * (size_t)R->link[l].body, R->link[l].C, R->link[l].lever);
+    for (size_t l = 0; l < R->nl; l++) {
+        const ws_rigid_link *L = &R->link[l];
+        add_coupling(A, n, L->body, L->lever, L->body, L->lever, L->C, 1.0);
+    }
+    /* A pair's energy (J_b dU_b - J_a dU_a)^T C (J_b dU_b - J_a dU_a): J^T C J at each end
+     * of a body in the solve, -J_a^T C J_b and its transpose between the two. */
     for (size_t q = 0; q < R->npair; q++) {
         const ws_rigid_pair *P = &R->pair[q];
         if (P->a != UINT32_MAX)
-            add_block(R->fac + 36 * (size_t)P->a, P->C, P->ra);
+            add_coupling(A, n, P->a, P->ra, P->a, P->ra, P->C, 1.0);
         if (P->b != UINT32_MAX)
-            add_block(R->fac + 36 * (size_t)P->b, P->C, P->rb);
+            add_coupling(A, n, P->b, P->rb, P->b, P->rb, P->C, 1.0);
+        if (P->a != UINT32_MAX && P->b != UINT32_MAX && !R->apart) {
+            add_coupling(A, n, P->a, P->ra, P->b, P->rb, P->C, -1.0);
+            add_coupling(A, n, P->b, P->rb, P->a, P->ra, P->C, -1.0);
+        }
     }
-    for (uint32_t j = 0; j < R->nb; j++)
-        if (cholesky(R->fac + 36 * (size_t)j, 6) != 0)
-            return -1;
-    return 0;
+    /* Each row's envelope: a body's rows start at the first body coupled to it (itself, with
+     * no pair to an earlier one), so that the factor of bodies with no pair costs what their
+     * own blocks' do. */
+    for (size_t i = 0; i < n; i++) {
+        size_t f = 0;
+        while (f < i && A[n * i + f] == 0.0)
+            f++;
+        R->env[i] = (uint32_t)f;
+    }
+    memcpy(R->fac, A, n * n * sizeof(double));
+    return cholesky(R->fac, n, R->env);
 }
 
 void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z)
 {
-    for (uint32_t j = 0; j < R->nb; j++)
-        cholesky_solve(R->fac + 36 * (size_t)j, 6, r + 6 * (size_t)j, z + 6 * (size_t)j);
+    cholesky_solve(R->fac, 6 * (size_t)R->nb, R->env, r, z);
 }
 
 /* Row i of the symmetric S times (x, y, z): what ws_sym_madd adds, without the add to a
@@ -475,29 +502,23 @@ void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
 int ws_rigid_coarse(ws_rigid *R, const ws_web *web)
 {
     ws_rigid_coarse_matrix(R, web);
-    return cholesky(R->coarse, 6 * (size_t)R->nb);
+    return cholesky(R->coarse, 6 * (size_t)R->nb, NULL);
 }
 
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
                              double *zr)
 {
-    double rz = 0.0;
-    for (uint32_t j = 0; j < R->nb; j++) {
-        const double *L = R->fac + 36 * (size_t)j, *rv = rr + 6 * (size_t)j;
-        double *zv = zr + 6 * (size_t)j;
-        cholesky_solve(L, 6, rv, zv);
-        for (int i = 0; i < 6; i++)
-            rz += rv[i] * zv[i];
-    }
+    const size_t nc = 6 * (size_t)R->nb;
+    cholesky_solve(R->fac, nc, R->env, rr, zr);
+    double rz = ws_rigid_dot(R, rr, zr);
     if (!R->coarse)
         return rz;
     /* The coarse correction, added (two-level additive Schwarz: a sum of symmetric positive
      * (semi-)definite parts, so CG stays valid). */
-    const size_t nc = 6 * (size_t)R->nb;
     double *c = R->cq; /* free while the CG runs */
     phi_transpose(R, rf, rr, c);
     double *g = R->cb;
-    cholesky_solve(R->coarse, nc, c, g);
+    cholesky_solve(R->coarse, nc, NULL, c, g);
     for (size_t k = 0; k < nc; k++) {
         rz += c[k] * g[k];
         zr[k] += g[k];

@@ -13,8 +13,10 @@
  * solve's vectors keep their film part as before (3 doubles a node) and put the bodies' in the
  * arrays here (6 a body: velocity change, then spin change). Body contacts whose friction is
  * in the solve (ws_rigid_pair) add (J_b dU_b - J_a dU_a)^T C (J_b dU_b - J_a dU_a) between two
- * bodies' rows. The module knows no body: the world fills a body's mass, inertia and
- * right-hand side and the contacts' levers and blocks. */
+ * bodies' rows. The bodies' block A_bb (the lower right, pairs and all) is a principal block of
+ * this matrix, so positive definite with it: the preconditioner solves it whole, by its Cholesky
+ * factor, and stays symmetric positive definite. The module knows no body: the world fills a
+ * body's mass, inertia and right-hand side and the contacts' levers and blocks. */
 #ifndef WS_WEB_COUPLED_H
 #define WS_WEB_COUPLED_H
 
@@ -51,8 +53,17 @@ typedef struct ws_rigid {
     size_t npair;
     double *mass;                  /* per body: its mass, kg */
     double *inertia;               /* per body: its global inertia, symmetric (WS_SYM doubles) */
-    double *fac;                   /* per body: the Cholesky factor of its diagonal block of the
-                                      coupled matrix (36 doubles, lower triangle row-major) */
+    /* The bodies' block of the coupled matrix, A_bb = diag(M_j) + sum J^T C J over the film's
+     * contacts + the pairs' terms (both ends' diagonal blocks and, between two bodies of the
+     * solve, the off-diagonal ones), (6 nb)^2 doubles row-major, and its Cholesky factor fac
+     * (lower triangle) over the envelope env (6 nb: row i's first entry that is not zero),
+     * set by ws_rigid_factor: the bodies solved together, a pair's strong coupling with them
+     * (docs/theory.md section 8b). */
+    double *abb, *fac;
+    uint32_t *env;
+    /* Set: the pairs' off-diagonal blocks left out of abb (each body alone, as the
+     * preconditioner once had it): a test's comparison; the operator keeps them. */
+    int apart;
     double *b, *x, *r, *z, *p, *q; /* the solve's vectors, 6 a body (x: dU, kept between
                                       the solves of one step) */
     /* The coarse space of the preconditioner: a column per body and direction, the body
@@ -77,12 +88,12 @@ typedef struct ws_rigid {
  * J_b dU_b - J_a dU_a, for the bodies' velocity changes dU (6 a body). */
 v3 ws_rigid_pair_slip(const ws_rigid *R, size_t q, const double *dU);
 
-/* Each body's diagonal block M_j + sum J^T C J (the film's contacts and the pairs' ends)
- * factored for the preconditioner. 0, or -1 when
- * a block is not positive definite (a NaN, a body of no mass). */
+/* The bodies' block A_bb of the coupled matrix (the masses, the film's contacts' J^T C J, the
+ * pairs' blocks between their bodies) into R->abb and factored into R->fac for the
+ * preconditioner. 0, or -1 when it is not positive definite (a NaN, a body of no mass). */
 int ws_rigid_factor(ws_rigid *R);
 
-/* z = B^-1 r per body, B its factored block (6 doubles a body; z may be r). */
+/* z = A_bb^-1 r, the bodies solved together (6 doubles a body; z may be r). */
 void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z);
 
 /* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr (the film's contacts'
@@ -103,8 +114,8 @@ int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
  * after the film's, the same to round-off. */
 void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web);
 
-/* The bodies' part of the preconditioner and the coarse correction: zr = B^-1 rr per body (B
- * its factored block), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
+/* The bodies' part of the preconditioner and the coarse correction: zr = A_bb^-1 rr (the
+ * bodies solved together), then, with R->coarse, c = (Phi^T A Phi)^-1 Phi^T (rf, rr) added as
  * Phi c into (zf, zr), zf the film's part already preconditioned. Returns what this adds to
  * r . z. */
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,

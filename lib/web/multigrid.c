@@ -572,22 +572,15 @@ static int point_factor(mg_level *L, int iy)
 }
 
 /* The bodies' rows of the coarsest level's dense matrix D (m unknowns, the bodies' after the
- * nodes'): each body's block M_j + sum J^T C J (from its factor L L^T) and the nodes' coupling
- * entries in both triangles. */
+ * nodes'): their block A_bb whole (the masses, the film's contacts' J^T C J and the pairs'
+ * blocks, between two bodies too: the bodies are the same unknowns on every level) and the
+ * nodes' coupling entries in both triangles. */
 static void coarsest_bodies(const ws_mg *mg, const mg_level *L, double *D, uint32_t m)
 {
     const uint32_t m0 = mg->m;
-    for (uint32_t j = 0; j < mg->nb; j++) {
-        const double *F = mg->rig->fac + 36 * (size_t)j;
-        const size_t o = m0 + 6 * (size_t)j;
-        for (int a = 0; a < 6; a++)
-            for (int b = 0; b < 6; b++) {
-                double v = 0.0;
-                for (int q = 0; q <= (a < b ? a : b); q++)
-                    v += F[6 * a + q] * F[6 * b + q];
-                D[(o + (size_t)a) * m + o + (size_t)b] = v;
-            }
-    }
+    const size_t nb6 = 6 * (size_t)mg->nb;
+    for (size_t a = 0; a < nb6; a++)
+        memcpy(D + (m0 + a) * m + m0, mg->rig->abb + nb6 * a, nb6 * sizeof(double));
     for (size_t e = 0; e < L->ng; e++) {
         const double *G = L->G + 18 * e;
         const size_t i = 3 * (size_t)L->gn[e], o = m0 + 6 * (size_t)L->gb[e];
@@ -1102,7 +1095,8 @@ static void point_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
  * (those after are still zero) and the bodies; the sweep leaves the residual r - A x in t (each
  * block's own couplings are solved exactly, so what is left at a node is what the blocks after
  * it add since, added as each is solved) and the bodies' residual, rb - A_bb xb - G^T x =
- * -G^T x, in rbn (the next level's: the bodies are the same unknowns there). */
+ * -G^T x, in rbn (the next level's: the bodies are the same unknowns there; A_bb is solved
+ * whole, the pairs' coupling between bodies with it, or that residual would keep it). */
 static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;

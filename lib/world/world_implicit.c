@@ -51,15 +51,19 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->cap = nl;
     const size_t v6 = 6 * (size_t)nb;
     R->link = ws_arena_alloc(arena, (nl + 1) * sizeof *R->link);
-    double *d =
-        ws_arena_alloc(arena, (nb * (1 + WS_SYM + 36) + 8 * v6 + v6 * v6 + 6 * v6 + 18 * (nl + 1)) *
-                                  sizeof(double));
+    /* The bodies' block and its factor, (6 nb)^2 each: nb is the dynamic bodies the film
+     * touches (a stack's boxes, tens at most). */
+    double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM) + 3 * v6 * v6 + 8 * v6 + 6 * v6 +
+                                       18 * (nl + 1)) *
+                                          sizeof(double));
+    R->env = ws_arena_alloc(arena, v6 * sizeof *R->env);
     R->phi_node = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_node);
     R->phi_body = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_body);
     R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
     R->crow = ws_arena_alloc(arena, ((size_t)nodes + 1) * sizeof *R->crow);
     R->cphi = ws_arena_alloc(arena, 2 * (nl + 1) * sizeof *R->cphi);
-    if (!R->link || !d || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow || !R->cphi) {
+    if (!R->link || !d || !R->env || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow ||
+        !R->cphi) {
         *fail = 1;
         return NULL;
     }
@@ -68,8 +72,9 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->q = d + 5 * v6;
     R->mass = d + 6 * v6;
     R->inertia = R->mass + nb;
-    R->fac = R->inertia + WS_SYM * (size_t)nb;
-    R->cb = R->fac + 36 * (size_t)nb;
+    R->abb = R->inertia + WS_SYM * (size_t)nb;
+    R->fac = R->abb + v6 * v6;
+    R->cb = R->fac + v6 * v6;
     R->cq = R->cb + v6;
     R->coarse = R->cq + v6;
     R->cyr = R->coarse + v6 * v6;
