@@ -18,6 +18,8 @@
  * in turn: CPU time a step and CG iterations, where the multigrid starts to pay; `crossing 0 1`
  * with a 1 kg box on each drum's middle, in the film's solve),
  * solve (`solve [duration] [dt ms] [preconditioner] [tolerance]`: one implicit run of case R),
+ * phases (`phases [duration] [r] [dt ms]`: case R's band refined r x r on the multigrid, CG
+ * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -357,6 +359,53 @@ int main(int argc, char **argv)
             fflush(stdout);
             ws_world_destroy(sc.world);
         }
+    } else if (!strcmp(what, "phases")) {
+        /* Case R's band at the real areal density refined r x r (`phases [duration] [r] [dt
+         * ms]`, default 1.5 s, 1 and 0.25 ms): CG iterations a step, mean and largest, and the
+         * CPU time per simulated second over every 50 ms of the run, to see where in the run
+         * (the pull-in, the settling, the tilt from 1 s) the iterations are taken; the
+         * multigrid at every r, as `refine` with preconditioner 2. */
+        const double T = duration > 0 ? duration : 1.5;
+        const int r = argc > 3 ? atoi(argv[3]) : 1;
+        tilt_options a = o;
+        a.areal_density = 0.018;
+        a.implicit = 1;
+        a.substeps = 1;
+        a.refine = r;
+        a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
+        a.dt = 1e-3 * (argc > 4 ? atof(argv[4]) : 0.25);
+        tilt_scene sc;
+        if (tilt_build(&a, &sc) != WS_OK) {
+            printf("  refine %d: cannot build\n", r);
+            return 1;
+        }
+        const long steps = lround(T / sc.dt), window = lround(0.05 / sc.dt);
+        ws_web_solver_stats prev;
+        ws_web_get_solver_stats(sc.world, sc.film, &prev);
+        uint64_t sum = 0, most = 0;
+        double c0 = cpu_now();
+        for (long k = 1; k <= steps; k++) {
+            if (ws_world_step(sc.world) != WS_OK) {
+                printf("  refine %d: %s\n", r, ws_world_last_error(sc.world));
+                break;
+            }
+            ws_web_solver_stats s;
+            ws_web_get_solver_stats(sc.world, sc.film, &s);
+            const uint64_t it = s.iterations - prev.iterations;
+            prev = s;
+            sum += it;
+            most = it > most ? it : most;
+            if (k % window == 0) {
+                const double c = cpu_now();
+                printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n",
+                       r, k * sc.dt, (double)sum / (double)window, (unsigned long long)most,
+                       (c - c0) / (window * sc.dt));
+                fflush(stdout);
+                sum = most = 0;
+                c0 = c;
+            }
+        }
+        ws_world_destroy(sc.world);
     } else if (!strcmp(what, "crossing")) {
         const int sides[] = {10, 12, 16, 24, 32, 40, 48, 64, 96};
         const int box = argc > 3 ? atoi(argv[3]) : 0; /* a box on the drum, in its solve */
