@@ -1435,26 +1435,34 @@ START_TEST(test_rows_mixed)
 }
 END_TEST
 
-/* A body in the film's solve, pressed on the band of cylinder_band: a ws_rigid of one body
- * (0.5 kg, inertia 1e-3 kg m^2, its centre on the axis) whose contacts hold the first quarter
- * of the band around (every row), each of the band's contact stiffness for its share (4000 /
- * r^2 N/m along the node's radius, a fifth of it across: a stuck contact), 1 / r^2 N s/m of
- * damping along the radius, added to the film's matrix as the world adds a contact. The
- * arrays are the caller's to free (free_pressed). */
+/* Bodies in the film's solve, pressed on the band of cylinder_band: a ws_rigid of nb bodies
+ * (1 or 2; centres on the axis) whose contacts hold the first quarter of the band around (every
+ * row), each of the band's contact stiffness for its share (4000 / r^2 N/m along the node's
+ * radius, a fifth of it across: a stuck contact), 1 / r^2 N s/m of damping along the radius,
+ * added to the film's matrix as the world adds a contact. One body: 0.5 kg, inertia 1e-3 kg m^2,
+ * the whole quarter. Two: each half of it (body 0 the first eighth around, 0.5 kg; body 1 the
+ * second, 0.8 kg; inertias 1e-3 and 2e-3 kg m^2), joined by the friction of a body contact in
+ * the solve (ws_rigid_pair) where they meet, on the band's middle row, as a wrapped stack's
+ * boxes are: at rest, c = 2 mu N / v_lim = 5e4 N s/m (mu 0.5, N 50 N, v_lim 1 mm/s) across the
+ * radius, h c = 50 kg over the step, a hundred times the boxes' masses. The arrays are the
+ * caller's to free (free_pressed). */
 typedef struct press_case {
     ws_rigid R;
-    uint32_t env[6];
+    uint32_t env[12];
+    ws_rigid_pair pair;
     double *d;
     void *mgbuf;
 } press_case;
 
-static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, press_case *o)
+static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, uint32_t nb,
+                       press_case *o)
 {
     ws_implicit *im = web->imp;
-    const uint32_t n = web->n, nx = (uint32_t)web->nx;
+    const uint32_t n = web->n, nx = (uint32_t)web->nx, ny = (uint32_t)web->ny;
+    const size_t v6 = 6 * (size_t)nb;
     ws_rigid *R = &o->R;
     memset(R, 0, sizeof *R);
-    R->nb = 1;
+    R->nb = nb;
     R->cap = n;
     R->link = calloc(n, sizeof *R->link);
     R->phi_node = calloc(n, sizeof *R->phi_node);
@@ -1462,23 +1470,29 @@ static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, pres
     R->phi_lever = calloc(3 * (size_t)n, sizeof *R->phi_lever);
     R->crow = calloc((size_t)n + 1, sizeof *R->crow);
     R->cphi = calloc(2 * ((size_t)n + 1), sizeof *R->cphi);
-    o->d = calloc(1 + WS_SYM + 2 * 36 + 8 * 6 + 36 + 36 + 18 * ((size_t)n + 1), sizeof(double));
+    o->d = calloc(nb * (1 + WS_SYM) + 3 * v6 * v6 + 8 * v6 + 6 * v6 + 18 * ((size_t)n + 1),
+                  sizeof(double));
     ck_assert(R->link && R->phi_node && R->phi_body && R->phi_lever && R->crow && R->cphi &&
               o->d);
     double *d = o->d;
-    R->b = d, R->x = d + 6, R->r = d + 12, R->z = d + 18, R->p = d + 24, R->q = d + 30;
-    R->cb = d + 36, R->cq = d + 42;
-    R->mass = d + 48;
-    R->inertia = R->mass + 1;
-    R->abb = R->inertia + WS_SYM;
-    R->fac = R->abb + 36;
+    R->b = d, R->x = d + v6, R->r = d + 2 * v6, R->z = d + 3 * v6, R->p = d + 4 * v6;
+    R->q = d + 5 * v6, R->cb = d + 6 * v6, R->cq = d + 7 * v6;
+    R->mass = d + 8 * v6;
+    R->inertia = R->mass + nb;
+    R->abb = R->inertia + nb * WS_SYM;
+    R->fac = R->abb + v6 * v6;
+    R->coarse = R->fac + v6 * v6;
+    R->cyr = R->coarse + v6 * v6;
+    R->cy = R->cyr + 6 * v6;
     R->env = o->env;
-    R->coarse = R->fac + 36;
-    R->cyr = R->coarse + 36;
-    R->cy = R->cyr + 36;
-    R->mass[0] = 0.5;
-    R->inertia[WS_SYM_XX] = R->inertia[WS_SYM_YY] = R->inertia[WS_SYM_ZZ] = 1e-3;
+    for (uint32_t j = 0; j < nb; j++) {
+        double *I = R->inertia + WS_SYM * j;
+        R->mass[j] = j ? 0.8 : 0.5;
+        I[WS_SYM_XX] = I[WS_SYM_YY] = I[WS_SYM_ZZ] = 1e-3 * (1 + j);
+    }
     R->b[0] = h * 1.0; /* a newton along x, the rest from the contacts */
+    if (nb == 2)
+        R->b[7] = -h * 0.5; /* and half a newton along -y on the second body */
     const double k = 4000.0 / (r * r), c = 1.0 / (r * r);
     for (uint32_t i = 0; i < n; i++) {
         if (i % nx >= nx / 4 || web->inv_m[i] == 0.0)
@@ -1492,14 +1506,27 @@ static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, pres
         ws_implicit_add(im, i, v3_make(0, 0, 0), K, D);
         ws_rigid_link *L = &R->link[R->nl++];
         L->node = i;
-        L->body = 0;
+        L->body = nb == 2 && i % nx >= nx / 8;
         L->lever = p;
         for (int q = 0; q < WS_SYM; q++)
             L->C[q] = h * h * K[q] + h * D[q];
     }
+    if (nb == 2) {
+        const uint32_t m = nx / 8 + nx * (ny / 2);
+        const v3 p = v3_make(x.x[m], x.y[m], x.z[m]);
+        const v3 e = v3_scale(v3_make(p.x, p.y, 0.0), 1.0 / sqrt(p.x * p.x + p.y * p.y));
+        const double hc = h * 2.0 * 0.5 * 50.0 / 1e-3;
+        ws_rigid_pair *P = &o->pair;
+        memset(P, 0, sizeof *P);
+        P->a = 0, P->b = 1, P->ra = P->rb = p;
+        ws_sym_add_outer(P->C, -hc, e);
+        P->C[WS_SYM_XX] += hc, P->C[WS_SYM_YY] += hc, P->C[WS_SYM_ZZ] += hc;
+        R->pair = P;
+        R->npair = 1;
+    }
     o->mgbuf = NULL;
     if (nest) {
-        const size_t bytes = ws_mg_body_bytes(im->mg, 1, R->cap);
+        const size_t bytes = ws_mg_body_bytes(im->mg, nb, R->cap);
         ck_assert(bytes > 0);
         o->mgbuf = malloc(bytes);
         ck_assert(o->mgbuf);
@@ -1535,7 +1562,7 @@ static int band_pressed(int r, int nest, int checks)
     ws_implicit *im = web->imp;
     ws_nodes3 x = web->x[w->cur], v = web->v[w->cur];
     press_case pb;
-    press_body(web, x, r, dt, nest, &pb);
+    press_body(web, x, r, dt, nest, 1, &pb);
     ws_rigid *R = &pb.R;
     im->warm = 0;
     im->rig = R;
@@ -1633,96 +1660,7 @@ START_TEST(test_band_bodies_nested)
 }
 END_TEST
 
-/* Two bodies in the band's solve, each pressing half of press_body's quarter of the band (body
- * 0 the first eighth around, 0.5 kg; body 1 the second, 0.8 kg; inertias 1e-3 and 2e-3 kg m^2,
- * both centred on the axis), joined by the friction of a body contact in the solve
- * (ws_rigid_pair) where they meet, on the band's middle row, as a wrapped stack's boxes are:
- * at rest, c = 2 mu N / v_lim = 5e4 N s/m (mu 0.5, N 50 N, v_lim 1 mm/s) across the radius, h c
- * = 50 kg over the step, a hundred times the boxes' masses. Arrays as press_body's (free_pair). */
-typedef struct pair_case {
-    ws_rigid R;
-    uint32_t env[12];
-    ws_rigid_pair pair;
-    double *d;
-    void *mgbuf;
-} pair_case;
-
-static void press_pair(ws_web *web, ws_nodes3 x, int r, double h, int nest, pair_case *o)
-{
-    ws_implicit *im = web->imp;
-    const uint32_t n = web->n, nx = (uint32_t)web->nx, ny = (uint32_t)web->ny;
-    const size_t v6 = 12;
-    ws_rigid *R = &o->R;
-    memset(R, 0, sizeof *R);
-    R->nb = 2;
-    R->cap = n;
-    R->link = calloc(n, sizeof *R->link);
-    R->phi_node = calloc(n, sizeof *R->phi_node);
-    R->phi_body = calloc(n, sizeof *R->phi_body);
-    R->phi_lever = calloc(3 * (size_t)n, sizeof *R->phi_lever);
-    R->crow = calloc((size_t)n + 1, sizeof *R->crow);
-    R->cphi = calloc(2 * ((size_t)n + 1), sizeof *R->cphi);
-    o->d = calloc(2 * (1 + WS_SYM) + 3 * v6 * v6 + 8 * v6 + 6 * v6 + 18 * ((size_t)n + 1),
-                  sizeof(double));
-    ck_assert(R->link && R->phi_node && R->phi_body && R->phi_lever && R->crow && R->cphi &&
-              o->d);
-    double *d = o->d;
-    R->b = d, R->x = d + v6, R->r = d + 2 * v6, R->z = d + 3 * v6, R->p = d + 4 * v6;
-    R->q = d + 5 * v6, R->cb = d + 6 * v6, R->cq = d + 7 * v6;
-    R->mass = d + 8 * v6;
-    R->inertia = R->mass + 2;
-    R->abb = R->inertia + 2 * WS_SYM;
-    R->fac = R->abb + v6 * v6;
-    R->coarse = R->fac + v6 * v6;
-    R->cyr = R->coarse + v6 * v6;
-    R->cy = R->cyr + 6 * v6;
-    R->env = o->env;
-    R->mass[0] = 0.5, R->mass[1] = 0.8;
-    for (int j = 0; j < 2; j++) {
-        double *I = R->inertia + WS_SYM * j;
-        I[WS_SYM_XX] = I[WS_SYM_YY] = I[WS_SYM_ZZ] = 1e-3 * (1 + j);
-    }
-    R->b[0] = h * 1.0, R->b[7] = -h * 0.5; /* a newton along x on one, half along -y on the other */
-    const double k = 4000.0 / (r * r), c = 1.0 / (r * r);
-    for (uint32_t i = 0; i < n; i++) {
-        if (i % nx >= nx / 4 || web->inv_m[i] == 0.0)
-            continue;
-        const v3 p = v3_make(x.x[i], x.y[i], x.z[i]);
-        const v3 e = v3_scale(v3_make(p.x, p.y, 0.0), 1.0 / sqrt(p.x * p.x + p.y * p.y));
-        double K[WS_SYM] = {0}, D[WS_SYM] = {0};
-        ws_sym_add_outer(K, 0.8 * k, e);
-        K[WS_SYM_XX] += 0.2 * k, K[WS_SYM_YY] += 0.2 * k, K[WS_SYM_ZZ] += 0.2 * k;
-        ws_sym_add_outer(D, c, e);
-        ws_implicit_add(im, i, v3_make(0, 0, 0), K, D);
-        ws_rigid_link *L = &R->link[R->nl++];
-        L->node = i;
-        L->body = i % nx >= nx / 8;
-        L->lever = p;
-        for (int q = 0; q < WS_SYM; q++)
-            L->C[q] = h * h * K[q] + h * D[q];
-    }
-    const uint32_t m = nx / 8 + nx * (ny / 2);
-    const v3 p = v3_make(x.x[m], x.y[m], x.z[m]);
-    const v3 e = v3_scale(v3_make(p.x, p.y, 0.0), 1.0 / sqrt(p.x * p.x + p.y * p.y));
-    const double hc = h * 2.0 * 0.5 * 50.0 / 1e-3;
-    ws_rigid_pair *P = &o->pair;
-    memset(P, 0, sizeof *P);
-    P->a = 0, P->b = 1, P->ra = P->rb = p;
-    ws_sym_add_outer(P->C, -hc, e);
-    P->C[WS_SYM_XX] += hc, P->C[WS_SYM_YY] += hc, P->C[WS_SYM_ZZ] += hc;
-    R->pair = P;
-    R->npair = 1;
-    o->mgbuf = NULL;
-    if (nest) {
-        const size_t bytes = ws_mg_body_bytes(im->mg, 2, R->cap);
-        ck_assert(bytes > 0);
-        o->mgbuf = malloc(bytes);
-        ck_assert(o->mgbuf);
-    }
-    R->mgbuf = o->mgbuf;
-}
-
-/* The solve of band_begun's next step (refinement r) from zero with press_pair's bodies in
+/* The solve of band_begun's next step (refinement r) from zero with press_body's two bodies in
  * it, nested in the multigrid (nest) or beside it, their block solved together or each alone
  * (apart): its iterations; the film's answer into dv (3 n, malloc'd, n into *n) and the
  * bodies' into xb (12). */
@@ -1731,8 +1669,8 @@ static int band_pair(int r, int nest, int apart, double **dv, uint32_t *n, doubl
     ws_web *web;
     ws_world *w = band_begun(r, 0.02, &web);
     ws_implicit *im = web->imp;
-    pair_case pc;
-    press_pair(web, web->x[w->cur], r, BAND_DT, nest, &pc);
+    press_case pc;
+    press_body(web, web->x[w->cur], r, BAND_DT, nest, 2, &pc);
     ws_rigid *R = &pc.R;
     R->apart = apart;
     im->warm = 0;
@@ -1745,16 +1683,14 @@ static int band_pair(int r, int nest, int apart, double **dv, uint32_t *n, doubl
     ck_assert(*dv);
     memcpy(*dv, im->dv, 3 * (size_t)web->n * sizeof(double));
     memcpy(xb, R->x, 12 * sizeof(double));
-    free(R->link), free(R->phi_node), free(R->phi_body), free(R->phi_lever);
-    free(R->crow), free(R->cphi);
-    free(pc.d), free(pc.mgbuf);
+    free_pressed(&pc);
     ws_world_destroy(w);
     return it;
 }
 
 START_TEST(test_bodies_solved_together)
 {
-    /* Two bodies joined by a strong pair (press_pair): the preconditioner that holds each body
+    /* Two bodies joined by a strong pair (press_body's two): the preconditioner that holds each body
      * alone leaves the pair's coupling of the two to the coarse space (beside the multigrid) or
      * to nothing at all (nested in it: a coarse level's sweep solves each body against the
      * nodes alone, and the bodies' residual it passes on keeps the pair's term), while
