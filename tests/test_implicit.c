@@ -940,6 +940,60 @@ static double dot3(const double *a, const double *b, uint32_t n)
     return s;
 }
 
+/* web's multigrid B as its last solve left it: symmetric (u.By = y.Bu to 1e-12 of |u| |By|, two
+ * random vectors u, y: rounding only), positive, and the cycle contracting (below); u (random)
+ * and Bu = B u left for the caller (3 n doubles each). */
+static void cycle_checks(ws_web *web, const char *what, double *u, double *Bu)
+{
+    ws_implicit *im = web->imp;
+    const uint32_t n = web->n;
+    double *y = malloc(3 * n * sizeof(double)), *By = malloc(3 * n * sizeof(double)),
+           *e = malloc(3 * n * sizeof(double)), *Ae = malloc(3 * n * sizeof(double)),
+           *BAe = malloc(3 * n * sizeof(double));
+    ck_assert(y && By && e && Ae && BAe);
+    random_vector(web, 1, u);
+    random_vector(web, 2, y);
+    (void)ws_mg_apply(im->mg, web, u, Bu);
+    (void)ws_mg_apply(im->mg, web, y, By);
+    const double uBy = dot3(u, By, n), yBu = dot3(y, Bu, n);
+    const double scale = sqrt(dot3(u, u, n) * dot3(By, By, n));
+    report("multigrid, %s, %d x %d (%d levels): u.By %.12g, y.Bu %.12g (rel %.2g), u.Bu %.6g",
+           what, web->nx, web->ny, ws_mg_levels(im->mg), uBy, yBu, (uBy - yBu) / scale,
+           dot3(u, Bu, n));
+    ck_assert_msg(fabs(uBy - yBu) <= 1e-12 * scale, "%s: B not symmetric: %.17g vs %.17g", what,
+                  uBy, yBu);
+    ck_assert_msg(dot3(u, Bu, n) > 0.0 && dot3(y, By, n) > 0.0, "%s: B not positive", what);
+    /* The cycle as an iteration, e <- (I - B A) e, by power iteration in A's inner product (40
+     * steps from a random e): the exact cycle's I - B A has its eigenvalues in [0, 1) (the
+     * smoothers and their adjoints around a coarse correction that removes at most all of the
+     * error), so B A's lie in (0, 1]. The cycle keeps the film's operator and the coarse
+     * levels in single precision, which moves them by the rounding (6e-8 of a block, times the
+     * blocks' condition): its factor must stay below 1 (with B symmetric, that is B positive
+     * definite) and B A's largest eigenvalue below 1 + 1e-5. */
+    double lmax = 0.0, rho = 0.0;
+    for (int pass = 0; pass < 2; pass++) { /* B A, then I - B A */
+        random_vector(web, 3 + (uint64_t)pass, e);
+        for (int k = 0; k < 40; k++) {
+            const double eAe = ws_implicit_apply_op(web, e, Ae);
+            (void)ws_mg_apply(im->mg, web, Ae, BAe);
+            const double lam = dot3(Ae, BAe, n) / eAe; /* (e, B A e)_A / (e, e)_A */
+            const double norm = sqrt(eAe);
+            for (uint32_t q = 0; q < 3 * n; q++)
+                e[q] = (pass ? e[q] - BAe[q] : BAe[q]) / norm;
+            if (pass)
+                rho = 1.0 - lam;
+            else
+                lmax = lam;
+        }
+    }
+    report("multigrid, %s: largest eigenvalue of B A %.9f, factor of I - B A %.3f", what, lmax,
+           rho);
+    ck_assert_msg(lmax > 0.0 && lmax <= 1.0 + 1e-5, "%s: B A's largest eigenvalue %.9f", what,
+                  lmax);
+    ck_assert_msg(rho < 1.0, "%s: the cycle does not contract: factor %g", what, rho);
+    free(y), free(By), free(e), free(Ae), free(BAe);
+}
+
 /* The sheet of test_multigrid refined r times in each direction (the same film: a spring's
  * EA and damping with its share of the width, a node's mass with its share of the area), 5
  * steps: its film solve to 1e-11 from zero by multigrid and by block Jacobi, their iterations;
@@ -994,9 +1048,8 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
     ws_nodes3 x = web->x[cur], v = web->v[cur];
     ck_assert_int_eq(ws_implicit_begin(web, x, v, v3_make(0, 0, -G0), w->time, 0.0), 0);
     double *dv_mg = malloc(3 * n * sizeof(double)), *u = malloc(3 * n * sizeof(double)),
-           *y = malloc(3 * n * sizeof(double)), *Bu = malloc(3 * n * sizeof(double)),
-           *Bv = malloc(3 * n * sizeof(double));
-    ck_assert(dv_mg && u && y && Bu && Bv);
+           *Bu = malloc(3 * n * sizeof(double));
+    ck_assert(dv_mg && u && Bu);
     im->warm = 0;
     ck_assert_int_eq(ws_implicit_solve(web, v, dt), 0);
     const int it_mg = im->last_iterations;
@@ -1017,53 +1070,7 @@ static void sheet_case(int r, double pre_x, double pre_y, int checks, int *it_mg
         ck_assert_msg(whole_rows == 0, "the drum's coarse levels solve %d rows whole",
                       whole_rows);
     }
-    random_vector(web, 1, u);
-    random_vector(web, 2, y);
-    (void)ws_mg_apply(im->mg, web, u, Bu);
-    (void)ws_mg_apply(im->mg, web, y, Bv);
-    const double uBv = dot3(u, Bv, n), vBu = dot3(y, Bu, n);
-    const double scale = sqrt(dot3(u, u, n) * dot3(Bv, Bv, n));
-    report("multigrid on a %d x %d sheet (%d levels): u.Bv %.12g, v.Bu %.12g (rel %.2g), "
-           "u.Bu %.6g",
-           nx, ny, ws_mg_levels(im->mg), uBv, vBu, (uBv - vBu) / scale, dot3(u, Bu, n));
-    ck_assert_msg(fabs(uBv - vBu) <= 1e-12 * scale, "B not symmetric: %.17g vs %.17g", uBv,
-                  vBu);
-    ck_assert_msg(dot3(u, Bu, n) > 0.0 && dot3(y, Bv, n) > 0.0, "B not positive");
-    /* The cycle as an iteration, e <- (I - B A) e, by power iteration in A's inner product (40
-     * steps from a random e): the exact cycle's I - B A has its eigenvalues in [0, 1) (the
-     * smoothers and their adjoints around a coarse correction that removes at most all of the
-     * error), so B A's lie in (0, 1]. The cycle keeps the film's operator and the coarse
-     * levels in single precision, which moves them by the rounding (6e-8 of a block, times the
-     * blocks' condition): its factor must stay below 1 (with B symmetric, that is B positive
-     * definite) and B A's largest eigenvalue below 1 + 1e-5. */
-    {
-        double *e = malloc(3 * n * sizeof(double)), *Ae = malloc(3 * n * sizeof(double)),
-               *BAe = malloc(3 * n * sizeof(double));
-        ck_assert(e && Ae && BAe);
-        double lmax = 0.0, rho = 0.0;
-        for (int pass = 0; pass < 2; pass++) { /* B A, then I - B A */
-            random_vector(web, 3 + (uint64_t)pass, e);
-            for (int k = 0; k < 40; k++) {
-                const double eAe = ws_implicit_apply_op(web, e, Ae);
-                (void)ws_mg_apply(im->mg, web, Ae, BAe);
-                double lam = dot3(Ae, BAe, n) / eAe; /* (e, B A e)_A / (e, e)_A */
-                if (pass)
-                    lam = 1.0 - lam;
-                const double norm = sqrt(eAe);
-                for (uint32_t q = 0; q < 3 * n; q++)
-                    e[q] = (pass ? e[q] - BAe[q] : BAe[q]) / norm;
-                if (pass)
-                    rho = lam;
-                else
-                    lmax = lam;
-            }
-        }
-        report("multigrid cycle: largest eigenvalue of B A %.9f, factor of I - B A %.3f", lmax,
-               rho);
-        ck_assert_msg(lmax > 0.0 && lmax <= 1.0 + 1e-5, "B A's largest eigenvalue %.9f", lmax);
-        ck_assert_msg(rho < 1.0, "the cycle does not contract: factor %g", rho);
-        free(e), free(Ae), free(BAe);
-    }
+    cycle_checks(web, "drum", u, Bu);
     /* Conjugate gradients with B on A x = b for a known x (u). */
     {
         double *b = malloc(3 * n * sizeof(double)), *xs = calloc(3 * n, sizeof(double)),
@@ -1111,7 +1118,7 @@ jacobi:
            nx, ny, it_mg, it_bj, diff, size);
     ck_assert_msg(size > 0.0 && diff <= 1e-7 * size, "dv apart by %g of %g", diff, size);
     ck_assert_msg(it_mg < it_bj, "multigrid took %d iterations, block Jacobi %d", it_mg, it_bj);
-    free(dv_mg), free(u), free(y), free(Bu), free(Bv);
+    free(dv_mg), free(u), free(Bu);
     ws_world_destroy(w);
     *it_mg_out = it_mg;
     *it_bj_out = it_bj;
@@ -1358,46 +1365,12 @@ static void rows_mixed_checks(ws_web *web, const char *what)
         ck_assert_msg(whole > 0 && whole < rows, "%s, level %d: %d of %d rows whole", what, k,
                       whole, rows);
     }
-    double *u = malloc(3 * n * sizeof(double)), *y = malloc(3 * n * sizeof(double)),
-           *Bu = malloc(3 * n * sizeof(double)), *By = malloc(3 * n * sizeof(double)),
-           *e = malloc(3 * n * sizeof(double)), *Ae = malloc(3 * n * sizeof(double)),
-           *BAe = malloc(3 * n * sizeof(double));
-    ck_assert(u && y && Bu && By && e && Ae && BAe);
-    random_vector(web, 1, u);
-    random_vector(web, 2, y);
-    (void)ws_mg_apply(im->mg, web, u, Bu);
-    (void)ws_mg_apply(im->mg, web, y, By);
-    const double uBy = dot3(u, By, n), yBu = dot3(y, Bu, n);
-    const double scale = sqrt(dot3(u, u, n) * dot3(By, By, n));
-    report("multigrid, rows mixed, %s %d x %d: u.By %.12g, y.Bu %.12g (rel %.2g)", what,
-           web->nx, web->ny, uBy, yBu, (uBy - yBu) / scale);
-    ck_assert_msg(fabs(uBy - yBu) <= 1e-12 * scale, "%s: B not symmetric: %.17g vs %.17g", what,
-                  uBy, yBu);
-    ck_assert_msg(dot3(u, Bu, n) > 0.0 && dot3(y, By, n) > 0.0, "%s: B not positive", what);
-    double lmax = 0.0, rho = 0.0;
-    for (int pass = 0; pass < 2; pass++) { /* B A, then I - B A */
-        random_vector(web, 3 + (uint64_t)pass, e);
-        for (int k = 0; k < 40; k++) {
-            const double eAe = ws_implicit_apply_op(web, e, Ae);
-            (void)ws_mg_apply(im->mg, web, Ae, BAe);
-            const double lam = dot3(Ae, BAe, n) / eAe;
-            const double norm = sqrt(eAe);
-            for (uint32_t q = 0; q < 3 * n; q++)
-                e[q] = (pass ? e[q] - BAe[q] : BAe[q]) / norm;
-            if (pass)
-                rho = 1.0 - lam;
-            else
-                lmax = lam;
-        }
-    }
-    report("multigrid, rows mixed, %s: largest eigenvalue of B A %.9f, factor of I - B A %.3f",
-           what, lmax, rho);
-    ck_assert_msg(lmax > 0.0 && lmax <= 1.0 + 1e-5, "%s: B A's largest eigenvalue %.9f", what,
-                  lmax);
-    ck_assert_msg(rho < 1.0, "%s: the cycle does not contract: factor %g", what, rho);
+    double *u = malloc(3 * n * sizeof(double)), *Bu = malloc(3 * n * sizeof(double));
+    ck_assert(u && Bu);
+    cycle_checks(web, what, u, Bu);
     ck_assert_int_eq(ws_mg_set_row(im->mg, 0, 0, 1), -1); /* the film's level has no rows */
     ck_assert_int_eq(ws_mg_set_row(im->mg, 1, ws_mg_rows(im->mg, 1, &whole), 1), -1);
-    free(u), free(y), free(Bu), free(By), free(e), free(Ae), free(BAe);
+    free(u), free(Bu);
 }
 
 static ws_world *choice_drum(int nx, int ny, int pre, double tol, ws_web_id *id, ws_status *st);
