@@ -21,16 +21,6 @@
  * sweep was for (bench/NOTES.md, session 13: 19.6 iterations a step at one sweep on the
  * unrefined band, 18.1 at two, for 10 % less time an iteration). */
 #define MG_SWEEPS_SEMI 1
-/* A band's film level is smoothed by its columns (the nodes up the band, ix fixed) solved whole:
- * damped block line Jacobi, z += MG_OMEGA_LINES T^-1 t with T the columns' block-tridiagonal
- * part of the film's matrix. The level halves around only, so its coarse level carries the
- * error smooth around and the smoother must take off the error rough around, whatever it does
- * up: a column solve is exact up, and with the couplings around left to the Jacobi step it
- * takes 1 - w off the error of half a wave around and |1 - 2 w| off the roughest, 1/3 at w =
- * 2/3 however strong up is against around (docs/theory.md 8a). 2 T - A = N + sum over the
- * springs across columns of (e_a + e_b)^T K (e_a + e_b) >= 0, so T^-1 A's eigenvalues lie in
- * (0, 2] and any w < 1 contracts. */
-#define MG_OMEGA_LINES (2.0 / 3.0)
 /* A coarse node's row holds its own block and those of its forward neighbours (slots 4 to 8 of
  * the 9 with dx, dy in -1..1, slot 3 (dy + 1) + dx + 1); a backward neighbour's block is that
  * neighbour's forward one (every block is symmetric: P is a scalar weight times the 3x3
@@ -105,18 +95,6 @@ struct ws_mg {
                      and FOP_B: one record a spring, one stream for the springs' pass */
     float *fnd;   /* the film's nodes' own blocks N (WS_SYM a node; at every setup) */
     float *fpinv; /* w times the inverse of the film's diagonal blocks D (likewise) */
-    /* The film level's columns solved whole (cols; a band's film level, MG_OMEGA_LINES): the
-     * block-tridiagonal part T of the film's matrix along each column, factored from the top
-     * row down (film_cols_factor, in double) into the pivots' inverses cpi and the couplings
-     * up cb (WS_SYM a node each, node i's block to node i + nx), both rounded once to single
-     * precision: a column's T holds every spring's block on its diagonal, so it is far better
-     * conditioned than a coarse level's closed row (whose factor needs double), and the
-     * case R bands took the same iterations with either (bench/NOTES.md, session 17); ly (3
-     * a node) the solve's vector. */
-    int cols;
-    float *cpi;
-    double *ly;
-    float *cb;
     float *fblk;  /* every float array above, `floats` */
     size_t floats;
     size_t doubles;
@@ -835,78 +813,6 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
 
 
 
-/* The film level's columns (film_cols_factor): T, the film's matrix but for its couplings
- * across columns (the nodes' blocks N with every spring's block on both its ends, and the
- * springs up a column between their ends), from the level's own numbers (fnd, fop: the
- * matrix its sweeps' products take), factored T = U P U^T by block elimination from the top
- * row down (so that the substitution that ends a solve runs up the node order, with the node
- * pass: film_nodes): P_k = T_kk - B_k P_{k+nx}^-1 B_k, B_k = T_{k,k+nx} (symmetric: a
- * spring's block is). The solve reads the same numbers both ways, so whatever the rounding it
- * is symmetric, and positive definite with the pivots (docs/theory.md 8a). A pinned node's
- * pivot inverse is zero (its dv stays zero), and it drops out of its column. 0, or -1 when a
- * pivot is not positive definite. */
-static int film_cols_factor(ws_mg *mg, const ws_web *web)
-{
-    const uint32_t n = web->n, nx = (uint32_t)web->nx;
-    double *D = mg->acc; /* level 1's sums: free until galerkin_film */
-    for (size_t q = 0; q < WS_SYM * (size_t)n; q++) {
-        D[q] = mg->fnd[q];
-        mg->cb[q] = 0.0f;
-    }
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const float *o = mg->fop + FOP * (size_t)s;
-        const double ex = o[0], ey = o[1], ez = o[2], a = o[3], b = o[4];
-        const double K[WS_SYM] = {[WS_SYM_XX] = a * ex * ex + b, [WS_SYM_YY] = a * ey * ey + b,
-                                  [WS_SYM_ZZ] = a * ez * ez + b, [WS_SYM_XY] = a * ex * ey,
-                                  [WS_SYM_XZ] = a * ex * ez, [WS_SYM_YZ] = a * ey * ez};
-        const uint32_t ia = web->sa[s], ib = web->sb[s];
-        sym_axpy(D + WS_SYM * (size_t)ia, 1.0, K);
-        sym_axpy(D + WS_SYM * (size_t)ib, 1.0, K);
-        const uint32_t lo = ia < ib ? ia : ib;
-        if ((ia > ib ? ia - ib : ib - ia) == nx) /* up a column */
-            for (int q = 0; q < WS_SYM; q++)
-                mg->cb[WS_SYM * (size_t)lo + q] -= (float)K[q];
-    }
-    for (uint32_t i = n; i-- > 0;) {
-        double *S = D + WS_SYM * (size_t)i;
-        if (web->inv_m[i] == 0.0) {
-            memset(S, 0, WS_SYM * sizeof(double));
-            continue;
-        }
-        if (i + nx < n) { /* P_i = T_ii - B_i P_{i+nx}^-1 B_i */
-            double B[9], Pf[9], C[9], U[9];
-            full_of(mg->cb + WS_SYM * (size_t)i, B);
-            full_of_sym(D + WS_SYM * (size_t)(i + nx), Pf);
-            mat_mul(B, Pf, 0, C);
-            mat_mul(C, B, 0, U);
-            sym_sub_full(S, U);
-        }
-        if (ws_sym_invert(S, S) != 0)
-            return -1;
-    }
-    for (size_t q = 0; q < WS_SYM * (size_t)n; q++)
-        mg->cpi[q] = (float)D[q];
-    return 0;
-}
-
-/* The first half of a column solve, from the top row down: y_k = P_k^-1 (s_k - B_k y_{k+nx})
- * into ly. */
-static void film_cols_down(const ws_mg *mg, uint32_t n, uint32_t nx, const double *restrict s)
-{
-    double *restrict y = mg->ly;
-    for (uint32_t i = n; i-- > 0;) {
-        const double *S = s + 3 * (size_t)i;
-        double g[3] = {S[0], S[1], S[2]};
-        if (i + nx < n)
-            fsym_sub(mg->cb + WS_SYM * (size_t)i, y + 3 * ((size_t)i + nx), g);
-        double *Y = y + 3 * (size_t)i;
-        const float *C = mg->cpi + WS_SYM * (size_t)i;
-        Y[0] = C[WS_SYM_XX] * g[0] + C[WS_SYM_XY] * g[1] + C[WS_SYM_XZ] * g[2];
-        Y[1] = C[WS_SYM_XY] * g[0] + C[WS_SYM_YY] * g[1] + C[WS_SYM_YZ] * g[2];
-        Y[2] = C[WS_SYM_XZ] * g[0] + C[WS_SYM_YZ] * g[1] + C[WS_SYM_ZZ] * g[2];
-    }
-}
-
 int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
 {
     if (!mg->springs_kept || begun != mg->kept_begun || h != mg->kept_h) {
@@ -920,8 +826,6 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
         mg->fnd[q] = (float)im->nd[q];
         mg->fpinv[q] = (float)(MG_OMEGA * im->pinv[q]);
     }
-    if (mg->cols && film_cols_factor(mg, web) != 0)
-        return -1;
     galerkin_film(mg, web, h);
     store_level(mg, 1);
     for (int k = 1; k + 1 < mg->nlev; k++) {
@@ -1409,30 +1313,10 @@ static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restr
 {
     double rz = 0.0;
     size_t l = 0;
-    const uint32_t nx = (uint32_t)mg->lv[0].nx;
-    const int cols = mg->cols && how != JACOBI_NONE;
-    if (cols)
-        film_cols_down(mg, n, nx, how == JACOBI_SET ? r : t);
     for (uint32_t i = 0; i < n; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
-        if (cols) { /* the column solve's second half: x_k = y_k - P_k^-1 B_{k-nx} x_{k-nx} */
-            double *X = mg->ly + 3 * (size_t)i;
-            if (i >= nx) {
-                double g[3] = {0.0, 0.0, 0.0}, u[3] = {0.0, 0.0, 0.0};
-                fsym_sub(mg->cb + WS_SYM * ((size_t)i - nx), X - 3 * (size_t)nx, g);
-                const float *C = mg->cpi + WS_SYM * (size_t)i;
-                u[0] = C[WS_SYM_XX] * g[0] + C[WS_SYM_XY] * g[1] + C[WS_SYM_XZ] * g[2];
-                u[1] = C[WS_SYM_XY] * g[0] + C[WS_SYM_YY] * g[1] + C[WS_SYM_YZ] * g[2];
-                u[2] = C[WS_SYM_XZ] * g[0] + C[WS_SYM_YZ] * g[1] + C[WS_SYM_ZZ] * g[2];
-                X[0] += u[0], X[1] += u[1], X[2] += u[2];
-            }
-            const double w = MG_OMEGA_LINES;
-            if (how == JACOBI_SET)
-                Z[0] = w * X[0], Z[1] = w * X[1], Z[2] = w * X[2];
-            else
-                Z[0] += w * X[0], Z[1] += w * X[1], Z[2] += w * X[2];
-        } else if (how != JACOBI_NONE) {
+        if (how != JACOBI_NONE) {
             const float *J = mg->fpinv + WS_SYM * (size_t)i;
             const double *D = how == JACOBI_SET ? R : T;
             const double xx = J[WS_SYM_XX], yy = J[WS_SYM_YY], zz = J[WS_SYM_ZZ],
@@ -1556,14 +1440,6 @@ int ws_mg_set_row(ws_mg *mg, int k, int iy, int whole)
     return whole ? line_factor(L, iy) : point_factor(L, iy);
 }
 
-int ws_mg_set_columns(ws_mg *mg, int on)
-{
-    if (!mg->cb)
-        return -1;
-    mg->cols = on != 0;
-    return 0;
-}
-
 int ws_mg_levels(const ws_mg *mg)
 {
     return mg ? mg->nlev : 1;
@@ -1643,7 +1519,6 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         return 0;
     const int k = nlev - 1;
     const uint32_t m = 3 * lv[k].n;
-    const int cols = lv[0].closed && !lv[0].cy; /* a band's film level: film_cols_factor */
     size_t doubles = 3 * (size_t)web->n + (size_t)m * m + 2 * STEN * (size_t)lv[1].n +
                      3 * (size_t)lv[1].nx,
            floats = 0;
@@ -1651,8 +1526,7 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         doubles += (9 + WS_SYM + 9) * (size_t)lv[i].n;
         floats += STEN * (size_t)lv[i].n;
     }
-    floats += FOP * (size_t)(web->ns ? web->ns : 1) + (2 + 2 * cols) * WS_SYM * (size_t)web->n;
-    doubles += cols ? 3 * (size_t)web->n : 0;
+    floats += FOP * (size_t)(web->ns ? web->ns : 1) + 2 * WS_SYM * (size_t)web->n;
     size_t nmaps = 0, rows = 0;
     for (int i = 0; i + 1 < nlev; i++)
         nmaps += (size_t)lv[i].nx + (size_t)lv[i].ny;
@@ -1705,12 +1579,6 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     }
     mg->fnd = fq, fq += WS_SYM * (size_t)web->n;
     mg->fpinv = fq, fq += WS_SYM * (size_t)web->n;
-    mg->cols = cols;
-    if (cols) {
-        mg->cb = fq, fq += WS_SYM * (size_t)web->n;
-        mg->cpi = fq, fq += WS_SYM * (size_t)web->n;
-        mg->ly = q, q += 3 * (size_t)web->n;
-    }
     mg->lv[0].t = q, q += 3 * (size_t)web->n;
     mg->chol = q, q += (size_t)m * m;
     mg->acc = q, q += STEN * (size_t)lv[1].n;

@@ -3,8 +3,8 @@
  * (node i + nx j, closed around when it is a band) is coarsened by two in each direction, level
  * after level (a band's film level around only), to at most 16 nodes; each coarser matrix is the Galerkin product P^T A P of the
  * finer one with bilinear interpolation P, so it stays symmetric positive definite and needs no
- * law of its own. One application is a V-cycle: damped block Jacobi (on a band, its columns
- * solved whole: line Jacobi up the band) on the film's own matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
+ * law of its own. One application is a V-cycle: damped block Jacobi on the film's own
+ * matrix-free operator (its springs' and nodes' blocks in single precision), symmetric block
  * Gauss-Seidel (forward before, backward after the coarse correction) on the coarse levels
  * (their blocks in single precision too; the rows along x where a point sweep would leave
  * the error constant along the row and alternating up are solved whole, a band's closed
@@ -81,11 +81,6 @@ double ws_mg_apply_bodies(ws_mg *mg, const ws_web *web, const double *r, double 
 
 /* The number of levels (the film's own one included), for the counts. */
 int ws_mg_levels(const ws_mg *mg);
-
-/* For tests: whether a band's film level is smoothed by its columns solved whole (on, the
- * default) or by block Jacobi node by node, from the next set-up. 0, or -1 when the film level
- * has no columns to solve (a sheet, whose levels halve both ways). */
-int ws_mg_set_columns(ws_mg *mg, int on);
 
 /* Coarse level k's rows (along x) and, into *whole, how many of them its sweeps solve whole
  * (chosen at each set-up); 0 when k is not a coarse level swept (1 .. levels - 2). */
