@@ -11,12 +11,23 @@
  * (mean over the steps and largest). Never fails on time.
  * Usage: bench_stop [duration s] [dt ms] [preconditioner] [tolerance] [test]: preconditioner
  * a ws_web_preconditioner (1 block Jacobi, 2 multigrid, 0 AUTO), tolerance 0 the default, test
- * 0 the solve's (rows), 1 the relative one. */
+ * 0 the solve's (rows), 1 the relative one.
+ * `bench_stop window file r duration [every]`: the band refined r x r at the real areal density
+ * restored from a checkpoint (bench_implicit's WS_BENCH_SAVE), each step's solves read through
+ * the solve's probe (ws_implicit_probe): see window_probe. */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
 #include "web/implicit.h"
 #include "world/world_internal.h"
+
+/* CPU seconds of this process (the runs are single-threaded). */
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
 
 typedef struct window {
     long steps;
@@ -47,9 +58,199 @@ static void window_print(const window *s, double t, double angle)
     fflush(stdout);
 }
 
+/* One window's sums over its steps (window_probe). */
+typedef struct probe_sums {
+    long steps, onepass;
+    double it, solves, first_it;
+    double start[WS_PROBE_KINDS], start_max[WS_PROBE_KINDS];
+    double above0[WS_PROBE_KINDS], above[WS_PROBE_MARKS];
+    long bind[WS_PROBE_KINDS];
+    double enter, leave, flip, ddv, ddu;
+    long cold; /* steps whose warm start already met the test */
+} probe_sums;
+
+static const char *const kind_name[WS_PROBE_KINDS] = {"free", "stick", "slip", "body"};
+
+static void probe_print(const probe_sums *s, double t)
+{
+    const double n = s->steps > 0 ? (double)s->steps : 1.0;
+    printf("%6.3f s  CG %5.2f it/step (first solve %5.2f) %4.2f solves/step, 1-pass %3.0f%%  "
+           "start/goal free %7.3g stick %7.3g slip %7.3g body %7.3g (max %7.3g %7.3g %7.3g %7.3g)"
+           "  rows>goal at start %6.1f %6.1f %6.1f %4.1f  after 1,2,4,8,16,32 it %6.1f %6.1f "
+           "%6.1f %5.1f %5.1f %5.1f  binds free %ld stick %ld slip %ld body %ld  contacts in "
+           "%5.2f out %5.2f stick<->slip %5.2f a step  |ddv|/|dv| %6.3f  |ddU|/|dU| %6.3f\n",
+           t, s->it / n, s->first_it / n, s->solves / n, 100.0 * s->onepass / n,
+           s->start[0] / n, s->start[1] / n, s->start[2] / n, s->start[3] / n, s->start_max[0],
+           s->start_max[1], s->start_max[2], s->start_max[3], s->above0[0] / n, s->above0[1] / n,
+           s->above0[2] / n, s->above0[3] / n, s->above[0] / n, s->above[1] / n, s->above[2] / n,
+           s->above[3] / n, s->above[4] / n, s->above[5] / n, s->bind[0], s->bind[1], s->bind[2],
+           s->bind[3], s->enter / n, s->leave / n, s->flip / n, s->ddv / n, s->ddu / n);
+    fflush(stdout);
+}
+
+/* `window file r duration [every]`: case R's band refined r x r at the real areal density on
+ * the multigrid (bench_implicit's `phases`), restored from `file` (bench_implicit's
+ * WS_BENCH_SAVE; "-" starts at t = 0), stepped `duration` s with the probe of the solve
+ * (ws_implicit_probe): per window of `every` s (default 0.05), the warm start's residual by
+ * kind of row over the goal, rows above the goal at the start and after some iterations, the
+ * binding row's kind, contacts entering and leaving and stick-slip changes a step, and how
+ * much dv (the film's velocity change) and dU (the bodies') change from step to step. With
+ * WS_PROBE_STEPS=file, a line a step into it. */
+static int window_probe(int argc, char **argv)
+{
+    tilt_options a;
+    tilt_default_options(&a);
+    a.variant = 'R';
+    a.quiet = 1;
+    a.wrapped = 1;
+    a.implicit = 1;
+    a.areal_density = 0.018;
+    a.substeps = 1;
+    a.refine = argc > 3 ? atoi(argv[3]) : 1;
+    a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
+    const double T = argc > 4 ? atof(argv[4]) : 0.1;
+    const double every = argc > 5 ? atof(argv[5]) : 0.05;
+    tilt_scene sc;
+    if (tilt_build(&a, &sc) != WS_OK)
+        return 1;
+    if (strcmp(argv[2], "-") && ws_world_restore_file(sc.world, argv[2]) != WS_OK) {
+        printf("restore %s: %s\n", argv[2], ws_world_last_error(sc.world));
+        return 1;
+    }
+    uint32_t slot;
+    if (ws_lookup_web(sc.world, sc.film, &slot) != WS_OK)
+        return 1;
+    ws_web *web = sc.world->webs[slot];
+    if (!web->imp && ws_implicit_reserve(&sc.world->mem, web) != 0)
+        return 1;
+    const uint32_t n = web->n;
+    ws_implicit_probe pr;
+    memset(&pr, 0, sizeof pr);
+    uint8_t *st = calloc(n, 1), *st0 = calloc(n, 1);
+    double *dv0 = calloc(3 * (size_t)n, sizeof(double));
+    if (!st || !st0 || !dv0)
+        return 1;
+    pr.state = st;
+    web->imp->probe = &pr;
+    FILE *steps_out = getenv("WS_PROBE_STEPS") ? fopen(getenv("WS_PROBE_STEPS"), "w") : NULL;
+    double t0;
+    ws_world_get_time(sc.world, &t0);
+    printf("case R refined %d (%u nodes, %d x %d), from t %.4f s (%.2f deg), %.3f s\n",
+           a.refine, n, web->nx, web->ny, t0, plane_angle(sc.world, sc.plane) * 180.0 / 3.14159265358979,
+           T);
+    const long steps = lround(T / sc.dt), per = lround(every / sc.dt);
+    probe_sums s;
+    memset(&s, 0, sizeof s);
+    double u0[2][6], du0[2][6] = {{0}};
+    for (int q = 0; q < 2; q++) {
+        ws_vec3 v, w;
+        ws_body_get_velocity(sc.world, sc.box[q], &v);
+        ws_body_get_angular_velocity(sc.world, sc.box[q], &w);
+        const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
+        memcpy(u0[q], u, sizeof u);
+    }
+    const double c0 = cpu_seconds();
+    for (long k = 1; k <= steps; k++) {
+        memcpy(st0, st, n);
+        memset(st, 0, n);
+        pr.solves = 0;
+        if (ws_world_step(sc.world) != WS_OK) {
+            printf("step %ld failed: %s\n", k, ws_world_last_error(sc.world));
+            return 1;
+        }
+        /* Step-to-step change of the film's dv and of the bodies' (dU, both boxes, their
+         * velocity and spin as they are, metres and radians a second). */
+        const double *dv = web->imp->dv;
+        double dd = 0.0, d2 = 0.0, ud = 0.0, u2 = 0.0;
+        for (size_t j = 0; j < 3 * (size_t)n; j++) {
+            dd += (dv[j] - dv0[j]) * (dv[j] - dv0[j]);
+            d2 += dv[j] * dv[j];
+        }
+        memcpy(dv0, dv, 3 * (size_t)n * sizeof(double));
+        for (int q = 0; q < 2; q++) {
+            ws_vec3 v, w;
+            ws_body_get_velocity(sc.world, sc.box[q], &v);
+            ws_body_get_angular_velocity(sc.world, sc.box[q], &w);
+            const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
+            for (int c = 0; c < 6; c++) {
+                const double du = u[c] - u0[q][c];
+                ud += (du - du0[q][c]) * (du - du0[q][c]);
+                u2 += du * du;
+                du0[q][c] = du;
+                u0[q][c] = u[c];
+            }
+        }
+        uint32_t enter = 0, leave = 0, flip = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            const int was = st0[i] >= 2, is = st[i] >= 2;
+            enter += !was && is;
+            leave += was && !is;
+            flip += was && is && st0[i] != st[i];
+        }
+        uint32_t its = 0;
+        for (uint32_t q = 0; q < pr.solves && q < WS_PROBE_PASSES; q++)
+            its += pr.it[q];
+        if (k > 1) { /* the first step after a restore starts cold */
+            s.steps++;
+            s.it += its;
+            s.first_it += pr.it[0];
+            s.solves += pr.solves;
+            s.onepass += pr.solves == 1;
+            s.cold += its == 0;
+            for (int q = 0; q < WS_PROBE_KINDS; q++) {
+                s.start[q] += pr.start[q];
+                s.start_max[q] = fmax(s.start_max[q], pr.start[q]);
+                s.above0[q] += pr.above0[q];
+            }
+            for (int m = 0; m < WS_PROBE_MARKS; m++)
+                for (int q = 0; q < WS_PROBE_KINDS; q++)
+                    s.above[m] += pr.above[m][q];
+            if (its > 0)
+                s.bind[pr.bind_kind]++;
+            s.enter += enter;
+            s.leave += leave;
+            s.flip += flip;
+            s.ddv += d2 > 0 ? sqrt(dd / d2) : 0.0;
+            s.ddu += u2 > 0 ? sqrt(ud / u2) : 0.0;
+        }
+        if (steps_out && k > 1) {
+            const uint32_t b = pr.bind_row;
+            fprintf(steps_out,
+                    "%.5f %u %u %u %.4g %.4g %.4g %.4g %u %u %u %u %u %u %u %u %u %u %s %d %d "
+                    "%.4g %u %u %u %.4g %.4g\n",
+                    t0 + k * sc.dt, its, pr.solves, pr.it[0], pr.start[0], pr.start[1],
+                    pr.start[2], pr.start[3], pr.above0[0], pr.above0[1], pr.above0[2],
+                    pr.above0[3], pr.above[0][0] + pr.above[0][1] + pr.above[0][2] + pr.above[0][3],
+                    pr.above[1][0] + pr.above[1][1] + pr.above[1][2] + pr.above[1][3],
+                    pr.above[2][0] + pr.above[2][1] + pr.above[2][2] + pr.above[2][3],
+                    pr.above[3][0] + pr.above[3][1] + pr.above[3][2] + pr.above[3][3],
+                    pr.above[4][0] + pr.above[4][1] + pr.above[4][2] + pr.above[4][3], b,
+                    kind_name[pr.bind_kind], b < n ? (int)(b % (uint32_t)web->nx) : -1,
+                    b < n ? (int)(b / (uint32_t)web->nx) : -1, pr.bind_value, enter, leave, flip,
+                    d2 > 0 ? sqrt(dd / d2) : 0.0, u2 > 0 ? sqrt(ud / u2) : 0.0);
+        }
+        if (k % per == 0) {
+            probe_print(&s, t0 + k * sc.dt);
+            memset(&s, 0, sizeof s);
+        }
+    }
+    printf("%.1f s CPU per simulated s (the probe's own passes included)\n",
+           (cpu_seconds() - c0) / T);
+    if (steps_out)
+        fclose(steps_out);
+    web->imp->probe = NULL;
+    free(st);
+    free(st0);
+    free(dv0);
+    ws_world_destroy(sc.world);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     (void)tilt_run; /* the example's driver: this bench steps the scene itself */
+    if (argc > 2 && !strcmp(argv[1], "window"))
+        return window_probe(argc, argv);
     tilt_options a;
     tilt_default_options(&a);
     a.variant = 'R';
