@@ -568,6 +568,17 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
+    if (R && im->warm && !im->cold_bodies) {
+        /* The bodies' start from the film's (a block Gauss-Seidel step): dU += A_bb^-1 (b_U -
+         * A_bb dU - A_bf dv), the bodies' best velocity change given the warm film. */
+        memset(z, 0, m * sizeof(double));
+        (void)ws_rigid_apply(R, web, x, R->x, z, R->q);
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->r[j] = R->b[j] - R->q[j];
+        ws_rigid_block_solve(R, R->r, R->z);
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->x[j] += R->z[j];
+    }
     (void)ws_implicit_apply_op(web, x, q);
     if (R)
         (void)ws_rigid_apply(R, web, x, R->x, q, R->q);

@@ -91,6 +91,8 @@ typedef struct ws_implicit {
      * turning rows in N^2 m^2 s^2). Filled at the end of every solve, for a bench. */
     double last_worst[3], last_rr[3];
     ws_implicit_probe *probe; /* a bench's record of the solves (NULL: none) */
+    int cold_bodies; /* set: the bodies start from rest, not from the warm film (a bench's
+                        comparison) */
 } ws_implicit;
 
 /* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
