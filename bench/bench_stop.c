@@ -67,6 +67,9 @@ typedef struct probe_sums {
     long bind[WS_PROBE_KINDS];
     double enter, leave, flip, ddv, ddu;
     long cold; /* steps whose warm start already met the test */
+    double du_lin[2], du_ang[2]; /* sums over the steps of |dV|^2, |dW|^2 of the boxes */
+    long where_up[12], where_around[4]; /* contacts in or out by twelfth up the band, quarter
+                                           around it */
 } probe_sums;
 
 static const char *const kind_name[WS_PROBE_KINDS] = {"free", "stick", "slip", "body"};
@@ -85,6 +88,17 @@ static void probe_print(const probe_sums *s, double t)
            s->above0[2] / n, s->above0[3] / n, s->above[0] / n, s->above[1] / n, s->above[2] / n,
            s->above[3] / n, s->above[4] / n, s->above[5] / n, s->bind[0], s->bind[1], s->bind[2],
            s->bind[3], s->enter / n, s->leave / n, s->flip / n, s->ddv / n, s->ddu / n);
+    printf("         boxes' velocity change a step, rms: bottom %.3g m/s %.3g rad/s, top %.3g m/s "
+           "%.3g rad/s\n",
+           sqrt(s->du_lin[0] / n), sqrt(s->du_ang[0] / n), sqrt(s->du_lin[1] / n),
+           sqrt(s->du_ang[1] / n));
+    printf("         contacts in or out by twelfth up the band:");
+    for (int q = 0; q < 12; q++)
+        printf(" %ld", s->where_up[q]);
+    printf("; by quarter around:");
+    for (int q = 0; q < 4; q++)
+        printf(" %ld", s->where_around[q]);
+    printf("\n");
     fflush(stdout);
 }
 
@@ -117,6 +131,11 @@ static int window_probe(int argc, char **argv)
         printf("restore %s: %s\n", argv[2], ws_world_last_error(sc.world));
         return 1;
     }
+    if (getenv("WS_PROBE_DT")) { /* the step, s, after the restore */
+        sc.dt = atof(getenv("WS_PROBE_DT"));
+        if (ws_world_set_dt(sc.world, sc.dt) != WS_OK)
+            return 1;
+    }
     uint32_t slot;
     if (ws_lookup_web(sc.world, sc.film, &slot) != WS_OK)
         return 1;
@@ -132,11 +151,20 @@ static int window_probe(int argc, char **argv)
         return 1;
     pr.state = st;
     web->imp->probe = &pr;
+    /* WS_PROBE_COLD=1: the bodies start each solve from rest, as before the film's warm
+     * start was carried over to them (ws_implicit's cold_bodies). */
+    web->imp->cold_bodies = getenv("WS_PROBE_COLD") && atoi(getenv("WS_PROBE_COLD"));
+    /* Studies of the cause: WS_PROBE_TOL, the solve's tolerance; WS_PROBE_HOLD=1, the bodies
+     * held during the film's solve. */
+    if (getenv("WS_PROBE_TOL"))
+        web->solver_tol = atof(getenv("WS_PROBE_TOL"));
+    if (getenv("WS_PROBE_HOLD"))
+        web->hold_bodies = atoi(getenv("WS_PROBE_HOLD"));
     FILE *steps_out = getenv("WS_PROBE_STEPS") ? fopen(getenv("WS_PROBE_STEPS"), "w") : NULL;
     double t0;
     ws_world_get_time(sc.world, &t0);
-    printf("case R refined %d (%u nodes, %d x %d), from t %.4f s (%.2f deg), %.3f s\n",
-           a.refine, n, web->nx, web->ny, t0, plane_angle(sc.world, sc.plane) * 180.0 / 3.14159265358979,
+    printf("case R refined %d (%u nodes, %d x %d), bodies %s, from t %.4f s (%.2f deg), %.3f s\n",
+           a.refine, n, web->nx, web->ny, web->imp->cold_bodies ? "cold" : "warm", t0, plane_angle(sc.world, sc.plane) * 180.0 / 3.14159265358979,
            T);
     const long steps = lround(T / sc.dt), per = lround(every / sc.dt);
     probe_sums s;
@@ -174,6 +202,10 @@ static int window_probe(int argc, char **argv)
             const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
             for (int c = 0; c < 6; c++) {
                 const double du = u[c] - u0[q][c];
+                if (c < 3)
+                    s.du_lin[q] += du * du;
+                else
+                    s.du_ang[q] += du * du;
                 ud += (du - du0[q][c]) * (du - du0[q][c]);
                 u2 += du * du;
                 du0[q][c] = du;
@@ -186,6 +218,10 @@ static int window_probe(int argc, char **argv)
             enter += !was && is;
             leave += was && !is;
             flip += was && is && st0[i] != st[i];
+            if (k > 1 && was != is) { /* where on the band: twelfths up it, quarters around */
+                s.where_up[12 * (i / (uint32_t)web->nx) / (uint32_t)web->ny]++;
+                s.where_around[4 * (i % (uint32_t)web->nx) / (uint32_t)web->nx]++;
+            }
         }
         uint32_t its = 0;
         for (uint32_t q = 0; q < pr.solves && q < WS_PROBE_PASSES; q++)
