@@ -14,7 +14,12 @@
  * 0 the solve's (rows), 1 the relative one.
  * `bench_stop window file r duration [every]`: the band refined r x r at the real areal density
  * restored from a checkpoint (bench_implicit's WS_BENCH_SAVE), each step's solves read through
- * the solve's probe (ws_implicit_probe): see window_probe. */
+ * the solve's probe (ws_implicit_probe), the boxes' velocity change, the film's load on them and
+ * the bodies' contacts: see window_probe. Studies by environment: WS_PROBE_COLD=1 (the bodies
+ * from rest), WS_PROBE_TOL=tol, WS_PROBE_HOLD=1 (the bodies held), WS_PROBE_DT=s (after the
+ * restore), WS_PROBE_DAMP=f,T[,1] (the box contacts' damping, or with 1 the film-box one's,
+ * times f for T s), WS_PROBE_CONTACTS=n (list the bodies' contacts of the first n steps),
+ * WS_PROBE_STEPS=file (a line a step). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -67,6 +72,10 @@ typedef struct probe_sums {
     long bind[WS_PROBE_KINDS];
     double enter, leave, flip, ddv, ddu;
     long cold; /* steps whose warm start already met the test */
+    double bc, bc_change; /* the bodies' contacts a step, and steps whose count changed */
+    double dfilm[2][6]; /* sums of the squared step-to-step change of the film's load on
+                           each box: force x y z (N), moment x y z (N m) */
+    double du_axis[2][6]; /* the same by component: dV x y z, dW x y z */
     double du_lin[2], du_ang[2]; /* sums over the steps of |dV|^2, |dW|^2 of the boxes */
     long where_up[12], where_around[4]; /* contacts in or out by twelfth up the band, quarter
                                            around it */
@@ -92,6 +101,21 @@ static void probe_print(const probe_sums *s, double t)
            "%.3g rad/s\n",
            sqrt(s->du_lin[0] / n), sqrt(s->du_ang[0] / n), sqrt(s->du_lin[1] / n),
            sqrt(s->du_ang[1] / n));
+    for (int q = 0; q < 2; q++)
+        printf("         %s box, rms by component: dV %.3g %.3g %.3g m/s, dW %.3g %.3g %.3g "
+               "rad/s\n",
+               q ? "top" : "bottom", sqrt(s->du_axis[q][0] / n), sqrt(s->du_axis[q][1] / n),
+               sqrt(s->du_axis[q][2] / n), sqrt(s->du_axis[q][3] / n),
+               sqrt(s->du_axis[q][4] / n), sqrt(s->du_axis[q][5] / n));
+    for (int q = 0; q < 2; q++)
+        printf("         %s box, the film's load, its change a step rms: force %.3g %.3g %.3g N, "
+               "moment %.3g %.3g %.3g N m\n",
+               q ? "top" : "bottom", sqrt(s->dfilm[q][0] / n), sqrt(s->dfilm[q][1] / n),
+               sqrt(s->dfilm[q][2] / n), sqrt(s->dfilm[q][3] / n), sqrt(s->dfilm[q][4] / n),
+               sqrt(s->dfilm[q][5] / n));
+    printf("         the bodies' contacts: %.2f a step, their number changed in %.0f %% of the "
+           "steps\n",
+           s->bc / n, 100.0 * s->bc_change / n);
     printf("         contacts in or out by twelfth up the band:");
     for (int q = 0; q < 12; q++)
         printf(" %ld", s->where_up[q]);
@@ -107,9 +131,11 @@ static void probe_print(const probe_sums *s, double t)
  * WS_BENCH_SAVE; "-" starts at t = 0), stepped `duration` s with the probe of the solve
  * (ws_implicit_probe): per window of `every` s (default 0.05), the warm start's residual by
  * kind of row over the goal, rows above the goal at the start and after some iterations, the
- * binding row's kind, contacts entering and leaving and stick-slip changes a step, and how
- * much dv (the film's velocity change) and dU (the bodies') change from step to step. With
- * WS_PROBE_STEPS=file, a line a step into it. */
+ * binding row's kind, contacts entering and leaving and stick-slip changes a step, how much dv
+ * (the film's velocity change) and dU (the bodies') change from step to step, the boxes'
+ * velocity change a step by component, the change of the film's load on them, and the bodies'
+ * contacts a step. With WS_PROBE_STEPS=file, a line a step into it (the file's head comment
+ * above lists the other knobs). */
 static int window_probe(int argc, char **argv)
 {
     tilt_options a;
@@ -130,6 +156,43 @@ static int window_probe(int argc, char **argv)
     if (strcmp(argv[2], "-") && ws_world_restore_file(sc.world, argv[2]) != WS_OK) {
         printf("restore %s: %s\n", argv[2], ws_world_last_error(sc.world));
         return 1;
+    }
+    /* WS_PROBE_DAMP=f,T[,film]: the box-box and box-plane contacts' damping (film 1: the
+     * film-box contact's) times f for the first T s, then as it was: whether a rattle is energy
+     * left over (it stays gone) or fed each step (it comes back). */
+    double damp_f = 1.0, damp_T = 0.0;
+    int damp_film = 0, npair = 0;
+    ws_material_id pa[2] = {{0}, {0}}, pb[2] = {{0}, {0}};
+    ws_contact_def cd0[2];
+    if (getenv("WS_PROBE_DAMP") &&
+        sscanf(getenv("WS_PROBE_DAMP"), "%lf,%lf,%d", &damp_f, &damp_T, &damp_film) >= 2) {
+        uint32_t bs[2], ws;
+        ws_body_id who[2] = {sc.box[0], sc.plane};
+        for (int q = 0; q < 2; q++)
+            if (ws_lookup_body(sc.world, who[q], &bs[q]) != WS_OK)
+                return 1;
+        if (ws_lookup_web(sc.world, sc.film, &ws) != WS_OK)
+            return 1;
+        const ws_slot_table *mt = &sc.world->mat_slots;
+        const uint64_t box = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->bodies.material[bs[0]]);
+        const uint64_t plane = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->bodies.material[bs[1]]);
+        const uint64_t film = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->webs[ws]->material);
+        pa[0].bits = box;
+        pb[0].bits = damp_film ? film : box;
+        pa[1].bits = box;
+        pb[1].bits = plane;
+        npair = damp_film ? 1 : 2;
+        for (int q = 0; q < npair; q++) {
+            if (ws_world_get_contact(sc.world, pa[q], pb[q], &cd0[q]) != WS_OK)
+                return 1;
+            ws_contact_def cd = cd0[q];
+            cd.damping *= damp_f;
+            printf("contacts %s: damping %g -> %g kg/s for %g s\n",
+                   damp_film ? "film-box" : q ? "box-plane" : "box-box", cd0[q].damping,
+                   cd.damping, damp_T);
+            if (ws_world_set_contact(sc.world, pa[q], pb[q], &cd) != WS_OK)
+                return 1;
+        }
     }
     if (getenv("WS_PROBE_DT")) { /* the step, s, after the restore */
         sc.dt = atof(getenv("WS_PROBE_DT"));
@@ -169,7 +232,8 @@ static int window_probe(int argc, char **argv)
     const long steps = lround(T / sc.dt), per = lround(every / sc.dt);
     probe_sums s;
     memset(&s, 0, sizeof s);
-    double u0[2][6], du0[2][6] = {{0}};
+    double u0[2][6], du0[2][6] = {{0}}, bf0[2][6] = {{0}};
+    size_t nbc0 = 0;
     for (int q = 0; q < 2; q++) {
         ws_vec3 v, w;
         ws_body_get_velocity(sc.world, sc.box[q], &v);
@@ -179,6 +243,10 @@ static int window_probe(int argc, char **argv)
     }
     const double c0 = cpu_seconds();
     for (long k = 1; k <= steps; k++) {
+        if (damp_T > 0.0 && k == lround(damp_T / sc.dt) + 1)
+            for (int q = 0; q < npair; q++)
+                if (ws_world_set_contact(sc.world, pa[q], pb[q], &cd0[q]) != WS_OK)
+                    return 1;
         memcpy(st0, st, n);
         memset(st, 0, n);
         pr.solves = 0;
@@ -206,12 +274,51 @@ static int window_probe(int argc, char **argv)
                     s.du_lin[q] += du * du;
                 else
                     s.du_ang[q] += du * du;
+                s.du_axis[q][c] += du * du;
                 ud += (du - du0[q][c]) * (du - du0[q][c]);
                 u2 += du * du;
                 du0[q][c] = du;
                 u0[q][c] = u[c];
             }
         }
+        /* The film's load on each box this step (its contacts' forces as the bodies take
+         * them) and its change from the last step. */
+        for (int q = 0; q < 2; q++) {
+            uint32_t bslot;
+            if (ws_lookup_body(sc.world, sc.box[q], &bslot) != WS_OK)
+                return 1;
+            const v3 F = web->bforce[sc.world->cur][bslot], M = web->bmoment[sc.world->cur][bslot];
+            const double d[6] = {F.x - bf0[q][0], F.y - bf0[q][1], F.z - bf0[q][2],
+                                 M.x - bf0[q][3], M.y - bf0[q][4], M.z - bf0[q][5]};
+            if (k > 1)
+                for (int c = 0; c < 6; c++)
+                    s.dfilm[q][c] += d[c] * d[c];
+            bf0[q][0] = F.x, bf0[q][1] = F.y, bf0[q][2] = F.z;
+            bf0[q][3] = M.x, bf0[q][4] = M.y, bf0[q][5] = M.z;
+        }
+        size_t nbc = 0;
+        ws_world_get_contact_count(sc.world, &nbc);
+        if (getenv("WS_PROBE_CONTACTS") && k <= atoi(getenv("WS_PROBE_CONTACTS"))) {
+            ws_contact_info ci[64];
+            size_t nc = 0;
+            ws_world_copy_contacts(sc.world, ci, 64, &nc);
+            printf("step %ld: %zu body contacts\n", k, nc);
+            for (size_t q = 0; q < nc && q < 64; q++) {
+                const char *nm[3] = {"bottom", "top", "plane/stop"};
+                const int ia = ci[q].body_a.bits == sc.box[0].bits ? 0
+                               : ci[q].body_a.bits == sc.box[1].bits ? 1 : 2;
+                const int ib = ci[q].body_b.bits == sc.box[0].bits ? 0
+                               : ci[q].body_b.bits == sc.box[1].bits ? 1 : 2;
+                printf("  %-10s %-10s kind %d at (%.4f %.4f %.4f) overlap %.3g mm N %.3g\n",
+                       nm[ia], nm[ib], ci[q].kind, ci[q].point.x, ci[q].point.y, ci[q].point.z,
+                       1e3 * ci[q].overlap, ci[q].normal_force);
+            }
+        }
+        if (k > 1) {
+            s.bc += (double)nbc;
+            s.bc_change += nbc != nbc0;
+        }
+        nbc0 = nbc;
         uint32_t enter = 0, leave = 0, flip = 0;
         for (uint32_t i = 0; i < n; i++) {
             const int was = st0[i] >= 2, is = st[i] >= 2;
