@@ -19,7 +19,9 @@
  * with a 1 kg box on each drum's middle, in the film's solve),
  * solve (`solve [duration] [dt ms] [preconditioner] [tolerance]`: one implicit run of case R),
  * phases (`phases [duration] [r] [dt ms]`: case R's band refined r x r on the multigrid, CG
- * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run),
+ * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run;
+ * WS_BENCH_SAVE=file with WS_BENCH_SAVE_AT=t saves the state at t, WS_BENCH_RESUME=file starts
+ * from a saved one),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
