@@ -19,7 +19,9 @@
  * with a 1 kg box on each drum's middle, in the film's solve),
  * solve (`solve [duration] [dt ms] [preconditioner] [tolerance]`: one implicit run of case R),
  * phases (`phases [duration] [r] [dt ms]`: case R's band refined r x r on the multigrid, CG
- * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run),
+ * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run;
+ * WS_BENCH_SAVE=file with WS_BENCH_SAVE_AT=t saves the state at t, WS_BENCH_RESUME=file starts
+ * from a saved one),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -379,7 +381,20 @@ int main(int argc, char **argv)
             printf("  refine %d: cannot build\n", r);
             return 1;
         }
+        /* Checkpoints of the later tilt (the environment, so the arguments stay as they are):
+         * WS_BENCH_RESUME=file restores a state saved by this same scene before the first
+         * step (the run then covers `duration` from the saved time), WS_BENCH_SAVE=file with
+         * WS_BENCH_SAVE_AT=t (s) saves the state once the run reaches t. */
+        const char *resume = getenv("WS_BENCH_RESUME"), *save = getenv("WS_BENCH_SAVE");
+        const double save_at = getenv("WS_BENCH_SAVE_AT") ? atof(getenv("WS_BENCH_SAVE_AT")) : -1;
+        if (resume && ws_world_restore_file(sc.world, resume) != WS_OK) {
+            printf("  resume %s: %s\n", resume, ws_world_last_error(sc.world));
+            return 1;
+        }
+        double t_start = 0;
+        ws_world_get_time(sc.world, &t_start);
         const long steps = lround(T / sc.dt), window = lround(0.05 / sc.dt);
+        int saved = 0;
         ws_web_solver_stats prev;
         ws_web_get_solver_stats(sc.world, sc.film, &prev);
         uint64_t sum = 0, most = 0;
@@ -393,12 +408,19 @@ int main(int argc, char **argv)
             ws_web_get_solver_stats(sc.world, sc.film, &s);
             const uint64_t it = s.iterations - prev.iterations;
             prev = s;
+            if (save && !saved && t_start + k * sc.dt >= save_at - 0.5 * sc.dt && save_at >= 0) {
+                saved = 1;
+                if (ws_world_save_file(sc.world, save) != WS_OK)
+                    printf("  save %s: %s\n", save, ws_world_last_error(sc.world));
+                else
+                    printf("  saved %s at t %.4f s\n", save, t_start + k * sc.dt);
+            }
             sum += it;
             most = it > most ? it : most;
             if (k % window == 0) {
                 const double c = cpu_now();
                 printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n",
-                       r, k * sc.dt, (double)sum / (double)window, (unsigned long long)most,
+                       r, t_start + k * sc.dt, (double)sum / (double)window, (unsigned long long)most,
                        (c - c0) / (window * sc.dt));
                 fflush(stdout);
                 sum = most = 0;

@@ -11,12 +11,28 @@
  * (mean over the steps and largest). Never fails on time.
  * Usage: bench_stop [duration s] [dt ms] [preconditioner] [tolerance] [test]: preconditioner
  * a ws_web_preconditioner (1 block Jacobi, 2 multigrid, 0 AUTO), tolerance 0 the default, test
- * 0 the solve's (rows), 1 the relative one. */
+ * 0 the solve's (rows), 1 the relative one.
+ * `bench_stop window file r duration [every]`: the band refined r x r at the real areal density
+ * restored from a checkpoint (bench_implicit's WS_BENCH_SAVE), each step's solves read through
+ * the solve's probe (ws_implicit_probe), the boxes' velocity change, the film's load on them and
+ * the bodies' contacts: see window_probe. Studies by environment: WS_PROBE_COLD=1 (the bodies
+ * from rest), WS_PROBE_TOL=tol, WS_PROBE_HOLD=1 (the bodies held), WS_PROBE_DT=s (after the
+ * restore), WS_PROBE_DAMP=f,T[,1] (the box contacts' damping, or with 1 the film-box one's,
+ * times f for T s), WS_PROBE_CONTACTS=n (list the bodies' contacts of the first n steps),
+ * WS_PROBE_STEPS=file (a line a step). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
 #include "web/implicit.h"
 #include "world/world_internal.h"
+
+/* CPU seconds of this process (the runs are single-threaded). */
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
 
 typedef struct window {
     long steps;
@@ -47,9 +63,337 @@ static void window_print(const window *s, double t, double angle)
     fflush(stdout);
 }
 
+/* One window's sums over its steps (window_probe). */
+typedef struct probe_sums {
+    long steps, onepass;
+    double it, solves, first_it;
+    double start[WS_PROBE_KINDS], start_max[WS_PROBE_KINDS];
+    double above0[WS_PROBE_KINDS], above[WS_PROBE_MARKS];
+    long bind[WS_PROBE_KINDS];
+    double enter, leave, flip, ddv, ddu;
+    long cold; /* steps whose warm start already met the test */
+    double bc, bc_change; /* the bodies' contacts a step, and steps whose count changed */
+    double dfilm[2][6]; /* sums of the squared step-to-step change of the film's load on
+                           each box: force x y z (N), moment x y z (N m) */
+    double du_axis[2][6]; /* the same by component: dV x y z, dW x y z */
+    double du_lin[2], du_ang[2]; /* sums over the steps of |dV|^2, |dW|^2 of the boxes */
+    long where_up[12], where_around[4]; /* contacts in or out by twelfth up the band, quarter
+                                           around it */
+} probe_sums;
+
+static const char *const kind_name[WS_PROBE_KINDS] = {"free", "stick", "slip", "body"};
+
+static void probe_print(const probe_sums *s, double t)
+{
+    const double n = s->steps > 0 ? (double)s->steps : 1.0;
+    printf("%6.3f s  CG %5.2f it/step (first solve %5.2f) %4.2f solves/step, 1-pass %3.0f%%  "
+           "start/goal free %7.3g stick %7.3g slip %7.3g body %7.3g (max %7.3g %7.3g %7.3g %7.3g)"
+           "  rows>goal at start %6.1f %6.1f %6.1f %4.1f  after 1,2,4,8,16,32 it %6.1f %6.1f "
+           "%6.1f %5.1f %5.1f %5.1f  binds free %ld stick %ld slip %ld body %ld  contacts in "
+           "%5.2f out %5.2f stick<->slip %5.2f a step  |ddv|/|dv| %6.3f  |ddU|/|dU| %6.3f\n",
+           t, s->it / n, s->first_it / n, s->solves / n, 100.0 * s->onepass / n,
+           s->start[0] / n, s->start[1] / n, s->start[2] / n, s->start[3] / n, s->start_max[0],
+           s->start_max[1], s->start_max[2], s->start_max[3], s->above0[0] / n, s->above0[1] / n,
+           s->above0[2] / n, s->above0[3] / n, s->above[0] / n, s->above[1] / n, s->above[2] / n,
+           s->above[3] / n, s->above[4] / n, s->above[5] / n, s->bind[0], s->bind[1], s->bind[2],
+           s->bind[3], s->enter / n, s->leave / n, s->flip / n, s->ddv / n, s->ddu / n);
+    printf("         boxes' velocity change a step, rms: bottom %.3g m/s %.3g rad/s, top %.3g m/s "
+           "%.3g rad/s\n",
+           sqrt(s->du_lin[0] / n), sqrt(s->du_ang[0] / n), sqrt(s->du_lin[1] / n),
+           sqrt(s->du_ang[1] / n));
+    for (int q = 0; q < 2; q++)
+        printf("         %s box, rms by component: dV %.3g %.3g %.3g m/s, dW %.3g %.3g %.3g "
+               "rad/s\n",
+               q ? "top" : "bottom", sqrt(s->du_axis[q][0] / n), sqrt(s->du_axis[q][1] / n),
+               sqrt(s->du_axis[q][2] / n), sqrt(s->du_axis[q][3] / n),
+               sqrt(s->du_axis[q][4] / n), sqrt(s->du_axis[q][5] / n));
+    for (int q = 0; q < 2; q++)
+        printf("         %s box, the film's load, its change a step rms: force %.3g %.3g %.3g N, "
+               "moment %.3g %.3g %.3g N m\n",
+               q ? "top" : "bottom", sqrt(s->dfilm[q][0] / n), sqrt(s->dfilm[q][1] / n),
+               sqrt(s->dfilm[q][2] / n), sqrt(s->dfilm[q][3] / n), sqrt(s->dfilm[q][4] / n),
+               sqrt(s->dfilm[q][5] / n));
+    printf("         the bodies' contacts: %.2f a step, their number changed in %.0f %% of the "
+           "steps\n",
+           s->bc / n, 100.0 * s->bc_change / n);
+    printf("         contacts in or out by twelfth up the band:");
+    for (int q = 0; q < 12; q++)
+        printf(" %ld", s->where_up[q]);
+    printf("; by quarter around:");
+    for (int q = 0; q < 4; q++)
+        printf(" %ld", s->where_around[q]);
+    printf("\n");
+    fflush(stdout);
+}
+
+/* `window file r duration [every]`: case R's band refined r x r at the real areal density on
+ * the multigrid (bench_implicit's `phases`), restored from `file` (bench_implicit's
+ * WS_BENCH_SAVE; "-" starts at t = 0), stepped `duration` s with the probe of the solve
+ * (ws_implicit_probe): per window of `every` s (default 0.05), the warm start's residual by
+ * kind of row over the goal, rows above the goal at the start and after some iterations, the
+ * binding row's kind, contacts entering and leaving and stick-slip changes a step, how much dv
+ * (the film's velocity change) and dU (the bodies') change from step to step, the boxes'
+ * velocity change a step by component, the change of the film's load on them, and the bodies'
+ * contacts a step. With WS_PROBE_STEPS=file, a line a step into it (the file's head comment
+ * above lists the other knobs). */
+static int window_probe(int argc, char **argv)
+{
+    tilt_options a;
+    tilt_default_options(&a);
+    a.variant = 'R';
+    a.quiet = 1;
+    a.wrapped = 1;
+    a.implicit = 1;
+    a.areal_density = 0.018;
+    a.substeps = 1;
+    a.refine = argc > 3 ? atoi(argv[3]) : 1;
+    a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
+    const double T = argc > 4 ? atof(argv[4]) : 0.1;
+    const double every = argc > 5 ? atof(argv[5]) : 0.05;
+    tilt_scene sc;
+    if (tilt_build(&a, &sc) != WS_OK)
+        return 1;
+    if (strcmp(argv[2], "-") && ws_world_restore_file(sc.world, argv[2]) != WS_OK) {
+        printf("restore %s: %s\n", argv[2], ws_world_last_error(sc.world));
+        return 1;
+    }
+    /* WS_PROBE_DAMP=f,T[,film]: the box-box and box-plane contacts' damping (film 1: the
+     * film-box contact's) times f for the first T s, then as it was: whether a rattle is energy
+     * left over (it stays gone) or fed each step (it comes back). */
+    double damp_f = 1.0, damp_T = 0.0;
+    int damp_film = 0, npair = 0;
+    ws_material_id pa[2] = {{0}, {0}}, pb[2] = {{0}, {0}};
+    ws_contact_def cd0[2];
+    if (getenv("WS_PROBE_DAMP") &&
+        sscanf(getenv("WS_PROBE_DAMP"), "%lf,%lf,%d", &damp_f, &damp_T, &damp_film) >= 2) {
+        uint32_t bs[2], ws;
+        ws_body_id who[2] = {sc.box[0], sc.plane};
+        for (int q = 0; q < 2; q++)
+            if (ws_lookup_body(sc.world, who[q], &bs[q]) != WS_OK)
+                return 1;
+        if (ws_lookup_web(sc.world, sc.film, &ws) != WS_OK)
+            return 1;
+        const ws_slot_table *mt = &sc.world->mat_slots;
+        const uint64_t box = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->bodies.material[bs[0]]);
+        const uint64_t plane = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->bodies.material[bs[1]]);
+        const uint64_t film = ws_slots_id(mt, WS_KIND_MATERIAL, sc.world->webs[ws]->material);
+        pa[0].bits = box;
+        pb[0].bits = damp_film ? film : box;
+        pa[1].bits = box;
+        pb[1].bits = plane;
+        npair = damp_film ? 1 : 2;
+        for (int q = 0; q < npair; q++) {
+            if (ws_world_get_contact(sc.world, pa[q], pb[q], &cd0[q]) != WS_OK)
+                return 1;
+            ws_contact_def cd = cd0[q];
+            cd.damping *= damp_f;
+            printf("contacts %s: damping %g -> %g kg/s for %g s\n",
+                   damp_film ? "film-box" : q ? "box-plane" : "box-box", cd0[q].damping,
+                   cd.damping, damp_T);
+            if (ws_world_set_contact(sc.world, pa[q], pb[q], &cd) != WS_OK)
+                return 1;
+        }
+    }
+    if (getenv("WS_PROBE_DT")) { /* the step, s, after the restore */
+        sc.dt = atof(getenv("WS_PROBE_DT"));
+        if (ws_world_set_dt(sc.world, sc.dt) != WS_OK)
+            return 1;
+    }
+    uint32_t slot;
+    if (ws_lookup_web(sc.world, sc.film, &slot) != WS_OK)
+        return 1;
+    ws_web *web = sc.world->webs[slot];
+    if (!web->imp && ws_implicit_reserve(&sc.world->mem, web) != 0)
+        return 1;
+    const uint32_t n = web->n;
+    ws_implicit_probe pr;
+    memset(&pr, 0, sizeof pr);
+    uint8_t *st = calloc(n, 1), *st0 = calloc(n, 1);
+    double *dv0 = calloc(3 * (size_t)n, sizeof(double));
+    if (!st || !st0 || !dv0)
+        return 1;
+    pr.state = st;
+    web->imp->probe = &pr;
+    /* WS_PROBE_COLD=1: the bodies start each solve from rest, as before the film's warm
+     * start was carried over to them (ws_implicit's cold_bodies). */
+    web->imp->cold_bodies = getenv("WS_PROBE_COLD") && atoi(getenv("WS_PROBE_COLD"));
+    /* Studies of the cause: WS_PROBE_TOL, the solve's tolerance; WS_PROBE_HOLD=1, the bodies
+     * held during the film's solve. */
+    if (getenv("WS_PROBE_TOL"))
+        web->solver_tol = atof(getenv("WS_PROBE_TOL"));
+    if (getenv("WS_PROBE_HOLD"))
+        web->hold_bodies = atoi(getenv("WS_PROBE_HOLD"));
+    FILE *steps_out = getenv("WS_PROBE_STEPS") ? fopen(getenv("WS_PROBE_STEPS"), "w") : NULL;
+    double t0;
+    ws_world_get_time(sc.world, &t0);
+    printf("case R refined %d (%u nodes, %d x %d), bodies %s, from t %.4f s (%.2f deg), %.3f s\n",
+           a.refine, n, web->nx, web->ny, web->imp->cold_bodies ? "cold" : "warm", t0, plane_angle(sc.world, sc.plane) * 180.0 / 3.14159265358979,
+           T);
+    const long steps = lround(T / sc.dt), per = lround(every / sc.dt);
+    probe_sums s;
+    memset(&s, 0, sizeof s);
+    double u0[2][6], du0[2][6] = {{0}}, bf0[2][6] = {{0}};
+    size_t nbc0 = 0;
+    for (int q = 0; q < 2; q++) {
+        ws_vec3 v, w;
+        ws_body_get_velocity(sc.world, sc.box[q], &v);
+        ws_body_get_angular_velocity(sc.world, sc.box[q], &w);
+        const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
+        memcpy(u0[q], u, sizeof u);
+    }
+    const double c0 = cpu_seconds();
+    for (long k = 1; k <= steps; k++) {
+        if (damp_T > 0.0 && k == lround(damp_T / sc.dt) + 1)
+            for (int q = 0; q < npair; q++)
+                if (ws_world_set_contact(sc.world, pa[q], pb[q], &cd0[q]) != WS_OK)
+                    return 1;
+        memcpy(st0, st, n);
+        memset(st, 0, n);
+        pr.solves = 0;
+        if (ws_world_step(sc.world) != WS_OK) {
+            printf("step %ld failed: %s\n", k, ws_world_last_error(sc.world));
+            return 1;
+        }
+        /* Step-to-step change of the film's dv and of the bodies' (dU, both boxes, their
+         * velocity and spin as they are, metres and radians a second). */
+        const double *dv = web->imp->dv;
+        double dd = 0.0, d2 = 0.0, ud = 0.0, u2 = 0.0;
+        for (size_t j = 0; j < 3 * (size_t)n; j++) {
+            dd += (dv[j] - dv0[j]) * (dv[j] - dv0[j]);
+            d2 += dv[j] * dv[j];
+        }
+        memcpy(dv0, dv, 3 * (size_t)n * sizeof(double));
+        for (int q = 0; q < 2; q++) {
+            ws_vec3 v, w;
+            ws_body_get_velocity(sc.world, sc.box[q], &v);
+            ws_body_get_angular_velocity(sc.world, sc.box[q], &w);
+            const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
+            for (int c = 0; c < 6; c++) {
+                const double du = u[c] - u0[q][c];
+                if (c < 3)
+                    s.du_lin[q] += du * du;
+                else
+                    s.du_ang[q] += du * du;
+                s.du_axis[q][c] += du * du;
+                ud += (du - du0[q][c]) * (du - du0[q][c]);
+                u2 += du * du;
+                du0[q][c] = du;
+                u0[q][c] = u[c];
+            }
+        }
+        /* The film's load on each box this step (its contacts' forces as the bodies take
+         * them) and its change from the last step. */
+        for (int q = 0; q < 2; q++) {
+            uint32_t bslot;
+            if (ws_lookup_body(sc.world, sc.box[q], &bslot) != WS_OK)
+                return 1;
+            const v3 F = web->bforce[sc.world->cur][bslot], M = web->bmoment[sc.world->cur][bslot];
+            const double d[6] = {F.x - bf0[q][0], F.y - bf0[q][1], F.z - bf0[q][2],
+                                 M.x - bf0[q][3], M.y - bf0[q][4], M.z - bf0[q][5]};
+            if (k > 1)
+                for (int c = 0; c < 6; c++)
+                    s.dfilm[q][c] += d[c] * d[c];
+            bf0[q][0] = F.x, bf0[q][1] = F.y, bf0[q][2] = F.z;
+            bf0[q][3] = M.x, bf0[q][4] = M.y, bf0[q][5] = M.z;
+        }
+        size_t nbc = 0;
+        ws_world_get_contact_count(sc.world, &nbc);
+        if (getenv("WS_PROBE_CONTACTS") && k <= atoi(getenv("WS_PROBE_CONTACTS"))) {
+            ws_contact_info ci[64];
+            size_t nc = 0;
+            ws_world_copy_contacts(sc.world, ci, 64, &nc);
+            printf("step %ld: %zu body contacts\n", k, nc);
+            for (size_t q = 0; q < nc && q < 64; q++) {
+                const char *nm[3] = {"bottom", "top", "plane/stop"};
+                const int ia = ci[q].body_a.bits == sc.box[0].bits ? 0
+                               : ci[q].body_a.bits == sc.box[1].bits ? 1 : 2;
+                const int ib = ci[q].body_b.bits == sc.box[0].bits ? 0
+                               : ci[q].body_b.bits == sc.box[1].bits ? 1 : 2;
+                printf("  %-10s %-10s kind %d at (%.4f %.4f %.4f) overlap %.3g mm N %.3g\n",
+                       nm[ia], nm[ib], ci[q].kind, ci[q].point.x, ci[q].point.y, ci[q].point.z,
+                       1e3 * ci[q].overlap, ci[q].normal_force);
+            }
+        }
+        if (k > 1) {
+            s.bc += (double)nbc;
+            s.bc_change += nbc != nbc0;
+        }
+        nbc0 = nbc;
+        uint32_t enter = 0, leave = 0, flip = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            const int was = st0[i] >= 2, is = st[i] >= 2;
+            enter += !was && is;
+            leave += was && !is;
+            flip += was && is && st0[i] != st[i];
+            if (k > 1 && was != is) { /* where on the band: twelfths up it, quarters around */
+                s.where_up[12 * (i / (uint32_t)web->nx) / (uint32_t)web->ny]++;
+                s.where_around[4 * (i % (uint32_t)web->nx) / (uint32_t)web->nx]++;
+            }
+        }
+        uint32_t its = 0;
+        for (uint32_t q = 0; q < pr.solves && q < WS_PROBE_PASSES; q++)
+            its += pr.it[q];
+        if (k > 1) { /* the first step after a restore starts cold */
+            s.steps++;
+            s.it += its;
+            s.first_it += pr.it[0];
+            s.solves += pr.solves;
+            s.onepass += pr.solves == 1;
+            s.cold += its == 0;
+            for (int q = 0; q < WS_PROBE_KINDS; q++) {
+                s.start[q] += pr.start[q];
+                s.start_max[q] = fmax(s.start_max[q], pr.start[q]);
+                s.above0[q] += pr.above0[q];
+            }
+            for (int m = 0; m < WS_PROBE_MARKS; m++)
+                for (int q = 0; q < WS_PROBE_KINDS; q++)
+                    s.above[m] += pr.above[m][q];
+            if (its > 0)
+                s.bind[pr.bind_kind]++;
+            s.enter += enter;
+            s.leave += leave;
+            s.flip += flip;
+            s.ddv += d2 > 0 ? sqrt(dd / d2) : 0.0;
+            s.ddu += u2 > 0 ? sqrt(ud / u2) : 0.0;
+        }
+        if (steps_out && k > 1) {
+            const uint32_t b = pr.bind_row;
+            fprintf(steps_out,
+                    "%.5f %u %u %u %.4g %.4g %.4g %.4g %u %u %u %u %u %u %u %u %u %u %s %d %d "
+                    "%.4g %u %u %u %.4g %.4g\n",
+                    t0 + k * sc.dt, its, pr.solves, pr.it[0], pr.start[0], pr.start[1],
+                    pr.start[2], pr.start[3], pr.above0[0], pr.above0[1], pr.above0[2],
+                    pr.above0[3], pr.above[0][0] + pr.above[0][1] + pr.above[0][2] + pr.above[0][3],
+                    pr.above[1][0] + pr.above[1][1] + pr.above[1][2] + pr.above[1][3],
+                    pr.above[2][0] + pr.above[2][1] + pr.above[2][2] + pr.above[2][3],
+                    pr.above[3][0] + pr.above[3][1] + pr.above[3][2] + pr.above[3][3],
+                    pr.above[4][0] + pr.above[4][1] + pr.above[4][2] + pr.above[4][3], b,
+                    kind_name[pr.bind_kind], b < n ? (int)(b % (uint32_t)web->nx) : -1,
+                    b < n ? (int)(b / (uint32_t)web->nx) : -1, pr.bind_value, enter, leave, flip,
+                    d2 > 0 ? sqrt(dd / d2) : 0.0, u2 > 0 ? sqrt(ud / u2) : 0.0);
+        }
+        if (k % per == 0) {
+            probe_print(&s, t0 + k * sc.dt);
+            memset(&s, 0, sizeof s);
+        }
+    }
+    printf("%.1f s CPU per simulated s (the probe's own passes included)\n",
+           (cpu_seconds() - c0) / T);
+    if (steps_out)
+        fclose(steps_out);
+    web->imp->probe = NULL;
+    free(st);
+    free(st0);
+    free(dv0);
+    ws_world_destroy(sc.world);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     (void)tilt_run; /* the example's driver: this bench steps the scene itself */
+    if (argc > 2 && !strcmp(argv[1], "window"))
+        return window_probe(argc, argv);
     tilt_options a;
     tilt_default_options(&a);
     a.variant = 'R';

@@ -468,6 +468,43 @@ static void residual_sites(ws_implicit *im, const ws_web *web, const ws_rigid *R
     }
 }
 
+/* A bench's probe (ws_implicit_probe): each kind's largest row measure of the residual (r, and
+ * R's rows) over the goal and its rows above 1 into top and above, the largest row of all into
+ * *row, *kind, *value. */
+static void probe_rows(const ws_implicit *im, const ws_web *web, const ws_rigid *R,
+                       const double *r, double goal, double *top, uint32_t *above,
+                       uint32_t *row, int *kind, double *value)
+{
+    const uint8_t *state = im->probe->state;
+    for (int k = 0; k < WS_PROBE_KINDS; k++)
+        top[k] = 0.0, above[k] = 0;
+    *value = -1.0;
+    for (uint32_t i = 0; i < web->n; i++) {
+        const double *Q = r + 3 * (size_t)i, *kc = im->kc + WS_SYM * (size_t)i;
+        const double *dc = im->dc + WS_SYM * (size_t)i;
+        int pressed = 0;
+        for (int k = 0; k < WS_SYM; k++)
+            pressed |= kc[k] != 0.0 || dc[k] != 0.0;
+        const int kd = !pressed ? 0 : state && state[i] == 3 ? 2 : 1;
+        const double s = sqrt(Q[0] * Q[0] + Q[1] * Q[1] + Q[2] * Q[2]) * web->inv_m[i] / goal;
+        top[kd] = fmax(top[kd], s);
+        above[kd] += s > 1.0;
+        if (s > *value)
+            *value = s, *row = i, *kind = kd;
+    }
+    for (uint32_t j = 0; R && j < R->nb; j++) {
+        ws_rigid one = *R;
+        one.nb = 1;
+        one.mass = R->mass + j;
+        one.inertia = R->inertia + WS_SYM * (size_t)j;
+        const double s = sqrt(bodies_worst2(&one, R->r + 6 * (size_t)j)) / goal;
+        top[3] = fmax(top[3], s);
+        above[3] += s > 1.0;
+        if (s > *value)
+            *value = s, *row = web->n + j, *kind = 3;
+    }
+}
+
 /* z = P r over the film's part (r, z) and the bodies' (R->r, R->z; R NULL when none): the
  * multigrid's cycle over both when the bodies are nested in it (nest); otherwise the film's
  * preconditioner (the multigrid mg, or block Jacobi when NULL), then each body's block and the
@@ -531,6 +568,17 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     for (uint32_t i = 0; i < n; i++) /* a pinned node's dv is zero (the warm start's too) */
         if (web->inv_m[i] == 0.0)
             x[3 * i] = x[3 * i + 1] = x[3 * i + 2] = 0.0;
+    if (R && im->warm && !im->cold_bodies) {
+        /* The bodies' start from the film's (a block Gauss-Seidel step): dU += A_bb^-1 (b_U -
+         * A_bb dU - A_bf dv), the bodies' best velocity change given the warm film. */
+        memset(z, 0, m * sizeof(double));
+        (void)ws_rigid_apply(R, web, x, R->x, z, R->q);
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->r[j] = R->b[j] - R->q[j];
+        ws_rigid_block_solve(R, R->r, R->z);
+        for (size_t j = 0; j < 6 * (size_t)R->nb; j++)
+            R->x[j] += R->z[j];
+    }
     (void)ws_implicit_apply_op(web, x, q);
     if (R)
         (void)ws_rigid_apply(R, web, x, R->x, q, R->q);
@@ -572,8 +620,25 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     if (!isfinite(rr))
         meas = NAN; /* a NaN row is never met */
     memcpy(p, z, m * sizeof(double));
+    ws_implicit_probe *pr = im->probe;
+    const int first = pr && pr->solves == 0;
+    double ptop[WS_PROBE_KINDS];
+    uint32_t pabove[WS_PROBE_KINDS];
+    if (pr) {
+        probe_rows(im, web, R, r, goal, ptop, pabove, &pr->bind_row, &pr->bind_kind,
+                   &pr->bind_value);
+        if (first)
+            for (int k = 0; k < WS_PROBE_KINDS; k++) {
+                pr->start[k] = ptop[k], pr->above0[k] = pabove[k];
+                for (int mk = 0; mk < WS_PROBE_MARKS; mk++)
+                    pr->above[mk][k] = 0;
+            }
+    }
     int it = 0;
     while (!(meas <= lim) && it < web->solver_maxit) {
+        if (pr && it > 0)
+            probe_rows(im, web, R, r, goal, ptop, pabove, &pr->bind_row, &pr->bind_kind,
+                       &pr->bind_value);
         const double pq = ws_implicit_apply_op(web, p, q) +
                           (R ? ws_rigid_apply(R, web, p, R->p, q, R->q) : 0.0);
         if (!(pq > 0.0) || !isfinite(pq))
@@ -593,6 +658,16 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         }
         meas = !isfinite(rr) ? NAN : im->stop_relative ? rr : w2;
         it++;
+        if (first && (it & (it - 1)) == 0 && it <= 32) {
+            uint32_t row;
+            int kind;
+            double value;
+            probe_rows(im, web, R, r, goal, ptop, pabove, &row, &kind, &value);
+            int mk = 0;
+            while ((1 << mk) != it)
+                mk++;
+            memcpy(pr->above[mk], pabove, sizeof pabove);
+        }
         const double rz1 = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
         const double beta = rz1 / rz;
         rz = rz1;
@@ -603,6 +678,11 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     }
     im->iterations += (uint64_t)it;
     im->last_iterations = it;
+    if (pr) {
+        if (pr->solves < WS_PROBE_PASSES)
+            pr->it[pr->solves] = (uint32_t)it;
+        pr->solves++;
+    }
     im->last_residual = scale > 0.0 ? sqrt(meas) / scale : 0.0;
     residual_sites(im, web, R, gh);
     const int ok = meas <= lim;

@@ -30,6 +30,30 @@ typedef struct ws_ispring {
                     b = h^2 kb), set by ws_implicit_solve */
 } ws_ispring;
 
+/* What a bench reads of the solves of a step (ws_implicit's probe; the library keeps none unless
+ * a bench sets one, and reads nothing from it). Kinds of rows: 0 a node without an active
+ * contact, 1 one whose contacts all stick (eq. 13's slip below v_lim), 2 one with a contact that
+ * slips, 3 the bodies (a body one row: the larger of its force and turning rows). A row's
+ * measure is the stopping test's, its residual as the velocity change it would give its own
+ * mass over the goal (solver_tol g h): the test is met when every row's is at most 1. */
+enum { WS_PROBE_KINDS = 4, WS_PROBE_MARKS = 6, WS_PROBE_PASSES = 8 };
+typedef struct ws_implicit_probe {
+    uint8_t *state;            /* per node, set by ws_node_links (0 none, 1 an inactive
+                                  contact, 2 stick, 3 slip); the bench's, n bytes */
+    uint32_t solves;           /* solves of the step (the active set's passes) */
+    uint32_t it[WS_PROBE_PASSES]; /* each pass's iterations */
+    double start[WS_PROBE_KINDS];   /* the first solve's start: each kind's largest measure */
+    uint32_t above0[WS_PROBE_KINDS]; /* and its rows above 1 by kind */
+    /* The first solve's rows above 1 by kind after 1, 2, 4, 8, 16 and 32 iterations (zero
+     * when it stopped before). */
+    uint32_t above[WS_PROBE_MARKS][WS_PROBE_KINDS];
+    /* The last solve's binding row: the largest measure before its last iteration (the start
+     * when it took none): node index (or n + the body's index), kind and measure. */
+    uint32_t bind_row;
+    int bind_kind;
+    double bind_value;
+} ws_implicit_probe;
+
 typedef struct ws_implicit {
     uint32_t n, ns;
     double *f;       /* force on each node at (x0, v0): springs, drag, gravity, contacts */
@@ -66,6 +90,9 @@ typedef struct ws_implicit {
      * m g h (g standard gravity), and the residual's squared norm (N^2 s^2, the bodies'
      * turning rows in N^2 m^2 s^2). Filled at the end of every solve, for a bench. */
     double last_worst[3], last_rr[3];
+    ws_implicit_probe *probe; /* a bench's record of the solves (NULL: none) */
+    int cold_bodies; /* set: the bodies start from rest, not from the warm film (a bench's
+                        comparison) */
 } ws_implicit;
 
 /* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
