@@ -1348,53 +1348,6 @@ START_TEST(test_band_rows_chosen)
 }
 END_TEST
 
-START_TEST(test_band_edge_rows)
-{
-    /* A band's free edges: its up springs' tension falls toward nothing there, so the outer
-     * rows are held around far more strongly than up, and their error smooth around and rough
-     * up is one no coarse level halved up carries: every coarse level of a band solves its two
-     * outer rows at each edge whole, whatever the rows' test finds (multigrid.c,
-     * MG_EDGE_ROWS). On a band of 161 rows 1 mm apart (its nodes 10 mm apart around),
-     * stretched 3x up so that it is held up far more strongly than around, the rows' test
-     * alone takes 4 rows of the first coarse level and none of the second (81 rows): with the
-     * edge rows, every level swept solves at least 4 rows whole (all of a level of fewer) and
-     * the second exactly 4; the cycle with them stays symmetric, positive definite and
-     * contracting (cycle_checks). */
-    ws_web_def solve;
-    ws_web_def_init(&solve);
-    solve.solver_tolerance = 1e-10;
-    solve.solver_max_iterations = 5000;
-    solve.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
-    ws_web_id id;
-    ws_world *w = cylinder_band(1, 0.16, 161, 2.0, &solve, &id);
-    ck_ok(w, ws_world_step_n(w, 5));
-    ws_web *web = web_of(w, id);
-    ws_implicit *im = web->imp;
-    ck_assert_msg(im && im->mg, "the band takes the multigrid");
-    const int cur = w->cur;
-    ck_assert_int_eq(ws_implicit_begin(web, web->x[cur], web->v[cur], NO_G, w->time, 0.0), 0);
-    im->warm = 0;
-    ck_assert_int_eq(ws_implicit_solve(web, web->v[cur], BAND_DT), 0);
-    ck_assert_int_gt(ws_mg_levels(im->mg), 3);
-    for (int k = 1; k < ws_mg_levels(im->mg) - 1; k++) {
-        int whole;
-        const int nk = ws_mg_rows(im->mg, k, &whole);
-        report("band of 161 rows 1 mm apart, level %d: %d of %d rows whole", k, whole, nk);
-        ck_assert_msg(whole >= (nk < 4 ? nk : 4), "level %d: %d of %d rows whole", k, whole,
-                      nk);
-        if (k == 2)
-            ck_assert_msg(nk > 4 && whole == 4, "level 2: the edge rows alone whole: %d of %d",
-                          whole, nk);
-    }
-    const uint32_t n = web->n;
-    double *u = malloc(3 * n * sizeof(double)), *Bu = malloc(3 * n * sizeof(double));
-    ck_assert(u && Bu);
-    cycle_checks(web, "band with its edge rows whole", u, Bu);
-    free(u), free(Bu);
-    ws_world_destroy(w);
-}
-END_TEST
-
 /* The checks of test_rows_mixed on web's multigrid as its last solve left it: the first two
  * coarse levels' rows set whole and node by node in turn (two of three, then one of three),
  * then B symmetric, positive, and the cycle contracting. */
@@ -2847,7 +2800,6 @@ int main(void)
     add_case(s, "refined_band_pressure", test_refined_band_pressure, 60);
     add_case(s, "band_multigrid_refined", test_band_multigrid_refined, 60);
     add_case(s, "band_rows_chosen", test_band_rows_chosen, 60);
-    add_case(s, "band_edge_rows", test_band_edge_rows, 60);
     add_case(s, "rows_mixed", test_rows_mixed, 60);
     add_case(s, "band_bodies_nested", test_band_bodies_nested, 60);
     add_case(s, "bodies_solved_together", test_bodies_solved_together, 60);

@@ -36,16 +36,6 @@
  * (solving them whole saved no iteration there), 0.20-0.33 at 4x (it saved a quarter), its
  * middle rows 0.65-0.92; at 4x 0.35 and 0.45 gave the same iterations, 0.3 4 % more. */
 #define MG_LINE_RHO 0.35
-/* A band's coarse levels solve this many rows at each free edge whole, whatever
- * row_held_along finds. There the up springs' tension falls toward nothing, so an edge row is
- * held around far more strongly than up and its x and y error smooth around and rough up is
- * one that the film level (halving around only) hands to level 1 and level 1's halving up
- * cannot carry: level 1's sweeps alone must take it. The row test is a mean over the row and
- * left these rows to point sweeps on the 2x refined reference band (0.37-0.50), where that
- * error was the cycle's slowest (factor 0.824, against 0.757 on the 1x band); solved whole,
- * 0.786, the slowest error then z motion smooth both ways (bench/NOTES.md, session 18). One
- * row a side gave the same factor; two cover the two outer rows that error spans. */
-#define MG_EDGE_ROWS 2
 #define CENTRE 4
 #define FOP 8   /* words a film spring in fop: ex ey ez a b, end a, end b, unused */
 #define FOP_A 5
@@ -846,9 +836,7 @@ int ws_mg_setup(ws_mg *mg, const ws_web *web, uint64_t begun, double h)
         mg_level *L = &mg->lv[k];
         L->lines = 0;
         for (int iy = 0; iy < L->ny; iy++) {
-            L->whole[iy] = (unsigned char)((L->closed && (iy < MG_EDGE_ROWS ||
-                                                          iy >= L->ny - MG_EDGE_ROWS)) ||
-                                           row_held_along(L, iy));
+            L->whole[iy] = (unsigned char)row_held_along(L, iy);
             L->lines += L->whole[iy];
             if ((L->whole[iy] ? line_factor(L, iy) : point_factor(L, iy)) != 0)
                 return -1;
