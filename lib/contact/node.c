@@ -690,7 +690,7 @@ void ws_node_merge_range(const ws_nmerge *M, uint32_t n0, uint32_t n1)
         const uint32_t m = j < M->count && M->nodes[j] < n1 ? M->nodes[j] : n1;
         const size_t shift = j < M->count ? M->place[j].at - os[M->nodes[j]] : out->n - old->n;
         if (os[m] > os[i])
-            memcpy(out->c + os[i] + shift, old->c + os[i], (os[m] - os[i]) * sizeof *out->c);
+            memcpy(out->c + (os[i] + shift), old->c + os[i], (os[m] - os[i]) * sizeof *out->c);
         for (uint32_t q = i; q < m; q++) /* modulo 2^64: the shift may be negative */
             M->nstart[q] = os[q] + shift;
         if (m == n1)
