@@ -367,12 +367,13 @@ typedef struct ws_node_found {
  * ws_node_index) holds for F's nodes: then it stays as it is. */
 int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *old);
 
-/* The plan of M (whose ostart, the index of the committed list old, of nn nodes, nstart and
- * room for F->count + 1 places are set) for the nodes found again F: out grown and sized for it,
- * the nodes whose fresh candidates are not those they had into `changed` (room for F->count;
- * it may be F->nodes itself), in order, their fresh candidates moved to the front of fresh: how
- * many, or -1 when out of memory (the committed list and its index unchanged). Nothing is
- * written in out: ws_node_merge_range does. */
+/* The plan of the merge M of the nodes found again F into the committed list old: M's ostart
+ * (old's index), nn, nstart (room for out's index) and place (room for F->count + 1) are set
+ * by the caller, the rest here. out is grown and sized for it, the nodes whose fresh
+ * candidates are not those they had go into `changed` (room for F->count; it may be F->nodes
+ * itself) in order, and their fresh candidates to the front of F's list: how many, or -1 when
+ * out of memory (old and its index unchanged). Nothing is written in out: ws_node_merge_range
+ * does. */
 long ws_node_merge_plan(ws_mem *mem, const ws_node_found *F, const ws_ncand_list *old, ws_nmerge *M,
                         ws_ncand_list *out, uint32_t *changed);
 /* The merge M carried out for the nodes [n0, n1): their candidates in out, their places in

@@ -940,8 +940,8 @@ int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_nmerge *M, int li
     for (size_t q = 0; q <= count;) {
         const uint64_t b0 = q < count ? (uint64_t)(M->nodes[q] / bl) * bl : UINT64_MAX,
                        b1 = q < count ? b0 + bl : UINT64_MAX;
-        /* The blocks before the next one that changed keep their stretches (their runs' faces
-         * have room), which now start at k: the candidates before are the blocks' before. */
+        /* The blocks before the next one that changed keep their stretches, which now start at
+         * k: the candidates before them are those of the blocks before (runs' faces have room). */
         for (; p < nold && old[p].n0 < b0; p++) {
             ws_nseg sg = old[p];
             sg.c1 = (uint32_t)k + (sg.c1 - sg.c0);
