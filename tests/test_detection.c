@@ -1245,10 +1245,11 @@ START_TEST(nodes_moved_relative_to_the_reference_are_flagged)
 END_TEST
 
 /* Candidate lists merged at random: nodes found again keep their candidates, lose them, gain
- * some or change one's feature. ws_node_same must tell whether any changed, ws_node_merge must
- * give the list a search of every node would (the old candidates of the other nodes, the fresh
- * ones of those found again) with the nodes that changed, and leave the index that of the
- * merged list. */
+ * some or change one's feature. ws_node_same must tell whether any changed; the merge, planned
+ * (ws_node_merge_plan) and carried out in pieces of nodes cut at random
+ * (ws_node_merge_range), must give the list a search of every node would (the old candidates
+ * of the other nodes, the fresh ones of those found again) with the nodes that changed, and the
+ * index of the merged list, the old one's left as it was. */
 START_TEST(merged_candidates_equal_the_list_they_stand_for)
 {
     enum { N = 40 };
@@ -1256,7 +1257,10 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
     ws_ncand *old = malloc(4 * N * sizeof *old), *fresh = malloc(4 * N * sizeof *fresh),
              *want = malloc(4 * N * sizeof *want), *out = NULL;
     size_t *start = malloc((N + 1) * sizeof *start), *index = malloc((N + 1) * sizeof *index);
-    ck_assert(old && fresh && want && start && index);
+    size_t *nstart = malloc((N + 1) * sizeof *nstart),
+           *kept_start = malloc((N + 1) * sizeof *start);
+    ws_nplace place[N + 1];
+    ck_assert(old && fresh && want && start && index && nstart && kept_start);
     ws_mem mem;
     ws_mem_init(&mem, NULL);
     size_t cap = 0, merges = 0, kept = 0;
@@ -1300,10 +1304,22 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
             continue;
         }
         ws_ncand_list lout = {out, 0, cap};
-        const long nchanged = ws_node_merge(&mem, &found, N, start, &lold, &lout, changed);
+        ws_nmerge M = {.ostart = start, .nstart = nstart, .place = place, .nn = N};
+        memcpy(kept_start, start, (N + 1) * sizeof *start);
+        const long nchanged = ws_node_merge_plan(&mem, &found, &lold, &M, &lout, changed);
         ck_assert_int_ge(nchanged, 0);
         out = lout.c;
         cap = lout.cap;
+        /* In pieces of 1 to 16 nodes, in an order of their own: the last first. */
+        uint32_t cut[N + 1], ncut = 0;
+        for (uint32_t i = 0; i < N; i += 1 + (uint32_t)(seed >> 60)) {
+            cut[ncut++] = i;
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        }
+        cut[ncut] = N;
+        for (uint32_t p = ncut; p-- > 0;)
+            ws_node_merge_range(&M, cut[p], cut[p + 1]);
+        ck_assert(!memcmp(start, kept_start, (N + 1) * sizeof *start));
         const size_t n = lout.n;
         merges++;
         ck_assert_uint_eq(n, nwant);
@@ -1311,7 +1327,7 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
         ck_assert_uint_eq((size_t)nchanged, expect);
         ck_assert(!expect || !memcmp(changed, expected, expect * sizeof *changed));
         ws_node_index(out, n, N, index);
-        ck_assert(!memcmp(start, index, (N + 1) * sizeof *start));
+        ck_assert(!memcmp(nstart, index, (N + 1) * sizeof *nstart));
     }
     report("candidate lists: %zu merged, %zu kept as they were", merges, kept);
     ck_assert(merges > 100 && kept > 100);
@@ -1321,6 +1337,8 @@ START_TEST(merged_candidates_equal_the_list_they_stand_for)
     free(want);
     free(start);
     free(index);
+    free(nstart);
+    free(kept_start);
 }
 END_TEST
 

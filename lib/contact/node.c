@@ -30,7 +30,8 @@ ws_node_contact *ws_node_contact_new(ws_mem *mem, uint32_t n)
     int ok = ws_nodes_alloc(mem, &nc->xdet, n) & ws_nodes_alloc(mem, &nc->xep, n);
     ok &= (nc->moved = ws_mem_calloc(mem, n ? n : 1, sizeof(uint32_t))) != NULL;
     ok &= (nc->redo = ws_mem_calloc(mem, n ? n : 1, sizeof(uint8_t))) != NULL;
-    ok &= (nc->cstart = ws_mem_calloc(mem, (size_t)n + 1, sizeof(size_t))) != NULL;
+    ok &= (nc->cstart[0] = ws_mem_calloc(mem, 2 * ((size_t)n + 1), sizeof(size_t))) != NULL;
+    nc->cstart[1] = nc->cstart[0] ? nc->cstart[0] + n + 1 : NULL; /* one block for both */
     if (ok)
         return nc;
     ws_node_contact_free(mem, nc, n);
@@ -43,11 +44,11 @@ void ws_node_contact_free(ws_mem *mem, ws_node_contact *nc, uint32_t n)
         return;
     for (int k = 0; k < 2; k++)
         ws_mem_free(mem, nc->cand[k].c, nc->cand[k].cap * sizeof(ws_ncand));
+    ws_mem_free(mem, nc->cstart[0], 2 * ((size_t)n + 1) * sizeof(size_t));
     ws_nodes_free(mem, &nc->xdet, n);
     ws_nodes_free(mem, &nc->xep, n);
     ws_mem_free(mem, nc->moved, (n ? n : 1) * sizeof(uint32_t));
     ws_mem_free(mem, nc->redo, (n ? n : 1) * sizeof(uint8_t));
-    ws_mem_free(mem, nc->cstart, ((size_t)n + 1) * sizeof(size_t));
     ws_mem_free(mem, nc->cbody, nc->cbody_cap);
     ws_mem_free(mem, nc->track, nc->track_cap * sizeof(ws_track));
     ws_mem_free(mem, nc->fresh.c, nc->fresh.cap * sizeof(ws_ncand));
@@ -441,7 +442,7 @@ static void rebase_flags(const ws_body_store *b, int cur, const ws_track *t, ws_
     flag_in_box(nc->redo + n0, (ws_nodes3){x.x + n0, x.y + n0, x.z + n0}, n1 - n0, b, cur, k,
                 b->layer[k] + web->layer + margin);
     if (nc->seg_list != nc->list) {
-        for (size_t q = nc->cstart[n0]; q < nc->cstart[n1]; q++)
+        for (size_t q = nc->cstart[nc->list][n0]; q < nc->cstart[nc->list][n1]; q++)
             nc->redo[c[q].node] |= (uint8_t)(c[q].body == k);
         return;
     }
@@ -621,20 +622,6 @@ void ws_node_index(const ws_ncand *c, size_t nc, uint32_t n, size_t *start)
     start[n] = nc;
 }
 
-/* Append src[from, from + len) to o at *k (src may be NULL when len is 0). A node has a
- * candidate or two: those are copied in place. */
-static inline void append_run(ws_ncand *o, size_t *k, const ws_ncand *src, size_t from, size_t len)
-{
-    if (len == 1)
-        o[*k] = src[from];
-    else if (len == 2) {
-        o[*k] = src[from];
-        o[*k + 1] = src[from + 1];
-    } else if (len)
-        memcpy(o + *k, src + from, len * sizeof *o);
-    *k += len;
-}
-
 /* Whether the len candidates at a + i and b + j (of one node) are alike: mostly one, compared
  * in place. The lists may be NULL when len is 0. */
 static inline int same_run(const ws_ncand *a, size_t i, const ws_ncand *b, size_t j, size_t len)
@@ -660,43 +647,62 @@ int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *ol
     return 1;
 }
 
-/* start[i] += shift for i in [i0, i1) (modulo 2^64: the shift may be negative). On vectors. */
-WS_VECTOR_LOOP
-static void shift_index(size_t *start, size_t i0, size_t i1, size_t shift)
+long ws_node_merge_plan(ws_mem *mem, const ws_node_found *F, const ws_ncand_list *old, ws_nmerge *M,
+                        ws_ncand_list *out, uint32_t *changed)
 {
-    for (size_t i = i0; i < i1; i++)
-        start[i] += shift;
-}
-
-long ws_node_merge(ws_mem *mem, const ws_node_found *F, uint32_t nn, size_t *start,
-                   const ws_ncand_list *old_list, ws_ncand_list *out, uint32_t *changed)
-{
-    const ws_ncand *old = old_list->c, *fresh = F->fresh->c;
-    const size_t nold = old_list->n, nfresh = F->fresh->n;
-    if (ws_array_reserve(mem, (void **)&out->c, &out->cap, nold + nfresh + 1, sizeof *out->c) != 0)
+    if (ws_array_reserve(mem, (void **)&out->c, &out->cap, old->n + F->fresh->n + 1,
+                         sizeof *out->c) != 0)
         return -1;
-    ws_ncand *o = out->c;
-    size_t k = 0, a = 0, f = 0, c = 0, i0 = 0;
-    /* Node by node found again: the old candidates of the nodes before it as they are, its
-     * old ones dropped, its fresh ones in their place. The nodes from i0 through it start
-     * k - a later in the merged list than in the old one (the shift of their stretch, read
-     * before it is applied: start[m + 1] is still the old list's). */
+    ws_ncand *fresh = M->fresh = F->fresh->c;
+    M->old = old;
+    size_t f = 0, g = 0, c = 0, shift = 0; /* the changed nodes' shift so far, modulo 2^64 */
     for (size_t q = 0; q < F->count; q++) {
         const uint32_t m = F->nodes[q];
-        const size_t e = start[m], f0 = f;
-        append_run(o, &k, old, a, e - a);
-        shift_index(start, i0, (size_t)m + 1, k - e);
-        a = start[m + 1];
-        f = run_end(fresh, nfresh, f, m);
-        if (a - e != f - f0 || !same_run(old, e, fresh, f0, f - f0))
-            changed[c++] = m;
-        append_run(o, &k, fresh, f0, f - f0);
-        i0 = (size_t)m + 1;
+        const size_t e = M->ostart[m], len = M->ostart[m + 1] - e, f0 = f;
+        f = run_end(fresh, F->fresh->n, f, m);
+        if (len == f - f0 && same_run(old->c, e, fresh, f0, len))
+            continue;
+        if (f > f0) /* after those of the changed nodes before it */
+            memmove(fresh + g, fresh + f0, (f - f0) * sizeof *fresh);
+        changed[c] = m;
+        M->place[c++] = (ws_nplace){g, e + shift};
+        g += f - f0;
+        shift += (f - f0) - len;
     }
-    shift_index(start, i0, (size_t)nn + 1, k - a);
-    append_run(o, &k, old, a, nold - a);
-    out->n = k;
+    M->place[c].fresh = g;
+    M->nodes = changed;
+    M->count = c;
+    M->out = out;
+    out->n = old->n + shift;
     return (long)c;
+}
+
+void ws_node_merge_range(const ws_nmerge *M, uint32_t n0, uint32_t n1)
+{
+    const size_t *os = M->ostart;
+    const ws_ncand_list *old = M->old, *out = M->out;
+    size_t j = 0; /* the first changed node from n0 on (they are few) */
+    while (j < M->count && M->nodes[j] < n0)
+        j++;
+    for (uint32_t i = n0;; j++) {
+        /* Nodes [i, m) keep their candidates, shifted by what the changed nodes before them
+         * added (all of them: past the last). */
+        const uint32_t m = j < M->count && M->nodes[j] < n1 ? M->nodes[j] : n1;
+        const size_t shift = j < M->count ? M->place[j].at - os[M->nodes[j]] : out->n - old->n;
+        if (os[m] > os[i])
+            memcpy(out->c + (os[i] + shift), old->c + os[i], (os[m] - os[i]) * sizeof *out->c);
+        for (uint32_t q = i; q < m; q++) /* modulo 2^64: the shift may be negative */
+            M->nstart[q] = os[q] + shift;
+        if (m == n1)
+            break;
+        const ws_nplace *P = &M->place[j];
+        M->nstart[m] = P->at;
+        if (P[1].fresh > P->fresh)
+            memcpy(out->c + P->at, M->fresh + P->fresh, (P[1].fresh - P->fresh) * sizeof *out->c);
+        i = m + 1;
+    }
+    if (n1 == M->nn)
+        M->nstart[n1] = out->n;
 }
 
 /* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
@@ -1169,10 +1175,10 @@ int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double d
     return !nc->search_all;
 }
 
-/* The moved nodes' candidates found again (nc->fresh) and brought into the committed list
- * `old`: it serves again, uncopied, when they are those it holds (mostly so), else the merge
- * goes into the other list, `*list`, and its stretches are cut again in the sweep blocks of
- * the nodes whose candidates changed alone. 0, or -1 when out of memory. */
+/* The moved nodes' candidates found again (nc->fresh) and brought into the committed list `old`:
+ * it serves again, uncopied, when they are those it holds (mostly so), else a merge into the other
+ * list, `*list`, is planned, carried out and cut again in the blocks of the nodes that changed,
+ * the rest left to the first sub-step's lanes (nc->merging). 0, or -1 when out of memory. */
 static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int old, int *list)
 {
     ws_node_contact *nc = web->contact;
@@ -1180,18 +1186,17 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
     const int found = find_candidates(S, web, nc->moved, moved, &nc->fresh);
     if (found < 0)
         return -1;
-    if (found == 1 || ws_node_same(&F, nc->cstart, nc->cand[old].c)) {
+    if (found == 1 || ws_node_same(&F, nc->cstart[old], nc->cand[old].c)) {
         *list = old;
         return 0;
     }
+    ws_nplace *room = ws_arena_alloc(S->g->arena, (moved + 1) * sizeof *room);
+    nc->merge = (ws_nmerge){
+        .ostart = nc->cstart[old], .nstart = nc->cstart[*list], .place = room, .nn = web->n};
     /* nc->moved keeps the nodes whose candidates changed. */
-    ws_ncand_list *L = &nc->cand[*list];
-    const long changed =
-        ws_node_merge(S->mem, &F, web->n, nc->cstart, &nc->cand[old], L, nc->moved);
-    return changed < 0 || ws_node_segments_merged(S->mem, web, L->c, L->n, *list, old, nc->moved,
-                                                  (size_t)changed)
-               ? -1
-               : 0;
+    nc->merging = room && ws_node_merge_plan(S->mem, &F, &nc->cand[old], &nc->merge,
+                                             &nc->cand[*list], nc->moved) >= 0;
+    return nc->merging ? ws_node_segments_merged(S->mem, web, &nc->merge, *list, old) : -1;
 }
 
 int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
@@ -1205,6 +1210,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
      * shows it). */
     int list = nc->list, all = nc->search_all;
     long moved = 0;
+    nc->merging = 0;
     if (!all &&
         (moved = ws_node_moved_end(S->b, S->cur, web, web->x[S->cur], S->margin, S->lanes,
                                    S->nlanes)) < 0)
@@ -1222,7 +1228,7 @@ int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
         if (all) {
             bad = track_bodies(S, web) || find_candidates(S, web, NULL, 0, &nc->cand[list]) < 0;
             if (!bad)
-                ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart);
+                ws_node_index(nc->cand[list].c, nc->cand[list].n, web->n, nc->cstart[list]);
         } else {
             bad = search_moved(S, web, (size_t)moved, old, &list);
         }

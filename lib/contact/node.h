@@ -41,6 +41,30 @@ typedef struct ws_ncand_list {
     size_t n, cap;
 } ws_ncand_list;
 
+/* Where a node's candidates come from in a merge (ws_nmerge): the first of its fresh ones,
+ * and where its candidates start in the merged list. */
+typedef struct ws_nplace {
+    size_t fresh, at;
+} ws_nplace;
+
+/* A merge of the candidates of nodes found again into the list `out`: the committed list's
+ * (old, indexed by ostart, of nn nodes) for the nodes whose candidates did not change, the
+ * fresh ones (fresh) of the `count` nodes that changed (nodes, increasing), with their places
+ * (place; place[count].fresh: the end of theirs); out's index into nstart. Planned on one
+ * thread (ws_node_merge_plan), carried out in pieces of nodes that may run at once
+ * (ws_node_merge_range). */
+typedef struct ws_nmerge {
+    const size_t *ostart;
+    size_t *nstart;
+    ws_nplace *place;
+    uint32_t nn;
+    const ws_ncand_list *old;
+    ws_ncand_list *out;
+    ws_ncand *fresh;
+    const uint32_t *nodes;
+    size_t count;
+} ws_nmerge;
+
 /* A body as a full detection of a web's node candidates saw it, relative to the web's
  * reference body (see ws_node_contact): its CoG (rho) and orientation (q) in the reference body's
  * frame (for a near body, as it was when it last moved past its bound, ws_node_moved); its
@@ -126,13 +150,18 @@ typedef struct ws_node_contact {
     ws_nodes3 xep;
     ws_move_test move; /* this step's (scratch) */
     int search_all;    /* this step finds every node again (ws_node_contact_begin) */
+    /* A merge planned in this step and not carried out whole (merging): the first sub-step's
+     * lanes carry it out, each for its own nodes, before they read the list. */
+    ws_nmerge merge;
+    int merging;
     m3 epoch_A;
     v3 epoch_r;
     qt epoch_q;
     double lever2;
-    /* Where each node's candidates start in the list last found or merged (n + 1, see
-     * ws_node_index). */
-    size_t *cstart;
+    /* Where each node's candidates start in each list (n + 1, see ws_node_index): a merge
+     * writes the new list's index from the committed one's, so that its pieces read no place
+     * another piece writes (ws_node_merge_range). */
+    size_t *cstart[2];
     /* cbody[k] (by body slot, cbody_cap of them): the candidates may name body k (a body near
      * some node searched since the full detection, find_candidates in node.c). */
     uint8_t *cbody;
@@ -338,12 +367,19 @@ typedef struct ws_node_found {
  * ws_node_index) holds for F's nodes: then it stays as it is. */
 int ws_node_same(const ws_node_found *F, const size_t *start, const ws_ncand *old);
 
-/* Candidates of the committed list `old` (indexed by start, of nn nodes) for the nodes not in
- * F and F's fresh ones, merged by node into out, start becoming its index; the nodes whose
- * fresh candidates are not those they had into `changed` (room for F->count; it may be
- * F->nodes itself), in order: how many, or -1 when out of memory (start unchanged). */
-long ws_node_merge(ws_mem *mem, const ws_node_found *F, uint32_t nn, size_t *start,
-                   const ws_ncand_list *old, ws_ncand_list *out, uint32_t *changed);
+/* The plan of the merge M of the nodes found again F into the committed list old: M's ostart
+ * (old's index), nn, nstart (room for out's index) and place (room for F->count + 1) are set
+ * by the caller, the rest here. out is grown and sized for it, the nodes whose fresh
+ * candidates are not those they had go into `changed` (room for F->count; it may be F->nodes
+ * itself) in order, and their fresh candidates to the front of F's list: how many, or -1 when
+ * out of memory (old and its index unchanged). Nothing is written in out: ws_node_merge_range
+ * does. */
+long ws_node_merge_plan(ws_mem *mem, const ws_node_found *F, const ws_ncand_list *old, ws_nmerge *M,
+                        ws_ncand_list *out, uint32_t *changed);
+/* The merge M carried out for the nodes [n0, n1): their candidates in out, their places in
+ * nstart (and nstart[nn] when n1 = nn). Pieces on distinct nodes may run at once; each reads
+ * only what the plan and the committed list hold. */
+void ws_node_merge_range(const ws_nmerge *M, uint32_t n0, uint32_t n1);
 
 /* Room for evaluating ncand candidates (web->act). 0, or -1 when out of memory. */
 int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand);
@@ -353,12 +389,12 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc);
  * see ws_nseg), which ws_node_contacts evaluates. 0, or -1 when out of memory. */
 int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list);
 
-/* The same for list `list` merged (ws_node_merge) from list `from`, where only the nodes
- * `nodes` (count of them, in increasing order) have other candidates: when the stretches are
- * those of `from`, only the blocks (rows) that hold one of the nodes are cut again. 0, or -1 when
- * out of memory. */
-int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
-                            int from, const uint32_t *nodes, size_t count);
+/* The same for list `list` merged (M, planned) from list `from`, where only M's nodes have
+ * other candidates: when the stretches are those of `from`, only the blocks (rows) that hold
+ * one of them are cut again, after their merge is carried out here (the rest is left to
+ * ws_node_merge_range); else the whole merge is carried out here and the list cut whole. 0, or
+ * -1 when out of memory. */
+int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_nmerge *M, int list, int from);
 
 /* A sub-step starts (on the web or a lane of it): the runs' faces are taken afresh, the list of
  * loads is empty. */

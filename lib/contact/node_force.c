@@ -923,40 +923,41 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     return seg_done(mem, web, &sc, list);
 }
 
-int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, int list,
-                            int from, const uint32_t *nodes, size_t count)
+int ws_node_segments_merged(ws_mem *mem, ws_web *web, const ws_nmerge *M, int list, int from)
 {
     ws_node_contact *nc = web->contact;
-    if (nc->seg_list != from)
-        return ws_node_segments(mem, web, cand, n, list);
-    const uint32_t bl = seg_block(web);
-    const size_t nold = nc->nseg;
+    const uint32_t bl = seg_block(web), nn = M->nn;
+    const size_t nold = nc->nseg, count = M->count, n = M->out->n;
+    if (nc->seg_list != from) /* cut whole, from the whole list merged here */
+        return ws_node_merge_range(M, 0, nn), ws_node_segments(mem, web, M->out->c, n, list);
     nc->seg_list = -1;
     /* The new stretches go after the old ones, then down in their place. */
     if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, nold + n + 1, sizeof *nc->seg) != 0)
         return -1;
     const ws_nseg *old = nc->seg;
-    seg_cut sc = {cand, nc->seg + nold, 0, 0, 0, 0, 0};
-    size_t p = 0, k = 0; /* the next old stretch; where the next candidates lie in cand */
+    seg_cut sc = {M->out->c, nc->seg + nold, 0, 0, 0, 0, 0};
+    size_t p = 0, k = 0; /* the next old stretch; where the next candidates lie in the list */
     for (size_t q = 0; q <= count;) {
-        const uint64_t b0 = q < count ? (uint64_t)(nodes[q] / bl) * bl : UINT64_MAX,
+        const uint64_t b0 = q < count ? (uint64_t)(M->nodes[q] / bl) * bl : UINT64_MAX,
                        b1 = q < count ? b0 + bl : UINT64_MAX;
-        /* The blocks before the next one that changed keep their stretches, which now start
-         * at k: the candidates before them are those of the blocks before. */
+        /* The blocks before the next one that changed keep their stretches, which now start at
+         * k: the candidates before them are those of the blocks before (runs' faces have room). */
         for (; p < nold && old[p].n0 < b0; p++) {
             ws_nseg sg = old[p];
             sg.c1 = (uint32_t)k + (sg.c1 - sg.c0);
             sg.c0 = (uint32_t)k;
             k = sg.c1;
-            seg_put(&sc, sg);
+            sc.seg[sc.nseg++] = sg;
         }
         if (q == count)
             break;
-        /* That block is cut again from the candidates it holds now. */
+        /* That block is cut again from its candidates, merged here up to the next node's. */
         for (; p < nold && old[p].n0 < b1; p++)
             ;
-        k = seg_cut_range(&sc, web, bl, k, n, b1);
-        while (q < count && nodes[q] < b1)
+        const uint32_t e = b1 < nn ? (uint32_t)b1 : nn;
+        ws_node_merge_range(M, (uint32_t)b0, e < nn ? e + 1 : nn);
+        k = seg_cut_range(&sc, web, bl, k, M->nstart[e], b1);
+        while (q < count && M->nodes[q] < b1)
             q++;
     }
     memmove(nc->seg, sc.seg, sc.nseg * sizeof *nc->seg);

@@ -577,7 +577,7 @@ static void walk_node_contact(ws_walk *k, ws_web *web, uint32_t slot)
     C->cand[list].n = nc;
     C->ref = ref;
     C->ntrack = nt;
-    ws_node_index(C->cand[list].c, nc, web->n, C->cstart);
+    ws_node_index(C->cand[list].c, nc, web->n, C->cstart[list]);
     C->seg_list = -1; /* the stretches are cut again from the list read */
 }
 

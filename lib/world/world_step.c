@@ -290,6 +290,9 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     uint32_t n0 = web->nx > 0 ? (uint32_t)web->nx * J->r0 : 0, n1;
     size_t next = J->r0 ? ws_node_first_segment(&J->cview, n0) : 0;
     ws_node_substep(&J->cview);
+    if (T->zero && T->web->contact->merging) /* the lane's part of the step's merge first */
+        ws_node_merge_range(&T->web->contact->merge, n0,
+                            J->r1 == rows ? web->n : J->cview.lane_end);
     const ws_web_pass P = {T->pass.x, T->pass.v, T->xd, T->vd, T->pass.h, w->def.max_speed};
     ws_web_sweep_begin(web, &P);
     /* Blocks of r rows from the lane's first row (the last may be shorter). */
@@ -555,7 +558,8 @@ static void search_piece(const search_task *T, uint32_t i, ws_mem *mem)
     J->found_bad = ws_node_find(&s, &J->view, nodes, (uint32_t)q0, q1 - q0, &J->found) != 0;
     const ws_node_contact *nc = T->web->contact;
     const ws_node_found F = {nodes, q1 - q0, &J->found};
-    J->found_same = nodes && !J->found_bad && ws_node_same(&F, nc->cstart, nc->cand[nc->list].c);
+    J->found_same =
+        nodes && !J->found_bad && ws_node_same(&F, nc->cstart[nc->list], nc->cand[nc->list].c);
 }
 
 static void search_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
@@ -797,6 +801,9 @@ static ws_status step_webs(ws_step *S)
         web->nfct[nxt] = 0;
         web->fck = nxt;
         if (web->integrator == WS_WEB_IMPLICIT) {
+            if (nc->merging) /* no lanes to carry it out */
+                ws_node_merge_range(&nc->merge, 0, web->n);
+            nc->merging = 0;
             ws_status st = ws_world_web_implicit(S, web, list);
             if (st != WS_OK)
                 return st;
@@ -832,6 +839,7 @@ static ws_status step_webs(ws_step *S)
             }
             T.body = T.body_part ? S : NULL;
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
+            nc->merging = 0; /* carried out by the first sub-step's lanes */
             xs = xd;
             vs = vd;
             if (web->law_failed) {
