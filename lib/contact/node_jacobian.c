@@ -214,14 +214,6 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
         const double nv = v3_dot(at.n, u), fe = L->fn - L->k * P->h * nv;
         if (!L->active && fe > 0.0)
             bring_in(L, fe);
-        /* A bench's probe: the node's contact state, a slipping contact above a sticking one
-         * above an inactive one. */
-        if (web->imp && web->imp->probe && web->imp->probe->state) {
-            uint8_t *st8 = &web->imp->probe->state[i];
-            const uint8_t q = !L->active ? 1 : v3_norm(L->t) < P->pp[b->material[bi]].vlim ? 2 : 3;
-            if (q > *st8)
-                *st8 = q;
-        }
     }
     return m;
 }

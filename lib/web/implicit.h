@@ -38,7 +38,7 @@ typedef struct ws_ispring {
  * mass over the goal (solver_tol g h): the test is met when every row's is at most 1. */
 enum { WS_PROBE_KINDS = 4, WS_PROBE_MARKS = 6, WS_PROBE_PASSES = 8 };
 typedef struct ws_implicit_probe {
-    uint8_t *state;            /* per node, set by ws_node_links (0 none, 1 an inactive
+    uint8_t *state;            /* per node, set from the step's links (0 none, 1 an inactive
                                   contact, 2 stick, 3 slip); the bench's, n bytes */
     uint32_t solves;           /* solves of the step (the active set's passes) */
     uint32_t it[WS_PROBE_PASSES]; /* each pass's iterations */

@@ -269,6 +269,19 @@ static void loads_moved(const ws_rigid *R, const uint32_t *slot, const ws_body_s
     }
 }
 
+/* A bench's probe: each node's contact state over the step's links, a slipping contact above
+ * a sticking one above an inactive one. */
+static void probe_states(ws_implicit_probe *pr, const ws_node_pass *P, const ws_node_link *L,
+                         size_t nl)
+{
+    for (size_t k = 0; k < nl; k++) {
+        const double vlim = P->pp[P->b->material[L[k].body]].vlim;
+        const uint8_t q = !L[k].active ? 1 : v3_norm(L[k].t) < vlim ? 2 : 3;
+        if (q > pr->state[L[k].node])
+            pr->state[L[k].node] = q;
+    }
+}
+
 ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
 {
     ws_world *w = S->w;
@@ -299,6 +312,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
                                         S->contact.margin, links, NULL);
+        if (im->probe && im->probe->state)
+            probe_states(im->probe, &np, links, nl);
         uint32_t *slot = NULL;
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
