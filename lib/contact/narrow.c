@@ -154,9 +154,9 @@ static double flat_share(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
  * pi + s u and pj + t w, separation k3 along the unit common normal. n is oriented out of a (in
  * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
  * the parameters, the oriented normal (for nearly parallel edges on faces lying on each other
- * turned towards those faces', flat_share) and the signed distance; 0 for parallel edges (the system
- * is singular: point-face contacts carry that case) or when the closest points are not interior
- * to both edges or the cones disagree. */
+ * turned towards those faces', flat_share) and the signed distance; 0 for parallel edges (the
+ * system is singular: point-face contacts carry that case) or when the closest points are not
+ * interior to both edges or the cones disagree. */
 static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double *s_out,
                      double *t_out, v3 *n_out, double *d_out)
 {
@@ -184,8 +184,7 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
          * the faces' (u x w swings by a tilt over sigma); the cone test has nothing to decide.
          * That normal is not orthogonal to both edges: the distance is taken between the
          * closest points (for u x w it is the same). */
-        n = unit(v3_add(v3_scale(v3_dot(n, nf) < 0.0 ? v3_neg(n) : n, 1.0 - g),
-                        v3_scale(nf, g)));
+        n = unit(v3_add(v3_scale(v3_dot(n, nf) < 0.0 ? v3_neg(n) : n, 1.0 - g), v3_scale(nf, g)));
         d = v3_dot(v3_add(r, v3_sub(v3_scale(w, t), v3_scale(u, s))), n);
     } else {
         if (!in_cone(n, n1i, n2i)) {
