@@ -34,9 +34,11 @@ static const golden table[] = {
     /* Wrapped: 2 film sub-steps since the film's safety factor (CHANGELOG). All six since the
      * body contacts' friction takes the film's law (contact/penalty.h, CHANGELOG); the wrapped
      * ones also since an edge pair's normal cone has its tolerance (side-by-side corners), and
-     * since the film's loads on the bodies are summed row by row (CHANGELOG). */
-    {'P', 1, 1, 4000, 0xe1130c08202e4a87ull, 400, 0xbada6f9a3d62e0e5ull},
-    {'R', 1, 1, 4000, 0x8a7fe867d8e4c7d5ull, 400, 0xe152ad0d61e747fbull},
+     * since the film's loads on the bodies are summed row by row (CHANGELOG), and since nearly
+     * parallel edge pairs on faces lying on each other take the faces' normal
+     * (WS_EDGE_FLAT_SIN: the stacked boxes' seam, CHANGELOG). */
+    {'P', 1, 1, 4000, 0x7e44b886ce0d174full, 400, 0x22fb0b5fbcb0ffbeull},
+    {'R', 1, 1, 4000, 0xee32f62037510b72ull, 400, 0xbeae48fc1c3bfabaull},
     /* The same without the gate: the same hashes. */
     {'P', 0, 0, 24000, 0xc9983f53e2ae6d92ull, 4000, 0x14732f747435d0a5ull},
     {'R', 0, 0, 28000, 0xb7fe5dddc837c9feull, 4000, 0x8a93e7e059ef2e97ull},

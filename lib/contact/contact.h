@@ -27,6 +27,30 @@
  * faces of 0.3 m: 1e-4 to 1e-3), and small beside any edge that truly turns away. */
 #define WS_CONE_TOL 1e-2
 
+/* Nearly parallel edges on faces lying on each other: the edge pair's normal is the faces'.
+ * Two faces lying on each other (stacked or side-by-side boxes: outward normals opposed within
+ * an angle psi, each face reaching out from its edge to the same side) touch over the convex
+ * polygon where they overlap; where two of their border edges cross at a small angle sigma (a
+ * yaw of sigma between equal boxes: at mid-edge), the edge pair carries that corner of it. Its
+ * normal as eq. 16-17 give it, u x w, is ill-conditioned there: a relative tilt delta of the
+ * edges out of the faces' plane turns it by delta / sigma, so for sigma of a few mrad the tilts
+ * of a resting load (1e-5 to 1e-3 rad) swing it across the cone test's tolerance (WS_CONE_TOL)
+ * and the pair switched on and off with them, a kick of its whole force each time (two stacked
+ * boxes at 2.6 mrad of yaw rattled so, the force of 50 N coming and going every other step).
+ * The faces' normal (the bisector n_k - n_l of the two opposed faces' normals, out of a) is
+ * what the contact has, and it is well-conditioned: the pair's normal is u x w turned towards
+ * it by a share g = (1 - s(sigma)) f(psi), s rising linearly from 0 at WS_EDGE_FLAT_SIN to 1 at
+ * twice it, f falling linearly from 1 at psi = WS_EDGE_FLAT_FACES to 0 at twice it, and a pair
+ * with g > 0 skips the cone test (its edges lie on each other's faces: a line contact, the
+ * case the tolerance is for). In the blend the normal swings by at most (1 - g) delta / sigma
+ * <= delta / (2 WS_EDGE_FLAT_SIN): 1e-2 for a tilt of 1e-3, within WS_CONE_TOL. The pair itself
+ * stays (dropping it left the corner to the neighbouring contacts and let squeezed cartons turn
+ * 2.5 times as far). Edges whose faces do not lie on each other (an edge resting across another
+ * edge, two blocks touching edge to edge diagonally) keep u x w and the cone test: there the
+ * normal lies well inside both cones. */
+#define WS_EDGE_FLAT_SIN 0.05
+#define WS_EDGE_FLAT_FACES 0.05
+
 /* How far past a face's outline (m, in the face's plane) a point of another body still counts on
  * the face, when it lies over the face's half of the rim (ws_point_on_face); edge pairs whose
  * closest points lie that near an edge's end are left to those point-face contacts. Two equal,

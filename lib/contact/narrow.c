@@ -100,12 +100,63 @@ static int in_cone(v3 n, v3 n1, v3 n2)
     return a >= -WS_CONE_TOL && b >= -WS_CONE_TOL;
 }
 
+static v3 unit(v3 a)
+{
+    return v3_scale(a, 1.0 / v3_norm(a));
+}
+
+/* 0 below lo, 1 above 2 lo, linear between. */
+static double ramp(double x, double lo)
+{
+    return x <= lo ? 0.0 : x >= 2.0 * lo ? 1.0 : x / lo - 1.0;
+}
+
+/* How nearly face 1 of edge i (normals n1i, n2i) and face 1 of edge j lie on each other near
+ * the edges: the cosine of the angle by which their normals miss being opposed, when the faces
+ * reach out from their edges to the same side (each face's direction into itself, away from its
+ * edge, is that of n1 c - n2 with c = n1 . n2); -1 when they reach to opposite sides, as for
+ * two blocks touching edge to edge diagonally, whose coplanar faces lie side by side. */
+static double face_on_face(v3 n1i, v3 n2i, v3 n1j, v3 n2j)
+{
+    v3 di = v3_madd(n2i, n1i, -v3_dot(n1i, n2i)), dj = v3_madd(n2j, n1j, -v3_dot(n1j, n2j));
+    return v3_dot(di, dj) > 0.0 ? -v3_dot(n1i, n1j) : -1.0;
+}
+
+/* The share g of the faces' normal in an edge pair's normal (WS_EDGE_FLAT_SIN): edges crossing
+ * at sin(angle) sigma, their faces with outward normals n1i, n2i and n1j, n2j; *nf the bisector
+ * n_k - n_l (out of a) of the most nearly opposed pair of those faces lying on each other, which
+ * misses being opposed by psi. g = (1 - s(sigma)) f(psi). */
+static double flat_share(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
+{
+    if (sigma >= 2.0 * WS_EDGE_FLAT_SIN)
+        return 0.0;
+    const v3 ni[4] = {n1i, n1i, n2i, n2i}, oi[4] = {n2i, n2i, n1i, n1i};
+    const v3 nj[4] = {n1j, n2j, n1j, n2j}, oj[4] = {n2j, n1j, n2j, n1j};
+    double c = -1.0;
+    int best = 0;
+    for (int k = 0; k < 4; k++) {
+        double ck = face_on_face(ni[k], oi[k], nj[k], oj[k]);
+        if (ck > c) {
+            c = ck;
+            best = k;
+        }
+    }
+    /* psi from 1 - cos(psi) = 2 sin^2(psi / 2), exact and well-conditioned near 0 */
+    double psi = 2.0 * asin(sqrt(fmin(1.0, fmax(0.0, 0.5 * (1.0 - c)))));
+    double f = 1.0 - ramp(psi, WS_EDGE_FLAT_FACES);
+    if (!(f > 0.0))
+        return 0.0;
+    *nf = unit(v3_sub(ni[best], nj[best]));
+    return (1.0 - ramp(sigma, WS_EDGE_FLAT_SIN)) * f;
+}
+
 /* Edge pi-qi of a against edge pj-qj of b, all in a's frame (eq. 16-17): closest points
  * pi + s u and pj + t w, separation k3 along the unit common normal. n is oriented out of a (in
  * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
- * the parameters, the oriented normal and the signed distance; 0 for parallel edges (the system
- * is singular: point-face contacts carry that case) or when the closest points are not interior
- * to both edges or the cones disagree. */
+ * the parameters, the oriented normal (for nearly parallel edges on faces lying on each other
+ * turned towards those faces', flat_share) and the signed distance; 0 for parallel edges (the
+ * system is singular: point-face contacts carry that case) or when the closest points are not
+ * interior to both edges or the cones disagree. */
 static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double *s_out,
                      double *t_out, v3 *n_out, double *d_out)
 {
@@ -125,17 +176,30 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     if (!(s > ls && s < 1.0 - ls && t > lt && t < 1.0 - lt))
         return 0;
     n = v3_scale(n, 1.0 / sqrt(nn));
-    if (!in_cone(n, n1i, n2i)) {
-        n = v3_neg(n);
-        if (!in_cone(n, n1i, n2i))
+    v3 nf;
+    double g = flat_share(sqrt(nn / (uu * ww)), n1i, n2i, n1j, n2j, &nf);
+    double d;
+    if (g > 0.0) {
+        /* Nearly parallel edges on faces lying on each other: a line contact, whose normal is
+         * the faces' (u x w swings by a tilt over sigma); the cone test has nothing to decide.
+         * That normal is not orthogonal to both edges: the distance is taken between the
+         * closest points (for u x w it is the same). */
+        n = unit(v3_add(v3_scale(v3_dot(n, nf) < 0.0 ? v3_neg(n) : n, 1.0 - g), v3_scale(nf, g)));
+        d = v3_dot(v3_add(r, v3_sub(v3_scale(w, t), v3_scale(u, s))), n);
+    } else {
+        if (!in_cone(n, n1i, n2i)) {
+            n = v3_neg(n);
+            if (!in_cone(n, n1i, n2i))
+                return 0;
+        }
+        if (!in_cone(v3_neg(n), n1j, n2j))
             return 0;
+        d = v3_dot(r, n);
     }
-    if (!in_cone(v3_neg(n), n1j, n2j))
-        return 0;
     *s_out = s;
     *t_out = t;
     *n_out = n;
-    *d_out = v3_dot(r, n);
+    *d_out = d;
     return 1;
 }
 
