@@ -126,6 +126,18 @@ static void probe_print(const probe_sums *s, double t)
     fflush(stdout);
 }
 
+/* The scene's film web, its implicit part reserved (NULL when either fails). */
+static ws_web *film_web(const tilt_scene *sc)
+{
+    uint32_t slot;
+    if (ws_lookup_web(sc->world, sc->film, &slot) != WS_OK)
+        return NULL;
+    ws_web *web = sc->world->webs[slot];
+    if (!web->imp && ws_implicit_reserve(&sc->world->mem, web) != 0)
+        return NULL;
+    return web;
+}
+
 /* `window file r duration [every]`: case R's band refined r x r at the real areal density on
  * the multigrid (bench_implicit's `phases`), restored from `file` (bench_implicit's
  * WS_BENCH_SAVE; "-" starts at t = 0), stepped `duration` s with the probe of the solve
@@ -199,11 +211,8 @@ static int window_probe(int argc, char **argv)
         if (ws_world_set_dt(sc.world, sc.dt) != WS_OK)
             return 1;
     }
-    uint32_t slot;
-    if (ws_lookup_web(sc.world, sc.film, &slot) != WS_OK)
-        return 1;
-    ws_web *web = sc.world->webs[slot];
-    if (!web->imp && ws_implicit_reserve(&sc.world->mem, web) != 0)
+    ws_web *web = film_web(&sc);
+    if (!web)
         return 1;
     const uint32_t n = web->n;
     ws_implicit_probe pr;
@@ -413,11 +422,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_stop: %s\n", ws_status_string(st));
         return 1;
     }
-    uint32_t slot;
-    if (ws_lookup_web(sc.world, sc.film, &slot) != WS_OK)
-        return 1;
-    ws_web *web = sc.world->webs[slot];
-    if (!web->imp && ws_implicit_reserve(&sc.world->mem, web) != 0)
+    ws_web *web = film_web(&sc);
+    if (!web)
         return 1;
     ws_implicit *im = web->imp;
     im->stop_relative = relative;

@@ -1062,6 +1062,21 @@ START_TEST(test_energy_guard_without_speed_limit)
 }
 END_TEST
 
+/* A 2 m square kinematic plane, its top face at z = 0, that tilts about y at `rate` rad/s from
+ * t0 (s). */
+static void tilting_plane(ws_world *w, double rate, double t0)
+{
+    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
+                                v3(0, 0, 0), "plane");
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_TILT;
+    dd.axis = v3(0, 1, 0);
+    dd.rate = rate;
+    dd.start_time = t0;
+    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+}
+
 /* A stack of two 0.25 m, 5 kg cubes on a plane tilting at 0.1 rad/s from t = 1 s (ramp
  * 0.05 s), stick friction mu = 0.3 with the given absolute tangential damping (0: the default
  * ratio), run until theta = 0.9 atan(mu) (15.0 deg). Out: the most contacts flagged slipping in
@@ -1075,15 +1090,7 @@ static void tilting_stack(double stick_damping, int *most_slipping, int *capped,
     ws_contact_def cd = contact_params(2e5, 10.0, 0.3, WS_FRICTION_STICK);
     cd.stick_damping = stick_damping;
     ws_world *w = contact_world(dt, &cd);
-    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
-                                v3(0, 0, 0), "plane");
-    ws_drive_def dd;
-    ws_drive_def_init(&dd);
-    dd.type = WS_DRIVE_TILT;
-    dd.axis = v3(0, 1, 0);
-    dd.rate = rate;
-    dd.start_time = t0;
-    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    tilting_plane(w, rate, t0);
     double gap = 2 * DELTA - m * G0 / (4 * 2e5);
     make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID, v3(0, 0, 0), "bottom");
     ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 2 * gap), Q_ID,
@@ -1124,15 +1131,7 @@ static void yawed_stack(double yaw, double t_end, int *switches, double *dw, dou
     const double a = 0.25, m = 5.0, k = 2e5, dt = 2.5e-4, rate = 0.1, t0 = 0.5, t_settle = 1.0;
     ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
     ws_world *w = contact_world(dt, &cd);
-    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
-                                v3(0, 0, 0), "plane");
-    ws_drive_def dd;
-    ws_drive_def_init(&dd);
-    dd.type = WS_DRIVE_TILT;
-    dd.axis = v3(0, 1, 0);
-    dd.rate = rate;
-    dd.start_time = t0;
-    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    tilting_plane(w, rate, t0);
     double gap = 2 * DELTA - m * G0 / (4 * k);
     ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID,
                               v3(0, 0, 0), "bottom");
