@@ -19,7 +19,8 @@
  * from rest), WS_PROBE_TOL=tol, WS_PROBE_HOLD=1 (the bodies held), WS_PROBE_DT=s (after the
  * restore), WS_PROBE_DAMP=f,T[,1] (the box contacts' damping, or with 1 the film-box one's,
  * times f for T s), WS_PROBE_CONTACTS=n (list the bodies' contacts of the first n steps),
- * WS_PROBE_STEPS=file (a line a step). */
+ * WS_PROBE_STEPS=file (a line a step, ending with the boxes' |dV| and |dW| that step, bottom
+ * then top, and the bodies' contact count). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -266,7 +267,7 @@ static int window_probe(int argc, char **argv)
         /* Step-to-step change of the film's dv and of the bodies' (dU, both boxes, their
          * velocity and spin as they are, metres and radians a second). */
         const double *dv = web->imp->dv;
-        double dd = 0.0, d2 = 0.0, ud = 0.0, u2 = 0.0;
+        double dd = 0.0, d2 = 0.0, ud = 0.0, u2 = 0.0, dlin[2] = {0.0, 0.0}, dang[2] = {0.0, 0.0};
         for (size_t j = 0; j < 3 * (size_t)n; j++) {
             dd += (dv[j] - dv0[j]) * (dv[j] - dv0[j]);
             d2 += dv[j] * dv[j];
@@ -279,10 +280,13 @@ static int window_probe(int argc, char **argv)
             const double u[6] = {v.x, v.y, v.z, w.x, w.y, w.z};
             for (int c = 0; c < 6; c++) {
                 const double du = u[c] - u0[q][c];
-                if (c < 3)
+                if (c < 3) {
                     s.du_lin[q] += du * du;
-                else
+                    dlin[q] += du * du;
+                } else {
                     s.du_ang[q] += du * du;
+                    dang[q] += du * du;
+                }
                 s.du_axis[q][c] += du * du;
                 ud += (du - du0[q][c]) * (du - du0[q][c]);
                 u2 += du * du;
@@ -369,7 +373,7 @@ static int window_probe(int argc, char **argv)
             const uint32_t b = pr.bind_row;
             fprintf(steps_out,
                     "%.5f %u %u %u %.4g %.4g %.4g %.4g %u %u %u %u %u %u %u %u %u %u %s %d %d "
-                    "%.4g %u %u %u %.4g %.4g\n",
+                    "%.4g %u %u %u %.4g %.4g %.3g %.3g %.3g %.3g %zu\n",
                     t0 + k * sc.dt, its, pr.solves, pr.it[0], pr.start[0], pr.start[1],
                     pr.start[2], pr.start[3], pr.above0[0], pr.above0[1], pr.above0[2],
                     pr.above0[3], pr.above[0][0] + pr.above[0][1] + pr.above[0][2] + pr.above[0][3],
@@ -379,7 +383,8 @@ static int window_probe(int argc, char **argv)
                     pr.above[4][0] + pr.above[4][1] + pr.above[4][2] + pr.above[4][3], b,
                     kind_name[pr.bind_kind], b < n ? (int)(b % (uint32_t)web->nx) : -1,
                     b < n ? (int)(b / (uint32_t)web->nx) : -1, pr.bind_value, enter, leave, flip,
-                    d2 > 0 ? sqrt(dd / d2) : 0.0, u2 > 0 ? sqrt(ud / u2) : 0.0);
+                    d2 > 0 ? sqrt(dd / d2) : 0.0, u2 > 0 ? sqrt(ud / u2) : 0.0, sqrt(dlin[0]),
+                    sqrt(dang[0]), sqrt(dlin[1]), sqrt(dang[1]), nbc);
         }
         if (k % per == 0) {
             probe_print(&s, t0 + k * sc.dt);
