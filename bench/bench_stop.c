@@ -127,6 +127,16 @@ static void probe_print(const probe_sums *s, double t)
     fflush(stdout);
 }
 
+/* Case R wrapped, its film implicit, the example's defaults otherwise, quiet. */
+static void case_r_implicit(tilt_options *a)
+{
+    tilt_default_options(a);
+    a->variant = 'R';
+    a->quiet = 1;
+    a->wrapped = 1;
+    a->implicit = 1;
+}
+
 /* The scene's film web, its implicit part reserved (NULL when either fails). */
 static ws_web *film_web(const tilt_scene *sc)
 {
@@ -152,11 +162,7 @@ static ws_web *film_web(const tilt_scene *sc)
 static int window_probe(int argc, char **argv)
 {
     tilt_options a;
-    tilt_default_options(&a);
-    a.variant = 'R';
-    a.quiet = 1;
-    a.wrapped = 1;
-    a.implicit = 1;
+    case_r_implicit(&a);
     a.areal_density = 0.018;
     a.substeps = 1;
     a.refine = argc > 3 ? atoi(argv[3]) : 1;
@@ -409,11 +415,7 @@ int main(int argc, char **argv)
     if (argc > 2 && !strcmp(argv[1], "window"))
         return window_probe(argc, argv);
     tilt_options a;
-    tilt_default_options(&a);
-    a.variant = 'R';
-    a.quiet = 1;
-    a.wrapped = 1;
-    a.implicit = 1;
+    case_r_implicit(&a);
     a.film_mass = 1.6e-6; /* as bench_implicit's solve: 1.6 mg nodes, one solve a step */
     a.substeps = 1;
     a.duration = argc > 1 ? atof(argv[1]) : 0.0;
