@@ -518,6 +518,24 @@ END_TEST
 /* Tipping rather than sliding                                                                */
 /* ======================================================================================== */
 
+/* A 2 m square kinematic plane, its top face at z = 0, that tilts about y at `rate` rad/s from
+ * t0 (s), reaching that rate over `ramp` s (below 0: the drive's default ramp). */
+static ws_body_id tilting_plane(ws_world *w, double rate, double t0, double ramp)
+{
+    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
+                                v3(0, 0, 0), "plane");
+    ws_drive_def dd;
+    ws_drive_def_init(&dd);
+    dd.type = WS_DRIVE_TILT;
+    dd.axis = v3(0, 1, 0);
+    dd.rate = rate;
+    dd.start_time = t0;
+    if (ramp >= 0.0)
+        dd.ramp_time = ramp;
+    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    return plane;
+}
+
 /* A tall box (w = d = 0.1 m, h = 0.4 m, 4 kg) on a plane tilting at 0.05 rad/s about y through
  * the origin (WS_DRIVE_TILT). mu = 0.8 > w/h = 0.25, so it tips before it can slide: statically
  * at tan(theta) = w/h, theta_c = 14.036 deg.
@@ -558,17 +576,7 @@ static tip_result run_tipping(ws_friction_model model)
     const double w_ = 0.1, h = 0.4, m = 4.0, k = 2e5, dt = 2.5e-4, rate = 0.05, t0 = 1.0;
     ws_contact_def cd = contact_params(k, 10.0, 0.8, model);
     ws_world *w = contact_world(dt, &cd);
-    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
-                                v3(0, 0, 0), "table");
-    ws_drive_def dd;
-    ws_drive_def_init(&dd);
-    dd.type = WS_DRIVE_TILT;
-    dd.axis = v3(0, 1, 0);
-    dd.point = v3(0, 0, 0);
-    dd.rate = rate;
-    dd.start_time = t0;
-    dd.ramp_time = 1.0;
-    ck_ok(w, ws_body_set_drive(w, plane, &dd));
+    ws_body_id plane = tilting_plane(w, rate, t0, 1.0);
     double gap = 2 * DELTA - m * G0 / (4 * k);
     ws_body_id box = make_box(w, WS_BODY_DYNAMIC, w_, w_, h, m, v3(0, 0, h / 2 + gap), Q_ID,
                               v3(0, 0, 0), "tall box");
@@ -1062,21 +1070,6 @@ START_TEST(test_energy_guard_without_speed_limit)
 }
 END_TEST
 
-/* A 2 m square kinematic plane, its top face at z = 0, that tilts about y at `rate` rad/s from
- * t0 (s). */
-static void tilting_plane(ws_world *w, double rate, double t0)
-{
-    ws_body_id plane = make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID,
-                                v3(0, 0, 0), "plane");
-    ws_drive_def dd;
-    ws_drive_def_init(&dd);
-    dd.type = WS_DRIVE_TILT;
-    dd.axis = v3(0, 1, 0);
-    dd.rate = rate;
-    dd.start_time = t0;
-    ck_ok(w, ws_body_set_drive(w, plane, &dd));
-}
-
 /* A stack of two 0.25 m, 5 kg cubes on a plane tilting at 0.1 rad/s from t = 1 s (ramp
  * 0.05 s), stick friction mu = 0.3 with the given absolute tangential damping (0: the default
  * ratio), run until theta = 0.9 atan(mu) (15.0 deg). Out: the most contacts flagged slipping in
@@ -1090,7 +1083,7 @@ static void tilting_stack(double stick_damping, int *most_slipping, int *capped,
     ws_contact_def cd = contact_params(2e5, 10.0, 0.3, WS_FRICTION_STICK);
     cd.stick_damping = stick_damping;
     ws_world *w = contact_world(dt, &cd);
-    tilting_plane(w, rate, t0);
+    tilting_plane(w, rate, t0, -1.0);
     double gap = 2 * DELTA - m * G0 / (4 * 2e5);
     make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID, v3(0, 0, 0), "bottom");
     ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 2 * gap), Q_ID,
@@ -1131,7 +1124,7 @@ static void yawed_stack(double yaw, double t_end, int *switches, double *dw, dou
     const double a = 0.25, m = 5.0, k = 2e5, dt = 2.5e-4, rate = 0.1, t0 = 0.5, t_settle = 1.0;
     ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
     ws_world *w = contact_world(dt, &cd);
-    tilting_plane(w, rate, t0);
+    tilting_plane(w, rate, t0, -1.0);
     double gap = 2 * DELTA - m * G0 / (4 * k);
     ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID,
                               v3(0, 0, 0), "bottom");
