@@ -16,6 +16,8 @@
 
 #define DELTA 1e-3 /* default contact layer of every body, m */
 #define DEG (3.14159265358979323846 / 180.0)
+/* contact.h's WS_EDGE_PARALLEL_SIN: below it a flat edge pair carries no force */
+#define WS_TEST_PARALLEL_FOOT 5e-4
 
 
 /* ck_ok for loops: Check's passing assertions cost a system call each (it records the
@@ -1194,6 +1196,105 @@ START_TEST(test_yawed_stack_contacts_settle)
 }
 END_TEST
 
+
+/* yawed_stack's cubes, the top one also shifted by off and started at vel: after t_settle
+ * (1 s), *switches counts the steps whose number of contacts between the cubes differs from the
+ * step before, *dw and *dv are the largest changes in one step of either cube's angular velocity
+ * (rad/s) and velocity (m/s), *kicks the steps in which either cube's spin changes by more than
+ * 1e-3 rad/s, *ee the most edge-edge contacts between the cubes in a step. */
+static void shifted_stack(double yaw, ws_vec3 off, ws_vec3 vel, int *switches, double *dw,
+                          double *dv, int *kicks, int *ee)
+{
+    const double a = 0.25, m = 5.0, k = 2e5, dt = 2.5e-4, rate = 0.1, t0 = 0.5, t_settle = 1.0;
+    const double t_end = 2.5;
+    ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
+    ws_world *w = contact_world(dt, &cd);
+    tilting_plane(w, rate, t0, -1.0);
+    double gap = 2 * DELTA - m * G0 / (4 * k);
+    ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID,
+                              v3(0, 0, 0), "bottom");
+    ws_quat q = {cos(0.5 * yaw), 0, 0, sin(0.5 * yaw)};
+    ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m,
+                              v3(off.x, off.y, 1.5 * a + 2 * gap + off.z), q, vel, "top");
+    const long steps = lround(t_end / dt);
+    ws_contact_info buf[64];
+    ws_vec3 w0[2] = {{0, 0, 0}, {0, 0, 0}}, v0[2] = {{0, 0, 0}, {0, 0, 0}};
+    int last = -1;
+    *switches = *kicks = *ee = 0;
+    *dw = *dv = 0.0;
+    for (long s = 1; s <= steps; s++) {
+        ck_ok(w, ws_world_step(w));
+        size_t n;
+        ck_ok(w, ws_world_copy_contacts_between(w, bot, top, buf, 64, &n));
+        int e = 0;
+        for (size_t i = 0; i < n; i++)
+            e += buf[i].kind == WS_CONTACT_EDGE_EDGE;
+        double dws = 0.0, dvs = 0.0;
+        for (int j = 0; j < 2; j++) {
+            ws_vec3 om, ve;
+            ck_ok(w, ws_body_get_angular_velocity(w, j ? top : bot, &om));
+            ck_ok(w, ws_body_get_velocity(w, j ? top : bot, &ve));
+            dws = fmax(dws, hypot(hypot(om.x - w0[j].x, om.y - w0[j].y), om.z - w0[j].z));
+            dvs = fmax(dvs, hypot(hypot(ve.x - v0[j].x, ve.y - v0[j].y), ve.z - v0[j].z));
+            w0[j] = om;
+            v0[j] = ve;
+        }
+        if (s * dt > t_settle) {
+            *switches += (int)n != last;
+            *ee = e > *ee ? e : *ee;
+            *dw = fmax(*dw, dws);
+            *dv = fmax(*dv, dvs);
+            *kicks += dws > 1e-3;
+        }
+        last = (int)n;
+    }
+    ws_world_destroy(w);
+}
+
+START_TEST(test_nearly_aligned_stack_no_kicks)
+{
+    /* Two equal cubes stacked nearly flush, the top one turned by 1.5-5e-4 rad about the
+     * vertical and shifted 0-50 um downhill, on the plane tilting at 0.1 rad/s (yawed_stack's
+     * case; a stack of equal boxes as in case R's seam). The edges of the faces lying on each
+     * other cross at sin(angle) sigma = yaw: at the lateral offset e of the two edges over sigma
+     * from where they are nearest, inside both edges only while |e| < sigma L / 2 (19-125 um).
+     * A step's creep and rocking move that crossing over the whole edge at these yaws, and an
+     * edge pair taken for one step at its full overlap kicks both cubes (contact.h,
+     * WS_EDGE_PARALLEL_SIN). A stack resting on the tilting plane turns with it steadily: no
+     * step may change either cube's spin by more than 1e-3 rad/s or its velocity by more than
+     * 1e-3 m/s. Runs whose contacts stay change by 2.2-2.5e-4 rad/s and 1.5-2.5e-4 m/s a step
+     * (the corners' springs' own ringing); the pair's kicks (before the fade, at the yaws of
+     * 1.5e-4 and 2e-4) 7e-3-0.02 rad/s and 0.8-2.6e-3 m/s: 1e-3 lies between, as in
+     * test_yawed_stack_contacts_settle. Below the fade's foot (yaw 5e-4) the nearly parallel
+     * pairs are out and the cubes' contacts must not change at all; at its foot they come and
+     * go with a share near 0, which is no kick. Not here: a top cube 10 um off at 1.5e-4, or
+     * 50 um off at 5e-4, whose corners cross the other cube's rim as the plane tilts: there a
+     * corner's point-face contact and the crossing edge pair were seen both counted for one
+     * step (bench/NOTES.md, session 18), a handover apart from these pairs. */
+    const struct {
+        double yaw, off, vel;
+    } cases[] = {{1.5e-4, 0.0, 2e-3}, {1.5e-4, 2e-5, 0.0}, {1.5e-4, 5e-5, 0.0},
+                 {2e-4, 2e-5, 0.0},   {5e-4, 0.0, 0.0},    {5e-4, 2e-5, 2e-3}};
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int sw, ee, kk;
+        double dw, dv;
+        shifted_stack(cases[i].yaw, v3(cases[i].off, 0, 0), v3(0, cases[i].vel, 0), &sw, &dw,
+                      &dv, &kk, &ee);
+        report("nearly aligned stack, yaw %.3g rad, shifted %.3g m, started at %.3g m/s: "
+               "contact count changes %d, edge-edge most %d, kicks %d; largest step change "
+               "%.3g rad/s, %.3g m/s",
+               cases[i].yaw, cases[i].off, cases[i].vel, sw, ee, kk, dw, dv);
+        ck_assert_msg(kk == 0 && dw < 1e-3, "yaw %g, shift %g: %d steps kicked the spin, by up "
+                      "to %g rad/s", cases[i].yaw, cases[i].off, kk, dw);
+        ck_assert_msg(dv < 1e-3, "yaw %g, shift %g: a cube's velocity changed by %g m/s in a "
+                      "step", cases[i].yaw, cases[i].off, dv);
+        if (cases[i].yaw < WS_TEST_PARALLEL_FOOT)
+            ck_assert_msg(sw == 0, "yaw %g, shift %g: the cubes' contacts changed in %d steps",
+                          cases[i].yaw, cases[i].off, sw);
+    }
+}
+END_TEST
+
 START_TEST(test_stick_stack_settles_on_tilt)
 {
     /* Below the onset tan(theta) = mu nothing slides: no contact may flag slipping (sliding,
@@ -1639,6 +1740,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_energy_guard_without_speed_limit);
     tcase_add_test(tc, test_stick_stack_settles_on_tilt);
     tcase_add_test(tc, test_yawed_stack_contacts_settle);
+    tcase_add_test(tc, test_nearly_aligned_stack_no_kicks);
     tcase_add_test(tc, test_stack_modes_bound_the_step);
     suite_add_tcase(s, tc);
     return s;

@@ -27,29 +27,59 @@
  * faces of 0.3 m: 1e-4 to 1e-3), and small beside any edge that truly turns away. */
 #define WS_CONE_TOL 1e-2
 
-/* Nearly parallel edges on faces lying on each other: the edge pair's normal is the faces'.
- * Two faces lying on each other (stacked or side-by-side boxes: outward normals opposed within
- * an angle psi, each face reaching out from its edge to the same side) touch over the convex
- * polygon where they overlap; where two of their border edges cross at a small angle sigma (a
- * yaw of sigma between equal boxes: at mid-edge), the edge pair carries that corner of it. Its
- * normal as eq. 16-17 give it, u x w, is ill-conditioned there: a relative tilt delta of the
- * edges out of the faces' plane turns it by delta / sigma, so for sigma of a few mrad the tilts
- * of a resting load (1e-5 to 1e-3 rad) swing it across the cone test's tolerance (WS_CONE_TOL)
- * and the pair switched on and off with them, a kick of its whole force each time (two stacked
- * boxes at 2.6 mrad of yaw rattled so, the force of 50 N coming and going every other step).
- * The faces' normal (the bisector n_k - n_l of the two opposed faces' normals, out of a) is
- * what the contact has, and it is well-conditioned: the pair's normal is u x w turned towards
- * it by a share g = (1 - s(sigma)) f(psi), s rising linearly from 0 at WS_EDGE_FLAT_SIN to 1 at
- * twice it, f falling linearly from 1 at psi = WS_EDGE_FLAT_FACES to 0 at twice it, and a pair
- * with g > 0 skips the cone test (its edges lie on each other's faces: a line contact, the
- * case the tolerance is for). In the blend the normal swings by at most (1 - g) delta / sigma
- * <= delta / (2 WS_EDGE_FLAT_SIN): 1e-2 for a tilt of 1e-3, within WS_CONE_TOL. The pair itself
- * stays (dropping it left the corner to the neighbouring contacts and let squeezed cartons turn
- * 2.5 times as far). Edges whose faces do not lie on each other (an edge resting across another
- * edge, two blocks touching edge to edge diagonally) keep u x w and the cone test: there the
- * normal lies well inside both cones. */
+/* Nearly parallel edges on faces lying on each other: the edge pair's normal is the faces'. Two
+ * faces lying on each other (stacked or side-by-side boxes: outward normals opposed within an angle
+ * psi, each face reaching out from its edge to the same side) touch over the convex polygon where
+ * they overlap; where two of their border edges cross at a small angle sigma (a yaw of sigma
+ * between equal boxes: at mid-edge), the edge pair carries that corner of it. Its normal as eq.
+ * 16-17 give it, u x w, is ill-conditioned there: a relative tilt delta of the edges out of the
+ * faces' plane turns it by delta / sigma, so for sigma of a few mrad the tilts of a resting load
+ * (1e-5 to 1e-3 rad) swing it across the cone test's tolerance (WS_CONE_TOL) and the pair switched
+ * on and off with them, a kick of its whole force each time (two stacked boxes at 2.6 mrad of yaw
+ * rattled so, the force of 50 N coming and going every other step). The faces' normal (the bisector
+ * n_k - n_l of the two opposed faces' normals, out of a) is what the contact has, and it is
+ * well-conditioned: the pair's normal is u x w turned towards it by a share g = (1 - s(sigma))
+ * f(psi), s rising linearly from 0 at WS_EDGE_FLAT_SIN to 1 at twice it, f falling linearly from 1
+ * at psi = WS_EDGE_FLAT_FACES to 0 at twice it, and a pair with g > 0 skips the cone test (its
+ * edges lie on each other's faces: a line contact, the case the tolerance is for). In the blend the
+ * normal swings by at most (1 - g) delta / sigma <= delta / (2 WS_EDGE_FLAT_SIN): 1e-2 for a tilt
+ * of 1e-3, within WS_CONE_TOL. The pair itself stays above 1e-3 (WS_EDGE_PARALLEL_SIN; dropping it
+ * to 0.1 left the corner to the neighbouring contacts and let squeezed cartons turn 2.5 times as
+ * far). Edges whose faces do not lie on each other (an edge resting across another edge, two blocks
+ * touching edge to edge diagonally) keep u x w and the cone test: there the normal lies well inside
+ * both cones. */
 #define WS_EDGE_FLAT_SIN 0.05
 #define WS_EDGE_FLAT_FACES 0.05
+
+/* Edges within a few 1e-4 of parallel on faces lying on each other: the pair's force fades out, the
+ * corners carry it. Such a pair is the vertex of the faces' overlap polygon where two of its
+ * borders cross, with interior angle pi - sigma. As sigma -> 0 the vertex straightens: the
+ * polygon's support is carried by its true corners (point-face contacts, and the edge pairs of
+ * edges crossing at large angles), and the nearly straight vertex's spring only adds force and
+ * stiffness along a line they already hold. Its existence is the worst of it: the crossing lies at
+ * the lateral offset e of the two borders over sigma from the point where they are nearest, and
+ * inside both edges only while |e| < sigma L / 2 (L the edge's length). A resting stack's offsets
+ * change by tens of nm a step (the faces' rocking turns the 3D lines' closest points as well: the
+ * normal's tilt over sigma), so at sigma = 1.4-1.7e-4 (case R's seam, sigma L = 35-42 um) the
+ * crossing swept the whole edge in a step, and the one step it lay inside both edges the pair came
+ * in at its full overlap (50-65 N), a kick of 5-6.6 mm/s and 0.01-0.06 rad/s on both boxes that
+ * rocked the stack for tens of steps. A hard bound under which the pair is skipped would move that
+ * jump to the bound (a pair inside the edges at its full force when sigma crosses it: cubes at a
+ * yaw of 5e-4 rattled so in 3 of 8 runs); instead the pair's share p(sigma) of its force rises
+ * linearly from 0 at WS_EDGE_PARALLEL_SIN to 1 at twice it, applied to every stiffness and damping
+ * of its laws (normal and tangential: force.c), so its force and the bodies' solve's friction from
+ * it (mu N) are continuous in sigma. With the flatness f(psi) of WS_EDGE_FLAT_FACES the share is
+ * w = 1 - (1 - p(sigma)) f(psi): 1 for edges whose faces do not lie on each other (f = 0: they keep
+ * the 1e-4 parallel bound of the singular closest points, and the cone test), and continuous in psi
+ * as in sigma. The bound: the crossing's range sigma L must be much more than what moves it a step,
+ * and more than the creep of a stuck interface under load (mu N / k_t, 9-18 um for the reference
+ * boxes) so that a creep does not carry it over the edge: at 5e-4 sigma L is 125 um on a 0.25 m
+ * edge, 7-14 times the creep, 1000 times a step's offset. The stacks measured
+ * (test_nearly_aligned_stack_no_kicks) kicked at yaws of 1.5-2e-4 and stood still from 3e-4; the
+ * fade's top, 1e-3 (250 um), keeps the pairs of the yaws of test_yawed_stack_contacts_settle (1e-3
+ * up) whole. A flat pair below the bound leaves its vertex to the corners, which is the
+ * face-on-face support the point-face contacts give aligned boxes (yaw 0). */
+#define WS_EDGE_PARALLEL_SIN 5e-4
 
 /* How far past a face's outline (m, in the face's plane) a point of another body still counts on
  * the face, when it lies over the face's half of the rim (ws_point_on_face); edge pairs whose
@@ -149,9 +179,12 @@ int ws_point_on_face(const ws_shape *sa, uint32_t f, v3 s, double lo, double hi,
  * the faces it projects into, so only that face pushes it out. */
 int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d);
 
-/* Geometry of a candidate at the committed state: contact point and normal (global, a to b) and
- * the signed distance; 1 when the layers overlap. */
-int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist);
+/* Geometry of a candidate at the committed state: contact point and normal (global, a to b),
+ * the signed distance and the contact's share of its laws' stiffness and damping (in (0, 1]:
+ * below 1 for a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN); 1 when the layers
+ * overlap. */
+int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist,
+                        double *share);
 
 /* Evaluate one candidate at the committed state: 1 when in contact, with the record filled, the
  * forces added to both bodies' accumulators and the stick anchors of *c updated. */

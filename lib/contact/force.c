@@ -19,8 +19,8 @@ static void apply(ws_body_store *b, int cur, uint32_t i, v3 xg, v3 F)
 int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
 {
     v3 xg, n;
-    double d;
-    if (!ws_contact_geometry(x, c, &xg, &n, &d)) {
+    double d, share;
+    if (!ws_contact_geometry(x, c, &xg, &n, &d, &share)) {
         c->anchored = 0;
         return 0;
     }
@@ -29,8 +29,11 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     const ws_pair_params *pp = ws_contact_params(x, ia, ib);
     double overlap = b->layer[ia] + b->layer[ib] - d;
     v3 vrel = v3_sub(point_velocity(b, x->cur, ib, xg), point_velocity(b, x->cur, ia, xg));
-    /* Spring on the overlap and damper on its rate; a contact never pulls. */
-    const ws_normal law = ws_normal_law(n, vrel, overlap, pp->k, pp->c);
+    /* Spring on the overlap and damper on its rate; a contact never pulls. A contact with a
+     * share below 1 (a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN) has that share of
+     * every stiffness and damping of its laws, normal and tangential, and so of its force. */
+    const double k = share * pp->k, kt = share * pp->kt;
+    const ws_normal law = ws_normal_law(n, vrel, overlap, k, share * pp->c);
     const double fn = law.fp;
     const v3 vt = law.t;
     v3 ft = v3_make(0, 0, 0);
@@ -55,12 +58,12 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
         v3 dd = v3_sub(xb, xa);
         v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
         double m_eff = 1.0 / (b->inv_mass[ia] + b->inv_mass[ib]);
-        ft = v3_add(v3_scale(dt, -pp->kt), v3_scale(vt, -ws_stick_damping(pp, m_eff)));
+        ft = v3_add(v3_scale(dt, -kt), v3_scale(vt, -share * ws_stick_damping(pp, m_eff)));
         double cap = pp->mu * fn, fts = v3_norm(ft);
         if (fts > cap) {
             ft = fts > 0.0 ? v3_scale(ft, cap / fts) : ft;
             /* The anchor slides so the spring alone carries the capped force. */
-            v3 dt_new = v3_scale(ft, -1.0 / pp->kt);
+            v3 dt_new = v3_scale(ft, -1.0 / kt);
             v3 xa_new = v3_sub(xb, dt_new);
             c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
             at_cap = 1;
@@ -70,7 +73,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
             dt = dt_new;
         }
         defl = dt;
-        energy_t = 0.5 * pp->kt * v3_norm2(dt);
+        energy_t = 0.5 * kt * v3_norm2(dt);
     }
     v3 F = v3_add(v3_scale(n, fn), ft);
     apply(b, x->cur, ib, xg, F);
@@ -87,7 +90,7 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     rec->vt = vt;
     rec->overlap = overlap;
     rec->fn = fn;
-    rec->energy = 0.5 * pp->k * overlap * overlap;
+    rec->energy = 0.5 * k * overlap * overlap;
     rec->energy_t = energy_t;
     return 1;
 }

@@ -122,11 +122,13 @@ static double face_on_face(v3 n1i, v3 n2i, v3 n1j, v3 n2j)
     return v3_dot(di, dj) > 0.0 ? -v3_dot(n1i, n1j) : -1.0;
 }
 
-/* The share g of the faces' normal in an edge pair's normal (WS_EDGE_FLAT_SIN): edges crossing
- * at sin(angle) sigma, their faces with outward normals n1i, n2i and n1j, n2j; *nf the bisector
+/* How flat an edge pair is: f(psi) in [0, 1] (WS_EDGE_FLAT_FACES), for edges crossing at
+ * sin(angle) sigma, their faces with outward normals n1i, n2i and n1j, n2j; *nf the bisector
  * n_k - n_l (out of a) of the most nearly opposed pair of those faces lying on each other, which
- * misses being opposed by psi. g = (1 - s(sigma)) f(psi). */
-static double flat_share(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
+ * misses being opposed by psi. 0 (and *nf untouched) for edges 2 WS_EDGE_FLAT_SIN or more from
+ * parallel. The share of the faces' normal is g = (1 - s(sigma)) f, that of the pair's force
+ * 1 - (1 - p(sigma)) f (contact.h). */
+static double flat_faces(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
 {
     if (sigma >= 2.0 * WS_EDGE_FLAT_SIN)
         return 0.0;
@@ -147,18 +149,20 @@ static double flat_share(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
     if (!(f > 0.0))
         return 0.0;
     *nf = unit(v3_sub(ni[best], nj[best]));
-    return (1.0 - ramp(sigma, WS_EDGE_FLAT_SIN)) * f;
+    return f;
 }
 
 /* Edge pi-qi of a against edge pj-qj of b, all in a's frame (eq. 16-17): closest points
  * pi + s u and pj + t w, separation k3 along the unit common normal. n is oriented out of a (in
  * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
  * the parameters, the oriented normal (for nearly parallel edges on faces lying on each other
- * turned towards those faces', flat_share) and the signed distance; 0 for parallel edges (the
- * system is singular: point-face contacts carry that case) or when the closest points are not
- * interior to both edges or the cones disagree. */
+ * turned towards those faces', flat_faces), the signed distance and the share of the pair's
+ * force (WS_EDGE_PARALLEL_SIN: 1 but for nearly parallel edges on faces lying on each other); 0
+ * for parallel edges (the system is singular: point-face contacts carry that case), flat pairs
+ * whose share is 0, or when the closest points are not interior to both edges or the cones
+ * disagree. */
 static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double *s_out,
-                     double *t_out, v3 *n_out, double *d_out)
+                     double *t_out, v3 *n_out, double *d_out, double *w_out)
 {
     v3 u = v3_sub(qi, pi), w = v3_sub(qj, pj);
     v3 n = v3_cross(u, w);
@@ -176,8 +180,14 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     if (!(s > ls && s < 1.0 - ls && t > lt && t < 1.0 - lt))
         return 0;
     n = v3_scale(n, 1.0 / sqrt(nn));
-    v3 nf;
-    double g = flat_share(sqrt(nn / (uu * ww)), n1i, n2i, n1j, n2j, &nf);
+    v3 nf = n;
+    const double sigma = sqrt(nn / (uu * ww));
+    const double f = flat_faces(sigma, n1i, n2i, n1j, n2j, &nf);
+    /* The flat pair's force fades out below WS_EDGE_PARALLEL_SIN, the corners carrying it. */
+    const double wt = 1.0 - f * (1.0 - ramp(sigma, WS_EDGE_PARALLEL_SIN));
+    if (!(wt > 0.0))
+        return 0;
+    const double g = f * (1.0 - ramp(sigma, WS_EDGE_FLAT_SIN));
     double d;
     if (g > 0.0) {
         /* Nearly parallel edges on faces lying on each other: a line contact, whose normal is
@@ -200,6 +210,7 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     *t_out = t;
     *n_out = n;
     *d_out = d;
+    *w_out = wt;
     return 1;
 }
 
@@ -357,7 +368,8 @@ int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j
 
 /* Geometry of one candidate at the committed state: contact point (global), normal (global, a to
  * b) and signed distance. Returns 1 when the layers overlap. */
-int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist)
+int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist,
+                        double *share)
 {
     const ws_body_store *b = x->b;
     const ws_body_state *st = &b->st[x->cur];
@@ -377,6 +389,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
         *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */
         *dist = d;
+        *share = 1.0;
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
@@ -386,10 +399,10 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
     v3 pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
     v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
-    double s, u, d;
+    double s, u, d, wt;
     v3 n;
     if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), &s, &u,
-                   &n, &d))
+                   &n, &d, &wt))
         return 0;
     if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
         return 0;
@@ -398,6 +411,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     *xg = v3_add(st->r[ia], m3_mul_v(Aa, mid));
     *ng = m3_mul_v(Aa, n);
     *dist = d;
+    *share = wt;
     return 1;
 }
 
