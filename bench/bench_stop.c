@@ -20,7 +20,10 @@
  * restore), WS_PROBE_DAMP=f,T[,1] (the box contacts' damping, or with 1 the film-box one's,
  * times f for T s), WS_PROBE_CONTACTS=n (list the bodies' contacts of the first n steps),
  * WS_PROBE_STEPS=file (a line a step, ending with the boxes' |dV| and |dW| that step, bottom
- * then top, and the bodies' contact count). */
+ * then top, and the bodies' contact count), WS_PROBE_LOADS=file (a line a step: each box's pose
+ * and the film's force and moment on it, the plane's and the box-box contacts, the film at the
+ * boxes' vertical edges: see loads_line), WS_PROBE_MIRROR=n and WS_PROBE_NODE=column,row (the
+ * band against its mirror image: see mirror_line). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -149,6 +152,92 @@ static ws_web *film_web(const tilt_scene *sc)
     return web;
 }
 
+/* WS_PROBE_LOADS=file: a line a step: t, then for each box (bottom, top) its centre (m), its
+ * small rotation 2 (e1 e2 e3) (rad), the film's force (N) and moment about its centre (N m);
+ * then the plane-bottom and the box-box contacts: count, edge-edge count, total normal force
+ * (N) and the force-weighted mean point (x y, m); then the film at the boxes' vertical edges
+ * (below). */
+static void loads_line(FILE *f, const tilt_scene *sc, const ws_web *web, double t)
+{
+    fprintf(f, "%.5f", t);
+    for (int q = 0; q < 2; q++) {
+        ws_vec3 p;
+        ws_quat e;
+        uint32_t bslot = 0;
+        ws_body_get_position(sc->world, sc->box[q], &p);
+        ws_body_get_orientation(sc->world, sc->box[q], &e);
+        ws_lookup_body(sc->world, sc->box[q], &bslot);
+        const v3 F = web->bforce[sc->world->cur][bslot], M = web->bmoment[sc->world->cur][bslot];
+        fprintf(f, "  %.6f %.6f %.6f %.3e %.3e %.3e  %.4f %.4f %.4f %.4f %.4f %.4f", p.x, p.y, p.z,
+                2 * e.e1, 2 * e.e2, 2 * e.e3, F.x, F.y, F.z, M.x, M.y, M.z);
+    }
+    ws_contact_info ci[64];
+    size_t nc = 0;
+    ws_world_copy_contacts(sc->world, ci, 64, &nc);
+    for (int g = 0; g < 2; g++) { /* 0: a box on the plane, 1: box on box */
+        int cnt = 0, ee = 0;
+        double N = 0.0, x = 0.0, y = 0.0;
+        for (size_t q = 0; q < nc && q < 64; q++) {
+            const int boxa = ci[q].body_a.bits == sc->box[0].bits || ci[q].body_a.bits == sc->box[1].bits;
+            const int boxb = ci[q].body_b.bits == sc->box[0].bits || ci[q].body_b.bits == sc->box[1].bits;
+            if ((boxa && boxb) != g)
+                continue;
+            cnt++;
+            ee += ci[q].kind != 0;
+            N += ci[q].normal_force;
+            x += ci[q].normal_force * ci[q].point.x;
+            y += ci[q].normal_force * ci[q].point.y;
+        }
+        fprintf(f, "  %d %d %.3f %.5f %.5f", cnt, ee, N, N > 0 ? x / N : 0.0, N > 0 ? y / N : 0.0);
+    }
+    /* The film at the boxes' vertical edges: the least distance of a node from an edge's line
+     * (the footprint's corners, the boxes taken at the origin, unturned: they move microns) and
+     * how many nodes lie inside the footprint (past the surface). */
+    {
+        const ws_nodes3 X = web->x[sc->world->cur];
+        double dmin = INFINITY;
+        int inside = 0;
+        for (uint32_t i = 0; i < web->n; i++) {
+            const double ax = fabs(X.x[i]), ay = fabs(X.y[i]);
+            dmin = fmin(dmin, hypot(ax - 0.125, ay - 0.125));
+            inside += ax < 0.125 && ay < 0.125 && X.z[i] > 0.002 && X.z[i] < 0.506;
+        }
+        fprintf(f, "  %.4e %d", dmin, inside);
+    }
+    fputc('\n', f);
+}
+
+/* WS_PROBE_MIRROR=n: for the first n steps, how far the band is from its mirror image in the
+ * diagonal plane x = y (the case is symmetric in it: node column i maps to 3 nx / 4 - i): the
+ * nodes whose contact state differs from their image's, the largest position difference and
+ * where; with WS_PROBE_NODE=column,row that node's position, velocity and state. */
+static void mirror_line(const ws_web *web, int cur, const uint8_t *st, long k)
+{
+    const ws_nodes3 X = web->x[cur], V = web->v[cur];
+    const int nx = web->nx;
+    uint32_t bad = 0, imax = 0;
+    double dmax = 0.0;
+    for (uint32_t i = 0; i < web->n; i++) {
+        const int col = (int)(i % (uint32_t)nx), row = (int)(i / (uint32_t)nx);
+        const uint32_t m = (uint32_t)((3 * nx / 4 - col + nx) % nx + row * nx);
+        bad += st[i] != st[m];
+        const double d =
+            fabs(X.x[i] - X.y[m]) + fabs(X.y[i] - X.x[m]) + fabs(X.z[i] - X.z[m]);
+        if (d > dmax)
+            dmax = d, imax = i;
+    }
+    printf("mirror step %ld: %u nodes in another contact state than their image, position "
+           "off by up to %.3g m (column %u row %u)\n",
+           k, bad, dmax, imax % (uint32_t)nx, imax / (uint32_t)nx);
+    int qc = 0, qr = 0;
+    if (getenv("WS_PROBE_NODE") && sscanf(getenv("WS_PROBE_NODE"), "%d,%d", &qc, &qr) == 2 &&
+        qc >= 0 && qc < nx && qr >= 0 && qr < web->ny) {
+        const uint32_t c = (uint32_t)(qc + qr * nx);
+        printf("  node %d,%d: x %.7f %.7f %.7f (x - y %.3g) v %.4g %.4g %.4g state %d\n", qc, qr,
+               X.x[c], X.y[c], X.z[c], X.x[c] - X.y[c], V.x[c], V.y[c], V.z[c], st[c]);
+    }
+}
+
 /* `window file r duration [every]`: case R's band refined r x r at the real areal density on
  * the multigrid (bench_implicit's `phases`), restored from `file` (bench_implicit's
  * WS_BENCH_SAVE; "-" starts at t = 0), stepped `duration` s with the probe of the solve
@@ -240,6 +329,7 @@ static int window_probe(int argc, char **argv)
     if (getenv("WS_PROBE_HOLD"))
         web->hold_bodies = atoi(getenv("WS_PROBE_HOLD"));
     FILE *steps_out = getenv("WS_PROBE_STEPS") ? fopen(getenv("WS_PROBE_STEPS"), "w") : NULL;
+    FILE *loads_out = getenv("WS_PROBE_LOADS") ? fopen(getenv("WS_PROBE_LOADS"), "w") : NULL;
     double t0;
     ws_world_get_time(sc.world, &t0);
     printf("case R refined %d (%u nodes, %d x %d), bodies %s, from t %.4f s (%.2f deg), %.3f s\n",
@@ -317,6 +407,10 @@ static int window_probe(int argc, char **argv)
         }
         size_t nbc = 0;
         ws_world_get_contact_count(sc.world, &nbc);
+        if (getenv("WS_PROBE_MIRROR") && k <= atoi(getenv("WS_PROBE_MIRROR")))
+            mirror_line(web, sc.world->cur, st, k);
+        if (loads_out && k > 1)
+            loads_line(loads_out, &sc, web, t0 + k * sc.dt);
         if (getenv("WS_PROBE_CONTACTS") && k <= atoi(getenv("WS_PROBE_CONTACTS"))) {
             ws_contact_info ci[64];
             size_t nc = 0;
@@ -401,6 +495,8 @@ static int window_probe(int argc, char **argv)
            (cpu_seconds() - c0) / T);
     if (steps_out)
         fclose(steps_out);
+    if (loads_out)
+        fclose(loads_out);
     web->imp->probe = NULL;
     free(st);
     free(st0);
