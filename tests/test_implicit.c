@@ -392,6 +392,292 @@ START_TEST(test_contact_jacobian)
 }
 END_TEST
 
+/* ---- a node past a convex body's edge: the faces' pushes blend (node_force.c) */
+
+/* A 0.2 m box (k 4000 N/m, c 1 N s/m, mu 0.5, v_lim 10 mm/s; 1 mm layers each: a 2 mm window)
+ * of 1e6 kg (the nodes' pushes barely move it) turned by 0.3 rad about z, and a web of n nodes
+ * (a chain, implicit) at the body-frame places p, stepped once so that the candidates are
+ * found; then x: the places again, from the body's frame as it stands after the step. */
+static ws_world *yawed_box_nodes(size_t n, const double *p, ws_web **web, ws_nodes3 *x)
+{
+    ws_world *w = world_g(1e-5, NO_G);
+    ws_shape_id box;
+    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &box));
+    ws_material_def md;
+    ws_material_def_init(&md);
+    ws_material_id film_mat, box_mat;
+    ck_ok(w, ws_material_create(w, &md, &film_mat));
+    ck_ok(w, ws_material_create(w, &md, &box_mat));
+    ws_contact_def cd;
+    ws_contact_def_init(&cd);
+    cd.stiffness = 4000.0;
+    cd.damping = 1.0;
+    cd.friction = 0.5;
+    cd.friction_vlim = 0.01;
+    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    ws_body_def bd;
+    ws_body_def_init(&bd);
+    bd.shape = box;
+    bd.mass = 1e6;
+    bd.material = box_mat;
+    bd.orientation = (ws_quat){cos(0.15), 0.0, 0.0, sin(0.15)};
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, &bd, &body));
+    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = 1e-3;
+    wd.law = law;
+    wd.material = film_mat;
+    wd.integrator = WS_WEB_IMPLICIT;
+    double *pos = calloc(3 * n, sizeof *pos), *rest = calloc(n, sizeof *rest);
+    uint32_t *pair = calloc(2 * n, sizeof *pair);
+    ck_assert(pos && rest && pair);
+    const m3 A0 = qt_to_m3(bd.orientation);
+    for (size_t i = 0; i < n; i++) {
+        const v3 g = m3_mul_v(&A0, v3_make(p[3 * i], p[3 * i + 1], p[3 * i + 2]));
+        pos[3 * i] = g.x, pos[3 * i + 1] = g.y, pos[3 * i + 2] = g.z;
+    }
+    for (size_t i = 0; i + 1 < n; i++) {
+        pair[2 * i] = (uint32_t)i, pair[2 * i + 1] = (uint32_t)(i + 1);
+        rest[i] = 0.2;
+    }
+    ws_web_id id = mesh_web(w, &wd, n, pos, pair, n - 1, rest, NULL, 0);
+    *web = web_of(w, id);
+    ck_ok(w, ws_world_step(w)); /* candidates found, faces prepared */
+    const ws_body_state *st = &w->bodies.st[w->cur];
+    *x = nodes_new(n);
+    for (size_t i = 0; i < n; i++) {
+        const v3 g = v3_add(st->r[0], m3_mul_v(&w->bodies.A[0],
+                                               v3_make(p[3 * i], p[3 * i + 1], p[3 * i + 2])));
+        x->x[i] = g.x, x->y[i] = g.y, x->z[i] = g.z;
+    }
+    free(pos);
+    free(rest);
+    free(pair);
+    return w;
+}
+
+/* The body's velocity at every node (no slip, no approach: the pushes alone). */
+static ws_nodes3 nodes_at_body(ws_world *w, size_t n)
+{
+    ws_nodes3 v = nodes_new(n);
+    const v3 vb = w->bodies.st[w->cur].v[0];
+    for (size_t i = 0; i < n; i++)
+        v.x[i] = vb.x, v.y[i] = vb.y, v.z[i] = vb.z;
+    return v;
+}
+
+START_TEST(test_push_past_edge_continuous)
+{
+    /* A node pressed past the box's vertical edge (+x, +y) at depth delta below both side
+     * faces, on the bisector and 1e-12 m to either side of it. The push must be continuous:
+     * its gradient is at most k (hi + delta) / W |n_A - n_B| / 2 ~ 2.5e4 N/m (W: the blend's
+     * width, 1 mm, or delta where that is less; hi 2 mm), so 1e-12 m moves it by 2.5e-8 N at
+     * most; bound 1e-7 N, against the push k (hi + delta) ~ 10 N, the node's overlap below the
+     * surface, along the bisector on it (to 1e-10 of it: round-off of the rotated planes, 1e-17
+     * m of depth, turns it by 1e-14), so with no moment about the vertical through the CoG.
+     * The shallowest face alone (the law before) turns it by 45 degrees across the bisector.
+     * Two depths: 1.5 mm (the width is 1 mm) and 0.4 mm (pinched to the depth). */
+    const double depths[2] = {1.5e-3, 0.4e-3}, k = 4000.0, hi = 2e-3, r2 = sqrt(0.5);
+    for (int dc = 0; dc < 2; dc++) {
+        const double de = depths[dc];
+        double p[9];
+        for (int j = 0; j < 3; j++) {
+            const double o = (j - 1) * 1e-12 * r2; /* across the bisector, 1e-12 m */
+            p[3 * j] = 0.1 - de + o, p[3 * j + 1] = 0.1 - de - o, p[3 * j + 2] = 0.0;
+        }
+        ws_web *web;
+        ws_nodes3 x;
+        ws_world *w = yawed_box_nodes(3, p, &web, &x);
+        ws_nodes3 v = nodes_at_body(w, 3);
+        const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
+        ws_node_link *L = calloc(cl->n + 1, sizeof *L);
+        v3 F[3];
+        for (uint32_t i = 0; i < 3; i++) {
+            int cnt;
+            F[i] = contact_force(w, web, cl, x, v, L, i, &cnt);
+            ck_assert_int_ge(cnt, 1);
+        }
+        const m3 *A = &w->bodies.A[0];
+        const v3 bis = m3_mul_v(A, v3_make(r2, r2, 0.0)), r = w->bodies.st[w->cur].r[0];
+        const double jm = v3_norm(v3_sub(F[0], F[1])), jp = v3_norm(v3_sub(F[2], F[1]));
+        const double want = k * (hi + de), size = v3_norm(F[1]);
+        const v3 across = v3_sub(F[1], v3_scale(bis, v3_dot(F[1], bis)));
+        const v3 lx = v3_sub(v3_make(x.x[1], x.y[1], x.z[1]), r);
+        const double mz = v3_cross(lx, F[1]).z;
+        report("push past the edge, %.1f mm deep: %.4f N (want %.4f); jumps %.2g, %.2g N across "
+               "the bisector; off it %.2g of the push; moment about z %.2g N m",
+               de * 1e3, size, want, jm, jp, v3_norm(across) / size, mz);
+        ck_assert_msg(jm <= 1e-7 && jp <= 1e-7, "the push jumps by %g, %g N across the bisector",
+                      jm, jp);
+        ck_assert_msg(fabs(size - want) <= 1e-9 * want, "push %.12g N, want %.12g", size, want);
+        ck_assert_msg(v3_norm(across) <= 1e-10 * size, "push off the bisector by %g N",
+                      v3_norm(across));
+        ck_assert_msg(fabs(mz) <= 1e-10 * size * v3_norm(lx), "moment about z %g N m", mz);
+        free(L);
+        free(x.x);
+        free(v.x);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
+START_TEST(test_push_continuous_onto_face)
+{
+    /* A node 0.5 mm from the box's vertical edge, 1e-12 m inside and outside face A's plane
+     * (x = 0.1) and 0.5 mm inside face B's: outside A's plane face A alone holds it (its push
+     * k (hi - d_A) along n_A), so just inside A must too. The blend's width is pinched to the
+     * depth for this: a fixed 1 mm width would turn the push there to 3/4 n_A + 1/4 n_B (18
+     * degrees), a jump of 2.5 N of 8. Bound 1e-7 N as above. */
+    const double p[6] = {0.1 - 1e-12, 0.1 - 5e-4, 0.0, 0.1 + 1e-12, 0.1 - 5e-4, 0.0};
+    ws_web *web;
+    ws_nodes3 x;
+    ws_world *w = yawed_box_nodes(2, p, &web, &x);
+    ws_nodes3 v = nodes_at_body(w, 2);
+    const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
+    ws_node_link *L = calloc(cl->n + 1, sizeof *L);
+    int c0, c1;
+    const v3 F0 = contact_force(w, web, cl, x, v, L, 0, &c0),
+             F1 = contact_force(w, web, cl, x, v, L, 1, &c1);
+    const double jump = v3_norm(v3_sub(F0, F1));
+    report("push onto face A's outside: %.6f N inside, %.6f N outside; jump %.2g N",
+           v3_norm(F0), v3_norm(F1), jump);
+    ck_assert_int_ge(c0, 1);
+    ck_assert_int_ge(c1, 1);
+    ck_assert_msg(jump <= 1e-7, "the push jumps by %g N at face A's plane", jump);
+    free(L);
+    free(x.x);
+    free(v.x);
+    ws_world_destroy(w);
+}
+END_TEST
+
+START_TEST(test_band_corners_mirror)
+{
+    /* Four nodes past the box's four vertical edges, on the bisectors, 0.8 mm deep (a refined
+     * band's corner columns, 0.4-0.8 mm past the edges): the set is the mirror image of itself
+     * (in the box's x-z and y-z planes), so the pushes' moment about the vertical through the
+     * CoG must vanish. Round-off (the box turned by 0.3 rad: its planes' depths differ by
+     * 1e-17 m) moves each push across by 1e-12 N at most (gradient 2.5e4 N/m times 1e-17 m,
+     * see above), a moment of 1e-13 N m; bound 1e-9 N m, against 0.8 N m from a single face's
+     * push at one corner (the shallowest face alone picked by round-off). Again with the
+     * corners' symmetric noise: each moved 1e-8 m across its bisector, mirror images moved
+     * mirror-wise, where each node's moment (1e-5 N m) cancels its image's. */
+    for (int noisy = 0; noisy < 2; noisy++) {
+        const double de = 0.8e-3, eta = noisy ? 1e-8 * sqrt(0.5) : 0.0;
+        double p[12];
+        for (int c = 0; c < 4; c++) {
+            const double sx = (c & 1) ? -1.0 : 1.0, sy = (c & 2) ? -1.0 : 1.0;
+            /* Mirror images in x -> -x and y -> -y: the offset (eta, -eta) mirrored. */
+            p[3 * c] = sx * (0.1 - de + eta), p[3 * c + 1] = sy * (0.1 - de - eta);
+            p[3 * c + 2] = 0.0;
+        }
+        ws_web *web;
+        ws_nodes3 x;
+        ws_world *w = yawed_box_nodes(4, p, &web, &x);
+        ws_nodes3 v = nodes_at_body(w, 4);
+        const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
+        ws_node_link *L = calloc(cl->n + 1, sizeof *L);
+        const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
+                                x,          v,      0.0,           1.0,         NULL};
+        const size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L, NULL);
+        double mz = 0.0, one = 0.0;
+        int act = 0;
+        for (size_t k = 0; k < n; k++)
+            if (L[k].active) {
+                const double m = v3_cross(L[k].lever, L[k].f).z;
+                mz += m;
+                one = fmax(one, fabs(m));
+                act++;
+            }
+        report("band corners%s: %d pushing contacts, moment about z %.2g N m (largest one's "
+               "%.2g)",
+               noisy ? ", 1e-8 m mirrored noise" : " on the bisectors", act, mz, one);
+        ck_assert_int_ge(act, 4);
+        ck_assert_msg(fabs(mz) <= 1e-9, "the corners twist the box: %g N m", mz);
+        free(L);
+        free(x.x);
+        free(v.x);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
+START_TEST(test_blend_jacobian)
+{
+    /* The exact derivatives of the contact forces of a node past the box's vertical edge where
+     * the faces blend, against central differences (steps 1e-8 m, 1e-8 m/s) to 1e-6 of their
+     * size, law by law: the width 1 mm (1.5 and 1.8 mm deep), pinched to the depth (0.3 and
+     * 0.4 mm deep), and outside the blend (1 and 3 mm deep: the shallowest face alone), one
+     * contact each (the shallower face's, its normal turning with the node in the blend);
+     * slipping at (3, 4, -1) mm/s and approaching. Truncation: (1e-8 / 3e-4)^2 ~ 1e-9 of the
+     * second derivative's scale. */
+    const double cases[3][2] = {{1.5e-3, 1.8e-3}, {0.3e-3, 0.4e-3}, {1e-3, 3e-3}};
+    const char *what[3] = {"blend, width 1 mm", "blend, width pinched", "shallowest face"};
+    const int links[3] = {1, 1, 1};
+    for (int cc = 0; cc < 3; cc++) {
+        const double p[3] = {0.1 - cases[cc][0], 0.1 - cases[cc][1], 0.0};
+        ws_web *web;
+        ws_nodes3 x;
+        ws_world *w = yawed_box_nodes(1, p, &web, &x);
+        ws_nodes3 v = nodes_at_body(w, 1);
+        const m3 *A = &w->bodies.A[0];
+        const v3 slip = m3_mul_v(A, v3_make(0.003, 0.004, -0.001));
+        v.x[0] += slip.x, v.y[0] += slip.y, v.z[0] += slip.z;
+        const ws_ncand_list *cl = &web->contact->cand[web->contact->list];
+        ws_node_link *L = calloc(cl->n + 1, sizeof *L);
+        ws_node_exact *E = calloc(cl->n + 1, sizeof *E);
+        const ws_node_pass P = {&w->bodies, w->cur, &w->node_geom, w->node_par, cl->c,
+                                x,          v,      0.0,           1.0,         NULL};
+        const size_t n = ws_node_links(&P, web, cl->n, NULL, 0.0, L, E);
+        double Jx[9] = {0}, Jv[9] = {0};
+        int act = 0;
+        for (size_t k = 0; k < n; k++)
+            if (L[k].active) {
+                act++;
+                for (int q = 0; q < 9; q++)
+                    Jx[q] += E[k].Jx[q], Jv[q] += E[k].Jv[q];
+            }
+        ck_assert_int_eq(act, links[cc]);
+        double Fx[9], Fv[9];
+        ws_nodes3 s[2] = {x, v};
+        for (int which = 0; which < 2; which++)
+            for (int k = 0; k < 3; k++) {
+                double *c = comp(s[which], k), keep = c[0];
+                int c1, c2;
+                c[0] = keep + 1e-8;
+                const v3 fp = contact_force(w, web, cl, x, v, L, 0, &c1);
+                c[0] = keep - 1e-8;
+                const v3 fm = contact_force(w, web, cl, x, v, L, 0, &c2);
+                c[0] = keep;
+                ck_assert_int_eq(c1, links[cc]);
+                ck_assert_int_eq(c2, links[cc]);
+                double *J = which ? Fv : Fx;
+                J[k] = (fp.x - fm.x) / 2e-8;
+                J[3 + k] = (fp.y - fm.y) / 2e-8;
+                J[6 + k] = (fp.z - fm.z) / 2e-8;
+            }
+        const double sx = max_abs(Fx, 9), sv = max_abs(Fv, 9);
+        double ex = 0, ev = 0;
+        for (int k = 0; k < 9; k++) {
+            ex = fmax(ex, fabs(Jx[k] - Fx[k]));
+            ev = fmax(ev, fabs(Jv[k] - Fv[k]));
+        }
+        report("contact past the edge (%s): exact vs finite differences %.2g, %.2g of %.3g N/m, "
+               "%.3g N s/m",
+               what[cc], ex / sx, ev / sv, sx, sv);
+        ck_assert_msg(ex <= 1e-6 * sx, "%s: df/dx off by %g of %g", what[cc], ex, sx);
+        ck_assert_msg(ev <= 1e-6 * sv, "%s: df/dv off by %g of %g", what[cc], ev, sv);
+        free(L);
+        free(E);
+        free(x.x);
+        free(v.x);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 /* ---- 2. backward Euler on a string's mode ---- */
 
 START_TEST(test_string_mode_amplification)
@@ -2840,6 +3126,10 @@ int main(void)
     Suite *s = suite_create("implicit");
     add_case(s, "spring_jacobian", test_spring_jacobian, 10);
     add_case(s, "contact_jacobian", test_contact_jacobian, 10);
+    add_case(s, "push_past_edge_continuous", test_push_past_edge_continuous, 10);
+    add_case(s, "push_continuous_onto_face", test_push_continuous_onto_face, 10);
+    add_case(s, "band_corners_mirror", test_band_corners_mirror, 10);
+    add_case(s, "blend_jacobian", test_blend_jacobian, 10);
     add_case(s, "coupled_jacobian", test_coupled_jacobian, 10);
     add_case(s, "body_on_film", test_body_on_film, 60);
     add_case(s, "film_body_momentum", test_film_body_momentum, 30);

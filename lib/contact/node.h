@@ -441,9 +441,13 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
                       uint64_t *checks);
 
 /* Where a node touches a body: the unit normal n from the body to the node, the distance d
- * along it and the window's top hi (the two layers). */
+ * it is pushed over (the overlap is hi - d) and the window's top hi (the two layers); for the
+ * exact derivatives, g, d's gradient in the node's place, and a face's normal's, dn/dx =
+ * ta tb^T: n and zero, but for a node past a convex body's edge, whose push turns from one
+ * face's normal to the other's (node_force.c, NODE_BLEND_WIDTH). (The rim's turning is
+ * ws_node_links's.) */
 typedef struct ws_node_touch_at {
-    v3 n;
+    v3 n, g, ta, tb;
     double d, hi;
 } ws_node_touch_at;
 

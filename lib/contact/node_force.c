@@ -357,30 +357,121 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
     L->n = 0;
 }
 
-/* Whether the face of candidate c (of body bi, shape sh) is the shallowest for a node at
- * (xx, xy, xz) under it at depth d: on a convex body, no other face's plane has the node
- * farther out (the prepared faces, global). Out of line: the few nodes below a face need it,
- * and inlined its values would crowd contacts_general's registers. */
+/* How far past a convex body's edge the push turns from one face's normal to the other's, for
+ * the implicit film (the explicit film keeps the shallowest face alone: with this law its
+ * wrapped loads' corner nodes settle otherwise, and a wrapped EUR load kept a drift of 0.101
+ * mm/s against the 0.1 its test allows; bench/NOTES.md, session 18, issue 17). A
+ * node below face f of a convex body at depth d < 0, e the largest signed distance to the
+ * body's other planes (the shallowest other depth, of face g), t = d - e, m = max(d, e): its
+ * push comes from one contact, f's where t > 0 (the lower face's index of f, g on a tie), with
+ * the overlap hi - m (m is the node's signed distance to the body's surface: the shallowest
+ * face's depth) along the unit normal
+ *
+ *     n = (s n_f + (1 - s) n_g) / |s n_f + (1 - s) n_g|,   s = min(1, 1/2 + t / (2 W)),
+ *     W = min(NODE_BLEND_WIDTH, -m);
+ *
+ * for t >= W that is n_f and d, the shallowest face alone, to the bit. Continuous: across the
+ * medial plane (t = 0) the contact passes from f to g with the same push, k (hi - m) along the
+ * bisector, where the shallowest face alone turned it by the faces' angle on a difference of
+ * round-off; on the edge line the push is the rounded rim's (in_wedge: k hi, its direction
+ * between the normals). One contact, as the rim's: one normal force, one friction in its
+ * tangent plane (two faces' contacts would each hold the node against the other's push by
+ * friction, and half shares each would let a corner sink twice as deep). The width pinches to
+ * the depth (-m) near the surface, so that the push is f's own by the time the node reaches
+ * g's plane (e = 0), past which f alone holds it; a fixed width would turn the push there by
+ * up to half the faces' angle. So the blend fills the wedge about the edge inside the body by
+ * angle, as the rim does outside it, turning as 1 / distance near the edge line as the rim.
+ *
+ * The width: a film node's layer is ~1 mm, which its push spans; W must stand far above
+ * round-off (1e-11 m, the medial plane's tie) and the noise that mirror-symmetric nodes carry
+ * (1e-8 m in the settling bands), so that mirror images get mirror pushes, and small beside a
+ * face (0.1-1 m): 1 mm. Nodes that lie more than 1 mm deeper beneath every other face's plane
+ * than beneath their shallowest face's (or more than their depth: nodes near a face's middle,
+ * not an edge) keep their results to the bit. */
+#define NODE_BLEND_WIDTH 1e-3
+
+/* Whether the face of candidate c (of non-convex shape sh, body bi) is the shallowest for a
+ * node at (xx, xy, xz) under it at depth d (ws_shallowest_face). Out of line: the few nodes
+ * below a face need it, and inlined its values would crowd contacts_general's registers. */
 NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, uint32_t bi,
                                        const ws_ncand *c, double xx, double xy, double xz, double d)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const v3 xi = v3_make(xx, xy, xz);
-    if (!sh->convex)
-        return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+    return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
+}
+
+/* The gradients of a face contact's push past a convex edge (NODE_BLEND_WIDTH), for the
+ * implicit film's exact derivatives: g, that of the distance pushed over (hi less the overlap);
+ * the normal's, dn/dx = a b^T (zero for a face alone). */
+typedef struct blend_grad {
+    v3 g, a, b;
+} blend_grad;
+
+/* The push of face candidate c of a convex shape sh on a node at xi below it at depth d < 0
+ * (NODE_BLEND_WIDTH's law; without `blend`, the shallowest face alone), the window's top hi
+ * (the two layers): whether it pushes, and then its normal and the distance it pushes over (hi
+ * less the overlap) and, with gr, their gradients in xi. The prepared faces (global). Out of
+ * line as shallowest. */
+NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, const ws_ncand *c,
+                                        v3 xi, double d, double hi, int blend, v3 *nrm,
+                                        double *dist, blend_grad *gr)
+{
+    const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const ws_wface *F = E->g->face + (c->feat - f);
-    for (uint32_t q = 0; q < sh->face_count; q++)
-        if (q != f && v3_dot(F[q].n, xi) - F[q].off > d)
+    double e = -INFINITY;
+    uint32_t qg = f;
+    for (uint32_t q = 0; q < sh->face_count; q++) {
+        const double dq = v3_dot(F[q].n, xi) - F[q].off;
+        if (q != f && dq > e) {
+            e = dq;
+            qg = q;
+        }
+    }
+    const double t = d - e, m = e > d ? e : d, W = fmin(NODE_BLEND_WIDTH, -m);
+    if (!blend || !(W > 0.0) || !(t < W)) {
+        /* The shallowest face alone, as far from an edge. */
+        if (e > d)
             return 0;
+        *nrm = F[f].n;
+        *dist = d;
+        if (gr)
+            *gr = (blend_grad){F[f].n, v3_make(0, 0, 0), v3_make(0, 0, 0)};
+        return 1;
+    }
+    if (t < 0.0 || (t == 0.0 && qg < f))
+        return 0; /* g's contact pushes */
+    const double s = 0.5 + t / (2.0 * W);
+    const v3 bl = v3_add(v3_scale(F[f].n, s), v3_scale(F[qg].n, 1.0 - s));
+    const double bn = v3_norm(bl);
+    const v3 n = v3_scale(bl, 1.0 / bn);
+    *nrm = n;
+    *dist = m;
+    if (gr) {
+        /* m's gradient is n_f (t >= 0 here); s's is (n_f - n_g) / (2 W) - t dW / (2 W^2) with
+         * dW = -n_f where the width is pinched to the depth; n's is (I - n n^T) (n_f - n_g) /
+         * |bl| ds^T. */
+        v3 ds = v3_scale(v3_sub(F[f].n, F[qg].n), 1.0 / (2.0 * W));
+        if (-m < NODE_BLEND_WIDTH)
+            ds = v3_madd(ds, F[f].n, t / (2.0 * W * W));
+        const v3 u = v3_sub(F[f].n, F[qg].n);
+        gr->g = F[f].n;
+        gr->a = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
+        gr->b = ds;
+    }
     return 1;
 }
 
-/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, the
- * shallowest under it, or the rim of an edge (in_wedge, sure as there); the normal from the
- * body to the node and the distance. The one-by-one pass's and the implicit film's test alike
- * (inlined: NODE_INLINE). */
+/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, below
+ * it the one push of a convex body's faces (convex_push) or the shallowest face of another's,
+ * or the rim of an edge (in_wedge, sure as there); the normal from the body to the node, the
+ * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, their
+ * gradients (a face's or rim's own: see ws_node_links). The one-by-one pass's and the implicit
+ * film's test alike (inlined: NODE_INLINE), but for `blend`: the implicit film's alone (1),
+ * the explicit film keeping the shallowest face (0; see NODE_BLEND_WIDTH). */
 static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
-                                       double top, int sure, v3 *nrm, double *dist)
+                                       double top, double hi, int sure, int blend, v3 *nrm,
+                                       double *dist, blend_grad *gr)
 {
     const ws_node_geom *g = E->g;
     if (c->local & WS_NCAND_EDGE)
@@ -393,8 +484,13 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 
      * are valid: no need to find its triangle. */
     if (!(c->local & WS_NCAND_INSIDE) && !in_wface(g, F, xi))
         return 0;
-    if (d < 0.0 && !shallowest(E, E->b->shape[c->body], c->body, c, xi.x, xi.y, xi.z, d))
-        return 0;
+    if (d < 0.0) {
+        const ws_shape *sh = E->b->shape[c->body];
+        if (sh->convex)
+            return convex_push(E, sh, c, xi, d, hi, blend, nrm, dist, gr);
+        if (!shallowest(E, sh, c->body, c, xi.x, xi.y, xi.z, d))
+            return 0;
+    }
     *nrm = F->n;
     *dist = d;
     return 1;
@@ -478,7 +574,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
-            if (touch_of(E, c, xi, lo, hi, sure, &nrm, &d))
+            if (touch_of(E, c, xi, lo, hi, hi, sure, 0, &nrm, &d, NULL))
                 act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
@@ -1097,5 +1193,18 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
     const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
     const ws_shape *sh = b->shape[c->body];
     at->hi = b->layer[c->body] + web->layer;
-    return touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, 0, &at->n, &at->d);
+    blend_grad gr = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
+    if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, 1, &at->n, &at->d,
+                  &gr))
+        return 0;
+    /* A face's or rim's distance changes along its normal; a blended push's as convex_push
+     * gives. */
+    at->g = at->n;
+    at->ta = at->tb = v3_make(0, 0, 0);
+    if (!(c->local & WS_NCAND_EDGE) && v3_dot(gr.g, gr.g) > 0.0) {
+        at->g = gr.g;
+        at->ta = gr.a;
+        at->tb = gr.b;
+    }
+    return 1;
 }

@@ -48,14 +48,16 @@ static void link_slip(ws_node_link *L, v3 t, double vlim)
 
 /* The exact derivatives of an active contact L's force (ws_node_exact) with the normal force f,
  * the relative velocity vr and its normal part vn, the contact's parameters p, G as link_of's.
- * df/dx = -k n^T - c vr^T G (the body's spin, of relative size c |w| / k, left out), and
+ * df/dx = -k gd^T - c vr^T G, gd the gradient of the distance pushed over (n, but past a
+ * convex edge where faces blend: ws_node_touch_at's g; the body's spin, of relative size
+ * c |w| / k, left out), and
  * df/du = -c n^T; friction's through its slip and through f. */
 static void exact_of(const ws_node_params *p, const ws_node_link *L, v3 vr, double vn, double f,
-                     const double G[9], int pinned, ws_node_exact *J)
+                     const double G[9], v3 gd, int pinned, ws_node_exact *J)
 {
     const v3 n = L->n;
     memset(J, 0, sizeof *J);
-    double dfx[3] = {-p->k * n.x, -p->k * n.y, -p->k * n.z};
+    double dfx[3] = {-p->k * gd.x, -p->k * gd.y, -p->k * gd.z};
     const double vrv[3] = {vr.x, vr.y, vr.z};
     for (int k = 0; k < 3; k++)
         for (int q = 0; q < 3; q++)
@@ -96,8 +98,8 @@ static void exact_of(const ws_node_params *p, const ws_node_link *L, v3 vr, doub
 /* One contact, its force and the matrix's blocks (see ws_node_link), for the node at x (velocity
  * u, a pinned one without friction) touching a body of motion b at `at`, the contact's
  * parameters p; with J not NULL its exact derivatives too (exact_of; zero when it does not
- * push). G: dn/dx (zero for a face, (P_e - n n^T) / d for an edge's rim, P_e the projection
- * across the edge), read for J alone. The force is the contact laws' (penalty.h), as the
+ * push). G: dn/dx (zero for a face but one past a convex edge, (P_e - n n^T) / d for an
+ * edge's rim, P_e the projection across the edge), read for J alone. The force is the contact laws' (penalty.h), as the
  * explicit film's. */
 static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_node_touch_at *at,
                     const double G[9], int pinned, ws_node_link *L, ws_node_exact *J)
@@ -123,7 +125,7 @@ static void link_of(const ws_node_params *p, v3 x, v3 u, ws_motion b, const ws_n
     link_slip(L, law.t, p->vlim);
     if (J) {
         if (L->active)
-            exact_of(p, L, kin.vr, law.vn, f, G, pinned, J);
+            exact_of(p, L, kin.vr, law.vn, f, G, at->g, pinned, J);
         else
             memset(J, 0, sizeof *J);
     }
@@ -190,6 +192,8 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
         if (!ws_node_touch(P, web, c, xi, reach, &at))
             continue;
         double G[9] = {0}; /* the exact derivatives' alone */
+        if (exact) /* a face's: zero, but past a convex edge (ws_node_touch_at) */
+            outer_add(G, 1.0, at.ta, at.tb);
         if (exact && (c->local & WS_NCAND_EDGE)) {
             /* The rim's normal turns with the node: dn/dx = (I - e e^T - n n^T) / d. */
             const ws_wedge *E = &P->g->edge[c->feat];
