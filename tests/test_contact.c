@@ -1708,8 +1708,9 @@ START_TEST(test_corner_carried_once_across_the_rim)
      * offset around the tolerance exactly one contact lies at V, whose normal force is the one
      * spring k (2 delta - h) (the overlap at V; no velocity at the first step), within 1e-5
      * relative (an edge pair's overlap is the one at its crossing, up to 3e-6 m from V along an
-     * edge rising 1e-4: 3e-10 m of the 2e-4 m overlap; a second spring would be 100 %). Before the hand-over was measured one way, offsets 3-5e-7 m counted V twice at
-     * one sign of the tilt and offsets 5-7e-7 m not at all at the other. */
+     * edge rising 1e-4: 3e-10 m of the 2e-4 m overlap; a second spring would be 100 %). Before
+     * the hand-over was measured one way, offsets of 4-5e-7 m counted V twice at one sign of the
+     * tilt and 5.1-6e-7 m not at all at the other (9 of 32 placements). */
     const double a = 0.25, m = 5.0, k = 2e5, shift = 0.01, ov = 2e-4;
     const double offs[] = {-2e-6, -3e-7, 0.0, 2e-7, 3e-7, 4e-7, 4.5e-7, 4.9e-7, 5e-7, 5.1e-7,
                            5.5e-7, 6e-7, 7e-7, 8e-7, 1e-6, 3e-6};
