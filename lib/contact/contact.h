@@ -82,8 +82,8 @@
 #define WS_EDGE_PARALLEL_SIN 5e-4
 
 /* How far past a face's outline (m, in the face's plane) a point of another body still counts on
- * the face, when it lies over the face's half of the rim (ws_point_on_face); edge pairs whose
- * closest points lie that near an edge's end are left to those point-face contacts. Two equal,
+ * the face, when it lies over the face's half of the rim (ws_point_on_face); edge pairs ending
+ * at such a point are left to its point-face contact (WS_EDGE_END_REACH). Two equal,
  * aligned boxes stacked (or a box flush against one of its own size) have each box's corners on
  * the other face's rim: 8 springs, two a corner. A moment of ~1 N m (a film's uneven pull)
  * turns the boxes by ~1e-6 rad and moves the corners 1.25e-7 m (over a 0.25 m box's
@@ -99,6 +99,30 @@
  * the force's line by 2e-6 of a 0.25 m face. Not the resting tilts of WS_CONE_TOL (1e-4 to
  * 1e-3 rad, 12-125 um at the corners): those are real offsets, which the edge pairs carry. */
 #define WS_OUTLINE_TOL 5e-7
+
+/* A corner's hand-over between its point-face contact and an edge pair, measured one way. A
+ * box's corner V just past another body's face rim is carried either by its point-face contact
+ * (V within WS_OUTLINE_TOL of the face's outline, in the face's plane) or by the edge pair of an
+ * edge E through V with the rim edge, whose closest point lies near V along E. The two used to
+ * measure different things: the pair was left out while its closest point lay within
+ * WS_OUTLINE_TOL of E's end along the 3D edge; but the common normal of E and the rim tilts with
+ * E out of the face's plane, which moves that closest point along E by the gap h between them
+ * times the tilt: 2e-7 m for the layers' 2 mm and a tilt of 1e-4 (two stacked cubes on a
+ * tilting plane). Between the two measures a corner was carried twice (twice its force for a
+ * step) at one sign of the tilt, and by nothing at the other (it came back later at its full
+ * overlap: 80 N in case R): a kick and tens of steps of rocking. Now an edge pair whose closest
+ * point lies within WS_EDGE_END_REACH of an edge's end is left out exactly when that end counts
+ * on the other body's face by the point-face contact's own tests (ws_point_on_face, and
+ * ws_shallowest_face inside the solid), and kept otherwise, however near the end (up to
+ * WS_FEATURE_TOL): exactly one of the two carries the corner wherever the pair's closest point
+ * lies inside E, which for a corner past the rim by the tolerance or more holds while h times
+ * the tilt stays below WS_OUTLINE_TOL (tilts below 2.5e-4 at the full 2 mm; at larger tilts a
+ * corner that far past the rim may find its crossing beyond its end, the gap that a clamped
+ * pair would close: not done). The reach bounds where the pair yields: above the tolerance plus
+ * the shift (2e-5 m for a tilt of 1e-2 over 2 mm, WS_CONE_TOL), and small beside a face, since a
+ * pair crossing the rim within it of a corner that already counts is the same support (a moment
+ * arm of 5e-5 m, 2e-4 of a 0.25 m face). */
+#define WS_EDGE_END_REACH 5e-5
 
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */

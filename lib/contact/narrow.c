@@ -172,12 +172,10 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
     v3 r = v3_sub(pj, pi);
     double ru = v3_dot(r, u), rw = v3_dot(r, w);
     double s = (ru * ww - uw * rw) / nn, t = (uw * ru - uu * rw) / nn;
-    /* Closest points within WS_OUTLINE_TOL of an edge's end lie within that of the end's point
-     * and of the other body's face rim: the point-face contact carries them (ws_point_on_face),
-     * once, and not with the sign of a sub-micrometre offset. */
-    double ls = fmax(WS_FEATURE_TOL, WS_OUTLINE_TOL / sqrt(uu));
-    double lt = fmax(WS_FEATURE_TOL, WS_OUTLINE_TOL / sqrt(ww));
-    if (!(s > ls && s < 1.0 - ls && t > lt && t < 1.0 - lt))
+    /* Closest points near an edge's end are handed over to the end's point-face contact by the
+     * caller (WS_EDGE_END_REACH), measured as that contact measures it. */
+    if (!(s > WS_FEATURE_TOL && s < 1.0 - WS_FEATURE_TOL && t > WS_FEATURE_TOL &&
+          t < 1.0 - WS_FEATURE_TOL))
         return 0;
     n = v3_scale(n, 1.0 / sqrt(nn));
     v3 nf = n;
@@ -225,6 +223,19 @@ int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d)
             return 0;
     }
     return 1;
+}
+
+/* Point s (frame of shape sa) carried by a point-face contact on one of sa's faces at a
+ * distance within (lo, hi): ws_point_on_face and, inside the solid, ws_shallowest_face, the
+ * tests of ws_contact_geometry's point-face branch. */
+static int point_carried(const ws_shape *sa, v3 s, double lo, double hi)
+{
+    for (uint32_t f = 0; f < sa->face_count; f++) {
+        double d;
+        if (ws_point_on_face(sa, f, s, lo, hi, &d) && (d >= 0.0 || ws_shallowest_face(sa, f, s, d)))
+            return 1;
+    }
+    return 0;
 }
 
 /* Relative transform of b into a's frame: s_a = R s_b + t. */
@@ -405,6 +416,20 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
                    &n, &d, &wt))
         return 0;
     if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
+        return 0;
+    /* A closest point within WS_EDGE_END_REACH of an edge's end is the end's (a corner's) when
+     * that end counts on the other body's face: the point-face contact carries it, and the pair
+     * not (contact.h). */
+    const double la = sqrt(v3_dot(v3_sub(qi, pi), v3_sub(qi, pi)));
+    const double lb = sqrt(v3_dot(v3_sub(qj, pj), v3_sub(qj, pj)));
+    if (fmin(s, 1.0 - s) * la < WS_EDGE_END_REACH) {
+        /* a's nearer end in b's frame: s_b = R^T (s_a - t) */
+        v3 ea = m3_tmul_v(&R, v3_sub(s < 0.5 ? pi : qi, t));
+        if (point_carried(sb, ea, -reach - sb->inner, reach))
+            return 0;
+    }
+    if (fmin(u, 1.0 - u) * lb < WS_EDGE_END_REACH &&
+        point_carried(sa, u < 0.5 ? pj : qj, -reach - sa->inner, reach))
         return 0;
     v3 xi = v3_madd(pi, v3_sub(qi, pi), s), xj = v3_madd(pj, v3_sub(qj, pj), u);
     v3 mid = v3_scale(v3_add(xi, xj), 0.5);
