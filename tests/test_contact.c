@@ -1113,6 +1113,40 @@ static void tilting_stack(double stick_damping, int *most_slipping, int *capped,
     ws_world_destroy(w);
 }
 
+/* The step of the stacks on the tilting plane (s). */
+#define STACK_DT 2.5e-4
+
+/* Two 0.25 m, 5 kg cubes (stick friction 0.5, k 2e5 N/m, c 10 N s/m) stacked at rest on their
+ * contacts' static overlap on a kinematic plane that tilts about y at 0.1 rad/s from t = 0.5 s,
+ * the top one turned by yaw about z, shifted by off and started at vel. */
+static ws_world *cube_stack(double yaw, ws_vec3 off, ws_vec3 vel, ws_body_id *bot,
+                            ws_body_id *top)
+{
+    const double a = 0.25, m = 5.0, k = 2e5, rate = 0.1, t0 = 0.5;
+    ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
+    ws_world *w = contact_world(STACK_DT, &cd);
+    tilting_plane(w, rate, t0, -1.0);
+    const double gap = 2 * DELTA - m * G0 / (4 * k);
+    *bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID, v3(0, 0, 0),
+                    "bottom");
+    ws_quat q = {cos(0.5 * yaw), 0, 0, sin(0.5 * yaw)};
+    *top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(off.x, off.y, 1.5 * a + 2 * gap + off.z),
+                    q, vel, "top");
+    return w;
+}
+
+/* The contacts between bodies a and b into buf (room for 64), their count into n: how many are
+ * edge pairs. */
+static int edge_pairs_between(ws_world *w, ws_body_id a, ws_body_id b, ws_contact_info *buf,
+                              size_t *n)
+{
+    ck_ok(w, ws_world_copy_contacts_between(w, a, b, buf, 64, n));
+    int e = 0;
+    for (size_t i = 0; i < *n; i++)
+        e += buf[i].kind == WS_CONTACT_EDGE_EDGE;
+    return e;
+}
+
 /* Two 0.25 m, 5 kg cubes stacked on a kinematic plane that tilts about y at 0.1 rad/s from
  * t = 0.5 s, the top cube turned `yaw` rad about the vertical on the bottom one (stick friction,
  * mu 0.5, the reference case's k and c): at a small yaw each cube's edges cross the other's
@@ -1123,16 +1157,9 @@ static void tilting_stack(double stick_damping, int *most_slipping, int *capped,
  * contacts seen between the cubes in one step. */
 static void yawed_stack(double yaw, double t_end, int *switches, double *dw, double *dv, int *ee)
 {
-    const double a = 0.25, m = 5.0, k = 2e5, dt = 2.5e-4, rate = 0.1, t0 = 0.5, t_settle = 1.0;
-    ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
-    ws_world *w = contact_world(dt, &cd);
-    tilting_plane(w, rate, t0, -1.0);
-    double gap = 2 * DELTA - m * G0 / (4 * k);
-    ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID,
-                              v3(0, 0, 0), "bottom");
-    ws_quat q = {cos(0.5 * yaw), 0, 0, sin(0.5 * yaw)};
-    ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, 1.5 * a + 2 * gap), q,
-                              v3(0, 0, 0), "top");
+    const double dt = STACK_DT, t_settle = 1.0;
+    ws_body_id bot, top;
+    ws_world *w = cube_stack(yaw, v3(0, 0, 0), v3(0, 0, 0), &bot, &top);
     const long steps = lround(t_end / dt);
     ws_contact_info buf[64];
     ws_vec3 w0 = v3(0, 0, 0), v0 = v3(0, 0, 0);
@@ -1142,10 +1169,7 @@ static void yawed_stack(double yaw, double t_end, int *switches, double *dw, dou
     for (long s = 1; s <= steps; s++) {
         ck_ok(w, ws_world_step(w));
         size_t n;
-        ck_ok(w, ws_world_copy_contacts_between(w, bot, top, buf, 64, &n));
-        int e = 0;
-        for (size_t i = 0; i < n; i++)
-            e += buf[i].kind == WS_CONTACT_EDGE_EDGE;
+        const int e = edge_pairs_between(w, bot, top, buf, &n);
         ws_vec3 om, vel;
         ck_ok(w, ws_body_get_angular_velocity(w, top, &om));
         ck_ok(w, ws_body_get_velocity(w, top, &vel));
@@ -1205,17 +1229,9 @@ END_TEST
 static void shifted_stack(double yaw, ws_vec3 off, ws_vec3 vel, int *switches, double *dw,
                           double *dv, int *kicks, int *ee)
 {
-    const double a = 0.25, m = 5.0, k = 2e5, dt = 2.5e-4, rate = 0.1, t0 = 0.5, t_settle = 1.0;
-    const double t_end = 2.5;
-    ws_contact_def cd = contact_params(k, 10.0, 0.5, WS_FRICTION_STICK);
-    ws_world *w = contact_world(dt, &cd);
-    tilting_plane(w, rate, t0, -1.0);
-    double gap = 2 * DELTA - m * G0 / (4 * k);
-    ws_body_id bot = make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + gap), Q_ID,
-                              v3(0, 0, 0), "bottom");
-    ws_quat q = {cos(0.5 * yaw), 0, 0, sin(0.5 * yaw)};
-    ws_body_id top = make_box(w, WS_BODY_DYNAMIC, a, a, a, m,
-                              v3(off.x, off.y, 1.5 * a + 2 * gap + off.z), q, vel, "top");
+    const double dt = STACK_DT, t_settle = 1.0, t_end = 2.5;
+    ws_body_id bot, top;
+    ws_world *w = cube_stack(yaw, off, vel, &bot, &top);
     const long steps = lround(t_end / dt);
     ws_contact_info buf[64];
     ws_vec3 w0[2] = {{0, 0, 0}, {0, 0, 0}}, v0[2] = {{0, 0, 0}, {0, 0, 0}};
@@ -1225,10 +1241,7 @@ static void shifted_stack(double yaw, ws_vec3 off, ws_vec3 vel, int *switches, d
     for (long s = 1; s <= steps; s++) {
         ck_ok(w, ws_world_step(w));
         size_t n;
-        ck_ok(w, ws_world_copy_contacts_between(w, bot, top, buf, 64, &n));
-        int e = 0;
-        for (size_t i = 0; i < n; i++)
-            e += buf[i].kind == WS_CONTACT_EDGE_EDGE;
+        const int e = edge_pairs_between(w, bot, top, buf, &n);
         double dws = 0.0, dvs = 0.0;
         for (int j = 0; j < 2; j++) {
             ws_vec3 om, ve;

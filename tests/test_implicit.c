@@ -259,11 +259,10 @@ static void contact_fd(ws_world *w, ws_web *web, const ws_ncand_list *cl, ws_nod
     }
 }
 
-/* The scene of the contact Jacobians: a 0.2 m box of 1 kg moving at (10, 20, 0) mm/s without
- * spin, and a web of two nodes (one spring, implicit): node 0 over its top face 1.5 mm up (the
- * window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along y, 1.41 mm from
- * it; stepped once, so the candidates are found and the faces prepared. x: the nodes' places. */
-static ws_world *box_two_nodes(ws_web **web, ws_nodes3 *x)
+/* The contact Jacobians' world: a 0.2 m box (k 4000 N/m, c 1 N s/m, mu 0.5, v_lim 10 mm/s,
+ * layers of 1 mm each) of the body def bd (its shape and material filled in here), and wd an
+ * implicit web's def of 1 g nodes, a stiff linear law and the film's material. */
+static ws_world *box_and_film(ws_body_def *bd, ws_web_def *wd)
 {
     ws_world *w = world_g(1e-5, NO_G);
     ws_shape_id box;
@@ -280,21 +279,30 @@ static ws_world *box_two_nodes(ws_web **web, ws_nodes3 *x)
     cd.friction = 0.5;
     cd.friction_vlim = 0.01;
     ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
+    bd->shape = box;
+    bd->material = box_mat;
+    ws_body_id body;
+    ck_ok(w, ws_body_create(w, bd, &body));
+    ws_web_def_init(wd);
+    wd->node_mass = 1e-3;
+    wd->law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
+    wd->material = film_mat;
+    wd->integrator = WS_WEB_IMPLICIT;
+    return w;
+}
+
+/* The scene of the contact Jacobians: a 0.2 m box of 1 kg moving at (10, 20, 0) mm/s without
+ * spin, and a web of two nodes (one spring, implicit): node 0 over its top face 1.5 mm up (the
+ * window is 2 mm: two 1 mm layers), node 1 at the rim of its top edge along y, 1.41 mm from
+ * it; stepped once, so the candidates are found and the faces prepared. x: the nodes' places. */
+static ws_world *box_two_nodes(ws_web **web, ws_nodes3 *x)
+{
     ws_body_def bd;
     ws_body_def_init(&bd);
-    bd.shape = box;
     bd.mass = 1.0;
-    bd.material = box_mat;
     bd.velocity = v3_make(0.01, 0.02, 0.0);
-    ws_body_id body;
-    ck_ok(w, ws_body_create(w, &bd, &body));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
     ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
+    ws_world *w = box_and_film(&bd, &wd);
     const double r = 1e-3 / sqrt(2.0);
     const double pos[6] = {0.03, -0.02, 0.1 + 1.5e-3, 0.1 + r, 0.05, 0.1 + r};
     const uint32_t pair[2] = {0, 1};
@@ -400,36 +408,12 @@ END_TEST
  * found; then x: the places again, from the body's frame as it stands after the step. */
 static ws_world *yawed_box_nodes(size_t n, const double *p, ws_web **web, ws_nodes3 *x)
 {
-    ws_world *w = world_g(1e-5, NO_G);
-    ws_shape_id box;
-    ck_ok(w, ws_shape_create_box(w, 0.2, 0.2, 0.2, &box));
-    ws_material_def md;
-    ws_material_def_init(&md);
-    ws_material_id film_mat, box_mat;
-    ck_ok(w, ws_material_create(w, &md, &film_mat));
-    ck_ok(w, ws_material_create(w, &md, &box_mat));
-    ws_contact_def cd;
-    ws_contact_def_init(&cd);
-    cd.stiffness = 4000.0;
-    cd.damping = 1.0;
-    cd.friction = 0.5;
-    cd.friction_vlim = 0.01;
-    ck_ok(w, ws_world_set_contact(w, film_mat, box_mat, &cd));
     ws_body_def bd;
     ws_body_def_init(&bd);
-    bd.shape = box;
     bd.mass = 1e6;
-    bd.material = box_mat;
     bd.orientation = (ws_quat){cos(0.15), 0.0, 0.0, sin(0.15)};
-    ws_body_id body;
-    ck_ok(w, ws_body_create(w, &bd, &body));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_ELASTIC, 1e-3, 0.0, 0.0, 0.0);
     ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-3;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
+    ws_world *w = box_and_film(&bd, &wd);
     double *pos = calloc(3 * n, sizeof *pos), *rest = calloc(n, sizeof *rest);
     uint32_t *pair = calloc(2 * n, sizeof *pair);
     ck_assert(pos && rest && pair);
