@@ -152,7 +152,19 @@ static double flat_faces(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
     return f;
 }
 
-/* Edge pi-qi of a against edge pj-qj of b, all in a's frame (eq. 16-17): closest points
+/* An edge from p to q and the outward normals n1, n2 of its two faces (its normal cone). */
+typedef struct edge_seg {
+    v3 p, q, n1, n2;
+} edge_seg;
+
+/* An edge pair's contact: the closest points' parameters s, t, the oriented normal n, the signed
+ * distance d and the share of the pair's force. */
+typedef struct edge_hit {
+    double s, t, d, share;
+    v3 n;
+} edge_hit;
+
+/* Edge ei = pi-qi of a against edge ej = pj-qj of b, all in a's frame (eq. 16-17): closest points
  * pi + s u and pj + t w, separation k3 along the unit common normal. n is oriented out of a (in
  * the cone of a's edge) and must point into b (its reverse in the cone of b's edge). Returns 1 with
  * the parameters, the oriented normal (for nearly parallel edges on faces lying on each other
@@ -160,11 +172,11 @@ static double flat_faces(double sigma, v3 n1i, v3 n2i, v3 n1j, v3 n2j, v3 *nf)
  * force (WS_EDGE_PARALLEL_SIN: 1 but for nearly parallel edges on faces lying on each other); 0
  * for parallel edges (the system is singular: point-face contacts carry that case), flat pairs
  * whose share is 0, or when the closest points are not interior to both edges or the cones
- * disagree. */
-static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j, double *s_out,
-                     double *t_out, v3 *n_out, double *d_out, double *w_out)
+ * disagree. The contact goes into hit. */
+static int edge_edge(const edge_seg *ei, const edge_seg *ej, edge_hit *hit)
 {
-    v3 u = v3_sub(qi, pi), w = v3_sub(qj, pj);
+    const v3 pi = ei->p, pj = ej->p, n1i = ei->n1, n2i = ei->n2, n1j = ej->n1, n2j = ej->n2;
+    v3 u = v3_sub(ei->q, pi), w = v3_sub(ej->q, pj);
     v3 n = v3_cross(u, w);
     double uu = v3_dot(u, u), ww = v3_dot(w, w), uw = v3_dot(u, w), nn = v3_dot(n, n);
     if (nn < 1e-8 * uu * ww)
@@ -204,11 +216,7 @@ static int edge_edge(v3 pi, v3 qi, v3 n1i, v3 n2i, v3 pj, v3 qj, v3 n1j, v3 n2j,
             return 0;
         d = v3_dot(r, n);
     }
-    *s_out = s;
-    *t_out = t;
-    *n_out = n;
-    *d_out = d;
-    *w_out = wt;
+    *hit = (edge_hit){.s = s, .t = t, .d = d, .share = wt, .n = n};
     return 1;
 }
 
@@ -410,11 +418,13 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
     v3 pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
     v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
-    double s, u, d, wt;
-    v3 n;
-    if (!edge_edge(pi, qi, F->n1, F->n2, pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), &s, &u,
-                   &n, &d, &wt))
+    const edge_seg ei = {pi, qi, F->n1, F->n2};
+    const edge_seg ej = {pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2)};
+    edge_hit h;
+    if (!edge_edge(&ei, &ej, &h))
         return 0;
+    const double s = h.s, u = h.t, d = h.d;
+    const v3 n = h.n;
     if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
         return 0;
     /* A closest point within WS_EDGE_END_REACH of an edge's end is the end's (a corner's) when
@@ -436,7 +446,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     *xg = v3_add(st->r[ia], m3_mul_v(Aa, mid));
     *ng = m3_mul_v(Aa, n);
     *dist = d;
-    *share = wt;
+    *share = h.share;
     return 1;
 }
 
