@@ -452,7 +452,8 @@ typedef struct ws_node_touch_at {
 } ws_node_touch_at;
 
 /* Whether candidate c holds the node at x, by the full tests of the one-by-one path (no short
- * cuts: eq. 14 for a face with the shallowest-face rule below it, the rim for an edge), with
+ * cuts: eq. 14 for a face, below it the push past a convex body's edge or the shallowest face
+ * of another body, the rim for an edge), with
  * the bodies of P (b, state cur, features g) and the window's top raised by `reach` (0: the
  * contact window itself): then where, in *at. For the implicit film, which evaluates each
  * node's contacts once a step, and those it may reach within it (contact/node_jacobian.c). */

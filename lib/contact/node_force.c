@@ -358,14 +358,12 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
 }
 
 /* How far past a convex body's edge the push turns from one face's normal to the other's, for
- * the implicit film (the explicit film keeps the shallowest face alone: with this law its
- * wrapped loads' corner nodes settle otherwise, and a wrapped EUR load kept a drift of 0.101
- * mm/s against the 0.1 its test allows; bench/NOTES.md, session 18, issue 17). A
- * node below face f of a convex body at depth d < 0, e the largest signed distance to the
- * body's other planes (the shallowest other depth, of face g), t = d - e, m = max(d, e): its
- * push comes from one contact, f's where t > 0 (the lower face's index of f, g on a tie), with
- * the overlap hi - m (m is the node's signed distance to the body's surface: the shallowest
- * face's depth) along the unit normal
+ * both films (the one-by-one pass and the implicit film's ws_node_touch alike; bench/NOTES.md,
+ * sessions 18 and 19, issue 17). A node below face f of a convex body at depth d < 0, e the
+ * largest signed distance to the body's other planes (the shallowest other depth, of face g),
+ * t = d - e, m = max(d, e): its push comes from one contact, f's where t > 0 (the lower face's
+ * index of f, g on a tie), with the overlap hi - m (m is the node's signed distance to the
+ * body's surface: the shallowest face's depth) along the unit normal
  *
  *     n = (s n_f + (1 - s) n_g) / |s n_f + (1 - s) n_g|,   s = min(1, 1/2 + t / (2 W)),
  *     W = min(NODE_BLEND_WIDTH, -m);
@@ -409,13 +407,12 @@ typedef struct blend_grad {
 } blend_grad;
 
 /* The push of face candidate c of a convex shape sh on a node at xi below it at depth d < 0
- * (NODE_BLEND_WIDTH's law; without `blend`, the shallowest face alone), the window's top hi
- * (the two layers): whether it pushes, and then its normal and the distance it pushes over (hi
- * less the overlap) and, with gr, their gradients in xi. The prepared faces (global). Out of
- * line as shallowest. */
+ * (NODE_BLEND_WIDTH's law), the window's top hi (the two layers): whether it pushes, and then
+ * its normal and the distance it pushes over (hi less the overlap) and, with gr, their
+ * gradients in xi. The prepared faces (global). Out of line as shallowest. */
 NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, const ws_ncand *c,
-                                        v3 xi, double d, double hi, int blend, v3 *nrm,
-                                        double *dist, blend_grad *gr)
+                                        v3 xi, double d, double hi, v3 *nrm, double *dist,
+                                        blend_grad *gr)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const ws_wface *F = E->g->face + (c->feat - f);
@@ -429,7 +426,7 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         }
     }
     const double t = d - e, m = e > d ? e : d, W = fmin(NODE_BLEND_WIDTH, -m);
-    if (!blend || !(W > 0.0) || !(t < W)) {
+    if (!(W > 0.0) || !(t < W)) {
         /* The shallowest face alone, as far from an edge. */
         if (e > d)
             return 0;
@@ -467,11 +464,10 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
  * or the rim of an edge (in_wedge, sure as there); the normal from the body to the node, the
  * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, their
  * gradients (a face's or rim's own: see ws_node_links). The one-by-one pass's and the implicit
- * film's test alike (inlined: NODE_INLINE), but for `blend`: the implicit film's alone (1),
- * the explicit film keeping the shallowest face (0; see NODE_BLEND_WIDTH). */
+ * film's test alike (inlined: NODE_INLINE). */
 static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
-                                       double top, double hi, int sure, int blend, v3 *nrm,
-                                       double *dist, blend_grad *gr)
+                                       double top, double hi, int sure, v3 *nrm, double *dist,
+                                       blend_grad *gr)
 {
     const ws_node_geom *g = E->g;
     if (c->local & WS_NCAND_EDGE)
@@ -487,7 +483,7 @@ static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 
     if (d < 0.0) {
         const ws_shape *sh = E->b->shape[c->body];
         if (sh->convex)
-            return convex_push(E, sh, c, xi, d, hi, blend, nrm, dist, gr);
+            return convex_push(E, sh, c, xi, d, hi, nrm, dist, gr);
         if (!shallowest(E, sh, c->body, c, xi.x, xi.y, xi.z, d))
             return 0;
     }
@@ -574,7 +570,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
             const ws_ncand *c = c0 + ws_lowest_bit(left);
             v3 nrm;
             double d;
-            if (touch_of(E, c, xi, lo, hi, hi, sure, 0, &nrm, &d, NULL))
+            if (touch_of(E, c, xi, lo, hi, hi, sure, &nrm, &d, NULL))
                 act_push(E->L, i, bi, nrm, d, hi, xi);
         }
     }
@@ -1194,7 +1190,7 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
     const ws_shape *sh = b->shape[c->body];
     at->hi = b->layer[c->body] + web->layer;
     blend_grad gr = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
-    if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, 1, &at->n, &at->d,
+    if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, &at->n, &at->d,
                   &gr))
         return 0;
     /* A face's or rim's distance changes along its normal; a blended push's as convex_push
