@@ -124,6 +124,16 @@
  * arm of 5e-5 m, 2e-4 of a 0.25 m face). */
 #define WS_EDGE_END_REACH 5e-5
 
+/* How near (m) a contact that starts in a step must lie to one between the same two bodies that
+ * ended in it to take over its stick anchor (ws_contact_handover). A corner's load passes
+ * between its point-face contact and the edge pair crossing the rim near it in one step
+ * (WS_EDGE_END_REACH): the pair's closest point then lies within WS_EDGE_END_REACH of the
+ * corner along its edge, and both contacts' points lie mid-way across the layers' gap, at
+ * heights that differ by the edge's tilt times that reach (a nm or less). Twice the reach holds
+ * that with room for a step's motion, and is small beside a box's face (4e-4 of 0.25 m) and
+ * the distances between its supports: two contacts this near are one support. */
+#define WS_ANCHOR_REACH (2.0 * WS_EDGE_END_REACH)
+
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
@@ -134,12 +144,16 @@ static inline int ws_bary_inside(double b1, double b2, double g00, double g01, d
 
 /* A candidate feature pair, kept between full detections. Point-face: a owns face fa, b owns
  * point fb. Edge-edge: a owns edge fa, b owns edge fb. The anchors (body frames) belong to the
- * stick friction model. */
+ * stick friction model. ended and fresh are scratch of one step's evaluation (world_step.c
+ * body_contacts), not state (neither saved nor hashed): ended is 1 for a contact anchored at
+ * the step's start and out of contact now (2 once its anchor is taken over), fresh 1 + the
+ * index of the record of a contact that started in the step with a new anchor, else 0. */
 typedef struct ws_cand {
     uint32_t a, b, fa, fb;
     uint32_t kind;
     uint32_t anchored;
     v3 anchor_a, anchor_b;
+    uint32_t ended, fresh;
 } ws_cand;
 
 /* An active contact of the last step. Normal from a to b; forces those on b. */
@@ -213,6 +227,24 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
 /* Evaluate one candidate at the committed state: 1 when in contact, with the record filled, the
  * forces added to both bodies' accumulators and the stick anchors of *c updated. */
 int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
+
+/* Where a candidate's features lie nearest each other at the committed state, whether or not
+ * they touch or its tests pass: the point mid-way between them (global; a point-face pair's
+ * point moved half its height over the face's plane towards it, an edge pair's segments'
+ * closest points), the unit normal's line (global; for an edge pair as ws_contact_geometry
+ * has it, but of either sign) and its share of the pair's laws. 0 when it has none (parallel
+ * edges, or a flat pair faded out). */
+int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *share);
+
+/* The stick anchors' hand-over, after every candidate of the step's sorted list c[0..n) was
+ * evaluated (records rec) and its scratch marks set: each contact that started in the step
+ * (fresh, in the list's order) takes over the anchor of the nearest contact between the same
+ * two bodies, in either order, that ended in the step within WS_ANCHOR_REACH of its point
+ * (the first of equals), each ended one given once. The deflection the ended anchors have
+ * now, along the ended contact's tangent plane and scaled by its share of the laws over the
+ * new one's, is projected on the new contact's tangent plane; the new contact's friction is
+ * evaluated again from it, its record and the bodies' loads updated. */
+void ws_contact_handover(ws_contact_ctx *x, ws_cand *c, size_t n, ws_contact_rec *rec);
 
 /* Sort candidates by key and carry stick anchors over from the previous list (also sorted). */
 void ws_contact_sort(ws_cand *c, size_t n);

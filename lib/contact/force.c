@@ -16,6 +16,47 @@ static void apply(ws_body_store *b, int cur, uint32_t i, v3 xg, v3 F)
     b->m[i] = v3_add(b->m[i], v3_cross(v3_sub(xg, b->st[cur].r[i]), F));
 }
 
+/* The stick law's friction of a contact at xg (normal n, tangential slip vt, normal force fn)
+ * from the anchors of *c, for its share of the pair's laws: the force on b into *ft, the
+ * spring's deflection after the update into *dt (anchor a slides with the slip when the force
+ * is capped), and whether it was capped and is sliding. */
+static void stick_friction(const ws_contact_ctx *x, ws_cand *c, const ws_pair_params *pp, v3 xg,
+                           v3 n, v3 vt, double fn, double share, v3 *ft_out, v3 *dt_out,
+                           int *at_cap, int *slipping)
+{
+    const ws_body_store *b = x->b;
+    const ws_body_state *st = &b->st[x->cur];
+    const uint32_t ia = c->a, ib = c->b;
+    const double kt = share * pp->kt;
+    if (!c->anchored) {
+        c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xg, st->r[ia]));
+        c->anchor_b = m3_tmul_v(&b->A[ib], v3_sub(xg, st->r[ib]));
+        c->anchored = 1;
+    }
+    v3 xa = v3_add(st->r[ia], m3_mul_v(&b->A[ia], c->anchor_a));
+    v3 xb = v3_add(st->r[ib], m3_mul_v(&b->A[ib], c->anchor_b));
+    v3 dd = v3_sub(xb, xa);
+    v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
+    double m_eff = 1.0 / (b->inv_mass[ia] + b->inv_mass[ib]);
+    v3 ft = v3_add(v3_scale(dt, -kt), v3_scale(vt, -share * ws_stick_damping(pp, m_eff)));
+    double cap = pp->mu * fn, fts = v3_norm(ft);
+    *at_cap = *slipping = 0;
+    if (fts > cap) {
+        ft = fts > 0.0 ? v3_scale(ft, cap / fts) : ft;
+        /* The anchor slides so the spring alone carries the capped force. */
+        v3 dt_new = v3_scale(ft, -1.0 / kt);
+        v3 xa_new = v3_sub(xb, dt_new);
+        c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
+        *at_cap = 1;
+        /* Sliding, not a step held at the cap: the anchor moves with the slip, at v_lim or
+         * faster (the regularised law's threshold). */
+        *slipping = v3_norm(vt) >= pp->vlim;
+        dt = dt_new;
+    }
+    *ft_out = ft;
+    *dt_out = dt;
+}
+
 int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
 {
     v3 xg, n;
@@ -47,33 +88,8 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
         slipping = at_cap = !(fr.s < 1.0);
         c->anchored = 0;
     } else {
-        const ws_body_state *st = &b->st[x->cur];
-        if (!c->anchored) {
-            c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xg, st->r[ia]));
-            c->anchor_b = m3_tmul_v(&b->A[ib], v3_sub(xg, st->r[ib]));
-            c->anchored = 1;
-        }
-        v3 xa = v3_add(st->r[ia], m3_mul_v(&b->A[ia], c->anchor_a));
-        v3 xb = v3_add(st->r[ib], m3_mul_v(&b->A[ib], c->anchor_b));
-        v3 dd = v3_sub(xb, xa);
-        v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
-        double m_eff = 1.0 / (b->inv_mass[ia] + b->inv_mass[ib]);
-        ft = v3_add(v3_scale(dt, -kt), v3_scale(vt, -share * ws_stick_damping(pp, m_eff)));
-        double cap = pp->mu * fn, fts = v3_norm(ft);
-        if (fts > cap) {
-            ft = fts > 0.0 ? v3_scale(ft, cap / fts) : ft;
-            /* The anchor slides so the spring alone carries the capped force. */
-            v3 dt_new = v3_scale(ft, -1.0 / kt);
-            v3 xa_new = v3_sub(xb, dt_new);
-            c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(xa_new, st->r[ia]));
-            at_cap = 1;
-            /* Sliding, not a step held at the cap: the anchor moves with the slip, at v_lim or
-             * faster (the regularised law's threshold). */
-            slipping = v3_norm(vt) >= pp->vlim;
-            dt = dt_new;
-        }
-        defl = dt;
-        energy_t = 0.5 * kt * v3_norm2(dt);
+        stick_friction(x, c, pp, xg, n, vt, fn, share, &ft, &defl, &at_cap, &slipping);
+        energy_t = 0.5 * kt * v3_norm2(defl);
     }
     v3 F = v3_add(v3_scale(n, fn), ft);
     apply(b, x->cur, ib, xg, F);
@@ -95,3 +111,89 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     return 1;
 }
 
+/* The first candidate of c[0..n) (sorted by ws_contact_sort) between a and b in that order. */
+static size_t pair_start(const ws_cand *c, size_t n, uint32_t a, uint32_t b)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c[mid].a < a || (c[mid].a == a && c[mid].b < b))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The contact of c[k] (fresh this step, its record rec) takes over the stick anchor of ended
+ * contact e: the deflection e's anchors have now, its part along e's normal (ne) taken out,
+ * scaled from e's share of the laws (se) to c's, with the sign of c's body order, and projected
+ * on c's tangent plane; then c's friction again from that anchor, the difference from the
+ * fresh anchor's applied to both bodies. */
+static void inherit(ws_contact_ctx *x, ws_cand *c, const ws_cand *e, v3 ne, double se,
+                    ws_contact_rec *rec)
+{
+    ws_body_store *b = x->b;
+    const ws_body_state *st = &b->st[x->cur];
+    v3 xg, n;
+    double d, share;
+    if (!ws_contact_geometry(x, c, &xg, &n, &d, &share))
+        return; /* it evaluated in contact at this state: not reached */
+    const uint32_t ia = c->a, ib = c->b;
+    v3 xa = v3_add(st->r[e->a], m3_mul_v(&b->A[e->a], e->anchor_a));
+    v3 xb = v3_add(st->r[e->b], m3_mul_v(&b->A[e->b], e->anchor_b));
+    v3 dd = v3_sub(xb, xa);
+    dd = v3_madd(dd, ne, -v3_dot(dd, ne));
+    dd = v3_scale(dd, (e->a == ia ? se : -se) / share);
+    v3 dt = v3_madd(dd, n, -v3_dot(dd, n));
+    /* Anchors at the contact point on b and the deflection back from it on a. */
+    c->anchor_b = m3_tmul_v(&b->A[ib], v3_sub(xg, st->r[ib]));
+    c->anchor_a = m3_tmul_v(&b->A[ia], v3_sub(v3_sub(xg, dt), st->r[ia]));
+    c->anchored = 1;
+    const ws_pair_params *pp = ws_contact_params(x, ia, ib);
+    v3 ft, defl;
+    int at_cap, slipping;
+    stick_friction(x, c, pp, xg, n, rec->vt, rec->fn, share, &ft, &defl, &at_cap, &slipping);
+    const v3 dF = v3_sub(ft, rec->ft);
+    apply(b, x->cur, ib, xg, dF);
+    apply(b, x->cur, ia, xg, v3_neg(dF));
+    rec->ft = ft;
+    rec->defl = defl;
+    rec->at_cap = (uint32_t)at_cap;
+    rec->slipping = (uint32_t)slipping;
+    rec->energy_t = 0.5 * share * pp->kt * v3_norm2(defl);
+}
+
+void ws_contact_handover(ws_contact_ctx *x, ws_cand *c, size_t n, ws_contact_rec *rec)
+{
+    for (size_t k = 0; k < n; k++) {
+        if (!c[k].fresh)
+            continue;
+        ws_contact_rec *r = &rec[c[k].fresh - 1];
+        /* The ended contacts between the same two bodies, in either order: two runs of the
+         * sorted list. The nearest within reach, the first of equals. */
+        size_t best = n;
+        double best_d = WS_ANCHOR_REACH, best_share = 0.0;
+        v3 best_n = v3_make(0, 0, 0);
+        for (int o = 0; o < 2; o++) {
+            const uint32_t a = o ? c[k].b : c[k].a, bb = o ? c[k].a : c[k].b;
+            for (size_t e = pair_start(c, n, a, bb); e < n && c[e].a == a && c[e].b == bb; e++) {
+                v3 xe, ne;
+                double se;
+                if (c[e].ended != 1 || !ws_contact_place(x, &c[e], &xe, &ne, &se))
+                    continue;
+                const double de = v3_norm(v3_sub(xe, r->x));
+                if (de <= best_d && (best == n || de < best_d || e < best)) {
+                    best = e;
+                    best_d = de;
+                    best_n = ne;
+                    best_share = se;
+                }
+            }
+        }
+        if (best == n)
+            continue;
+        c[best].ended = 2; /* given: one inheritor per ended contact */
+        inherit(x, &c[k], &c[best], best_n, best_share, r);
+    }
+}

@@ -269,6 +269,7 @@ static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a,
     c->kind = kind;
     c->anchored = 0;
     c->anchor_a = c->anchor_b = v3_make(0, 0, 0);
+    c->ended = c->fresh = 0;
     return 0;
 }
 
@@ -447,6 +448,60 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
     *ng = m3_mul_v(Aa, n);
     *dist = d;
     *share = h.share;
+    return 1;
+}
+
+int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *share)
+{
+    const ws_body_store *b = x->b;
+    const ws_body_state *st = &b->st[x->cur];
+    const uint32_t ia = c->a, ib = c->b;
+    const ws_shape *sa = b->shape[ia], *sb = b->shape[ib];
+    const m3 *Aa = &b->A[ia];
+    if (c->kind == WS_CONTACT_POINT_FACE) {
+        v3 pg = v3_add(st->r[ib], m3_mul_v(&b->A[ib], sb->vertices[c->fb]));
+        v3 s = m3_tmul_v(Aa, v3_sub(pg, st->r[ia]));
+        const ws_face *fc = &sa->faces[c->fa];
+        *ng = m3_mul_v(Aa, fc->normal);
+        *xg = v3_madd(pg, *ng, -0.5 * (v3_dot(fc->normal, s) - fc->offset));
+        *share = 1.0;
+        return 1;
+    }
+    const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
+    m3 R;
+    v3 t;
+    relative(b, x->cur, ia, ib, &R, &t);
+    const v3 pi = sa->vertices[F->a], pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
+    const v3 u = v3_sub(sa->vertices[F->b], pi),
+             w = v3_sub(v3_add(m3_mul_v(&R, sb->vertices[E->b]), t), pj);
+    v3 n = v3_cross(u, w);
+    const double uu = v3_dot(u, u), ww = v3_dot(w, w), uw = v3_dot(u, w), nn = v3_dot(n, n);
+    if (nn < 1e-8 * uu * ww)
+        return 0;
+    /* The segments' closest points: the lines', clamped to the segments. */
+    const v3 r = v3_sub(pi, pj);
+    const double ru = v3_dot(r, u), rw = v3_dot(r, w);
+    double s = fmin(1.0, fmax(0.0, (uw * rw - ru * ww) / nn));
+    double tt = (uw * s + rw) / ww;
+    if (tt < 0.0 || tt > 1.0) {
+        tt = fmin(1.0, fmax(0.0, tt));
+        s = fmin(1.0, fmax(0.0, (uw * tt - ru) / uu));
+    }
+    /* The pair's normal and share as edge_edge has them (the flat faces' blend and fade). */
+    n = v3_scale(n, 1.0 / sqrt(nn));
+    v3 nf = n;
+    const double sigma = sqrt(nn / (uu * ww));
+    const double f = flat_faces(sigma, F->n1, F->n2, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2), &nf);
+    const double wt = 1.0 - f * (1.0 - ramp(sigma, WS_EDGE_PARALLEL_SIN));
+    if (!(wt > 0.0))
+        return 0;
+    const double g = f * (1.0 - ramp(sigma, WS_EDGE_FLAT_SIN));
+    if (g > 0.0)
+        n = unit(v3_add(v3_scale(v3_dot(n, nf) < 0.0 ? v3_neg(n) : n, 1.0 - g), v3_scale(nf, g)));
+    const v3 mid = v3_scale(v3_add(v3_madd(pi, u, s), v3_madd(pj, w, tt)), 0.5);
+    *xg = v3_add(st->r[ia], m3_mul_v(Aa, mid));
+    *ng = m3_mul_v(Aa, n);
+    *share = wt;
     return 1;
 }
 

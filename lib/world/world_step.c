@@ -1070,10 +1070,28 @@ static void body_contacts(ws_step *S)
     }
     if (S->narrow_bad)
         return;
-    size_t nrec = 0;
-    for (size_t k = 0; k < w->ncand[nxt]; k++)
-        if (ws_contact_eval(&S->contact, &w->cand[nxt][k], &w->rec[nxt][nrec]))
+    /* A contact that starts in the step next to one between the same bodies that ends in it
+     * (a corner's load passing between its point-face contact and an edge pair) takes over
+     * that one's stick anchor, so the friction it carried does not vanish for a step: the
+     * candidates are marked here, in the list's order, and matched after. */
+    size_t nrec = 0, fresh = 0, ended = 0;
+    for (size_t k = 0; k < w->ncand[nxt]; k++) {
+        ws_cand *c = &w->cand[nxt][k];
+        const uint32_t was = c->anchored;
+        c->ended = c->fresh = 0;
+        if (ws_contact_eval(&S->contact, c, &w->rec[nxt][nrec])) {
+            if (!was && c->anchored) {
+                c->fresh = (uint32_t)nrec + 1;
+                fresh++;
+            }
             nrec++;
+        } else if (was) {
+            c->ended = 1;
+            ended++;
+        }
+    }
+    if (fresh && ended)
+        ws_contact_handover(&S->contact, w->cand[nxt], w->ncand[nxt], w->rec[nxt]);
     S->nrec = nrec;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
