@@ -124,6 +124,8 @@ typedef struct tilt_result {
     uint64_t hash;
     uint32_t film_nodes;                  /* wrapped: nodes of the film */
     ws_web_solver_stats solver;           /* wrapped, implicit film: its solves */
+    double friction_use;                  /* dt over the regularised friction's explicit limit,
+                                             the run's largest (ws_world_stats) */
 } tilt_result;
 
 static void tilt_default_options(tilt_options *o)
@@ -769,6 +771,9 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         fprintf(stderr, "\r  t = %.2f s of %.2f s: done\n", res->end_time, sc.duration);
     res->cog_distance_end = distance(w, sc.box[0], sc.box[1]);
     ws_world_get_state_hash(w, &res->hash);
+    ws_world_stats stats;
+    if (ws_world_get_stats(w, &stats) == WS_OK)
+        res->friction_use = stats.friction_step_use;
     if (sc.film.bits) {
         res->film_nodes = (uint32_t)nodes;
         ws_web_get_solver_stats(w, sc.film, &res->solver);
@@ -981,6 +986,11 @@ int main(int argc, char **argv)
         printf("  plane angle at the end %.2f deg (t = %.3f s); %ld steps in %.3f s "
                "(%.0f steps/s)\n",
                r.final_angle, r.end_time, r.steps, r.wall_seconds, r.steps / r.wall_seconds);
+        if (r.friction_use > 1.0)
+            printf("  note: dt is %.2f times the regularised friction's explicit limit between "
+                   "the bodies: their contacts slip back and forth every step and the load creeps "
+                   "too fast (docs/theory.md 8); use --stick, or a smaller dt\n",
+                   r.friction_use);
         if (o.csv)
             printf("  time series: %s\n", o.csv);
         if (o.vtk_dir)

@@ -1420,6 +1420,83 @@ START_TEST(test_stack_modes_bound_the_step)
 }
 END_TEST
 
+/* The log hook's warnings, counted, the last one kept. */
+typedef struct warnings {
+    int count;
+    char last[512];
+} warnings;
+
+static void count_warnings(void *user, ws_log_level level, const char *message)
+{
+    warnings *wn = user;
+    if (level != WS_LOG_WARNING)
+        return;
+    wn->count++;
+    snprintf(wn->last, sizeof wn->last, "%s", message);
+}
+
+/* A cube resting on a kinematic plane for `seconds`, friction by `model`; its stats after. */
+static ws_world_stats resting_cube(double dt, double seconds, ws_friction_model model,
+                                   warnings *wn)
+{
+    const double a = 0.25, m = 5.0, k = 2e5;
+    ws_world_def d;
+    ws_world_def_init(&d);
+    d.dt = dt;
+    d.log = count_warnings;
+    d.log_user = wn;
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_contact_def cd = contact_params(k, 100.0, 0.3, model);
+    ck_ok(w, ws_world_set_default_contact(w, &cd));
+    make_box(w, WS_BODY_KINEMATIC, 2.0, 2.0, 0.05, 0, v3(0, 0, -0.025), Q_ID, v3(0, 0, 0),
+             "plane");
+    make_box(w, WS_BODY_DYNAMIC, a, a, a, m, v3(0, 0, a / 2 + 2 * DELTA - m * G0 / (4 * k)),
+             Q_ID, v3(0, 0, 0), "cube");
+    for (long i = 0; i < lround(seconds / dt); i++)
+        ck_ok(w, ws_world_step(w));
+    ws_world_stats st;
+    ck_ok(w, ws_world_get_stats(w, &st));
+    ws_world_destroy(w);
+    return st;
+}
+
+START_TEST(test_friction_limit_measured)
+{
+    /* Below v_lim the regularised law (eq. 13) is a damper of slope 2 mu F_n / v_lim on each
+     * contact, which the bodies' step takes explicitly: stable while dt lambda <= 2, lambda the
+     * highest rate of M^-1 C. A cube of side a resting on a plane on its 4 corners (F_n = m g /
+     * 4 each, c = mu m g / (2 v_lim)) has it in its yaw: the corners at a / sqrt(2) from the
+     * axis, lambda = 4 c (a^2 / 2) / (m a^2 / 6) = 6 mu g / v_lim = 1765.8 1/s (the sway with
+     * rocking, 4 c (1 + 6 r_z^2 / a^2) / m, is 10.1 c / m against yaw's 12 c / m). The stats
+     * report dt lambda / 2. Tolerance 1e-3: the corners' normal forces at rest are m g / 4 to
+     * 1e-6 (the cube starts at its resting overlap) and the power iteration's 40 steps leave
+     * (10.1 / 12)^80 ~ 1e-6. The stats hold what 16 measures 64 steps apart all pass, so each
+     * run is longer than 1024 steps. Past the limit (1.5 ms: 1.32) the log hook hears it once; below
+     * (0.25 ms) not at all; the stick law has no such damper (0; at 1 ms, below its anchors'
+     * own per-pair bound of 1.12 ms). */
+    const double lambda = 6.0 * 0.3 * G0 / 0.01;
+    warnings wn = {0, ""};
+    ws_world_stats st = resting_cube(2.5e-4, 0.3, WS_FRICTION_REGULARIZED, &wn);
+    report("resting cube: friction_step_use %.6f at 0.25 ms (theory %.6f)", st.friction_step_use,
+           2.5e-4 * lambda / 2);
+    ck_assert_msg(fabs(st.friction_step_use / (2.5e-4 * lambda / 2) - 1.0) < 1e-3,
+                  "friction_step_use %g, theory %g", st.friction_step_use, 2.5e-4 * lambda / 2);
+    ck_assert_int_eq(wn.count, 0);
+    st = resting_cube(1.5e-3, 1.6, WS_FRICTION_REGULARIZED, &wn);
+    report("resting cube at 1.5 ms: friction_step_use %.4f (theory %.4f); warning: %s",
+           st.friction_step_use, 1.5e-3 * lambda / 2, wn.last);
+    ck_assert_msg(fabs(st.friction_step_use / (1.5e-3 * lambda / 2) - 1.0) < 1e-3,
+                  "friction_step_use %g at 1.5 ms", st.friction_step_use);
+    ck_assert_int_eq(wn.count, 1);
+    ck_assert_msg(strstr(wn.last, "friction") && strstr(wn.last, "dt <="), "%s", wn.last);
+    wn.count = 0;
+    st = resting_cube(1.0e-3, 1.2, WS_FRICTION_STICK, &wn);
+    ck_assert(st.friction_step_use == 0.0);
+    ck_assert_int_eq(wn.count, 0);
+}
+END_TEST
+
 /* ======================================================================================== */
 /* Contact geometry: interface stiffness, reports by pair, the layers in the reference stack  */
 /* ======================================================================================== */
@@ -1928,6 +2005,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_yawed_stack_contacts_settle);
     tcase_add_test(tc, test_nearly_aligned_stack_no_kicks);
     tcase_add_test(tc, test_stack_modes_bound_the_step);
+    tcase_add_test(tc, test_friction_limit_measured);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -262,6 +262,7 @@ void ws_world_destroy(ws_world *w)
         ws_mem_free(m, w->cand[k], w->capcand[k] * sizeof *w->cand[k]);
         ws_mem_free(m, w->rec[k], w->caprec[k] * sizeof *w->rec[k]);
     }
+    ws_mem_free(m, w->friction_scratch, w->friction_cap * sizeof *w->friction_scratch);
     ws_arena_free(&w->arena);
     ws_mem local = *m;
     ws_mem_free(&local, w, sizeof *w);

@@ -75,6 +75,12 @@ typedef struct ws_contact_limit {
  * power iterations over a 33-body load cost more than the step itself. */
 #define WS_CONTACT_CHECK_EVERY 64
 
+/* The regularised friction's explicit limit counts where it holds this many measures in a row
+ * (WS_CONTACT_CHECK_EVERY steps apart: 0.26 s at dt 0.25 ms): a stack dropped onto a plane
+ * passes it for single measures as it bounces, with no harm; the clamped wrapped stacks of
+ * the reference cases stay past it (docs/theory.md, section 8). */
+#define WS_FRICTION_HELD 16
+
 /* The contacts' measured stable step (world_step.c, contacts_ready) and when it was taken. */
 typedef struct ws_contact_check {
     int valid;
@@ -97,6 +103,16 @@ struct ws_world {
     uint64_t last_full_step;
     int cand_valid; /* 0 forces a full detection on the next step */
     ws_contact_check contact_check; /* not state: measured again after a restore */
+    /* The regularised friction's explicit limit (world_step.c, friction_check): when it was
+     * last measured (steps + 1; 0 never), the last WS_FRICTION_HELD measures (a ring, `nuse`
+     * of them taken), and whether the log hook has heard it is passed. */
+    uint64_t friction_step;
+    v3 *friction_scratch; /* its power iteration's vectors, 4 (slots + 1); kept, so that a
+                             steady run's measures take nothing from the allocator */
+    size_t friction_cap;
+    double friction_uses[WS_FRICTION_HELD];
+    uint64_t nuse;
+    int friction_warned;
     double travel;  /* bound on how far any body point moved since the last full detection, m */
     int cur;        /* committed buffer: bodies, candidates, contact records */
     int in_step;    /* 1 while ws_world_step runs: its callbacks may only read */

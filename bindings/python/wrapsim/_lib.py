@@ -181,7 +181,8 @@ class WorldStats(Structure):
         ("seconds_total", c_double),
         ("web_step_use", c_double),
         ("body_step_use", c_double),
-        ("reserved", c_uint64 * 2),
+        ("friction_step_use", c_double),
+        ("reserved", c_uint64 * 1),
     ]
 
 
