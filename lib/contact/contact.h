@@ -162,15 +162,16 @@ static inline int ws_bary_inside(double b1, double b2, double g00, double g01, d
  * stick friction model. ended and fresh are scratch of one step's evaluation (world_step.c
  * body_contacts), not state (neither saved nor hashed): ended is 1 for a contact anchored at
  * the step's start and out of contact now (2 once its anchor is taken over), fresh 1 + the
- * index of the record of a contact that started in the step with a new anchor, else 0; share
- * the contact's share of its laws as a twin corner (ws_contact_twins). */
+ * index of the record of a contact that started in the step with a new anchor, else 0;
+ * twin_cut what a twin corner gives up of its laws (ws_contact_twins; 0, as a zeroed record
+ * has it, for none). */
 typedef struct ws_cand {
     uint32_t a, b, fa, fb;
     uint32_t kind;
     uint32_t anchored;
     v3 anchor_a, anchor_b;
     uint32_t ended, fresh;
-    double share; /* scratch: the twin share of a point-face contact (ws_contact_twins), else 1 */
+    double twin_cut; /* scratch: 1 less a point-face contact's twin share (ws_contact_twins) */
 } ws_cand;
 
 /* An active contact of the last step. Normal from a to b; forces those on b. */
@@ -254,12 +255,13 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
 int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *share);
 
 /* The twin corners' shares (WS_TWIN_REACH) of the step's sorted candidates c[0..n) at the
- * committed state, into each one's share (1 for edge pairs and corners without a twin): for
+ * committed state, as each one's twin_cut (0 for edge pairs and corners without a twin): for
  * each two bodies, a point-face contact of one's vertex on the other's face and one the other
  * way are twins when each is the other's nearest in the faces' plane among those whose faces
- * lie on each other (the first of equals). Both in contact, each gets 1 - tau m_other / (m_A +
- * m_B), tau the pairing's fade; one out of contact leaves the other 1 (its own share, as placed
- * for the hand-over, is the same formula). To run before the candidates are evaluated. */
+ * lie on each other (the first of equals). Both in contact, each gives up tau m_other / (m_A +
+ * m_B), tau the pairing's fade; one out of contact leaves the other whole (its own cut, as
+ * placed for the hand-over, is the same formula). To run before the candidates are
+ * evaluated. */
 void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n);
 
 /* The first candidate of c[0..n) (sorted by ws_contact_sort) between a and b in that order. */

@@ -164,7 +164,8 @@ void ws_contact_handover(ws_contact_ctx *x, ws_cand *c, size_t n, ws_contact_rec
         v3 best_n = v3_make(0, 0, 0);
         for (int o = 0; o < 2; o++) {
             const uint32_t a = o ? c[k].b : c[k].a, bb = o ? c[k].a : c[k].b;
-            for (size_t e = ws_contact_pair_start(c, n, a, bb); e < n && c[e].a == a && c[e].b == bb; e++) {
+            for (size_t e = ws_contact_pair_start(c, n, a, bb);
+                 e < n && c[e].a == a && c[e].b == bb; e++) {
                 v3 xe, ne;
                 double se;
                 if (c[e].ended != 1 || !ws_contact_place(x, &c[e], &xe, &ne, &se))

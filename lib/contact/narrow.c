@@ -270,7 +270,7 @@ static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a,
     c->anchored = 0;
     c->anchor_a = c->anchor_b = v3_make(0, 0, 0);
     c->ended = c->fresh = 0;
-    c->share = 1.0;
+    c->twin_cut = 0.0;
     return 0;
 }
 
@@ -410,7 +410,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
         *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */
         *dist = d;
-        *share = c->share;
+        *share = 1.0 - c->twin_cut;
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
@@ -465,7 +465,7 @@ int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double
         const ws_face *fc = &sa->faces[c->fa];
         *ng = m3_mul_v(Aa, fc->normal);
         *xg = v3_madd(pg, *ng, -0.5 * (v3_dot(fc->normal, s) - fc->offset));
-        *share = c->share;
+        *share = 1.0 - c->twin_cut;
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
@@ -576,17 +576,17 @@ static double pf_margin(const ws_contact_ctx *x, const ws_cand *c, v3 s, int *to
     return fmax(0.0, WS_OUTLINE_TOL - outside_face(sa, c->fa, s));
 }
 
-/* The share of twin i against its twin j (margins mi, mj, fade tau). */
-static double twin_share(double mi, double mj, double tau)
+/* What twin i gives up of its laws to its twin j (margins mi, mj, fade tau). */
+static double twin_cut(double mi, double mj, double tau)
 {
     const double sum = mi + mj;
-    return 1.0 - tau * (sum > 0.0 ? mj / sum : 0.5);
+    return tau * (sum > 0.0 ? mj / sum : 0.5);
 }
 
 void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n)
 {
     for (size_t k = 0; k < n; k++)
-        c[k].share = 1.0;
+        c[k].twin_cut = 0.0;
     /* Each run of point-face candidates between a and b (a < b) against the one between b and
      * a: mutual nearest neighbours in the faces' plane are twins. */
     for (size_t p0 = 0; p0 < n;) {
@@ -623,8 +623,8 @@ void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n)
             int ti, tj;
             const double mi = pf_margin(x, &c[i], si, &ti), mj = pf_margin(x, &c[j], sj, &tj);
             /* A twin out of contact carries nothing: the other carries its corner whole. */
-            c[i].share = tj || !ti ? twin_share(mi, mj, tau) : 1.0;
-            c[j].share = ti || !tj ? twin_share(mj, mi, tau) : 1.0;
+            c[i].twin_cut = tj || !ti ? twin_cut(mi, mj, tau) : 0.0;
+            c[j].twin_cut = ti || !tj ? twin_cut(mj, mi, tau) : 0.0;
         }
     }
 }
