@@ -75,11 +75,12 @@ WS_API ws_status ws_world_copy_contacts_between(const ws_world *world, ws_body_i
 
 /** The normal stiffness of the interface between two bodies as the last step left it: every
  *  active contact point between them is a penalty spring of the pair's stiffness k (N/m) in
- *  parallel, so the interface stiffness is k times the number of points. A box resting on a
- *  larger plane touches it at its 4 corners (4k); two equal boxes stacked face to face touch at
- *  8 points, each corner of either box lying in the other's face (8k): the same pair parameters
- *  give an interface twice as stiff (see docs/theory.md, "Contact geometry").
- *  @param stiffness  N/m, summed over the active points; 0 when they do not touch
+ *  parallel, times its share of the pair's laws, so the interface stiffness is k times the
+ *  number of supports. A box resting on a larger plane touches it at its 4 corners (4k); two
+ *  equal boxes stacked face to face have 8 contacts, each corner of either box lying on the
+ *  other's face, but the two at a corner are twins sharing one spring (4k, as when shifted;
+ *  see docs/theory.md, "Contact geometry").
+ *  @param stiffness  N/m, summed over the active points' shares; 0 when they do not touch
  *  @param points     number of active contact points; may be NULL
  *  @return WS_OK, WS_ERR_STALE_HANDLE (a or b), WS_ERR_INVALID_ARGUMENT (a == b, stiffness
  *          NULL). */

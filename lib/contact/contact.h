@@ -134,6 +134,21 @@
  * the distances between its supports: two contacts this near are one support. */
 #define WS_ANCHOR_REACH (2.0 * WS_EDGE_END_REACH)
 
+/* Twin corners: how near (m, in the faces' plane) a point-face contact of body A's vertex on
+ * B's face and one of B's vertex on A's face must lie to be one vertex of the faces' overlap
+ * polygon, carried once between them (ws_contact_twins). Two equal boxes stacked flush have
+ * each corner of the interface twice, a corner of either box on the other's rim; shifted or
+ * turned so that one of the two lies past the rim by WS_OUTLINE_TOL it drops out, and the
+ * interface's stiffness halved on a half-micron shift. Twins' shares of their laws sum to 1
+ * and follow each one's margin to its drop, m = WS_OUTLINE_TOL - (its distance past the other
+ * face's outline, 0 inside): share_A = 1 - m_B / (m_A + m_B), 1/2 each when aligned, 0 for one
+ * at its drop. Both counted, the two corners lie within sqrt(2) WS_OUTLINE_TOL of each other
+ * (each within the tolerance of the other's rim, on both of its borders); twice the tolerance
+ * holds them, and the pairing fades out linearly from there to twice it (the shares then back
+ * to 1 each: contacts that far apart are two vertices), as it does over the faces' angle by
+ * WS_EDGE_FLAT_FACES (faces that do not lie on each other). */
+#define WS_TWIN_REACH (2.0 * WS_OUTLINE_TOL)
+
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
@@ -147,13 +162,16 @@ static inline int ws_bary_inside(double b1, double b2, double g00, double g01, d
  * stick friction model. ended and fresh are scratch of one step's evaluation (world_step.c
  * body_contacts), not state (neither saved nor hashed): ended is 1 for a contact anchored at
  * the step's start and out of contact now (2 once its anchor is taken over), fresh 1 + the
- * index of the record of a contact that started in the step with a new anchor, else 0. */
+ * index of the record of a contact that started in the step with a new anchor, else 0;
+ * twin_cut what a twin corner gives up of its laws (ws_contact_twins; 0, as a zeroed record
+ * has it, for none). */
 typedef struct ws_cand {
     uint32_t a, b, fa, fb;
     uint32_t kind;
     uint32_t anchored;
     v3 anchor_a, anchor_b;
     uint32_t ended, fresh;
+    double twin_cut; /* scratch: 1 less a point-face contact's twin share (ws_contact_twins) */
 } ws_cand;
 
 /* An active contact of the last step. Normal from a to b; forces those on b. */
@@ -219,8 +237,8 @@ int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d);
 
 /* Geometry of a candidate at the committed state: contact point and normal (global, a to b),
  * the signed distance and the contact's share of its laws' stiffness and damping (in (0, 1]:
- * below 1 for a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN); 1 when the layers
- * overlap. */
+ * below 1 for a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN, and for a twin corner,
+ * the candidate's share as ws_contact_twins set it); 1 when the layers overlap. */
 int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist,
                         double *share);
 
@@ -235,6 +253,30 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
  * has it, but of either sign) and its share of the pair's laws. 0 when it has none (parallel
  * edges, or a flat pair faded out). */
 int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *share);
+
+/* The twin corners' shares (WS_TWIN_REACH) of the step's sorted candidates c[0..n) at the
+ * committed state, as each one's twin_cut (0 for edge pairs and corners without a twin): for
+ * each two bodies, a point-face contact of one's vertex on the other's face and one the other
+ * way are twins when each is the other's nearest in the faces' plane among those whose faces
+ * lie on each other (the first of equals). Both in contact, each gives up tau m_other / (m_A +
+ * m_B), tau the pairing's fade; one out of contact leaves the other whole (its own cut, as
+ * placed for the hand-over, is the same formula). To run before the candidates are
+ * evaluated. */
+void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n);
+
+/* The first candidate of c[0..n) (sorted by ws_contact_sort) between a and b in that order. */
+static inline size_t ws_contact_pair_start(const ws_cand *c, size_t n, uint32_t a, uint32_t b)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (c[mid].a < a || (c[mid].a == a && c[mid].b < b))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
 
 /* The stick anchors' hand-over, after every candidate of the step's sorted list c[0..n) was
  * evaluated (records rec) and its scratch marks set: each contact that started in the step

@@ -71,8 +71,9 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     double overlap = b->layer[ia] + b->layer[ib] - d;
     v3 vrel = v3_sub(point_velocity(b, x->cur, ib, xg), point_velocity(b, x->cur, ia, xg));
     /* Spring on the overlap and damper on its rate; a contact never pulls. A contact with a
-     * share below 1 (a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN) has that share of
-     * every stiffness and damping of its laws, normal and tangential, and so of its force. */
+     * share below 1 (a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN; a twin corner,
+     * WS_TWIN_REACH) has that share of every stiffness and damping of its laws, normal and
+     * tangential, and so of its force. */
     const double k = share * pp->k, kt = share * pp->kt;
     const ws_normal law = ws_normal_law(n, vrel, overlap, k, share * pp->c);
     const double fn = law.fp;
@@ -109,20 +110,6 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
     rec->energy = 0.5 * k * overlap * overlap;
     rec->energy_t = energy_t;
     return 1;
-}
-
-/* The first candidate of c[0..n) (sorted by ws_contact_sort) between a and b in that order. */
-static size_t pair_start(const ws_cand *c, size_t n, uint32_t a, uint32_t b)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (c[mid].a < a || (c[mid].a == a && c[mid].b < b))
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
 }
 
 /* The contact of c[k] (fresh this step, its record rec) takes over the stick anchor of ended
@@ -177,7 +164,8 @@ void ws_contact_handover(ws_contact_ctx *x, ws_cand *c, size_t n, ws_contact_rec
         v3 best_n = v3_make(0, 0, 0);
         for (int o = 0; o < 2; o++) {
             const uint32_t a = o ? c[k].b : c[k].a, bb = o ? c[k].a : c[k].b;
-            for (size_t e = pair_start(c, n, a, bb); e < n && c[e].a == a && c[e].b == bb; e++) {
+            for (size_t e = ws_contact_pair_start(c, n, a, bb);
+                 e < n && c[e].a == a && c[e].b == bb; e++) {
                 v3 xe, ne;
                 double se;
                 if (c[e].ended != 1 || !ws_contact_place(x, &c[e], &xe, &ne, &se))

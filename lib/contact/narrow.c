@@ -270,6 +270,7 @@ static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a,
     c->anchored = 0;
     c->anchor_a = c->anchor_b = v3_make(0, 0, 0);
     c->ended = c->fresh = 0;
+    c->twin_cut = 0.0;
     return 0;
 }
 
@@ -409,7 +410,7 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
         *xg = v3_madd(pg, *ng, -0.5 * d); /* mid-way between the point and the face */
         *dist = d;
-        *share = 1.0;
+        *share = 1.0 - c->twin_cut;
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
@@ -464,7 +465,7 @@ int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double
         const ws_face *fc = &sa->faces[c->fa];
         *ng = m3_mul_v(Aa, fc->normal);
         *xg = v3_madd(pg, *ng, -0.5 * (v3_dot(fc->normal, s) - fc->offset));
-        *share = 1.0;
+        *share = 1.0 - c->twin_cut;
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
@@ -503,6 +504,129 @@ int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double
     *ng = m3_mul_v(Aa, n);
     *share = wt;
     return 1;
+}
+
+/* ---- twin corners (WS_TWIN_REACH) ---- */
+
+/* A point-face candidate's vertex (global), its face's outward normal (global) and the vertex in
+ * the face owner's frame. */
+static void pf_place(const ws_contact_ctx *x, const ws_cand *c, v3 *pg, v3 *ng, v3 *s)
+{
+    const ws_body_store *b = x->b;
+    const ws_body_state *st = &b->st[x->cur];
+    const m3 *Aa = &b->A[c->a];
+    *pg = v3_add(st->r[c->b], m3_mul_v(&b->A[c->b], b->shape[c->b]->vertices[c->fb]));
+    *s = m3_tmul_v(Aa, v3_sub(*pg, st->r[c->a]));
+    *ng = m3_mul_v(Aa, b->shape[c->a]->faces[c->fa].normal);
+}
+
+/* The fade tau in [0, 1] of the pairing of two point-face candidates of opposite body order
+ * (vertices pi, pj, face normals ni, nj, global) and their distance in the faces' plane (that of
+ * the bisector ni - nj, symmetric in i and j): 1 for faces lying on each other (f(psi) of the
+ * edge pairs, WS_EDGE_FLAT_FACES) and vertices within WS_TWIN_REACH, falling linearly to 0 at
+ * twice either. */
+static double twin_fade(v3 pi, v3 ni, v3 pj, v3 nj, double *dt)
+{
+    const double c = -v3_dot(ni, nj);
+    const double psi = 2.0 * asin(sqrt(fmin(1.0, fmax(0.0, 0.5 * (1.0 - c)))));
+    const double f = 1.0 - ramp(psi, WS_EDGE_FLAT_FACES);
+    *dt = INFINITY;
+    if (!(f > 0.0))
+        return 0.0;
+    const v3 nb = unit(v3_sub(ni, nj)), d = v3_sub(pi, pj);
+    *dt = v3_norm(v3_madd(d, nb, -v3_dot(d, nb)));
+    return f * (1.0 - ramp(*dt, WS_TWIN_REACH));
+}
+
+/* The nearest in the faces' plane among c[q0..q1) to candidate i, with a fade above 0: its
+ * index (the first of equals), or q1. */
+static size_t twin_nearest(const ws_contact_ctx *x, const ws_cand *c, size_t i, size_t q0,
+                           size_t q1)
+{
+    v3 pi, ni, si;
+    pf_place(x, &c[i], &pi, &ni, &si);
+    size_t best = q1;
+    double best_d = INFINITY;
+    for (size_t j = q0; j < q1; j++) {
+        v3 pj, nj, sj;
+        pf_place(x, &c[j], &pj, &nj, &sj);
+        double d;
+        if (twin_fade(pi, ni, pj, nj, &d) > 0.0 && d < best_d) {
+            best = j;
+            best_d = d;
+        }
+    }
+    return best;
+}
+
+/* A point-face candidate's margin to its drop across the rim, WS_OUTLINE_TOL less the distance
+ * of its vertex's projection past the face's outline (the tolerance inside the face, 0 from
+ * where ws_point_on_face stops counting it), and whether it is in contact now (the tests of
+ * ws_contact_geometry's point-face branch). */
+static double pf_margin(const ws_contact_ctx *x, const ws_cand *c, v3 s, int *touching)
+{
+    const ws_body_store *b = x->b;
+    const ws_shape *sa = b->shape[c->a];
+    const double reach = b->layer[c->a] + b->layer[c->b];
+    double d;
+    *touching = ws_point_on_face(sa, c->fa, s, -reach - sa->inner, reach, &d) &&
+                (d >= 0.0 || ws_shallowest_face(sa, c->fa, s, d));
+    if (ws_point_in_face(sa, c->fa, s, -INFINITY, INFINITY, &d))
+        return WS_OUTLINE_TOL;
+    return fmax(0.0, WS_OUTLINE_TOL - outside_face(sa, c->fa, s));
+}
+
+/* What twin i gives up of its laws to its twin j (margins mi, mj, fade tau). */
+static double twin_cut(double mi, double mj, double tau)
+{
+    const double sum = mi + mj;
+    return tau * (sum > 0.0 ? mj / sum : 0.5);
+}
+
+void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n)
+{
+    for (size_t k = 0; k < n; k++)
+        c[k].twin_cut = 0.0;
+    /* Each run of point-face candidates between a and b (a < b) against the one between b and
+     * a: mutual nearest neighbours in the faces' plane are twins. */
+    for (size_t p0 = 0; p0 < n;) {
+        size_t p1 = p0;
+        while (p1 < n && c[p1].a == c[p0].a && c[p1].b == c[p0].b)
+            p1++;
+        const uint32_t a = c[p0].a, b = c[p0].b;
+        size_t r0 = p0, r1 = p1;
+        p0 = p1;
+        if (a >= b)
+            continue;
+        while (r0 < r1 && c[r0].kind != WS_CONTACT_POINT_FACE)
+            r0++;
+        while (r1 > r0 && c[r1 - 1].kind != WS_CONTACT_POINT_FACE)
+            r1--;
+        size_t q0 = ws_contact_pair_start(c, n, b, a), q1 = q0;
+        while (q1 < n && c[q1].a == b && c[q1].b == a)
+            q1++;
+        while (q0 < q1 && c[q0].kind != WS_CONTACT_POINT_FACE)
+            q0++;
+        while (q1 > q0 && c[q1 - 1].kind != WS_CONTACT_POINT_FACE)
+            q1--;
+        if (r0 == r1 || q0 == q1)
+            continue;
+        for (size_t i = r0; i < r1; i++) {
+            const size_t j = twin_nearest(x, c, i, q0, q1);
+            if (j == q1 || twin_nearest(x, c, j, r0, r1) != i)
+                continue;
+            v3 pi, ni, si, pj, nj, sj;
+            pf_place(x, &c[i], &pi, &ni, &si);
+            pf_place(x, &c[j], &pj, &nj, &sj);
+            double dt;
+            const double tau = twin_fade(pi, ni, pj, nj, &dt);
+            int ti, tj;
+            const double mi = pf_margin(x, &c[i], si, &ti), mj = pf_margin(x, &c[j], sj, &tj);
+            /* A twin out of contact carries nothing: the other carries its corner whole. */
+            c[i].twin_cut = tj || !ti ? twin_cut(mi, mj, tau) : 0.0;
+            c[j].twin_cut = ti || !tj ? twin_cut(mj, mi, tau) : 0.0;
+        }
+    }
 }
 
 static int cand_cmp(const ws_cand *p, const ws_cand *q)

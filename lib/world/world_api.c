@@ -912,14 +912,17 @@ ws_status ws_world_get_interface_stiffness(const ws_world *w, ws_body_id a, ws_b
     ws_status s = pair_call(w, a, b, "ws_world_get_interface_stiffness", &ia, &ib);
     if (s != WS_OK)
         return s;
-    /* Every active contact point is a spring k of the pair in parallel with the others. */
+    /* Every active contact point is a spring of the pair in parallel with the others: k times
+     * its share of the laws (a twin corner's, a fading edge pair's), which its record's energy
+     * 0.5 share k overlap^2 holds (the records saved with the state keep it). */
     const uint32_t *mat = w->bodies.material;
     double k = w->params[w->pair_index[mat[ia] * w->pair_dim + mat[ib]]].k, sum = 0.0;
     size_t n = 0;
     for (size_t q = 0; q < w->nrec[w->cur]; q++) {
         const ws_contact_rec *c = &w->rec[w->cur][q];
         if ((c->a == ia && c->b == ib) || (c->a == ib && c->b == ia)) {
-            sum += k;
+            const double ov2 = c->overlap * c->overlap;
+            sum += ov2 > 0.0 ? 2.0 * c->energy / ov2 : k;
             n++;
         }
     }

@@ -1076,6 +1076,9 @@ static void body_contacts(ws_step *S)
      * that one's stick anchor, so the friction it carried does not vanish for a step: the
      * candidates are marked here, in the list's order, and matched after. */
     size_t nrec = 0, fresh = 0, ended = 0;
+    /* Twin corners (two bodies' vertices at one corner of their faces' overlap) share one
+     * corner's laws: their shares first, from the same state the evaluation reads. */
+    ws_contact_twins(&S->contact, w->cand[nxt], w->ncand[nxt]);
     for (size_t k = 0; k < w->ncand[nxt]; k++) {
         ws_cand *c = &w->cand[nxt][k];
         const uint32_t was = c->anchored;

@@ -737,8 +737,8 @@ class World:
 
     def interface_stiffness(self, a, b):
         """(stiffness N/m, points): the summed normal stiffness of the active contact points
-        between Bodies a and b and their number (4 for a box on a larger plane, 8 for two equal
-        boxes face to face)."""
+        between Bodies a and b (each one's share of k) and their number (4 for a box on a larger
+        plane, 4k; 8 for two equal boxes face to face, twins at each corner, 4k)."""
         k, n = c_double(), c_size_t()
         self._call("ws_world_get_interface_stiffness", a._id, b._id, byref(k), byref(n))
         return k.value, n.value
