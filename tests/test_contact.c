@@ -1473,9 +1473,9 @@ START_TEST(test_friction_limit_measured)
      * report dt lambda / 2. Tolerance 1e-3: the corners' normal forces at rest are m g / 4 to
      * 1e-6 (the cube starts at its resting overlap) and the power iteration's 40 steps leave
      * (10.1 / 12)^80 ~ 1e-6. The stats hold what 16 measures 64 steps apart all pass, so each
-     * run is longer than 1024 steps. Past the limit (1.5 ms: 1.32) the log hook hears it once; below
-     * (0.25 ms) not at all; the stick law has no such damper (0; at 1 ms, below its anchors'
-     * own per-pair bound of 1.12 ms). */
+     * run is longer than 1024 steps. Past the limit (1.5 ms: 1.32) the log hook hears it once;
+     * below (0.25 ms) not at all; the stick law has no such damper (0; at 1 ms, below its
+     * anchors' own per-pair bound of 1.12 ms). */
     const double lambda = 6.0 * 0.3 * G0 / 0.01;
     warnings wn = {0, ""};
     ws_world_stats st = resting_cube(2.5e-4, 0.3, WS_FRICTION_REGULARIZED, &wn);

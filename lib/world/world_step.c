@@ -1172,8 +1172,9 @@ static double mass_norm(const ws_body_store *b, const v3 *x)
 }
 
 /* The largest eigenvalue of M^-1 K (or M^-1 C, or friction's) for the contacts of this step,
- * by power iteration in the M inner product, where the operator is symmetric: each iterate's ratio
- * |y|_M / |x|_M is at most the eigenvalue and rises to it. x and y: scratch of 2 slots each. */
+ * by power iteration in the M inner product, where the operator is symmetric: each iterate's
+ * ratio |y|_M / |x|_M is at most the eigenvalue and rises to it. x and y: scratch of 2 slots
+ * each. */
 static double contact_rate(const ws_step *S, int what, v3 *x, v3 *y)
 {
     const ws_body_store *b = S->b;
@@ -1218,7 +1219,8 @@ static ws_status contacts_ready(ws_step *S)
         if (!x)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
         v3 *y = x + 2 * (n + 1);
-        const double K = contact_rate(S, RATE_SPRING, x, y), C = contact_rate(S, RATE_DAMPER, x, y);
+        const double K = contact_rate(S, RATE_SPRING, x, y);
+        const double C = contact_rate(S, RATE_DAMPER, x, y);
         /* ws_contact_stable_dt with m = 1; no bound when no contact pushes. */
         *cc = (ws_contact_check){1,         w->steps, S->nrec, S->pair_dt,
                                  K > 0.0 ? (sqrt(C * C + 4.0 * K) - C) / K : 0.0,
@@ -1249,7 +1251,8 @@ static ws_status contacts_ready(ws_step *S)
 static ws_status friction_check(ws_step *S)
 {
     ws_world *w = S->w;
-    if (S->nrec == 0 || (w->friction_step && w->steps + 1 - w->friction_step < WS_CONTACT_CHECK_EVERY))
+    const uint64_t since = w->steps + 1 - w->friction_step;
+    if (S->nrec == 0 || (w->friction_step && since < WS_CONTACT_CHECK_EVERY))
         return WS_OK;
     const size_t n = S->b->slots;
     if (ws_array_reserve(&w->mem, (void **)&w->friction_scratch, &w->friction_cap, 4 * (n + 1),
