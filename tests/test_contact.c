@@ -2174,11 +2174,17 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_stiff_contact_refused_with_advice);
     tcase_add_test(tc, test_stiff_but_stable_runs);
     tcase_add_test(tc, test_energy_guard_without_speed_limit);
+    tcase_add_test(tc, test_stack_modes_bound_the_step);
+    tcase_add_test(tc, test_friction_limit_measured);
+    suite_add_tcase(s, tc);
+
+    /* Stacks run for seconds of simulated time, several runs a test: under the sanitizers on
+     * a loaded machine one test takes more than the 20 s above. */
+    tc = tcase_create("stacks");
+    tcase_set_timeout(tc, 120);
     tcase_add_test(tc, test_stick_stack_settles_on_tilt);
     tcase_add_test(tc, test_yawed_stack_contacts_settle);
     tcase_add_test(tc, test_nearly_aligned_stack_no_kicks);
-    tcase_add_test(tc, test_stack_modes_bound_the_step);
-    tcase_add_test(tc, test_friction_limit_measured);
     suite_add_tcase(s, tc);
     return s;
 }
