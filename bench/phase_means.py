@@ -43,6 +43,7 @@ def main(paths):
         print(__doc__.strip())
         return 2
     logs = [read(p) for p in paths]
+    logs = [(r if r is not None else "?", rows) for r, rows in logs]  # "?": no window yet
     head = "%-12s" % "phase"
     for r, _ in logs:
         head += "  %9s %9s" % ("r%s it" % r, "CPU")
