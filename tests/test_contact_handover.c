@@ -141,6 +141,22 @@ static void start(scene *S, ws_cand *c, ws_contact_rec *rec, uint32_t r)
     c->fresh = r + 1;
 }
 
+/* Two records the same field by field (a record's padding is never written, so the records
+ * are not compared as bytes). */
+static int same_rec(const ws_contact_rec *p, const ws_contact_rec *q)
+{
+    const v3 *pv[] = {&p->x, &p->n, &p->ft, &p->vt, &p->defl};
+    const v3 *qv[] = {&q->x, &q->n, &q->ft, &q->vt, &q->defl};
+    for (int i = 0; i < 5; i++)
+        if (memcmp(pv[i], qv[i], sizeof(v3)) != 0)
+            return 0;
+    return p->a == q->a && p->b == q->b && p->kind == q->kind && p->slipping == q->slipping &&
+           p->at_cap == q->at_cap && memcmp(&p->overlap, &q->overlap, sizeof(double)) == 0 &&
+           memcmp(&p->fn, &q->fn, sizeof(double)) == 0 &&
+           memcmp(&p->energy, &q->energy, sizeof(double)) == 0 &&
+           memcmp(&p->energy_t, &q->energy_t, sizeof(double)) == 0;
+}
+
 START_TEST(test_handover_carries_the_deflection_once)
 {
     /* The point-face pair (A's face, V) ended with a deflection D = (4, -2, 0) um (tangential
@@ -181,7 +197,7 @@ START_TEST(test_handover_carries_the_deflection_once)
     ck_assert(v3_norm(v3_add(v3_sub(S.w->bodies.f[S.A], fA), dF)) < 1e-12);
     /* the second starter keeps its fresh anchor and its record */
     ck_assert(v3_norm(deflection(&S, &c[2])) < 1e-15);
-    ck_assert(memcmp(&rec[1], &fresh, sizeof fresh) == 0);
+    ck_assert(same_rec(&rec[1], &fresh));
     ws_world_destroy(S.w);
 }
 END_TEST
