@@ -26,6 +26,18 @@ typedef enum ws_integrator {
     WS_INTEGRATOR_PAPER_EXPLICIT = 1
 } ws_integrator;
 
+/** How a step takes the bodies' regularised friction (WS_FRICTION_REGULARIZED contacts). */
+typedef enum ws_friction_step {
+    /** Linearly implicit (the default): the friction at the end of the step, linearised about
+     *  its start (eq. 13 and its slopes), solved over all bodies at once, so it holds bodies
+     *  still at any dt, however hard they are clamped together (docs/theory.md, section 5). */
+    WS_FRICTION_STEP_IMPLICIT = 0,
+    /** Explicit, as the paper: the friction at the start of the step. Stable only while dt
+     *  lambda <= 2 (ws_world_stats.friction_step_use), beyond which clamped bodies slip back
+     *  and forth every step and a load creeps faster than the law allows. */
+    WS_FRICTION_STEP_EXPLICIT = 1
+} ws_friction_step;
+
 /** A piece of a step's work given to the host's scheduler: items [start, end) of it, on worker
  *  `worker` (< ws_world_def.worker_count, distinct among pieces that run at once), with the
  *  task's own context. */
@@ -82,6 +94,8 @@ typedef struct ws_world_def {
     ws_enqueue_task_fn *enqueue_task;
     ws_finish_task_fn *finish_task; /**< see enqueue_task */
     void *task_context;             /**< passed to enqueue_task and finish_task */
+    /** How the bodies' regularised friction is stepped; default WS_FRICTION_STEP_IMPLICIT. */
+    ws_friction_step friction_step;
 } ws_world_def;
 
 /** The most workers a world takes. */

@@ -36,11 +36,10 @@ static void link_slip(ws_node_link *L, v3 t, double vlim)
 {
     const double tl = v3_norm(t), s = tl / vlim;
     L->t = t;
-    L->phi = 2.0 / vlim;
+    L->phi = ws_friction_phi(tl, vlim);
     L->dp = 2.0 / vlim;
     L->tt = v3_make(0, 0, 0);
     if (tl > 0.0) {
-        L->phi = ws_friction_p(s) / tl;
         L->dp = ws_friction_slope(s) / vlim;
         L->tt = v3_scale(t, 1.0 / tl);
     }

@@ -159,7 +159,9 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         !(d.max_speed > 0.0) || !(d.max_angular_speed > 0.0) ||
         !(d.stable_fraction > 0.0 && d.stable_fraction <= 1.0) ||
         (d.integrator != WS_INTEGRATOR_SYMPLECTIC_EULER &&
-         d.integrator != WS_INTEGRATOR_PAPER_EXPLICIT))
+         d.integrator != WS_INTEGRATOR_PAPER_EXPLICIT) ||
+        (d.friction_step != WS_FRICTION_STEP_IMPLICIT &&
+         d.friction_step != WS_FRICTION_STEP_EXPLICIT))
         return WS_ERR_INVALID_ARGUMENT;
     int hooks = (d.allocator.alloc != NULL) + (d.allocator.realloc != NULL) +
                 (d.allocator.free != NULL);

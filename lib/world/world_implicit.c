@@ -3,7 +3,7 @@
  * contacts' loads on the bodies. The dynamic bodies the film touches are unknowns of the solve
  * beside its nodes (web/coupled.h, docs/theory.md section 8b), their other loads (gravity, body
  * contacts, elements, webs stepped before) known, but for their contacts' regularised
- * friction, which goes into the solve with them (pairs_make; explicit, it chatters past 0.33 ms
+ * friction, which goes into the solve with them (world_friction.c; explicit, it chatters past 0.33 ms
  * on a wrapped stack); with hold_bodies they are held at their state at t as for the explicit
  * film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
@@ -90,14 +90,7 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
         if (j == UINT32_MAX)
             continue;
         R->mass[j] = b->mass[i];
-        /* The global inertia A J A^T. */
-        const m3 At = m3_transpose(&b->A[i]), JA = m3_mul(&b->J[i], &At);
-        const m3 I = m3_mul(&b->A[i], &JA);
-        double *S = R->inertia + WS_SYM * (size_t)j;
-        S[WS_SYM_XX] = I.m[0], S[WS_SYM_YY] = I.m[4], S[WS_SYM_ZZ] = I.m[8];
-        S[WS_SYM_XY] = 0.5 * (I.m[1] + I.m[3]);
-        S[WS_SYM_XZ] = 0.5 * (I.m[2] + I.m[6]);
-        S[WS_SYM_YZ] = 0.5 * (I.m[5] + I.m[7]);
+        ws_world_body_inertia(b, i, R->inertia + WS_SYM * (size_t)j);
     }
     *slot_out = slot;
     return R;
@@ -115,80 +108,6 @@ static int first_coupled(const ws_world *w, const ws_web *web)
             return o == web;
     }
     return 0;
-}
-
-/* The body contacts of the step whose regularised friction (eq. 13) goes into the solve with
- * the bodies (docs/theory.md section 8b): those of a body of the solve with another or with a
- * world element that push, with a friction coefficient, under the regularised law (the stick
- * model's anchor spring has its own damping and stays in the bodies' step). Each as the damper its friction is over the slip at
- * the start, c = mu N p(s) / |t| (2 mu N / v_lim at rest, link_slip's secant in
- * contact/node_jacobian.c), C = h c (I - n n^T); into R->pair from the step's arena. 0, or -1
- * when out of memory. */
-static int pairs_make(ws_step *S, ws_rigid *R, const uint32_t *slot, double h)
-{
-    const ws_world *w = S->w;
-    const ws_body_store *b = S->b;
-    const ws_contact_rec *rec = w->rec[S->nxt];
-    R->npair = 0;
-    R->pair = NULL;
-    if (S->body_later || S->nrec == 0)
-        return 0; /* the body contacts not yet evaluated (not with an implicit web) */
-    if (!(R->pair = ws_arena_alloc(S->arena, S->nrec * sizeof *R->pair)))
-        return -1;
-    for (size_t k = 0; k < S->nrec; k++) {
-        const ws_contact_rec *c = &rec[k];
-        const uint32_t ja = slot[c->a], jb = slot[c->b];
-        /* Both sides in the solve, or one of them a world element (its motion given): a
-         * dynamic body outside the solve keeps the pair's friction in its own step. */
-        const int out_a = ja == UINT32_MAX && b->type[c->a] == WS_BODY_DYNAMIC,
-                  out_b = jb == UINT32_MAX && b->type[c->b] == WS_BODY_DYNAMIC;
-        if ((ja == UINT32_MAX && jb == UINT32_MAX) || out_a || out_b)
-            continue;
-        const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
-        if (pp->model != WS_FRICTION_REGULARIZED || !(pp->mu > 0.0) || !(c->fn > 0.0))
-            continue;
-        const double tl = v3_norm(c->vt), s = tl / pp->vlim;
-        const double phi = tl > 0.0 ? ws_friction_p(s) / tl : 2.0 / pp->vlim;
-        const double hc = h * pp->mu * c->fn * phi;
-        ws_rigid_pair *P = &R->pair[R->npair++];
-        P->a = ja;
-        P->b = jb;
-        P->tag = (uint32_t)k;
-        P->ra = v3_sub(c->x, b->st[S->cur].r[c->a]);
-        P->rb = v3_sub(c->x, b->st[S->cur].r[c->b]);
-        memset(P->C, 0, sizeof P->C);
-        ws_sym_add_outer(P->C, -hc, c->n);
-        P->C[WS_SYM_XX] += hc;
-        P->C[WS_SYM_YY] += hc;
-        P->C[WS_SYM_ZZ] += hc;
-    }
-    return 0;
-}
-
-/* The pairs' friction over the solved step, -C (J_b dU_b - J_a dU_a) / h on body b and the
- * opposite on a, added to their loads and to the contact's record (its friction at the end of
- * the step, as the bodies take it). */
-static void pairs_loads(ws_step *S, const ws_rigid *R, double h)
-{
-    ws_body_store *b = S->b;
-    ws_contact_rec *rec = S->w->rec[S->nxt];
-    for (size_t q = 0; q < R->npair; q++) {
-        const ws_rigid_pair *P = &R->pair[q];
-        ws_contact_rec *c = &rec[P->tag];
-        const v3 d = ws_rigid_pair_slip(R, q, R->x);
-        double g[3] = {0.0, 0.0, 0.0};
-        ws_sym_madd(P->C, d.x, d.y, d.z, g);
-        const v3 F = v3_scale(v3_make(g[0], g[1], g[2]), -1.0 / h);
-        c->ft = v3_add(c->ft, F);
-        if (P->b != UINT32_MAX) {
-            b->f[c->b] = v3_add(b->f[c->b], F);
-            b->m[c->b] = v3_add(b->m[c->b], v3_cross(P->rb, F));
-        }
-        if (P->a != UINT32_MAX) {
-            b->f[c->a] = v3_sub(b->f[c->a], F);
-            b->m[c->a] = v3_sub(b->m[c->a], v3_cross(P->ra, F));
-        }
-    }
 }
 
 /* The velocity of body bi's point at lever r at t. */
@@ -326,7 +245,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
             R->coarse = NULL; /* a test's comparison: the plain block-diagonal preconditioner */
         /* The body-body friction in the solve: one solve a step (no sub-steps), of the first
          * web that couples the bodies. */
-        if (R && n == 1 && first_coupled(w, web) && pairs_make(S, R, slot, h) != 0)
+        if (R && n == 1 && !S->body_later && first_coupled(w, web) &&
+            ws_world_friction_pairs(S, R, slot, h, 0) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
         /* The active set: a solve with the contacts that push, then with those whose linear
@@ -376,7 +296,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
             loads_moved(R, slot, b, cur, links, nl, h, share, web->fc[nxt], web->bforce[nxt],
                         web->bmoment[nxt]);
         if (R && R->npair)
-            pairs_loads(S, R, h);
+            ws_world_friction_loads(S, R, h);
         xs = xd;
         vs = vd;
     }

@@ -195,6 +195,9 @@ typedef struct ws_step {
      * film like them (the broad phase's pairs found); and whether it ran out of the room
      * reserved for it there (then it runs again on the calling thread). */
     int narrow_later, narrow_bad;
+    /* By contact record: its friction taken into a solve this step (world_friction.c; NULL
+     * before any is). */
+    uint8_t *friction_taken;
 } ws_step;
 
 /* Record an error (and log it) and return the status. The world may be const for callers that
@@ -257,6 +260,24 @@ int ws_world_node_params(ws_world *w, uint32_t web_material);
  * converge or a node runs away, WS_ERR_CALLBACK when a law fails, WS_ERR_OUT_OF_MEMORY; the
  * committed state is not written. */
 ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list);
+/* The bodies' regularised friction at the end of the step (world_friction.c): every contact of
+ * it no web's solve took, solved over the bodies at once, its change over the step added to
+ * the bodies' loads and the records. Before the integration, all loads known. */
+ws_status ws_world_friction_step(ws_step *S);
+/* The body contacts whose friction goes into a solve with the bodies slot (UINT32_MAX: not in
+ * it; a contact with a dynamic body outside stays out) for step h: each the damper its eq. 13
+ * is over the slip at the start, C = h mu N phi (I - n n^T) (the secant), or with tangent set
+ * the law's slope along the slip in place of the secant there (ws_friction_slopes_at), into
+ * R->pair (from the step's arena), and marked taken. 0, or -1 when out of memory. */
+struct ws_rigid;
+int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot, double h,
+                            int tangent);
+/* The pairs' friction over the solved step R->x, -C (J_b dU_b - J_a dU_a) / h on body b and the
+ * opposite on a, added to their loads (and the guard's record of contact loads) and to the
+ * contact's record: its friction at the end of the step, as the bodies take it. */
+void ws_world_friction_loads(ws_step *S, const struct ws_rigid *R, double h);
+/* A body's global inertia A J A^T as a symmetric 3 x 3 (WS_SYM doubles, web/implicit.h). */
+void ws_world_body_inertia(const ws_body_store *b, size_t i, double *S);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 /* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */

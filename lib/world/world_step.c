@@ -7,7 +7,9 @@
  *       then the deformable elements (rods, springs, bushings: world_element.c), then the
  *       webs' (with workers and only explicit webs the candidates are evaluated beside the
  *       film's first sub-step and the elements follow the film: the same sums, step_once);
- *   (4) integration into the other state buffer; world elements from their drives at t + dt;
+ *   (4) the bodies' friction taken at the end of the step (world_friction.c: one solve over
+ *       the bodies, its change added to their loads); integration into the other state
+ *       buffer; world elements from their drives at t + dt;
  *   (5) health check; (6) commit by swapping buffers and t += dt.
  * Nothing is committed before (6), so a failed step leaves the world as it was. */
 #include "contact/penalty.h"
@@ -1252,7 +1254,7 @@ static ws_status friction_check(ws_step *S)
 {
     ws_world *w = S->w;
     const uint64_t since = w->steps + 1 - w->friction_step;
-    if (S->nrec == 0 || (w->friction_step && since < WS_CONTACT_CHECK_EVERY))
+    if (w->def.friction_step != WS_FRICTION_STEP_EXPLICIT || S->nrec == 0 || (w->friction_step && since < WS_CONTACT_CHECK_EVERY))
         return WS_OK;
     const size_t n = S->b->slots;
     if (ws_array_reserve(&w->mem, (void **)&w->friction_scratch, &w->friction_cap, 4 * (n + 1),
@@ -1436,7 +1438,7 @@ static ws_status step_once(ws_world *w)
             if (w->web_slots.dense[k] != UINT32_MAX)
                 web_loads(&S, w->webs[k]);
     }
-    if ((s = integrate(&S)) != WS_OK)
+    if ((s = ws_world_friction_step(&S)) != WS_OK || (s = integrate(&S)) != WS_OK)
         return s;
     S.stats->narrow_checks += S.contact.narrow_checks;
     if ((s = health(&S)) != WS_OK || (s = energy_guard(&S)) != WS_OK)

@@ -276,6 +276,29 @@ def test_contacts_between_and_interface_stiffness():
         assert e.value.status == ws.WS_ERR_INVALID_ARGUMENT
 
 
+def test_friction_step_choice():
+    """A 5 kg cube on a plane, gravity tilted to tan(theta) = 0.15 < mu = 0.3, at dt = 1.5 ms:
+    eq. 13 holds it at the creep speed v_lim (1 - sqrt(1 - tan(theta) / mu)) = 2.929 mm/s
+    (docs/theory.md section 5), a fixed point of the friction taken at the end of the step at
+    any dt: to 1e-4 after 0.45 s (the start's bounce long gone). Taken explicitly
+    (friction_step = WS_FRICTION_STEP_EXPLICIT), past its limit at this dt, it creeps faster
+    by more than 5 % (3.44 mm/s)."""
+    th, a = np.arctan(0.15), 0.25
+    law = 0.01 * (1 - np.sqrt(1 - 0.15 / 0.3))
+    speeds = []
+    for step in (ws.WS_FRICTION_STEP_IMPLICIT, ws.WS_FRICTION_STEP_EXPLICIT):
+        with ws.World(dt=1.5e-3, friction_step=step,
+                      gravity=(9.81 * np.sin(th), 0, -9.81 * np.cos(th))) as w:
+            w.set_default_contact(stiffness=2e5, damping=100.0, friction=0.3)
+            w.body(w.box(2.0, 2.0, 0.05), type="kinematic", position=(0, 0, -0.025))
+            cube = w.body(w.box(a, a, a), mass=5.0,
+                          position=(0, 0, a / 2 + 0.002 - 5.0 * 9.81 * np.cos(th) / 8e5))
+            w.step(300)
+            speeds.append(cube.velocity[0])
+    assert speeds[0] == pytest.approx(law, rel=1e-4)
+    assert speeds[1] > 1.05 * law
+
+
 def test_mesh_centroid_offset_places_body_where_the_mesh_was():
     """A tetrahedron given at (1, 2, 3): moved by its centroid, (1, 2, 3) + a/4 (1, 1, 1); a
     body created there puts the vertices back where they were given (1e-12 m, round-off)."""

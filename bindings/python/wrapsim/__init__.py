@@ -21,7 +21,8 @@ from ._lib import (  # noqa: F401  (re-exported constants)
     WS_ERR_BUFFER_TOO_SMALL, WS_ERR_IO, WS_ERR_UNSUPPORTED, WS_ERR_IN_STEP, WS_ERR_FORMAT,
     WS_LOG_DEBUG, WS_LOG_INFO, WS_LOG_WARNING, WS_LOG_ERROR, WS_FEATURE_CCD,
     WS_INTEGRATOR_SYMPLECTIC_EULER,
-    WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK, WS_BODY_DYNAMIC,
+    WS_INTEGRATOR_PAPER_EXPLICIT, WS_FRICTION_REGULARIZED, WS_FRICTION_STICK,
+    WS_FRICTION_STEP_IMPLICIT, WS_FRICTION_STEP_EXPLICIT, WS_BODY_DYNAMIC,
     WS_BODY_KINEMATIC, WS_DRIVE_STATIC, WS_DRIVE_TILT, WS_DRIVE_SINE, WS_DRIVE_CALLBACK,
     WS_CONTACT_POINT_FACE, WS_CONTACT_EDGE_EDGE, WS_CONTACT_FACE_POINT, WS_LAW_LINEAR_ELASTIC,
     WS_LAW_LINEAR_VISCOELASTIC, WS_LAW_TENSION_COMPRESSION, WS_LAW_LINEAR_VISCOUS,
@@ -410,7 +411,8 @@ class World:
     """A world: owner of every shape, body, material, law and web. Use as a context manager, or
     call close(). Keyword arguments are the fields of ws_world_def (dt, gravity, integrator,
     full_detection_until, detection_interval, contact_margin, max_speed, max_angular_speed,
-    use_ccd, profile, user_data); `log` may be a callable(level, message)."""
+    use_ccd, profile, user_data, stable_fraction, worker_count, friction_step); `log` may be a
+    callable(level, message)."""
 
     def __init__(self, log=None, **kwargs):
         self._ptr = None

@@ -1,0 +1,204 @@
+/* The bodies' regularised friction taken at the end of the step (docs/theory.md, section 5).
+ * Below v_lim eq. 13 is a damper whose rate on a clamped stack is far past the explicit limit
+ * 2 / dt (the film presses the boxes together at several times their weight): taken at the
+ * step's start the boxes twist back and forth every step and a load creeps faster than the
+ * law allows. Here each contact's friction is linearised about the slip at the start,
+ * F(t + dt) = F(t) - C (dt), C its slopes on the tangent plane (ws_friction_slopes_at: the
+ * secant across the slip, the law's slope along it, which is zero once it slides, so a sliding
+ * box feels Coulomb's force to the bit), taken at the slip at the end of the step, and the
+ * bodies' velocity changes dU over the step solve
+ *
+ *     (M + h sum J^T C J) dU = h F,      J the contact point's motion,
+ *
+ * all bodies at once (the twist of one box against another is a mode of the pair, not of
+ * either: a per-contact or per-body damper overshoots, the boxes swap velocities). The
+ * friction's change over the step, -C J dU, is added to the bodies' loads, and the integrators
+ * take the loads as before. The matrix is the bodies' block of an implicit web's coupled solve
+ * (web/coupled.h) with no film in it; a web that puts the bodies in its own solve takes the
+ * friction of its bodies' contacts there (world_implicit.c), and those contacts are left out
+ * here. */
+#include "contact/penalty.h"
+#include "web/coupled.h"
+#include "world/world_internal.h"
+
+#include <string.h>
+
+void ws_world_body_inertia(const ws_body_store *b, size_t i, double *S)
+{
+    /* The global inertia A J A^T, symmetrised against round-off. */
+    const m3 At = m3_transpose(&b->A[i]), JA = m3_mul(&b->J[i], &At);
+    const m3 I = m3_mul(&b->A[i], &JA);
+    S[WS_SYM_XX] = I.m[0], S[WS_SYM_YY] = I.m[4], S[WS_SYM_ZZ] = I.m[8];
+    S[WS_SYM_XY] = 0.5 * (I.m[1] + I.m[3]);
+    S[WS_SYM_XZ] = 0.5 * (I.m[2] + I.m[6]);
+    S[WS_SYM_YZ] = 0.5 * (I.m[5] + I.m[7]);
+}
+
+/* Whether record c's friction is a damper for a solve: the regularised law, a friction
+ * coefficient, a contact that pushes. */
+static int damps(const ws_step *S, const ws_contact_rec *c)
+{
+    const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
+    return pp->model == WS_FRICTION_REGULARIZED && pp->mu > 0.0 && c->fn > 0.0;
+}
+
+int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, double h,
+                            int tangent)
+{
+    const ws_world *w = S->w;
+    const ws_body_store *b = S->b;
+    const ws_contact_rec *rec = w->rec[S->nxt];
+    R->npair = 0;
+    R->pair = NULL;
+    if (S->nrec == 0)
+        return 0;
+    if (!(R->pair = ws_arena_alloc(S->arena, S->nrec * sizeof *R->pair)))
+        return -1;
+    if (!S->friction_taken) {
+        if (!(S->friction_taken = ws_arena_alloc(S->arena, S->nrec)))
+            return -1;
+        memset(S->friction_taken, 0, S->nrec);
+    }
+    for (size_t k = 0; k < S->nrec; k++) {
+        const ws_contact_rec *c = &rec[k];
+        const uint32_t ja = slot[c->a], jb = slot[c->b];
+        /* Both sides in the solve, or one of them a world element (its motion given): a
+         * dynamic body outside the solve keeps the pair's friction in its own step. */
+        const int out_a = ja == UINT32_MAX && b->type[c->a] == WS_BODY_DYNAMIC,
+                  out_b = jb == UINT32_MAX && b->type[c->b] == WS_BODY_DYNAMIC;
+        if ((ja == UINT32_MAX && jb == UINT32_MAX) || out_a || out_b || S->friction_taken[k] ||
+            !damps(S, c))
+            continue;
+        const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
+        const double v = v3_norm(c->vt);
+        /* The secant on the whole plane, or the law's own slope along the slip. */
+        const ws_friction_slopes sl = ws_friction_slopes_at(v, pp->mu * c->fn, pp->vlim);
+        const double hc = h * pp->mu * c->fn * ws_friction_phi(v, pp->vlim),
+                     along = tangent ? h * sl.along : hc;
+        ws_rigid_pair *P = &R->pair[R->npair++];
+        P->a = ja;
+        P->b = jb;
+        P->tag = (uint32_t)k;
+        P->ra = v3_sub(c->x, b->st[S->cur].r[c->a]);
+        P->rb = v3_sub(c->x, b->st[S->cur].r[c->b]);
+        memset(P->C, 0, sizeof P->C);
+        ws_sym_add_outer(P->C, -hc, c->n);
+        P->C[WS_SYM_XX] += hc;
+        P->C[WS_SYM_YY] += hc;
+        P->C[WS_SYM_ZZ] += hc;
+        if (along != hc && v > 0.0)
+            ws_sym_add_outer(P->C, along - hc, v3_scale(c->vt, 1.0 / v));
+        S->friction_taken[k] = 1;
+    }
+    return 0;
+}
+
+void ws_world_friction_loads(ws_step *S, const ws_rigid *R, double h)
+{
+    ws_body_store *b = S->b;
+    ws_contact_rec *rec = S->w->rec[S->nxt];
+    for (size_t q = 0; q < R->npair; q++) {
+        const ws_rigid_pair *P = &R->pair[q];
+        ws_contact_rec *c = &rec[P->tag];
+        const v3 d = ws_rigid_pair_slip(R, q, R->x);
+        double g[3] = {0.0, 0.0, 0.0};
+        ws_sym_madd(P->C, d.x, d.y, d.z, g);
+        const v3 F = v3_scale(v3_make(g[0], g[1], g[2]), -1.0 / h);
+        const v3 Mb = v3_cross(P->rb, F), Ma = v3_cross(P->ra, F);
+        c->ft = v3_add(c->ft, F);
+        /* A contact's load on the bodies, for the energy guard as the rest of it. */
+        if (P->b != UINT32_MAX) {
+            b->f[c->b] = v3_add(b->f[c->b], F);
+            b->m[c->b] = v3_add(b->m[c->b], Mb);
+            S->guard_f[c->b] = v3_add(S->guard_f[c->b], F);
+            S->guard_m[c->b] = v3_add(S->guard_m[c->b], Mb);
+        }
+        if (P->a != UINT32_MAX) {
+            b->f[c->a] = v3_sub(b->f[c->a], F);
+            b->m[c->a] = v3_sub(b->m[c->a], Ma);
+            S->guard_f[c->a] = v3_sub(S->guard_f[c->a], F);
+            S->guard_m[c->a] = v3_sub(S->guard_m[c->a], Ma);
+        }
+    }
+}
+
+/* The solve's bodies: every dynamic body of a contact whose friction damps and no web took,
+ * an index in slot (UINT32_MAX for the others), with its mass and global inertia and the
+ * solve's scratch, from the step's arena. NULL with *fail 0 when there is none, with *fail 1
+ * when out of memory. */
+static ws_rigid *bodies_make(ws_step *S, uint32_t **slot_out, int *fail)
+{
+    const ws_body_store *b = S->b;
+    const ws_contact_rec *rec = S->w->rec[S->nxt];
+    *fail = 1;
+    uint32_t *slot = ws_arena_alloc(S->arena, (b->slots + 1) * sizeof *slot);
+    if (!slot)
+        return NULL;
+    for (size_t i = 0; i < b->slots; i++)
+        slot[i] = UINT32_MAX;
+    uint32_t nb = 0;
+    for (size_t k = 0; k < S->nrec; k++) {
+        const ws_contact_rec *c = &rec[k];
+        if ((S->friction_taken && S->friction_taken[k]) || !damps(S, c))
+            continue;
+        const uint32_t ends[2] = {c->a, c->b};
+        for (int e = 0; e < 2; e++)
+            if (b->type[ends[e]] == WS_BODY_DYNAMIC && slot[ends[e]] == UINT32_MAX)
+                slot[ends[e]] = nb++;
+    }
+    *fail = 0;
+    if (nb == 0)
+        return NULL;
+    *fail = 1;
+    const size_t v6 = 6 * (size_t)nb;
+    ws_rigid *R = ws_arena_alloc(S->arena, sizeof *R);
+    double *d = ws_arena_alloc(S->arena, (nb * (1 + WS_SYM) + 2 * v6 * v6 + 2 * v6) * sizeof *d);
+    uint32_t *env = ws_arena_alloc(S->arena, v6 * sizeof *env);
+    if (!R || !d || !env)
+        return NULL;
+    memset(R, 0, sizeof *R);
+    R->nb = nb;
+    R->env = env;
+    R->mass = d;
+    R->inertia = R->mass + nb;
+    R->abb = R->inertia + WS_SYM * (size_t)nb;
+    R->fac = R->abb + v6 * v6;
+    R->b = R->fac + v6 * v6;
+    R->x = R->b + v6;
+    for (size_t i = 0; i < b->slots; i++) {
+        const uint32_t j = slot[i];
+        if (j == UINT32_MAX)
+            continue;
+        R->mass[j] = b->mass[i];
+        ws_world_body_inertia(b, i, R->inertia + WS_SYM * (size_t)j);
+        double *B = R->b + 6 * (size_t)j;
+        B[0] = S->dt * b->f[i].x, B[1] = S->dt * b->f[i].y, B[2] = S->dt * b->f[i].z;
+        B[3] = S->dt * b->m[i].x, B[4] = S->dt * b->m[i].y, B[5] = S->dt * b->m[i].z;
+    }
+    *fail = 0;
+    *slot_out = slot;
+    return R;
+}
+
+ws_status ws_world_friction_step(ws_step *S)
+{
+    ws_world *w = S->w;
+    if (w->def.friction_step != WS_FRICTION_STEP_IMPLICIT || S->nrec == 0)
+        return WS_OK;
+    uint32_t *slot = NULL;
+    int fail = 0;
+    ws_rigid *R = bodies_make(S, &slot, &fail);
+    if (!R) {
+        return fail ? ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for the friction")
+                    : WS_OK;
+    }
+    if (ws_world_friction_pairs(S, R, slot, S->dt, 1) != 0)
+        return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for the friction");
+    /* Positive definite for bodies of positive mass and finite loads (the masses' block plus
+     * dampers' energies); a NaN among the loads is left for the health check to name. */
+    if (ws_rigid_factor(R) != 0)
+        return WS_OK;
+    ws_rigid_block_solve(R, R->b, R->x);
+    ws_world_friction_loads(S, R, S->dt);
+    return WS_OK;
+}
