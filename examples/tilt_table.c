@@ -25,7 +25,7 @@
  * Build:  cc tilt_table.c $(pkg-config --cflags --libs libwrapsim) -o tilt_table
  * Run:    ./tilt_table [--variant P|R] [--stick] [--csv FILE] [--no-ccd]
  *                      [--vtk DIR [--vtk-every S] [--vtk-stride N] [--vtk-springs] [--vtk-ascii]]
- *                      [--paper-integrator] [--duration S] [--quiet]
+ *                      [--paper-integrator] [--explicit-friction] [--duration S] [--quiet]
  *                      [--wrapped [--film-mass KG] [--substeps N]]
  *         ./tilt_table --help
  *         Exit status 0 when the run ends, 1 when it fails (the library or a file), 2 on a bad
@@ -56,6 +56,7 @@ typedef struct tilt_options {
     int stick;            /* 1: stick friction model instead of the paper's regularised law */
     int use_ccd;          /* 1: libccd gate (when built in) */
     int paper_integrator; /* 1: the paper's explicit scheme */
+    int explicit_friction; /* 1: the bodies' friction taken at the step's start, as the paper */
     double duration;      /* s; 0 = 6 s for P, 7 s for R */
     const char *csv;      /* time series file, or NULL */
     const char *vtk_dir;  /* directory for VTK frames, or NULL */
@@ -238,6 +239,8 @@ static ws_status tilt_build(const tilt_options *o, tilt_scene *sc)
     wd.worker_count = o->workers > 0 ? (uint32_t)o->workers : 1u;
     wd.integrator = o->paper_integrator ? WS_INTEGRATOR_PAPER_EXPLICIT
                                         : WS_INTEGRATOR_SYMPLECTIC_EULER;
+    wd.friction_step =
+        o->explicit_friction ? WS_FRICTION_STEP_EXPLICIT : WS_FRICTION_STEP_IMPLICIT;
     ws_status s = ws_world_create(&wd, &sc->world);
     if (s != WS_OK)
         return s;
@@ -810,6 +813,7 @@ static void usage(FILE *f)
             "  --vtk-ascii        ASCII files instead of compressed binary\n"
             "  --no-ccd           without the libccd gate\n"
             "  --paper-integrator the paper's explicit scheme\n"
+            "  --explicit-friction the bodies' friction at the step's start, as the paper\n"
             "  --quiet            no progress, no summary\n"
             "  --help             this text\n"
             "Exit status: 0 done, 1 the run failed (the library or a file), 2 a bad option.\n");
@@ -853,12 +857,13 @@ int main(int argc, char **argv)
     tilt_default_options(&o);
     enum { O_VARIANT = 1, O_STICK, O_NO_CCD, O_PAPER, O_CSV, O_VTK, O_DURATION, O_QUIET,
            O_WRAPPED, O_FILM_MASS, O_SUBSTEPS, O_HELP, O_VTK_EVERY, O_VTK_STRIDE, O_VTK_SPRINGS,
-           O_VTK_ASCII };
+           O_VTK_ASCII, O_EXPLICIT_FRICTION };
     static const struct option longopts[] = {
         {"variant", required_argument, NULL, O_VARIANT},
         {"stick", no_argument, NULL, O_STICK},
         {"no-ccd", no_argument, NULL, O_NO_CCD},
         {"paper-integrator", no_argument, NULL, O_PAPER},
+        {"explicit-friction", no_argument, NULL, O_EXPLICIT_FRICTION},
         {"csv", required_argument, NULL, O_CSV},
         {"vtk", required_argument, NULL, O_VTK},
         {"vtk-every", required_argument, NULL, O_VTK_EVERY},
@@ -886,6 +891,7 @@ int main(int argc, char **argv)
         case O_STICK: o.stick = 1; break;
         case O_NO_CCD: o.use_ccd = 0; break;
         case O_PAPER: o.paper_integrator = 1; break;
+        case O_EXPLICIT_FRICTION: o.explicit_friction = 1; break;
         case O_CSV: o.csv = optarg; break;
         case O_VTK: o.vtk_dir = optarg; break;
         case O_VTK_SPRINGS: o.vtk_springs = 1; break;
@@ -989,7 +995,8 @@ int main(int argc, char **argv)
         if (r.friction_use > 1.0)
             printf("  note: dt is %.2f times the regularised friction's explicit limit between "
                    "the bodies: their contacts slip back and forth every step and the load creeps "
-                   "too fast (docs/theory.md 8); use --stick, or a smaller dt\n",
+                   "too fast (docs/theory.md 5, 8); leave out --explicit-friction, use --stick, "
+                   "or a smaller dt\n",
                    r.friction_use);
         if (o.csv)
             printf("  time series: %s\n", o.csv);

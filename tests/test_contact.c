@@ -1483,7 +1483,8 @@ START_TEST(test_friction_limit_measured)
      * (WS_FRICTION_STEP_EXPLICIT), as this limit is its. */
     const double lambda = 6.0 * 0.3 * G0 / 0.01;
     warnings wn = {0, ""};
-    ws_world_stats st = resting_cube(2.5e-4, 0.3, WS_FRICTION_REGULARIZED, WS_FRICTION_STEP_EXPLICIT, &wn);
+    ws_world_stats st =
+        resting_cube(2.5e-4, 0.3, WS_FRICTION_REGULARIZED, WS_FRICTION_STEP_EXPLICIT, &wn);
     report("resting cube: friction_step_use %.6f at 0.25 ms (theory %.6f)", st.friction_step_use,
            2.5e-4 * lambda / 2);
     ck_assert_msg(fabs(st.friction_step_use / (2.5e-4 * lambda / 2) - 1.0) < 1e-3,
@@ -1577,14 +1578,14 @@ START_TEST(test_end_of_step_friction_holds_twists)
     /* A cube resting on a plane, and two stacked, given yaw spins (the stack's the same and
      * opposite: its counter-twist, the mode a clamping film drives), at dt = 1.4 ms, where the
      * regularised friction's damper is past its explicit limit (dt lambda / 2 = 1.24 for the
-     * cube: test_friction_limit_measured; the stack's contacts refuse 1.5 ms). At rest the law says each spin decays: eq. 13 is a
-     * damper of rate lambda, so within 1.6 s (lambda = 1766 1/s) nothing is left. Taken at the
-     * end of the step the spins decay by 1 / (1 + dt lambda) or faster a step: below 1e-9
-     * rad/s after 1.6 s (from 2e-2: a factor 2e7, reached in 50 steps of 1 / 1.4). Taken
-     * explicitly they grow by |1 - dt lambda| = 1.47 a step until the corners slip at v_lim
-     * and keep twisting back and forth at that size: the same bound fails, which is what
-     * makes it the test (asserted: above 1e-3 rad/s). 1.6 s: the stats' use is what 16 measures
-     * 64 steps apart all pass. */
+     * cube: test_friction_limit_measured; the stack's contacts refuse 1.5 ms). At rest the law
+     * says each spin decays: eq. 13 is a damper of rate lambda, so within 1.6 s (lambda = 1766
+     * 1/s) nothing is left. Taken at the end of the step the spins decay by 1 / (1 + dt
+     * lambda) = 1 / 3.5 or faster a step: below 1e-9 rad/s after 1.6 s (from 2e-2: a factor
+     * 2e7, 14 such steps of 1143). Taken explicitly they grow by |1 - dt lambda| = 1.47 a
+     * step until the corners slip at v_lim and keep twisting back and forth at that size: the
+     * same bound fails, which is what makes it the test (asserted: above 1e-3 rad/s). 1.6 s:
+     * the stats' use is what 16 measures 64 steps apart all pass. */
     const ws_vec3 g = v3(0, 0, -G0);
     const double one[1] = {0.02}, two[2] = {0.02, -0.02};
     const double dt = 1.4e-3;
