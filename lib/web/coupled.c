@@ -551,3 +551,122 @@ double ws_rigid_dot(const ws_rigid *R, const double *a, const double *b)
         s += a[k] * b[k];
     return s;
 }
+
+/* y = A x for the bodies and pairs alone: M_j x_j, then the pairs' terms. */
+static void pairs_only_apply(const ws_rigid *R, const double *x, double *y)
+{
+    for (uint32_t j = 0; j < R->nb; j++)
+        body_mass_apply(R, j, x + 6 * (size_t)j, y + 6 * (size_t)j);
+    pairs_apply(R, x, y);
+}
+
+/* z = L^-T L^-1 r for a 6 x 6 lower factor L (row-major) and its diagonal's reciprocals rd. */
+static void solve6(const double *L, const double *rd, const double *r, double *z)
+{
+    double y[6];
+    for (int i = 0; i < 6; i++) {
+        double s = r[i];
+        for (int k = 0; k < i; k++)
+            s -= L[6 * i + k] * y[k];
+        y[i] = s * rd[i];
+    }
+    for (int i = 5; i >= 0; i--) {
+        double s = y[i];
+        for (int k = i + 1; k < 6; k++)
+            s -= L[6 * k + i] * z[k];
+        z[i] = s * rd[i];
+    }
+}
+
+/* Each body's own block of A, inverted into R->fac (36 doubles a body): an iteration then
+ * multiplies by it, six rows of six, where solving with its factor would take a chain of
+ * dependent steps twice. */
+static int invert_blocks(ws_rigid *R)
+{
+    const int ix[3][3] = {{WS_SYM_XX, WS_SYM_XY, WS_SYM_XZ},
+                          {WS_SYM_XY, WS_SYM_YY, WS_SYM_YZ},
+                          {WS_SYM_XZ, WS_SYM_YZ, WS_SYM_ZZ}};
+    memset(R->fac, 0, 36 * (size_t)R->nb * sizeof(double));
+    for (uint32_t j = 0; j < R->nb; j++) {
+        double *B = R->fac + 36 * (size_t)j;
+        const double *I = R->inertia + WS_SYM * (size_t)j;
+        B[0] = B[7] = B[14] = R->mass[j];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++)
+                B[6 * (3 + i) + 3 + k] = I[ix[i][k]];
+    }
+    for (size_t q = 0; q < R->npair; q++) {
+        const ws_rigid_pair *P = &R->pair[q];
+        if (P->a != UINT32_MAX)
+            add_coupling(R->fac + 36 * (size_t)P->a, 6, 0, P->ra, 0, P->ra, P->C, 1.0);
+        if (P->b != UINT32_MAX)
+            add_coupling(R->fac + 36 * (size_t)P->b, 6, 0, P->rb, 0, P->rb, P->C, 1.0);
+    }
+    for (uint32_t j = 0; j < R->nb; j++) {
+        double *B = R->fac + 36 * (size_t)j, rd[6];
+        if (cholesky(B, 6, NULL) != 0)
+            return -1;
+        for (int i = 0; i < 6; i++)
+            rd[i] = 1.0 / B[7 * i];
+        double inv[36];
+        for (int k = 0; k < 6; k++) {
+            double e[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0}, col[6];
+            e[k] = 1.0;
+            solve6(B, rd, e, col);
+            for (int i = 0; i < 6; i++)
+                inv[6 * i + k] = col[i];
+        }
+        memcpy(B, inv, sizeof inv);
+    }
+    return 0;
+}
+
+/* z = (block of each body)^-1 r; returns r . z. */
+static double blocks_solve(const ws_rigid *R, const double *r, double *z)
+{
+    double rz = 0.0;
+    for (uint32_t j = 0; j < R->nb; j++) {
+        const size_t o = 6 * (size_t)j;
+        const double *B = R->fac + 36 * (size_t)j;
+        for (int i = 0; i < 6; i++) {
+            double s = 0.0;
+            for (int k = 0; k < 6; k++)
+                s += B[6 * i + k] * r[o + (size_t)k];
+            z[o + (size_t)i] = s;
+        }
+        for (int k = 0; k < 6; k++)
+            rz += r[o + (size_t)k] * z[o + (size_t)k];
+    }
+    return rz;
+}
+
+int ws_rigid_pairs_solve(ws_rigid *R, double tol, int maxit, int *iterations, double *residual)
+{
+    const size_t n = 6 * (size_t)R->nb;
+    *iterations = 0;
+    *residual = 0.0;
+    if (invert_blocks(R) != 0)
+        return -1;
+    memset(R->x, 0, n * sizeof(double));
+    memcpy(R->r, R->b, n * sizeof(double));
+    double rz = blocks_solve(R, R->r, R->z);
+    const double rz0 = rz;
+    if (!(rz0 > 0.0))
+        return rz0 == 0.0 ? 0 : -1; /* no load: no change; a NaN: not solved */
+    memcpy(R->p, R->z, n * sizeof(double));
+    for (int it = 1; it <= maxit; it++) {
+        pairs_only_apply(R, R->p, R->q);
+        const double pq = ws_rigid_dot(R, R->p, R->q);
+        if (!(pq > 0.0))
+            return -1;
+        ws_rigid_step(R, rz / pq);
+        const double rz_new = blocks_solve(R, R->r, R->z);
+        *iterations = it;
+        *residual = sqrt(fmax(rz_new, 0.0) / rz0);
+        if (*residual <= tol)
+            return 0;
+        ws_rigid_direction(R, rz_new / rz);
+        rz = rz_new;
+    }
+    return -1;
+}

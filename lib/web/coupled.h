@@ -130,4 +130,15 @@ void ws_rigid_direction(ws_rigid *R, double beta);
 /* a . b over the bodies' part. */
 double ws_rigid_dot(const ws_rigid *R, const double *a, const double *b);
 
+/* The bodies and their pairs alone (no film: R->nl = 0), A = diag(M_j) + the pairs' terms,
+ * solved for R->x from R->b by conjugate gradients preconditioned by each body's own block
+ * (its mass and its pairs' J^T C J at its end, inverted into R->fac, 36 doubles a body; the
+ * pairs' coupling between bodies in the operator alone), from x = 0, until sqrt(r . z) is at
+ * most tol times its start, at most maxit iterations; R->r, z, p, q are its scratch. The
+ * count of iterations into *iterations and the last ratio into *residual. 0, or -1 when a
+ * block is not positive definite or it did not converge. Its cost is a pass over the pairs an
+ * iteration, where the whole block's factor costs the cube of the bodies' rows (a pallet's
+ * cartons: 4x a step). */
+int ws_rigid_pairs_solve(ws_rigid *R, double tol, int maxit, int *iterations, double *residual);
+
 #endif
