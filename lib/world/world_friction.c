@@ -31,15 +31,22 @@
  * 1e-10). */
 #define WS_FRICTION_TOL 1e-8
 
-void ws_world_body_inertia(const ws_body_store *b, size_t i, double *S)
+void ws_world_rigid_bodies(ws_rigid *R, const ws_body_store *b, const uint32_t *slot)
 {
-    /* The global inertia A J A^T, symmetrised against round-off. */
-    const m3 At = m3_transpose(&b->A[i]), JA = m3_mul(&b->J[i], &At);
-    const m3 I = m3_mul(&b->A[i], &JA);
-    S[WS_SYM_XX] = I.m[0], S[WS_SYM_YY] = I.m[4], S[WS_SYM_ZZ] = I.m[8];
-    S[WS_SYM_XY] = 0.5 * (I.m[1] + I.m[3]);
-    S[WS_SYM_XZ] = 0.5 * (I.m[2] + I.m[6]);
-    S[WS_SYM_YZ] = 0.5 * (I.m[5] + I.m[7]);
+    for (size_t i = 0; i < b->slots; i++) {
+        const uint32_t j = slot[i];
+        if (j == UINT32_MAX)
+            continue;
+        R->mass[j] = b->mass[i];
+        /* The global inertia A J A^T, symmetrised against round-off. */
+        const m3 At = m3_transpose(&b->A[i]), JA = m3_mul(&b->J[i], &At);
+        const m3 I = m3_mul(&b->A[i], &JA);
+        double *S = R->inertia + WS_SYM * (size_t)j;
+        S[WS_SYM_XX] = I.m[0], S[WS_SYM_YY] = I.m[4], S[WS_SYM_ZZ] = I.m[8];
+        S[WS_SYM_XY] = 0.5 * (I.m[1] + I.m[3]);
+        S[WS_SYM_XZ] = 0.5 * (I.m[2] + I.m[6]);
+        S[WS_SYM_YZ] = 0.5 * (I.m[5] + I.m[7]);
+    }
 }
 
 /* Whether record c's friction is a damper for a solve: the regularised law, a friction
@@ -174,12 +181,11 @@ static ws_rigid *bodies_make(ws_step *S, uint32_t **slot_out, int *fail)
     R->z = R->r + v6;
     R->p = R->z + v6;
     R->q = R->p + v6;
+    ws_world_rigid_bodies(R, b, slot);
     for (size_t i = 0; i < b->slots; i++) {
         const uint32_t j = slot[i];
         if (j == UINT32_MAX)
             continue;
-        R->mass[j] = b->mass[i];
-        ws_world_body_inertia(b, i, R->inertia + WS_SYM * (size_t)j);
         double *B = R->b + 6 * (size_t)j;
         B[0] = S->dt * b->f[i].x, B[1] = S->dt * b->f[i].y, B[2] = S->dt * b->f[i].z;
         B[3] = S->dt * b->m[i].x, B[4] = S->dt * b->m[i].y, B[5] = S->dt * b->m[i].z;

@@ -85,13 +85,7 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
         *fail = 1;
         return NULL;
     }
-    for (size_t i = 0; i < b->slots; i++) {
-        const uint32_t j = slot[i];
-        if (j == UINT32_MAX)
-            continue;
-        R->mass[j] = b->mass[i];
-        ws_world_body_inertia(b, i, R->inertia + WS_SYM * (size_t)j);
-    }
+    ws_world_rigid_bodies(R, b, slot);
     *slot_out = slot;
     return R;
 }

@@ -276,8 +276,9 @@ int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot
  * opposite on a, added to their loads (and the guard's record of contact loads) and to the
  * contact's record: its friction at the end of the step, as the bodies take it. */
 void ws_world_friction_loads(ws_step *S, const struct ws_rigid *R, double h);
-/* A body's global inertia A J A^T as a symmetric 3 x 3 (WS_SYM doubles, web/implicit.h). */
-void ws_world_body_inertia(const ws_body_store *b, size_t i, double *S);
+/* The mass and global inertia A J A^T (symmetric, WS_SYM doubles) of each body of a solve
+ * (slot: its index in R, UINT32_MAX for the others) into R->mass and R->inertia. */
+void ws_world_rigid_bodies(struct ws_rigid *R, const ws_body_store *b, const uint32_t *slot);
 /* The stable sub-step of a web with the stiffest contact its material can have. */
 double ws_world_web_stable_dt(ws_world *w, const ws_web *web);
 /* The smallest node mass (kg) that makes the web stable at sub-step h by the same bound. */
