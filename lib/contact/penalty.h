@@ -72,20 +72,6 @@ static inline double ws_friction_phi(double v, double vlim)
     return v > 0.0 ? ws_friction_p(v / vlim) / v : 2.0 / vlim;
 }
 
-/* The slopes of eq. 13's friction F(t) = -cap p(|t| / v_lim) t / |t| on the tangent plane at a
- * slip speed v = |t|: dF/dt = -(across (I - e e^T) + along e e^T) there, e = t / v. Across the
- * slip the secant, cap phi; along it cap p'(s) / v_lim, zero at and above v_lim, where the
- * force's size is the cap (both 2 cap / v_lim at rest, where the direction is none). */
-typedef struct ws_friction_slopes {
-    double across, along;
-} ws_friction_slopes;
-
-static inline ws_friction_slopes ws_friction_slopes_at(double v, double cap, double vlim)
-{
-    return (ws_friction_slopes){cap * ws_friction_phi(v, vlim),
-                                cap * ws_friction_slope(v / vlim) / vlim};
-}
-
 /* The friction of a contact slipping at t (a tangential velocity) that slides at the force
  * cap = mu F_n (Coulomb's), for the pair's v_lim: cap p(|t| / v_lim) against t (eq. 13), at most
  * the force that stops a mass m slipping at |t| within a step h, m |t| / h (the explicit film's

@@ -3,10 +3,10 @@
  * 2 / dt (the film presses the boxes together at several times their weight): taken at the
  * step's start the boxes twist back and forth every step and a load creeps faster than the
  * law allows. Here each contact's friction is linearised about the slip at the start,
- * F(t + dt) = F(t) - C (dt), C its slopes on the tangent plane (ws_friction_slopes_at: the
- * secant across the slip, the law's slope along it, which is zero once it slides, so a sliding
- * box feels Coulomb's force to the bit), taken at the slip at the end of the step, and the
- * bodies' velocity changes dU over the step solve
+ * F(t1) = F(t0) - C (t1 - t0) for the slips t0 at the start and t1 at the end, C its slopes on
+ * the tangent plane (the secant across the slip, ws_friction_phi; the law's slope along it,
+ * ws_friction_slope, zero once it slides, so a sliding box feels Coulomb's force to the bit),
+ * and the bodies' velocity changes dU over the step solve
  *
  *     (M + h sum J^T C J) dU = h F,      J the contact point's motion,
  *
@@ -15,9 +15,9 @@
  * friction's change over the step, -C J dU, is added to the bodies' loads, and the integrators
  * take the loads as before. The matrix is the bodies' block of an implicit web's coupled solve
  * (web/coupled.h) with no film in it, solved by conjugate gradients preconditioned by each
- * body's own block (a pallet of 64 cartons: the whole block's factor cost 4x the step); a web that puts the bodies in its own solve takes the
- * friction of its bodies' contacts there (world_implicit.c), and those contacts are left out
- * here. */
+ * body's own block (the whole block's factor cost a pile of 64 cartons 4x a step). A web that
+ * puts the bodies in its own solve takes the friction of its bodies' contacts there
+ * (world_implicit.c), and those contacts are left out here. */
 #include "contact/penalty.h"
 #include "web/coupled.h"
 #include "world/world_internal.h"
@@ -86,10 +86,12 @@ int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, doubl
             continue;
         const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
         const double v = v3_norm(c->vt);
-        /* The secant on the whole plane, or the law's own slope along the slip. */
-        const ws_friction_slopes sl = ws_friction_slopes_at(v, pp->mu * c->fn, pp->vlim);
+        /* The secant on the whole plane, or along the slip the law's own slope, cap p'(s) /
+         * v_lim (zero at and above v_lim, where the force's size is the cap). */
         const double hc = h * pp->mu * c->fn * ws_friction_phi(v, pp->vlim),
-                     along = tangent ? h * sl.along : hc;
+                     along = tangent ? h * (pp->mu * c->fn * ws_friction_slope(v / pp->vlim) /
+                                            pp->vlim)
+                                     : hc;
         ws_rigid_pair *P = &R->pair[R->npair++];
         P->a = ja;
         P->b = jb;

@@ -267,7 +267,7 @@ ws_status ws_world_friction_step(ws_step *S);
 /* The body contacts whose friction goes into a solve with the bodies slot (UINT32_MAX: not in
  * it; a contact with a dynamic body outside stays out) for step h: each the damper its eq. 13
  * is over the slip at the start, C = h mu N phi (I - n n^T) (the secant), or with tangent set
- * the law's slope along the slip in place of the secant there (ws_friction_slopes_at), into
+ * the law's slope along the slip in place of the secant there (ws_friction_slope), into
  * R->pair (from the step's arena), and marked taken. 0, or -1 when out of memory. */
 struct ws_rigid;
 int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot, double h,

@@ -1254,7 +1254,8 @@ static ws_status friction_check(ws_step *S)
 {
     ws_world *w = S->w;
     const uint64_t since = w->steps + 1 - w->friction_step;
-    if (w->def.friction_step != WS_FRICTION_STEP_EXPLICIT || S->nrec == 0 || (w->friction_step && since < WS_CONTACT_CHECK_EVERY))
+    if (w->def.friction_step != WS_FRICTION_STEP_EXPLICIT || S->nrec == 0 ||
+        (w->friction_step && since < WS_CONTACT_CHECK_EVERY))
         return WS_OK;
     const size_t n = S->b->slots;
     if (ws_array_reserve(&w->mem, (void **)&w->friction_scratch, &w->friction_cap, 4 * (n + 1),
