@@ -3,9 +3,9 @@
  * contacts' loads on the bodies. The dynamic bodies the film touches are unknowns of the solve
  * beside its nodes (web/coupled.h, docs/theory.md section 8b), their other loads (gravity, body
  * contacts, elements, webs stepped before) known, but for their contacts' regularised
- * friction, which goes into the solve with them (world_friction.c; explicit, it chatters past 0.33 ms
- * on a wrapped stack); with hold_bodies they are held at their state at t as for the explicit
- * film (deviation (h) of docs/design.md). */
+ * friction, which goes into the solve with them (world_friction.c's pairs; explicit, it
+ * chatters past 0.33 ms on a wrapped stack); with hold_bodies they are held at their state at
+ * t as for the explicit film (deviation (h) of docs/design.md). */
 #include "contact/node_jacobian.h"
 #include "contact/penalty.h"
 #include "web/coupled.h"
