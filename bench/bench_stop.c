@@ -23,7 +23,12 @@
  * then top, and the bodies' contact count), WS_PROBE_LOADS=file (a line a step: each box's pose
  * and the film's force and moment on it, the plane's and the box-box contacts, the film at the
  * boxes' vertical edges: see loads_line), WS_PROBE_MIRROR=n and WS_PROBE_NODE=column,row (the
- * band against its mirror image: see mirror_line). */
+ * band against its mirror image: see mirror_line), WS_PROBE_NODES=file (a line a node at the
+ * end: column, row, its contact's comings and goings, steps in contact, rms of its dv and of
+ * dv's change from step to step, its position), WS_PROBE_WATCH=column,row (that node's
+ * contacts a step: active at the start, normal force at the start and at the end by the
+ * linear model, the body's point's and the node's velocity along the normal; its springs'
+ * strains). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
