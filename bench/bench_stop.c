@@ -23,7 +23,12 @@
  * then top, and the bodies' contact count), WS_PROBE_LOADS=file (a line a step: each box's pose
  * and the film's force and moment on it, the plane's and the box-box contacts, the film at the
  * boxes' vertical edges: see loads_line), WS_PROBE_MIRROR=n and WS_PROBE_NODE=column,row (the
- * band against its mirror image: see mirror_line). */
+ * band against its mirror image: see mirror_line), WS_PROBE_NODES=file (a line a node at the
+ * end: column, row, its contact's comings and goings, steps in contact, rms of its dv and of
+ * dv's change from step to step, its position), WS_PROBE_WATCH=column,row (that node's
+ * contacts a step: active at the start, normal force at the start and at the end by the
+ * linear model, the body's point's and the node's velocity along the normal; its springs'
+ * strains). */
 #define TILT_TABLE_NO_MAIN
 #include "../examples/tilt_table.c"
 
@@ -330,6 +335,13 @@ static int window_probe(int argc, char **argv)
         web->hold_bodies = atoi(getenv("WS_PROBE_HOLD"));
     FILE *steps_out = getenv("WS_PROBE_STEPS") ? fopen(getenv("WS_PROBE_STEPS"), "w") : NULL;
     FILE *loads_out = getenv("WS_PROBE_LOADS") ? fopen(getenv("WS_PROBE_LOADS"), "w") : NULL;
+    /* WS_PROBE_NODES=file: per node over the run, its contact's comings and goings, the steps
+     * it was in contact, and its dv's size and step-to-step change (rms), a line a node. */
+    FILE *nodes_out = getenv("WS_PROBE_NODES") ? fopen(getenv("WS_PROBE_NODES"), "w") : NULL;
+    double *nd_dv = calloc(n, sizeof(double)), *nd_ddv = calloc(n, sizeof(double));
+    uint32_t *nd_flip = calloc(n, sizeof(uint32_t)), *nd_on = calloc(n, sizeof(uint32_t));
+    if (!nd_dv || !nd_ddv || !nd_flip || !nd_on)
+        return 1;
     double t0;
     ws_world_get_time(sc.world, &t0);
     printf("case R refined %d (%u nodes, %d x %d), bodies %s, from t %.4f s (%.2f deg), %.3f s\n",
@@ -356,17 +368,60 @@ static int window_probe(int argc, char **argv)
         memcpy(st0, st, n);
         memset(st, 0, n);
         pr.solves = 0;
+        pr.watch_count = 0;
+        int wc = -1, wr = -1;
+        if (getenv("WS_PROBE_WATCH") &&
+            sscanf(getenv("WS_PROBE_WATCH"), "%d,%d", &wc, &wr) == 2) {
+            pr.watch_on = 1;
+            pr.watch = (uint32_t)(wc + wr * web->nx);
+        }
         if (ws_world_step(sc.world) != WS_OK) {
             printf("step %ld failed: %s\n", k, ws_world_last_error(sc.world));
             return 1;
         }
         /* Step-to-step change of the film's dv and of the bodies' (dU, both boxes, their
          * velocity and spin as they are, metres and radians a second). */
+        if (pr.watch_on) {
+            /* WS_PROBE_WATCH=column,row: that node's contacts at the start and the normal force
+             * their linear model ends with, its velocity, and its springs' strains. */
+            const uint32_t i = pr.watch;
+            const ws_nodes3 X = web->x[sc.world->cur], V = web->v[sc.world->cur];
+            const double *D = web->imp->dv + 3 * (size_t)i;
+            printf("watch %ld x %.7f %.7f %.7f v %.5f %.5f %.5f dv %.3g %.3g %.3g its %u\n", k,
+                   X.x[i], X.y[i], X.z[i], V.x[i], V.y[i], V.z[i], D[0], D[1], D[2],
+                   pr.it[0]);
+            for (uint32_t q = 0; q < pr.watch_count; q++) {
+                const double *nn = pr.watch_link[q].n;
+                const double nv = nn[0] * V.x[i] + nn[1] * V.y[i] + nn[2] * V.z[i],
+                             nd = nn[0] * D[0] + nn[1] * D[1] + nn[2] * D[2];
+                printf("   link body %u active %d fn %.4g fe %.4g fin %.3g n %.3f %.3f %.3f slip "
+                       "%.3g n.u_body %.4g n.v_node %.4g\n",
+                       pr.watch_link[q].body, pr.watch_link[q].active, pr.watch_link[q].fn,
+                       pr.watch_link[q].fn - pr.watch_link[q].k * sc.dt * nv -
+                           pr.watch_link[q].c * nd,
+                       pr.watch_link[q].fin, nn[0], nn[1], nn[2], pr.watch_link[q].slip,
+                       pr.watch_link[q].nu, nv);
+            }
+            printf("   strains");
+            for (uint32_t s2 = 0; s2 < web->ns; s2++)
+                if (web->sa[s2] == i || web->sb[s2] == i) {
+                    const uint32_t a2 = web->sa[s2], b2 = web->sb[s2];
+                    const double l = sqrt((X.x[a2] - X.x[b2]) * (X.x[a2] - X.x[b2]) +
+                                          (X.y[a2] - X.y[b2]) * (X.y[a2] - X.y[b2]) +
+                                          (X.z[a2] - X.z[b2]) * (X.z[a2] - X.z[b2]));
+                    printf(" k%d %.4f", web->kind[s2], l * web->inv_l0[s2] - 1.0);
+                }
+            printf("\n");
+        }
         const double *dv = web->imp->dv;
         double dd = 0.0, d2 = 0.0, ud = 0.0, u2 = 0.0, dlin[2] = {0.0, 0.0}, dang[2] = {0.0, 0.0};
         for (size_t j = 0; j < 3 * (size_t)n; j++) {
             dd += (dv[j] - dv0[j]) * (dv[j] - dv0[j]);
             d2 += dv[j] * dv[j];
+            if (k > 1) {
+                nd_dv[j / 3] += dv[j] * dv[j];
+                nd_ddv[j / 3] += (dv[j] - dv0[j]) * (dv[j] - dv0[j]);
+            }
         }
         memcpy(dv0, dv, 3 * (size_t)n * sizeof(double));
         for (int q = 0; q < 2; q++) {
@@ -438,6 +493,10 @@ static int window_probe(int argc, char **argv)
             enter += !was && is;
             leave += was && !is;
             flip += was && is && st0[i] != st[i];
+            if (k > 1) {
+                nd_flip[i] += was != is;
+                nd_on[i] += is;
+            }
             if (k > 1 && was != is) { /* where on the band: twelfths up it, quarters around */
                 s.where_up[12 * (i / (uint32_t)web->nx) / (uint32_t)web->ny]++;
                 s.where_around[4 * (i % (uint32_t)web->nx) / (uint32_t)web->nx]++;
@@ -495,6 +554,18 @@ static int window_probe(int argc, char **argv)
            (cpu_seconds() - c0) / T);
     if (steps_out)
         fclose(steps_out);
+    if (nodes_out) {
+        const ws_nodes3 X = web->x[sc.world->cur];
+        for (uint32_t i = 0; i < n; i++)
+            fprintf(nodes_out, "%u %u %u %u %.4g %.4g %.5f %.5f %.5f\n", i % (uint32_t)web->nx,
+                    i / (uint32_t)web->nx, nd_flip[i], nd_on[i], sqrt(nd_dv[i] / (steps - 1)),
+                    sqrt(nd_ddv[i] / (steps - 1)), X.x[i], X.y[i], X.z[i]);
+        fclose(nodes_out);
+    }
+    free(nd_dv);
+    free(nd_ddv);
+    free(nd_flip);
+    free(nd_on);
     if (loads_out)
         fclose(loads_out);
     web->imp->probe = NULL;

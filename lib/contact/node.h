@@ -429,6 +429,10 @@ typedef struct ws_node_pass {
     ws_nodes3 x, v;
     double h, share;
     v3 *fc;
+    /* The implicit film's (ws_node_links): the dynamic bodies move in the film's solve, so the
+     * step's active set takes a node's motion relative to its body's contact point; 0: the
+     * bodies held (the solve takes them at rest over the step). */
+    int bodies_move;
 } ws_node_pass;
 
 /* Evaluate the stretches from *next on whose nodes lie below n1 (the end of a sweep block),

@@ -214,7 +214,14 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
         v3 u = nodes_get(P->v, i);
         if (guess)
             u = v3_add(u, v3_make(guess[3 * i], guess[3 * i + 1], guess[3 * i + 2]));
-        const double nv = v3_dot(at.n, u), fe = L->fn - L->k * P->h * nv;
+        /* Relative to the body's point when the body moves in the solve: a face that moves
+         * with the node (a stack turning with the platform) is not reached by the node's own
+         * speed, and one brought in while it is not reached pulls the node in by its linear
+         * model for the step, to let it go the next (docs/theory.md 8b). */
+        if (P->bodies_move && b->type[bi] == WS_BODY_DYNAMIC) {
+            L->ub = v3_dot(at.n, v3_add(mb.v, v3_cross(mb.w, L->lever)));
+        }
+        const double nv = v3_dot(at.n, u) - L->ub, fe = L->fn - L->k * P->h * nv;
         if (!L->active && fe > 0.0)
             bring_in(L, fe);
     }
@@ -255,8 +262,8 @@ size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_n
         ws_node_link *c = &L[k];
         const uint32_t i = c->node;
         const double *D = dv + 3 * (size_t)i;
-        const double nv = c->n.x * v1.x[i] + c->n.y * v1.y[i] + c->n.z * v1.z[i],
-                     nd = c->n.x * D[0] + c->n.y * D[1] + c->n.z * D[2];
+        const double nv = c->n.x * v1.x[i] + c->n.y * v1.y[i] + c->n.z * v1.z[i] - c->ub - c->dub,
+                     nd = c->n.x * D[0] + c->n.y * D[1] + c->n.z * D[2] - c->dub;
         const double fe = c->fn - c->k * h * nv - c->c * nd;
         /* Contacts come in and never leave within a step: a node that would leave its face
          * keeps the linear model of its force for this one step (which may end pulling a

@@ -24,6 +24,10 @@ typedef struct ws_node_link {
     double mu;   /* its friction coefficient, 0 for a pinned node */
     v3 t, tt;    /* the tangential slip at the start and its direction (zero at rest) */
     double phi, dp; /* eq. 13 over the slip: F_t = -mu N phi t; dp = p'(s) / v_lim */
+    /* The body's contact point's velocity along n at the start (ub) and its change over the
+     * step (dub, the solve's, set by its caller before ws_node_link_update), when the body moves
+     * in the film's solve (ws_node_pass's bodies_move); both 0 when it is held there. */
+    double ub, dub;
     double K[WS_SYM], D[WS_SYM];
 } ws_node_link;
 
@@ -39,7 +43,8 @@ typedef struct ws_node_exact {
  * material, the window raised by reach: each into out (room for count), their number returned.
  * A contact that pushes at the start starts active, with its friction, and so does one that the
  * node reaches within the step P->h at its present velocity plus `guess` (xyz per node; NULL:
- * none) (with the normal force it would end with); any other (beyond the window, or leaving
+ * none), relative to its body's point when P->bodies_move and the body is dynamic (with the
+ * normal force it would end with); any other (beyond the window, or leaving
  * it) starts inactive with its normal force's linear model alone (f = fn n, K, D along n),
  * which ws_node_link_update may bring in. P's share and fc are not read. exact (room for count,
  * or NULL: not computed) receives each contact's exact derivatives, in the order of out. */
@@ -47,7 +52,8 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
                      double reach, ws_node_link *out, ws_node_exact *exact);
 
 /* After a solve over step h (dv; new velocities v1): each contact's normal force at the end of
- * the step by its linear model, fn - k h n.v1 - c n.dv; an inactive contact becomes active
+ * the step by its linear model, fn - k h n.(v1 - ub - dub) - c n.(dv - dub) (the node's motion
+ * relative to the body's point, as the solve takes it); an inactive contact becomes active
  * when it pushes by more than fin (an active one stays). Returns how many changed. */
 size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
                            double h);

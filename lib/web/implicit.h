@@ -52,6 +52,18 @@ typedef struct ws_implicit_probe {
     uint32_t bind_row;
     int bind_kind;
     double bind_value;
+    /* One node's contacts at the start of the step (watch_on set: node watch): up to 4, each
+     * its body, whether it starts active, the normal force at the start, k, c and the unit
+     * normal. */
+    int watch_on;
+    uint32_t watch, watch_count;
+    struct {
+        uint32_t body;
+        int active;
+        double fn, k, c, fin;
+        double n[3], slip;
+        double nu; /* the body's point's velocity along the normal at the start */
+    } watch_link[4];
 } ws_implicit_probe;
 
 typedef struct ws_implicit {

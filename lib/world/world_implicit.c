@@ -182,6 +182,21 @@ static void loads_moved(const ws_rigid *R, const uint32_t *slot, const ws_body_s
     }
 }
 
+/* The solve's change of each contact's body point velocity along its normal (dub), for the
+ * active set's test of the contacts' end forces (ws_node_link_update). */
+static void body_moves(const ws_rigid *R, const uint32_t *slot, ws_node_link *L, size_t nl)
+{
+    for (size_t k = 0; k < nl; k++) {
+        const uint32_t j = slot[L[k].body];
+        if (j == UINT32_MAX)
+            continue;
+        const double *dU = R->x + 6 * (size_t)j;
+        const v3 du = v3_add(v3_make(dU[0], dU[1], dU[2]),
+                             v3_cross(v3_make(dU[3], dU[4], dU[5]), L[k].lever));
+        L[k].dub = v3_dot(L[k].n, du);
+    }
+}
+
 /* A bench's probe: each node's contact state over the step's links, a slipping contact above
  * a sticking one above an inactive one. */
 static void probe_states(ws_implicit_probe *pr, const ws_node_pass *P, const ws_node_link *L,
@@ -192,6 +207,21 @@ static void probe_states(ws_implicit_probe *pr, const ws_node_pass *P, const ws_
         const uint8_t q = !L[k].active ? 1 : v3_norm(L[k].t) < vlim ? 2 : 3;
         if (q > pr->state[L[k].node])
             pr->state[L[k].node] = q;
+        if (pr->watch_on && L[k].node == pr->watch && pr->watch_count < 4) {
+            const uint32_t j = pr->watch_count++;
+            pr->watch_link[j].body = L[k].body;
+            pr->watch_link[j].active = L[k].active;
+            pr->watch_link[j].fn = L[k].fn;
+            pr->watch_link[j].k = L[k].k;
+            pr->watch_link[j].c = L[k].c;
+            pr->watch_link[j].fin = L[k].fin;
+            pr->watch_link[j].n[0] = L[k].n.x;
+            pr->watch_link[j].n[1] = L[k].n.y;
+            pr->watch_link[j].n[2] = L[k].n.z;
+            pr->watch_link[j].slip = v3_norm(L[k].t);
+            pr->watch_link[j].nu =
+                v3_dot(L[k].n, point_velocity(P->b, P->cur, L[k].body, L[k].lever));
+        }
     }
 }
 
@@ -222,7 +252,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                            w->time, label(web));
         /* The contacts the step may reach: those of nodes within a step's travel of the
          * window's top, bounded by the margin the candidates cover. */
-        const ws_node_pass np = {b, cur, &w->node_geom, w->node_par, cl->c, xs, vs, h, share, NULL};
+        const ws_node_pass np = {b, cur,   &w->node_geom, w->node_par,      cl->c, xs, vs,
+                                 h, share, NULL,          !web->hold_bodies};
         const size_t nl = ws_node_links(&np, web, cl->n, im->warm ? im->dv : NULL,
                                         S->contact.margin, links, NULL);
         if (im->probe && im->probe->state)
@@ -257,6 +288,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
             if (!ok)
                 break;
             ws_implicit_velocities(web, vs, vd);
+            if (R)
+                body_moves(R, slot, links, nl);
             if (pass + 1 == WS_IMPLICIT_PASSES ||
                 ws_node_link_update(links, nl, im->dv, vd, h) == 0)
                 break;

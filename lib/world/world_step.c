@@ -825,7 +825,7 @@ static ws_status step_webs(ws_step *S)
             lane_task T = {w,
                            web,
                            {b, cur, &w->node_geom, w->node_par, nc->cand[list].c, xs, vs, h, share,
-                            web->fc[nxt]},
+                            web->fc[nxt], 0},
                            xd,
                            vd,
                            s == 0,
