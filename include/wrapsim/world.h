@@ -168,14 +168,16 @@ typedef struct ws_world_stats {
     /** dt as a fraction of the bodies' contact stable step (ws_world_estimate_stable_dt without
      *  the elements; 0 when no two bodies can touch); refused above 1. */
     double body_step_use;
-    /** dt as a fraction of the regularised friction's explicit limit 2 / lambda, held: the
+    /** With ws_world_def.friction_step = WS_FRICTION_STEP_EXPLICIT (0 otherwise: taken at the
+     *  end of the step the friction has no such limit), dt as a fraction of the regularised
+     *  friction's explicit limit 2 / lambda, held: the
      *  largest value that 16 measures in a row all passed since the world was made (lambda:
      *  the highest rate of the bodies' contacts' friction below v_lim as dampers, slope
      *  2 mu F_n / v_lim, on the bodies' masses; measured every 64 steps while contacts act;
      *  0 before 16 measures). Above 1 the bodies' contacts slip back and forth every step and
      *  a load creeps faster than the law allows (docs/theory.md, section 8); the step is not
-     *  refused, the log hook hears it once (WS_LOG_WARNING). Use a smaller dt or
-     *  WS_FRICTION_STICK. */
+     *  refused, the log hook hears it once (WS_LOG_WARNING). Use a smaller dt,
+     *  WS_FRICTION_STEP_IMPLICIT or WS_FRICTION_STICK. */
     double friction_step_use;
     uint64_t reserved[1];      /**< zero; room to grow */
 } ws_world_stats;
