@@ -5,8 +5,9 @@
  * law allows. Here each contact's friction is linearised about the slip at the start,
  * F(t1) = F(t0) - C (t1 - t0) for the slips t0 at the start and t1 at the end, C its slopes on
  * the tangent plane (the secant across the slip, ws_friction_phi; the law's slope along it,
- * ws_friction_slope, zero once it slides, so a sliding box feels Coulomb's force to the bit),
- * and the bodies' velocity changes dU over the step solve
+ * ws_friction_slope, zero once it slides, so a sliding box feels Coulomb's force to the bit;
+ * where the step reverses a slip, the secant along it too, so that the friction at most stops
+ * it), and the bodies' velocity changes dU over the step solve
  *
  *     (M + h sum J^T C J) dU = h F,      J the contact point's motion,
  *
@@ -17,7 +18,7 @@
  * (web/coupled.h) with no film in it, solved by conjugate gradients preconditioned by each
  * body's own block (the whole block's factor cost a pile of 64 cartons 4x a step). A web that
  * puts the bodies in its own solve takes the friction of its bodies' contacts there
- * (world_implicit.c), and those contacts are left out here. */
+ * (world_implicit.c), linearised the same way, and those contacts are left out here. */
 #include "contact/penalty.h"
 #include "web/coupled.h"
 #include "world/world_internal.h"
@@ -30,6 +31,11 @@
  * the loads): two boxes take 2-3 iterations, a pile of 64 cartons 18 (13 at 1e-6, 22 at
  * 1e-10). */
 #define WS_FRICTION_TOL 1e-8
+
+/* The most solves a step: the first, and again while a slip the step reverses turns its pair's
+ * slope to the secant (ws_world_friction_turned; a pair turns once, so the turns end; one more
+ * solve settles them in the cases measured). The last solve's answer is kept. */
+#define WS_FRICTION_SOLVES 4
 
 void ws_world_rigid_bodies(ws_rigid *R, const ws_body_store *b, const uint32_t *slot)
 {
@@ -57,8 +63,27 @@ static int damps(const ws_step *S, const ws_contact_rec *c)
     return pp->model == WS_FRICTION_REGULARIZED && pp->mu > 0.0 && c->fn > 0.0;
 }
 
-int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, double h,
-                            int tangent)
+/* Pair P's slopes h C for contact c: the secant across the slip, and along it the law's own
+ * slope, cap p'(s) / v_lim (zero at and above v_lim, where the force's size is the cap), or
+ * with slope clear the secant there too. */
+static void pair_damper(const ws_step *S, ws_rigid_pair *P, const ws_contact_rec *c, double h,
+                        int slope)
+{
+    const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
+    const double v = v3_norm(c->vt);
+    const double hc = h * pp->mu * c->fn * ws_friction_phi(v, pp->vlim),
+                 along = slope ? h * pp->mu * c->fn * ws_friction_slope(v / pp->vlim) / pp->vlim
+                               : hc;
+    memset(P->C, 0, sizeof P->C);
+    ws_sym_add_outer(P->C, -hc, c->n);
+    P->C[WS_SYM_XX] += hc;
+    P->C[WS_SYM_YY] += hc;
+    P->C[WS_SYM_ZZ] += hc;
+    if (along != hc && v > 0.0)
+        ws_sym_add_outer(P->C, along - hc, v3_scale(c->vt, 1.0 / v));
+}
+
+int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, double h)
 {
     const ws_world *w = S->w;
     const ws_body_store *b = S->b;
@@ -84,30 +109,36 @@ int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, doubl
         if ((ja == UINT32_MAX && jb == UINT32_MAX) || out_a || out_b || S->friction_taken[k] ||
             !damps(S, c))
             continue;
-        const ws_pair_params *pp = ws_contact_params(&S->contact, c->a, c->b);
-        const double v = v3_norm(c->vt);
-        /* The secant on the whole plane, or along the slip the law's own slope, cap p'(s) /
-         * v_lim (zero at and above v_lim, where the force's size is the cap). */
-        const double hc = h * pp->mu * c->fn * ws_friction_phi(v, pp->vlim),
-                     along = tangent ? h * (pp->mu * c->fn * ws_friction_slope(v / pp->vlim) /
-                                            pp->vlim)
-                                     : hc;
         ws_rigid_pair *P = &R->pair[R->npair++];
         P->a = ja;
         P->b = jb;
         P->tag = (uint32_t)k;
         P->ra = v3_sub(c->x, b->st[S->cur].r[c->a]);
         P->rb = v3_sub(c->x, b->st[S->cur].r[c->b]);
-        memset(P->C, 0, sizeof P->C);
-        ws_sym_add_outer(P->C, -hc, c->n);
-        P->C[WS_SYM_XX] += hc;
-        P->C[WS_SYM_YY] += hc;
-        P->C[WS_SYM_ZZ] += hc;
-        if (along != hc && v > 0.0)
-            ws_sym_add_outer(P->C, along - hc, v3_scale(c->vt, 1.0 / v));
+        pair_damper(S, P, c, h, 1);
         S->friction_taken[k] = 1;
     }
     return 0;
+}
+
+size_t ws_world_friction_turned(ws_step *S, ws_rigid *R, double h)
+{
+    const ws_contact_rec *rec = S->w->rec[S->nxt];
+    size_t turned = 0;
+    for (size_t q = 0; q < R->npair; q++) {
+        ws_rigid_pair *P = &R->pair[q];
+        const ws_contact_rec *c = &rec[P->tag];
+        /* At rest the slope is the secant already; a pair turned once stays so. */
+        if (S->friction_taken[P->tag] == 2 || !(v3_norm(c->vt) > 0.0))
+            continue;
+        const v3 t1 = v3_add(c->vt, ws_rigid_pair_slip(R, q, R->x));
+        if (v3_dot(t1, c->vt) < 0.0) {
+            pair_damper(S, P, c, h, 0);
+            S->friction_taken[P->tag] = 2;
+            turned++;
+        }
+    }
+    return turned;
 }
 
 void ws_world_friction_loads(ws_step *S, const ws_rigid *R, double h)
@@ -209,25 +240,29 @@ ws_status ws_world_friction_step(ws_step *S)
         return fail ? ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for the friction")
                     : WS_OK;
     }
-    if (ws_world_friction_pairs(S, R, slot, S->dt, 1) != 0)
+    if (ws_world_friction_pairs(S, R, slot, S->dt) != 0)
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for the friction");
     /* Positive definite for bodies of positive mass (the masses plus the dampers' energies):
      * conjugate gradients converge, in a few iterations where the dampers are weak against
      * the masses and in at most the rows' count where they are not. A NaN among the loads
      * is left as it is for the health check to name. */
-    int it = 0;
-    double res = 0.0;
     const int maxit = 10 * 6 * (int)R->nb + 100;
-    if (ws_rigid_pairs_solve(R, WS_FRICTION_TOL, maxit, &it, &res) != 0) {
-        if (!isfinite(res) || res == 0.0)
-            return WS_OK;
-        S->stats->numerical_errors++;
-        return ws_fail(w, WS_ERR_NUMERICAL,
-                       "step at t = %.6g s: the bodies' friction at the end of the step (%zu "
-                       "contacts, %u bodies) did not converge: residual %.3g of the loads' "
-                       "after %d iterations (tolerance %.3g); the step was undone. Take a "
-                       "smaller dt, or WS_FRICTION_STEP_EXPLICIT",
-                       w->time, R->npair, R->nb, res, it, WS_FRICTION_TOL);
+    for (int solve = 0;; solve++) {
+        int it = 0;
+        double res = 0.0;
+        if (ws_rigid_pairs_solve(R, WS_FRICTION_TOL, maxit, &it, &res) != 0) {
+            if (!isfinite(res) || res == 0.0)
+                return WS_OK;
+            S->stats->numerical_errors++;
+            return ws_fail(w, WS_ERR_NUMERICAL,
+                           "step at t = %.6g s: the bodies' friction at the end of the step "
+                           "(%zu contacts, %u bodies) did not converge: residual %.3g of the "
+                           "loads' after %d iterations (tolerance %.3g); the step was undone. "
+                           "Take a smaller dt, or WS_FRICTION_STEP_EXPLICIT",
+                           w->time, R->npair, R->nb, res, it, WS_FRICTION_TOL);
+        }
+        if (solve + 1 == WS_FRICTION_SOLVES || ws_world_friction_turned(S, R, S->dt) == 0)
+            break;
     }
     ws_world_friction_loads(S, R, S->dt);
     return WS_OK;

@@ -271,11 +271,12 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         /* The body-body friction in the solve: one solve a step (no sub-steps), of the first
          * web that couples the bodies. */
         if (R && n == 1 && !S->body_later && first_coupled(w, web) &&
-            ws_world_friction_pairs(S, R, slot, h, 0) != 0)
+            ws_world_friction_pairs(S, R, slot, h) != 0)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));
         /* The active set: a solve with the contacts that push, then with those whose linear
-         * model pushes at the end of the step, until no contact changes (at most
+         * model pushes at the end of the step, and with the bodies' friction turned to the
+         * secant where the step reverses a slip, until nothing changes (at most
          * WS_IMPLICIT_PASSES solves; the last set is kept). Each solve starts from the last. */
         int ok = 1;
         for (int pass = 0; pass < WS_IMPLICIT_PASSES; pass++) {
@@ -290,8 +291,12 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
             ws_implicit_velocities(web, vs, vd);
             if (R)
                 body_moves(R, slot, links, nl);
-            if (pass + 1 == WS_IMPLICIT_PASSES ||
-                ws_node_link_update(links, nl, im->dv, vd, h) == 0)
+            if (pass + 1 == WS_IMPLICIT_PASSES)
+                break;
+            /* Both tests run: each readies its own change for the next solve. */
+            const size_t moved = ws_node_link_update(links, nl, im->dv, vd, h);
+            const size_t turned = R && R->npair ? ws_world_friction_turned(S, R, h) : 0;
+            if (moved == 0 && turned == 0)
                 break;
         }
         if (!ok) {

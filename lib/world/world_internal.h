@@ -265,13 +265,16 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list);
  * the bodies' loads and the records. Before the integration, all loads known. */
 ws_status ws_world_friction_step(ws_step *S);
 /* The body contacts whose friction goes into a solve with the bodies slot (UINT32_MAX: not in
- * it; a contact with a dynamic body outside stays out) for step h: each the damper its eq. 13
- * is over the slip at the start, C = h mu N phi (I - n n^T) (the secant), or with tangent set
- * the law's slope along the slip in place of the secant there (ws_friction_slope), into
- * R->pair (from the step's arena), and marked taken. 0, or -1 when out of memory. */
+ * it; a contact with a dynamic body outside stays out) for step h: each its eq. 13 linearised
+ * about the slip at the start, h C with C = mu N phi across the slip (the secant) and
+ * mu N p'(s) / v_lim along it (the law's slope, ws_friction_slope), into R->pair (from the
+ * step's arena), and marked taken. 0, or -1 when out of memory. */
 struct ws_rigid;
-int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot, double h,
-                            int tangent);
+int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot, double h);
+/* After a solve R->x: the pairs whose slip the step reverses (its end slip against its start),
+ * their slope along the slip turned to the secant (the law's line through zero: the friction
+ * at most stops the slip), for the next solve. How many turned. */
+size_t ws_world_friction_turned(ws_step *S, struct ws_rigid *R, double h);
 /* The pairs' friction over the solved step R->x, -C (J_b dU_b - J_a dU_a) / h on body b and the
  * opposite on a, added to their loads (and the guard's record of contact loads) and to the
  * contact's record: its friction at the end of the step, as the bodies take it. */
