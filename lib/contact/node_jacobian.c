@@ -218,7 +218,11 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
          * with the node (a stack turning with the platform) is not reached by the node's own
          * speed, and one brought in while it is not reached pulls the node in by its linear
          * model for the step, to let it go the next (docs/theory.md 8b). */
-        if (P->bodies_move && b->type[bi] == WS_BODY_DYNAMIC) {
+        if (b->type[bi] == WS_BODY_KINEMATIC) {
+            /* A world element moves as it is told over the step, solve or no solve. */
+            L->uk = v3_add(mb.v, v3_cross(mb.w, L->lever));
+            L->ub = v3_dot(at.n, L->uk);
+        } else if (P->bodies_move && b->type[bi] == WS_BODY_DYNAMIC) {
             L->ub = v3_dot(at.n, v3_add(mb.v, v3_cross(mb.w, L->lever)));
         }
         const double nv = v3_dot(at.n, u) - L->ub, fe = L->fn - L->k * P->h * nv;
@@ -240,9 +244,9 @@ size_t ws_node_link_loads(const ws_node_link *L, size_t count, const double *dv,
             continue;
         const double *D = dv + 3 * (size_t)i;
         const v3 u = nodes_get(v1, i);
-        /* f - K h v1 - D dv: the force the node's solve took over the step. */
+        /* f - K h (v1 - uk) - D dv: the force the node's solve took over the step. */
         double o[3] = {0.0, 0.0, 0.0};
-        ws_sym_madd(c->K, h * u.x, h * u.y, h * u.z, o);
+        ws_sym_madd(c->K, h * (u.x - c->uk.x), h * (u.y - c->uk.y), h * (u.z - c->uk.z), o);
         ws_sym_madd(c->D, D[0], D[1], D[2], o);
         const v3 F = v3_sub(c->f, v3_make(o[0], o[1], o[2]));
         const v3 load = v3_scale(F, -share);

@@ -28,6 +28,9 @@ typedef struct ws_node_link {
      * step (dub, the solve's, set by its caller before ws_node_link_update), when the body moves
      * in the film's solve (ws_node_pass's bodies_move); both 0 when it is held there. */
     double ub, dub;
+    /* A world element's contact point's velocity at the start (its motion over the step is
+     * given, not solved: the face moves h uk in it); zero for the other bodies. */
+    v3 uk;
     double K[WS_SYM], D[WS_SYM];
 } ws_node_link;
 

@@ -134,7 +134,11 @@ static void links_into(ws_implicit *im, ws_rigid *R, const uint32_t *slot, const
             continue;
         const uint32_t j = R ? slot[c->body] : UINT32_MAX;
         if (j == UINT32_MAX) {
-            ws_implicit_add(im, c->node, c->f, c->K, c->D);
+            /* A world element's face moves h uk over the step (zero for the others). */
+            double ku[3] = {0.0, 0.0, 0.0};
+            ws_sym_madd(c->K, h * c->uk.x, h * c->uk.y, h * c->uk.z, ku);
+            ws_implicit_add(im, c->node, v3_add(c->f, v3_make(ku[0], ku[1], ku[2])), c->K,
+                            c->D);
             continue;
         }
         const v3 u0 = point_velocity(b, cur, c->body, c->lever), u = nodes_get(v, c->node);
