@@ -2356,6 +2356,29 @@ static void cube_and_film(ws_world *w, ws_material_id *film, ws_body_def *bd)
     bd->material = box_mat;
 }
 
+/* A free square implicit film of n x n nodes of mass m, `spacing` apart from `origin` in the xy
+ * plane, its springs at rest length (the linear viscoelastic law, 100 N/m, 0.2 N s/m), of
+ * material film, solved to tolerance tol. */
+static ws_web_id free_film(ws_world *w, ws_material_id film, double m, double tol, uint32_t n,
+                           ws_vec3 origin, double spacing)
+{
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.node_mass = m;
+    wd.law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 100.0, 0.0, 0.2, 0.0);
+    wd.material = film;
+    wd.integrator = WS_WEB_IMPLICIT;
+    wd.solver_tolerance = tol;
+    ws_sheet_def sd;
+    ws_sheet_def_init(&sd);
+    sd.nx = sd.ny = n;
+    sd.origin = origin;
+    sd.spacing_x = sd.spacing_y = spacing;
+    ws_web_id web;
+    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    return web;
+}
+
 /* A box of `mass` kg, 0.1 m a side, dropped from rest just touching the middle of a square
  * implicit sheet (0.4 m, 21 x 21 nodes, its border pinned, pre-stretched 5 %) under gravity,
  * at step dt, the box held during the film's solve or in it; after T s: the box's speed, the
@@ -2493,23 +2516,8 @@ START_TEST(test_film_body_momentum)
     bd.angular_velocity = v3_make(0.0, 0.0, 2.0);
     ws_body_id body;
     ck_ok(w, ws_body_create(w, &bd, &body));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 100.0, 0.0, 0.2, 0.0);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = mn;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
-    wd.solver_tolerance = 1e-11;
     enum { N = 11 };
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = N;
-    sd.ny = N;
-    sd.origin = v3_make(-0.1, -0.1, 0.0);
-    sd.spacing_x = sd.spacing_y = 0.02;
-    ws_web_id web;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    const ws_web_id web = free_film(w, film_mat, mn, 1e-11, N, v3_make(-0.1, -0.1, 0.0), 0.02);
     double vn[3 * N * N];
     size_t cnt;
     v3 P0 = v3_make(0, 0, 0);
@@ -2558,23 +2566,8 @@ static void film_under_moving_box(ws_vec3 u, double gap, int steps, double out[3
     bd.velocity = u;
     ws_body_id body;
     ck_ok(w, ws_body_create(w, &bd, &body));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 100.0, 0.0, 0.2, 0.0);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = 1e-7;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
-    wd.solver_tolerance = 1e-9;
     enum { N = 5 };
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = N;
-    sd.ny = N;
-    sd.origin = v3_make(-0.02, -0.02, 0.0);
-    sd.spacing_x = sd.spacing_y = 0.01;
-    ws_web_id web;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    const ws_web_id web = free_film(w, film_mat, 1e-7, 1e-9, N, v3_make(-0.02, -0.02, 0.0), 0.01);
     double vn[3 * N * N] = {0}, fc[3 * N * N] = {0};
     size_t cnt = 0;
     /* The nodes start at the box's velocity. */
@@ -2656,24 +2649,10 @@ static void film_on_kinematic_box(ws_vec3 u, int steps, double out[2])
     dd.callback = steady_drive;
     dd.callback_user = &u;
     ck_ok(w, ws_body_set_drive(w, body, &dd));
-    ws_law_id law = make_law(w, WS_LAW_LINEAR_VISCOELASTIC, 100.0, 0.0, 0.2, 0.0);
-    ws_web_def wd;
-    ws_web_def_init(&wd);
-    wd.node_mass = m;
-    wd.law = law;
-    wd.material = film_mat;
-    wd.integrator = WS_WEB_IMPLICIT;
-    wd.solver_tolerance = 1e-9;
     enum { N = 5 };
-    ws_sheet_def sd;
-    ws_sheet_def_init(&sd);
-    sd.nx = N;
-    sd.ny = N;
     /* In the two 1 mm layers' window, pressed in by its weight. */
-    sd.origin = v3_make(-0.02, -0.02, 0.05 + 2e-3 - m * G0 / k);
-    sd.spacing_x = sd.spacing_y = 0.01;
-    ws_web_id web;
-    ck_ok(w, ws_web_create_sheet(w, &wd, &sd, &web));
+    const ws_web_id web =
+        free_film(w, film_mat, m, 1e-9, N, v3_make(-0.02, -0.02, 0.05 + 2e-3 - m * G0 / k), 0.01);
     const ws_nodes3 V = web_of(w, web)->v[w->cur];
     for (size_t i = 0; i < N * N; i++)
         V.x[i] = u.x, V.y[i] = u.y, V.z[i] = u.z;
