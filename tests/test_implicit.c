@@ -2550,6 +2550,33 @@ START_TEST(test_film_body_momentum)
 }
 END_TEST
 
+/* Every node of the web at velocity u. */
+static void film_set_velocity(ws_world *w, ws_web_id web, ws_vec3 u)
+{
+    const ws_web *wb = web_of(w, web);
+    const ws_nodes3 V = wb->v[w->cur];
+    for (size_t i = 0; i < wb->n; i++)
+        V.x[i] = u.x, V.y[i] = u.y, V.z[i] = u.z;
+}
+
+/* After a step, the most a node's velocity is off u (into *dv) and its contact force off
+ * (0, 0, fz) (into *df), each kept as the larger of what it holds and the step's. */
+static void film_departure(ws_world *w, ws_web_id web, ws_vec3 u, double fz, double *dv,
+                           double *df)
+{
+    enum { MOST = 64 };
+    double vn[3 * MOST], fc[3 * MOST];
+    size_t nv = 0, nf = 0;
+    ck_ok(w, ws_web_copy_velocities(w, web, vn, MOST, &nv));
+    ck_ok(w, ws_web_copy_contact_forces(w, web, fc, MOST, &nf));
+    ck_assert(nv == nf && nv <= MOST);
+    for (size_t i = 0; i < nv; i++) {
+        const v3 d = v3_make(vn[3 * i] - u.x, vn[3 * i + 1] - u.y, vn[3 * i + 2] - u.z);
+        *dv = fmax(*dv, v3_norm(d));
+        *df = fmax(*df, v3_norm(v3_make(fc[3 * i], fc[3 * i + 1], fc[3 * i + 2] - fz)));
+    }
+}
+
 /* Galilean invariance of the node contacts' active set: no gravity, a free square of film (5 x
  * 5 nodes of 0.1 mg, its springs at rest length) lies flat under a free 0.1 m box, the box's
  * face `gap` outside the contact window (the two 1 mm layers), the box in the film's solve, and
@@ -2568,22 +2595,12 @@ static void film_under_moving_box(ws_vec3 u, double gap, int steps, double out[3
     ck_ok(w, ws_body_create(w, &bd, &body));
     enum { N = 5 };
     const ws_web_id web = free_film(w, film_mat, 1e-7, 1e-9, N, v3_make(-0.02, -0.02, 0.0), 0.01);
-    double vn[3 * N * N] = {0}, fc[3 * N * N] = {0};
-    size_t cnt = 0;
     /* The nodes start at the box's velocity. */
-    const ws_nodes3 V = web_of(w, web)->v[w->cur];
-    for (size_t i = 0; i < N * N; i++)
-        V.x[i] = u.x, V.y[i] = u.y, V.z[i] = u.z;
+    film_set_velocity(w, web, u);
     out[0] = out[1] = out[2] = 0.0;
     for (int k = 0; k < steps; k++) {
         ck_ok(w, ws_world_step(w));
-        ck_ok(w, ws_web_copy_velocities(w, web, vn, N * N, &cnt));
-        ck_ok(w, ws_web_copy_contact_forces(w, web, fc, N * N, &cnt));
-        for (size_t i = 0; i < cnt; i++) {
-            const v3 d = v3_make(vn[3 * i] - u.x, vn[3 * i + 1] - u.y, vn[3 * i + 2] - u.z);
-            out[0] = fmax(out[0], v3_norm(d));
-            out[2] = fmax(out[2], v3_norm(v3_make(fc[3 * i], fc[3 * i + 1], fc[3 * i + 2])));
-        }
+        film_departure(w, web, u, 0.0, &out[0], &out[2]);
         ws_vec3 vb;
         ck_ok(w, ws_body_get_velocity(w, body, &vb));
         out[1] = fmax(out[1], v3_norm(v3_sub(vb, u)));
@@ -2653,22 +2670,11 @@ static void film_on_kinematic_box(ws_vec3 u, int steps, double out[2])
     /* In the two 1 mm layers' window, pressed in by its weight. */
     const ws_web_id web =
         free_film(w, film_mat, m, 1e-9, N, v3_make(-0.02, -0.02, 0.05 + 2e-3 - m * G0 / k), 0.01);
-    const ws_nodes3 V = web_of(w, web)->v[w->cur];
-    for (size_t i = 0; i < N * N; i++)
-        V.x[i] = u.x, V.y[i] = u.y, V.z[i] = u.z;
-    double vn[3 * N * N] = {0}, fc[3 * N * N] = {0};
-    size_t cnt = 0;
+    film_set_velocity(w, web, u);
     out[0] = out[1] = 0.0;
     for (int s = 0; s < steps; s++) {
         ck_ok(w, ws_world_step(w));
-        ck_ok(w, ws_web_copy_velocities(w, web, vn, N * N, &cnt));
-        ck_ok(w, ws_web_copy_contact_forces(w, web, fc, N * N, &cnt));
-        for (size_t i = 0; i < cnt; i++) {
-            const v3 d = v3_make(vn[3 * i] - u.x, vn[3 * i + 1] - u.y, vn[3 * i + 2] - u.z);
-            out[0] = fmax(out[0], v3_norm(d));
-            const v3 f = v3_make(fc[3 * i], fc[3 * i + 1], fc[3 * i + 2] - m * G0);
-            out[1] = fmax(out[1], v3_norm(f));
-        }
+        film_departure(w, web, u, m * G0, &out[0], &out[1]);
     }
     ws_world_destroy(w);
 }
