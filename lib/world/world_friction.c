@@ -116,7 +116,7 @@ int ws_world_friction_pairs(ws_step *S, ws_rigid *R, const uint32_t *slot, doubl
         P->ra = v3_sub(c->x, b->st[S->cur].r[c->a]);
         P->rb = v3_sub(c->x, b->st[S->cur].r[c->b]);
         pair_damper(S, P, c, h, 1);
-        S->friction_taken[k] = 1;
+        S->friction_taken[k] = WS_FRICTION_TAKEN;
     }
     return 0;
 }
@@ -129,12 +129,12 @@ size_t ws_world_friction_turned(ws_step *S, ws_rigid *R, double h)
         ws_rigid_pair *P = &R->pair[q];
         const ws_contact_rec *c = &rec[P->tag];
         /* At rest the slope is the secant already; a pair turned once stays so. */
-        if (S->friction_taken[P->tag] == 2 || !(v3_norm(c->vt) > 0.0))
+        if (S->friction_taken[P->tag] == WS_FRICTION_TURNED || !(v3_norm(c->vt) > 0.0))
             continue;
         const v3 t1 = v3_add(c->vt, ws_rigid_pair_slip(R, q, R->x));
         if (v3_dot(t1, c->vt) < 0.0) {
             pair_damper(S, P, c, h, 0);
-            S->friction_taken[P->tag] = 2;
+            S->friction_taken[P->tag] = WS_FRICTION_TURNED;
             turned++;
         }
     }

@@ -195,8 +195,9 @@ typedef struct ws_step {
      * film like them (the broad phase's pairs found); and whether it ran out of the room
      * reserved for it there (then it runs again on the calling thread). */
     int narrow_later, narrow_bad;
-    /* By contact record: its friction taken into a solve this step (world_friction.c; NULL
-     * before any is). */
+    /* By contact record: its friction taken into a solve this step, WS_FRICTION_TAKEN, and
+     * WS_FRICTION_TURNED once its slope along the slip turned to the secant (world_friction.c;
+     * NULL before any is; 0: not taken). */
     uint8_t *friction_taken;
 } ws_step;
 
@@ -269,6 +270,7 @@ ws_status ws_world_friction_step(ws_step *S);
  * about the slip at the start, h C with C = mu N phi across the slip (the secant) and
  * mu N p'(s) / v_lim along it (the law's slope, ws_friction_slope), into R->pair (from the
  * step's arena), and marked taken. 0, or -1 when out of memory. */
+enum { WS_FRICTION_TAKEN = 1, WS_FRICTION_TURNED = 2 };
 struct ws_rigid;
 int ws_world_friction_pairs(ws_step *S, struct ws_rigid *R, const uint32_t *slot, double h);
 /* After a solve R->x: the pairs whose slip the step reverses (its end slip against its start),
