@@ -21,7 +21,8 @@
  * phases (`phases [duration] [r] [dt ms]`: case R's band refined r x r on the multigrid, CG
  * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run;
  * WS_BENCH_SAVE=file with WS_BENCH_SAVE_AT=t saves the state at t, WS_BENCH_RESUME=file starts
- * from a saved one),
+ * from a saved one), tilt (`tilt [duration] [r] [tolerance] [dt ms]`: as phases, at that
+ * solve tolerance, and then the run's answers; WS_BENCH_RESUME as phases),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -35,6 +36,38 @@ static double cpu_now(void)
     struct timespec ts;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* `tilt`'s log of every 50 ms of a run: CG iterations a step, mean and largest, and CPU s per
+ * simulated s, as `phases` prints them. */
+typedef struct window_log {
+    int r;
+    long window, k;
+    double dt, cpu;
+    uint64_t iterations, sum, most;
+} window_log;
+
+static void window_step(const tilt_scene *sc, void *user)
+{
+    window_log *log = user;
+    ws_web_solver_stats s;
+    ws_web_get_solver_stats(sc->world, sc->film, &s);
+    const uint64_t it = s.iterations - log->iterations;
+    log->iterations = s.iterations;
+    if (log->k++ == 0)
+        return; /* the first step's count is the run's so far when it resumes */
+    log->sum += it;
+    log->most = it > log->most ? it : log->most;
+    if (log->k % log->window)
+        return;
+    double t, c = cpu_now();
+    ws_world_get_time(sc->world, &t);
+    printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n", log->r, t,
+           (double)log->sum / (double)(log->window - (log->k == log->window)),
+           (unsigned long long)log->most, (c - log->cpu) / (log->window * log->dt));
+    fflush(stdout);
+    log->sum = log->most = 0;
+    log->cpu = c;
 }
 
 static void line(const char *name, const tilt_options *o)
@@ -428,6 +461,38 @@ int main(int argc, char **argv)
             }
         }
         ws_world_destroy(sc.world);
+    } else if (!strcmp(what, "tilt")) {
+        /* `tilt [duration] [r] [tolerance] [dt ms]`: case R's run with its band refined r x r
+         * on the multigrid at that solve tolerance (0: the default), as `phases` every 50 ms,
+         * and then its answers (lift-off, tipping, slide) and CPU time; WS_BENCH_RESUME=file
+         * starts from a state `phases` saved (the slide then counts from it): whether a
+         * tolerance moves the answers, and what it costs. */
+        tilt_options a = o;
+        a.areal_density = 0.018;
+        a.implicit = 1;
+        a.substeps = 1;
+        a.refine = argc > 3 ? atoi(argv[3]) : 1;
+        a.solver_tolerance = argc > 4 ? atof(argv[4]) : 0.0;
+        a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
+        a.dt = 1e-3 * (argc > 5 ? atof(argv[5]) : 0.25);
+        a.resume = getenv("WS_BENCH_RESUME");
+        window_log log = {.r = a.refine, .window = lround(0.05 / a.dt), .dt = a.dt,
+                          .cpu = cpu_now()};
+        a.each_step = window_step;
+        a.user = &log;
+        const double c0 = log.cpu;
+        tilt_result res;
+        tilt_run(&a, &res);
+        if (res.status != WS_OK) {
+            printf("  refine %d: %s\n", a.refine, res.error);
+            return 1;
+        }
+        printf("  refine %d, tolerance %g: lift %.3f deg  tip %.3f deg  slide %.3f mm (from "
+               "%s)  to t %.3f s: %.1f s CPU, CG %.2f it/step; state %016llx\n",
+               a.refine, a.solver_tolerance, res.lift_angle, res.over_angle,
+               1e3 * res.max_relative_slip, a.resume ? "the saved state" : "t = 0",
+               res.end_time, cpu_now() - c0,
+               (double)res.solver.iterations / (double)res.steps, (unsigned long long)res.hash);
     } else if (!strcmp(what, "crossing")) {
         const int sides[] = {10, 12, 16, 24, 32, 40, 48, 64, 96};
         const int box = argc > 3 ? atoi(argv[3]) : 0; /* a box on the drum, in its solve */

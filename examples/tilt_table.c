@@ -51,6 +51,8 @@
 #define TILT_SLIDE_HOLD 0.2 /* s: gross slip must last this long to count as a slide */
 #define TILT_START 1.0      /* s: the platform stands level until then, then tilts */
 
+struct tilt_scene;
+
 typedef struct tilt_options {
     char variant;         /* 'P' or 'R' */
     int stick;            /* 1: stick friction model instead of the paper's regularised law */
@@ -79,6 +81,11 @@ typedef struct tilt_options {
     int preconditioner;   /* implicit film: ws_web_preconditioner; 0 = AUTO */
     double dt;            /* s; 0 = 0.25 ms */
     int hold_bodies;      /* implicit film: 1 holds the boxes during its solve (ws_web_def) */
+    const char *resume;   /* a state saved from this same scene (ws_world_save_file): the run
+                             starts from it, and runs `duration` from its time; the slides are
+                             then measured from the saved state's positions */
+    void (*each_step)(const struct tilt_scene *sc, void *user); /* after every step, or NULL */
+    void *user;
 } tilt_options;
 
 typedef struct tilt_scene {
@@ -565,6 +572,11 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         return res->status = s;
     }
     ws_world *w = sc.world;
+    if (o->resume && (s = ws_world_restore_file(w, o->resume)) != WS_OK) {
+        snprintf(res->error, sizeof res->error, "%s", ws_world_last_error(w));
+        ws_world_destroy(w);
+        return res->status = s;
+    }
     FILE *csv = NULL;
     ws_vtk_series *vtk = NULL;
     if (o->csv && !(csv = fopen(o->csv, "w"))) {
@@ -760,6 +772,8 @@ static ws_status tilt_run(const tilt_options *o, tilt_result *res)
         if ((s = ws_world_step(w)) != WS_OK)
             break;
         res->steps++;
+        if (o->each_step)
+            o->each_step(&sc, o->user);
         if (!o->quiet && now() > next_report) {
             fprintf(stderr, "\r  t = %.2f s of %.2f s", t, sc.duration);
             next_report = now() + 0.5;
