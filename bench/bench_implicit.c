@@ -41,8 +41,8 @@ static double cpu_now(void)
 /* `tilt`'s log of every 50 ms of a run: CG iterations a step, mean and largest, and CPU s per
  * simulated s, as `phases` prints them. */
 typedef struct window_log {
-    int r;
-    long window, k;
+    int r, known; /* known: `iterations` holds the run's count before the next step */
+    long window, k, counted;
     double dt, cpu;
     uint64_t iterations, sum, most;
 } window_log;
@@ -54,19 +54,22 @@ static void window_step(const tilt_scene *sc, void *user)
     ws_web_get_solver_stats(sc->world, sc->film, &s);
     const uint64_t it = s.iterations - log->iterations;
     log->iterations = s.iterations;
-    if (log->k++ == 0)
-        return; /* the first step's count is the run's so far when it resumes */
-    log->sum += it;
-    log->most = it > log->most ? it : log->most;
-    if (log->k % log->window)
+    if (log->known) { /* a resumed run's first count is its history's */
+        log->sum += it;
+        log->most = it > log->most ? it : log->most;
+        log->counted++;
+    }
+    log->known = 1;
+    if (++log->k % log->window)
         return;
     double t, c = cpu_now();
     ws_world_get_time(sc->world, &t);
     printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n", log->r, t,
-           (double)log->sum / (double)(log->window - (log->k == log->window)),
+           log->counted ? (double)log->sum / (double)log->counted : 0.0,
            (unsigned long long)log->most, (c - log->cpu) / (log->window * log->dt));
     fflush(stdout);
     log->sum = log->most = 0;
+    log->counted = 0;
     log->cpu = c;
 }
 
@@ -430,17 +433,13 @@ int main(int argc, char **argv)
         int saved = 0;
         ws_web_solver_stats prev;
         ws_web_get_solver_stats(sc.world, sc.film, &prev);
-        uint64_t sum = 0, most = 0;
-        double c0 = cpu_now();
+        window_log log = {.r = r, .known = 1, .iterations = prev.iterations, .window = window,
+                          .dt = sc.dt, .cpu = cpu_now()};
         for (long k = 1; k <= steps; k++) {
             if (ws_world_step(sc.world) != WS_OK) {
                 printf("  refine %d: %s\n", r, ws_world_last_error(sc.world));
                 break;
             }
-            ws_web_solver_stats s;
-            ws_web_get_solver_stats(sc.world, sc.film, &s);
-            const uint64_t it = s.iterations - prev.iterations;
-            prev = s;
             if (save && !saved && t_start + k * sc.dt >= save_at - 0.5 * sc.dt && save_at >= 0) {
                 saved = 1;
                 if (ws_world_save_file(sc.world, save) != WS_OK)
@@ -448,17 +447,7 @@ int main(int argc, char **argv)
                 else
                     printf("  saved %s at t %.4f s\n", save, t_start + k * sc.dt);
             }
-            sum += it;
-            most = it > most ? it : most;
-            if (k % window == 0) {
-                const double c = cpu_now();
-                printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n",
-                       r, t_start + k * sc.dt, (double)sum / (double)window, (unsigned long long)most,
-                       (c - c0) / (window * sc.dt));
-                fflush(stdout);
-                sum = most = 0;
-                c0 = c;
-            }
+            window_step(&sc, &log);
         }
         ws_world_destroy(sc.world);
     } else if (!strcmp(what, "tilt")) {
