@@ -1,7 +1,7 @@
 /* The plain scalar explicit loop over a film (bench_plain.c, bench_pallet.c): the film's nodes,
  * their places and masses, its springs with their rest lengths and a tension-compression law,
- * gravity and symplectic Euler, but no contacts and no bodies. Written as a C programmer would
- * write it first: nodes as structures, a list of springs, one loop over the springs and one over
+ * gravity and symplectic Euler, but no bodies; with plain_step_contacts, each node against
+ * each box at rest too. Written as a C programmer would write it first: nodes as structures, a list of springs, one loop over the springs and one over
  * the nodes; the including benchmark is compiled without vectors (bench/meson.build). */
 #ifndef BENCH_PLAIN_FILM_H
 #define BENCH_PLAIN_FILM_H
@@ -41,8 +41,8 @@ static double plain_law(const plain_spring *s, double eps, double epsd)
     return s->kc * eps + s->dk * ramp + s->c * epsd;
 }
 
-static void plain_step(plain_node *nd, size_t n, const plain_spring *sp, size_t ns, double h,
-                       double gz)
+/* Gravity and the springs' forces into f. */
+static void plain_forces(plain_node *nd, size_t n, const plain_spring *sp, size_t ns, double gz)
 {
     for (size_t i = 0; i < n; i++) {
         nd[i].f[0] = 0.0;
@@ -66,11 +66,123 @@ static void plain_step(plain_node *nd, size_t n, const plain_spring *sp, size_t 
             B->f[c] -= t * d[c];
         }
     }
+}
+
+/* Symplectic Euler over h. */
+static void plain_advance(plain_node *nd, size_t n, double h)
+{
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++) {
             nd[i].v[c] += h * nd[i].inv_m * nd[i].f[c];
             nd[i].x[c] += h * nd[i].v[c];
         }
+}
+
+static void plain_step(plain_node *nd, size_t n, const plain_spring *sp, size_t ns, double h,
+                       double gz)
+{
+    plain_forces(nd, n, sp, ns, gz);
+    plain_advance(nd, n, h);
+}
+
+/* The plain loop's contacts, as a first version would write them: every node against every
+ * box, each box at rest (its centre c, rotation rows R, half sizes h grown by the contact
+ * layer). A node inside a box is pushed out through the nearest face: normal force k d - c v_n
+ * (no pull), friction mu f_n against the tangential velocity, regularised below v_lim as the
+ * library's law is (f_t = -mu f_n v_t / max(|v_t|, v_lim)); the box's load (force and moment
+ * about c) is summed too, as the bodies would need it. */
+typedef struct plain_box {
+    double c[3], R[3][3], h[3];
+    double f[3], m[3]; /* the load the film puts on the box */
+} plain_box;
+
+typedef struct plain_contact {
+    double k, c, mu, vlim;
+    long touching; /* node contacts evaluated so far */
+} plain_contact;
+
+static inline void plain_contacts(plain_node *nd, size_t n, plain_box *bx, size_t nb, plain_contact *pc)
+{
+    for (size_t i = 0; i < n; i++)
+        for (size_t b = 0; b < nb; b++) {
+            plain_box *B = &bx[b];
+            double r[3], l[3];
+            for (int a = 0; a < 3; a++)
+                r[a] = nd[i].x[a] - B->c[a];
+            int inside = 1;
+            for (int a = 0; a < 3; a++) {
+                l[a] = B->R[a][0] * r[0] + B->R[a][1] * r[1] + B->R[a][2] * r[2];
+                inside &= fabs(l[a]) < B->h[a];
+            }
+            if (!inside)
+                continue;
+            int face = 0;
+            double depth = B->h[0] - fabs(l[0]);
+            for (int a = 1; a < 3; a++)
+                if (B->h[a] - fabs(l[a]) < depth) {
+                    depth = B->h[a] - fabs(l[a]);
+                    face = a;
+                }
+            double nrm[3], vn = 0.0, vt[3], st = 0.0;
+            for (int a = 0; a < 3; a++) {
+                nrm[a] = (l[face] < 0.0 ? -1.0 : 1.0) * B->R[face][a];
+                vn += nd[i].v[a] * nrm[a];
+            }
+            double fn = pc->k * depth - pc->c * vn;
+            if (fn <= 0.0)
+                continue;
+            for (int a = 0; a < 3; a++) {
+                vt[a] = nd[i].v[a] - vn * nrm[a];
+                st += vt[a] * vt[a];
+            }
+            st = sqrt(st);
+            const double ft = pc->mu * fn / (st > pc->vlim ? st : pc->vlim);
+            double f[3];
+            for (int a = 0; a < 3; a++) {
+                f[a] = fn * nrm[a] - ft * vt[a];
+                nd[i].f[a] += f[a];
+                B->f[a] -= f[a];
+            }
+            B->m[0] -= r[1] * f[2] - r[2] * f[1];
+            B->m[1] -= r[2] * f[0] - r[0] * f[2];
+            B->m[2] -= r[0] * f[1] - r[1] * f[0];
+            pc->touching++;
+        }
+}
+
+/* plain_step with the contacts between the springs' forces and the integration. */
+static inline void plain_step_contacts(plain_node *nd, size_t n, const plain_spring *sp, size_t ns,
+                                double h, double gz, plain_box *bx, size_t nb, plain_contact *pc)
+{
+    plain_forces(nd, n, sp, ns, gz);
+    for (size_t b = 0; b < nb; b++)
+        for (int a = 0; a < 3; a++)
+            bx[b].f[a] = bx[b].m[a] = 0.0;
+    plain_contacts(nd, n, bx, nb, pc);
+    plain_advance(nd, n, h);
+}
+
+/* Box b of the world as it stands: its centre and rotation, half sizes h grown by layer. */
+static inline void plain_box_load(ws_world *w, ws_body_id b, const double h[3], double layer,
+                           plain_box *B)
+{
+    ws_vec3 c;
+    ws_quat q;
+    ws_body_get_position(w, b, &c);
+    ws_body_get_orientation(w, b, &q);
+    B->c[0] = c.x, B->c[1] = c.y, B->c[2] = c.z;
+    /* Rows of R^T (world to body): the body's axes in world coordinates. */
+    const double e0 = q.e0, e1 = q.e1, e2 = q.e2, e3 = q.e3;
+    const double A[3][3] = {
+        {1 - 2 * (e2 * e2 + e3 * e3), 2 * (e1 * e2 - e0 * e3), 2 * (e1 * e3 + e0 * e2)},
+        {2 * (e1 * e2 + e0 * e3), 1 - 2 * (e1 * e1 + e3 * e3), 2 * (e2 * e3 - e0 * e1)},
+        {2 * (e1 * e3 - e0 * e2), 2 * (e2 * e3 + e0 * e1), 1 - 2 * (e1 * e1 + e2 * e2)}};
+    for (int a = 0; a < 3; a++) {
+        for (int k = 0; k < 3; k++)
+            B->R[a][k] = A[k][a];
+        B->h[a] = h[a] + layer;
+        B->f[a] = B->m[a] = 0.0;
+    }
 }
 
 typedef struct plain_film {

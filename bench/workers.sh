@@ -1,9 +1,10 @@
 #!/bin/sh
 # Workers: the wrapped reference case at 1, 2 and 4 workers and the plain loop (bench_plain, one
-# core), run one after another in interleaved rounds, so that a machine whose speed drifts
-# drifts across all of them alike. Prints each round's wall times, the ratios 1→2 (speed-up)
-# and 2-workers / plain, and their medians; the last also per node-update (the wrapped case
-# takes its film's sub-steps a step, the plain loop one). A figure, not a test: it never fails on time. The
+# core), without and with contacts, run one after another in interleaved rounds, so that a
+# machine whose speed drifts drifts across all of them alike. Prints each round's wall times,
+# the ratios 1→2 (speed-up) and 2-workers / plain, and their medians; the last also per
+# node-update (the wrapped case takes its film's sub-steps a step, the plain loop one; the
+# plain loop with contacts takes them too, so its node-updates are the case's). A figure, not a test: it never fails on time. The
 # runs take the whole machine in turn (a run at 2 workers needs 2 free cores): say how loaded
 # it was (uptime) next to the figures.
 #
@@ -39,13 +40,14 @@ handover() {
     if [ -x "$pp" ]; then "$pp" "$1" | sed -n 's/.*round trip \([0-9.]*\) ns.*/\1/p'; else echo -; fi
 }
 echo "hand-over before: $(handover 500000) ns"
-# One build's four runs: prints their wall times.
+# One build's five runs: prints their wall times.
 runs() {
     /usr/bin/time -f %e -o "$tmp/1" "$1/bench/bench_wrapped" "$steps" P 1 >/dev/null
     /usr/bin/time -f %e -o "$tmp/2" "$1/bench/bench_wrapped" "$steps" P 2 >/dev/null
     /usr/bin/time -f %e -o "$tmp/4" "$1/bench/bench_wrapped" "$steps" P 4 >/dev/null
     /usr/bin/time -f %e -o "$tmp/p" "$1/bench/bench_plain" "$steps" >/dev/null
-    echo "$(cat "$tmp/1") $(cat "$tmp/2") $(cat "$tmp/4") $(cat "$tmp/p")"
+    /usr/bin/time -f %e -o "$tmp/c" "$1/bench/bench_plain" "$steps" law 1 contacts >/dev/null
+    echo "$(cat "$tmp/1") $(cat "$tmp/2") $(cat "$tmp/4") $(cat "$tmp/p") $(cat "$tmp/c")"
 }
 r=1
 while [ "$r" -le "$rounds" ]; do
@@ -65,9 +67,11 @@ while [ "$r" -le "$rounds" ]; do
 done | awk -v subs="$subs" -v a="$dir" -v b="$other" '
     { k = $1; n[k]++; i = n[k];
       printf "round %d %s: load %s, hand-over %s ns; 1 worker %.2f s, 2 workers %.2f s, " \
-             "4 workers %.2f s, plain %.2f s; 1->2 %.2fx, 1->4 %.2fx, 2 workers / plain %.3f\n",
-             i, (k == "A" ? a : b), $2, $3, $4, $5, $6, $7, $4 / $5, $4 / $6, $5 / $7;
-      s[k, i] = $4 / $5; f[k, i] = $4 / $6; q[k, i] = $5 / $7; o[k, i] = $4 / $7; t2[k, i] = $5 }
+             "4 workers %.2f s, plain %.2f s, plain with contacts %.2f s; 1->2 %.2fx, " \
+             "1->4 %.2fx, 2 workers / plain %.3f\n",
+             i, (k == "A" ? a : b), $2, $3, $4, $5, $6, $7, $8, $4 / $5, $4 / $6, $5 / $7;
+      s[k, i] = $4 / $5; f[k, i] = $4 / $6; q[k, i] = $5 / $7; o[k, i] = $4 / $7; t2[k, i] = $5
+      qc[k, i] = $5 / $8; oc[k, i] = $4 / $8 }
     function med(a, k, m, i, j, t, v) {
         for (i = 1; i <= m; i++) v[i] = a[k, i];
         for (i = 1; i <= m; i++) for (j = i + 1; j <= m; j++)
@@ -82,7 +86,10 @@ done | awk -v subs="$subs" -v a="$dir" -v b="$other" '
                    "1 worker / plain %.3f (%d rounds)\n", (k == "A" ? a : b),
                    med(s, k, m), med(f, k, m), med(q, k, m), med(o, k, m), m;
             printf "per node-update %s: 2 workers / plain %.3f, 1 worker / plain %.3f\n",
-                   (k == "A" ? a : b), med(q, k, m) / subs, med(o, k, m) / subs }
+                   (k == "A" ? a : b), med(q, k, m) / subs, med(o, k, m) / subs
+            printf "per node-update %s: 2 workers / plain with contacts %.3f, 1 worker / " \
+                   "plain with contacts %.3f\n", (k == "A" ? a : b), med(qc, k, m),
+                   med(oc, k, m) }
         if (n["B"]) {
             for (i = 1; i <= n["B"]; i++) rr["R", i] = t2["B", i] / t2["A", i];
             printf "median of the rounds %s / %s, 2 workers: %.3f\n", b, a, med(rr, "R", n["B"]) } }'
