@@ -258,6 +258,27 @@ size_t ws_node_link_loads(const ws_node_link *L, size_t count, const double *dv,
     return m;
 }
 
+int ws_node_link_stick(const ws_node_link *c, const ws_node_end *e, double m, double h, v3 *dF)
+{
+    *dF = v3_make(0.0, 0.0, 0.0);
+    if (!c->active || !(c->mu > 0.0) || !(m > 0.0))
+        return 0;
+    const v3 n = c->n;
+    const v3 r = v3_sub(e->v1, e->ub), t1 = v3_madd(r, n, -v3_dot(n, r));
+    /* f - h K (v1 - uk) - D (dv - du): the force the solve took over the step. */
+    const v3 q = v3_sub(e->v1, e->uk), d = v3_sub(e->dv, e->du);
+    double o[3] = {0.0, 0.0, 0.0};
+    ws_sym_madd(c->K, h * q.x, h * q.y, h * q.z, o);
+    ws_sym_madd(c->D, d.x, d.y, d.z, o);
+    const v3 F = v3_sub(c->f, v3_make(o[0], o[1], o[2]));
+    const double fn = v3_dot(n, F);
+    const v3 stop = v3_scale(t1, -m / h), held = v3_add(v3_madd(F, n, -fn), stop);
+    if (!(fn > 0.0) || !(v3_norm(held) <= c->mu * fn))
+        return 0;
+    *dF = stop;
+    return 1;
+}
+
 size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
                            double h)
 {

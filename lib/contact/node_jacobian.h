@@ -61,6 +61,24 @@ size_t ws_node_links(const ws_node_pass *P, const ws_web *web, size_t count, con
 size_t ws_node_link_update(ws_node_link *L, size_t count, const double *dv, ws_nodes3 v1,
                            double h);
 
+/* The motion a contact's static friction test takes at the end of a solved step: its node's
+ * velocity v1 and change dv, its body's point's velocity change du (the solve's; zero for a body
+ * held in it or a world element), the velocity its normal force's linear model takes the node
+ * against (uk, plus the point's velocity at the end when the body moves in the solve) and the
+ * velocity of the body's point at the end, which the slip is measured against. */
+typedef struct ws_node_end {
+    v3 v1, dv, du, uk, ub;
+} ws_node_end;
+
+/* Coulomb's static friction over the solved step h for an active contact c with friction, as
+ * the explicit film's friction stops a node's slip within its sub-step (friction_of): t1 the
+ * node's slip at the end of the step (tangential, against e->ub), F the contact's force over
+ * the step as the solve took it (ws_node_link_loads'). When the friction that ends the step
+ * without slip, F's tangential part minus m t1 / h (m the node's mass), lies within mu times
+ * F's normal part, the contact sticks: returns 1 with that change of force in *dF (the node's
+ * velocity then changes by -t1: h dF / m); else 0 (the node slides by eq. 13, as solved). */
+int ws_node_link_stick(const ws_node_link *c, const ws_node_end *e, double m, double h, v3 *dF);
+
 /* After the web's solve over step h (dv, the new velocities v1): each contact's force at the
  * end of the step as the solve took it, f + Jx h v1 + Jv dv with the matrix's blocks, times
  * share into the node's record fc and, opposite, onto its body (bforce, bmoment: about the

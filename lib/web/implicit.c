@@ -700,17 +700,12 @@ void ws_implicit_velocities(const ws_web *web, ws_nodes3 v, ws_nodes3 vd)
     }
 }
 
-size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, ws_nodes3 vd,
-                          double h, double vmax)
+size_t ws_implicit_finish(const ws_web *web, ws_nodes3 x, ws_nodes3 xd, ws_nodes3 vd, double h,
+                          double vmax)
 {
-    const double *dv = web->imp->dv;
     size_t fast = 0;
     for (uint32_t i = 0; i < web->n; i++) {
-        const double ux = v.x[i] + dv[3 * i], uy = v.y[i] + dv[3 * i + 1],
-                     uz = v.z[i] + dv[3 * i + 2];
-        vd.x[i] = ux;
-        vd.y[i] = uy;
-        vd.z[i] = uz;
+        const double ux = vd.x[i], uy = vd.y[i], uz = vd.z[i];
         xd.x[i] = x.x[i] + h * ux;
         xd.y[i] = x.y[i] + h * uy;
         xd.z[i] = x.z[i] + h * uz;

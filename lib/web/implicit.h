@@ -137,9 +137,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h);
 /* The new velocities alone, vd = v + dv. */
 void ws_implicit_velocities(const ws_web *web, ws_nodes3 v, ws_nodes3 vd);
 
-/* The new state: vd = v + dv, xd = x + h vd. Returns how many nodes end faster than vmax, with
- * a NaN speed or with one whose square overflows. */
-size_t ws_implicit_finish(ws_web *web, ws_nodes3 x, ws_nodes3 v, ws_nodes3 xd, ws_nodes3 vd,
+/* The new places xd = x + h vd, with the new velocities vd as ws_implicit_velocities set them
+ * (and the static friction changed them). Returns how many nodes end faster than vmax, with a
+ * NaN speed or with one whose square overflows. */
+size_t ws_implicit_finish(const ws_web *web, ws_nodes3 x, ws_nodes3 xd, ws_nodes3 vd,
                           double h, double vmax);
 
 /* y = A p over step h (the matrix the solve uses), p and y xyz per node, y zero at pinned

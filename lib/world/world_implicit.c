@@ -201,6 +201,43 @@ static void body_moves(const ws_rigid *R, const uint32_t *slot, ws_node_link *L,
     }
 }
 
+/* Coulomb's static friction over the solved sub-step h (ws_node_link_stick, docs/theory.md 8c):
+ * each sticking contact's node ends it moving with its body's point along the face, its
+ * velocity in vd changed by h dF / m, and dF times share into the node's record and, opposite,
+ * onto its body, in link order (node order: the same sums for any worker count). Contacts with
+ * a body of the solve (R, slot) measure the slip against the point as the solve moved it. */
+static void stick_links(const ws_step *S, ws_web *web, const ws_rigid *R, const uint32_t *slot,
+                        const ws_node_link *L, size_t nl, ws_nodes3 vd, double h, double share)
+{
+    const double *dv = web->imp->dv;
+    v3 *fc = web->fc[S->nxt], *bforce = web->bforce[S->nxt], *bmoment = web->bmoment[S->nxt];
+    for (size_t k = 0; k < nl; k++) {
+        const ws_node_link *c = &L[k];
+        const uint32_t i = c->node;
+        if (!c->active || !(c->mu > 0.0))
+            continue;
+        const uint32_t j = R ? slot[c->body] : UINT32_MAX;
+        const v3 u0 = point_velocity(S->b, S->cur, c->body, c->lever);
+        ws_node_end e = {nodes_get(vd, i), v3_make(dv[3 * i], dv[3 * i + 1], dv[3 * i + 2]),
+                         v3_make(0, 0, 0), c->uk, u0};
+        if (j != UINT32_MAX) {
+            const double *dU = R->x + 6 * (size_t)j;
+            e.du = v3_add(v3_make(dU[0], dU[1], dU[2]),
+                          v3_cross(v3_make(dU[3], dU[4], dU[5]), c->lever));
+            e.ub = v3_add(u0, e.du);
+            e.uk = e.ub;
+        }
+        v3 dF;
+        if (!ws_node_link_stick(c, &e, web->m[i], h, &dF))
+            continue;
+        nodes_set(vd, i, v3_madd(e.v1, dF, h / web->m[i]));
+        const v3 d = v3_scale(dF, share);
+        fc[i] = v3_add(fc[i], d);
+        bforce[c->body] = v3_sub(bforce[c->body], d);
+        bmoment[c->body] = v3_sub(bmoment[c->body], v3_cross(c->lever, d));
+    }
+}
+
 /* A bench's probe: each node's contact state over the step's links, a slipping contact above
  * a sticking one above an inactive one. */
 static void probe_states(ws_implicit_probe *pr, const ws_node_pass *P, const ws_node_link *L,
@@ -313,7 +350,8 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
                            label(web), w->time, im->last_residual, im->last_iterations,
                            web->solver_tol, web->solver_maxit);
         }
-        const size_t fast = ws_implicit_finish(web, xs, vs, xd, vd, h, w->def.max_speed);
+        stick_links(S, web, R, slot, links, nl, vd, h, share);
+        const size_t fast = ws_implicit_finish(web, xs, xd, vd, h, w->def.max_speed);
         if (fast) {
             S->stats->numerical_errors++;
             const double vmax = ws_web_fastest(web, vd);
