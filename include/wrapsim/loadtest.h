@@ -273,6 +273,12 @@ typedef struct ws_wrap_def {
      *  defaults. Must be above strain_around and strain_up (the film would break as it is
      *  laid). */
     double rupture_strain;
+    /* ---- the film's integrator (trailing field: older callers get the default) ---- */
+    /** ws_web_integrator: WS_WEB_EXPLICIT (the default) or WS_WEB_IMPLICIT, the film at any
+     *  node mass in one sub-step (docs/guide.md, "The implicit film"); with node_mass = 0 the
+     *  band keeps its real mass, whose inertia matters on a sled, impact or vibration test.
+     *  An implicit band takes one sub-step when substeps is 0. */
+    int integrator;
 } ws_wrap_def;
 
 /** Fill a wrap Def with the defaults above. NULL is ignored.
@@ -364,6 +370,12 @@ typedef struct ws_spiral_wrap_def {
      *  laid). The top sheet, not pre-stretched, takes the same limit: it breaks early, if
      *  ever. */
     double rupture_strain;
+    /* ---- the film's integrator (trailing field: older callers get the default) ---- */
+    /** ws_web_integrator: WS_WEB_EXPLICIT (the default) or WS_WEB_IMPLICIT, the film at its real
+     *  mass (node_mass_min 0, the default) in one sub-step where the explicit film needs
+     *  hundreds (docs/guide.md, "The implicit film"). An implicit film takes one sub-step when
+     *  substeps is 0. */
+    int integrator;
 } ws_spiral_wrap_def;
 
 /** Fill a spiral wrap Def with the defaults above. NULL is ignored. */

@@ -759,6 +759,8 @@ static ws_status check_wrap(const ws_world *w, const ws_wrap_def *d, const ws_lo
         bad = "node_mass must be >= 0 kg";
     else if (d->substeps < 0)
         bad = "substeps must be >= 1, or 0 for the fewest the stable-step check accepts";
+    else if (d->integrator != WS_WEB_EXPLICIT && d->integrator != WS_WEB_IMPLICIT)
+        bad = "integrator must be WS_WEB_EXPLICIT (0) or WS_WEB_IMPLICIT (1)";
     else if (!(isfinite(d->elongation_at_break) && d->elongation_at_break >= 0) ||
              !(isfinite(d->powered_prestretch) && d->powered_prestretch >= 0) ||
              !(isfinite(d->rupture_strain) && d->rupture_strain >= 0))
@@ -848,6 +850,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
     wd.contact_layer = ld->contact_layer;
     wd.material = ld->info.film_material;
     wd.substeps = d.substeps > 0 ? d.substeps : 1;
+    wd.integrator = d.integrator;
     wd.name = "film";
     wd.rupture_strain = wrap_rupture(&d);
     ws_band_def bd;
@@ -866,7 +869,7 @@ ws_status ws_load_wrap_band(ws_world *w, ws_load *ld, const ws_wrap_def *def, ws
         wd.law_cross = up;
         s = ws_web_create_band(w, &wd, &bd, &ld->info.film);
     }
-    if (s == WS_OK && d.substeps == 0 &&
+    if (s == WS_OK && d.substeps == 0 && d.integrator == WS_WEB_EXPLICIT &&
         (s = ws_load_fit_substeps(w, ld->info.film, "ws_load_wrap_band")) != WS_OK) {
         ws_web_destroy(w, ld->info.film);
         ld->info.film = (ws_web_id){0};

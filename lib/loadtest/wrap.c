@@ -104,6 +104,8 @@ static const char *spiral_bad(const ws_spiral_wrap_def *d)
         return "node_mass_min must be >= 0 kg";
     if (d->substeps < 0 || d->substeps > 100000)
         return "substeps must be 1 .. 100000, or 0 for the fewest the stable-step check accepts";
+    if (d->integrator != WS_WEB_EXPLICIT && d->integrator != WS_WEB_IMPLICIT)
+        return "integrator must be WS_WEB_EXPLICIT (0) or WS_WEB_IMPLICIT (1)";
     if (!in_range(d->elongation_at_break, 0, 100) || !in_range(d->rupture_strain, 0, 100))
         return "elongation_at_break and rupture_strain must be 0 .. 100";
     if (d->rupture_strain == 0 && d->elongation_at_break > 0 &&
@@ -701,6 +703,7 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
         wd.law = around;
         wd.law_cross = up;
         wd.substeps = d.substeps > 0 ? d.substeps : 1;
+        wd.integrator = d.integrator;
         wd.name = "spiral film";
         wd.rupture_strain = spiral_rupture(&d);
         ws_web_mesh_def md;
@@ -715,7 +718,7 @@ ws_status ws_load_wrap_spiral(ws_world *w, ws_load *ld, const ws_spiral_wrap_def
         md.stiffness_scales = m.scale;
         if ((s = ws_web_create_mesh(w, &wd, &md, &ld->info.film)) != WS_OK)
             goto done;
-        if (d.substeps == 0 &&
+        if (d.substeps == 0 && d.integrator == WS_WEB_EXPLICIT &&
             (s = ws_load_fit_substeps(w, ld->info.film, "ws_load_wrap_spiral")) != WS_OK) {
             ws_web_destroy(w, ld->info.film);
             ld->info.film = (ws_web_id){0};

@@ -616,7 +616,7 @@ class WrapDef(Structure):
         ("top_margin", c_double), ("node_pitch", c_double), ("node_mass", c_double),
         ("substeps", c_int),
         ("elongation_at_break", c_double), ("powered_prestretch", c_double),
-        ("rupture_strain", c_double),
+        ("rupture_strain", c_double), ("integrator", c_int),
     ]
 
 
@@ -630,7 +630,7 @@ class SpiralWrapDef(Structure):
         ("top_margin", c_double), ("rope_revolutions", c_double), ("rope_height", c_double),
         ("top_sheet", c_int), ("top_sheet_gauge", c_double),
         ("node_pitch", c_double), ("node_mass_min", c_double), ("substeps", c_int),
-        ("elongation_at_break", c_double), ("rupture_strain", c_double),
+        ("elongation_at_break", c_double), ("rupture_strain", c_double), ("integrator", c_int),
     ]
 
 

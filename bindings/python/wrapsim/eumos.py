@@ -54,6 +54,10 @@ def load_def(d):
     return ld
 
 
+#: ws_web_integrator by its load file name.
+_INTEGRATORS = {"explicit": 0, "implicit": 1}
+
+
 def wrap_def(d):
     """The ws_wrap_def of a load file's unit_load.wrap section, or None when unwrapped."""
     w = d["unit_load"]["wrap"]
@@ -73,6 +77,7 @@ def wrap_def(d):
     wd.elongation_at_break = w["elongation_at_break_percent"] / 100
     wd.powered_prestretch = w["powered_prestretch_percent"] / 100
     wd.rupture_strain = w["rupture_strain_percent"] / 100
+    wd.integrator = _INTEGRATORS[w["integrator"]]
     return wd
 
 
@@ -104,6 +109,7 @@ def spiral_def(d):
     sd.node_mass_min = w["node_mass_min_kg"]
     sd.elongation_at_break = w["elongation_at_break_percent"] / 100
     sd.rupture_strain = w["rupture_strain_percent"] / 100
+    sd.integrator = _INTEGRATORS[w["integrator"]]
     return sd
 
 

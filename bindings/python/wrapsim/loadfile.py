@@ -137,6 +137,10 @@ SPEC = _section({
             "rupture_strain_percent": _num("%", 0.0, 0.0, 10000.0,
                                            doc="the film's rupture strain from its rest length; "
                                                "0: from the two above"),
+            "integrator": _str(["explicit", "implicit"], "explicit",
+                               doc="the film's: implicit is stable at any node mass in one "
+                                   "sub-step (the film's real mass, its inertia on a sled, "
+                                   "impact or vibration test)"),
         }, optional=True, doc="a band of film around the load (absent: unwrapped)"),
         "spiral_wrap": _section({
             "width_m": _num("m", 0.5, 0.0, 10.0, True, doc="film width off the roll"),
@@ -179,6 +183,10 @@ SPEC = _section({
                                            doc="the film's rupture strain from its rest length "
                                                "on the load; 0: from the elongation at break "
                                                "and the pre-stretch"),
+            "integrator": _str(["explicit", "implicit"], "explicit",
+                               doc="the film's: implicit is stable at any node mass in one "
+                                   "sub-step (the film's real mass, its inertia on a sled, "
+                                   "impact or vibration test)"),
         }, optional=True, doc="the spiral wrap of a stretch-wrapping machine (absent: none)"),
     }, optional=True, doc="a pallet with layers of cartons (the EUMOS test)"),
     "stack": _section({
@@ -206,6 +214,10 @@ SPEC = _section({
         "spring_stiffness_N_per_m": _num("N/m", 2000.0, 0.0, 1e9, True),
         "spring_damping_kg_per_s": _num("kg/s", 0.1, 0.0, 1e6),
         "node_mass_kg": _num("kg", 1e-3, 0.0, 10.0, True),
+        "integrator": _str(["explicit", "implicit"], "explicit",
+                           doc="the film's: implicit is stable at any node mass in one "
+                               "sub-step (the film's real mass, its inertia on a sled, "
+                               "impact or vibration test)"),
     }, optional=True, doc="a band of film around the stack (absent: unwrapped)"),
     "test": _section({
         "type": _str(["tilt", "eumos", "impact", "vibration"], "tilt",

@@ -94,11 +94,14 @@ def build(d):
         film = w.web_band(law_a, cartons, law_cross=law_u, node_mass=wr["node_mass_kg"],
                           contact_layer=layer, material=film_mat, name="film", z_bottom=z0,
                           z_top=z1, n_around=n_around, n_up=n_up,
-                          prestretch_around=around_x - 1, prestretch_up=up_x - 1)
+                          prestretch_around=around_x - 1, prestretch_up=up_x - 1,
+                          integrator=wr["integrator"])
         # Sub-steps within the film check's safety factor (stable_fraction, world.h): 1 g
-        # nodes at the default dt use 0.685 of their stable sub-step alone, 0.34 in two.
+        # nodes at the default dt use 0.685 of their stable sub-step alone, 0.34 in two. An
+        # implicit film takes one at any mass.
         f = _make(L.WorldDef, {}).stable_fraction
-        film.substeps = max(1, math.ceil(w.stats()["web_step_use"] / f))
+        if wr["integrator"] == "explicit":
+            film.substeps = max(1, math.ceil(w.stats()["web_step_use"] / f))
     return dict(world=w, platform=platform, stop=stop, cartons=cartons, film=film, pivot=pivot)
 
 
