@@ -14,6 +14,22 @@ def _init(struct, name):
     return d
 
 
+def _wrapped_layer(w, sd):
+    """The default load cut to one layer of cartons in world w, wrapped by spiral Def sd: the
+    load (to destroy) and the film's web id."""
+    lib = _c()
+    ld = _init(L.LoadDef, "ws_load_def_init_sized")
+    ld.layers = 1
+    load = ctypes.c_void_p()
+    assert lib.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+    web = L.WebId()
+    if lib.ws_load_wrap_spiral(w.ptr, load, byref(sd), byref(web)) != 0:
+        msg = w.last_error
+        lib.ws_load_destroy(load)
+        raise AssertionError(msg)
+    return load, web
+
+
 def test_spiral_wrap_through_the_table():
     lib = _c()
     sd = _init(L.SpiralWrapDef, "ws_spiral_wrap_def_init_sized")
@@ -25,15 +41,9 @@ def test_spiral_wrap_through_the_table():
     assert lib.ws_spiral_wrap_layers(byref(sd), 1.154, 0.146, 4.0, 1.3, 0.6, byref(n)) == 0
     assert n.value == 4
     with World(detection_interval=10) as w:
-        ld = _init(L.LoadDef, "ws_load_def_init_sized")
-        ld.layers = 1
-        load = ctypes.c_void_p()
-        assert lib.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+        sd.node_mass_min = 1e-3
+        load, web = _wrapped_layer(w, sd)
         try:
-            sd.node_mass_min = 1e-3
-            web = L.WebId()
-            assert lib.ws_load_wrap_spiral(w.ptr, load, byref(sd), byref(web)) == 0, \
-                w.last_error
             assert lib.ws_world_step_n(w.ptr, 200) == 0, w.last_error
             bands = (L.LoadContainment * 3)()
             assert lib.ws_load_get_containment(w.ptr, load, bands, 3) == 0, w.last_error
@@ -67,14 +77,8 @@ def test_the_spiral_film_implicit_at_its_real_mass():
                             "test": {"type": "eumos"}})
     assert eumos.wrap_def(d2).integrator == 0
     with World(detection_interval=10) as w:
-        ld = _init(L.LoadDef, "ws_load_def_init_sized")
-        ld.layers = 1
-        load = ctypes.c_void_p()
-        assert lib.ws_load_build(w.ptr, byref(ld), byref(load)) == 0, w.last_error
+        load, web = _wrapped_layer(w, sd)
         try:
-            web = L.WebId()
-            assert lib.ws_load_wrap_spiral(w.ptr, load, byref(sd), byref(web)) == 0, \
-                w.last_error
             info = L.WebInfo()
             assert lib.ws_web_get_info(w.ptr, web, byref(info)) == 0
             assert info.substeps == 1
