@@ -110,6 +110,14 @@ static v3 point_velocity(const ws_body_store *b, int cur, uint32_t bi, v3 r)
     return v3_add(b->st[cur].v[bi], v3_cross(b->wg[bi], r));
 }
 
+/* The change over the solved step of the velocity of body j's point at lever r (the solve's dU,
+ * R->x, 6 a body). */
+static v3 point_change(const ws_rigid *R, uint32_t j, v3 r)
+{
+    const double *dU = R->x + 6 * (size_t)j;
+    return v3_add(v3_make(dU[0], dU[1], dU[2]), v3_cross(v3_make(dU[3], dU[4], dU[5]), r));
+}
+
 /* The contacts L into the film's matrix for step h (ws_implicit_add), and, for those with a
  * body of the solve (slot), into R: the link, the body's right-hand side h (F + sum J^T (-(f0 +
  * h K J U0) + h K v0)) with F its known load, and the node's force f0 + h K J U0, so that both
@@ -172,10 +180,8 @@ static void loads_moved(const ws_rigid *R, const uint32_t *slot, const ws_body_s
         const uint32_t j = slot[c->body];
         if (!c->active || j == UINT32_MAX)
             continue;
-        const double *dU = R->x + 6 * (size_t)j;
         const v3 u0 = point_velocity(b, cur, c->body, c->lever),
-                 du = v3_add(v3_make(dU[0], dU[1], dU[2]),
-                             v3_cross(v3_make(dU[3], dU[4], dU[5]), c->lever));
+                 du = point_change(R, j, c->lever);
         double o[3] = {0.0, 0.0, 0.0};
         ws_sym_madd(c->K, h * (u0.x + du.x), h * (u0.y + du.y), h * (u0.z + du.z), o);
         ws_sym_madd(c->D, du.x, du.y, du.z, o);
@@ -194,10 +200,7 @@ static void body_moves(const ws_rigid *R, const uint32_t *slot, ws_node_link *L,
         const uint32_t j = slot[L[k].body];
         if (j == UINT32_MAX)
             continue;
-        const double *dU = R->x + 6 * (size_t)j;
-        const v3 du = v3_add(v3_make(dU[0], dU[1], dU[2]),
-                             v3_cross(v3_make(dU[3], dU[4], dU[5]), L[k].lever));
-        L[k].dub = v3_dot(L[k].n, du);
+        L[k].dub = v3_dot(L[k].n, point_change(R, j, L[k].lever));
     }
 }
 
@@ -221,9 +224,7 @@ static void stick_links(const ws_step *S, ws_web *web, const ws_rigid *R, const 
         ws_node_end e = {nodes_get(vd, i), v3_make(dv[3 * i], dv[3 * i + 1], dv[3 * i + 2]),
                          v3_make(0, 0, 0), c->uk, u0};
         if (j != UINT32_MAX) {
-            const double *dU = R->x + 6 * (size_t)j;
-            e.du = v3_add(v3_make(dU[0], dU[1], dU[2]),
-                          v3_cross(v3_make(dU[3], dU[4], dU[5]), c->lever));
+            e.du = point_change(R, j, c->lever);
             e.ub = v3_add(u0, e.du);
             e.uk = e.ub;
         }
