@@ -1,8 +1,9 @@
 /* The plain scalar explicit loop over a film (bench_plain.c, bench_pallet.c): the film's nodes,
  * their places and masses, its springs with their rest lengths and a tension-compression law,
  * gravity and symplectic Euler, but no bodies; with plain_step_contacts, each node against
- * each box at rest too. Written as a C programmer would write it first: nodes as structures, a list of springs, one loop over the springs and one over
- * the nodes; the including benchmark is compiled without vectors (bench/meson.build). */
+ * each box at rest too. Written as a C programmer would write it first: nodes as structures, a
+ * list of springs, one loop over the springs and one over the nodes; the including benchmark
+ * is compiled without vectors (bench/meson.build). */
 #ifndef BENCH_PLAIN_FILM_H
 #define BENCH_PLAIN_FILM_H
 
@@ -101,7 +102,8 @@ typedef struct plain_contact {
     long touching; /* node contacts evaluated so far */
 } plain_contact;
 
-static inline void plain_contacts(plain_node *nd, size_t n, plain_box *bx, size_t nb, plain_contact *pc)
+static inline void plain_contacts(plain_node *nd, size_t n, plain_box *bx, size_t nb,
+                                  plain_contact *pc)
 {
     for (size_t i = 0; i < n; i++)
         for (size_t b = 0; b < nb; b++) {
