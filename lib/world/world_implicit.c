@@ -279,6 +279,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         !(links = ws_arena_alloc(S->arena, (cl->n + 1) * sizeof *links)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'", label(web));
     ws_implicit *im = web->imp;
+    im->run = ws_world_runner(w);
     const int n = web->substeps;
     const double h = S->dt / n, share = 1.0 / n;
     ws_nodes3 xs = web->x[cur], vs = web->v[cur];
