@@ -728,6 +728,18 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
     ws_rigid *R = im->rig && im->rig->nb ? im->rig : NULL; /* bodies in the solve */
     im->solves++;
+    if (R && R->bstart) { /* each block's first link, when they are in node order */
+        size_t l = 0;
+        R->blocked = 1;
+        for (size_t e = 1; e < R->nl; e++)
+            R->blocked &= R->link[e].node >= R->link[e - 1].node;
+        for (uint32_t k = 0; k < im->nblk; k++) {
+            while (l < R->nl && R->link[l].node < im->blk[k].n0)
+                l++;
+            R->bstart[k] = l;
+        }
+        R->bstart[im->nblk] = R->nl;
+    }
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; and the film's weight over the step, the floor
      * of the earlier relative test's scale (a film at rest, b about 0, was not asked for a
