@@ -24,33 +24,37 @@ static uint32_t block_of(const ws_web *web, uint32_t rows, uint32_t i)
     return web->nx > 0 ? i / (uint32_t)web->nx / rows : 0u;
 }
 
-/* Spring s into block k's runs, whose last ends at last[k]: counted in the block's r1, and
- * with fill written at rng's r1 too. */
-static void run_add(ws_implicit *im, uint32_t k, uint32_t s, uint32_t *last, int fill)
+/* Spring s, its ends in block k as `ends` says (WS_RUN_*), into the block's runs, whose last
+ * ends at last[k] with those ends (lends[k]): counted in the block's r1, and with fill written
+ * at rng's r1 too. */
+static void run_add(ws_implicit *im, uint32_t k, uint32_t s, uint32_t ends, uint32_t *last,
+                    uint32_t *lends, int fill)
 {
     ws_iblock *B = &im->blk[k];
-    if (last[k] == s) {
+    if (last[k] == s && lends[k] == ends) {
         if (fill)
-            im->rng[2 * (size_t)(B->r1 - 1) + 1] = s + 1;
+            im->rng[B->r1 - 1].end = s + 1;
     } else {
         if (fill)
-            im->rng[2 * (size_t)B->r1] = s, im->rng[2 * (size_t)B->r1 + 1] = s + 1;
+            im->rng[B->r1] = (ws_irun){s, s + 1, ends};
         B->r1++;
     }
     last[k] = s + 1;
+    lends[k] = ends;
 }
 
-/* Every spring into the runs of the blocks of its ends, in the springs' order (last: room for
- * nblk). */
+/* Every spring into the runs of the blocks of its ends, in the springs' order (last, lends:
+ * room for nblk each). */
 static void runs_walk(ws_implicit *im, const ws_web *web, uint32_t rows, uint32_t *last, int fill)
 {
+    uint32_t *lends = last + im->nblk;
     for (uint32_t k = 0; k < im->nblk; k++)
         last[k] = UINT32_MAX;
     for (uint32_t s = 0; s < web->ns; s++) {
         const uint32_t a = block_of(web, rows, web->sa[s]), b = block_of(web, rows, web->sb[s]);
-        run_add(im, a, s, last, fill);
+        run_add(im, a, s, b == a ? WS_RUN_AB : WS_RUN_A, last, lends, fill);
         if (b != a)
-            run_add(im, b, s, last, fill);
+            run_add(im, b, s, WS_RUN_B, last, lends, fill);
     }
 }
 
@@ -59,11 +63,11 @@ static int blocks_make(ws_mem *mem, const ws_web *web, ws_implicit *im)
 {
     const uint32_t rows = ws_web_block_rows(web), cnt = web->nx > 0 ? ws_web_block_count(web) : 1;
     im->nblk = cnt ? cnt : 1;
-    uint32_t *last = ws_mem_calloc(mem, im->nblk, sizeof *last);
+    uint32_t *last = ws_mem_calloc(mem, 2 * (size_t)im->nblk, sizeof *last);
     im->blk = ws_mem_calloc(mem, im->nblk, sizeof *im->blk);
     im->part = ws_mem_calloc(mem, (size_t)im->nblk * WS_PARTS, sizeof(double));
     if (!last || !im->blk || !im->part) {
-        ws_mem_free(mem, last, last ? im->nblk * sizeof *last : 0);
+        ws_mem_free(mem, last, last ? 2 * (size_t)im->nblk * sizeof *last : 0);
         return -1;
     }
     runs_walk(im, web, rows, last, 0); /* each block's runs counted in its r1 */
@@ -78,10 +82,10 @@ static int blocks_make(ws_mem *mem, const ws_web *web, ws_implicit *im)
         B->n1 = (uint32_t)(n1 < web->n ? n1 : web->n);
     }
     im->nrng = at;
-    im->rng = ws_mem_calloc(mem, 2 * (im->nrng ? im->nrng : 1), sizeof(uint32_t));
+    im->rng = ws_mem_calloc(mem, im->nrng ? im->nrng : 1, sizeof *im->rng);
     if (im->rng)
         runs_walk(im, web, rows, last, 1);
-    ws_mem_free(mem, last, im->nblk * sizeof *last);
+    ws_mem_free(mem, last, 2 * (size_t)im->nblk * sizeof *last);
     return im->rng ? 0 : -1;
 }
 
@@ -141,7 +145,7 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     if (im->part)
         ws_mem_free(mem, im->part, (size_t)im->nblk * WS_PARTS * sizeof(double));
     if (im->rng)
-        ws_mem_free(mem, im->rng, 2 * (im->nrng ? im->nrng : 1) * sizeof(uint32_t));
+        ws_mem_free(mem, im->rng, (im->nrng ? im->nrng : 1) * sizeof *im->rng);
     ws_mem_free(mem, im, sizeof *im);
     web->imp = NULL;
 }
@@ -219,10 +223,10 @@ static void begin_springs(void *ctx, uint32_t k)
     ws_implicit *im = web->imp;
     const ws_iblock *B = &im->blk[k];
     int failed = 0;
-    for (uint32_t g = B->r0; g < B->r1; g++)
-        for (uint32_t s = im->rng[2 * (size_t)g]; s < im->rng[2 * (size_t)g + 1]; s++) {
-            if (web->sa[s] - B->n0 >= B->n1 - B->n0)
-                continue; /* its end a's block's */
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        if (!(im->rng[g].ends & WS_RUN_A))
+            continue; /* their end a's block's */
+        for (uint32_t s = im->rng[g].first; s < im->rng[g].end; s++) {
             ws_ispring *q = &im->sp[s];
             double *fe = im->sf + 3 * (size_t)s;
             spring_state z;
@@ -252,6 +256,7 @@ static void begin_springs(void *ctx, uint32_t k)
             *q = (ws_ispring){e.x, e.y, e.z, ka, kb, Fud > 0.0 ? Fud * il0 : 0.0, 0.0, 0.0};
             failed |= !(isfinite(ka) && isfinite(q->cs));
         }
+    }
     im->part[WS_PARTS * (size_t)k + WS_PART_MAX] = failed;
 }
 
@@ -269,19 +274,20 @@ static void begin_nodes(void *ctx, uint32_t k)
         f[3 * i + 1] = m * P->gravity.y - c * P->v.y[i];
         f[3 * i + 2] = m * P->gravity.z - c * P->v.z[i];
     }
-    const uint32_t n0 = B->n0, span = B->n1 - B->n0;
-    for (uint32_t g = B->r0; g < B->r1; g++)
-        for (uint32_t s = im->rng[2 * (size_t)g]; s < im->rng[2 * (size_t)g + 1]; s++) {
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const uint32_t ends = im->rng[g].ends;
+        for (uint32_t s = im->rng[g].first; s < im->rng[g].end; s++) {
             const ws_ispring *q = &im->sp[s];
             if (q->ex == 0.0 && q->ey == 0.0 && q->ez == 0.0)
                 continue; /* broken, or its ends together: no force */
             const double *fe = im->sf + 3 * (size_t)s;
             const uint32_t a = web->sa[s], b = web->sb[s];
-            if (a - n0 < span)
+            if (ends & WS_RUN_A)
                 f[3 * a] += fe[0], f[3 * a + 1] += fe[1], f[3 * a + 2] += fe[2];
-            if (b - n0 < span)
+            if (ends & WS_RUN_B)
                 f[3 * b] -= fe[0], f[3 * b + 1] -= fe[1], f[3 * b + 2] -= fe[2];
         }
+    }
 }
 
 /* Whether every law of the web is of the film form: no callback of the user's then runs in
@@ -414,6 +420,32 @@ typedef struct op_pass {
     double *y;
 } op_pass;
 
+/* The springs [s0, s1) of a run's terms of y = A p into the ends `ends` names (a constant at
+ * each call: its loop tests nothing). */
+static inline void op_springs(const ws_web *web, uint32_t s0, uint32_t s1, uint32_t ends,
+                              const double *restrict p, double *restrict y)
+{
+    const ws_implicit *im = web->imp;
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = s0; s < s1; s++) {
+        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
+        const uint32_t a = sa[s], b = sb[s];
+        const double *A = p + 3 * (size_t)a, *Bp = p + 3 * (size_t)b;
+        const double dx = A[0] - Bp[0], dy = A[1] - Bp[1], dz = A[2] - Bp[2];
+        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
+        const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
+                     tz = ed * q[2] + q[4] * dz;
+        if (ends & WS_RUN_A) {
+            double *YA = y + 3 * (size_t)a;
+            YA[0] += tx, YA[1] += ty, YA[2] += tz;
+        }
+        if (ends & WS_RUN_B) {
+            double *YB = y + 3 * (size_t)b;
+            YB[0] -= tx, YB[1] -= ty, YB[2] -= tz;
+        }
+    }
+}
+
 static void op_block(void *ctx, uint32_t k)
 {
     const op_pass *O = ctx;
@@ -422,7 +454,7 @@ static void op_block(void *ctx, uint32_t k)
     const ws_iblock *B = &im->blk[k];
     const double *restrict p = O->p;
     double *restrict y = O->y;
-    const uint32_t n0 = B->n0, span = B->n1 - B->n0;
+    const uint32_t n0 = B->n0;
     for (uint32_t i = n0; i < B->n1; i++) {
         const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
         double *Y = y + 3 * (size_t)i;
@@ -430,25 +462,15 @@ static void op_block(void *ctx, uint32_t k)
         Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
         Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
     }
-    const uint32_t *sa = web->sa, *sb = web->sb;
-    for (uint32_t r = B->r0; r < B->r1; r++)
-        for (uint32_t s = im->rng[2 * (size_t)r]; s < im->rng[2 * (size_t)r + 1]; s++) {
-            const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
-            const uint32_t a = sa[s], b = sb[s];
-            const double *A = p + 3 * (size_t)a, *Bp = p + 3 * (size_t)b;
-            const double dx = A[0] - Bp[0], dy = A[1] - Bp[1], dz = A[2] - Bp[2];
-            const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
-            const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
-                         tz = ed * q[2] + q[4] * dz;
-            if (a - n0 < span) {
-                double *YA = y + 3 * (size_t)a;
-                YA[0] += tx, YA[1] += ty, YA[2] += tz;
-            }
-            if (b - n0 < span) {
-                double *YB = y + 3 * (size_t)b;
-                YB[0] -= tx, YB[1] -= ty, YB[2] -= tz;
-            }
-        }
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const ws_irun *u = &im->rng[g];
+        if (u->ends == WS_RUN_AB)
+            op_springs(web, u->first, u->end, WS_RUN_AB, p, y);
+        else if (u->ends == WS_RUN_A)
+            op_springs(web, u->first, u->end, WS_RUN_A, p, y);
+        else
+            op_springs(web, u->first, u->end, WS_RUN_B, p, y);
+    }
     double py = 0.0;
     if (web->same_inv_m) { /* no pinned node */
         for (size_t j = 3 * (size_t)n0; j < 3 * (size_t)B->n1; j++)

@@ -68,13 +68,19 @@ typedef struct ws_implicit_probe {
 } ws_implicit_probe;
 
 /* A block of the solve's nodes (ws_implicit.blk): its nodes [n0, n1) and, in ws_implicit.rng
- * [r0, r1), the runs of springs that touch them, [first, end) pairs in the springs' order. A
- * pass over a block's runs that adds each spring's term to the ends within the block adds to
- * every node what a pass over all the springs adds, in the same order: blocks run on any
- * workers give the bits of one pass. */
+ * [r0, r1), the runs of springs that touch them in the springs' order. A pass over a block's
+ * runs that adds each spring's term to the ends within the block adds to every node what a
+ * pass over all the springs adds, in the same order: blocks run on any workers give the bits
+ * of one pass. A run's springs have the same ends in the block (WS_RUN_A, WS_RUN_B or both),
+ * so its loop tests none. */
 typedef struct ws_iblock {
     uint32_t n0, n1, r0, r1;
 } ws_iblock;
+
+enum { WS_RUN_A = 1, WS_RUN_B = 2, WS_RUN_AB = 3 };
+typedef struct ws_irun {
+    uint32_t first, end, ends;
+} ws_irun;
 
 /* Sums of a block pass (ws_implicit.part): each block's into its own slots, added in block
  * order after the pass. */
@@ -87,7 +93,7 @@ typedef struct ws_implicit {
      * (WS_PARTS a block), and the step's workers (set by the world for each step). */
     uint32_t nblk;
     ws_iblock *blk;
-    uint32_t *rng;
+    ws_irun *rng;
     size_t nrng;
     double *part;
     ws_runner run;

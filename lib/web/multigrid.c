@@ -7,6 +7,13 @@
 
 #include <string.h>
 
+/* Inlined where a loop's choices are constants at the call (GCC leaves some out of line). */
+#if defined(__GNUC__)
+#define MG_INLINE inline __attribute__((always_inline))
+#else
+#define MG_INLINE inline
+#endif
+
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
 #define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
 /* The film level's smoother: damped block Jacobi, this many sweeps before and after the coarse
@@ -1363,7 +1370,7 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
  * contacts are sorted by node (ws_mg_bodies checks it), so a pass over the nodes walks them
  * with a cursor *l and meets node i's contacts when it is at node i, its z or t in hand. */
 /* rbo += J^T C Z over node i's contacts (the bodies' residual takes -A_bf z). */
-static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
+static MG_INLINE void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
                                   double *rbo)
 {
     for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
@@ -1378,7 +1385,7 @@ static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, cons
 }
 
 /* T += C J zb over node i's contacts (T, the film's residual, takes -A_fb zb). */
-static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
+static MG_INLINE void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
                                   double *T)
 {
     for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
@@ -1393,8 +1400,9 @@ static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, cons
 /* Fine row iy of level k: x += P x_c there, u the row's room (level k + 1's nx vectors); on
  * the film's level with r given, t = r - N x - A_fb zb over the row too, *l the contacts'
  * cursor. */
-static void prolong_row(const ws_mg *mg, const ws_web *web, int k, int iy, double *u, double *x,
-                        const double *r, double *t, const double *zb, size_t *l)
+static MG_INLINE void prolong_row(const ws_mg *mg, const ws_web *web, int k, int iy, double *u,
+                                  double *x, const double *r, double *t, const double *zb,
+                                  size_t *l)
 {
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
@@ -1447,8 +1455,14 @@ static void prolong_block(void *ctx, uint32_t b)
     const uint32_t nx = (uint32_t)mg->lv[0].nx;
     double *u = mg->brow + 3 * (size_t)mg->lv[1].nx * b;
     size_t l = P->zb ? mg->lstart[b] : 0;
-    for (uint32_t iy = mg->blocks[b].n0 / nx; iy < mg->blocks[b].n1 / nx; iy++)
-        prolong_row(mg, P->web, 0, (int)iy, u, P->x, P->r, P->t, P->zb, &l);
+    for (uint32_t iy = mg->blocks[b].n0 / nx; iy < mg->blocks[b].n1 / nx; iy++) {
+        if (P->zb) /* each choice its own loop */
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, P->r, P->t, P->zb, &l);
+        else if (P->r)
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, P->r, P->t, NULL, &l);
+        else
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, NULL, NULL, NULL, &l);
+    }
 }
 
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
@@ -1534,45 +1548,69 @@ typedef struct film_pass {
     const double *zb;
 } film_pass;
 
-static void film_nodes_block(void *ctx, uint32_t b)
+/* The node pass over nodes [n0, n1) with the contacts' cursor at l (the pass's own choices
+ * constants at each call, so each of film_nodes_block's loops tests none of them); returns
+ * r . z over them without residual. */
+static MG_INLINE double nodes_run(const ws_mg *mg, uint32_t n0, uint32_t n1, size_t l,
+                                  const double *restrict r, double *restrict t,
+                                  double *restrict z, int how, int residual, const double *zb,
+                                  double *rbo)
 {
-    const film_pass *F = ctx;
-    const ws_mg *mg = F->mg;
-    const ws_iblock *B = &mg->blocks[b];
-    const double *restrict r = F->r;
-    double *restrict z = F->z, *restrict t = F->t;
-    double *rbo = F->rbo ? mg->bpart + 6 * (size_t)mg->nb * b : NULL;
-    if (rbo)
-        memset(rbo, 0, 6 * (size_t)mg->nb * sizeof(double));
     double rz = 0.0;
-    size_t l = mg->rig && mg->nb ? mg->lstart[b] : 0;
-    for (uint32_t i = B->n0; i < B->n1; i++) {
+    for (uint32_t i = n0; i < n1; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
-        if (F->how != JACOBI_NONE) {
+        if (how != JACOBI_NONE) {
             const float *J = mg->fpinv + WS_SYM * (size_t)i;
-            const double *D = F->how == JACOBI_SET ? R : T;
-            const double xx = J[WS_SYM_XX], yy = J[WS_SYM_YY], zz = J[WS_SYM_ZZ], xy = J[WS_SYM_XY],
-                         xz = J[WS_SYM_XZ], yz = J[WS_SYM_YZ];
+            const double *D = how == JACOBI_SET ? R : T;
+            const double xx = J[WS_SYM_XX], yy = J[WS_SYM_YY], zz = J[WS_SYM_ZZ],
+                         xy = J[WS_SYM_XY], xz = J[WS_SYM_XZ], yz = J[WS_SYM_YZ];
             const double u0 = xx * D[0] + xy * D[1] + xz * D[2],
                          u1 = xy * D[0] + yy * D[1] + yz * D[2],
                          u2 = xz * D[0] + yz * D[1] + zz * D[2];
-            if (F->how == JACOBI_SET)
+            if (how == JACOBI_SET)
                 Z[0] = u0, Z[1] = u1, Z[2] = u2;
             else
                 Z[0] += u0, Z[1] += u1, Z[2] += u2;
         }
         if (rbo)
             node_to_bodies(mg->rig, &l, i, Z, rbo);
-        if (F->residual) {
+        if (residual) {
             T[0] = R[0], T[1] = R[1], T[2] = R[2];
             fsym_sub(mg->fnd + WS_SYM * (size_t)i, Z, T);
-            if (F->zb)
-                bodies_to_node(mg->rig, &l, i, F->zb, T);
+            if (zb)
+                bodies_to_node(mg->rig, &l, i, zb, T);
         } else {
             rz += R[0] * Z[0] + R[1] * Z[1] + R[2] * Z[2];
         }
     }
+    return rz;
+}
+
+static void film_nodes_block(void *ctx, uint32_t b)
+{
+    const film_pass *F = ctx;
+    const ws_mg *mg = F->mg;
+    const ws_iblock *B = &mg->blocks[b];
+    double *rbo = F->rbo ? mg->bpart + 6 * (size_t)mg->nb * b : NULL;
+    if (rbo)
+        memset(rbo, 0, 6 * (size_t)mg->nb * sizeof(double));
+    const size_t l = mg->rig && mg->nb ? mg->lstart[b] : 0;
+    const uint32_t n0 = B->n0, n1 = B->n1;
+    double rz = 0.0;
+    /* The apply's passes (ws_mg's apply): each its own loop. */
+    if (!F->residual)
+        rz = nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_ADD, 0, NULL, NULL);
+    else if (F->zb)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_ADD, 1, F->zb, NULL);
+    else if (F->how == JACOBI_SET && rbo)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_SET, 1, NULL, rbo);
+    else if (F->how == JACOBI_SET)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_SET, 1, NULL, NULL);
+    else if (rbo)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, F->how, 1, NULL, rbo);
+    else
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, F->how, 1, NULL, NULL);
     F->web->imp->part[WS_PARTS * (size_t)b + WS_PART_SUM] = rz;
 }
 
@@ -1592,37 +1630,48 @@ static double film_nodes(const ws_mg *mg, const ws_web *web, const double *r, do
     return rz;
 }
 
-/* t -= the springs' part of A z over block b's nodes, with the springs' blocks as the level
- * keeps them (e, a, b in single precision), the block's runs of springs in their order. */
+/* t -= the springs' part of A z over the springs [s0, s1) of a run, into the ends `ends`
+ * names (a constant at each call), with the springs' blocks as the level keeps them (e, a, b
+ * in single precision). */
+static inline void film_run(const ws_mg *mg, uint32_t s0, uint32_t s1, uint32_t ends,
+                            const double *restrict z, double *restrict t)
+{
+    for (uint32_t s = s0; s < s1; s++) {
+        const float *q = mg->fop + FOP * (size_t)s; /* ex ey ez a b, ends */
+        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], bb = q[4];
+        uint32_t ia, ib;
+        memcpy(&ia, q + FOP_A, sizeof ia);
+        memcpy(&ib, q + FOP_B, sizeof ib);
+        const double *A = z + 3 * (size_t)ia, *Bz = z + 3 * (size_t)ib;
+        const double dx = A[0] - Bz[0], dy = A[1] - Bz[1], dz = A[2] - Bz[2];
+        const double ed = a * (ex * dx + ey * dy + ez * dz);
+        const double tx = ed * ex + bb * dx, ty = ed * ey + bb * dy, tz = ed * ez + bb * dz;
+        if (ends & WS_RUN_A) {
+            double *TA = t + 3 * (size_t)ia;
+            TA[0] -= tx, TA[1] -= ty, TA[2] -= tz;
+        }
+        if (ends & WS_RUN_B) {
+            double *TB = t + 3 * (size_t)ib;
+            TB[0] += tx, TB[1] += ty, TB[2] += tz;
+        }
+    }
+}
+
+/* film_run over block b's runs of springs, in their order. */
 static void film_springs_block(void *ctx, uint32_t b)
 {
     const film_pass *F = ctx;
-    const ws_mg *mg = F->mg;
     const ws_implicit *im = F->web->imp;
-    const ws_iblock *B = &mg->blocks[b];
-    const double *restrict z = F->z;
-    double *restrict t = F->t;
-    const uint32_t n0 = B->n0, span = B->n1 - B->n0;
-    for (uint32_t g = B->r0; g < B->r1; g++)
-        for (uint32_t s = im->rng[2 * (size_t)g]; s < im->rng[2 * (size_t)g + 1]; s++) {
-            const float *q = mg->fop + FOP * (size_t)s; /* ex ey ez a b, ends */
-            const double ex = q[0], ey = q[1], ez = q[2], a = q[3], bb = q[4];
-            uint32_t ia, ib;
-            memcpy(&ia, q + FOP_A, sizeof ia);
-            memcpy(&ib, q + FOP_B, sizeof ib);
-            const double *A = z + 3 * (size_t)ia, *Bz = z + 3 * (size_t)ib;
-            const double dx = A[0] - Bz[0], dy = A[1] - Bz[1], dz = A[2] - Bz[2];
-            const double ed = a * (ex * dx + ey * dy + ez * dz);
-            const double tx = ed * ex + bb * dx, ty = ed * ey + bb * dy, tz = ed * ez + bb * dz;
-            if (ia - n0 < span) {
-                double *TA = t + 3 * (size_t)ia;
-                TA[0] -= tx, TA[1] -= ty, TA[2] -= tz;
-            }
-            if (ib - n0 < span) {
-                double *TB = t + 3 * (size_t)ib;
-                TB[0] += tx, TB[1] += ty, TB[2] += tz;
-            }
-        }
+    const ws_iblock *B = &F->mg->blocks[b];
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const ws_irun *u = &im->rng[g];
+        if (u->ends == WS_RUN_AB)
+            film_run(F->mg, u->first, u->end, WS_RUN_AB, F->z, F->t);
+        else if (u->ends == WS_RUN_A)
+            film_run(F->mg, u->first, u->end, WS_RUN_A, F->z, F->t);
+        else
+            film_run(F->mg, u->first, u->end, WS_RUN_B, F->z, F->t);
+    }
 }
 
 static void film_springs(const ws_mg *mg, const ws_web *web, const double *z, double *t)
