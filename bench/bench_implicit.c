@@ -21,8 +21,9 @@
  * phases (`phases [duration] [r] [dt ms]`: case R's band refined r x r on the multigrid, CG
  * iterations a step, mean and largest, and CPU s per simulated s, every 50 ms of the run;
  * WS_BENCH_SAVE=file with WS_BENCH_SAVE_AT=t saves the state at t, WS_BENCH_RESUME=file starts
- * from a saved one), tilt (`tilt [duration] [r] [tolerance] [dt ms]`: as phases, at that
- * solve tolerance, and then the run's answers; WS_BENCH_RESUME as phases),
+ * from a saved one; WS_BENCH_WORKERS=n steps on n workers, the wall time printed beside the
+ * CPU time), tilt (`tilt [duration] [r] [tolerance] [dt ms]`: as phases, at that solve
+ * tolerance, and then the run's answers; WS_BENCH_RESUME and WS_BENCH_WORKERS as phases),
  * why (dt 1 ms: the boxes held during the film's solve or in it, box-box friction
  * regularised or stick; both at 0.25 and 0.125 ms; `why [duration] [case]` runs case 0..7
  * alone). */
@@ -31,6 +32,13 @@
 
 /* CPU seconds of this process: on a machine shared with other work the process's own time,
  * not the wall clock, is what a refinement costs (the runs are single-threaded). */
+static double wall_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
 static double cpu_now(void)
 {
     struct timespec ts;
@@ -43,7 +51,7 @@ static double cpu_now(void)
 typedef struct window_log {
     int r, known; /* known: `iterations` holds the run's count before the next step */
     long window, k, counted;
-    double dt, cpu;
+    double dt, cpu, wall;
     uint64_t iterations, sum, most;
 } window_log;
 
@@ -62,15 +70,26 @@ static void window_step(const tilt_scene *sc, void *user)
     log->known = 1;
     if (++log->k % log->window)
         return;
-    double t, c = cpu_now();
+    double t, c = cpu_now(), wl = wall_now();
     ws_world_get_time(sc->world, &t);
-    printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU per simulated s\n", log->r, t,
-           log->counted ? (double)log->sum / (double)log->counted : 0.0,
-           (unsigned long long)log->most, (c - log->cpu) / (log->window * log->dt));
+    printf("  r %d  t %.2f s  CG %.2f it/step  most %llu  %.1f s CPU and %.1f s wall per "
+           "simulated s\n",
+           log->r, t, log->counted ? (double)log->sum / (double)log->counted : 0.0,
+           (unsigned long long)log->most, (c - log->cpu) / (log->window * log->dt),
+           (wl - log->wall) / (log->window * log->dt));
     fflush(stdout);
     log->sum = log->most = 0;
     log->counted = 0;
     log->cpu = c;
+    log->wall = wl;
+}
+
+/* The workers of `phases` and `tilt` (WS_BENCH_WORKERS, default 1): the state is the same for
+ * any count, the wall time is not. */
+static int bench_workers(void)
+{
+    const char *e = getenv("WS_BENCH_WORKERS");
+    return e && atoi(e) > 0 ? atoi(e) : 1;
 }
 
 static void line(const char *name, const tilt_options *o)
@@ -412,6 +431,7 @@ int main(int argc, char **argv)
         a.refine = r;
         a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
         a.dt = 1e-3 * (argc > 4 ? atof(argv[4]) : 0.25);
+        a.workers = bench_workers();
         tilt_scene sc;
         if (tilt_build(&a, &sc) != WS_OK) {
             printf("  refine %d: cannot build\n", r);
@@ -434,7 +454,7 @@ int main(int argc, char **argv)
         ws_web_solver_stats prev;
         ws_web_get_solver_stats(sc.world, sc.film, &prev);
         window_log log = {.r = r, .known = 1, .iterations = prev.iterations, .window = window,
-                          .dt = sc.dt, .cpu = cpu_now()};
+                          .dt = sc.dt, .cpu = cpu_now(), .wall = wall_now()};
         for (long k = 1; k <= steps; k++) {
             if (ws_world_step(sc.world) != WS_OK) {
                 printf("  refine %d: %s\n", r, ws_world_last_error(sc.world));
@@ -449,6 +469,9 @@ int main(int argc, char **argv)
             }
             window_step(&sc, &log);
         }
+        uint64_t hash = 0;
+        ws_world_get_state_hash(sc.world, &hash);
+        printf("  state hash %016llx (%d workers)\n", (unsigned long long)hash, a.workers);
         ws_world_destroy(sc.world);
     } else if (!strcmp(what, "tilt")) {
         /* `tilt [duration] [r] [tolerance] [dt ms]`: case R's run with its band refined r x r
@@ -465,8 +488,9 @@ int main(int argc, char **argv)
         a.preconditioner = WS_WEB_PRECONDITIONER_MULTIGRID;
         a.dt = 1e-3 * (argc > 5 ? atof(argv[5]) : 0.25);
         a.resume = getenv("WS_BENCH_RESUME");
+        a.workers = bench_workers();
         window_log log = {.r = a.refine, .window = lround(0.05 / a.dt), .dt = a.dt,
-                          .cpu = cpu_now()};
+                          .cpu = cpu_now(), .wall = wall_now()};
         a.each_step = window_step;
         a.user = &log;
         const double c0 = log.cpu;

@@ -257,3 +257,33 @@ void ws_pool_run(ws_pool *p, ws_task_fn *task, int32_t count, int32_t shared, vo
     atomic_store(&p->caller_asleep, 0);
     pthread_mutex_unlock(&p->lock);
 }
+
+/* A task over lanes of consecutive items (ws_runner_for). */
+typedef struct lanes_task {
+    ws_item_fn *fn;
+    void *ctx;
+    uint32_t count, lanes;
+} lanes_task;
+
+static void lanes_run(int32_t start, int32_t end, uint32_t worker, void *c)
+{
+    (void)worker;
+    const lanes_task *T = c;
+    for (int32_t l = start; l < end; l++) {
+        const uint32_t i0 = (uint32_t)((uint64_t)T->count * (uint32_t)l / T->lanes),
+                       i1 = (uint32_t)((uint64_t)T->count * ((uint32_t)l + 1) / T->lanes);
+        for (uint32_t i = i0; i < i1; i++)
+            T->fn(T->ctx, i);
+    }
+}
+
+void ws_runner_for(const ws_runner *run, uint32_t count, ws_item_fn *fn, void *ctx)
+{
+    if (!run || !run->run || run->workers <= 1 || count < 2) {
+        for (uint32_t i = 0; i < count; i++)
+            fn(ctx, i);
+        return;
+    }
+    lanes_task T = {fn, ctx, count, count < run->items ? count : run->items};
+    run->run(run->self, lanes_run, T.lanes, &T);
+}

@@ -23,4 +23,19 @@ void ws_pool_destroy(ws_mem *mem, ws_pool *pool);
  * and go to whichever is free first (0 <= shared <= count). */
 void ws_pool_run(ws_pool *pool, ws_task_fn *task, int32_t count, int32_t shared, void *ctx);
 
+/* How a module below the world runs a task on the step's workers (the world's threads or the
+ * host's scheduler; world_step.c's ws_world_runner): run(self, task, count, ctx) returns once
+ * items [0, count) of task have run, count at most `items`, at most `workers` of them at once.
+ * A runner whose run is NULL has one worker: the caller runs the items itself. */
+typedef struct ws_runner {
+    void (*run)(void *self, ws_task_fn *task, uint32_t count, void *ctx);
+    void *self;
+    uint32_t workers, items;
+} ws_runner;
+
+/* fn(ctx, i) for i in [0, count) on run's workers (NULL, or one worker: in order here), cut
+ * into at most run->items lanes of consecutive items. */
+typedef void ws_item_fn(void *ctx, uint32_t i);
+void ws_runner_for(const ws_runner *run, uint32_t count, ws_item_fn *fn, void *ctx);
+
 #endif

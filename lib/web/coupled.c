@@ -178,23 +178,24 @@ static void pairs_apply(const ws_rigid *R, const double *pr, double *yr)
     }
 }
 
-double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
-                      double *y, double *yr)
+/* The film's contacts' terms of ws_rigid_apply for links [l0, l1): -C J pr into y at their
+ * nodes (not at pinned ones), the bodies' rows into yr (added to what is there); returns p .
+ * (what it added to y). A run of links on one body (a node's neighbours mostly press on the
+ * same box) sums its body's row in registers, stored once at the run's end: the same sums in
+ * the same order as adding into yr link by link, without a chain of loads and stores through
+ * memory. */
+static double links_apply(const ws_rigid *R, const ws_web *web, size_t l0, size_t l1,
+                          const double *p, const double *pr, double *y, double *yr)
 {
     double added = 0.0;
-    for (uint32_t j = 0; j < R->nb; j++)
-        body_mass_apply(R, j, pr + 6 * (size_t)j, yr + 6 * (size_t)j);
-    /* A run of links on one body (a node's neighbours mostly press on the same box) sums its
-     * body's row in registers, stored once at the run's end: the same sums in the same order
-     * as adding into yr link by link, without a chain of loads and stores through memory. */
-    size_t l = 0;
-    while (l < R->nl) {
+    size_t l = l0;
+    while (l < l1) {
         const uint32_t j = R->link[l].body;
         const double *P = pr + 6 * (size_t)j;
         const v3 V = v3_make(P[0], P[1], P[2]), W = v3_make(P[3], P[4], P[5]);
         double *Y = yr + 6 * (size_t)j;
         double y0 = Y[0], y1 = Y[1], y2 = Y[2], y3 = Y[3], y4 = Y[4], y5 = Y[5];
-        for (; l < R->nl && R->link[l].body == j; l++) {
+        for (; l < l1 && R->link[l].body == j; l++) {
             const ws_rigid_link *L = &R->link[l];
             const double *pn = p + 3 * (size_t)L->node;
             /* The contact point's motion J P, the node's relative to it, and C on both. */
@@ -216,6 +217,49 @@ double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, con
             added -= pn[0] * cj[0] + pn[1] * cj[1] + pn[2] * cj[2];
         }
         Y[0] = y0, Y[1] = y1, Y[2] = y2, Y[3] = y3, Y[4] = y4, Y[5] = y5;
+    }
+    return added;
+}
+
+/* links_apply over the links of the solve's block b (R->bstart), the bodies' rows into the
+ * block's share (R->bpart), what it adds to p . y into the solve's block sums. */
+typedef struct rigid_pass {
+    const ws_rigid *R;
+    const ws_web *web;
+    const double *p, *pr;
+    double *y;
+} rigid_pass;
+
+static void rigid_block(void *ctx, uint32_t b)
+{
+    const rigid_pass *P = ctx;
+    const ws_rigid *R = P->R;
+    double *part = R->bpart + 6 * (size_t)R->nb * b;
+    memset(part, 0, 6 * (size_t)R->nb * sizeof(double));
+    P->web->imp->part[WS_PARTS * (size_t)b + WS_PART_SUM] =
+        links_apply(R, P->web, R->bstart[b], R->bstart[b + 1], P->p, P->pr, P->y, part);
+}
+
+double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
+                      double *y, double *yr)
+{
+    for (uint32_t j = 0; j < R->nb; j++)
+        body_mass_apply(R, j, pr + 6 * (size_t)j, yr + 6 * (size_t)j);
+    double added = 0.0;
+    if (R->bstart && R->blocked) {
+        /* Block by block on the workers (the links are in node order, each block's its
+         * nodes'); the blocks' shares added in block order. */
+        const ws_implicit *im = web->imp;
+        rigid_pass P = {R, web, p, pr, y};
+        ws_implicit_blocks_run(im, rigid_block, &P);
+        for (uint32_t b = 0; b < im->nblk; b++) {
+            const double *part = R->bpart + 6 * (size_t)R->nb * b;
+            for (size_t q = 0; q < 6 * (size_t)R->nb; q++)
+                yr[q] += part[q];
+            added += im->part[WS_PARTS * (size_t)b + WS_PART_SUM];
+        }
+    } else {
+        added = links_apply(R, web, 0, R->nl, p, pr, y, yr);
     }
     pairs_apply(R, pr, yr);
     return added + ws_rigid_dot(R, pr, yr);

@@ -82,6 +82,13 @@ typedef struct ws_rigid {
     /* Scratch for the film's multigrid to nest the bodies in (ws_mg_body_bytes; NULL: none,
      * then the preconditioner is the block one with the coarse space). */
     void *mgbuf;
+    /* The links of each of the solve's blocks of nodes (web/implicit.h's ws_iblock), from
+     * bstart[b] to bstart[b + 1], and each block's share of the bodies' rows in the operator
+     * (6 nb a block): set by the solve when the world gives room for them and the links are
+     * in node order (blocked; otherwise the links in one pass). */
+    size_t *bstart;
+    double *bpart;
+    int blocked;
 } ws_rigid;
 
 /* The velocity change over the step of pair q's contact point on body b relative to a's,

@@ -18,6 +18,77 @@ static size_t scratch_doubles(uint32_t n)
     return 8 * VEC(n) + 4 * SYMS(n); /* f fs b dv r z p q, kc dc pinv nd */
 }
 
+/* The block of node i: a grid web's rows, ws_web_block_rows at a time; a mesh web's one. */
+static uint32_t block_of(const ws_web *web, uint32_t rows, uint32_t i)
+{
+    return web->nx > 0 ? i / (uint32_t)web->nx / rows : 0u;
+}
+
+/* Spring s, its ends in block k as `ends` says (WS_RUN_*), into the block's runs, whose last
+ * ends at last[k] with those ends (lends[k]): counted in the block's r1, and with fill written
+ * at rng's r1 too. */
+static void run_add(ws_implicit *im, uint32_t k, uint32_t s, uint32_t ends, uint32_t *last,
+                    uint32_t *lends, int fill)
+{
+    ws_iblock *B = &im->blk[k];
+    if (last[k] == s && lends[k] == ends) {
+        if (fill)
+            im->rng[B->r1 - 1].end = s + 1;
+    } else {
+        if (fill)
+            im->rng[B->r1] = (ws_irun){s, s + 1, ends};
+        B->r1++;
+    }
+    last[k] = s + 1;
+    lends[k] = ends;
+}
+
+/* Every spring into the runs of the blocks of its ends, in the springs' order (last, lends:
+ * room for nblk each). */
+static void runs_walk(ws_implicit *im, const ws_web *web, uint32_t rows, uint32_t *last, int fill)
+{
+    uint32_t *lends = last + im->nblk;
+    for (uint32_t k = 0; k < im->nblk; k++)
+        last[k] = UINT32_MAX;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        const uint32_t a = block_of(web, rows, web->sa[s]), b = block_of(web, rows, web->sb[s]);
+        run_add(im, a, s, b == a ? WS_RUN_AB : WS_RUN_A, last, lends, fill);
+        if (b != a)
+            run_add(im, b, s, WS_RUN_B, last, lends, fill);
+    }
+}
+
+/* The solve's blocks and their runs of springs (ws_iblock). 0, or -1 when out of memory. */
+static int blocks_make(ws_mem *mem, const ws_web *web, ws_implicit *im)
+{
+    const uint32_t rows = ws_web_block_rows(web), cnt = web->nx > 0 ? ws_web_block_count(web) : 1;
+    im->nblk = cnt ? cnt : 1;
+    uint32_t *last = ws_mem_calloc(mem, 2 * (size_t)im->nblk, sizeof *last);
+    im->blk = ws_mem_calloc(mem, im->nblk, sizeof *im->blk);
+    im->part = ws_mem_calloc(mem, (size_t)im->nblk * WS_PARTS, sizeof(double));
+    if (!last || !im->blk || !im->part) {
+        ws_mem_free(mem, last, last ? 2 * (size_t)im->nblk * sizeof *last : 0);
+        return -1;
+    }
+    runs_walk(im, web, rows, last, 0); /* each block's runs counted in its r1 */
+    uint32_t at = 0;
+    for (uint32_t k = 0; k < im->nblk; k++) {
+        ws_iblock *B = &im->blk[k];
+        const uint32_t runs = B->r1, row = (uint32_t)(web->nx > 0 ? web->nx : 0);
+        const uint64_t n0 = row ? (uint64_t)k * rows * row : 0, n1 = row ? n0 + rows * row : web->n;
+        B->r0 = B->r1 = at;
+        at += runs;
+        B->n0 = (uint32_t)(n0 < web->n ? n0 : web->n);
+        B->n1 = (uint32_t)(n1 < web->n ? n1 : web->n);
+    }
+    im->nrng = at;
+    im->rng = ws_mem_calloc(mem, im->nrng ? im->nrng : 1, sizeof *im->rng);
+    if (im->rng)
+        runs_walk(im, web, rows, last, 1);
+    ws_mem_free(mem, last, 2 * (size_t)im->nblk * sizeof *last);
+    return im->rng ? 0 : -1;
+}
+
 int ws_implicit_reserve(ws_mem *mem, ws_web *web)
 {
     if (web->imp)
@@ -25,21 +96,20 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     ws_implicit *im = ws_mem_calloc(mem, 1, sizeof *im);
     if (!im)
         return -1;
+    web->imp = im;
     const uint32_t n = web->n, ns = web->ns;
-    double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
-    ws_ispring *sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
-    double *op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
-    if (!blk || !sp || !op) {
-        ws_mem_free(mem, blk, blk ? scratch_doubles(n) * sizeof(double) : 0);
-        ws_mem_free(mem, sp, sp ? (ns ? ns : 1) * sizeof(ws_ispring) : 0);
-        ws_mem_free(mem, op, op ? OPS(ns) * sizeof(double) : 0);
-        ws_mem_free(mem, im, sizeof *im);
-        return -1;
-    }
     im->n = n;
     im->ns = ns;
-    im->sp = sp;
-    im->op = op;
+    double *blk = ws_mem_calloc(mem, scratch_doubles(n), sizeof(double));
+    im->f = blk;
+    im->sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
+    im->op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
+    im->sf = ws_mem_calloc(mem, VEC(ns ? ns : 1), sizeof(double));
+    if (!blk || !im->sp || !im->op || !im->sf || blocks_make(mem, web, im) != 0 ||
+        ws_mg_reserve(mem, web, &im->mg) != 0) {
+        ws_implicit_free(mem, web);
+        return -1;
+    }
     double *q = blk;
     im->f = q, q += VEC(n);
     im->b = q, q += VEC(n);
@@ -53,14 +123,6 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->dc = q, q += SYMS(n);
     im->pinv = q, q += SYMS(n);
     im->nd = q;
-    if (ws_mg_reserve(mem, web, &im->mg) != 0) {
-        ws_mem_free(mem, blk, scratch_doubles(n) * sizeof(double));
-        ws_mem_free(mem, sp, (ns ? ns : 1) * sizeof(ws_ispring));
-        ws_mem_free(mem, op, OPS(ns) * sizeof(double));
-        ws_mem_free(mem, im, sizeof *im);
-        return -1;
-    }
-    web->imp = im;
     return 0;
 }
 
@@ -70,11 +132,27 @@ void ws_implicit_free(ws_mem *mem, ws_web *web)
     if (!im)
         return;
     ws_mg_free(mem, im->mg);
-    ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
-    ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
-    ws_mem_free(mem, im->op, OPS(im->ns) * sizeof(double));
+    if (im->f)
+        ws_mem_free(mem, im->f, scratch_doubles(im->n) * sizeof(double));
+    if (im->sp)
+        ws_mem_free(mem, im->sp, (im->ns ? im->ns : 1) * sizeof(ws_ispring));
+    if (im->op)
+        ws_mem_free(mem, im->op, OPS(im->ns) * sizeof(double));
+    if (im->sf)
+        ws_mem_free(mem, im->sf, VEC(im->ns ? im->ns : 1) * sizeof(double));
+    if (im->blk)
+        ws_mem_free(mem, im->blk, im->nblk * sizeof *im->blk);
+    if (im->part)
+        ws_mem_free(mem, im->part, (size_t)im->nblk * WS_PARTS * sizeof(double));
+    if (im->rng)
+        ws_mem_free(mem, im->rng, (im->nrng ? im->nrng : 1) * sizeof *im->rng);
     ws_mem_free(mem, im, sizeof *im);
     web->imp = NULL;
+}
+
+void ws_implicit_blocks_run(const ws_implicit *im, ws_block_fn *fn, void *ctx)
+{
+    ws_runner_for(&im->run, im->nblk, fn, ctx);
 }
 
 /* A spring in a state (x, v): its direction e (unit, a to b), the velocity of b relative to a,
@@ -128,59 +206,117 @@ static int spring_broken(const ws_web *web, uint32_t s)
     return web->nbroken && web->broken && web->broken[s];
 }
 
+/* ws_implicit_begin's passes, block by block: each spring's matrix terms and force F e from
+ * its law, by the block of its end a (begin_springs); then each node's force, gravity and drag
+ * and its springs' forces in their order (begin_nodes). */
+typedef struct begin_pass {
+    ws_web *web;
+    ws_nodes3 x, v;
+    v3 gravity;
+    double t, since;
+} begin_pass;
+
+static void begin_springs(void *ctx, uint32_t k)
+{
+    const begin_pass *P = ctx;
+    const ws_web *web = P->web;
+    ws_implicit *im = web->imp;
+    const ws_iblock *B = &im->blk[k];
+    int failed = 0;
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        if (!(im->rng[g].ends & WS_RUN_A))
+            continue; /* their end a's block's */
+        for (uint32_t s = im->rng[g].first; s < im->rng[g].end; s++) {
+            ws_ispring *q = &im->sp[s];
+            double *fe = im->sf + 3 * (size_t)s;
+            spring_state z;
+            *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            fe[0] = fe[1] = fe[2] = 0.0;
+            if (spring_broken(web, s) || !spring_geometry(web, P->x, P->v, s, &z))
+                continue;
+            if (spring_law(web, s, P->t, P->since, &z) || !isfinite(z.F)) {
+                failed = 1;
+                continue;
+            }
+            const v3 e = z.e;
+            const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
+            fe[0] = F * e.x, fe[1] = F * e.y, fe[2] = F * e.z;
+            /* -df_a/dx_a = (dF/du / l0 - F / l) e e^T + (F / l) I. In compression F / l is
+             * negative and would make the matrix indefinite (the buckling instability of a
+             * compressed string): the matrix takes the transverse term only when it pulls, and
+             * the axial stiffness never below zero (a softening table law), so it stays
+             * positive semi-definite. The rate's dependence on the direction (dF/du_dot times
+             * the node's transverse velocity) is left out too: it is not symmetric, and it is
+             * small where the film moves slowly across its springs. */
+            const double il0 = web->inv_l0[s];
+            const double kb = F > 0.0 ? F / l : 0.0;
+            double ka = Fu * il0 - kb;
+            if (ka < -kb)
+                ka = -kb;
+            *q = (ws_ispring){e.x, e.y, e.z, ka, kb, Fud > 0.0 ? Fud * il0 : 0.0, 0.0, 0.0};
+            failed |= !(isfinite(ka) && isfinite(q->cs));
+        }
+    }
+    im->part[WS_PARTS * (size_t)k + WS_PART_MAX] = failed;
+}
+
+static void begin_nodes(void *ctx, uint32_t k)
+{
+    const begin_pass *P = ctx;
+    const ws_web *web = P->web;
+    const ws_implicit *im = web->imp;
+    const ws_iblock *B = &im->blk[k];
+    double *f = im->f;
+    const double c = web->damping;
+    for (uint32_t i = B->n0; i < B->n1; i++) {
+        const double m = web->m[i];
+        f[3 * i] = m * P->gravity.x - c * P->v.x[i];
+        f[3 * i + 1] = m * P->gravity.y - c * P->v.y[i];
+        f[3 * i + 2] = m * P->gravity.z - c * P->v.z[i];
+    }
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const uint32_t ends = im->rng[g].ends;
+        for (uint32_t s = im->rng[g].first; s < im->rng[g].end; s++) {
+            const ws_ispring *q = &im->sp[s];
+            if (q->ex == 0.0 && q->ey == 0.0 && q->ez == 0.0)
+                continue; /* broken, or its ends together: no force */
+            const double *fe = im->sf + 3 * (size_t)s;
+            const uint32_t a = web->sa[s], b = web->sb[s];
+            if (ends & WS_RUN_A)
+                f[3 * a] += fe[0], f[3 * a + 1] += fe[1], f[3 * a + 2] += fe[2];
+            if (ends & WS_RUN_B)
+                f[3 * b] -= fe[0], f[3 * b + 1] -= fe[1], f[3 * b + 2] -= fe[2];
+        }
+    }
+}
+
+/* Whether every law of the web is of the film form: no callback of the user's then runs in
+ * the springs' pass, which may run on the workers (their callbacks run on the stepping
+ * thread alone, docs/guide.md). */
+static int laws_plain(const ws_web *web)
+{
+    double kc, dk, w, c;
+    for (int q = 0; q < 3; q++)
+        if (web->law[q] && !ws_law_film_form(web->law[q], &kc, &dk, &w, &c))
+            return 0;
+    return 1;
+}
+
 int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t, double since)
 {
     ws_implicit *im = web->imp;
-    const uint32_t n = web->n;
-    double *f = im->f;
-    const double c = web->damping;
     im->begun++; /* the springs' blocks are about to change */
-    for (uint32_t i = 0; i < n; i++) {
-        const double m = web->m[i];
-        f[3 * i] = m * gravity.x - c * v.x[i];
-        f[3 * i + 1] = m * gravity.y - c * v.y[i];
-        f[3 * i + 2] = m * gravity.z - c * v.z[i];
-    }
-    for (uint32_t s = 0; s < web->ns; s++) {
-        ws_ispring *q = &im->sp[s];
-        spring_state z;
-        if (spring_broken(web, s) || !spring_geometry(web, x, v, s, &z)) {
-            *q = (ws_ispring){0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-            continue;
-        }
-        if (spring_law(web, s, t, since, &z) || !isfinite(z.F))
+    begin_pass P = {web, x, v, gravity, t, since};
+    const ws_runner run = im->run;
+    if (!laws_plain(web))
+        im->run.run = NULL; /* the springs' laws on this thread */
+    ws_implicit_blocks_run(im, begin_springs, &P);
+    im->run = run;
+    for (uint32_t k = 0; k < im->nblk; k++)
+        if (im->part[WS_PARTS * (size_t)k + WS_PART_MAX] != 0.0)
             return 1;
-        const v3 e = z.e;
-        const double F = z.F, l = z.l, Fu = z.Fu, Fud = z.Fud;
-        const uint32_t a = web->sa[s], b = web->sb[s];
-        f[3 * a] += F * e.x;
-        f[3 * a + 1] += F * e.y;
-        f[3 * a + 2] += F * e.z;
-        f[3 * b] -= F * e.x;
-        f[3 * b + 1] -= F * e.y;
-        f[3 * b + 2] -= F * e.z;
-        /* -df_a/dx_a = (dF/du / l0 - F / l) e e^T + (F / l) I. In compression F / l is negative
-         * and would make the matrix indefinite (the buckling instability of a compressed
-         * string): the matrix takes the transverse term only when it pulls, and the axial
-         * stiffness never below zero (a softening table law), so it stays positive
-         * semi-definite. The rate's dependence on the direction (dF/du_dot times the node's
-         * transverse velocity) is left out too: it is not symmetric, and it is small where
-         * the film moves slowly across its springs. */
-        const double il0 = web->inv_l0[s];
-        const double kb = F > 0.0 ? F / l : 0.0;
-        double ka = Fu * il0 - kb;
-        if (ka < -kb)
-            ka = -kb;
-        q->ex = e.x;
-        q->ey = e.y;
-        q->ez = e.z;
-        q->ka = ka;
-        q->kb = kb;
-        q->cs = Fud > 0.0 ? Fud * il0 : 0.0;
-        if (!(isfinite(ka) && isfinite(q->cs)))
-            return 1;
-    }
-    memcpy(im->fs, f, VEC(n) * sizeof(double));
+    ws_implicit_blocks_run(im, begin_nodes, &P);
+    memcpy(im->fs, im->f, VEC(im->n) * sizeof(double));
     ws_implicit_reset(im);
     return 0;
 }
@@ -276,47 +412,94 @@ static void operator_for(const ws_web *web, double h)
 }
 
 /* y = A p with the parts operator_for set, and p . y returned. A pinned node's p is zero (its
- * preconditioner is), so its y is not needed: it is set to zero. */
-double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
+ * preconditioner is), so its y is not needed: it is set to zero. Block by block (ws_iblock):
+ * each node's sum is the springs' order's, whatever the workers. */
+typedef struct op_pass {
+    const ws_web *web;
+    const double *p;
+    double *y;
+} op_pass;
+
+/* The springs [s0, s1) of a run's terms of y = A p into the ends `ends` names (a constant at
+ * each call: its loop tests nothing). */
+static inline void op_springs(const ws_web *web, uint32_t s0, uint32_t s1, uint32_t ends,
+                              const double *restrict p, double *restrict y)
 {
     const ws_implicit *im = web->imp;
-    const uint32_t n = web->n;
-    for (uint32_t i = 0; i < n; i++) {
+    const uint32_t *sa = web->sa, *sb = web->sb;
+    for (uint32_t s = s0; s < s1; s++) {
+        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
+        const uint32_t a = sa[s], b = sb[s];
+        const double *A = p + 3 * (size_t)a, *Bp = p + 3 * (size_t)b;
+        const double dx = A[0] - Bp[0], dy = A[1] - Bp[1], dz = A[2] - Bp[2];
+        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
+        const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
+                     tz = ed * q[2] + q[4] * dz;
+        if (ends & WS_RUN_A) {
+            double *YA = y + 3 * (size_t)a;
+            YA[0] += tx, YA[1] += ty, YA[2] += tz;
+        }
+        if (ends & WS_RUN_B) {
+            double *YB = y + 3 * (size_t)b;
+            YB[0] -= tx, YB[1] -= ty, YB[2] -= tz;
+        }
+    }
+}
+
+static void op_block(void *ctx, uint32_t k)
+{
+    const op_pass *O = ctx;
+    const ws_web *web = O->web;
+    const ws_implicit *im = web->imp;
+    const ws_iblock *B = &im->blk[k];
+    const double *restrict p = O->p;
+    double *restrict y = O->y;
+    const uint32_t n0 = B->n0;
+    for (uint32_t i = n0; i < B->n1; i++) {
         const double *P = p + 3 * (size_t)i, *S = im->nd + WS_SYM * (size_t)i;
         double *Y = y + 3 * (size_t)i;
         Y[0] = S[WS_SYM_XX] * P[0] + S[WS_SYM_XY] * P[1] + S[WS_SYM_XZ] * P[2];
         Y[1] = S[WS_SYM_XY] * P[0] + S[WS_SYM_YY] * P[1] + S[WS_SYM_YZ] * P[2];
         Y[2] = S[WS_SYM_XZ] * P[0] + S[WS_SYM_YZ] * P[1] + S[WS_SYM_ZZ] * P[2];
     }
-    const uint32_t *sa = web->sa, *sb = web->sb;
-    for (uint32_t s = 0; s < web->ns; s++) {
-        const double *q = im->op + 5 * (size_t)s; /* ex ey ez a b */
-        const double *A = p + 3 * (size_t)sa[s], *B = p + 3 * (size_t)sb[s];
-        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
-        const double ed = q[3] * (q[0] * dx + q[1] * dy + q[2] * dz);
-        const double tx = ed * q[0] + q[4] * dx, ty = ed * q[1] + q[4] * dy,
-                     tz = ed * q[2] + q[4] * dz;
-        double *YA = y + 3 * (size_t)sa[s], *YB = y + 3 * (size_t)sb[s];
-        YA[0] += tx;
-        YA[1] += ty;
-        YA[2] += tz;
-        YB[0] -= tx;
-        YB[1] -= ty;
-        YB[2] -= tz;
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const ws_irun *u = &im->rng[g];
+        if (u->ends == WS_RUN_AB)
+            op_springs(web, u->first, u->end, WS_RUN_AB, p, y);
+        else if (u->ends == WS_RUN_A)
+            op_springs(web, u->first, u->end, WS_RUN_A, p, y);
+        else
+            op_springs(web, u->first, u->end, WS_RUN_B, p, y);
     }
     double py = 0.0;
     if (web->same_inv_m) { /* no pinned node */
-        for (size_t j = 0; j < VEC(n); j++)
+        for (size_t j = 3 * (size_t)n0; j < 3 * (size_t)B->n1; j++)
             py += p[j] * y[j];
-        return py;
+    } else {
+        for (uint32_t i = n0; i < B->n1; i++) {
+            double *Y = y + 3 * (size_t)i;
+            if (web->inv_m[i] == 0.0)
+                Y[0] = Y[1] = Y[2] = 0.0;
+            py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
+        }
     }
-    for (uint32_t i = 0; i < n; i++) {
-        double *Y = y + 3 * (size_t)i;
-        if (web->inv_m[i] == 0.0)
-            Y[0] = Y[1] = Y[2] = 0.0;
-        py += p[3 * i] * Y[0] + p[3 * i + 1] * Y[1] + p[3 * i + 2] * Y[2];
-    }
-    return py;
+    im->part[WS_PARTS * (size_t)k + WS_PART_SUM] = py;
+}
+
+/* The blocks' sums of slot `slot` added in block order. */
+static double parts_sum(const ws_implicit *im, int slot)
+{
+    double s = 0.0;
+    for (uint32_t k = 0; k < im->nblk; k++)
+        s += im->part[WS_PARTS * (size_t)k + (size_t)slot];
+    return s;
+}
+
+double ws_implicit_apply_op(const ws_web *web, const double *restrict p, double *restrict y)
+{
+    op_pass O = {web, p, y};
+    ws_implicit_blocks_run(web->imp, op_block, &O);
+    return parts_sum(web->imp, WS_PART_SUM);
 }
 
 /* The inverse of every node's diagonal block of A (block Jacobi); a pinned node's is zero, so
@@ -520,6 +703,45 @@ static double precondition_all(const ws_implicit *im, const ws_web *web, ws_mg *
     return rz;
 }
 
+/* A CG iteration's passes over the film's rows, block by block: dv += alpha p and r -= alpha q
+ * with each block's sum of |r_i|^2 and largest |r_i|^2 / m_i^2 (cg_step_block), and p = z + beta
+ * p (cg_direction_block). */
+typedef struct cg_pass {
+    const ws_web *web;
+    double alpha, beta;
+} cg_pass;
+
+static void cg_step_block(void *ctx, uint32_t k)
+{
+    const cg_pass *C = ctx;
+    const ws_web *web = C->web;
+    const ws_implicit *im = web->imp;
+    const ws_iblock *B = &im->blk[k];
+    const double alpha = C->alpha;
+    double rr = 0.0, w2 = 0.0;
+    for (uint32_t i = B->n0; i < B->n1; i++) {
+        double *X = im->dv + 3 * (size_t)i, *Q = im->r + 3 * (size_t)i;
+        const double *P = im->p + 3 * (size_t)i, *AP = im->q + 3 * (size_t)i;
+        X[0] += alpha * P[0], X[1] += alpha * P[1], X[2] += alpha * P[2];
+        Q[0] -= alpha * AP[0], Q[1] -= alpha * AP[1], Q[2] -= alpha * AP[2];
+        const double s = Q[0] * Q[0] + Q[1] * Q[1] + Q[2] * Q[2], u = web->inv_m[i];
+        rr += s;
+        if (s * (u * u) > w2)
+            w2 = s * (u * u);
+    }
+    im->part[WS_PARTS * (size_t)k + WS_PART_SUM] = rr;
+    im->part[WS_PARTS * (size_t)k + WS_PART_MAX] = w2;
+}
+
+static void cg_direction_block(void *ctx, uint32_t k)
+{
+    const cg_pass *C = ctx;
+    const ws_implicit *im = C->web->imp;
+    const ws_iblock *B = &im->blk[k];
+    for (size_t j = 3 * (size_t)B->n0; j < 3 * (size_t)B->n1; j++)
+        im->p[j] = im->z[j] + C->beta * im->p[j];
+}
+
 int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
 {
     ws_implicit *im = web->imp;
@@ -528,6 +750,18 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     double *b = im->b, *x = im->dv, *r = im->r, *z = im->z, *p = im->p, *q = im->q;
     ws_rigid *R = im->rig && im->rig->nb ? im->rig : NULL; /* bodies in the solve */
     im->solves++;
+    if (R && R->bstart) { /* each block's first link, when they are in node order */
+        size_t l = 0;
+        R->blocked = 1;
+        for (size_t e = 1; e < R->nl; e++)
+            R->blocked &= R->link[e].node >= R->link[e - 1].node;
+        for (uint32_t k = 0; k < im->nblk; k++) {
+            while (l < R->nl && R->link[l].node < im->blk[k].n0)
+                l++;
+            R->bstart[k] = l;
+        }
+        R->bstart[im->nblk] = R->nl;
+    }
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; and the film's weight over the step, the floor
      * of the earlier relative test's scale (a film at rest, b about 0, was not asked for a
@@ -646,16 +880,11 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         const double alpha = rz / pq;
         rr = R ? ws_rigid_step(R, alpha) : 0.0;
         double w2 = R && !im->stop_relative ? bodies_worst2(R, R->r) : 0.0;
-        for (uint32_t i = 0; i < n; i++) {
-            double *X = x + 3 * (size_t)i, *Q = r + 3 * (size_t)i;
-            const double *P = p + 3 * (size_t)i, *AP = q + 3 * (size_t)i;
-            X[0] += alpha * P[0], X[1] += alpha * P[1], X[2] += alpha * P[2];
-            Q[0] -= alpha * AP[0], Q[1] -= alpha * AP[1], Q[2] -= alpha * AP[2];
-            const double s = Q[0] * Q[0] + Q[1] * Q[1] + Q[2] * Q[2], u = web->inv_m[i];
-            rr += s;
-            if (s * (u * u) > w2)
-                w2 = s * (u * u);
-        }
+        cg_pass C = {web, alpha, 0.0};
+        ws_implicit_blocks_run(im, cg_step_block, &C);
+        rr += parts_sum(im, WS_PART_SUM);
+        for (uint32_t k = 0; k < im->nblk; k++)
+            w2 = fmax(w2, im->part[WS_PARTS * (size_t)k + WS_PART_MAX]);
         meas = !isfinite(rr) ? NAN : im->stop_relative ? rr : w2;
         it++;
         if (first && (it & (it - 1)) == 0 && it <= 32) {
@@ -671,8 +900,8 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
         const double rz1 = precondition_all(im, web, nested ? mg : NULL, mg, R, r, z);
         const double beta = rz1 / rz;
         rz = rz1;
-        for (size_t j = 0; j < m; j++)
-            p[j] = z[j] + beta * p[j];
+        cg_pass D = {web, 0.0, beta};
+        ws_implicit_blocks_run(im, cg_direction_block, &D);
         if (R)
             ws_rigid_direction(R, beta);
     }

@@ -17,6 +17,7 @@
 #ifndef WS_WEB_IMPLICIT_H
 #define WS_WEB_IMPLICIT_H
 
+#include "base/pool.h"
 #include "web/web.h"
 
 /* A symmetric 3x3 block: xx, yy, zz, xy, xz, yz. */
@@ -66,12 +67,41 @@ typedef struct ws_implicit_probe {
     } watch_link[4];
 } ws_implicit_probe;
 
+/* A block of the solve's nodes (ws_implicit.blk): its nodes [n0, n1) and, in ws_implicit.rng
+ * [r0, r1), the runs of springs that touch them in the springs' order. A pass over a block's
+ * runs that adds each spring's term to the ends within the block adds to every node what a
+ * pass over all the springs adds, in the same order: blocks run on any workers give the bits
+ * of one pass. A run's springs have the same ends in the block (WS_RUN_A, WS_RUN_B or both),
+ * so its loop tests none. */
+typedef struct ws_iblock {
+    uint32_t n0, n1, r0, r1;
+} ws_iblock;
+
+enum { WS_RUN_A = 1, WS_RUN_B = 2, WS_RUN_AB = 3 };
+typedef struct ws_irun {
+    uint32_t first, end, ends;
+} ws_irun;
+
+/* Sums of a block pass (ws_implicit.part): each block's into its own slots, added in block
+ * order after the pass. */
+enum { WS_PART_SUM, WS_PART_MAX, WS_PARTS };
+
 typedef struct ws_implicit {
     uint32_t n, ns;
+    /* The blocks the solve's passes run in (a grid web's rows, ws_web_block_rows at a time; a
+     * mesh web's nodes one block), the runs of springs they list (2 a run), each block's sums
+     * (WS_PARTS a block), and the step's workers (set by the world for each step). */
+    uint32_t nblk;
+    ws_iblock *blk;
+    ws_irun *rng;
+    size_t nrng;
+    double *part;
+    ws_runner run;
     double *f;       /* force on each node at (x0, v0): springs, drag, gravity, contacts */
     double *fs;      /* the same without the contacts (ws_implicit_reset) */
     double *kc, *dc; /* per node, symmetric: -df/dx and -df/dv of its contacts */
     ws_ispring *sp;  /* per spring */
+    double *sf;      /* per spring, its force on end a at the step's start, F e (xyz) */
     double *op;      /* per spring, the solve's A block as its products read it, packed: e and
                         a, b of ws_ispring (5 doubles a spring; ws_implicit_apply_op) */
     double *b, *dv, *r, *z, *p, *q; /* the solve's vectors; dv kept for the warm start */
@@ -106,6 +136,11 @@ typedef struct ws_implicit {
     int cold_bodies; /* set: the bodies start from rest, not from the warm film (a bench's
                         comparison) */
 } ws_implicit;
+
+/* fn(ctx, b) for every block b of the solve (im->blk), on the step's workers (im->run): the
+ * blocks in order on one worker, shared among lanes of consecutive blocks on more. */
+typedef ws_item_fn ws_block_fn;
+void ws_implicit_blocks_run(const ws_implicit *im, ws_block_fn *fn, void *ctx);
 
 /* The implicit scratch of a web (web->imp), made when missing. 0, or -1 when out of memory. */
 int ws_implicit_reserve(ws_mem *mem, ws_web *web);

@@ -7,6 +7,13 @@
 
 #include <string.h>
 
+/* Inlined where a loop's choices are constants at the call (GCC leaves some out of line). */
+#if defined(__GNUC__)
+#define MG_INLINE inline __attribute__((always_inline))
+#else
+#define MG_INLINE inline
+#endif
+
 #define MG_LEVELS 16   /* levels at most (a grid of 2^15 nodes a side would need them) */
 #define MG_COARSEST 16 /* a level of this many nodes or fewer is the coarsest */
 /* The film level's smoother: damped block Jacobi, this many sweeps before and after the coarse
@@ -84,6 +91,17 @@ struct ws_mg {
     double *chol; /* its Cholesky factor, lower, m x m */
     double *acc;  /* a coarse level's blocks as they are summed (level 1's size) */
     double *row;  /* a coarse row of vectors (level 1's nx), for restriction and prolongation */
+    /* The film level's passes run in the solve's blocks (web/implicit.h's ws_iblock, nblk of
+     * them): each block's own coarse row for prolongation (brow, level 1's nx each), every
+     * film row restricted along x (rrow, level 0's ny rows of level 1's nx), and with bodies
+     * nested each block's first contact (lstart, nblk + 1) and its share of the bodies'
+     * residual (bpart, 6 nb a block). */
+    uint32_t nblk;
+    const ws_iblock *blocks;
+    double *brow, *rrow, *bpart;
+    double *rpart; /* each row's share of the bodies' sums in a coarse sweep (6 nb a row of
+                      level 1's, the largest) */
+    size_t *lstart;
     double *sacc; /* level 1's springs' part, kept while the springs' blocks are: made for the
                      step ws_implicit_begin began (its count kept_begun) and the step h */
     int springs_kept;
@@ -762,7 +780,9 @@ size_t ws_mg_body_bytes(const ws_mg *mg, uint32_t nb, size_t nl)
     if (!mg || !nb || nb > WS_MG_NEST_BODIES_MAX)
         return 0;
     const size_t m = mg->m + 6 * (size_t)nb;
-    size_t d = m * m + m + 18 * (size_t)nb, u = (size_t)mg->lv[1].n * nb;
+    size_t d = m * m + m + 18 * (size_t)nb + 6 * (size_t)nb * (mg->nblk + (size_t)mg->lv[1].ny) +
+               mg->nblk + 1,
+           u = (size_t)mg->lv[1].n * nb;
     for (int k = 1; k < mg->nlev; k++) {
         const size_t pairs = pairs_room(mg, k, nb, nl);
         d += 12 * (size_t)nb + 18 * pairs;
@@ -790,6 +810,20 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
     mg->bsc = q, q += m;
     mg->brz = q, q += 12 * (size_t)nb;
     mg->bsum = q, q += 6 * (size_t)nb;
+    mg->bpart = q, q += 6 * (size_t)nb * mg->nblk;
+    mg->rpart = q, q += 6 * (size_t)nb * (size_t)mg->lv[1].ny;
+    mg->lstart = (size_t *)(void *)q, q += mg->nblk + 1;
+    {
+        /* Each block's first contact (they are sorted by node). */
+        const ws_iblock *blk = mg->blocks;
+        size_t l = 0;
+        for (uint32_t b = 0; b < mg->nblk; b++) {
+            while (l < R->nl && R->link[l].node < blk[b].n0)
+                l++;
+            mg->lstart[b] = l;
+        }
+        mg->lstart[mg->nblk] = R->nl;
+    }
     for (int k = 1; k < mg->nlev; k++) {
         mg_level *L = &mg->lv[k];
         L->xb = q, q += 6 * (size_t)nb;
@@ -939,25 +973,58 @@ static inline void row_beside(const mg_level *L, int ix, int iy, int dy, int64_t
     j[2] = ix + 1 < L->nx ? b + ix + 1 : L->closed ? b : -1;
 }
 
-/* Forward, row iy solved whole (its factor from line_factor) against the row before it (those
- * after are still zero) and the bodies: then the row before takes -A_{row-1,row} x_row into t
- * (the row itself is solved exactly: its own couplings leave nothing), and the bodies -G^T x
- * into rbn. */
-static void line_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
+/* A coarse level's rows are swept in two colours: forward the even rows, then the odd ones;
+ * backward the odd rows, then the even ones, each row's nodes in reverse (the forward sweep's
+ * exact reverse, so that B_k stays symmetric). The stencil reaches the rows beside a row alone,
+ * so the rows of one colour do not meet: they run on the workers at once, and the sweep is the
+ * same whatever their number (the bodies' sums are each row's, added in the sweep's order). In
+ * the forward sweep from x = 0 an even row meets no other row (the odd ones are still zero),
+ * and an odd row both even rows beside it (KNOWN_BELOW | KNOWN_ABOVE). */
+enum { KNOWN_BELOW = 1, KNOWN_ABOVE = 2 };
+
+/* Whether node k's neighbour j in slot o is known in a forward sweep: one before it in its
+ * row, or in a row beside that `known` names. */
+static inline int known_before(int64_t k, int o, int64_t j, int known)
+{
+    const int dy = o / 3 - 1;
+    if (j < 0)
+        return 0;
+    if (dy == 0)
+        return j < k;
+    return (known & (dy < 0 ? KNOWN_BELOW : KNOWN_ABOVE)) != 0;
+}
+
+/* s -= A_kj x_j over node (ix, iy)'s neighbours in the rows beside that `known` names. */
+static inline void rows_take(const mg_level *L, int ix, int iy, int known, double *s)
+{
+    const int64_t k = ix + (int64_t)L->nx * iy;
+    int64_t j[3];
+    for (int dy = -1; dy <= 1; dy += 2) {
+        if (!(known & (dy < 0 ? KNOWN_BELOW : KNOWN_ABOVE)))
+            continue;
+        row_beside(L, ix, iy, dy, j);
+        for (int o = 0; o < 3; o++)
+            if (j[o] >= 0)
+                fsym_sub(off_block(L, (size_t)k, 3 * (dy + 1) + o, j[o]), L->x + 3 * (size_t)j[o],
+                         s);
+    }
+}
+
+/* Forward, row iy solved whole (its factor from line_factor) against the rows beside it that
+ * `known` names and the bodies; the bodies take -G^T x into rbn (NULL: none). The row itself is
+ * solved exactly: its own couplings leave nothing in t. */
+static void line_row_forward(const ws_mg *mg, mg_level *L, int iy, int known, int write_below,
+                             double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
     const size_t k0 = (size_t)L->nx * (size_t)iy;
     double *Xr = L->x + 3 * k0, acc[3] = {0.0, 0.0, 0.0};
-    int64_t j[3];
     for (int ix = 0; ix < L->nx; ix++) {
         const int64_t k = (int64_t)k0 + ix;
-        row_beside(L, ix, iy, -1, j);
         const double *R = L->r + 3 * (size_t)k;
         double *X = L->x + 3 * (size_t)k;
         X[0] = R[0], X[1] = R[1], X[2] = R[2];
-        for (int o = 0; o < 3; o++)
-            if (j[o] >= 0)
-                fsym_sub(AT(L, (size_t)j[o], 8 - o), L->x + 3 * (size_t)j[o], X);
+        rows_take(L, ix, iy, known, X);
         const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
         for (uint32_t e = e0; e < e1; e++)
             g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], X);
@@ -966,11 +1033,14 @@ static void line_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
     for (int ix = L->nx - 1; ix >= 0; ix--) {
         const int64_t k = (int64_t)k0 + ix;
         line_up(L, k0, ix, Xr);
-        row_beside(L, ix, iy, -1, j);
         const double *X = L->x + 3 * (size_t)k;
-        for (int o = 0; o < 3; o++) /* t_j -= A_jk x_k for the row before */
-            if (j[o] >= 0)
-                fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
+        if (write_below) { /* t_j -= A_jk x_k for the row before in the chunk */
+            int64_t j[3];
+            row_beside(L, ix, iy, -1, j);
+            for (int o = 0; o < 3; o++)
+                if (j[o] >= 0)
+                    fsym_sub(AT(L, (size_t)j[o], 8 - o), X, L->t + 3 * (size_t)j[o]);
+        }
         const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
         for (uint32_t e = e0; e < e1; e++)
             gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
@@ -1012,18 +1082,6 @@ static void line_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
     }
 }
 
-/* Node k's neighbour j in slot o (-1: none) in a forward sweep: s -= A_kj x_j when j is before
- * k (the nodes after are still zero), its block into *B (NULL when not). */
-static inline void gs_take(const mg_level *L, int64_t k, int o, int64_t j, const float **B,
-                           double *s)
-{
-    *B = NULL;
-    if (j < 0 || j > k)
-        return;
-    *B = off_block(L, (size_t)k, o, j);
-    fsym_sub(*B, L->x + 3 * (size_t)j, s);
-}
-
 /* x_k = D_k^-1 s (the inverse of the node's own block, point_factor). */
 static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
 {
@@ -1033,10 +1091,11 @@ static inline void gs_solve(const mg_level *L, int64_t k, const double *s)
     ws_sym_madd(S, s[0], s[1], s[2], X);
 }
 
-/* Forward, row iy node by node: a node meets only the nodes before it (those after are still
- * zero) and the bodies, and each node before it that it meets takes -A_jk x_k into t (with the
- * block its own solve has just read), the bodies -G^T x_k into rbn. */
-static void point_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
+/* Forward, row iy node by node: a node meets the nodes known before it (known_before) and the
+ * bodies; each node before it in its row takes -A_jk x_k into t (with the block its own solve
+ * has just read; the rows beside gather theirs, row_gather), the bodies -G^T x_k into rbn. */
+static void point_row_forward(const ws_mg *mg, mg_level *L, int iy, int known, int write_below,
+                              double *rbn)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
     for (int ix = 0; ix < L->nx; ix++) {
@@ -1046,16 +1105,20 @@ static void point_row_forward(const ws_mg *mg, mg_level *L, int iy, double *rbn)
         const double *R = L->r + 3 * (size_t)k;
         double s[3] = {R[0], R[1], R[2]};
         const float *B[9];
-        for (int o = 0; o < 9; o++)
-            if (o != CENTRE)
-                gs_take(L, k, o, j[o], &B[o], s);
+        for (int o = 0; o < 9; o++) {
+            B[o] = NULL;
+            if (o == CENTRE || !known_before(k, o, j[o], known))
+                continue;
+            B[o] = off_block(L, (size_t)k, o, j[o]);
+            fsym_sub(B[o], L->x + 3 * (size_t)j[o], s);
+        }
         const uint32_t e0 = nb6 ? L->gs[k] : 0, e1 = nb6 ? L->gs[k + 1] : 0;
         for (uint32_t e = e0; e < e1; e++)
             g_sub(L->G + 18 * (size_t)e, L->xb + 6 * (size_t)L->gb[e], s);
         gs_solve(L, k, s);
         const double *X = L->x + 3 * (size_t)k;
-        for (int o = 0; o < 9; o++) /* t_j -= A_jk x_k, A_jk = A_kj */
-            if (o != CENTRE && B[o])
+        for (int o = write_below ? 0 : CENTRE - 1; o <= CENTRE + 1; o++)
+            if (B[o]) /* t_j -= A_jk x_k, A_jk = A_kj */
                 fsym_sub(B[o], X, L->t + 3 * (size_t)j[o]);
         for (uint32_t e = e0; e < e1; e++)
             gt_sub(L->G + 18 * (size_t)e, X, rbn + 6 * (size_t)L->gb[e]);
@@ -1086,50 +1149,149 @@ static void point_row_backward(const ws_mg *mg, mg_level *L, int iy, double *sb)
     }
 }
 
-/* The sweeps of symmetric block Gauss-Seidel on a coarse level L, the blocks a level's rows
- * solved whole (L->whole) and its other nodes one by one, taken in the grid's order: the
- * bodies nested (mg->nb) first in the forward sweep and last in the backward one, which takes
- * the same blocks in reverse, so that the two mirror each other (B_k symmetric) and every
- * coupling term is taken in the node loops, where the node's x is at hand. Forward from x = 0:
- * the bodies from their right-hand side alone, then each block meets only the blocks before it
- * (those after are still zero) and the bodies; the sweep leaves the residual r - A x in t (each
- * block's own couplings are solved exactly, so what is left at a node is what the blocks after
- * it add since, added as each is solved) and the bodies' residual, rb - A_bb xb - G^T x =
- * -G^T x, in rbn (the next level's: the bodies are the same unknowns there; A_bb is solved
- * whole, the pairs' coupling between bodies with it, or that residual would keep it). */
-static void gauss_seidel_forward(const ws_mg *mg, mg_level *L, double *rbn)
+/* A coarse level's rows in chunks of MG_CHUNK_ROWS, chunk c rows [c R, (c + 1) R). */
+#define MG_CHUNK_ROWS 8
+
+static int chunk_count(const mg_level *L)
+{
+    return (L->ny + MG_CHUNK_ROWS - 1) / MG_CHUNK_ROWS;
+}
+
+/* One colour of a coarse level's sweep (sweep_chunks): chunk 2 i + colour for item i. */
+typedef struct sweep_pass {
+    const ws_mg *mg;
+    mg_level *L;
+    int colour, forward;
+} sweep_pass;
+
+/* The bodies' share of row iy in a sweep (6 nb doubles; NULL without bodies). */
+static double *row_part(const ws_mg *mg, int iy)
+{
+    return mg->nb ? mg->rpart + 6 * (size_t)mg->nb * (size_t)iy : NULL;
+}
+
+static void sweep_chunk(void *ctx, uint32_t i)
+{
+    const sweep_pass *P = ctx;
+    const ws_mg *mg = P->mg;
+    mg_level *L = P->L;
+    const int c = 2 * (int)i + P->colour, y0 = c * MG_CHUNK_ROWS;
+    const int y1 = y0 + MG_CHUNK_ROWS < L->ny ? y0 + MG_CHUNK_ROWS : L->ny;
+    for (int q = 0; q < y1 - y0; q++) {
+        const int iy = P->forward ? y0 + q : y1 - 1 - q;
+        double *part = row_part(mg, iy);
+        if (part)
+            memset(part, 0, 6 * (size_t)mg->nb * sizeof(double));
+        if (!P->forward) {
+            if (L->whole[iy])
+                line_row_backward(mg, L, iy, part);
+            else
+                point_row_backward(mg, L, iy, part);
+            continue;
+        }
+        /* The row below is known within the chunk, or in an even chunk below an odd one; the
+         * row above only in an even chunk above an odd one. */
+        const int inside = iy > y0, odd = P->colour;
+        const int known =
+            (inside || odd ? KNOWN_BELOW : 0) | (iy + 1 == y1 && odd ? KNOWN_ABOVE : 0);
+        if (L->whole[iy])
+            line_row_forward(mg, L, iy, known, inside, part);
+        else
+            point_row_forward(mg, L, iy, known, inside, part);
+    }
+}
+
+/* After the forward sweep, an even chunk's edge rows take -A_kj x_j from the odd chunks' rows
+ * beside them. */
+static void gather_chunk(void *ctx, uint32_t i)
+{
+    const sweep_pass *P = ctx;
+    mg_level *L = P->L;
+    const int y0 = 2 * (int)i * MG_CHUNK_ROWS;
+    const int y1 = y0 + MG_CHUNK_ROWS < L->ny ? y0 + MG_CHUNK_ROWS : L->ny;
+    for (int e = 0; e < 2; e++) {
+        const int iy = e ? y1 - 1 : y0, known = e ? KNOWN_ABOVE : KNOWN_BELOW;
+        for (int ix = 0; ix < L->nx; ix++)
+            rows_take(L, ix, iy, known, L->t + 3 * ((size_t)ix + (size_t)L->nx * (size_t)iy));
+    }
+}
+
+/* The chunks of a colour on the workers, a level large enough to share (a smaller one's on
+ * this thread: the same sums either way). */
+#define MG_SHARED_NODES 256
+
+static void sweep_chunks(const ws_mg *mg, const ws_runner *run, mg_level *L, int colour,
+                         int forward, ws_item_fn *fn)
+{
+    sweep_pass P = {mg, L, colour, forward};
+    const uint32_t chunks = (uint32_t)((chunk_count(L) - colour + 1) / 2);
+    ws_runner_for(L->n >= MG_SHARED_NODES ? run : NULL, chunks, fn, &P);
+}
+
+/* out = base + the rows' shares in a forward sweep's order (the even chunks' rows, then the odd
+ * chunks'; backward: its reverse). */
+static void rows_sum(const ws_mg *mg, const mg_level *L, int forward, const double *base,
+                     double *out)
 {
     const size_t nb6 = 6 * (size_t)mg->nb;
+    if (base)
+        memcpy(out, base, nb6 * sizeof(double));
+    else
+        memset(out, 0, nb6 * sizeof(double));
+    const int chunks = chunk_count(L);
+    for (int pass = 0; pass < 2; pass++) {
+        const int colour = forward ? pass : 1 - pass;
+        for (int k = 0; k < chunks; k++) {
+            const int c = forward ? k : chunks - 1 - k;
+            if ((c & 1) != colour)
+                continue;
+            for (int q = 0; q < MG_CHUNK_ROWS; q++) {
+                const int iy = forward ? c * MG_CHUNK_ROWS + q : (c + 1) * MG_CHUNK_ROWS - 1 - q;
+                if (iy >= L->ny)
+                    continue;
+                const double *part = row_part(mg, iy);
+                for (size_t z = 0; z < nb6; z++)
+                    out[z] += part[z];
+            }
+        }
+    }
+}
+
+/* The sweeps of symmetric block Gauss-Seidel on a coarse level L, the blocks a level's rows
+ * solved whole (L->whole) and its other nodes one by one, the rows in two colours (above):
+ * the bodies nested (mg->nb) first in the forward sweep and last in the backward one, which
+ * takes the same blocks in reverse, so that the two mirror each other (B_k symmetric) and
+ * every coupling term is taken in the node loops, where the node's x is at hand. Forward from
+ * x = 0: the bodies from their right-hand side alone, then each block meets only the blocks
+ * known before it (the others are still zero) and the bodies; the sweep leaves the residual
+ * r - A x in t (each block's own couplings are solved exactly, so what is left at a node is
+ * what the blocks after it add since: a row's later nodes as each is solved, the odd rows'
+ * into the even rows' beside them at the end) and the bodies' residual, rb - A_bb xb - G^T x =
+ * -G^T x, in rbn (the next level's: the bodies are the same unknowns there; A_bb is solved
+ * whole, the pairs' coupling between bodies with it, or that residual would keep it). */
+static void gauss_seidel_forward(const ws_mg *mg, const ws_runner *run, mg_level *L, double *rbn)
+{
     memset(L->t, 0, 3 * (size_t)L->n * sizeof(double));
-    if (nb6) {
+    if (mg->nb)
         ws_rigid_block_solve(mg->rig, L->rb, L->xb);
-        memset(rbn, 0, nb6 * sizeof(double));
-    }
-    for (int iy = 0; iy < L->ny; iy++) {
-        if (L->whole[iy])
-            line_row_forward(mg, L, iy, rbn);
-        else
-            point_row_forward(mg, L, iy, rbn);
-    }
+    sweep_chunks(mg, run, L, 0, 1, sweep_chunk);
+    sweep_chunks(mg, run, L, 1, 1, sweep_chunk);
+    sweep_chunks(mg, run, L, 0, 1, gather_chunk);
+    if (mg->nb)
+        rows_sum(mg, L, 1, NULL, rbn);
 }
 
 /* Backward from the x and xb there are: the blocks in reverse, each against every neighbour
  * and the bodies, its new x taken off the bodies' right-hand side (in mg->bsum), which they
  * are solved with at the end. */
-static void gauss_seidel_backward(const ws_mg *mg, mg_level *L)
+static void gauss_seidel_backward(const ws_mg *mg, const ws_runner *run, mg_level *L)
 {
-    const size_t nb6 = 6 * (size_t)mg->nb;
-    double *sb = mg->bsum;
-    if (nb6)
-        memcpy(sb, L->rb, nb6 * sizeof(double));
-    for (int iy = L->ny - 1; iy >= 0; iy--) {
-        if (L->whole[iy])
-            line_row_backward(mg, L, iy, sb);
-        else
-            point_row_backward(mg, L, iy, sb);
+    sweep_chunks(mg, run, L, 1, 0, sweep_chunk);
+    sweep_chunks(mg, run, L, 0, 0, sweep_chunk);
+    if (mg->nb) { /* the bodies last: xb = A_bb^-1 (rb - G^T x) */
+        rows_sum(mg, L, 0, L->rb, mg->bsum);
+        ws_rigid_block_solve(mg->rig, mg->bsum, L->xb);
     }
-    if (nb6) /* the bodies last: xb = A_bb^-1 (rb - G^T x) */
-        ws_rigid_block_solve(mg->rig, sb, L->xb);
 }
 
 /* Whether fine node i of level k is left out of P (a pinned film node: its dv is zero). */
@@ -1141,33 +1303,64 @@ static inline int left_out(const ws_web *web, int k, uint32_t i)
 /* c->r = P^T t (t a level-k vector; the film's pinned nodes left out). P is a map along x
  * times one along y: each fine row is restricted along x into mg->row, which is added to the
  * coarse rows it maps to. */
+/* Fine row iy of level k's t restricted along x into u (level k + 1's nx vectors). */
+static void restrict_row(const ws_mg *mg, const ws_web *web, int k, const double *t, int iy,
+                         double *u)
+{
+    const mg_level *f = &mg->lv[k];
+    memset(u, 0, 3 * (size_t)mg->lv[k + 1].nx * sizeof(double));
+    for (int ix = 0; ix < f->nx; ix++) {
+        const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
+        if (left_out(web, k, i))
+            continue;
+        const map1d *mx = &f->mx[ix];
+        const double *T = t + 3 * (size_t)i;
+        for (int a = 0; a < mx->n; a++) {
+            double *U = u + 3 * (size_t)mx->c[a];
+            const double w = mx->w[a];
+            U[0] += w * T[0];
+            U[1] += w * T[1];
+            U[2] += w * T[2];
+        }
+    }
+}
+
+/* The film level's rows restricted along x, block by block, into rrow (restrict_to). */
+typedef struct restrict_pass {
+    const ws_mg *mg;
+    const ws_web *web;
+    const double *t;
+} restrict_pass;
+
+static void restrict_block(void *ctx, uint32_t b)
+{
+    const restrict_pass *P = ctx;
+    const ws_mg *mg = P->mg;
+    const uint32_t nx = (uint32_t)mg->lv[0].nx;
+    const size_t row = 3 * (size_t)mg->lv[1].nx;
+    for (uint32_t iy = mg->blocks[b].n0 / nx; iy < mg->blocks[b].n1 / nx; iy++)
+        restrict_row(mg, P->web, 0, P->t, (int)iy, mg->rrow + row * iy);
+}
+
 static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *t)
 {
     const mg_level *f = &mg->lv[k];
     const mg_level *c = &mg->lv[k + 1];
-    double *u = mg->row;
+    const size_t row = 3 * (size_t)c->nx;
+    if (k == 0) {
+        restrict_pass P = {mg, web, t};
+        ws_implicit_blocks_run(web->imp, restrict_block, &P);
+    }
     memset(c->r, 0, 3 * (size_t)c->n * sizeof(double));
     for (int iy = 0; iy < f->ny; iy++) {
-        memset(u, 0, 3 * (size_t)c->nx * sizeof(double));
-        for (int ix = 0; ix < f->nx; ix++) {
-            const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-            if (left_out(web, k, i))
-                continue;
-            const map1d *mx = &f->mx[ix];
-            const double *T = t + 3 * (size_t)i;
-            for (int a = 0; a < mx->n; a++) {
-                double *U = u + 3 * (size_t)mx->c[a];
-                const double w = mx->w[a];
-                U[0] += w * T[0];
-                U[1] += w * T[1];
-                U[2] += w * T[2];
-            }
-        }
+        double *u = k == 0 ? mg->rrow + row * (size_t)iy : mg->row;
+        if (k != 0)
+            restrict_row(mg, web, k, t, iy, u);
         const map1d *my = &f->my[iy];
         for (int b = 0; b < my->n; b++) {
-            double *R = c->r + 3 * (size_t)c->nx * (size_t)my->c[b];
+            double *R = c->r + row * (size_t)my->c[b];
             const double w = my->w[b];
-            for (size_t q = 0; q < 3 * (size_t)c->nx; q++)
+            for (size_t q = 0; q < row; q++)
                 R[q] += w * u[q];
         }
     }
@@ -1177,7 +1370,7 @@ static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double 
  * contacts are sorted by node (ws_mg_bodies checks it), so a pass over the nodes walks them
  * with a cursor *l and meets node i's contacts when it is at node i, its z or t in hand. */
 /* rbo += J^T C Z over node i's contacts (the bodies' residual takes -A_bf z). */
-static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
+static MG_INLINE void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, const double *Z,
                                   double *rbo)
 {
     for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
@@ -1192,7 +1385,7 @@ static inline void node_to_bodies(const ws_rigid *R, size_t *l, uint32_t i, cons
 }
 
 /* T += C J zb over node i's contacts (T, the film's residual, takes -A_fb zb). */
-static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
+static MG_INLINE void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, const double *zb,
                                   double *T)
 {
     for (; *l < R->nl && R->link[*l].node == i; (*l)++) {
@@ -1204,51 +1397,89 @@ static inline void bodies_to_node(const ws_rigid *R, size_t *l, uint32_t i, cons
     }
 }
 
+/* Fine row iy of level k: x += P x_c there, u the row's room (level k + 1's nx vectors); on
+ * the film's level with r given, t = r - N x - A_fb zb over the row too, *l the contacts'
+ * cursor. */
+static MG_INLINE void prolong_row(const ws_mg *mg, const ws_web *web, int k, int iy, double *u,
+                                  double *x, const double *r, double *t, const double *zb,
+                                  size_t *l)
+{
+    const mg_level *f = &mg->lv[k];
+    const mg_level *c = &mg->lv[k + 1];
+    const map1d *my = &f->my[iy];
+    const double *C0 = c->x + 3 * (size_t)c->nx * (size_t)my->c[0];
+    if (my->n == 1) {
+        memcpy(u, C0, 3 * (size_t)c->nx * sizeof(double));
+    } else {
+        const double *C1 = c->x + 3 * (size_t)c->nx * (size_t)my->c[1];
+        const double w0 = my->w[0], w1 = my->w[1];
+        for (size_t q = 0; q < 3 * (size_t)c->nx; q++)
+            u[q] = w0 * C0[q] + w1 * C1[q];
+    }
+    for (int ix = 0; ix < f->nx; ix++) {
+        const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
+        double *X = x + 3 * (size_t)i;
+        if (!left_out(web, k, i)) {
+            const map1d *mx = &f->mx[ix];
+            for (int a = 0; a < mx->n; a++) {
+                const double *U = u + 3 * (size_t)mx->c[a];
+                const double w = mx->w[a];
+                X[0] += w * U[0];
+                X[1] += w * U[1];
+                X[2] += w * U[2];
+            }
+        }
+        if (r) {
+            const double *R = r + 3 * (size_t)i;
+            double *T = t + 3 * (size_t)i;
+            T[0] = R[0], T[1] = R[1], T[2] = R[2];
+            fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
+            if (zb)
+                bodies_to_node(mg->rig, l, i, zb, T);
+        }
+    }
+}
+
+/* The film level's prolongation, block by block (prolong_add). */
+typedef struct prolong_pass {
+    const ws_mg *mg;
+    const ws_web *web;
+    double *x, *t;
+    const double *r, *zb;
+} prolong_pass;
+
+static void prolong_block(void *ctx, uint32_t b)
+{
+    const prolong_pass *P = ctx;
+    const ws_mg *mg = P->mg;
+    const uint32_t nx = (uint32_t)mg->lv[0].nx;
+    double *u = mg->brow + 3 * (size_t)mg->lv[1].nx * b;
+    size_t l = P->zb ? mg->lstart[b] : 0;
+    for (uint32_t iy = mg->blocks[b].n0 / nx; iy < mg->blocks[b].n1 / nx; iy++) {
+        if (P->zb) /* each choice its own loop */
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, P->r, P->t, P->zb, &l);
+        else if (P->r)
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, P->r, P->t, NULL, &l);
+        else
+            prolong_row(mg, P->web, 0, (int)iy, u, P->x, NULL, NULL, NULL, &l);
+    }
+}
+
 /* x += P c->x on level k (the film's pinned nodes left out): each fine row's coarse values
- * interpolated along y into mg->row, then along x. On the film's level (r given) the node pass
- * of the product that follows is taken on the way: t = r - N x, and with the bodies nested
- * (zb given) t -= A_fb zb. */
+ * interpolated along y into a row of room, then along x, the film's level's rows block by
+ * block. On the film's level (r given) the node pass of the product that follows is taken on
+ * the way: t = r - N x, and with the bodies nested (zb given) t -= A_fb zb. */
 static void prolong_add(const ws_mg *mg, const ws_web *web, int k, double *x, const double *r,
                         double *t, const double *zb)
 {
-    size_t l = 0;
-    const mg_level *f = &mg->lv[k];
-    const mg_level *c = &mg->lv[k + 1];
-    double *u = mg->row;
-    for (int iy = 0; iy < f->ny; iy++) {
-        const map1d *my = &f->my[iy];
-        const double *C0 = c->x + 3 * (size_t)c->nx * (size_t)my->c[0];
-        if (my->n == 1) {
-            memcpy(u, C0, 3 * (size_t)c->nx * sizeof(double));
-        } else {
-            const double *C1 = c->x + 3 * (size_t)c->nx * (size_t)my->c[1];
-            const double w0 = my->w[0], w1 = my->w[1];
-            for (size_t q = 0; q < 3 * (size_t)c->nx; q++)
-                u[q] = w0 * C0[q] + w1 * C1[q];
-        }
-        for (int ix = 0; ix < f->nx; ix++) {
-            const uint32_t i = (uint32_t)ix + (uint32_t)f->nx * (uint32_t)iy;
-            double *X = x + 3 * (size_t)i;
-            if (!left_out(web, k, i)) {
-                const map1d *mx = &f->mx[ix];
-                for (int a = 0; a < mx->n; a++) {
-                    const double *U = u + 3 * (size_t)mx->c[a];
-                    const double w = mx->w[a];
-                    X[0] += w * U[0];
-                    X[1] += w * U[1];
-                    X[2] += w * U[2];
-                }
-            }
-            if (r) {
-                const double *R = r + 3 * (size_t)i;
-                double *T = t + 3 * (size_t)i;
-                T[0] = R[0], T[1] = R[1], T[2] = R[2];
-                fsym_sub(mg->fnd + WS_SYM * (size_t)i, X, T);
-                if (zb)
-                    bodies_to_node(mg->rig, &l, i, zb, T);
-            }
-        }
+    if (k == 0) {
+        prolong_pass P = {mg, web, x, t, r, zb};
+        ws_implicit_blocks_run(web->imp, prolong_block, &P);
+        return;
     }
+    size_t l = 0;
+    for (int iy = 0; iy < mg->lv[k].ny; iy++)
+        prolong_row(mg, web, k, iy, mg->row, x, r, t, zb, &l);
 }
 
 /* x = L^-T L^-1 r on the coarsest level. */
@@ -1291,29 +1522,42 @@ static void cycle(ws_mg *mg, const ws_web *web, int k)
         return;
     }
     mg_level *L = &mg->lv[k];
-    gauss_seidel_forward(mg, L, mg->lv[k + 1].rb);
+    gauss_seidel_forward(mg, &web->imp->run, L, mg->lv[k + 1].rb);
     restrict_to(mg, web, k, L->t);
     cycle(mg, web, k + 1);
     prolong_add(mg, web, k, L->x, NULL, NULL, NULL);
     for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
         L->xb[q] += mg->lv[k + 1].xb[q];
-    gauss_seidel_backward(mg, L);
+    gauss_seidel_backward(mg, &web->imp->run, L);
 }
 
-/* The film level's node pass of a Jacobi sweep: z_i = J_i r_i (how JACOBI_SET), z_i += J_i t_i
- * (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i = r_i - N_i z_i (the springs'
- * part follows in film_springs). J = w D^-1 and N, the nodes' own blocks, as the level keeps
- * them (single precision). With the bodies nested, zb given: t_i -= (A_fb zb)_i too; rbo
- * given: rbo -= A_bf z with the new z (never both). Returns r . z. */
+/* The film level's node pass of a Jacobi sweep over block b's nodes: z_i = J_i r_i (how
+ * JACOBI_SET), z_i += J_i t_i (JACOBI_ADD) or z left (JACOBI_NONE), then, with residual, t_i =
+ * r_i - N_i z_i (the springs' part follows in film_springs). J = w D^-1 and N, the nodes' own
+ * blocks, as the level keeps them (single precision). With the bodies nested, zb given: t_i -=
+ * (A_fb zb)_i too; rbo given: the block's share of -A_bf z with the new z into its bpart
+ * (never both). Without residual, r . z over the block into the solve's block sums. */
 enum { JACOBI_NONE, JACOBI_SET, JACOBI_ADD };
 
-static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restrict r,
-                                double *restrict t, double *restrict z, int how, int residual,
-                                const double *zb, double *rbo)
+typedef struct film_pass {
+    const ws_mg *mg;
+    const ws_web *web;
+    const double *r;
+    double *t, *z;
+    int how, residual, rbo;
+    const double *zb;
+} film_pass;
+
+/* The node pass over nodes [n0, n1) with the contacts' cursor at l (the pass's own choices
+ * constants at each call, so each of film_nodes_block's loops tests none of them); returns
+ * r . z over them without residual. */
+static MG_INLINE double nodes_run(const ws_mg *mg, uint32_t n0, uint32_t n1, size_t l,
+                                  const double *restrict r, double *restrict t,
+                                  double *restrict z, int how, int residual, const double *zb,
+                                  double *rbo)
 {
     double rz = 0.0;
-    size_t l = 0;
-    for (uint32_t i = 0; i < n; i++) {
+    for (uint32_t i = n0; i < n1; i++) {
         const double *R = r + 3 * (size_t)i;
         double *Z = z + 3 * (size_t)i, *T = t + 3 * (size_t)i;
         if (how != JACOBI_NONE) {
@@ -1343,29 +1587,97 @@ static inline double film_nodes(const ws_mg *mg, uint32_t n, const double *restr
     return rz;
 }
 
-/* t -= the springs' part of A z, with the springs' blocks as the level keeps them (e, a, b in
- * single precision). */
-static void film_springs(const ws_mg *mg, const ws_web *web, const double *restrict z,
-                         double *restrict t)
+static void film_nodes_block(void *ctx, uint32_t b)
 {
-    for (uint32_t s = 0; s < web->ns; s++) {
+    const film_pass *F = ctx;
+    const ws_mg *mg = F->mg;
+    const ws_iblock *B = &mg->blocks[b];
+    double *rbo = F->rbo ? mg->bpart + 6 * (size_t)mg->nb * b : NULL;
+    if (rbo)
+        memset(rbo, 0, 6 * (size_t)mg->nb * sizeof(double));
+    const size_t l = mg->rig && mg->nb ? mg->lstart[b] : 0;
+    const uint32_t n0 = B->n0, n1 = B->n1;
+    double rz = 0.0;
+    /* The apply's passes (ws_mg's apply): each its own loop. */
+    if (!F->residual)
+        rz = nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_ADD, 0, NULL, NULL);
+    else if (F->zb)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_ADD, 1, F->zb, NULL);
+    else if (F->how == JACOBI_SET && rbo)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_SET, 1, NULL, rbo);
+    else if (F->how == JACOBI_SET)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, JACOBI_SET, 1, NULL, NULL);
+    else if (rbo)
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, F->how, 1, NULL, rbo);
+    else
+        nodes_run(mg, n0, n1, l, F->r, F->t, F->z, F->how, 1, NULL, NULL);
+    F->web->imp->part[WS_PARTS * (size_t)b + WS_PART_SUM] = rz;
+}
+
+/* The node pass over the film's blocks (film_nodes_block); with rbo, the blocks' shares of
+ * -A_bf z added to it in block order. Returns r . z (without residual). */
+static double film_nodes(const ws_mg *mg, const ws_web *web, const double *r, double *t, double *z,
+                         int how, int residual, const double *zb, double *rbo)
+{
+    film_pass F = {mg, web, r, t, z, how, residual, rbo != NULL, zb};
+    ws_implicit_blocks_run(web->imp, film_nodes_block, &F);
+    for (uint32_t b = 0; rbo && b < mg->nblk; b++)
+        for (size_t q = 0; q < 6 * (size_t)mg->nb; q++)
+            rbo[q] += mg->bpart[6 * (size_t)mg->nb * b + q];
+    double rz = 0.0;
+    for (uint32_t b = 0; !residual && b < mg->nblk; b++)
+        rz += web->imp->part[WS_PARTS * (size_t)b + WS_PART_SUM];
+    return rz;
+}
+
+/* t -= the springs' part of A z over the springs [s0, s1) of a run, into the ends `ends`
+ * names (a constant at each call), with the springs' blocks as the level keeps them (e, a, b
+ * in single precision). */
+static inline void film_run(const ws_mg *mg, uint32_t s0, uint32_t s1, uint32_t ends,
+                            const double *restrict z, double *restrict t)
+{
+    for (uint32_t s = s0; s < s1; s++) {
         const float *q = mg->fop + FOP * (size_t)s; /* ex ey ez a b, ends */
-        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], b = q[4];
+        const double ex = q[0], ey = q[1], ez = q[2], a = q[3], bb = q[4];
         uint32_t ia, ib;
         memcpy(&ia, q + FOP_A, sizeof ia);
         memcpy(&ib, q + FOP_B, sizeof ib);
-        const double *A = z + 3 * (size_t)ia, *B = z + 3 * (size_t)ib;
-        const double dx = A[0] - B[0], dy = A[1] - B[1], dz = A[2] - B[2];
+        const double *A = z + 3 * (size_t)ia, *Bz = z + 3 * (size_t)ib;
+        const double dx = A[0] - Bz[0], dy = A[1] - Bz[1], dz = A[2] - Bz[2];
         const double ed = a * (ex * dx + ey * dy + ez * dz);
-        const double tx = ed * ex + b * dx, ty = ed * ey + b * dy, tz = ed * ez + b * dz;
-        double *TA = t + 3 * (size_t)ia, *TB = t + 3 * (size_t)ib;
-        TA[0] -= tx;
-        TA[1] -= ty;
-        TA[2] -= tz;
-        TB[0] += tx;
-        TB[1] += ty;
-        TB[2] += tz;
+        const double tx = ed * ex + bb * dx, ty = ed * ey + bb * dy, tz = ed * ez + bb * dz;
+        if (ends & WS_RUN_A) {
+            double *TA = t + 3 * (size_t)ia;
+            TA[0] -= tx, TA[1] -= ty, TA[2] -= tz;
+        }
+        if (ends & WS_RUN_B) {
+            double *TB = t + 3 * (size_t)ib;
+            TB[0] += tx, TB[1] += ty, TB[2] += tz;
+        }
     }
+}
+
+/* film_run over block b's runs of springs, in their order. */
+static void film_springs_block(void *ctx, uint32_t b)
+{
+    const film_pass *F = ctx;
+    const ws_implicit *im = F->web->imp;
+    const ws_iblock *B = &F->mg->blocks[b];
+    for (uint32_t g = B->r0; g < B->r1; g++) {
+        const ws_irun *u = &im->rng[g];
+        if (u->ends == WS_RUN_AB)
+            film_run(F->mg, u->first, u->end, WS_RUN_AB, F->z, F->t);
+        else if (u->ends == WS_RUN_A)
+            film_run(F->mg, u->first, u->end, WS_RUN_A, F->z, F->t);
+        else
+            film_run(F->mg, u->first, u->end, WS_RUN_B, F->z, F->t);
+    }
+}
+
+static void film_springs(const ws_mg *mg, const ws_web *web, const double *z, double *t)
+{
+    film_pass F = {mg, web, NULL, t, (double *)(uintptr_t)z, JACOBI_NONE, 0, 0, NULL};
+    ws_implicit_blocks_run(web->imp, film_springs_block, &F);
 }
 
 /* z = B r (and zb = B rb with bodies nested): on the film's level mg->sweeps Jacobi sweeps
@@ -1377,16 +1689,15 @@ static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, co
                     double *zb)
 {
     double *t = mg->lv[0].t;
-    const uint32_t n = web->n;
     const size_t nb6 = 6 * (size_t)mg->nb;
     /* The bodies' right-hand side for level 1, rb - A_bf z, taken with the last pre-sweep's z. */
     double *rbo = nb6 ? mg->lv[1].rb : NULL;
     if (nb6)
         memcpy(rbo, rb, nb6 * sizeof(double));
-    (void)film_nodes(mg, n, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
+    (void)film_nodes(mg, web, r, t, z, JACOBI_SET, 1, NULL, mg->sweeps == 1 ? rbo : NULL);
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) { /* after it, t = r - A z */
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
+        (void)film_nodes(mg, web, r, t, z, JACOBI_ADD, 1, NULL, s + 1 == mg->sweeps ? rbo : NULL);
         film_springs(mg, web, z, t);
     }
     restrict_to(mg, web, 0, t);
@@ -1396,10 +1707,10 @@ static double apply(ws_mg *mg, const ws_web *web, const double *r, double *z, co
     prolong_add(mg, web, 0, z, r, t, nb6 ? zb : NULL); /* and t = r - N z - A_fb zb */
     film_springs(mg, web, z, t);
     for (int s = 1; s < mg->sweeps; s++) {
-        (void)film_nodes(mg, n, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
+        (void)film_nodes(mg, web, r, t, z, JACOBI_ADD, 1, nb6 ? zb : NULL, NULL);
         film_springs(mg, web, z, t);
     }
-    double rz = film_nodes(mg, n, r, t, z, JACOBI_ADD, 0, NULL, NULL);
+    double rz = film_nodes(mg, web, r, t, z, JACOBI_ADD, 0, NULL, NULL);
     for (size_t q = 0; q < nb6; q++)
         rz += rb[q] * zb[q];
     return rz;
@@ -1519,8 +1830,9 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
         return 0;
     const int k = nlev - 1;
     const uint32_t m = 3 * lv[k].n;
+    const uint32_t nblk = web->imp->nblk;
     size_t doubles = 3 * (size_t)web->n + (size_t)m * m + 2 * STEN * (size_t)lv[1].n +
-                     3 * (size_t)lv[1].nx,
+                     3 * (size_t)lv[1].nx * (1 + (size_t)nblk + (size_t)lv[0].ny),
            floats = 0;
     for (int i = 1; i < nlev; i++) {
         doubles += (9 + WS_SYM + 9) * (size_t)lv[i].n;
@@ -1584,6 +1896,10 @@ int ws_mg_reserve(ws_mem *mem, const ws_web *web, ws_mg **out)
     mg->acc = q, q += STEN * (size_t)lv[1].n;
     mg->sacc = q, q += STEN * (size_t)lv[1].n;
     mg->row = q, q += 3 * (size_t)lv[1].nx;
+    mg->nblk = nblk;
+    mg->blocks = web->imp->blk;
+    mg->brow = q, q += 3 * (size_t)lv[1].nx * nblk;
+    mg->rrow = q, q += 3 * (size_t)lv[1].nx * (size_t)lv[0].ny;
     for (int i = 1; i < nlev; i++) {
         mg_level *L = &mg->lv[i];
         L->a = fq, fq += STEN * (size_t)L->n;

@@ -29,9 +29,10 @@ static const char *label(const ws_web *web)
  * scratch (with the coarse space's set-up's, for a web of `nodes` nodes) from the step's arena.
  * NULL (and *fail 0) when no dynamic body is touched, NULL with *fail 1 when out of memory. */
 static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_node_link *L,
-                            size_t nl, uint32_t nodes, const ws_mg *mg, uint32_t **slot_out,
-                            int *fail)
+                            size_t nl, const ws_web *web, uint32_t **slot_out, int *fail)
 {
+    const uint32_t nodes = web->n, nblk = web->imp->nblk;
+    const ws_mg *mg = web->imp->mg;
     *fail = 1;
     uint32_t *slot = ws_arena_alloc(arena, (b->slots + 1) * sizeof *slot);
     ws_rigid *R = ws_arena_alloc(arena, sizeof *R);
@@ -62,8 +63,10 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
     R->crow = ws_arena_alloc(arena, ((size_t)nodes + 1) * sizeof *R->crow);
     R->cphi = ws_arena_alloc(arena, 2 * (nl + 1) * sizeof *R->cphi);
+    R->bstart = ws_arena_alloc(arena, ((size_t)nblk + 1) * sizeof *R->bstart);
+    R->bpart = ws_arena_alloc(arena, (size_t)nblk * v6 * sizeof *R->bpart);
     if (!R->link || !d || !R->env || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow ||
-        !R->cphi) {
+        !R->cphi || !R->bstart || !R->bpart) {
         *fail = 1;
         return NULL;
     }
@@ -279,6 +282,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         !(links = ws_arena_alloc(S->arena, (cl->n + 1) * sizeof *links)))
         return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'", label(web));
     ws_implicit *im = web->imp;
+    im->run = ws_world_runner(w);
     const int n = web->substeps;
     const double h = S->dt / n, share = 1.0 / n;
     ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -304,7 +308,7 @@ ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list)
         int nomem = 0;
         ws_rigid *R = web->hold_bodies
                           ? NULL
-                          : rigid_make(S->arena, b, links, nl, web->n, im->mg, &slot, &nomem);
+                          : rigid_make(S->arena, b, links, nl, web, &slot, &nomem);
         if (nomem)
             return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory for web '%s'",
                            label(web));

@@ -261,6 +261,10 @@ int ws_world_node_params(ws_world *w, uint32_t web_material);
  * converge or a node runs away, WS_ERR_CALLBACK when a law fails, WS_ERR_OUT_OF_MEMORY; the
  * committed state is not written. */
 ws_status ws_world_web_implicit(ws_step *S, ws_web *web, int list);
+
+/* The step's workers as a module below the world runs a task on them (base/pool.h): the
+ * world's threads or the host's scheduler; one worker, the caller, when worker_count is 1. */
+ws_runner ws_world_runner(ws_world *w);
 /* The bodies' regularised friction at the end of the step (world_friction.c): every contact of
  * it no web's solve took, solved over the bodies at once, its change over the step added to
  * the bodies' loads and the records. Before the integration, all loads known. */

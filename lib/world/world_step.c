@@ -465,6 +465,19 @@ static void run_task(ws_world *w, ws_task_fn *task, uint32_t count, uint32_t sha
     }
 }
 
+static void runner_run(void *self, ws_task_fn *task, uint32_t count, void *ctx)
+{
+    run_task(self, task, count, 0, ctx);
+}
+
+ws_runner ws_world_runner(ws_world *w)
+{
+    const uint32_t k = w->def.worker_count;
+    if (k <= 1)
+        return (ws_runner){NULL, NULL, 1, 1};
+    return (ws_runner){runner_run, w, k, WS_LANES_PER_WORKER * k};
+}
+
 /* The move test of a web's nodes, lane by lane (ws_task_fn; the nodes of lane i as it sweeps
  * them): each lane flags its nodes, lists the flagged ones and measures them against the far
  * bodies (ws_node_flag_lane, into fl[i]); and prepares the features of every lanes-th body
