@@ -808,12 +808,8 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
             continue;
         }
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
-            const uint32_t l = ws_lowest_bit(bits), i = node + l;
-            const size_t e = 4 * g + l;
-            const v3 Fb = tmp_get(T->b, e);
-            fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
-            load[s] = (act_load){Fb, tmp_get(T->m, e)};
-            lbody[s] = body;
+            const uint32_t l = ws_lowest_bit(bits);
+            flush_one(T, 4 * g + l, fc + node + l, load + s, lbody + s, body);
         }
     }
     B->n = 0;
