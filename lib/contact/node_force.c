@@ -35,16 +35,13 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
     double l2 = v3_dot(r, r);
     if (!(l2 < hi * hi) || !(l2 > 0.0))
         return 0;
-    /* Outside both faces' planes: in the wedge between them. */
-    if (!sure && !(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
-        return 0;
-    /* And not over either face: r = a n1 + b n2 with a, b > 0. */
-    const double c = E->c, den = 1.0 - c * c;
-    if (den < 1e-12)
-        return 0;
+    const double c = E->c;
+    if (1.0 - c * c < 1e-12)
+        return 0; /* faces about parallel: no wedge between them */
+    /* Outside both faces' planes, and not over either face: r = a n1 + b n2 with a, b > 0. */
     if (!sure) {
         const double r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
-        if (!(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+        if (!(r1 > 0.0 && r2 > 0.0 && r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
             return 0;
     }
     double l = sqrt(l2);
@@ -907,18 +904,15 @@ typedef struct seg_cut {
     uint32_t faces; /* one past the highest face a run lies on */
 } seg_cut;
 
-static void seg_put(seg_cut *sc, ws_nseg sg)
-{
-    sc->seg[sc->nseg++] = sg;
-    if (sg.run && sc->cand[sg.c0].feat >= sc->faces)
-        sc->faces = sc->cand[sg.c0].feat + 1;
-}
-
+/* The stretch of candidates [c0, c1), unless empty. */
 static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    if (c0 != c1)
-        seg_put(sc, (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0,
-                              (uint32_t)c1, run});
+    if (c0 == c1)
+        return;
+    sc->seg[sc->nseg++] =
+        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
+    if (run && sc->cand[c0].feat >= sc->faces)
+        sc->faces = sc->cand[c0].feat + 1;
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -1211,14 +1205,10 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
     if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, &at->n, &at->d,
                   &gr))
         return 0;
-    /* A face's or rim's distance changes along its normal; a blended push's as convex_push
-     * gives. */
-    at->g = at->n;
-    at->ta = at->tb = v3_make(0, 0, 0);
-    if (!(c->local & WS_NCAND_EDGE) && v3_dot(gr.g, gr.g) > 0.0) {
-        at->g = gr.g;
-        at->ta = gr.a;
-        at->tb = gr.b;
-    }
+    /* A face's or rim's distance changes along its normal (gr is left zero); a blended push's
+     * as convex_push gives. */
+    at->g = v3_dot(gr.g, gr.g) > 0.0 ? gr.g : at->n;
+    at->ta = gr.a;
+    at->tb = gr.b;
     return 1;
 }
