@@ -544,17 +544,12 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     return 0;
 }
 
-size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1)
-{
-    ws_node_contact *nc = web->contact;
-    return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
-}
-
 void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                        ws_node_lane *L)
 {
     ws_node_contact *nc = web->contact;
-    const size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    const size_t flagged =
+        nc->move.c > 0.0 ? flag_moved(nc, x, v, L->n0, L->n1) : flag_epoch(nc, x, L->n0, L->n1);
     for (size_t q = 0; nc->move.rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_flags(b, cur, &nc->track[q], web, x, L->margin, L->n0, L->n1);
@@ -1159,12 +1154,6 @@ void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, cons
             prepare_body(b, cur, g, k);
             g->ready[k] = 1;
         }
-}
-
-void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
-{
-    (void)mem; /* its tables are the arena's, given back with it */
-    memset(g, 0, sizeof *g);
 }
 
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,

@@ -478,7 +478,6 @@ void ws_world_free_webs(ws_world *w)
     ws_mem_free(&w->mem, w->webs, w->web_cap * sizeof *w->webs);
     ws_slots_destroy(&w->mem, &w->web_slots);
     ws_mem_free(&w->mem, w->node_par, w->node_par_cap * sizeof *w->node_par);
-    ws_node_geometry_free(&w->mem, &w->node_geom);
 }
 
 static ws_status get_web(const ws_world *w, ws_web_id id, const ws_web **web)
