@@ -57,7 +57,6 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
-
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
@@ -286,33 +285,6 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
-/* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
- * web's one mass for every node when same (then m is not read). */
-static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double *restrict m,
-                                  size_t n, int same)
-{
-    const v3 g = web->g;
-    const double c = web->damping, m1 = web->m1;
-    for (size_t i = 0; i < n; i++) {
-        const double mi = same ? m1 : m[i];
-        f.x[i] = g.x * mi - c * v.x[i];
-        f.y[i] = g.y * mi - c * v.y[i];
-        f.z[i] = g.z * mi - c * v.z[i];
-    }
-}
-
-/* The same on nodes [n0, n1), the case chosen outside the loop: each case a loop of its own. */
-WS_VECTOR_LOOP
-static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
-{
-    const in3 vi = in_at(v, n0);
-    const out3 f = out_at(web->f, n0);
-    if (web->same_m)
-        base_forces_of(web, vi, f, NULL, n1 - n0, 1);
-    else
-        base_forces_of(web, vi, f, web->m + n0, n1 - n0, 0);
-}
-
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
@@ -321,10 +293,19 @@ static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
     return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
+/* The same on nodes [n0, n1), the start of their forces: a mesh web's, or a row whose springs
+ * go one by one, where their laws cost far more than this loop. */
+static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
+{
+    for (size_t i = n0; i < n1; i++)
+        nodes_set(web->f, (uint32_t)i, base_force(web, v, i));
+}
+
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
  * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. Masses as in base_forces_of; without
- * drag the velocities are not read. */
+ * order is that of the results (the state hash): keep it. Node i's mass is m[i], or the web's
+ * one mass for every node when same (then m is not read); without drag the velocities are not
+ * read. */
 static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
                                  size_t k, int same, int drag)
 {
@@ -415,16 +396,13 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const double *from[6] = {x.x, x.y, x.z, v.x, v.y, v.z};
     double in[7 * L];
     for (size_t i = 0; i < L; i++) {
         const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
         const int row = r + i < ny;
-        in[i] = row ? x.x[b] - x.x[a] : 0.0;
-        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
-        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
-        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
-        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
-        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
+        for (size_t q = 0; q < 6; q++)
+            in[q * L + i] = row ? from[q][b] - from[q][a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
     double *out = web->tmp + 3 * WS_WEB_CHUNK;
