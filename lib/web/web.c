@@ -655,17 +655,10 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v)
     return most;
 }
 
-/* What the free nodes can bear: from the Gershgorin bound of each node's row of the stiffness
- * matrix, k = kc + 2 sum of its springs' largest stiffness / l0, and its damping c = cc + 2 sum
- * of theirs / l0 + the node drag (summed in the force scratch: not state, no step is running
- * when this is asked), the least stable step, the least mass stable at sub-step h, the least
- * mass and the largest k. */
-typedef struct node_limits {
-    double dt, mass, min_mass, max_k;
-} node_limits;
-
-static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
+ws_web_limits ws_web_node_limits(const ws_web *web, double kc, double cc, double h)
 {
+    /* Each node's k and c summed in the force scratch: not state, no step is running when this
+     * is asked. */
     ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
         acc.x[i] = acc.y[i] = 0.0;
@@ -679,7 +672,7 @@ static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
         acc.y[web->sa[s]] += c;
         acc.y[web->sb[s]] += c;
     }
-    node_limits o = {INFINITY, 0.0, INFINITY, 0.0};
+    ws_web_limits o = {INFINITY, 0.0, INFINITY};
     for (uint32_t i = 0; i < web->n; i++) {
         if (web->inv_m[i] == 0.0)
             continue;
@@ -698,26 +691,8 @@ static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
         const double m = 0.25 * h * h * k + 0.5 * h * c;
         o.mass = m <= o.mass ? o.mass : m; /* NaN wins */
         o.min_mass = fmin(o.min_mass, web->m[i]);
-        o.max_k = fmax(o.max_k, k);
     }
     return o;
-}
-
-double ws_web_stable_dt(const ws_web *web, double kc, double cc)
-{
-    return limits_of(web, kc, cc, 0.0).dt;
-}
-
-double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h)
-{
-    return limits_of(web, kc, cc, h).mass;
-}
-
-void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k)
-{
-    const node_limits o = limits_of(web, kc, 0.0, 0.0);
-    *min_mass = o.min_mass;
-    *max_k = o.max_k;
 }
 
 double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)
