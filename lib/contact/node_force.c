@@ -589,12 +589,12 @@ _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty ba
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
  * filled by the first of them (run_face_of). */
 typedef struct ws_run_face {
-    double nx, ny, nz, off;                    /* the face's plane, global: d = n . x - off */
-    double hi, lo;                             /* the contact window of d */
-    double rx, ry, rz, vx, vy, vz, wx, wy, wz; /* the body's CoG, velocity and spin */
-    double k, c, mu, vlim;                     /* the contact's parameters */
-    uint32_t body;                             /* the body's slot */
-    uint64_t gen;                              /* the sub-step filled in, nc->rface_gen */
+    v3 n;                  /* the face's plane, global: d = n . x - off */
+    double off, hi, lo;    /* and the contact window of d */
+    ws_motion b;           /* the body's CoG, velocity and spin */
+    double k, c, mu, vlim; /* the contact's parameters */
+    uint32_t body;         /* the body's slot */
+    uint64_t gen;          /* the sub-step filled in, nc->rface_gen */
 } run_face;
 
 /* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
@@ -613,7 +613,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
                           const double *restrict y, const double *restrict z, double *restrict d,
                           uint64_t *restrict below)
 {
-    const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
+    const double nx = q->n.x, ny = q->n.y, nz = q->n.z, off = q->off, hi = q->hi, lo = q->lo;
     uint64_t in = 0, neg = 0;
     for (size_t i = 0; i < 4 * nv; i++) {
         double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
@@ -698,10 +698,10 @@ static void run_normal(size_t ng, const run_group *restrict grp, ws_nodes3 p, ws
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
-        /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
-        const ws_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
-                             v3_make(q->wx, q->wy, q->wz)};
+        /* Into locals: loads in the loop, some under a select, would keep it off vectors (the
+         * motion member by member: GCC copies it whole through the stack, a step slower). */
+        const v3 n = q->n;
+        const ws_motion b = {q->b.r, q->b.v, q->b.w};
         const double hi = q->hi, k = q->k, c = q->c;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -727,7 +727,7 @@ static void run_friction(size_t ng, const run_group *restrict grp, ws_nodes3 f,
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const v3 n = q->n;
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -747,7 +747,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const v3 n = q->n;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
             const double fn = T->fn[e];
@@ -827,9 +827,8 @@ static const run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const ws_wface *F = &E->g->face[c->feat];
     const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
-    const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
-    *e = (run_face){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,   r.y,     r.z, vb.x,         vb.y,
-                    vb.z, wb.x, wb.y, wb.z,   p->k, p->c, p->mu, p->vlim, bi,  nc->rface_gen};
+    const ws_motion mb = {st->r[bi], st->v[bi], b->wg[bi]};
+    *e = (run_face){F->n, F->off, hi, lo, mb, p->k, p->c, p->mu, p->vlim, bi, nc->rface_gen};
     return e;
 }
 
