@@ -344,20 +344,10 @@ static void row_forces(ws_web *web, ws_nodes3 v, size_t q, size_t k)
  * computed as before and the broken ones' forces are then set to zero (cut_chunk); a broken
  * wrap spring counts as one whose ends coincide (no force); a row of up-springs with a broken
  * one among them goes spring by spring (spring_one_in, which skips the broken), as the springs
- * of a general law do. */
-static int any_broken(const ws_web *web, size_t s0, size_t m)
-{
-    if (!web->nbroken)
-        return 0;
-    const uint8_t *b = web->broken + s0;
-    uint8_t any = 0;
-    for (size_t i = 0; i < m; i++)
-        any |= b[i];
-    return any != 0;
-}
-
-/* The forces t of springs s0 + i, i in [0, m): zero where broken. Selected, not multiplied, so
- * a broken spring stretched to any length gives a zero. */
+ * of a general law do.
+ *
+ * cut_chunk: the forces t of springs s0 + i, i in [0, m), zero where broken. Selected, not
+ * multiplied, so a broken spring stretched to any length gives a zero. */
 WS_VECTOR_LOOP
 static void cut_chunk(const uint8_t *restrict broken, size_t m, out3 t)
 {
@@ -481,7 +471,8 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
     const uint32_t lo = (uint32_t)(nx * r0), hi = (uint32_t)(nx * r1);
     const size_t s0 = cols * ny + nx * j;
     const ws_spring_form *p = &web->form[WS_SPRING_UP];
-    if (web->law[WS_SPRING_UP] && (p->gen || any_broken(web, s0, nx))) {
+    /* Spring by spring: a general law's, or a row with a broken one (a flag of 1). */
+    if (web->law[WS_SPRING_UP] && (p->gen || (web->nbroken && memchr(web->broken + s0, 1, nx)))) {
         for (size_t i = 0; i < nx; i++)
             spring_one_in(web, x, v, (uint32_t)(s0 + i), lo, hi);
     } else if (web->law[WS_SPRING_UP]) {
