@@ -68,14 +68,11 @@ static inline uint64_t inside_box(v3 p, v3 lo, v3 hi, double e)
 /* The box of the web's nodes x. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
-    v3 l = nodes_get(x, 0), h = l;
+    *lo = *hi = nodes_get(x, 0);
     for (uint32_t i = 1; i < web->n; i++) {
-        v3 p = nodes_get(x, i);
-        l = v3_min(l, p);
-        h = v3_max(h, p);
+        *lo = v3_min(*lo, nodes_get(x, i));
+        *hi = v3_max(*hi, nodes_get(x, i));
     }
-    *lo = l;
-    *hi = h;
 }
 
 /* Largest distance from p to a corner of the box (lo, hi). */
