@@ -20,11 +20,10 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
     return in;
 }
 
-/* A node against the rounded rim of a convex edge: only in the edge's own region, where the
- * direction from the edge to the node lies strictly between the normals of its two faces
- * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
- * to the node and the distance. `sure`: the faces' planes have shown the direction to lie
- * between the normals (corner_left), which is then not tested again. */
+/* A node against the rounded rim of a convex edge, closer than `hi` and only where the direction
+ * from the edge to the node lies strictly between its faces' normals (elsewhere a face holds the
+ * node): the unit normal from the edge to the node and the distance. `sure`: the faces' planes
+ * have shown that direction already (corner_left). */
 static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
@@ -78,15 +77,12 @@ static inline v3 pushed(uint64_t push, v3 a)
     return v3_make(ws_pick(push, a.x, -0.0), ws_pick(push, a.y, -0.0), ws_pick(push, a.z, -0.0));
 }
 
-/* The friction on a node: from the contact's normal n, the node's tangential velocity relative
- * to the body t, its force with every normal force in k, its 1 / mass and mass, Coulomb's force
- * mu fn and the contact's v_lim (ws_friction_law). None for a pinned node or one that does
- * not slip; taken only where the contact pushes. Straight-line code, so loops of it run on
- * vectors.
- *
- * Eq. 13, limited to the force that stops the node's slip within this sub-step h, its slip
- * predicted with every normal force in and none of the frictions, so that the result does not
- * depend on the order of a corner's faces (docs/theory.md, section 6). */
+/* Eq. 13's friction on a node (ws_friction_law) from the contact's normal n, the node's
+ * tangential velocity t relative to the body, its force k with every normal force in, its
+ * 1 / mass and mass, Coulomb's force cap and v_lim; none for a pinned node. Limited to the force
+ * that stops the node's slip within the sub-step h, the slip predicted with every normal force
+ * in and no friction, so that the result does not depend on the order of a corner's faces
+ * (docs/theory.md, section 6). Straight-line code, for loops on vectors. */
 static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
                              double h)
 {
@@ -166,11 +162,10 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
     L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of the contact laws (penalty.h) on a node at x (velocity u) against a body
- * b at depth d along n (body to node), in the window of top hi, stiffness k, damping c: its
- * vector p, the lever l from the CoG, the tangential velocity t relative to the body, and fn
- * (negative where it would pull). Straight-line code, so loops of it run on vectors; both
- * passes (act_normal, run_normal) take it from here. */
+/* The contact laws' normal force (penalty.h) on a node at x (velocity u) against body b at depth
+ * d along n (body to node), window top hi, stiffness k, damping c: its vector p, the lever l from
+ * the CoG, the tangential velocity t relative to the body and fn (negative where it would pull).
+ * Both passes (act_normal, run_normal) take it from here, on vectors. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
@@ -203,9 +198,7 @@ static void act_normal(size_t ng, act_group *restrict G)
     }
 }
 
-/* The frictions of the contacts of groups [0, ng), and the loads on the bodies, each the
- * opposite of the contact force (friction and normal force) times share, with its moment about
- * the CoG. */
+/* The frictions of the contacts of groups [0, ng) and their loads on the bodies (body_load). */
 WS_VECTOR_LOOP
 static void act_friction(size_t ng, double h, double share, act_group *restrict G)
 {
@@ -256,9 +249,7 @@ typedef struct corner_memo {
     double eps;
 } corner_memo;
 
-/* What the node contacts of a sweep block read: the bodies and their state, their faces in the
- * global frame, the web and its node state (x, v), the contact parameters by body material and
- * the list of contacts gone one by one. */
+/* What the node contacts of a sweep block read (L: the list of the contacts gone one by one). */
 typedef struct node_env {
     const ws_body_store *b;
     const ws_body_state *st;
@@ -355,34 +346,29 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
 }
 
 /* How far past a convex body's edge the push turns from one face's normal to the other's, for
- * both films (the one-by-one pass and the implicit film's ws_node_touch alike; bench/NOTES.md,
- * sessions 18 and 19, issue 17). A node below face f of a convex body at depth d < 0, e the
- * largest signed distance to the body's other planes (the shallowest other depth, of face g),
- * t = d - e, m = max(d, e): its push comes from one contact, f's where t > 0 (the lower face's
- * index of f, g on a tie), with the overlap hi - m (m is the node's signed distance to the
- * body's surface: the shallowest face's depth) along the unit normal
+ * both films (the one-by-one pass and ws_node_touch alike; bench/NOTES.md, sessions 18 and 19).
+ * A node below face f of a convex body at depth d < 0, e the largest signed distance to the
+ * body's other planes (the shallowest other depth, of face g), t = d - e, m = max(d, e) (its
+ * signed distance to the body's surface): its push comes from one contact, f's where t > 0 (the
+ * lower face's index of f, g on a tie), with the overlap hi - m along the unit normal
  *
  *     n = (s n_f + (1 - s) n_g) / |s n_f + (1 - s) n_g|,   s = min(1, 1/2 + t / (2 W)),
  *     W = min(NODE_BLEND_WIDTH, -m);
  *
  * for t >= W that is n_f and d, the shallowest face alone, to the bit. Continuous: across the
  * medial plane (t = 0) the contact passes from f to g with the same push, k (hi - m) along the
- * bisector, where the shallowest face alone turned it by the faces' angle on a difference of
- * round-off; on the edge line the push is the rounded rim's (in_wedge: k hi, its direction
- * between the normals). One contact, as the rim's: one normal force, one friction in its
- * tangent plane (two faces' contacts would each hold the node against the other's push by
- * friction, and half shares each would let a corner sink twice as deep). The width pinches to
- * the depth (-m) near the surface, so that the push is f's own by the time the node reaches
- * g's plane (e = 0), past which f alone holds it; a fixed width would turn the push there by
- * up to half the faces' angle. So the blend fills the wedge about the edge inside the body by
- * angle, as the rim does outside it, turning as 1 / distance near the edge line as the rim.
+ * bisector, which the shallowest face alone would turn by the faces' angle on a difference of
+ * round-off; on the edge line the push is the rounded rim's (in_wedge). One contact, as the
+ * rim's: one normal force, one friction in its tangent plane (two faces' contacts would each
+ * hold the node against the other's push by friction, and half shares each would let a corner
+ * sink twice as deep). The width pinches to the depth (-m) near the surface, so that the push
+ * is f's own by the time the node reaches g's plane (e = 0); a fixed width would turn it there
+ * by up to half the faces' angle. So the blend fills the wedge about the edge inside the body
+ * by angle, as the rim does outside it, turning as 1 / distance near the edge line.
  *
- * The width: a film node's layer is ~1 mm, which its push spans; W must stand far above
- * round-off (1e-11 m, the medial plane's tie) and the noise that mirror-symmetric nodes carry
- * (1e-8 m in the settling bands), so that mirror images get mirror pushes, and small beside a
- * face (0.1-1 m): 1 mm. Nodes that lie more than 1 mm deeper beneath every other face's plane
- * than beneath their shallowest face's (or more than their depth: nodes near a face's middle,
- * not an edge) keep their results to the bit. */
+ * The width: far above round-off (1e-11 m, the medial plane's tie) and the noise that
+ * mirror-symmetric nodes carry (1e-8 m in the settling bands), so that mirror images get mirror
+ * pushes; within a film node's layer (~1 mm), which its push spans, and small beside a face. */
 #define NODE_BLEND_WIDTH 1e-3
 
 /* Whether the face of candidate c (of non-convex shape sh, body bi) is the shallowest for a
@@ -445,10 +431,10 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         /* m's gradient is n_f (t >= 0 here); s's is (n_f - n_g) / (2 W) - t dW / (2 W^2) with
          * dW = -n_f where the width is pinched to the depth; n's is (I - n n^T) (n_f - n_g) /
          * |bl| ds^T. */
-        v3 ds = v3_scale(v3_sub(F[f].n, F[qg].n), 1.0 / (2.0 * W));
+        const v3 u = v3_sub(F[f].n, F[qg].n);
+        v3 ds = v3_scale(u, 1.0 / (2.0 * W));
         if (-m < NODE_BLEND_WIDTH)
             ds = v3_madd(ds, F[f].n, t / (2.0 * W * W));
-        const v3 u = v3_sub(F[f].n, F[qg].n);
         gr->g = F[f].n;
         gr->a = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
         gr->b = ds;
@@ -456,12 +442,10 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
     return 1;
 }
 
-/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, below
- * it the one push of a convex body's faces (convex_push) or the shallowest face of another's,
- * or the rim of an edge (in_wedge, sure as there); the normal from the body to the node, the
- * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, their
- * gradients (a face's or rim's own: see ws_node_links). The one-by-one pass's and the implicit
- * film's test alike (inlined: NODE_INLINE). */
+/* Whether candidate c holds the node at xi in the window (lo, top), by the one-by-one pass's
+ * and the implicit film's test alike (ws_node_touch): the normal from the body to the node, the
+ * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, a
+ * blended push's gradients (convex_push). `sure` as in_wedge's. */
 static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
                                        double top, double hi, int sure, v3 *nrm, double *dist,
                                        blend_grad *gr)
@@ -548,8 +532,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         const v3 xi = nodes_get(E->x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         const double hi = b->layer[bi] + E->web->layer, lo = -hi - sh->inner;
-        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
-         * their tests: a corner's three (marked by the detection) as its planes leave them. */
+        /* The node's candidates of this body (at most 32 at a time) left to their tests. */
         uint32_t left;
         int sure = 0;
         if ((c0->local & WS_NCAND_CORNER) && !E->web->contact->runs_off) {
@@ -867,8 +850,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
             contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
-        /* The batch runs first if the chunk's groups (nv at most) could take it past its
-         * size. */
+        /* The batch runs first if the chunk's groups (nv at most) could overfill it. */
         if (B->n + nv > B->max)
             run_flush(E, B, h, share, fc);
         /* The groups: each from the first node in the window not yet in one, so that nodes in
@@ -1185,9 +1167,8 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
     ws_mem_free(mem, nc->rtmp, nc->rtmp_cap * sizeof(double));
     ws_mem_free(mem, nc->rface, nc->rface_cap * sizeof *nc->rface);
     nc->rface = NULL;
-    nc->act = NULL;
+    nc->act = nc->rtmp = NULL;
     nc->act_id = NULL;
-    nc->rtmp = NULL;
     nc->act_cap = nc->rtmp_cap = nc->rface_cap = 0;
 }
 
