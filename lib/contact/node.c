@@ -138,9 +138,8 @@ static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web
     return best;
 }
 
-/* The reference frame of a web's moves: the pose and velocity of its reference body in state
- * cur, or the global frame, as the move test holds them (A, r, vr, wr and the conjugate
- * orientation pc; the rest zero). Local coordinates of a global point p: A^T (p - r). */
+/* The reference frame of a web's moves as the move test holds it (A, r, vr, wr, the conjugate
+ * orientation pc; the rest zero): its reference body's at state cur, or the global frame. */
 static ws_move_test ref_frame(const ws_body_store *b, int cur, const ws_web *web)
 {
     const uint32_t k = web->contact->ref;
@@ -178,14 +177,14 @@ static int may_reach(double d, double gap, double margin)
     return d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= gap;
 }
 
-/* Nodes are turned to the reference frame REF_CHUNK at a time (to_ref). Flags are found
- * FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
+/* Nodes are turned to the reference frame REF_CHUNK at a time (ws_node_ref_nodes). Flags are
+ * found FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
  * narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector iteration and
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* The rows of to_ref's scratch: the nodes' global x, y, z; in the reference frame, s; at the
- * epoch, g; |s|^2. */
+/* The rows of ws_node_ref_nodes' scratch: the nodes' global x, y, z; in the reference frame,
+ * s; at the epoch, g; |s|^2. */
 enum { T_X, T_S = 3, T_G = 6, T_L2 = 9, T_ROWS };
 
 /* m nodes (rows T_X of t) to the reference frame M: s = A^T (x - r) into rows T_S, and their
@@ -209,10 +208,8 @@ static void ref_chunk(size_t m, const ws_move_test *M, const ws_node_contact *nc
     }
 }
 
-/* Nodes to the reference frame M: s = A^T (x - r), into xdet, and their place at the epoch,
- * epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the listed
- * ones when `only` is set. Gathered REF_CHUNK at a time, turned on vectors, put back: the
- * gather costs little beside the search that follows every call. */
+/* Gathered REF_CHUNK at a time, turned on vectors (ref_chunk), put back: the gather costs
+ * little beside the search that follows every call. */
 void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
                        size_t count)
 {
@@ -307,8 +304,7 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
 /* The per-node test of ws_node_moved with sub-steps (c > 0): 1 in nc->redo for a node whose
  * measure |u| + c |w| reaches the bound (or is NaN), else 0; how many are flagged. u is the
  * node's move in the reference frame since it was found, w its velocity relative to the
- * reference body's point where it is. Straight-line code, on vectors. Most groups of nodes have
- * none flagged: their bytes are cleared, not narrowed. */
+ * reference body's point where it is. Straight-line code, on vectors. */
 WS_VECTOR_LOOP
 static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
@@ -471,26 +467,23 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     ws_move_test *M = &nc->move;
     *M = ref_frame(b, cur, web);
     M->reach = far_corner(M->r, nc->box_lo, nc->box_hi) + margin;
-    /* The contacts of this step are evaluated with the bodies as they are now (state cur),
-     * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
-     * move relative to the reference counts as it stands: its CoG's move and its turn times
-     * its lever since its record. Near ones must stay within margin / 8 of it. A far one
-     * closes on a node by at most its own move (twice: since the node was last found, the
-     * body moved at most its move then plus its move now, which `gap` and `close` count) and
-     * the node's (under a quarter margin): it must not reach the node.
+    /* The contacts of this step see the bodies as they are now (state cur) and the nodes now
+     * or, with sub-steps, where they go within the step. So a body's move relative to the
+     * reference counts as it stands: its CoG's move plus its turn times its lever since its
+     * record. A near one must stay within margin / 8 of its record. A far one closes on a
+     * node by at most its own move, twice (its move when the node was last found, which `gap`
+     * counts, and its move now), and the node's (under a quarter margin): it must not reach
+     * the node.
      *
-     * A near body past its bound is re-based (rebase_body) rather than every node found
-     * again: its record becomes its pose now, and the nodes in its box grown by the reach
-     * (layers + margin), in its frame now, are found again now and count their moves from
-     * here, against the new record, like any node found. Any other node is farther than the
-     * reach from every point of the body now. Until it is found again, the contacts see it
-     * within a quarter margin of where it was found (see below), so within half the margin of
-     * where it is now; and the body's points stay within margin / 8 of where they are now
-     * (their deviation from the new record, past which the body is re-based again), with the
-     * lever of its bounding sphere, which holds wherever the nodes go. Together under 5/8 of
-     * the margin: the node stays farther than the layers from the body, cannot touch it and
-     * needs no candidate of it. The holders of its
-     * candidates are found again too: the body may have jumped, so that they are out of its
+     * A near body past its bound is re-based rather than every node found again: its record
+     * becomes its pose now, and the nodes in its box grown by the reach (layers + margin) are
+     * found again now, counting their moves from here like any node found. Any other node is
+     * farther than the reach from every point of the body now. Until it is found again the
+     * contacts see it within a quarter margin of where it was found, so within half the margin
+     * of where it is now, and the body's points within margin / 8 of where they are now (at
+     * its bounding sphere's lever, which holds wherever the nodes go): under 5/8 of the margin
+     * together, so the node cannot touch the body and needs no candidate of it. The holders of
+     * its candidates are found again too: the body may have jumped, leaving them outside its
      * grown box with a candidate that no longer holds (a flag INSIDE). */
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
@@ -505,27 +498,25 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
             return -1;
     }
     /* Per node (flag_moved): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
-     * h_more the time its sub-steps go beyond this state. Two near bodies' deviations (margin /
-     * 4) and the rest (margin / 16, for what the sub-steps' forces add) keep a node's move
-     * relative to any near body under half the margin: what the candidates were found to
-     * cover. With one sub-step the contacts see the nodes only where they are now, which the
-     * test measures, and nothing is added: flagged at |u| = 1/4 of the margin. Either way a
-     * node stays within a quarter margin of where it was found wherever the contacts see it. */
+     * h_more the time its sub-steps go beyond this state; with one sub-step the contacts see the
+     * nodes only where the test measures them, and the bound is 1/4 (MOVE_SUBSTEP joins the
+     * node's part). Either way a node stays within a quarter margin of where it was found
+     * wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin;
     M->c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     M->lim = lim;
     if (M->c <= 0.0) {
-        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
-         * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
-         * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
-         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between
-         * the two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2)
-         * |s| <= turn |s|, and lever2 bounds |s|^2 of every node found since the full
-         * detection. So |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches
-         * lim - drift: it stays within lim of where it was found, as above. A new epoch (the
-         * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
-         * node is flagged before it has moved 7/8 of the bound; it costs about what turning
-         * every node costs, and a load that rocks on its film needs one every few steps. */
+        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet, is
+         * |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r + epoch_A s
+         * with the epoch's pose (ws_node_ref_nodes writes both for a node found since). g lies
+         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between the
+         * two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2) |s| <=
+         * turn |s|, and lever2 bounds |s|^2 of every node found since the full detection. So
+         * |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches lim - drift: it stays
+         * within lim of where it was found. A new epoch (the pose now, every g from its s, drift
+         * 0) starts when the drift reaches lim / 8, so no node is flagged before it has moved 7/8
+         * of the bound; it costs about what turning every node costs, and a load that rocks on its
+         * film needs one every few steps. */
         const qt p = qt_conj(M->pc);
         const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
         double drift = v3_norm(v3_sub(M->r, nc->epoch_r)) + turn * sqrt(nc->lever2);
