@@ -366,31 +366,24 @@ static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
     return count;
 }
 
-/* The flagged nodes of [n0, n1) (flags 0 or 1) into `moved`, in order; how many. Thirty-two
- * flags at a time, then eight: most steps flag few nodes, and those in runs. */
+/* The flagged nodes of [n0, n1) (flags 0 or 1) into `moved`, in order; how many. On a
+ * little-endian machine thirty-two flags at a time, by the set bits of the words that hold
+ * any: most steps flag few nodes, and those in runs. Elsewhere (and for the rest) one by one. */
 static size_t collect_flagged(const uint8_t *flag, size_t n0, size_t n1, uint32_t *moved)
 {
     size_t count = 0, i = n0;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     for (; i + 32 <= n1; i += 32) {
         uint64_t word[4];
         memcpy(word, flag + i, sizeof word);
         if (!(word[0] | word[1] | word[2] | word[3]))
             continue;
-        for (size_t w = 0; w < 4; w++) {
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
+        /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
+        for (size_t w = 0; w < 4; w++)
             for (uint64_t b = word[w]; b; b &= b - 1)
                 moved[count++] = (uint32_t)(i + 8 * w + ws_lowest_bit(b) / 8);
-#else
-            if (!word[w])
-                continue;
-            for (size_t j = i + 8 * w; j < i + 8 * w + 8; j++) {
-                moved[count] = (uint32_t)j;
-                count += flag[j];
-            }
-#endif
-        }
     }
+#endif
     for (; i < n1; i++) {
         moved[count] = (uint32_t)i;
         count += flag[i];
