@@ -139,10 +139,9 @@ static act_list act_open(ws_node_contact *nc)
 {
     const size_t cap = nc->act_cap; /* a multiple of 4 (ws_node_scratch) */
     uint32_t *id = nc->act_id;
-    act_list L = {(act_group *)nc->act, id,   id + cap, id + 2 * cap,
-                  id + 3 * cap,         NULL, 0,        nc->act_nl};
-    L.load = (act_load *)(nc->act + ACT_GROUP * cap);
-    return L;
+    act_load *load = (act_load *)(nc->act + ACT_GROUP * cap);
+    return (act_list){(act_group *)nc->act, id,   id + cap, id + 2 * cap,
+                      id + 3 * cap,         load, 0,        nc->act_nl};
 }
 
 /* Contact `node` against body `body` as contacts_general finds it: along n, at depth d, in the
