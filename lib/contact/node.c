@@ -301,41 +301,15 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
         redo[i] = (uint8_t)flag[i];
 }
 
-/* The per-node test of ws_node_moved with sub-steps (c > 0): 1 in nc->redo for a node whose
- * measure |u| + c |w| reaches the bound (or is NaN), else 0; how many are flagged. u is the
- * node's move in the reference frame since it was found, w its velocity relative to the
- * reference body's point where it is. Straight-line code, on vectors. */
+/* The per-node test of ws_node_moved on nodes [n0, n1): 1 in nc->redo for a node whose
+ * measure reaches the bound (or is NaN), else 0; how many are flagged. With sub-steps (c > 0)
+ * the measure is |u| + c |w|, u the node's move in the reference frame since it was found, w
+ * its velocity relative to the reference body's point where it is. With one, it is the node's
+ * distance from its place at the epoch (xep), a new epoch started first when renew asks (the
+ * reference body's pose (A, r) now, each node's xep from its xdet): only a new epoch turns the
+ * nodes. Straight-line code, on vectors. */
 WS_VECTOR_LOOP
-static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
-{
-    const ws_move_test M = nc->move;
-    uint64_t flag[FLAG_CHUNK];
-    size_t count = 0;
-    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
-        const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
-                               *restrict oz = nc->xdet.z + i0;
-        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
-        const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
-        for (size_t i = 0; i < e; i++) {
-            v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
-            v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(ox[i], oy[i], oz[i]));
-            v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
-            uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
-            flag[i] = f;
-            count += f;
-        }
-        put_flags(nc->redo + i0, flag, e, count != before);
-    }
-    return count;
-}
-
-/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in nc->redo for a
- * node whose distance from its place at the epoch (xep) reaches lim (or is NaN), else 0; how
- * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
- * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
-WS_VECTOR_LOOP
-static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
+static size_t flag_nodes(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
     const ws_move_test M = nc->move;
     const double lim2 = M.lim * M.lim;
@@ -343,23 +317,35 @@ static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
         const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
-        double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
-                         *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
         const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
                                *restrict sz = nc->xdet.z + i0;
-        if (M.renew)
+        double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
+                         *restrict oz = nc->xep.z + i0;
+        if (M.c > 0.0) {
             for (size_t i = 0; i < e; i++) {
-                v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
-                ox[i] = g.x;
-                oy[i] = g.y;
-                oz[i] = g.z;
+                v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
+                v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(sx[i], sy[i], sz[i]));
+                v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
+                uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
+                flag[i] = f;
+                count += f;
             }
-        for (size_t i = 0; i < e; i++) {
-            uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
-                                           v3_make(ox[i], oy[i], oz[i]))) < lim2);
-            flag[i] = f;
-            count += f;
+        } else {
+            if (M.renew)
+                for (size_t i = 0; i < e; i++) {
+                    v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
+                    ox[i] = g.x;
+                    oy[i] = g.y;
+                    oz[i] = g.z;
+                }
+            for (size_t i = 0; i < e; i++) {
+                uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
+                                               v3_make(ox[i], oy[i], oz[i]))) < lim2);
+                flag[i] = f;
+                count += f;
+            }
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
@@ -490,7 +476,7 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
         if (!t->near && may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Per node (flag_moved): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
+    /* Per node (flag_nodes): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
      * h_more the time its sub-steps go beyond this state; with one sub-step the contacts see the
      * nodes only where the test measures them, and the bound is 1/4 (MOVE_SUBSTEP joins the
      * node's part). Either way a node stays within a quarter margin of where it was found
@@ -529,8 +515,7 @@ void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x
                        ws_node_lane *L)
 {
     ws_node_contact *nc = web->contact;
-    const size_t flagged =
-        nc->move.c > 0.0 ? flag_moved(nc, x, v, L->n0, L->n1) : flag_epoch(nc, x, L->n0, L->n1);
+    const size_t flagged = flag_nodes(nc, x, v, L->n0, L->n1);
     for (size_t q = 0; nc->move.rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_flags(b, cur, &nc->track[q], web, x, L->margin, L->n0, L->n1);
