@@ -436,11 +436,9 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     const ws_body_state *st = &b->st[cur];
     /* A body made since the full detection: find every node again. */
     for (uint32_t k = 0, q = 0; k < b->slots; k++) {
-        if (q < nc->ntrack && nc->track[q].body == k) {
+        if (q < nc->ntrack && nc->track[q].body == k)
             q++;
-            continue;
-        }
-        if (b->alive[k])
+        else if (b->alive[k])
             return -1;
     }
     ws_move_test *M = &nc->move;
@@ -1157,12 +1155,9 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
 int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
 {
     ws_node_contact *nc = web->contact;
-    /* Node candidates: all found again when asked, when the record is invalid or when a body
-     * may have come near (ws_node_moved says -1); else those of the nodes that moved far
-     * enough relative to the near bodies, or that a near body past its bound may meet, merged
-     * into the others. Either way the list holds every node-feature pair that can touch in
-     * this step, and the result is the same as finding them every step (tests/test_detection.c
-     * shows it). */
+    /* All found again, or those of the nodes the move test flagged merged into the others:
+     * either way the list holds every node-feature pair that can touch in this step, and the
+     * result is that of finding them every step (tests/test_detection.c). */
     int list = nc->list, all = nc->search_all;
     long moved = 0;
     nc->merging = 0;
