@@ -995,9 +995,8 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     ws_node_contact *nc = web->contact;
     nc->seg_list = -1;
     nc->nseg = 0;
-    if (rtmp_reserve(mem, nc, web->n) != 0)
-        return -1;
-    if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
+    if (rtmp_reserve(mem, nc, web->n) != 0 ||
+        ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
         return -1;
     seg_cut sc = {cand, nc->seg, 0, 0, 0, 0, 0};
     seg_cut_range(&sc, web, seg_block(web), 0, n, UINT64_MAX);
