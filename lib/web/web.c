@@ -358,13 +358,12 @@ static void cut_chunk(const uint8_t *restrict broken, size_t m, out3 t)
     }
 }
 
-/* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
- * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
- * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
- * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 where the ends lie
- * apart, 0 where they coincide (out: these four). film_pull, as spring_run takes it; taken
- * apart from the rows, the division and square root of one row's wrap no longer hold up the
- * rest of its forces. */
+/* The wrap springs of a closed band (node nx - 1 of a row to its node 0) by film_pull,
+ * WS_WEB_WRAPS rows at once as the lanes of a vector. in, seven arrays of WS_WEB_WRAPS: the
+ * second end's place (dx, dy, dz) and velocity (ux, uy, uz) relative to the first, 1 / rest
+ * length; out, four: the force on the first end (tx, ty, tz), and 1 where the ends lie apart,
+ * 0 where they coincide. Apart from its row, a wrap's division and square root do not hold up
+ * the rest of the row's forces. */
 WS_VECTOR_LOOP
 static void wrap_lanes(const double *restrict in, ws_spring_form p, double *restrict out)
 {
@@ -460,10 +459,8 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, int lane_f
     around_row(web, x, v, r);
 }
 
-/* The up-springs and shear pairs from row j to row j + 1 onto their ends in rows [r0, r1)
- * (all of the grid's rows for both ends). At the edge of a lane (ws_web_forces_rows) each of
- * the two lanes computes these springs and takes its own row's side, which gets the values and
- * the order it gets in one sweep. */
+/* The up-springs and shear pairs from row j to row j + 1 onto their ends in rows [r0, r1): all
+ * rows for both ends, or at a lane's edge its own row's side (web.h, "Lanes"). */
 static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1)
 {
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
@@ -545,9 +542,7 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
         *n1 = web->n;
         return;
     }
-    /* Row j is complete once row j + 1 is started and the springs between the two are in. A
-     * lane's first row is started as the lane before would have started it, and gets the
-     * springs from the row before. */
+    /* Row j is complete once row j + 1 is started and the springs between the two are in. */
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     if (j0 == 0) {
         grid_row(web, x, v, 0, 0);
