@@ -99,11 +99,10 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
 /* ---- the contacts of a sweep block gone one by one
  *
  * The one-by-one pass lists the contacts whose tests it passed, in node order, in groups of
- * four (nc->act). At the block's end their normal forces go on vectors and into f, and once
- * every normal force of the block is in, their frictions go on vectors and they are applied
- * to the nodes. Runs apply theirs in batches (run_flush), into the places in the list of loads
- * they took. The loads on the bodies of both go to one list of loads in node order, which is
- * summed last: the bodies' totals are added in the same order however the candidates are cut. */
+ * four (nc->act), which act_apply evaluates at the block's end; runs apply theirs in batches
+ * (run_flush). The loads on the bodies of both go to one list in node order, each into the
+ * place its contact took, and are summed last: the bodies' totals are added in the same order
+ * however the candidates are cut. */
 
 /* Four contacts of the list side by side (wide.h), lane l of group g the list's contact
  * 4 g + l, so that a pass over the groups runs on vectors with one pointer. */
@@ -292,23 +291,21 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
     act_group *G = L->grp;
     /* The body's values kept from one contact to the next, as most are of the body before. */
     uint32_t body = UINT32_MAX;
-    v3 r = v3_make(0, 0, 0), vb = r, wb = r;
+    ws_motion mb = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
     ws_node_params p = {0.0, 0.0, 0.0, 0.0};
     for (size_t q = 0; q < m; q++) {
         const uint32_t i = L->node[q], bi = L->body[q];
         if (bi != body) {
             body = bi;
-            r = st->r[bi];
-            vb = st->v[bi];
-            wb = b->wg[bi];
+            mb = (ws_motion){st->r[bi], st->v[bi], b->wg[bi]};
             p = pp[b->material[bi]];
         }
         act_group *e = &G[q >> 2];
         const size_t l = q & 3;
         ws_lane_set(&e->u, l, nodes_get(v, i));
-        ws_lane_set(&e->r, l, r);
-        ws_lane_set(&e->v, l, vb);
-        ws_lane_set(&e->w, l, wb);
+        ws_lane_set(&e->r, l, mb.r);
+        ws_lane_set(&e->v, l, mb.v);
+        ws_lane_set(&e->w, l, mb.w);
         e->kp.v[l] = p.k;
         e->cp.v[l] = p.c;
         e->mu.v[l] = p.mu;
@@ -1141,21 +1138,21 @@ int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
      * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
      * different sets of the first-level cache. Grown by half at least: the candidates of a
      * web being wrapped grow step by step, and each new room is cleared. */
-    if (ncand + 4 > nc->act_cap) {
-        size_t need =
-            ncand + 4 > nc->act_cap + nc->act_cap / 2 ? ncand + 4 : nc->act_cap + nc->act_cap / 2;
-        need = (((need + 7) / 8) | 1) * 8;
-        /* The new room is taken before the old is let go: out of memory, the web keeps the
-         * room it had, of the size it had (a restore that fails leaves the world as it was).
-         * The ids' four arrays follow the doubles' in one block. */
-        double *act = ws_mem_calloc(mem, need, ACT_BYTES);
-        if (!act)
-            return -1;
-        ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
-        nc->act = act;
-        nc->act_id = (uint32_t *)(act + need * ACT_ARRAYS);
-        nc->act_cap = need;
-    }
+    if (ncand + 4 <= nc->act_cap)
+        return 0;
+    const size_t grown = nc->act_cap + nc->act_cap / 2,
+                 least = ncand + 4 > grown ? ncand + 4 : grown;
+    const size_t need = (((least + 7) / 8) | 1) * 8;
+    /* The new room is taken before the old is let go: out of memory, the web keeps the room it
+     * had, of the size it had (a restore that fails leaves the world as it was). The ids' four
+     * arrays follow the doubles' in one block. */
+    double *act = ws_mem_calloc(mem, need, ACT_BYTES);
+    if (!act)
+        return -1;
+    ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
+    nc->act = act;
+    nc->act_id = (uint32_t *)(act + need * ACT_ARRAYS);
+    nc->act_cap = need;
     return 0;
 }
 
