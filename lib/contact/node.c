@@ -239,9 +239,8 @@ void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const ui
     nc->lever2 = lever2;
 }
 
-/* A full detection's record (see ws_node_contact): the web's box from its nodes at state cur
- * and every body, near the web or how far from it, with its pose then; xdet from the nodes. 0,
- * or -1 when out of memory. */
+/* A full detection's record (ws_node_contact): the web's box and xdet from its nodes at state
+ * cur, every body near the web or how far from it, with its pose then. 0, or -1 out of memory. */
 static int track_bodies(const ws_node_step *S, ws_web *web)
 {
     const ws_body_store *b = S->b;
@@ -664,10 +663,9 @@ void ws_node_merge_range(const ws_nmerge *M, uint32_t n0, uint32_t n1)
         M->nstart[n1] = out->n;
 }
 
-/* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
- * (WS_NCAND_CORNER on the first) when they are two faces and then the edge between them, on a
- * flat convex shape, where the contacts tell them apart by the two faces' planes. Neither face
- * is one the node is well inside of (convex_candidates lists no edge of such a face). */
+/* The candidates of a node against body shape sh just listed, out[n0, n): marked when they are
+ * a corner (WS_NCAND_CORNER, node.h). Neither of its faces is one the node is well inside of
+ * (convex_candidates lists no edge of such a face). */
 static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
 {
     if (n - n0 != 3 || !sh->convex || !sh->flat)
