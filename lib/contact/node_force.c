@@ -614,9 +614,8 @@ typedef struct run_group {
     uint64_t bits;      /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
-/* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
- * passes' scratch (run_tmp). The list of loads keeps their places, so they may wait until the
- * block's end. */
+/* The groups of a sweep block's runs waiting for the run passes (their places in the list of
+ * loads kept, they may wait until the block's end), and the passes' scratch (run_tmp). */
 typedef struct run_batch {
     run_group *grp;
     struct run_tmp *tmp;
@@ -871,9 +870,8 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
     }
 }
 
-/* The stretches being cut into seg, which has room for one per candidate (none is empty): a
- * pending run of single inside candidates [r0, r1) and, before it, pending candidates to go one by
- * one [g0, r0). */
+/* The stretches being cut into seg (room for one a candidate; none is empty), and pending: a run
+ * of single inside candidates [r0, r1) and, before it, candidates to go one by one [g0, r0). */
 typedef struct seg_cut {
     const ws_ncand *cand;
     ws_nseg *seg;
@@ -904,9 +902,8 @@ static void seg_close_run(seg_cut *sc)
     sc->r0 = sc->r1;
 }
 
-/* Cut the candidates from k on (of n) whose nodes lie below stop, the start of a block of bl
- * nodes (seg_block); the index past them. A block's stretches depend on its own candidates
- * alone. */
+/* Cut the candidates from k on (of n) whose nodes lie below stop, a block's start (blocks of bl
+ * nodes, seg_block); the index past them. A block's stretches depend on its candidates alone. */
 static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t k, size_t n,
                             uint64_t stop)
 {
