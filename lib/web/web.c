@@ -171,9 +171,8 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
 }
 
 /* Tension / length of a spring of film form p whose second end is at d from its first and moves
- * at u relative to it, rest length 1 / il0. Computed unconditionally and then selected, so the
- * loops over springs have no branches. A spring whose ends coincide has no direction to pull
- * along and gets no force. */
+ * at u relative to it, rest length 1 / il0; none where the ends coincide (no direction to pull
+ * along). Computed, then selected, so the loops over springs have no branches. */
 static inline double film_pull(const ws_spring_form *p, v3 d, v3 u, double il0)
 {
     double l2 = d.x * d.x + d.y * d.y + d.z * d.z;
@@ -302,10 +301,9 @@ static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
 }
 
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
- * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. Node i's mass is m[i], or the web's
- * one mass for every node when same (then m is not read); without drag the velocities are not
- * read. */
+ * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1] (the
+ * order of the results, the state hash: keep it). Masses m[i], or the one mass m1 when same (m
+ * is not read); without drag the velocities are not read. */
 static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
                                  size_t k, int same, int drag)
 {
@@ -626,9 +624,7 @@ size_t ws_web_integrate_block(ws_web *web, const ws_web_pass *p, uint32_t n0, ui
 {
     /* A speed whose square overflows counts as too fast even without a limit (max_speed
      * infinite): a node's state never goes infinite unnoticed. */
-    double lim2 = p->vmax * p->vmax;
-    lim2 = lim2 <= DBL_MAX ? lim2 : DBL_MAX;
-    return advance(web, p, n0, n1 - n0, lim2);
+    return advance(web, p, n0, n1 - n0, fmin(p->vmax * p->vmax, DBL_MAX));
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)
