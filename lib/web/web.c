@@ -27,14 +27,12 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     web->first_spring = UINT32_MAX;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
-        ok &= ws_nodes_alloc(mem, &web->x[k], n);
-        ok &= ws_nodes_alloc(mem, &web->v[k], n);
+        ok &= ws_nodes_alloc(mem, &web->x[k], n) & ws_nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
     ok &= ws_nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= ws_nodes_alloc(mem, &web->xsub, n);
-    ok &= ws_nodes_alloc(mem, &web->vsub, n);
+    ok &= ws_nodes_alloc(mem, &web->xsub, n) & ws_nodes_alloc(mem, &web->vsub, n);
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -42,11 +40,9 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     ok &= (web->sb = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->inv_l0 = ws_mem_calloc(mem, (size_t)ns + WS_WEB_PAD, sizeof(double))) != NULL;
     ok &= (web->kind = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint8_t))) != NULL;
-    if (!ok) {
+    if (!ok)
         ws_web_free(mem, web);
-        return WS_ERR_OUT_OF_MEMORY;
-    }
-    return WS_OK;
+    return ok ? WS_OK : WS_ERR_OUT_OF_MEMORY;
 }
 
 void ws_web_free(ws_mem *mem, ws_web *web)
