@@ -1171,11 +1171,10 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
 {
     const ws_body_store *b = P->b;
     const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
-    const ws_shape *sh = b->shape[c->body];
     at->hi = b->layer[c->body] + web->layer;
+    const double lo = -at->hi - b->shape[c->body]->inner;
     blend_grad gr = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
-    if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, &at->n, &at->d,
-                  &gr))
+    if (!touch_of(&E, c, x, lo, at->hi + reach, at->hi, 0, &at->n, &at->d, &gr))
         return 0;
     /* A face's or rim's distance changes along its normal (gr is left zero); a blended push's
      * as convex_push gives. */
