@@ -226,13 +226,9 @@ void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const ui
         }
         ref_chunk(m, M, nc, t);
         for (size_t j = 0; j < m; j++) {
-            const size_t i = only ? only[q0 + j] : q0 + j;
-            nc->xdet.x[i] = t[T_S][j];
-            nc->xdet.y[i] = t[T_S + 1][j];
-            nc->xdet.z[i] = t[T_S + 2][j];
-            nc->xep.x[i] = t[T_G][j];
-            nc->xep.y[i] = t[T_G + 1][j];
-            nc->xep.z[i] = t[T_G + 2][j];
+            const uint32_t i = only ? only[q0 + j] : (uint32_t)(q0 + j);
+            nodes_set(nc->xdet, i, v3_make(t[T_S][j], t[T_S + 1][j], t[T_S + 2][j]));
+            nodes_set(nc->xep, i, v3_make(t[T_G][j], t[T_G + 1][j], t[T_G + 2][j]));
             lever2 = t[T_L2][j] > lever2 ? t[T_L2][j] : lever2;
         }
     }
