@@ -378,20 +378,14 @@ NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, ui
     return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
 }
 
-/* The gradients of a face contact's push past a convex edge (NODE_BLEND_WIDTH), for the
- * implicit film's exact derivatives: g, that of the distance pushed over (hi less the overlap);
- * the normal's, dn/dx = a b^T (zero for a face alone). */
-typedef struct blend_grad {
-    v3 g, a, b;
-} blend_grad;
-
 /* The push of face candidate c of a convex shape sh on a node at xi below it at depth d < 0
  * (NODE_BLEND_WIDTH's law), the window's top hi (the two layers): whether it pushes, and then
- * its normal and the distance it pushes over (hi less the overlap) and, with gr, their
- * gradients in xi. The prepared faces (global). Out of line as shallowest. */
+ * its normal and the distance it pushes over (hi less the overlap) and, with gr (zeroed by the
+ * caller), their gradients in xi for the implicit film's exact derivatives (ws_node_touch_at:
+ * g, and dn/dx = ta tb^T). The prepared faces (global). Out of line as shallowest. */
 NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, const ws_ncand *c,
                                         v3 xi, double d, double hi, v3 *nrm, double *dist,
-                                        blend_grad *gr)
+                                        ws_node_touch_at *gr)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const ws_wface *F = E->g->face + (c->feat - f);
@@ -412,7 +406,7 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         *nrm = F[f].n;
         *dist = d;
         if (gr)
-            *gr = (blend_grad){F[f].n, v3_make(0, 0, 0), v3_make(0, 0, 0)};
+            gr->g = F[f].n;
         return 1;
     }
     if (t < 0.0 || (t == 0.0 && qg < f))
@@ -432,8 +426,8 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         if (-m < NODE_BLEND_WIDTH)
             ds = v3_madd(ds, F[f].n, t / (2.0 * W * W));
         gr->g = F[f].n;
-        gr->a = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
-        gr->b = ds;
+        gr->ta = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
+        gr->tb = ds;
     }
     return 1;
 }
@@ -444,7 +438,7 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
  * blended push's gradients (convex_push). `sure` as in_wedge's. */
 static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
                                        double top, double hi, int sure, v3 *nrm, double *dist,
-                                       blend_grad *gr)
+                                       ws_node_touch_at *gr)
 {
     const ws_node_geom *g = E->g;
     if (c->local & WS_NCAND_EDGE)
@@ -1173,13 +1167,12 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
     const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
     at->hi = b->layer[c->body] + web->layer;
     const double lo = -at->hi - b->shape[c->body]->inner;
-    blend_grad gr = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
-    if (!touch_of(&E, c, x, lo, at->hi + reach, at->hi, 0, &at->n, &at->d, &gr))
+    at->g = at->ta = at->tb = v3_make(0, 0, 0);
+    if (!touch_of(&E, c, x, lo, at->hi + reach, at->hi, 0, &at->n, &at->d, at))
         return 0;
-    /* A face's or rim's distance changes along its normal (gr is left zero); a blended push's
+    /* A face's or rim's distance changes along its normal (g is left zero); a blended push's
      * as convex_push gives. */
-    at->g = v3_dot(gr.g, gr.g) > 0.0 ? gr.g : at->n;
-    at->ta = gr.a;
-    at->tb = gr.b;
+    if (!(v3_dot(at->g, at->g) > 0.0))
+        at->g = at->n;
     return 1;
 }
