@@ -440,23 +440,21 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     *M = ref_frame(b, cur, web);
     M->reach = far_corner(M->r, nc->box_lo, nc->box_hi) + margin;
     /* The contacts of this step see the bodies as they are now (state cur) and the nodes now
-     * or, with sub-steps, where they go within the step. So a body's move relative to the
-     * reference counts as it stands: its CoG's move plus its turn times its lever since its
-     * record. A near one must stay within margin / 8 of its record. A far one closes on a
-     * node by at most its own move, twice (its move when the node was last found, which `gap`
-     * counts, and its move now), and the node's (under a quarter margin): it must not reach
-     * the node.
+     * or, with sub-steps, where they go within the step; so a body's move relative to the
+     * reference counts as it stands, its CoG's move plus its turn times its lever since its
+     * record. A near one must stay within margin / 8 of its record. A far one closes on a node
+     * by at most its own move twice (when the node was last found, in `gap`, and now) and the
+     * node's (under a quarter margin): it must not reach the node.
      *
      * A near body past its bound is re-based rather than every node found again: its record
      * becomes its pose now, and the nodes in its box grown by the reach (layers + margin) are
-     * found again now, counting their moves from here like any node found. Any other node is
-     * farther than the reach from every point of the body now. Until it is found again the
-     * contacts see it within a quarter margin of where it was found, so within half the margin
-     * of where it is now, and the body's points within margin / 8 of where they are now (at
-     * its bounding sphere's lever, which holds wherever the nodes go): under 5/8 of the margin
-     * together, so the node cannot touch the body and needs no candidate of it. The holders of
-     * its candidates are found again too: the body may have jumped, leaving them outside its
-     * grown box with a candidate that no longer holds (a flag INSIDE). */
+     * found again now, like any node found. Any other node is farther than the reach from
+     * every point of the body now; until it is found again the contacts see it within half the
+     * margin of where it is now (a quarter of where it was found), and the body's points within
+     * margin / 8 of theirs (at its bounding sphere's lever, wherever the nodes go): under 5/8
+     * of the margin together, so the node cannot touch the body and needs no candidate of it.
+     * The holders of its candidates are found again too: the body may have jumped, leaving
+     * them outside its grown box with a candidate that no longer holds (a flag INSIDE). */
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         const double d = body_move(t, st, M, t->near ? 0.0 : M->reach);
