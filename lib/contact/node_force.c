@@ -620,10 +620,10 @@ typedef struct run_batch {
 } run_batch;
 
 /* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
- * the nodes' arrays, with act_apply's arithmetic operation by operation
- * (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other
- * contact, so its force with every normal force in is its force with this one. Lanes of a group
- * not in the window, or not the run's, keep their forces.
+ * the nodes' arrays, with act_apply's arithmetic operation by operation (the test
+ * film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other contact,
+ * so its force with every normal force in is its force with this one. Lanes of a group not in
+ * the window, or not the run's, keep their forces.
  *
  * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
  * between in run_tmp, so that the long chains of several groups' arithmetic overlap
