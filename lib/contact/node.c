@@ -68,14 +68,11 @@ static inline uint64_t inside_box(v3 p, v3 lo, v3 hi, double e)
 /* The box of the web's nodes x. */
 static void web_box(const ws_web *web, ws_nodes3 x, v3 *lo, v3 *hi)
 {
-    v3 l = nodes_get(x, 0), h = l;
+    *lo = *hi = nodes_get(x, 0);
     for (uint32_t i = 1; i < web->n; i++) {
-        v3 p = nodes_get(x, i);
-        l = v3_min(l, p);
-        h = v3_max(h, p);
+        *lo = v3_min(*lo, nodes_get(x, i));
+        *hi = v3_max(*hi, nodes_get(x, i));
     }
-    *lo = l;
-    *hi = h;
 }
 
 /* Largest distance from p to a corner of the box (lo, hi). */
@@ -141,9 +138,8 @@ static double body_gap(const ws_body_store *b, int cur, uint32_t k, const ws_web
     return best;
 }
 
-/* The reference frame of a web's moves: the pose and velocity of its reference body in state
- * cur, or the global frame, as the move test holds them (A, r, vr, wr and the conjugate
- * orientation pc; the rest zero). Local coordinates of a global point p: A^T (p - r). */
+/* The reference frame of a web's moves as the move test holds it (A, r, vr, wr, the conjugate
+ * orientation pc; the rest zero): its reference body's at state cur, or the global frame. */
 static ws_move_test ref_frame(const ws_body_store *b, int cur, const ws_web *web)
 {
     const uint32_t k = web->contact->ref;
@@ -181,14 +177,14 @@ static int may_reach(double d, double gap, double margin)
     return d + MOVE_PART(MOVE_NODE + MOVE_SUBSTEP) * margin >= gap;
 }
 
-/* Nodes are turned to the reference frame REF_CHUNK at a time (to_ref). Flags are found
- * FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
+/* Nodes are turned to the reference frame REF_CHUNK at a time (ws_node_ref_nodes). Flags are
+ * found FLAG_CHUNK nodes at a time as 64-bit values, as wide as the doubles they come from, then
  * narrowed to bytes: a loop that writes the bytes at once takes 32 nodes a vector iteration and
  * runs out of registers. */
 enum { REF_CHUNK = 64, FLAG_CHUNK = 256 };
 
-/* The rows of to_ref's scratch: the nodes' global x, y, z; in the reference frame, s; at the
- * epoch, g; |s|^2. */
+/* The rows of ws_node_ref_nodes' scratch: the nodes' global x, y, z; in the reference frame,
+ * s; at the epoch, g; |s|^2. */
 enum { T_X, T_S = 3, T_G = 6, T_L2 = 9, T_ROWS };
 
 /* m nodes (rows T_X of t) to the reference frame M: s = A^T (x - r) into rows T_S, and their
@@ -212,10 +208,8 @@ static void ref_chunk(size_t m, const ws_move_test *M, const ws_node_contact *nc
     }
 }
 
-/* Nodes to the reference frame M: s = A^T (x - r), into xdet, and their place at the epoch,
- * epoch_r + epoch_A s, into xep, with lever2 kept the largest |s|^2; all of them, or the listed
- * ones when `only` is set. Gathered REF_CHUNK at a time, turned on vectors, put back: the
- * gather costs little beside the search that follows every call. */
+/* Gathered REF_CHUNK at a time, turned on vectors (ref_chunk), put back: the gather costs
+ * little beside the search that follows every call. */
 void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const uint32_t *only,
                        size_t count)
 {
@@ -232,22 +226,17 @@ void ws_node_ref_nodes(ws_web *web, ws_nodes3 x, const ws_move_test *M, const ui
         }
         ref_chunk(m, M, nc, t);
         for (size_t j = 0; j < m; j++) {
-            const size_t i = only ? only[q0 + j] : q0 + j;
-            nc->xdet.x[i] = t[T_S][j];
-            nc->xdet.y[i] = t[T_S + 1][j];
-            nc->xdet.z[i] = t[T_S + 2][j];
-            nc->xep.x[i] = t[T_G][j];
-            nc->xep.y[i] = t[T_G + 1][j];
-            nc->xep.z[i] = t[T_G + 2][j];
+            const uint32_t i = only ? only[q0 + j] : (uint32_t)(q0 + j);
+            nodes_set(nc->xdet, i, v3_make(t[T_S][j], t[T_S + 1][j], t[T_S + 2][j]));
+            nodes_set(nc->xep, i, v3_make(t[T_G][j], t[T_G + 1][j], t[T_G + 2][j]));
             lever2 = t[T_L2][j] > lever2 ? t[T_L2][j] : lever2;
         }
     }
     nc->lever2 = lever2;
 }
 
-/* A full detection's record (see ws_node_contact): the web's box from its nodes at state cur
- * and every body, near the web or how far from it, with its pose then; xdet from the nodes. 0,
- * or -1 when out of memory. */
+/* A full detection's record (ws_node_contact): the web's box and xdet from its nodes at state
+ * cur, every body near the web or how far from it, with its pose then. 0, or -1 out of memory. */
 static int track_bodies(const ws_node_step *S, ws_web *web)
 {
     const ws_body_store *b = S->b;
@@ -307,42 +296,15 @@ static inline void put_flags(uint8_t *restrict redo, const uint64_t *restrict fl
         redo[i] = (uint8_t)flag[i];
 }
 
-/* The per-node test of ws_node_moved with sub-steps (c > 0): 1 in nc->redo for a node whose
- * measure |u| + c |w| reaches the bound (or is NaN), else 0; how many are flagged. u is the
- * node's move in the reference frame since it was found, w its velocity relative to the
- * reference body's point where it is. Straight-line code, on vectors. Most groups of nodes have
- * none flagged: their bytes are cleared, not narrowed. */
+/* The per-node test of ws_node_moved on nodes [n0, n1): 1 in nc->redo for a node whose
+ * measure reaches the bound (or is NaN), else 0; how many are flagged. With sub-steps (c > 0)
+ * the measure is |u| + c |w|, u the node's move in the reference frame since it was found, w
+ * its velocity relative to the reference body's point where it is. With one, it is the node's
+ * distance from its place at the epoch (xep), a new epoch started first when renew asks (the
+ * reference body's pose (A, r) now, each node's xep from its xdet): only a new epoch turns the
+ * nodes. Straight-line code, on vectors. */
 WS_VECTOR_LOOP
-static size_t flag_moved(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
-{
-    const ws_move_test M = nc->move;
-    uint64_t flag[FLAG_CHUNK];
-    size_t count = 0;
-    for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
-        const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
-        const double *restrict ox = nc->xdet.x + i0, *restrict oy = nc->xdet.y + i0,
-                               *restrict oz = nc->xdet.z + i0;
-        const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
-        const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
-        for (size_t i = 0; i < e; i++) {
-            v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
-            v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(ox[i], oy[i], oz[i]));
-            v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
-            uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
-            flag[i] = f;
-            count += f;
-        }
-        put_flags(nc->redo + i0, flag, e, count != before);
-    }
-    return count;
-}
-
-/* The per-node test of ws_node_moved with one sub-step, from the epoch: 1 in nc->redo for a
- * node whose distance from its place at the epoch (xep) reaches lim (or is NaN), else 0; how
- * many are flagged. With `renew` a new epoch starts first: the reference body's pose (A, r) now,
- * each node's xep from its xdet. As flag_moved, but only a new epoch turns the nodes. */
-WS_VECTOR_LOOP
-static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
+static size_t flag_nodes(ws_node_contact *nc, ws_nodes3 x, ws_nodes3 v, size_t n0, size_t n1)
 {
     const ws_move_test M = nc->move;
     const double lim2 = M.lim * M.lim;
@@ -350,54 +312,59 @@ static size_t flag_epoch(ws_node_contact *nc, ws_nodes3 x, size_t n0, size_t n1)
     size_t count = 0;
     for (size_t i0 = n0; i0 < n1; i0 += FLAG_CHUNK) {
         const size_t e = n1 - i0 < FLAG_CHUNK ? n1 - i0 : (size_t)FLAG_CHUNK, before = count;
-        double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
-                         *restrict oz = nc->xep.z + i0;
         const double *restrict qx = x.x + i0, *restrict qy = x.y + i0, *restrict qz = x.z + i0;
+        const double *restrict vx = v.x + i0, *restrict vy = v.y + i0, *restrict vz = v.z + i0;
         const double *restrict sx = nc->xdet.x + i0, *restrict sy = nc->xdet.y + i0,
                                *restrict sz = nc->xdet.z + i0;
-        if (M.renew)
+        double *restrict ox = nc->xep.x + i0, *restrict oy = nc->xep.y + i0,
+                         *restrict oz = nc->xep.z + i0;
+        if (M.c > 0.0) {
             for (size_t i = 0; i < e; i++) {
-                v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
-                ox[i] = g.x;
-                oy[i] = g.y;
-                oz[i] = g.z;
+                v3 p = v3_sub(v3_make(qx[i], qy[i], qz[i]), M.r);
+                v3 u = v3_sub(m3_tmul_v(&M.A, p), v3_make(sx[i], sy[i], sz[i]));
+                v3 w = v3_sub(v3_sub(v3_make(vx[i], vy[i], vz[i]), M.vr), v3_cross(M.wr, p));
+                uint64_t f = !(v3_norm(u) + M.c * v3_norm(w) < M.lim);
+                flag[i] = f;
+                count += f;
             }
-        for (size_t i = 0; i < e; i++) {
-            uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
-                                           v3_make(ox[i], oy[i], oz[i]))) < lim2);
-            flag[i] = f;
-            count += f;
+        } else {
+            if (M.renew)
+                for (size_t i = 0; i < e; i++) {
+                    v3 g = v3_add(M.r, m3_mul_v(&M.A, v3_make(sx[i], sy[i], sz[i])));
+                    ox[i] = g.x;
+                    oy[i] = g.y;
+                    oz[i] = g.z;
+                }
+            for (size_t i = 0; i < e; i++) {
+                uint64_t f = !(v3_norm2(v3_sub(v3_make(qx[i], qy[i], qz[i]),
+                                               v3_make(ox[i], oy[i], oz[i]))) < lim2);
+                flag[i] = f;
+                count += f;
+            }
         }
         put_flags(nc->redo + i0, flag, e, count != before);
     }
     return count;
 }
 
-/* The flagged nodes of [n0, n1) (flags 0 or 1) into `moved`, in order; how many. Thirty-two
- * flags at a time, then eight: most steps flag few nodes, and those in runs. */
+/* The flagged nodes of [n0, n1) (flags 0 or 1) into `moved`, in order; how many. On a
+ * little-endian machine thirty-two flags at a time, by the set bits of the words that hold
+ * any: most steps flag few nodes, and those in runs. Elsewhere (and for the rest) one by one. */
 static size_t collect_flagged(const uint8_t *flag, size_t n0, size_t n1, uint32_t *moved)
 {
     size_t count = 0, i = n0;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     for (; i + 32 <= n1; i += 32) {
         uint64_t word[4];
         memcpy(word, flag + i, sizeof word);
         if (!(word[0] | word[1] | word[2] | word[3]))
             continue;
-        for (size_t w = 0; w < 4; w++) {
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-            /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
+        /* Flag j is byte j - i - 8 w of word w: its lowest bit is set when it is 1. */
+        for (size_t w = 0; w < 4; w++)
             for (uint64_t b = word[w]; b; b &= b - 1)
                 moved[count++] = (uint32_t)(i + 8 * w + ws_lowest_bit(b) / 8);
-#else
-            if (!word[w])
-                continue;
-            for (size_t j = i + 8 * w; j < i + 8 * w + 8; j++) {
-                moved[count] = (uint32_t)j;
-                count += flag[j];
-            }
-#endif
-        }
     }
+#endif
     for (; i < n1; i++) {
         moved[count] = (uint32_t)i;
         count += flag[i];
@@ -464,37 +431,30 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     const ws_body_state *st = &b->st[cur];
     /* A body made since the full detection: find every node again. */
     for (uint32_t k = 0, q = 0; k < b->slots; k++) {
-        if (q < nc->ntrack && nc->track[q].body == k) {
+        if (q < nc->ntrack && nc->track[q].body == k)
             q++;
-            continue;
-        }
-        if (b->alive[k])
+        else if (b->alive[k])
             return -1;
     }
     ws_move_test *M = &nc->move;
     *M = ref_frame(b, cur, web);
     M->reach = far_corner(M->r, nc->box_lo, nc->box_hi) + margin;
-    /* The contacts of this step are evaluated with the bodies as they are now (state cur),
-     * the nodes now and, with sub-steps, where the nodes go within the step. So a body's
-     * move relative to the reference counts as it stands: its CoG's move and its turn times
-     * its lever since its record. Near ones must stay within margin / 8 of it. A far one
-     * closes on a node by at most its own move (twice: since the node was last found, the
-     * body moved at most its move then plus its move now, which `gap` and `close` count) and
-     * the node's (under a quarter margin): it must not reach the node.
+    /* The contacts of this step see the bodies as they are now (state cur) and the nodes now
+     * or, with sub-steps, where they go within the step; so a body's move relative to the
+     * reference counts as it stands, its CoG's move plus its turn times its lever since its
+     * record. A near one must stay within margin / 8 of its record. A far one closes on a node
+     * by at most its own move twice (when the node was last found, in `gap`, and now) and the
+     * node's (under a quarter margin): it must not reach the node.
      *
-     * A near body past its bound is re-based (rebase_body) rather than every node found
-     * again: its record becomes its pose now, and the nodes in its box grown by the reach
-     * (layers + margin), in its frame now, are found again now and count their moves from
-     * here, against the new record, like any node found. Any other node is farther than the
-     * reach from every point of the body now. Until it is found again, the contacts see it
-     * within a quarter margin of where it was found (see below), so within half the margin of
-     * where it is now; and the body's points stay within margin / 8 of where they are now
-     * (their deviation from the new record, past which the body is re-based again), with the
-     * lever of its bounding sphere, which holds wherever the nodes go. Together under 5/8 of
-     * the margin: the node stays farther than the layers from the body, cannot touch it and
-     * needs no candidate of it. The holders of its
-     * candidates are found again too: the body may have jumped, so that they are out of its
-     * grown box with a candidate that no longer holds (a flag INSIDE). */
+     * A near body past its bound is re-based rather than every node found again: its record
+     * becomes its pose now, and the nodes in its box grown by the reach (layers + margin) are
+     * found again now, like any node found. Any other node is farther than the reach from
+     * every point of the body now; until it is found again the contacts see it within half the
+     * margin of where it is now (a quarter of where it was found), and the body's points within
+     * margin / 8 of theirs (at its bounding sphere's lever, wherever the nodes go): under 5/8
+     * of the margin together, so the node cannot touch the body and needs no candidate of it.
+     * The holders of its candidates are found again too: the body may have jumped, leaving
+     * them outside its grown box with a candidate that no longer holds (a flag INSIDE). */
     for (size_t q = 0; q < nc->ntrack; q++) {
         ws_track *t = &nc->track[q];
         const double d = body_move(t, st, M, t->near ? 0.0 : M->reach);
@@ -507,28 +467,26 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
         if (!t->near && may_reach(d, t->gap, margin))
             return -1;
     }
-    /* Per node (flag_moved): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
-     * h_more the time its sub-steps go beyond this state. Two near bodies' deviations (margin /
-     * 4) and the rest (margin / 16, for what the sub-steps' forces add) keep a node's move
-     * relative to any near body under half the margin: what the candidates were found to
-     * cover. With one sub-step the contacts see the nodes only where they are now, which the
-     * test measures, and nothing is added: flagged at |u| = 1/4 of the margin. Either way a
-     * node stays within a quarter margin of where it was found wherever the contacts see it. */
+    /* Per node (flag_nodes): flagged when |u| + 1.5 |w| h_more reaches 3/16 of the margin,
+     * h_more the time its sub-steps go beyond this state; with one sub-step the contacts see the
+     * nodes only where the test measures them, and the bound is 1/4 (MOVE_SUBSTEP joins the
+     * node's part). Either way a node stays within a quarter margin of where it was found
+     * wherever the contacts see it. */
     const double lim = MOVE_PART(web->substeps > 1 ? MOVE_NODE : MOVE_NODE + MOVE_SUBSTEP) * margin;
     M->c = 1.5 * dt * (web->substeps - 1) / web->substeps;
     M->lim = lim;
     if (M->c <= 0.0) {
-        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet,
-         * is |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r +
-         * epoch_A s with the epoch's pose (to_ref writes both for a node found since). g lies
-         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between
-         * the two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2)
-         * |s| <= turn |s|, and lever2 bounds |s|^2 of every node found since the full
-         * detection. So |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches
-         * lim - drift: it stays within lim of where it was found, as above. A new epoch (the
-         * pose now, every g from its s, drift 0) starts when the drift reaches lim / 8, so no
-         * node is flagged before it has moved 7/8 of the bound; it costs about what turning
-         * every node costs, and a load that rocks on its film needs one every few steps. */
+        /* Without a turn per node: the measure |u| = |A^T (x - r) - s|, s the node's xdet, is
+         * |x - (r + A s)| (A is a rotation), and every node's xep holds g = epoch_r + epoch_A s
+         * with the epoch's pose (ws_node_ref_nodes writes both for a node found since). g lies
+         * within drift = |r - epoch_r| + turn sqrt(lever2) of r + A s, turn the angle between the
+         * two orientations: |(epoch_A - A) s| = |(epoch_A A^T - I) A s| <= 2 sin(turn / 2) |s| <=
+         * turn |s|, and lever2 bounds |s|^2 of every node found since the full detection. So
+         * |u| <= |x - g| + drift, and a node is flagged when |x - g| reaches lim - drift: it stays
+         * within lim of where it was found. A new epoch (the pose now, every g from its s, drift
+         * 0) starts when the drift reaches lim / 8, so no node is flagged before it has moved 7/8
+         * of the bound; it costs about what turning every node costs, and a load that rocks on its
+         * film needs one every few steps. */
         const qt p = qt_conj(M->pc);
         const double turn = v3_norm(qt_to_rotvec(qt_mul(qt_conj(nc->epoch_q), p)));
         double drift = v3_norm(v3_sub(M->r, nc->epoch_r)) + turn * sqrt(nc->lever2);
@@ -544,17 +502,11 @@ int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt,
     return 0;
 }
 
-size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1)
-{
-    ws_node_contact *nc = web->contact;
-    return nc->move.c > 0.0 ? flag_moved(nc, x, v, n0, n1) : flag_epoch(nc, x, n0, n1);
-}
-
 void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                        ws_node_lane *L)
 {
     ws_node_contact *nc = web->contact;
-    const size_t flagged = ws_node_flag(web, x, v, L->n0, L->n1);
+    const size_t flagged = flag_nodes(nc, x, v, L->n0, L->n1);
     for (size_t q = 0; nc->move.rebase && q < nc->ntrack; q++)
         if (nc->track[q].rebase)
             rebase_flags(b, cur, &nc->track[q], web, x, L->margin, L->n0, L->n1);
@@ -705,10 +657,9 @@ void ws_node_merge_range(const ws_nmerge *M, uint32_t n0, uint32_t n1)
         M->nstart[n1] = out->n;
 }
 
-/* The candidates of a node against body shape sh just listed, out[n0, n): marked a corner
- * (WS_NCAND_CORNER on the first) when they are two faces and then the edge between them, on a
- * flat convex shape, where the contacts tell them apart by the two faces' planes. Neither face
- * is one the node is well inside of (convex_candidates lists no edge of such a face). */
+/* The candidates of a node against body shape sh just listed, out[n0, n): marked when they are
+ * a corner (WS_NCAND_CORNER, node.h). Neither of its faces is one the node is well inside of
+ * (convex_candidates lists no edge of such a face). */
 static void mark_corner(const ws_shape *sh, ws_ncand *out, size_t n0, size_t n)
 {
     if (n - n0 != 3 || !sh->convex || !sh->flat)
@@ -1161,12 +1112,6 @@ void ws_node_prepare_some(const ws_body_store *b, int cur, ws_node_geom *g, cons
         }
 }
 
-void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g)
-{
-    (void)mem; /* its tables are the arena's, given back with it */
-    memset(g, 0, sizeof *g);
-}
-
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
                           int all)
 {
@@ -1202,12 +1147,9 @@ static int search_moved(const ws_node_step *S, ws_web *web, size_t moved, int ol
 int ws_node_contact_update(const ws_node_step *S, ws_web *web, int *searched)
 {
     ws_node_contact *nc = web->contact;
-    /* Node candidates: all found again when asked, when the record is invalid or when a body
-     * may have come near (ws_node_moved says -1); else those of the nodes that moved far
-     * enough relative to the near bodies, or that a near body past its bound may meet, merged
-     * into the others. Either way the list holds every node-feature pair that can touch in
-     * this step, and the result is the same as finding them every step (tests/test_detection.c
-     * shows it). */
+    /* All found again, or those of the nodes the move test flagged merged into the others:
+     * either way the list holds every node-feature pair that can touch in this step, and the
+     * result is that of finding them every step (tests/test_detection.c). */
     int list = nc->list, all = nc->search_all;
     long moved = 0;
     nc->merging = 0;

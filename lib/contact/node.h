@@ -81,7 +81,7 @@ typedef struct ws_track {
     double lo, hi, gap, lever;
 } ws_track;
 
-/* The move test of a step between its parts (ws_node_moved_begin, ws_node_flag,
+/* The move test of a step between its parts (ws_node_moved_begin, ws_node_flag_lane,
  * ws_node_moved_end): the reference body's pose (A, r, conjugate orientation pc) and velocity
  * (vr, global turn rate wr) now, the per-node bound lim with the share c of a node's
  * velocity that counts (0: one sub-step, measured from the epoch, which renew starts anew),
@@ -268,7 +268,7 @@ int ws_node_find(const ws_node_step *S, ws_web *web, const uint32_t *nodes, uint
 /* The first of the two calls of a step before a web's sub-steps: whether every node is to be
  * found again at state cur (when `all`, the record of the last search is invalid, or a body
  * may have come near: 0 returned), or the per-node move test is to run (1 returned: over every
- * node, in any pieces, ws_node_flag, then ws_node_contact_update). */
+ * node, in any pieces, ws_node_flag_lane, then ws_node_contact_update). */
 int ws_node_contact_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin,
                           int all);
 /* The second: the candidates brought up to date at state cur (all found again, or those of
@@ -298,7 +298,6 @@ static inline void ws_node_prepare(const ws_body_store *b, int cur, ws_node_geom
 {
     ws_node_prepare_some(b, cur, g, web, 0, 1);
 }
-void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* Which nodes must find their candidates again before this step, state cur, (x, v), dt: a
  * node whose move relative to the web's reference body, with what its sub-steps may add, could
@@ -315,14 +314,12 @@ void ws_node_geometry_free(ws_mem *mem, ws_node_geom *g);
 
 /* ws_node_moved in parts, so that the per-node test runs in pieces (a lane's nodes): the
  * bodies' part, -1 when every node must be found again, else 0 with the test set up in
- * nc->move; the nodes [n0, n1) flagged in nc->redo, how many (the pieces may run at once on
- * distinct nodes), or, by ws_node_flag_lane, with those a re-based near body may meet, listed
- * and measured against the far bodies (L: the lanes cover the nodes in order, whole rows of a
- * grid web); the rest, given the lanes, as ws_node_moved returns, but with the listed nodes
- * not yet moved to the reference frame: the search of their candidates does that
- * (ws_node_to_ref, in its pieces when it has any). */
+ * nc->move; the lane's nodes flagged in nc->redo (the lanes may run at once on distinct
+ * nodes), with those a re-based near body may meet, listed and measured against the far bodies
+ * (L: the lanes cover the nodes in order, whole rows of a grid web); the rest, given the lanes, as
+ * ws_node_moved returns, but with the listed nodes not yet moved to the reference frame: the search
+ * of their candidates does that (ws_node_to_ref, in its pieces when it has any). */
 int ws_node_moved_begin(const ws_body_store *b, int cur, ws_web *web, double dt, double margin);
-size_t ws_node_flag(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t n0, uint32_t n1);
 void ws_node_flag_lane(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, ws_nodes3 v,
                        ws_node_lane *L);
 long ws_node_moved_end(const ws_body_store *b, int cur, ws_web *web, ws_nodes3 x, double margin,

@@ -20,11 +20,10 @@ static inline int in_wface(const ws_node_geom *g, const ws_wface *F, v3 x)
     return in;
 }
 
-/* A node against the rounded rim of a convex edge: only in the edge's own region, where the
- * direction from the edge to the node lies strictly between the normals of its two faces
- * (elsewhere a face holds the node), and closer than `hi`. Gives the unit normal from the edge
- * to the node and the distance. `sure`: the faces' planes have shown the direction to lie
- * between the normals (corner_left), which is then not tested again. */
+/* A node against the rounded rim of a convex edge, closer than `hi` and only where the direction
+ * from the edge to the node lies strictly between its faces' normals (elsewhere a face holds the
+ * node): the unit normal from the edge to the node and the distance. `sure`: the faces' planes
+ * have shown that direction already (corner_left). */
 static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm, double *dist)
 {
     v3 rp = v3_sub(x, E->p);
@@ -35,16 +34,13 @@ static inline int in_wedge(const ws_wedge *E, v3 x, double hi, int sure, v3 *nrm
     double l2 = v3_dot(r, r);
     if (!(l2 < hi * hi) || !(l2 > 0.0))
         return 0;
-    /* Outside both faces' planes: in the wedge between them. */
-    if (!sure && !(v3_dot(r, E->n1) > 0.0 && v3_dot(r, E->n2) > 0.0))
-        return 0;
-    /* And not over either face: r = a n1 + b n2 with a, b > 0. */
-    const double c = E->c, den = 1.0 - c * c;
-    if (den < 1e-12)
-        return 0;
+    const double c = E->c;
+    if (1.0 - c * c < 1e-12)
+        return 0; /* faces about parallel: no wedge between them */
+    /* Outside both faces' planes, and not over either face: r = a n1 + b n2 with a, b > 0. */
     if (!sure) {
         const double r1 = v3_dot(r, E->n1), r2 = v3_dot(r, E->n2);
-        if (!(r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
+        if (!(r1 > 0.0 && r2 > 0.0 && r1 - c * r2 > 0.0 && r2 - c * r1 > 0.0))
             return 0;
     }
     double l = sqrt(l2);
@@ -81,15 +77,12 @@ static inline v3 pushed(uint64_t push, v3 a)
     return v3_make(ws_pick(push, a.x, -0.0), ws_pick(push, a.y, -0.0), ws_pick(push, a.z, -0.0));
 }
 
-/* The friction on a node: from the contact's normal n, the node's tangential velocity relative
- * to the body t, its force with every normal force in k, its 1 / mass and mass, Coulomb's force
- * mu fn and the contact's v_lim (ws_friction_law). None for a pinned node or one that does
- * not slip; taken only where the contact pushes. Straight-line code, so loops of it run on
- * vectors.
- *
- * Eq. 13, limited to the force that stops the node's slip within this sub-step h, its slip
- * predicted with every normal force in and none of the frictions, so that the result does not
- * depend on the order of a corner's faces (docs/theory.md, section 6). */
+/* Eq. 13's friction on a node (ws_friction_law) from the contact's normal n, the node's
+ * tangential velocity t relative to the body, its force k with every normal force in, its
+ * 1 / mass and mass, Coulomb's force cap and v_lim; none for a pinned node. Limited to the force
+ * that stops the node's slip within the sub-step h, the slip predicted with every normal force
+ * in and no friction, so that the result does not depend on the order of a corner's faces
+ * (docs/theory.md, section 6). Straight-line code, for loops on vectors. */
 static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double cap, double vlim,
                              double h)
 {
@@ -106,11 +99,10 @@ static inline v3 friction_of(v3 n, v3 t, v3 k, double im, double mass, double ca
 /* ---- the contacts of a sweep block gone one by one
  *
  * The one-by-one pass lists the contacts whose tests it passed, in node order, in groups of
- * four (nc->act). At the block's end their normal forces go on vectors and into f, and once
- * every normal force of the block is in, their frictions go on vectors and they are applied
- * to the nodes. Runs apply theirs in batches (run_flush), into the places in the list of loads
- * they took. The loads on the bodies of both go to one list of loads in node order, which is
- * summed last: the bodies' totals are added in the same order however the candidates are cut. */
+ * four (nc->act), which act_apply evaluates at the block's end; runs apply theirs in batches
+ * (run_flush). The loads on the bodies of both go to one list in node order, each into the
+ * place its contact took, and are summed last: the bodies' totals are added in the same order
+ * however the candidates are cut. */
 
 /* Four contacts of the list side by side (wide.h), lane l of group g the list's contact
  * 4 g + l, so that a pass over the groups runs on vectors with one pointer. */
@@ -146,10 +138,9 @@ static act_list act_open(ws_node_contact *nc)
 {
     const size_t cap = nc->act_cap; /* a multiple of 4 (ws_node_scratch) */
     uint32_t *id = nc->act_id;
-    act_list L = {(act_group *)nc->act, id,   id + cap, id + 2 * cap,
-                  id + 3 * cap,         NULL, 0,        nc->act_nl};
-    L.load = (act_load *)(nc->act + ACT_GROUP * cap);
-    return L;
+    act_load *load = (act_load *)(nc->act + ACT_GROUP * cap);
+    return (act_list){(act_group *)nc->act, id,   id + cap, id + 2 * cap,
+                      id + 3 * cap,         load, 0,        nc->act_nl};
 }
 
 /* Contact `node` against body `body` as contacts_general finds it: along n, at depth d, in the
@@ -169,11 +160,10 @@ static inline void act_push(act_list *L, uint32_t node, uint32_t body, v3 n, dou
     L->slot[q] = (uint32_t)L->nl++;
 }
 
-/* The normal force of the contact laws (penalty.h) on a node at x (velocity u) against a body
- * b at depth d along n (body to node), in the window of top hi, stiffness k, damping c: its
- * vector p, the lever l from the CoG, the tangential velocity t relative to the body, and fn
- * (negative where it would pull). Straight-line code, so loops of it run on vectors; both
- * passes (act_normal, run_normal) take it from here. */
+/* The contact laws' normal force (penalty.h) on a node at x (velocity u) against body b at depth
+ * d along n (body to node), window top hi, stiffness k, damping c: its vector p, the lever l from
+ * the CoG, the tangential velocity t relative to the body and fn (negative where it would pull).
+ * Both passes (act_normal, run_normal) take it from here, on vectors. */
 typedef struct node_normal {
     v3 p, l, t;
     double fn;
@@ -206,9 +196,7 @@ static void act_normal(size_t ng, act_group *restrict G)
     }
 }
 
-/* The frictions of the contacts of groups [0, ng), and the loads on the bodies, each the
- * opposite of the contact force (friction and normal force) times share, with its moment about
- * the CoG. */
+/* The frictions of the contacts of groups [0, ng) and their loads on the bodies (body_load). */
 WS_VECTOR_LOOP
 static void act_friction(size_t ng, double h, double share, act_group *restrict G)
 {
@@ -259,9 +247,7 @@ typedef struct corner_memo {
     double eps;
 } corner_memo;
 
-/* What the node contacts of a sweep block read: the bodies and their state, their faces in the
- * global frame, the web and its node state (x, v), the contact parameters by body material and
- * the list of contacts gone one by one. */
+/* What the node contacts of a sweep block read (L: the list of the contacts gone one by one). */
 typedef struct node_env {
     const ws_body_store *b;
     const ws_body_state *st;
@@ -305,23 +291,21 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
     act_group *G = L->grp;
     /* The body's values kept from one contact to the next, as most are of the body before. */
     uint32_t body = UINT32_MAX;
-    v3 r = v3_make(0, 0, 0), vb = r, wb = r;
+    ws_motion mb = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
     ws_node_params p = {0.0, 0.0, 0.0, 0.0};
     for (size_t q = 0; q < m; q++) {
         const uint32_t i = L->node[q], bi = L->body[q];
         if (bi != body) {
             body = bi;
-            r = st->r[bi];
-            vb = st->v[bi];
-            wb = b->wg[bi];
+            mb = (ws_motion){st->r[bi], st->v[bi], b->wg[bi]};
             p = pp[b->material[bi]];
         }
         act_group *e = &G[q >> 2];
         const size_t l = q & 3;
         ws_lane_set(&e->u, l, nodes_get(v, i));
-        ws_lane_set(&e->r, l, r);
-        ws_lane_set(&e->v, l, vb);
-        ws_lane_set(&e->w, l, wb);
+        ws_lane_set(&e->r, l, mb.r);
+        ws_lane_set(&e->v, l, mb.v);
+        ws_lane_set(&e->w, l, mb.w);
         e->kp.v[l] = p.k;
         e->cp.v[l] = p.c;
         e->mu.v[l] = p.mu;
@@ -358,34 +342,29 @@ static void act_apply(const node_env *E, double h, double share, v3 *fc)
 }
 
 /* How far past a convex body's edge the push turns from one face's normal to the other's, for
- * both films (the one-by-one pass and the implicit film's ws_node_touch alike; bench/NOTES.md,
- * sessions 18 and 19, issue 17). A node below face f of a convex body at depth d < 0, e the
- * largest signed distance to the body's other planes (the shallowest other depth, of face g),
- * t = d - e, m = max(d, e): its push comes from one contact, f's where t > 0 (the lower face's
- * index of f, g on a tie), with the overlap hi - m (m is the node's signed distance to the
- * body's surface: the shallowest face's depth) along the unit normal
+ * both films (the one-by-one pass and ws_node_touch alike; bench/NOTES.md, sessions 18 and 19).
+ * A node below face f of a convex body at depth d < 0, e the largest signed distance to the
+ * body's other planes (the shallowest other depth, of face g), t = d - e, m = max(d, e) (its
+ * signed distance to the body's surface): its push comes from one contact, f's where t > 0 (the
+ * lower face's index of f, g on a tie), with the overlap hi - m along the unit normal
  *
  *     n = (s n_f + (1 - s) n_g) / |s n_f + (1 - s) n_g|,   s = min(1, 1/2 + t / (2 W)),
  *     W = min(NODE_BLEND_WIDTH, -m);
  *
  * for t >= W that is n_f and d, the shallowest face alone, to the bit. Continuous: across the
  * medial plane (t = 0) the contact passes from f to g with the same push, k (hi - m) along the
- * bisector, where the shallowest face alone turned it by the faces' angle on a difference of
- * round-off; on the edge line the push is the rounded rim's (in_wedge: k hi, its direction
- * between the normals). One contact, as the rim's: one normal force, one friction in its
- * tangent plane (two faces' contacts would each hold the node against the other's push by
- * friction, and half shares each would let a corner sink twice as deep). The width pinches to
- * the depth (-m) near the surface, so that the push is f's own by the time the node reaches
- * g's plane (e = 0), past which f alone holds it; a fixed width would turn the push there by
- * up to half the faces' angle. So the blend fills the wedge about the edge inside the body by
- * angle, as the rim does outside it, turning as 1 / distance near the edge line as the rim.
+ * bisector, which the shallowest face alone would turn by the faces' angle on a difference of
+ * round-off; on the edge line the push is the rounded rim's (in_wedge). One contact, as the
+ * rim's: one normal force, one friction in its tangent plane (two faces' contacts would each
+ * hold the node against the other's push by friction, and half shares each would let a corner
+ * sink twice as deep). The width pinches to the depth (-m) near the surface, so that the push
+ * is f's own by the time the node reaches g's plane (e = 0); a fixed width would turn it there
+ * by up to half the faces' angle. So the blend fills the wedge about the edge inside the body
+ * by angle, as the rim does outside it, turning as 1 / distance near the edge line.
  *
- * The width: a film node's layer is ~1 mm, which its push spans; W must stand far above
- * round-off (1e-11 m, the medial plane's tie) and the noise that mirror-symmetric nodes carry
- * (1e-8 m in the settling bands), so that mirror images get mirror pushes, and small beside a
- * face (0.1-1 m): 1 mm. Nodes that lie more than 1 mm deeper beneath every other face's plane
- * than beneath their shallowest face's (or more than their depth: nodes near a face's middle,
- * not an edge) keep their results to the bit. */
+ * The width: far above round-off (1e-11 m, the medial plane's tie) and the noise that
+ * mirror-symmetric nodes carry (1e-8 m in the settling bands), so that mirror images get mirror
+ * pushes; within a film node's layer (~1 mm), which its push spans, and small beside a face. */
 #define NODE_BLEND_WIDTH 1e-3
 
 /* Whether the face of candidate c (of non-convex shape sh, body bi) is the shallowest for a
@@ -399,20 +378,14 @@ NODE_OUT_OF_LINE static int shallowest(const node_env *E, const ws_shape *sh, ui
     return ws_shallowest_face(sh, f, m3_tmul_v(&E->b->A[bi], v3_sub(xi, E->st->r[bi])), d);
 }
 
-/* The gradients of a face contact's push past a convex edge (NODE_BLEND_WIDTH), for the
- * implicit film's exact derivatives: g, that of the distance pushed over (hi less the overlap);
- * the normal's, dn/dx = a b^T (zero for a face alone). */
-typedef struct blend_grad {
-    v3 g, a, b;
-} blend_grad;
-
 /* The push of face candidate c of a convex shape sh on a node at xi below it at depth d < 0
  * (NODE_BLEND_WIDTH's law), the window's top hi (the two layers): whether it pushes, and then
- * its normal and the distance it pushes over (hi less the overlap) and, with gr, their
- * gradients in xi. The prepared faces (global). Out of line as shallowest. */
+ * its normal and the distance it pushes over (hi less the overlap) and, with gr (zeroed by the
+ * caller), their gradients in xi for the implicit film's exact derivatives (ws_node_touch_at:
+ * g, and dn/dx = ta tb^T). The prepared faces (global). Out of line as shallowest. */
 NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, const ws_ncand *c,
                                         v3 xi, double d, double hi, v3 *nrm, double *dist,
-                                        blend_grad *gr)
+                                        ws_node_touch_at *gr)
 {
     const uint32_t f = c->local & ~WS_NCAND_FLAGS;
     const ws_wface *F = E->g->face + (c->feat - f);
@@ -433,7 +406,7 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         *nrm = F[f].n;
         *dist = d;
         if (gr)
-            *gr = (blend_grad){F[f].n, v3_make(0, 0, 0), v3_make(0, 0, 0)};
+            gr->g = F[f].n;
         return 1;
     }
     if (t < 0.0 || (t == 0.0 && qg < f))
@@ -448,26 +421,24 @@ NODE_OUT_OF_LINE static int convex_push(const node_env *E, const ws_shape *sh, c
         /* m's gradient is n_f (t >= 0 here); s's is (n_f - n_g) / (2 W) - t dW / (2 W^2) with
          * dW = -n_f where the width is pinched to the depth; n's is (I - n n^T) (n_f - n_g) /
          * |bl| ds^T. */
-        v3 ds = v3_scale(v3_sub(F[f].n, F[qg].n), 1.0 / (2.0 * W));
+        const v3 u = v3_sub(F[f].n, F[qg].n);
+        v3 ds = v3_scale(u, 1.0 / (2.0 * W));
         if (-m < NODE_BLEND_WIDTH)
             ds = v3_madd(ds, F[f].n, t / (2.0 * W * W));
-        const v3 u = v3_sub(F[f].n, F[qg].n);
         gr->g = F[f].n;
-        gr->a = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
-        gr->b = ds;
+        gr->ta = v3_scale(v3_madd(u, n, -v3_dot(n, u)), 1.0 / bn);
+        gr->tb = ds;
     }
     return 1;
 }
 
-/* Whether candidate c holds the node at xi in the window (lo, top): eq. 14 for a face, below
- * it the one push of a convex body's faces (convex_push) or the shallowest face of another's,
- * or the rim of an edge (in_wedge, sure as there); the normal from the body to the node, the
- * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, their
- * gradients (a face's or rim's own: see ws_node_links). The one-by-one pass's and the implicit
- * film's test alike (inlined: NODE_INLINE). */
+/* Whether candidate c holds the node at xi in the window (lo, top), by the one-by-one pass's
+ * and the implicit film's test alike (ws_node_touch): the normal from the body to the node, the
+ * distance it pushes over (hi: the window's top without the caller's reach) and, with gr, a
+ * blended push's gradients (convex_push). `sure` as in_wedge's. */
 static inline NODE_INLINE int touch_of(const node_env *E, const ws_ncand *c, v3 xi, double lo,
                                        double top, double hi, int sure, v3 *nrm, double *dist,
-                                       blend_grad *gr)
+                                       ws_node_touch_at *gr)
 {
     const ws_node_geom *g = E->g;
     if (c->local & WS_NCAND_EDGE)
@@ -551,8 +522,7 @@ static void contacts_general(const node_env *E, const ws_ncand *cand, size_t n)
         const v3 xi = nodes_get(E->x, i);
         /* The contact window of the pair: the two layers outside, the body's inner depth in. */
         const double hi = b->layer[bi] + E->web->layer, lo = -hi - sh->inner;
-        /* The node's candidates of this body, [k, e) (at most 32 at a time), and those left to
-         * their tests: a corner's three (marked by the detection) as its planes leave them. */
+        /* The node's candidates of this body (at most 32 at a time) left to their tests. */
         uint32_t left;
         int sure = 0;
         if ((c0->local & WS_NCAND_CORNER) && !E->web->contact->runs_off) {
@@ -592,12 +562,12 @@ _Static_assert(RUN_GROUPS >= RUN_CHUNK / 4, "a chunk's groups fit in an empty ba
 /* What a run needs of its face and body, the same for every run on the face in a sub-step:
  * filled by the first of them (run_face_of). */
 typedef struct ws_run_face {
-    double nx, ny, nz, off;                    /* the face's plane, global: d = n . x - off */
-    double hi, lo;                             /* the contact window of d */
-    double rx, ry, rz, vx, vy, vz, wx, wy, wz; /* the body's CoG, velocity and spin */
-    double k, c, mu, vlim;                     /* the contact's parameters */
-    uint32_t body;                             /* the body's slot */
-    uint64_t gen;                              /* the sub-step filled in, nc->rface_gen */
+    v3 n;                  /* the face's plane, global: d = n . x - off */
+    double off, hi, lo;    /* and the contact window of d */
+    ws_motion b;           /* the body's CoG, velocity and spin */
+    double k, c, mu, vlim; /* the contact's parameters */
+    uint32_t body;         /* the body's slot */
+    uint64_t gen;          /* the sub-step filled in, nc->rface_gen */
 } run_face;
 
 /* Bit i, for i below RUN_CHUNK: a table, so that a loop sets bit i of a word with an AND
@@ -616,7 +586,7 @@ static uint64_t run_depth(size_t nv, const run_face *restrict q, const double *r
                           const double *restrict y, const double *restrict z, double *restrict d,
                           uint64_t *restrict below)
 {
-    const double nx = q->nx, ny = q->ny, nz = q->nz, off = q->off, hi = q->hi, lo = q->lo;
+    const double nx = q->n.x, ny = q->n.y, nz = q->n.z, off = q->off, hi = q->hi, lo = q->lo;
     uint64_t in = 0, neg = 0;
     for (size_t i = 0; i < 4 * nv; i++) {
         double e = nx * x[i] + ny * y[i] + nz * z[i] - off;
@@ -638,9 +608,8 @@ typedef struct run_group {
     uint64_t bits;      /* those in the window: bit l for node + l (none past the run) */
 } run_group;
 
-/* The groups of a sweep block's runs waiting for the run passes (n of RUN_GROUPS), and the
- * passes' scratch (run_tmp). The list of loads keeps their places, so they may wait until the
- * block's end. */
+/* The groups of a sweep block's runs waiting for the run passes (their places in the list of
+ * loads kept, they may wait until the block's end), and the passes' scratch (run_tmp). */
 typedef struct run_batch {
     run_group *grp;
     struct run_tmp *tmp;
@@ -651,10 +620,10 @@ typedef struct run_batch {
 } run_batch;
 
 /* The contacts of the run nodes in the window, a group of four nodes at a time, straight from
- * the nodes' arrays, with act_apply's arithmetic operation by operation
- * (film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other
- * contact, so its force with every normal force in is its force with this one. Lanes of a group
- * not in the window, or not the run's, keep their forces.
+ * the nodes' arrays, with act_apply's arithmetic operation by operation (the test
+ * film_runs_equal_one_by_one holds them to it, to the bit). A run's node has no other contact,
+ * so its force with every normal force in is its force with this one. Lanes of a group not in
+ * the window, or not the run's, keep their forces.
  *
  * In three passes over all the groups (run_normal, run_friction, run_apply), their values in
  * between in run_tmp, so that the long chains of several groups' arithmetic overlap
@@ -701,10 +670,10 @@ static void run_normal(size_t ng, const run_group *restrict grp, ws_nodes3 p, ws
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
         const uint64_t bits = grp[g].bits;
-        /* Into locals: loads in the loop, some under a select, would keep it off vectors. */
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
-        const ws_motion b = {v3_make(q->rx, q->ry, q->rz), v3_make(q->vx, q->vy, q->vz),
-                             v3_make(q->wx, q->wy, q->wz)};
+        /* Into locals: loads in the loop, some under a select, would keep it off vectors (the
+         * motion member by member: GCC copies it whole through the stack, a step slower). */
+        const v3 n = q->n;
+        const ws_motion b = {q->b.r, q->b.v, q->b.w};
         const double hi = q->hi, k = q->k, c = q->c;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -730,7 +699,7 @@ static void run_friction(size_t ng, const run_group *restrict grp, ws_nodes3 f,
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const v3 n = q->n;
         const double mu = q->mu, vlim = q->vlim;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
@@ -750,7 +719,7 @@ static void run_apply(size_t ng, const run_group *restrict grp, double *restrict
     for (size_t g = 0; g < ng; g++) {
         const run_face *q = grp[g].rf;
         const size_t o = grp[g].node;
-        const v3 n = v3_make(q->nx, q->ny, q->nz);
+        const v3 n = q->n;
         for (size_t l = 0; l < WS_LANES; l++) {
             const size_t t = o + l, e = 4 * g + l;
             const double fn = T->fn[e];
@@ -808,12 +777,8 @@ static void run_flush(const node_env *E, run_batch *B, double h, double share, v
             continue;
         }
         for (uint32_t bits = G->bits; bits; bits &= bits - 1, s++) {
-            const uint32_t l = ws_lowest_bit(bits), i = node + l;
-            const size_t e = 4 * g + l;
-            const v3 Fb = tmp_get(T->b, e);
-            fc[i] = v3_sub(fc[i], Fb); /* the share: -Fb, to the bit */
-            load[s] = (act_load){Fb, tmp_get(T->m, e)};
-            lbody[s] = body;
+            const uint32_t l = ws_lowest_bit(bits);
+            flush_one(T, 4 * g + l, fc + node + l, load + s, lbody + s, body);
         }
     }
     B->n = 0;
@@ -834,9 +799,8 @@ static const run_face *run_face_of(const node_env *E, const ws_ncand *c)
     const ws_wface *F = &E->g->face[c->feat];
     const ws_node_params *p = &E->pp[b->material[bi]];
     const double hi = b->layer[bi] + web->layer, lo = -hi - b->shape[bi]->inner;
-    const v3 n = F->n, r = st->r[bi], vb = st->v[bi], wb = b->wg[bi];
-    *e = (run_face){n.x,  n.y,  n.z,  F->off, hi,   lo,   r.x,   r.y,     r.z, vb.x,         vb.y,
-                    vb.z, wb.x, wb.y, wb.z,   p->k, p->c, p->mu, p->vlim, bi,  nc->rface_gen};
+    const ws_motion mb = {st->r[bi], st->v[bi], b->wg[bi]};
+    *e = (run_face){F->n, F->off, hi, lo, mb, p->k, p->c, p->mu, p->vlim, bi, nc->rface_gen};
     return e;
 }
 
@@ -875,8 +839,7 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
             contacts_general(E, c + (o - sg->n0), m);
             continue;
         }
-        /* The batch runs first if the chunk's groups (nv at most) could take it past its
-         * size. */
+        /* The batch runs first if the chunk's groups (nv at most) could overfill it. */
         if (B->n + nv > B->max)
             run_flush(E, B, h, share, fc);
         /* The groups: each from the first node in the window not yet in one, so that nodes in
@@ -901,9 +864,8 @@ static void contacts_run(const node_env *E, run_batch *B, const ws_ncand *cand, 
     }
 }
 
-/* The stretches being cut into seg, which has room for one per candidate (none is empty): a
- * pending run of single inside candidates [r0, r1) and, before it, pending candidates to go one by
- * one [g0, r0). */
+/* The stretches being cut into seg (room for one a candidate; none is empty), and pending: a run
+ * of single inside candidates [r0, r1) and, before it, candidates to go one by one [g0, r0). */
 typedef struct seg_cut {
     const ws_ncand *cand;
     ws_nseg *seg;
@@ -911,18 +873,15 @@ typedef struct seg_cut {
     uint32_t faces; /* one past the highest face a run lies on */
 } seg_cut;
 
-static void seg_put(seg_cut *sc, ws_nseg sg)
-{
-    sc->seg[sc->nseg++] = sg;
-    if (sg.run && sc->cand[sg.c0].feat >= sc->faces)
-        sc->faces = sc->cand[sg.c0].feat + 1;
-}
-
+/* The stretch of candidates [c0, c1), unless empty. */
 static void seg_emit(seg_cut *sc, size_t c0, size_t c1, int run)
 {
-    if (c0 != c1)
-        seg_put(sc, (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0,
-                              (uint32_t)c1, run});
+    if (c0 == c1)
+        return;
+    sc->seg[sc->nseg++] =
+        (ws_nseg){sc->cand[c0].node, sc->cand[c1 - 1].node + 1, (uint32_t)c0, (uint32_t)c1, run};
+    if (run && sc->cand[c0].feat >= sc->faces)
+        sc->faces = sc->cand[c0].feat + 1;
 }
 
 /* The pending run ends: a run if long enough (after the pending one-by-one ones), else its
@@ -937,9 +896,8 @@ static void seg_close_run(seg_cut *sc)
     sc->r0 = sc->r1;
 }
 
-/* Cut the candidates from k on (of n) whose nodes lie below stop, the start of a block of bl
- * nodes (seg_block); the index past them. A block's stretches depend on its own candidates
- * alone. */
+/* Cut the candidates from k on (of n) whose nodes lie below stop, a block's start (blocks of bl
+ * nodes, seg_block); the index past them. A block's stretches depend on its candidates alone. */
 static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t k, size_t n,
                             uint64_t stop)
 {
@@ -1025,9 +983,8 @@ int ws_node_segments(ws_mem *mem, ws_web *web, const ws_ncand *cand, size_t n, i
     ws_node_contact *nc = web->contact;
     nc->seg_list = -1;
     nc->nseg = 0;
-    if (rtmp_reserve(mem, nc, web->n) != 0)
-        return -1;
-    if (ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
+    if (rtmp_reserve(mem, nc, web->n) != 0 ||
+        ws_array_reserve(mem, (void **)&nc->seg, &nc->seg_cap, n + 1, sizeof *nc->seg) != 0)
         return -1;
     seg_cut sc = {cand, nc->seg, 0, 0, 0, 0, 0};
     seg_cut_range(&sc, web, seg_block(web), 0, n, UINT64_MAX);
@@ -1172,21 +1129,21 @@ int ws_node_scratch(ws_mem *mem, ws_node_contact *nc, size_t ncand)
      * groups of four); an odd number of cache lines, so that the id arrays' starts fall in
      * different sets of the first-level cache. Grown by half at least: the candidates of a
      * web being wrapped grow step by step, and each new room is cleared. */
-    if (ncand + 4 > nc->act_cap) {
-        size_t need =
-            ncand + 4 > nc->act_cap + nc->act_cap / 2 ? ncand + 4 : nc->act_cap + nc->act_cap / 2;
-        need = (((need + 7) / 8) | 1) * 8;
-        /* The new room is taken before the old is let go: out of memory, the web keeps the
-         * room it had, of the size it had (a restore that fails leaves the world as it was).
-         * The ids' four arrays follow the doubles' in one block. */
-        double *act = ws_mem_calloc(mem, need, ACT_BYTES);
-        if (!act)
-            return -1;
-        ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
-        nc->act = act;
-        nc->act_id = (uint32_t *)(act + need * ACT_ARRAYS);
-        nc->act_cap = need;
-    }
+    if (ncand + 4 <= nc->act_cap)
+        return 0;
+    const size_t grown = nc->act_cap + nc->act_cap / 2,
+                 least = ncand + 4 > grown ? ncand + 4 : grown;
+    const size_t need = (((least + 7) / 8) | 1) * 8;
+    /* The new room is taken before the old is let go: out of memory, the web keeps the room it
+     * had, of the size it had (a restore that fails leaves the world as it was). The ids' four
+     * arrays follow the doubles' in one block. */
+    double *act = ws_mem_calloc(mem, need, ACT_BYTES);
+    if (!act)
+        return -1;
+    ws_mem_free(mem, nc->act, nc->act_cap * ACT_BYTES);
+    nc->act = act;
+    nc->act_id = (uint32_t *)(act + need * ACT_ARRAYS);
+    nc->act_cap = need;
     return 0;
 }
 
@@ -1196,9 +1153,8 @@ void ws_node_scratch_free(ws_mem *mem, ws_node_contact *nc)
     ws_mem_free(mem, nc->rtmp, nc->rtmp_cap * sizeof(double));
     ws_mem_free(mem, nc->rface, nc->rface_cap * sizeof *nc->rface);
     nc->rface = NULL;
-    nc->act = NULL;
+    nc->act = nc->rtmp = NULL;
     nc->act_id = NULL;
-    nc->rtmp = NULL;
     nc->act_cap = nc->rtmp_cap = nc->rface_cap = 0;
 }
 
@@ -1209,20 +1165,14 @@ int ws_node_touch(const ws_node_pass *P, const ws_web *web, const ws_ncand *c, v
 {
     const ws_body_store *b = P->b;
     const node_env E = {.b = b, .st = &b->st[P->cur], .g = P->g};
-    const ws_shape *sh = b->shape[c->body];
     at->hi = b->layer[c->body] + web->layer;
-    blend_grad gr = {v3_make(0, 0, 0), v3_make(0, 0, 0), v3_make(0, 0, 0)};
-    if (!touch_of(&E, c, x, -at->hi - sh->inner, at->hi + reach, at->hi, 0, &at->n, &at->d,
-                  &gr))
+    const double lo = -at->hi - b->shape[c->body]->inner;
+    at->g = at->ta = at->tb = v3_make(0, 0, 0);
+    if (!touch_of(&E, c, x, lo, at->hi + reach, at->hi, 0, &at->n, &at->d, at))
         return 0;
-    /* A face's or rim's distance changes along its normal; a blended push's as convex_push
-     * gives. */
-    at->g = at->n;
-    at->ta = at->tb = v3_make(0, 0, 0);
-    if (!(c->local & WS_NCAND_EDGE) && v3_dot(gr.g, gr.g) > 0.0) {
-        at->g = gr.g;
-        at->ta = gr.a;
-        at->tb = gr.b;
-    }
+    /* A face's or rim's distance changes along its normal (g is left zero); a blended push's
+     * as convex_push gives. */
+    if (!(v3_dot(at->g, at->g) > 0.0))
+        at->g = at->n;
     return 1;
 }

@@ -581,7 +581,7 @@ static const char *web_label(const ws_web *web)
 }
 
 /* Node means of tension or strain over the springs of one kind at each node; 0 where none. The
- * sums go through the force scratch, which holds nothing between steps (see limits_of in web.c),
+ * sums go through the force scratch, which holds nothing between steps (ws_web_node_limits),
  * so the writer needs no room of its own for them. */
 static void emit_node_means(vtk_file *f, ws_web *web, ws_nodes3 x, ws_nodes3 v, int what, int kind,
                             const char *name)

@@ -27,14 +27,12 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     web->first_spring = UINT32_MAX;
     int ok = 1;
     for (int k = 0; k < 2; k++) {
-        ok &= ws_nodes_alloc(mem, &web->x[k], n);
-        ok &= ws_nodes_alloc(mem, &web->v[k], n);
+        ok &= ws_nodes_alloc(mem, &web->x[k], n) & ws_nodes_alloc(mem, &web->v[k], n);
         ok &= (web->fc[k] = ws_mem_calloc(mem, n, sizeof(v3))) != NULL;
     }
     ok &= ws_nodes_alloc(mem, &web->fmem, n);
     web->f = web->fmem;
-    ok &= ws_nodes_alloc(mem, &web->xsub, n);
-    ok &= ws_nodes_alloc(mem, &web->vsub, n);
+    ok &= ws_nodes_alloc(mem, &web->xsub, n) & ws_nodes_alloc(mem, &web->vsub, n);
     ok &= (web->tmp = ws_mem_calloc(mem, WS_WEB_TMP, sizeof(double))) != NULL;
     ok &= (web->m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
     ok &= (web->inv_m = ws_mem_calloc(mem, n, sizeof(double))) != NULL;
@@ -42,11 +40,9 @@ ws_status ws_web_alloc(ws_mem *mem, ws_web *web, uint32_t n, uint32_t ns)
     ok &= (web->sb = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint32_t))) != NULL;
     ok &= (web->inv_l0 = ws_mem_calloc(mem, (size_t)ns + WS_WEB_PAD, sizeof(double))) != NULL;
     ok &= (web->kind = ws_mem_calloc(mem, ns ? ns : 1, sizeof(uint8_t))) != NULL;
-    if (!ok) {
+    if (!ok)
         ws_web_free(mem, web);
-        return WS_ERR_OUT_OF_MEMORY;
-    }
-    return WS_OK;
+    return ok ? WS_OK : WS_ERR_OUT_OF_MEMORY;
 }
 
 void ws_web_free(ws_mem *mem, ws_web *web)
@@ -57,7 +53,6 @@ void ws_web_free(ws_mem *mem, ws_web *web)
         ws_nodes_free(mem, &web->v[k], web->n);
         ws_mem_free(mem, web->fc[k], n * sizeof(v3));
         ws_mem_free(mem, web->fct[k], web->fct_cap[k] * sizeof(uint32_t));
-
         ws_mem_free(mem, web->bforce[k], web->bcap * sizeof(v3));
         ws_mem_free(mem, web->bmoment[k], web->bcap * sizeof(v3));
     }
@@ -172,9 +167,8 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt)
 }
 
 /* Tension / length of a spring of film form p whose second end is at d from its first and moves
- * at u relative to it, rest length 1 / il0. Computed unconditionally and then selected, so the
- * loops over springs have no branches. A spring whose ends coincide has no direction to pull
- * along and gets no force. */
+ * at u relative to it, rest length 1 / il0; none where the ends coincide (no direction to pull
+ * along). Computed, then selected, so the loops over springs have no branches. */
 static inline double film_pull(const ws_spring_form *p, v3 d, v3 u, double il0)
 {
     double l2 = d.x * d.x + d.y * d.y + d.z * d.z;
@@ -286,33 +280,6 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
-/* Gravity and node drag on n nodes: the start of their force f. Node i's mass is m[i], or the
- * web's one mass for every node when same (then m is not read). */
-static inline void base_forces_of(const ws_web *web, in3 v, out3 f, const double *restrict m,
-                                  size_t n, int same)
-{
-    const v3 g = web->g;
-    const double c = web->damping, m1 = web->m1;
-    for (size_t i = 0; i < n; i++) {
-        const double mi = same ? m1 : m[i];
-        f.x[i] = g.x * mi - c * v.x[i];
-        f.y[i] = g.y * mi - c * v.y[i];
-        f.z[i] = g.z * mi - c * v.z[i];
-    }
-}
-
-/* The same on nodes [n0, n1), the case chosen outside the loop: each case a loop of its own. */
-WS_VECTOR_LOOP
-static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
-{
-    const in3 vi = in_at(v, n0);
-    const out3 f = out_at(web->f, n0);
-    if (web->same_m)
-        base_forces_of(web, vi, f, NULL, n1 - n0, 1);
-    else
-        base_forces_of(web, vi, f, web->m + n0, n1 - n0, 0);
-}
-
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
@@ -321,10 +288,18 @@ static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
     return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
 }
 
+/* The same on nodes [n0, n1), the start of their forces: a mesh web's, or a row whose springs
+ * go one by one, where their laws cost far more than this loop. */
+static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
+{
+    for (size_t i = n0; i < n1; i++)
+        nodes_set(web->f, (uint32_t)i, base_force(web, v, i));
+}
+
 /* Nodes i in [1, k) of a row, node i between the around-springs i - 1 and i whose forces on
- * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1]. The
- * order is that of the results (the state hash): keep it. Masses as in base_forces_of; without
- * drag the velocities are not read. */
+ * their first ends are t[i - 1] and t[i]: gravity and drag, then + t[i], then - t[i - 1] (the
+ * order of the results, the state hash: keep it). Masses m[i], or the one mass m1 when same (m
+ * is not read); without drag the velocities are not read. */
 static inline void row_forces_of(const ws_web *web, in3 v, in3 t, out3 f, const double *restrict m,
                                  size_t k, int same, int drag)
 {
@@ -363,20 +338,10 @@ static void row_forces(ws_web *web, ws_nodes3 v, size_t q, size_t k)
  * computed as before and the broken ones' forces are then set to zero (cut_chunk); a broken
  * wrap spring counts as one whose ends coincide (no force); a row of up-springs with a broken
  * one among them goes spring by spring (spring_one_in, which skips the broken), as the springs
- * of a general law do. */
-static int any_broken(const ws_web *web, size_t s0, size_t m)
-{
-    if (!web->nbroken)
-        return 0;
-    const uint8_t *b = web->broken + s0;
-    uint8_t any = 0;
-    for (size_t i = 0; i < m; i++)
-        any |= b[i];
-    return any != 0;
-}
-
-/* The forces t of springs s0 + i, i in [0, m): zero where broken. Selected, not multiplied, so
- * a broken spring stretched to any length gives a zero. */
+ * of a general law do.
+ *
+ * cut_chunk: the forces t of springs s0 + i, i in [0, m), zero where broken. Selected, not
+ * multiplied, so a broken spring stretched to any length gives a zero. */
 WS_VECTOR_LOOP
 static void cut_chunk(const uint8_t *restrict broken, size_t m, out3 t)
 {
@@ -387,13 +352,12 @@ static void cut_chunk(const uint8_t *restrict broken, size_t m, out3 t)
     }
 }
 
-/* The wrap springs of a closed band (node nx - 1 of a row to its node 0), WS_WEB_WRAPS rows
- * at once as the lanes of a vector: with the second end of lane i at (dx, dy, dz)[i] from its
- * first, moving at (ux, uy, uz)[i] relative to it, rest length 1 / il0[i] (in: these seven
- * arrays of WS_WEB_WRAPS), the force on the first end (tx, ty, tz)[i] and 1 where the ends lie
- * apart, 0 where they coincide (out: these four). film_pull, as spring_run takes it; taken
- * apart from the rows, the division and square root of one row's wrap no longer hold up the
- * rest of its forces. */
+/* The wrap springs of a closed band (node nx - 1 of a row to its node 0) by film_pull,
+ * WS_WEB_WRAPS rows at once as the lanes of a vector. in, seven arrays of WS_WEB_WRAPS: the
+ * second end's place (dx, dy, dz) and velocity (ux, uy, uz) relative to the first, 1 / rest
+ * length; out, four: the force on the first end (tx, ty, tz), and 1 where the ends lie apart,
+ * 0 where they coincide. Apart from its row, a wrap's division and square root do not hold up
+ * the rest of the row's forces. */
 WS_VECTOR_LOOP
 static void wrap_lanes(const double *restrict in, ws_spring_form p, double *restrict out)
 {
@@ -415,16 +379,13 @@ static void wrap_rows(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r)
 {
     enum { L = WS_WEB_WRAPS };
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const double *from[6] = {x.x, x.y, x.z, v.x, v.y, v.z};
     double in[7 * L];
     for (size_t i = 0; i < L; i++) {
         const size_t b = nx * (r + i), a = b + nx - 1; /* the spring from a to b */
         const int row = r + i < ny;
-        in[i] = row ? x.x[b] - x.x[a] : 0.0;
-        in[L + i] = row ? x.y[b] - x.y[a] : 0.0;
-        in[2 * L + i] = row ? x.z[b] - x.z[a] : 0.0;
-        in[3 * L + i] = row ? v.x[b] - v.x[a] : 0.0;
-        in[4 * L + i] = row ? v.y[b] - v.y[a] : 0.0;
-        in[5 * L + i] = row ? v.z[b] - v.z[a] : 0.0;
+        for (size_t q = 0; q < 6; q++)
+            in[q * L + i] = row ? from[q][b] - from[q][a] : 0.0;
         in[6 * L + i] = row ? web->inv_l0[nx * (r + i + 1) - 1] : 0.0;
     }
     double *out = web->tmp + 3 * WS_WEB_CHUNK;
@@ -492,10 +453,8 @@ static void grid_row(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t r, int lane_f
     around_row(web, x, v, r);
 }
 
-/* The up-springs and shear pairs from row j to row j + 1 onto their ends in rows [r0, r1)
- * (all of the grid's rows for both ends). At the edge of a lane (ws_web_forces_rows) each of
- * the two lanes computes these springs and takes its own row's side, which gets the values and
- * the order it gets in one sweep. */
+/* The up-springs and shear pairs from row j to row j + 1 onto their ends in rows [r0, r1): all
+ * rows for both ends, or at a lane's edge its own row's side (web.h, "Lanes"). */
 static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t r0, size_t r1)
 {
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
@@ -503,7 +462,8 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
     const uint32_t lo = (uint32_t)(nx * r0), hi = (uint32_t)(nx * r1);
     const size_t s0 = cols * ny + nx * j;
     const ws_spring_form *p = &web->form[WS_SPRING_UP];
-    if (web->law[WS_SPRING_UP] && (p->gen || any_broken(web, s0, nx))) {
+    /* Spring by spring: a general law's, or a row with a broken one (a flag of 1). */
+    if (web->law[WS_SPRING_UP] && (p->gen || (web->nbroken && memchr(web->broken + s0, 1, nx)))) {
         for (size_t i = 0; i < nx; i++)
             spring_one_in(web, x, v, (uint32_t)(s0 + i), lo, hi);
     } else if (web->law[WS_SPRING_UP]) {
@@ -576,9 +536,7 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
         *n1 = web->n;
         return;
     }
-    /* Row j is complete once row j + 1 is started and the springs between the two are in. A
-     * lane's first row is started as the lane before would have started it, and gets the
-     * springs from the row before. */
+    /* Row j is complete once row j + 1 is started and the springs between the two are in. */
     const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
     if (j0 == 0) {
         grid_row(web, x, v, 0, 0);
@@ -662,9 +620,7 @@ size_t ws_web_integrate_block(ws_web *web, const ws_web_pass *p, uint32_t n0, ui
 {
     /* A speed whose square overflows counts as too fast even without a limit (max_speed
      * infinite): a node's state never goes infinite unnoticed. */
-    double lim2 = p->vmax * p->vmax;
-    lim2 = lim2 <= DBL_MAX ? lim2 : DBL_MAX;
-    return advance(web, p, n0, n1 - n0, lim2);
+    return advance(web, p, n0, n1 - n0, fmin(p->vmax * p->vmax, DBL_MAX));
 }
 
 double ws_web_fastest(const ws_web *web, ws_nodes3 v)
@@ -677,17 +633,10 @@ double ws_web_fastest(const ws_web *web, ws_nodes3 v)
     return most;
 }
 
-/* What the free nodes can bear: from the Gershgorin bound of each node's row of the stiffness
- * matrix, k = kc + 2 sum of its springs' largest stiffness / l0, and its damping c = cc + 2 sum
- * of theirs / l0 + the node drag (summed in the force scratch: not state, no step is running
- * when this is asked), the least stable step, the least mass stable at sub-step h, the least
- * mass and the largest k. */
-typedef struct node_limits {
-    double dt, mass, min_mass, max_k;
-} node_limits;
-
-static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
+ws_web_limits ws_web_node_limits(const ws_web *web, double kc, double cc, double h)
 {
+    /* Each node's k and c summed in the force scratch: not state, no step is running when this
+     * is asked. */
     ws_nodes3 acc = web->f;
     for (uint32_t i = 0; i < web->n; i++)
         acc.x[i] = acc.y[i] = 0.0;
@@ -701,7 +650,7 @@ static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
         acc.y[web->sa[s]] += c;
         acc.y[web->sb[s]] += c;
     }
-    node_limits o = {INFINITY, 0.0, INFINITY, 0.0};
+    ws_web_limits o = {INFINITY, 0.0, INFINITY};
     for (uint32_t i = 0; i < web->n; i++) {
         if (web->inv_m[i] == 0.0)
             continue;
@@ -720,26 +669,8 @@ static node_limits limits_of(const ws_web *web, double kc, double cc, double h)
         const double m = 0.25 * h * h * k + 0.5 * h * c;
         o.mass = m <= o.mass ? o.mass : m; /* NaN wins */
         o.min_mass = fmin(o.min_mass, web->m[i]);
-        o.max_k = fmax(o.max_k, k);
     }
     return o;
-}
-
-double ws_web_stable_dt(const ws_web *web, double kc, double cc)
-{
-    return limits_of(web, kc, cc, 0.0).dt;
-}
-
-double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h)
-{
-    return limits_of(web, kc, cc, h).mass;
-}
-
-void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k)
-{
-    const node_limits o = limits_of(web, kc, 0.0, 0.0);
-    *min_mass = o.min_mass;
-    *max_k = o.max_k;
 }
 
 double ws_web_spring_strain(const ws_web *web, ws_nodes3 x, uint32_t s)

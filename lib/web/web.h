@@ -65,7 +65,7 @@ typedef struct ws_web {
     ws_nodes3 x[2], v[2];    /* state, double-buffered like the bodies' */
     ws_nodes3 f;             /* force accumulator (scratch): in a sweep, the velocities it
                                 writes (ws_web_sweep_begin), else fmem */
-    ws_nodes3 fmem;          /* scratch of n nodes' vectors (limits_of, writers) */
+    ws_nodes3 fmem;          /* scratch of n nodes' vectors (ws_web_node_limits, writers) */
     ws_nodes3 xsub, vsub;    /* state between sub-steps (scratch): a sub-step never writes
                                 the state it reads */
     double *tmp;             /* spring forces of a chunk of springs, 3 WS_WEB_CHUNK, then of
@@ -195,15 +195,16 @@ void ws_web_sweep_end(ws_web *web);
 size_t ws_web_integrate_block(ws_web *web, const ws_web_pass *p, uint32_t n0, uint32_t n1);
 /* The largest node speed in v (NaN when one is NaN), m/s. */
 double ws_web_fastest(const ws_web *web, ws_nodes3 v);
-/* Largest stable step for the springs and node drag alone plus a contact of stiffness kc and
- * damping cc on every node (explicit limit with damping, Gershgorin bound on the stiffness). */
-double ws_web_stable_dt(const ws_web *web, double kc, double cc);
-/* The smallest node mass that makes every free node stable at step h with a contact of
- * stiffness kc and damping cc (the inverse of ws_web_stable_dt's bound, node by node: the
- * largest over the free nodes of h^2 k / 4 + h c / 2), kg; 0 without free nodes. */
-double ws_web_mass_for_step(const ws_web *web, double kc, double cc, double h);
-/* Smallest node mass and largest 2 sum(k) + kc over the free nodes (for error messages). */
-void ws_web_stiffest_node(const ws_web *web, double kc, double *min_mass, double *max_k);
+/* What the free nodes bear with a contact of stiffness kc and damping cc on every node, from
+ * each node's stiffness k = kc + 2 sum of its springs' largest stiffness / l0 (the Gershgorin
+ * bound of its row) and damping c = cc + 2 sum of theirs / l0 + the node drag: the largest
+ * stable step for them all (explicit limit with damping), s; the smallest node mass that makes
+ * every one stable at step h (the inverse of that bound, node by node: the largest of
+ * h^2 k / 4 + h c / 2), kg, 0 without free nodes; their smallest mass (for error messages). */
+typedef struct ws_web_limits {
+    double dt, mass, min_mass;
+} ws_web_limits;
+ws_web_limits ws_web_node_limits(const ws_web *web, double kc, double cc, double h);
 /* Room for the broken flags (all clear) before a rupture limit is first set. 0, or -1 when
  * out of memory. */
 int ws_web_rupture_alloc(ws_mem *mem, ws_web *web);

@@ -164,9 +164,9 @@ static double round_up_4(double x)
 static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double stable,
                               const char *what)
 {
-    double mmin, kmax, f = w->def.stable_fraction;
+    const double f = w->def.stable_fraction;
+    const double mmin = ws_web_node_limits(web, 0.0, 0.0, 0.0).min_mass;
     w->stats.numerical_errors++; /* refused or ran away: either way a WS_ERR_NUMERICAL step */
-    ws_web_stiffest_node(web, 0.0, &mmin, &kmax);
     double allowed = f * stable; /* what the check lets dt/substeps use */
     if (h <= allowed) /* ran away though stable as its laws state them: sub-steps would not help */
         return ws_fail(w, WS_ERR_NUMERICAL,
@@ -188,7 +188,7 @@ static ws_status web_unstable(ws_world *w, const ws_web *web, double h, double s
                  "step = %.3g); use a softer or less pre-stretched film, or",
                  WS_WEB_MAX_SUBSTEPS, q);
     }
-    /* Node mass: the check's own bound inverted (ws_web_mass_for_step): a stable sub-step of
+    /* Node mass: the check's own bound inverted (ws_web_node_limits): a stable sub-step of
      * h / f. */
     double m = round_up_4(ws_world_web_mass_for(w, web, h / f) * (1.0 + 1e-9)); /* round-off */
     if (m > 0.0 && m < 1e300)

@@ -478,7 +478,6 @@ void ws_world_free_webs(ws_world *w)
     ws_mem_free(&w->mem, w->webs, w->web_cap * sizeof *w->webs);
     ws_slots_destroy(&w->mem, &w->web_slots);
     ws_mem_free(&w->mem, w->node_par, w->node_par_cap * sizeof *w->node_par);
-    ws_node_geometry_free(&w->mem, &w->node_geom);
 }
 
 static ws_status get_web(const ws_world *w, ws_web_id id, const ws_web **web)
@@ -545,14 +544,14 @@ double ws_world_web_stable_dt(ws_world *w, const ws_web *web)
 {
     double kc, cc;
     web_contact_bounds(w, web, &kc, &cc);
-    return ws_web_stable_dt(web, kc, cc);
+    return ws_web_node_limits(web, kc, cc, 0.0).dt;
 }
 
 double ws_world_web_mass_for(ws_world *w, const ws_web *web, double h)
 {
     double kc, cc;
     web_contact_bounds(w, web, &kc, &cc);
-    return ws_web_mass_for_step(web, kc, cc, h);
+    return ws_web_node_limits(web, kc, cc, h).mass;
 }
 
 ws_status ws_web_get_stable_dt(const ws_world *w, ws_web_id id, double *dt)
