@@ -1300,9 +1300,6 @@ static inline int left_out(const ws_web *web, int k, uint32_t i)
     return k == 0 && !web->same_inv_m && web->inv_m[i] == 0.0;
 }
 
-/* c->r = P^T t (t a level-k vector; the film's pinned nodes left out). P is a map along x
- * times one along y: each fine row is restricted along x into mg->row, which is added to the
- * coarse rows it maps to. */
 /* Fine row iy of level k's t restricted along x into u (level k + 1's nx vectors). */
 static void restrict_row(const ws_mg *mg, const ws_web *web, int k, const double *t, int iy,
                          double *u)
@@ -1342,6 +1339,10 @@ static void restrict_block(void *ctx, uint32_t b)
         restrict_row(mg, P->web, 0, P->t, (int)iy, mg->rrow + row * iy);
 }
 
+/* c->r = P^T t (t a level-k vector; the film's pinned nodes left out). P is a map along x
+ * times one along y: each fine row is restricted along x (the film's level's rows block by
+ * block into rrow, a coarse level's into mg->row), then added to the coarse rows it maps to
+ * in the rows' order. */
 static void restrict_to(const ws_mg *mg, const ws_web *web, int k, const double *t)
 {
     const mg_level *f = &mg->lv[k];
