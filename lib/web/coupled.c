@@ -240,6 +240,17 @@ static void rigid_block(void *ctx, uint32_t b)
         links_apply(R, P->web, R->bstart[b], R->bstart[b + 1], P->p, P->pr, P->y, part);
 }
 
+void ws_rigid_block_starts(const ws_rigid *R, const ws_iblock *blk, uint32_t nblk, size_t *start)
+{
+    size_t l = 0;
+    for (uint32_t k = 0; k < nblk; k++) {
+        while (l < R->nl && R->link[l].node < blk[k].n0)
+            l++;
+        start[k] = l;
+    }
+    start[nblk] = R->nl;
+}
+
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
                       double *y, double *yr)
 {

@@ -103,6 +103,10 @@ int ws_rigid_factor(ws_rigid *R);
 /* z = A_bb^-1 r, the bodies solved together (6 doubles a body; z may be r). */
 void ws_rigid_block_solve(const ws_rigid *R, const double *r, double *z);
 
+/* Each of the nblk blocks' first link into start (nblk + 1: the last R->nl), the links being
+ * in node order (web/implicit.h's ws_iblock). */
+void ws_rigid_block_starts(const ws_rigid *R, const ws_iblock *blk, uint32_t nblk, size_t *start);
+
 /* The bodies' part of y = A p: yr = M pr + the coupling's terms into yr (the film's contacts'
  * and the body-body pairs'), and the coupling's
  * -C J pr added into the film part y (y untouched at pinned nodes). Returns the dot product

@@ -290,26 +290,16 @@ static void begin_nodes(void *ctx, uint32_t k)
     }
 }
 
-/* Whether every law of the web is of the film form: no callback of the user's then runs in
- * the springs' pass, which may run on the workers (their callbacks run on the stepping
- * thread alone, docs/guide.md). */
-static int laws_plain(const ws_web *web)
-{
-    double kc, dk, w, c;
-    for (int q = 0; q < 3; q++)
-        if (web->law[q] && !ws_law_film_form(web->law[q], &kc, &dk, &w, &c))
-            return 0;
-    return 1;
-}
-
 int ws_implicit_begin(ws_web *web, ws_nodes3 x, ws_nodes3 v, v3 gravity, double t, double since)
 {
     ws_implicit *im = web->imp;
     im->begun++; /* the springs' blocks are about to change */
     begin_pass P = {web, x, v, gravity, t, since};
     const ws_runner run = im->run;
-    if (!laws_plain(web))
-        im->run.run = NULL; /* the springs' laws on this thread */
+    /* A law with history or a user's function is not called from the workers (the explicit
+     * sweep's rule): the springs' laws then run on this thread. */
+    if (!ws_web_sweep_parallel(web))
+        im->run.run = NULL;
     ws_implicit_blocks_run(im, begin_springs, &P);
     im->run = run;
     for (uint32_t k = 0; k < im->nblk; k++)
@@ -751,16 +741,10 @@ int ws_implicit_solve(ws_web *web, ws_nodes3 v, double h)
     ws_rigid *R = im->rig && im->rig->nb ? im->rig : NULL; /* bodies in the solve */
     im->solves++;
     if (R && R->bstart) { /* each block's first link, when they are in node order */
-        size_t l = 0;
         R->blocked = 1;
         for (size_t e = 1; e < R->nl; e++)
             R->blocked &= R->link[e].node >= R->link[e - 1].node;
-        for (uint32_t k = 0; k < im->nblk; k++) {
-            while (l < R->nl && R->link[l].node < im->blk[k].n0)
-                l++;
-            R->bstart[k] = l;
-        }
-        R->bstart[im->nblk] = R->nl;
+        ws_rigid_block_starts(R, im->blk, im->nblk, R->bstart);
     }
     im->last_iterations = 0;
     /* b = h f + h^2 df/dx v0 = h f - h^2 K v0; and the film's weight over the step, the floor

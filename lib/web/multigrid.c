@@ -813,17 +813,7 @@ int ws_mg_bodies(ws_mg *mg, const ws_rigid *R, void *buf)
     mg->bpart = q, q += 6 * (size_t)nb * mg->nblk;
     mg->rpart = q, q += 6 * (size_t)nb * (size_t)mg->lv[1].ny;
     mg->lstart = (size_t *)(void *)q, q += mg->nblk + 1;
-    {
-        /* Each block's first contact (they are sorted by node). */
-        const ws_iblock *blk = mg->blocks;
-        size_t l = 0;
-        for (uint32_t b = 0; b < mg->nblk; b++) {
-            while (l < R->nl && R->link[l].node < blk[b].n0)
-                l++;
-            mg->lstart[b] = l;
-        }
-        mg->lstart[mg->nblk] = R->nl;
-    }
+    ws_rigid_block_starts(R, mg->blocks, mg->nblk, mg->lstart);
     for (int k = 1; k < mg->nlev; k++) {
         mg_level *L = &mg->lv[k];
         L->xb = q, q += 6 * (size_t)nb;
