@@ -512,3 +512,41 @@ def test_spiral_wrapped_pallet_passes_eumos(tmp_path):
     assert [c["band"] for c in v["containment"]] == ["bottom", "middle", "top"]
     assert all(c["line_load_N_per_m"] > 100 for c in v["containment"])
     assert 0.05 < v["film_peak_strain"] < 0.3
+
+
+def test_threads_give_the_same_run(tmp_path, capsys, monkeypatch):
+    # The world's workers share a step's film and contacts so that the state is the same to the
+    # bit for any count (tests/test_workers.c): a run on one thread and on two writes the same
+    # verdict, state hash and time series. The wrapped cubes (film, tilt) and a 2-layer pallet
+    # spiral-wrapped on the EUMOS sled, each shortened. The worlds are checked to get the count.
+    import wrapsim
+    from wrapsim import eumos, loadrun
+    counts = []
+
+    class Counted(wrapsim.World):
+        def __init__(self, *a, **kw):
+            counts.append(kw.get("worker_count"))
+            super().__init__(*a, **kw)
+
+    monkeypatch.setattr(loadrun, "World", Counted)
+    monkeypatch.setattr(eumos, "World", Counted)
+    wrapped = json.loads((LOADS / "two_cubes_R_wrapped.json").read_text())
+    wrapped["simulation"]["full_detection_until_s"] = 0.1
+    wrapped["test"].update(start_s=0.1, rate_deg_per_s=40.0, duration_s=0.4)
+    pallet = json.loads((LOADS / "eur_pallet_spiral.json").read_text())
+    pallet["unit_load"].update(layers=2, settle_s=0.1)
+    pallet["test"].update(hold_s=0.1)
+    for name, d in (("wrapped", wrapped), ("pallet", pallet)):
+        load = write(tmp_path, d, name + ".json")
+        runs = []
+        for threads in (1, 2):
+            out = tmp_path / f"{name}{threads}"
+            code = cli.main(["run", str(load), "-o", str(out), "-q", "--threads", str(threads)])
+            v = json.loads((out / "verdict.json").read_text())
+            runs.append((code, v["state_hash"], v["passed"],
+                         (out / "timeseries.csv").read_text()))
+        assert runs[0] == runs[1], (name, runs[0][:3], runs[1][:3])
+    assert counts == [1, 2, 1, 2], counts
+    assert cli.main(["run", str(load), "--threads", "0"]) == 2
+    assert "--threads: 0 is not between 1 and 64" in capsys.readouterr().err
+    assert 1 <= cli.default_threads() <= cli.MAX_THREADS

@@ -1,14 +1,19 @@
 """The `wrapsim` command (also `python3 -m wrapsim`).
 
-  wrapsim run LOAD.json [-o DIR]      run a load file's test; the verdict on stdout, and in DIR
+  wrapsim run LOAD.json [-o DIR] [--threads N]
+                                      run a load file's test; the verdict on stdout, and in DIR
                                       verdict.json, timeseries.csv, PNG plots, report.html
-  wrapsim kvalue LOAD.json [-o DIR]   the EUMOS k-value search of a unit load
+  wrapsim kvalue LOAD.json [-o DIR] [--threads N]
+                                      the EUMOS k-value search of a unit load
   wrapsim check LOAD.json             check a load file without running it
   wrapsim sweep LOAD.json --vary KEY=VALUES [...] [--samples N --seed S]
                 [--scheduler ADDRESS] [--workers N] [-o DIR] [--resume]
                                       a study on a Dask cluster; rows in DIR/results.csv
   wrapsim schema                      the load file's JSON Schema
   wrapsim info                        the library in use: path, version, build features
+A run steps on --threads workers, by default every core the command may use; its answers are
+the same to the bit for any count. A sweep's runs take one each (the cluster's workers are the
+cores).
 Exit status: 0 pass (or success), 1 fail, 2 bad input.
 """
 
@@ -23,6 +28,31 @@ from .loadfile import LoadFileError, json_schema, load, parse, validate
 def _err(text):
     print(f"wrapsim: {text}", file=sys.stderr)
     return 2
+
+
+# The library's bound on a world's workers (WS_MAX_WORKERS).
+MAX_THREADS = 64
+
+
+def default_threads():
+    """The cores this process may run on (its affinity where the system says it), at most
+    MAX_THREADS."""
+    import os
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        n = os.cpu_count() or 1
+    return max(1, min(n, MAX_THREADS))
+
+
+def _threads(args):
+    """The run's workers from --threads, or None (with the message printed) when out of
+    range."""
+    n = default_threads() if args.threads is None else args.threads
+    if not 1 <= n <= MAX_THREADS:
+        _err(f"--threads: {n} is not between 1 and {MAX_THREADS}")
+        return None
+    return n
 
 
 def _info(args):
@@ -55,12 +85,15 @@ def _run(args):
         d = load(args.load)
     except LoadFileError as e:
         return _err(e)
+    threads = _threads(args)
+    if threads is None:
+        return 2
     out = args.output or "wrapsim-out"
     import os
     # The bar's label stays short so that the bar keeps to one line of a terminal.
     desc = d["name"] if len(d["name"]) <= 32 else d["name"][:31] + "…"
     result, series = loadrun.run(d, progress=not args.quiet, desc=desc,
-                                 paraview=os.path.join(out, "paraview"))
+                                 paraview=os.path.join(out, "paraview"), threads=threads)
     report.write_all(out, d, result, series)
     print(f"{d['name']}: {'PASS' if result['passed'] else 'FAIL'}")
     for c in result["criteria"]:
@@ -102,10 +135,13 @@ def _kvalue(args):
             raise LoadFileError("test.type: the k-value search needs 'eumos'")
     except LoadFileError as e:
         return _err(e)
+    threads = _threads(args)
+    if threads is None:
+        return 2
     if not args.quiet:
         print(f"{d['name']}: EUMOS k-value search from {args.k_low:g} to {args.k_high:g} g "
               f"(to {args.tolerance:g} g)", file=sys.stderr)
-    k = eumos.find_k(d, args.k_low, args.k_high, args.tolerance)
+    k = eumos.find_k(d, args.k_low, args.k_high, args.tolerance, threads)
     print(f"{d['name']}: k-value {k['k_value_g']:.3f} g (fails at {k['k_fail_g']:.3f} g; "
           f"{k['runs']} runs)")
     if args.output:
@@ -133,6 +169,8 @@ def build_parser():
     p.add_argument("load", help="the load file (JSON, or YAML with python3-yaml)")
     p.add_argument("-o", "--output", help="output folder (default wrapsim-out)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--threads", type=int, metavar="N",
+                   help="workers a step uses (default: every core this command may use)")
     p.set_defaults(func=_run)
     p = sub.add_parser("kvalue", help="the EUMOS k-value: the largest k g the load passes")
     p.add_argument("load")
@@ -141,6 +179,8 @@ def build_parser():
     p.add_argument("--tolerance", type=float, default=0.01, help="bracket width, g")
     p.add_argument("-o", "--output", help="folder for kvalue.json")
     p.add_argument("-q", "--quiet", action="store_true")
+    p.add_argument("--threads", type=int, metavar="N",
+                   help="workers a step uses (default: every core this command may use)")
     p.set_defaults(func=_kvalue)
     p = sub.add_parser("check", help="check a load file without running it")
     p.add_argument("load")

@@ -206,11 +206,12 @@ def prepare(w, d):
     return load
 
 
-def run(d, progress=False, desc="wrapsim", paraview=None):
-    """Build the unit load, wrap it, let it settle, run the EUMOS test. Returns (result, series)
-    like loadrun.run: the verdict as a JSON-able dict and the sampled time series."""
+def run(d, progress=False, desc="wrapsim", paraview=None, threads=1):
+    """Build the unit load, wrap it, let it settle, run the EUMOS test on `threads` workers.
+    Returns (result, series) like loadrun.run: the verdict as a JSON-able dict and the sampled
+    time series."""
     lib = _c()
-    with World(**world_params(d)) as w:
+    with World(**world_params(d, threads)) as w:
         load = prepare(w, d)
         try:
             info = L.LoadInfo()
@@ -256,13 +257,13 @@ def run(d, progress=False, desc="wrapsim", paraview=None):
     return result, series
 
 
-def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01):
-    """The EUMOS k-value of the load file's load (ws_loadtest_find_k): every run starts from
-    one settled (and wrapped) state. Returns a dict: k_value, k_fail (g), runs, settled (the
+def find_k(d, k_low=0.05, k_high=1.0, tolerance=0.01, threads=1):
+    """The EUMOS k-value of the load file's load (ws_loadtest_find_k), each run stepped on
+    `threads` workers: every run starts from one settled (and wrapped) state. Returns a dict: k_value, k_fail (g), runs, settled (the
     load stood still before the runs) and settle_s (how long it settled)."""
     lib = _c()
     wdef = _init(L.WorldDef, "ws_world_def_init_sized")
-    for field, value in world_params(d).items():
+    for field, value in world_params(d, threads).items():
         setattr(wdef, field, value)
     ld = load_def(d)
     ed = eumos_def(d)

@@ -20,22 +20,23 @@ from . import _lib as L
 from ._run import _progress
 
 
-def world_params(d):
-    """The ws_world_def fields a load file's `simulation` section sets."""
+def world_params(d, threads=1):
+    """The ws_world_def fields a load file's `simulation` section sets, and the step's
+    workers (`threads`: the run's answers are the same to the bit for any count)."""
     s = d["simulation"]
     return dict(dt=s["dt_s"], full_detection_until=s["full_detection_until_s"],
-                detection_interval=s["detection_interval"])
+                detection_interval=s["detection_interval"], worker_count=threads)
 
 
-def build(d):
-    """A world with the platform, the stack and the film of a checked load file. Returns
-    a dict: world, platform, stop (or None), cartons (bottom first), film (or None),
-    pivot (x, z) of the tip edge in the platform's frame."""
+def build(d, threads=1):
+    """A world with the platform, the stack and the film of a checked load file, stepped on
+    `threads` workers. Returns a dict: world, platform, stop (or None), cartons (bottom first),
+    film (or None), pivot (x, z) of the tip edge in the platform's frame."""
     plat, stack, mats = d["platform"], d["stack"], d["materials"]
     c = stack["carton"]
     layer = stack["contact_layer_m"]
     gap = 2 * layer
-    w = World(**world_params(d))
+    w = World(**world_params(d, threads))
     carton_mat, plat_mat = w.material("carton"), w.material("platform")
 
     def pair(m):
@@ -135,18 +136,19 @@ def paraview_series(w, d, folder):
     return w.vtk_series(folder, "run", time_stride=every)
 
 
-def run(d, progress=False, desc="wrapsim", paraview=None):
+def run(d, progress=False, desc="wrapsim", paraview=None, threads=1):
     """Run a checked load file's test. Returns (result, series): result is a JSON-able dict
     with the measured values, the criteria and the verdict; series a dict of numpy columns
     (for the tilt, named by series_columns()). `paraview`: a folder for a ParaView collection
-    of the run (run.pvd), or None."""
+    of the run (run.pvd), or None. `threads`: the world's workers (the same answers for any
+    count)."""
     if d["test"]["type"] == "eumos":
         from . import eumos
-        return eumos.run(d, progress, desc, paraview)
+        return eumos.run(d, progress, desc, paraview, threads)
     if d["unit_load"] is not None:
         from . import loadtests
-        return loadtests.run(d, progress, desc, paraview)
-    sc = build(d)
+        return loadtests.run(d, progress, desc, paraview, threads)
+    sc = build(d, threads)
     w, platform, cartons, film = sc["world"], sc["platform"], sc["cartons"], sc["film"]
     test = d["test"]
     every = d["output"]["sample_interval_s"]

@@ -130,13 +130,13 @@ def _result_dict(d, res, state_hash):
     return out
 
 
-def run(d, progress=False, desc="wrapsim", paraview=None):
+def run(d, progress=False, desc="wrapsim", paraview=None, threads=1):
     """Build the unit load (wrapped when the file says so), let it settle and run its tilt,
-    impact or vibration test. Returns (result, series) like loadrun.run."""
+    impact or vibration test on `threads` workers. Returns (result, series) like loadrun.run."""
     kind = d["test"]["type"]
     lib = _c()
     make = {"tilt": _tilt, "impact": _impact, "vibration": _vibration}[kind]
-    with World(**world_params(d)) as w:
+    with World(**world_params(d, threads)) as w:
         load = prepare(w, d)
         try:
             td, fn, duration, keep = make(d)
