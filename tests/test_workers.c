@@ -131,6 +131,7 @@ typedef struct sheet_run {
     int narrow_tight; /* the narrow phase beside the film has little room: it runs again */
     uint64_t *narrow_reruns, *full; /* how many did, and the full detections (may be NULL) */
     int implicit; /* the implicit film at the real film's areal density, on the multigrid */
+    int one_lane; /* a sheet of one sweep block onto a second box on the first */
 } sheet_run;
 
 /* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, 3 mm above a
@@ -146,6 +147,9 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     w->narrow_tight = r->narrow_tight;
     add_ground(w, 2.0, no_material());
     *box = add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
+    if (r->one_lane) /* 1 mm above the first box: it lands, and the two press on each other */
+        *box = add_box(w, 0.25, 0.2, 0.2, 8.0, (ws_vec3){0.02, 0.01, 0.401}, no_material(),
+                       "top box");
     ws_law_def ld;
     ws_law_def_init(&ld);
     ld.type = (ws_law_type)r->law_type;
@@ -173,6 +177,11 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     sd.spacing_x = sd.spacing_y = 0.0125;
     /* The implicit sheet 0.1 mm above the box: it lands after 4.5 ms (18 steps). */
     sd.origin = (ws_vec3){-0.2975, -0.24375, r->implicit ? 0.3001 : 0.303};
+    if (r->one_lane) { /* 24 x 16 = 384 nodes: one block, so one lane */
+        sd.nx = 24;
+        sd.ny = 16;
+        sd.origin = (ws_vec3){-0.14375 + 0.02, -0.09375 + 0.01, 0.504};
+    }
     sd.prestretch_x = sd.prestretch_y = 0.02;
     sd.shear = 1;
     ck_ok(w, ws_web_create_sheet(w, &wd, &sd, web));
@@ -246,7 +255,7 @@ static long sheet_steps(void)
 START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
         r.workers = k;
@@ -256,12 +265,12 @@ START_TEST(test_sheet_same_for_any_workers)
     }
     /* A host's scheduler: the pieces last first, then each on a thread of its own. */
     int calls = 0;
-    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
     uint64_t h = sheet_hash(&r, steps, &calls);
     ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
     ck_assert_msg(calls > 0, "the host's scheduler was never called");
-    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
     h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -269,7 +278,7 @@ START_TEST(test_sheet_same_for_any_workers)
      * pieces that run out are searched again on the world's thread, and the list is the
      * same. */
     uint64_t reruns = 0;
-    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL, 0};
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL, 0, 0};
     h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "pieces searched again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -277,6 +286,39 @@ START_TEST(test_sheet_same_for_any_workers)
     report("workers: sheet, %ld steps: 0x%016llx for 1-%d workers, both schedulers and %llu "
            "pieces of searches run again",
            steps, (unsigned long long)one, short_run() ? 2 : 4, (unsigned long long)reruns);
+}
+END_TEST
+
+/* A web swept in one lane (a grid of one block, or a mesh web) leaves a worker free: with
+ * workers the body contacts run beside it, a piece of them beside each sub-step, and a full
+ * detection's narrow phase beside the first. A sheet of one block dropped onto a box that
+ * lands on another (full detection every 5th step): on 1, 2 and 3 workers and both host
+ * schedulers, the state hash is the same to the bit, and the host's scheduler gets the body
+ * part (a law not of film form keeps its lane on the stepping thread: test_sheet_law_with_history). */
+START_TEST(test_bodies_beside_one_lane)
+{
+    const long steps = sheet_steps();
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    for (int k = 2; k <= 3; k++) {
+        r.workers = k;
+        const uint64_t h = sheet_hash(&r, steps, NULL);
+        ck_assert_msg(h == one, "%d workers, one lane: 0x%016llx, 1 worker 0x%016llx", k,
+                      (unsigned long long)h, (unsigned long long)one);
+    }
+    int calls = 0;
+    r = (sheet_run){2, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
+    uint64_t h = sheet_hash(&r, steps, &calls);
+    ck_assert_msg(h == one, "reverse scheduler, one lane: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    ck_assert_msg(calls > 0, "the host's scheduler never got the body part");
+    r = (sheet_run){3, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
+    h = sheet_hash(&r, steps, NULL);
+    ck_assert_msg(h == one, "threaded scheduler, one lane: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    report("workers: one-lane sheet on two boxes, %ld steps: 0x%016llx for 1-3 workers and "
+           "both schedulers (%d tasks to the host)",
+           steps, (unsigned long long)one, calls);
 }
 END_TEST
 
@@ -289,7 +331,7 @@ START_TEST(test_detection_beside_the_film)
 {
     const long steps = sheet_steps();
     uint64_t full = 0, reruns = 0;
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full, 0};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     /* ceil(steps / 5) full detections, the first of them at step 0. */
     ck_assert_msg(full == (uint64_t)(steps + 4) / 5, "%llu full detections in %ld steps",
@@ -301,7 +343,7 @@ START_TEST(test_detection_beside_the_film)
                       "%d workers, a full detection every 5th step: 0x%016llx, 1 worker 0x%016llx",
                       k, (unsigned long long)h, (unsigned long long)one);
     }
-    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL, 0};
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL, 0, 0};
     const uint64_t h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "narrow phases run again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -341,7 +383,7 @@ START_TEST(test_refused_after_the_film)
         ws_world_def_init(&d);
         d.dt = 2.5e-4;
         d.worker_count = 2;
-        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
         ws_body_id box;
         ws_web_id web;
         ws_world *w = sheet_world(&d, &r, &box, &web);
@@ -400,14 +442,14 @@ START_TEST(test_sheet_law_with_history)
      * history or a user's function would be) sweeps in one lane whatever the workers: the
      * same hash, and the host's scheduler never called. */
     const long steps = short_run() ? 120 : 500;
-    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     int calls = 0;
-    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
     ck_assert(sheet_hash(&r, steps, &calls) == one);
     ck_assert_int_eq(calls, 0);
     if (!short_run()) {
-        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0};
+        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
         ck_assert(sheet_hash(&r, steps, NULL) == one);
     }
 }
@@ -428,7 +470,7 @@ START_TEST(test_implicit_same_for_any_workers)
     const long steps = shorter ? 30 : 120;
     for (int law = 0; law < 2; law++) {
         const int type = law ? WS_LAW_CUBIC_ELASTIC : WS_LAW_LINEAR_VISCOELASTIC;
-        sheet_run r = {1, 0, type, 0, NULL, 0, 0, NULL, NULL, 1};
+        sheet_run r = {1, 0, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
         const uint64_t one = sheet_hash(&r, steps, NULL);
         for (int k = 2; k <= (shorter ? 2 : 3); k++) {
             r.workers = k;
@@ -439,13 +481,13 @@ START_TEST(test_implicit_same_for_any_workers)
         if (law && shorter)
             continue;
         int calls = 0;
-        r = (sheet_run){3, 1, type, 0, NULL, 0, 0, NULL, NULL, 1};
+        r = (sheet_run){3, 1, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
         uint64_t h = sheet_hash(&r, steps, &calls);
         ck_assert_msg(h == one, "law %d, reverse scheduler: 0x%016llx, 1 worker 0x%016llx", type,
                       (unsigned long long)h, (unsigned long long)one);
         ck_assert_msg(calls > 0, "the host's scheduler was never called");
         if (!shorter) {
-            r = (sheet_run){2, 2, type, 0, NULL, 0, 0, NULL, NULL, 1};
+            r = (sheet_run){2, 2, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
             h = sheet_hash(&r, steps, NULL);
             ck_assert_msg(h == one, "law %d, threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
                           type, (unsigned long long)h, (unsigned long long)one);
@@ -606,6 +648,7 @@ int main(void)
     add_case(s, "wrapped_same_for_any_workers", test_wrapped_same_for_any_workers, 300);
     add_case(s, "sheet_same_for_any_workers", test_sheet_same_for_any_workers, 300);
     add_case(s, "detection_beside_the_film", test_detection_beside_the_film, 300);
+    add_case(s, "bodies_beside_one_lane", test_bodies_beside_one_lane, 300);
     add_case(s, "refused_after_the_film", test_refused_after_the_film, 300);
     add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
     add_case(s, "implicit_same_for_any_workers", test_implicit_same_for_any_workers, 300);

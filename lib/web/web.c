@@ -513,15 +513,18 @@ void ws_web_sweep_laws(ws_web *web, v3 g, double t, double since)
                    !(g.y == 0.0 && signbit(g.y)) && !(g.z == 0.0 && signbit(g.z));
 }
 
-int ws_web_sweep_parallel(const ws_web *web)
+int ws_web_laws_on_workers(const ws_web *web)
 {
-    if (web->nx <= 0 || ws_web_block_count(web) < 2)
-        return 0;
     double kc, dk, w, c;
     for (int q = 0; q < 3; q++)
         if (web->law[q] && !ws_law_film_form(web->law[q], &kc, &dk, &w, &c))
             return 0;
     return 1;
+}
+
+int ws_web_sweep_parallel(const ws_web *web)
+{
+    return web->nx > 0 && ws_web_block_count(web) >= 2 && ws_web_laws_on_workers(web);
 }
 
 void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,

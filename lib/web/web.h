@@ -181,6 +181,9 @@ typedef struct ws_web_pass {
 } ws_web_pass;
 void ws_web_sweep_laws(ws_web *web, v3 gravity, double t, double since);
 int ws_web_sweep_parallel(const ws_web *web);
+/* Whether every law of the web is of film form, so that its sweep calls no user's function
+ * and may run on any worker (in lanes, or in one beside other work). */
+int ws_web_laws_on_workers(const ws_web *web);
 void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,
                         uint32_t *n0, uint32_t *n1);
 /* A sweep keeps the nodes' forces in the velocities it writes (p->vd) until it integrates

@@ -187,6 +187,7 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
+    size_t fresh, ended; /* the body contacts' anchors taken and ended so far (body_contacts) */
     double pair_dt; /* the bodies' per-pair stable step (ws_world_contact_limit), s */
     /* The body contacts still to run (in the film's first sub-step in lanes, or after it),
      * and the webs' loads to add after the elements' (world_step.c, step_once). */

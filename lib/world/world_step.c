@@ -249,6 +249,7 @@ static ws_status webs_ready(ws_world *w)
 }
 
 static void body_contacts(ws_step *S);
+static void body_contacts_part(ws_step *S, uint32_t part, uint32_t parts);
 
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
@@ -266,19 +267,22 @@ typedef struct lane_task {
      * contacts (BODY_CONTACTS, the last's), each where its sub-step's lanes leave room. */
     ws_step *body;
     int body_part;
+    uint32_t piece, pieces; /* the body contacts' piece in this sub-step (body_contacts_part) */
 } lane_task;
 
 enum { BODY_NARROW = 1, BODY_CONTACTS = 2 };
 
-/* The body part of a sub-step's task: the narrow phase, the contacts or both (lane_task). */
-static void body_item(ws_step *S, int part)
+/* The body part of a sub-step's task: the narrow phase, a piece of the contacts or both
+ * (lane_task). */
+static void body_item(const lane_task *T)
 {
-    if ((part & BODY_NARROW) && S->narrow_later) {
+    ws_step *S = T->body;
+    if ((T->body_part & BODY_NARROW) && S->narrow_later) {
         S->narrow_bad = detect_narrow(S, NULL) != 0;
         S->narrow_later = 0;
     }
-    if (part & BODY_CONTACTS)
-        body_contacts(S);
+    if (T->body_part & BODY_CONTACTS)
+        body_contacts_part(S, T->piece, T->pieces);
 }
 
 static void lane_open(ws_world *w, ws_web *web, uint32_t i);
@@ -333,7 +337,7 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         if ((uint32_t)i < T->lanes)
             sweep_lane(T, &T->w->lane_job[i]);
         else
-            body_item(T->body, T->body_part);
+            body_item(T);
     }
 }
 
@@ -844,14 +848,24 @@ static ws_status step_webs(ws_step *S)
                            s == 0,
                            lanes,
                            NULL,
-                           0};
+                           0,
+                           0,
+                           1};
             /* The body part beside the lanes: the narrow phase in the first sub-step, the
-             * contacts in the last, so that each fills a sub-step's slack. */
-            if (lanes > 1 && s == 0 && S->narrow_later)
+             * contacts in the last, so that each fills a sub-step's slack (S->body_later:
+             * there are workers). A web swept in one lane takes it beside that lane when the
+             * lane may run on any worker (a mesh web of film-form laws; a law that calls the
+             * user's code keeps its lane, and so the task, on this thread), the contacts in
+             * a piece beside each sub-step: one lane leaves a worker free in every one. */
+            const int beside = lanes > 1 || ws_web_laws_on_workers(web);
+            if (beside && s == 0 && S->narrow_later)
                 T.body_part |= BODY_NARROW;
-            if (lanes > 1 && s == n - 1 && S->body_later) {
+            if (beside && S->body_later && (lanes == 1 || s == n - 1)) {
                 T.body_part |= BODY_CONTACTS;
-                S->body_later = 0;
+                T.pieces = lanes == 1 ? (uint32_t)n : 1;
+                T.piece = lanes == 1 ? (uint32_t)s : 0;
+                if (s == n - 1)
+                    S->body_later = 0;
             }
             T.body = T.body_part ? S : NULL;
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
@@ -1072,17 +1086,30 @@ static ws_status detect(ws_step *S)
 }
 
 /* The body contacts (stage 3): every candidate evaluated into a record of nxt, and the
- * contacts' share of each body's load kept for the energy guard (gravity taken out). */
-static void body_contacts(ws_step *S)
+ * contacts' share of each body's load kept for the energy guard (gravity taken out); in
+ * `parts` pieces, piece `part` evaluating its share of the candidates in their order, so that
+ * a web swept in one lane can take a piece beside each of its sub-steps (step_webs). Piece 0
+ * begins (a waiting narrow phase, the twins), the last ends (the anchors handed over, the
+ * guard's record): the pieces in order are the one pass. */
+static void body_contacts_part(ws_step *S, uint32_t part, uint32_t parts)
 {
     ws_world *w = S->w;
     const ws_body_store *b = S->b;
     const int nxt = S->nxt;
-    /* A full detection's narrow phase first, when it still waits (detect_full); when it
-     * ran out of room beside the film, both run again on the calling thread (step_once). */
-    if (S->narrow_later) {
-        S->narrow_bad = detect_narrow(S, NULL) != 0;
-        S->narrow_later = 0;
+    if (part == 0) {
+        /* A full detection's narrow phase first, when it still waits (detect_full); when it
+         * ran out of room beside the film, both run again on the calling thread
+         * (step_once). */
+        if (S->narrow_later) {
+            S->narrow_bad = detect_narrow(S, NULL) != 0;
+            S->narrow_later = 0;
+        }
+        if (S->narrow_bad)
+            return;
+        S->nrec = S->fresh = S->ended = 0;
+        /* Twin corners (two bodies' vertices at one corner of their faces' overlap) share
+         * one corner's laws: their shares first, from the same state the evaluation reads. */
+        ws_contact_twins(&S->contact, w->cand[nxt], w->ncand[nxt]);
     }
     if (S->narrow_bad)
         return;
@@ -1090,28 +1117,26 @@ static void body_contacts(ws_step *S)
      * (a corner's load passing between its point-face contact and an edge pair) takes over
      * that one's stick anchor, so the friction it carried does not vanish for a step: the
      * candidates are marked here, in the list's order, and matched after. */
-    size_t nrec = 0, fresh = 0, ended = 0;
-    /* Twin corners (two bodies' vertices at one corner of their faces' overlap) share one
-     * corner's laws: their shares first, from the same state the evaluation reads. */
-    ws_contact_twins(&S->contact, w->cand[nxt], w->ncand[nxt]);
-    for (size_t k = 0; k < w->ncand[nxt]; k++) {
+    const size_t n = w->ncand[nxt], k0 = n * part / parts, k1 = n * (part + 1) / parts;
+    for (size_t k = k0; k < k1; k++) {
         ws_cand *c = &w->cand[nxt][k];
         const uint32_t was = c->anchored;
         c->ended = c->fresh = 0;
-        if (ws_contact_eval(&S->contact, c, &w->rec[nxt][nrec])) {
+        if (ws_contact_eval(&S->contact, c, &w->rec[nxt][S->nrec])) {
             if (!was && c->anchored) {
-                c->fresh = (uint32_t)nrec + 1;
-                fresh++;
+                c->fresh = (uint32_t)S->nrec + 1;
+                S->fresh++;
             }
-            nrec++;
+            S->nrec++;
         } else if (was) {
             c->ended = 1;
-            ended++;
+            S->ended++;
         }
     }
-    if (fresh && ended)
+    if (part + 1 < parts)
+        return;
+    if (S->fresh && S->ended)
         ws_contact_handover(&S->contact, w->cand[nxt], w->ncand[nxt], w->rec[nxt]);
-    S->nrec = nrec;
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
@@ -1120,6 +1145,11 @@ static void body_contacts(ws_step *S)
         S->guard_f[i] = v3_sub(b->f[i], g);
         S->guard_m[i] = b->m[i];
     }
+}
+
+static void body_contacts(ws_step *S)
+{
+    body_contacts_part(S, 0, 1);
 }
 
 /* What contact_operator takes of each contact: its normal spring, its normal damper, or its
