@@ -147,8 +147,9 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     w->narrow_tight = r->narrow_tight;
     add_ground(w, 2.0, no_material());
     *box = add_box(w, 0.4, 0.3, 0.3, 20.0, (ws_vec3){0.0, 0.0, 0.15}, no_material(), "box");
-    if (r->one_lane) /* 1 mm above the first box: it lands, and the two press on each other */
-        *box = add_box(w, 0.25, 0.2, 0.2, 8.0, (ws_vec3){0.02, 0.01, 0.401}, no_material(),
+    if (r->one_lane) /* 1 mm above the first box, its twin in plan: it lands, and the two
+                        press on each other, corner on corner (twin corners) */
+        *box = add_box(w, 0.4, 0.3, 0.2, 8.0, (ws_vec3){0.0, 0.0, 0.401}, no_material(),
                        "top box");
     ws_law_def ld;
     ws_law_def_init(&ld);
@@ -180,7 +181,7 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     if (r->one_lane) { /* 24 x 16 = 384 nodes: one block, so one lane */
         sd.nx = 24;
         sd.ny = 16;
-        sd.origin = (ws_vec3){-0.14375 + 0.02, -0.09375 + 0.01, 0.504};
+        sd.origin = (ws_vec3){-0.14375, -0.09375, 0.504};
     }
     sd.prestretch_x = sd.prestretch_y = 0.02;
     sd.shear = 1;

@@ -245,6 +245,12 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
 /* Evaluate one candidate at the committed state: 1 when in contact, with the record filled, the
  * forces added to both bodies' accumulators and the stick anchors of *c updated. */
 int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
+/* ws_contact_eval in two halves, so that candidates can be measured on several threads and
+ * their forces added in the list's order after: the record and the anchors (1 when in
+ * contact; it reads the bodies' state, writes *c, *rec and x->narrow_checks), and the
+ * record's force and moment added to both bodies' accumulators, as ws_contact_eval adds them. */
+int ws_contact_measure(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec);
+void ws_contact_apply(const ws_contact_ctx *x, const ws_contact_rec *rec);
 
 /* Where a candidate's features lie nearest each other at the committed state, whether or not
  * they touch or its tests pass: the point mid-way between them (global; a point-face pair's
@@ -263,6 +269,12 @@ int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double
  * placed for the hand-over, is the same formula). To run before the candidates are
  * evaluated. */
 void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n);
+/* ws_contact_twins in parts, for several threads: every cut cleared first, then part `part` of
+ * `parts` takes the runs (a, b), a < b, that start in its share of the list, writing only
+ * their candidates' cuts and those of their runs (b, a): the parts never meet. */
+void ws_contact_twins_clear(ws_cand *c, size_t n);
+void ws_contact_twins_part(const ws_contact_ctx *x, ws_cand *c, size_t n, uint32_t part,
+                           uint32_t parts);
 
 /* The first candidate of c[0..n) (sorted by ws_contact_sort) between a and b in that order. */
 static inline size_t ws_contact_pair_start(const ws_cand *c, size_t n, uint32_t a, uint32_t b)

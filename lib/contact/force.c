@@ -59,6 +59,21 @@ static void stick_friction(const ws_contact_ctx *x, ws_cand *c, const ws_pair_pa
 
 int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
 {
+    if (!ws_contact_measure(x, c, rec))
+        return 0;
+    ws_contact_apply(x, rec);
+    return 1;
+}
+
+void ws_contact_apply(const ws_contact_ctx *x, const ws_contact_rec *rec)
+{
+    const v3 F = v3_add(v3_scale(rec->n, rec->fn), rec->ft);
+    apply(x->b, x->cur, rec->b, rec->x, F);
+    apply(x->b, x->cur, rec->a, rec->x, v3_neg(F));
+}
+
+int ws_contact_measure(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
+{
     v3 xg, n;
     double d, share;
     if (!ws_contact_geometry(x, c, &xg, &n, &d, &share)) {
@@ -92,9 +107,6 @@ int ws_contact_eval(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
         stick_friction(x, c, pp, xg, n, vt, fn, share, &ft, &defl, &at_cap, &slipping);
         energy_t = 0.5 * kt * v3_norm2(defl);
     }
-    v3 F = v3_add(v3_scale(n, fn), ft);
-    apply(b, x->cur, ib, xg, F);
-    apply(b, x->cur, ia, xg, v3_neg(F));
     rec->a = ia;
     rec->b = ib;
     rec->kind = c->kind;

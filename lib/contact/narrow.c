@@ -585,11 +585,28 @@ static double twin_cut(double mi, double mj, double tau)
 
 void ws_contact_twins(ws_contact_ctx *x, ws_cand *c, size_t n)
 {
+    ws_contact_twins_clear(c, n);
+    ws_contact_twins_part(x, c, n, 0, 1);
+}
+
+void ws_contact_twins_clear(ws_cand *c, size_t n)
+{
     for (size_t k = 0; k < n; k++)
         c[k].twin_cut = 0.0;
+}
+
+void ws_contact_twins_part(const ws_contact_ctx *x, ws_cand *c, size_t n, uint32_t part,
+                           uint32_t parts)
+{
+    /* The runs that start in the part's share of the list: from the first run start at or
+     * after its first candidate. */
+    const size_t k0 = n * part / parts, k1 = n * (part + 1) / parts;
+    size_t p0 = k0;
+    while (p0 > 0 && p0 < n && c[p0 - 1].a == c[p0].a && c[p0 - 1].b == c[p0].b)
+        p0++;
     /* Each run of point-face candidates between a and b (a < b) against the one between b and
      * a: mutual nearest neighbours in the faces' plane are twins. */
-    for (size_t p0 = 0; p0 < n;) {
+    while (p0 < k1) {
         size_t p1 = p0;
         while (p1 < n && c[p1].a == c[p0].a && c[p1].b == c[p0].b)
             p1++;

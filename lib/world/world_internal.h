@@ -187,7 +187,12 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
-    size_t fresh, ended; /* the body contacts' anchors taken and ended so far (body_contacts) */
+    /* The body contacts measured in pieces beside a web in one lane (world_step.c,
+     * contacts_piece): a record and a state a candidate, the checks of each piece (arena). */
+    struct ws_contact_rec *mrec;
+    uint8_t *mstate;
+    uint64_t *mchecks;
+    uint32_t mpieces;
     double pair_dt; /* the bodies' per-pair stable step (ws_world_contact_limit), s */
     /* The body contacts still to run (in the film's first sub-step in lanes, or after it),
      * and the webs' loads to add after the elements' (world_step.c, step_once). */

@@ -249,7 +249,10 @@ static ws_status webs_ready(ws_world *w)
 }
 
 static void body_contacts(ws_step *S);
-static void body_contacts_part(ws_step *S, uint32_t part, uint32_t parts);
+static int contacts_begin(ws_step *S, uint32_t pieces, int twins);
+static void contacts_twins_ready(ws_step *S, int whole);
+static void contacts_piece(ws_step *S, uint32_t p);
+static void contacts_end(ws_step *S);
 
 /* What every lane of a web's sub-step reads (the lanes' own parts are in w->lane_job). */
 typedef struct lane_task {
@@ -267,22 +270,39 @@ typedef struct lane_task {
      * contacts (BODY_CONTACTS, the last's), each where its sub-step's lanes leave room. */
     ws_step *body;
     int body_part;
-    uint32_t piece, pieces; /* the body contacts' piece in this sub-step (body_contacts_part) */
+    /* Beside a web in one lane (body_plan): the body part in `items` items of the task, the
+     * twins in as many parts (BODY_TWINS), the measured pieces [piece0, piece0 + pieces)
+     * shared among them (contacts_piece; 0 pieces: the contacts whole, as body_contacts takes
+     * them); after a narrow phase (its item the task's only) the twins' cuts cleared, and with
+     * twins_after 2 the twins whole too. */
+    uint32_t piece0, pieces, items;
+    int twins_after;
 } lane_task;
 
-enum { BODY_NARROW = 1, BODY_CONTACTS = 2 };
+enum { BODY_NARROW = 1, BODY_CONTACTS = 2, BODY_TWINS = 4 };
 
-/* The body part of a sub-step's task: the narrow phase, a piece of the contacts or both
- * (lane_task). */
-static void body_item(const lane_task *T)
+/* Body item j of a sub-step's task: the narrow phase, item j's part of the twins, the contacts
+ * (whole, or item j's share of the sub-step's measured pieces), as T says (lane_task). */
+static void body_item(const lane_task *T, uint32_t j)
 {
     ws_step *S = T->body;
+    ws_world *w = S->w;
     if ((T->body_part & BODY_NARROW) && S->narrow_later) {
         S->narrow_bad = detect_narrow(S, NULL) != 0;
         S->narrow_later = 0;
+        if (T->twins_after && !S->narrow_bad)
+            contacts_twins_ready(S, T->twins_after == 2);
     }
-    if (T->body_part & BODY_CONTACTS)
-        body_contacts_part(S, T->piece, T->pieces);
+    if ((T->body_part & BODY_TWINS) && !S->narrow_bad)
+        ws_contact_twins_part(&S->contact, w->cand[S->nxt], w->ncand[S->nxt], j, T->items);
+    if (!(T->body_part & BODY_CONTACTS))
+        return;
+    if (!T->pieces) {
+        body_contacts(S);
+        return;
+    }
+    for (uint32_t p = j * T->pieces / T->items; p < (j + 1) * T->pieces / T->items; p++)
+        contacts_piece(S, T->piece0 + p);
 }
 
 static void lane_open(ws_world *w, ws_web *web, uint32_t i);
@@ -337,7 +357,7 @@ static void lane_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
         if ((uint32_t)i < T->lanes)
             sweep_lane(T, &T->w->lane_job[i]);
         else
-            body_item(T);
+            body_item(T, (uint32_t)i - T->lanes);
     }
 }
 
@@ -725,7 +745,7 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *b
  * lane, right here. Returns how many nodes ended too fast. */
 static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
 {
-    const uint32_t body = T->body != NULL;
+    const uint32_t body = T->body ? T->items : 0;
     run_task(w, lane_items, lanes + body, body, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
@@ -756,6 +776,49 @@ static int bodies_beside_film(const ws_world *w)
         webs = 1;
     }
     return webs && w->def.worker_count > 1;
+}
+
+/* Where the body part goes beside a web swept in one lane of n sub-steps: a waiting narrow
+ * phase alone in the first sub-step's one item (the candidates are not known before it); the
+ * twins, in `width` parts, in a sub-step of their own when there is one to
+ * spare, else whole after the narrow phase or on this thread before the sub-steps; the
+ * measured pieces, `width` a sub-step, in the sub-steps after. Each stage needs the one
+ * before it done, and the sub-steps' tasks run one after another. */
+typedef struct body_plan {
+    int narrow;     /* the narrow phase waits: in sub-step 0 */
+    int twins;      /* the twins' sub-step, or -1 */
+    int measure;    /* the first sub-step of the measured pieces */
+    uint32_t width; /* body items of a sub-step: WS_LANES_PER_WORKER a worker, for balance
+                       beside the lane (the pool's room: its lanes' items and one) */
+} body_plan;
+
+static body_plan body_plan_of(const ws_step *S, int n)
+{
+    body_plan p = {S->narrow_later != 0, -1, 0, WS_LANES_PER_WORKER * S->w->def.worker_count};
+    if (n - p.narrow >= 2)
+        p.twins = p.narrow;
+    p.measure = p.twins >= 0 ? p.twins + 1 : p.narrow && n > 1;
+    return p;
+}
+
+/* Sub-step s's body part into T (its body_part, items and pieces). */
+static void body_task(const body_plan *p, int s, lane_task *T)
+{
+    T->items = 1;
+    if (p->narrow && s == 0) {
+        T->body_part |= BODY_NARROW;
+        T->twins_after = p->twins < 0 ? 2 : 1;
+    }
+    if (s == p->twins) {
+        T->body_part |= BODY_TWINS;
+        T->items = p->width;
+    }
+    if (s >= p->measure) {
+        T->body_part |= BODY_CONTACTS;
+        T->piece0 = (uint32_t)(s - p->measure) * p->width;
+        T->pieces = p->width;
+        T->items = T->body_part & BODY_NARROW ? 1 : p->width;
+    }
 }
 
 /* Sub-steps of every web: springs, node contacts (the bodies held at t), node integration,
@@ -831,6 +894,21 @@ static ws_status step_webs(ws_step *S)
         }
         int n = web->substeps;
         double h = S->dt / n, share = 1.0 / n;
+        /* The body contacts beside the sub-steps (S->body_later: there are workers): beside
+         * the last one's lanes, or beside a web swept in one lane that may run on any worker
+         * (its laws of the film form: a law that calls the user's code keeps its lane, and so
+         * the task, on this thread) as body_plan lays them out, their forces added in the
+         * list's order after the last sub-step (contacts_end). */
+        const int beside = lanes > 1 || ws_web_laws_on_workers(web);
+        body_plan plan = {0, -1, 0, 0};
+        uint32_t pieces = 0;
+        if (beside && lanes == 1 && S->body_later) {
+            plan = body_plan_of(S, n);
+            pieces = (uint32_t)(n - plan.measure) * plan.width;
+            const int twins = plan.narrow ? 0 : plan.twins >= 0 ? 1 : 2;
+            if (!contacts_begin(S, pieces, twins))
+                return ws_fail(w, WS_ERR_OUT_OF_MEMORY, "step: out of memory");
+        }
         /* Sub-steps alternate between the next state and the web's scratch state so that
          * none writes what it reads, and the last lands in the next state. */
         ws_nodes3 xs = web->x[cur], vs = web->v[cur];
@@ -850,25 +928,31 @@ static ws_status step_webs(ws_step *S)
                            NULL,
                            0,
                            0,
-                           1};
+                           0,
+                           1,
+                           0};
             /* The body part beside the lanes: the narrow phase in the first sub-step, the
              * contacts in the last, so that each fills a sub-step's slack (S->body_later:
              * there are workers). A web swept in one lane takes it beside that lane when the
              * lane may run on any worker (a mesh web of film-form laws; a law that calls the
              * user's code keeps its lane, and so the task, on this thread), the contacts in
              * a piece beside each sub-step: one lane leaves a worker free in every one. */
-            const int beside = lanes > 1 || ws_web_laws_on_workers(web);
-            if (beside && s == 0 && S->narrow_later)
-                T.body_part |= BODY_NARROW;
-            if (beside && S->body_later && (lanes == 1 || s == n - 1)) {
-                T.body_part |= BODY_CONTACTS;
-                T.pieces = lanes == 1 ? (uint32_t)n : 1;
-                T.piece = lanes == 1 ? (uint32_t)s : 0;
+            if (pieces) {
+                body_task(&plan, s, &T);
                 if (s == n - 1)
                     S->body_later = 0;
+            } else {
+                if (beside && s == 0 && S->narrow_later)
+                    T.body_part |= BODY_NARROW;
+                if (beside && S->body_later && s == n - 1) {
+                    T.body_part |= BODY_CONTACTS;
+                    S->body_later = 0;
+                }
             }
             T.body = T.body_part ? S : NULL;
             size_t fast = sweep(w, web, lanes, &T, web->bforce[nxt], web->bmoment[nxt]);
+            if (pieces && s == n - 1)
+                contacts_end(S);
             nc->merging = 0; /* carried out by the first sub-step's lanes */
             xs = xd;
             vs = vd;
@@ -1085,71 +1169,148 @@ static ws_status detect(ws_step *S)
     return WS_OK;
 }
 
-/* The body contacts (stage 3): every candidate evaluated into a record of nxt, and the
- * contacts' share of each body's load kept for the energy guard (gravity taken out); in
- * `parts` pieces, piece `part` evaluating its share of the candidates in their order, so that
- * a web swept in one lane can take a piece beside each of its sub-steps (step_webs). Piece 0
- * begins (a waiting narrow phase, the twins), the last ends (the anchors handed over, the
- * guard's record): the pieces in order are the one pass. */
-static void body_contacts_part(ws_step *S, uint32_t part, uint32_t parts)
+/* The body contacts' record of each body's load for the energy guard (gravity taken out),
+ * once they are all added. */
+static void guard_record(ws_step *S)
 {
-    ws_world *w = S->w;
     const ws_body_store *b = S->b;
-    const int nxt = S->nxt;
-    if (part == 0) {
-        /* A full detection's narrow phase first, when it still waits (detect_full); when it
-         * ran out of room beside the film, both run again on the calling thread
-         * (step_once). */
-        if (S->narrow_later) {
-            S->narrow_bad = detect_narrow(S, NULL) != 0;
-            S->narrow_later = 0;
-        }
-        if (S->narrow_bad)
-            return;
-        S->nrec = S->fresh = S->ended = 0;
-        /* Twin corners (two bodies' vertices at one corner of their faces' overlap) share
-         * one corner's laws: their shares first, from the same state the evaluation reads. */
-        ws_contact_twins(&S->contact, w->cand[nxt], w->ncand[nxt]);
-    }
-    if (S->narrow_bad)
-        return;
-    /* A contact that starts in the step next to one between the same bodies that ends in it
-     * (a corner's load passing between its point-face contact and an edge pair) takes over
-     * that one's stick anchor, so the friction it carried does not vanish for a step: the
-     * candidates are marked here, in the list's order, and matched after. */
-    const size_t n = w->ncand[nxt], k0 = n * part / parts, k1 = n * (part + 1) / parts;
-    for (size_t k = k0; k < k1; k++) {
-        ws_cand *c = &w->cand[nxt][k];
-        const uint32_t was = c->anchored;
-        c->ended = c->fresh = 0;
-        if (ws_contact_eval(&S->contact, c, &w->rec[nxt][S->nrec])) {
-            if (!was && c->anchored) {
-                c->fresh = (uint32_t)S->nrec + 1;
-                S->fresh++;
-            }
-            S->nrec++;
-        } else if (was) {
-            c->ended = 1;
-            S->ended++;
-        }
-    }
-    if (part + 1 < parts)
-        return;
-    if (S->fresh && S->ended)
-        ws_contact_handover(&S->contact, w->cand[nxt], w->ncand[nxt], w->rec[nxt]);
     for (size_t i = 0; i < b->slots; i++) {
         if (!b->alive[i])
             continue;
-        v3 g = b->type[i] == WS_BODY_DYNAMIC ? v3_scale(w->def.gravity, b->mass[i])
+        v3 g = b->type[i] == WS_BODY_DYNAMIC ? v3_scale(S->w->def.gravity, b->mass[i])
                                               : v3_make(0, 0, 0);
         S->guard_f[i] = v3_sub(b->f[i], g);
         S->guard_m[i] = b->m[i];
     }
 }
 
+/* Twin corners (two bodies' vertices at one corner of their faces' overlap) share one
+ * corner's laws: their shares, from the same state the evaluation reads, before any
+ * candidate is evaluated; the cuts cleared, and with `whole` found (else the parts of a
+ * body item each find theirs, body_item). */
+static void contacts_twins_ready(ws_step *S, int whole)
+{
+    ws_world *w = S->w;
+    ws_contact_twins_clear(w->cand[S->nxt], w->ncand[S->nxt]);
+    if (whole)
+        ws_contact_twins_part(&S->contact, w->cand[S->nxt], w->ncand[S->nxt], 0, 1);
+}
+
+/* The body contacts (stage 3): every candidate evaluated into a record of nxt, its forces
+ * added to the bodies' accumulators in the list's order, and the guard's record. A contact
+ * that starts in the step next to one between the same bodies that ends in it (a corner's
+ * load passing between its point-face contact and an edge pair) takes over that one's stick
+ * anchor, so the friction it carried does not vanish for a step: the candidates are marked
+ * here, in the list's order, and matched after. */
 static void body_contacts(ws_step *S)
 {
-    body_contacts_part(S, 0, 1);
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    /* A full detection's narrow phase first, when it still waits (detect_full); when it ran
+     * out of room beside the film, both run again on the calling thread (step_once). */
+    if (S->narrow_later) {
+        S->narrow_bad = detect_narrow(S, NULL) != 0;
+        S->narrow_later = 0;
+    }
+    if (S->narrow_bad)
+        return;
+    contacts_twins_ready(S, 1);
+    size_t nrec = 0, fresh = 0, ended = 0;
+    for (size_t k = 0; k < w->ncand[nxt]; k++) {
+        ws_cand *c = &w->cand[nxt][k];
+        const uint32_t was = c->anchored;
+        c->ended = c->fresh = 0;
+        if (ws_contact_eval(&S->contact, c, &w->rec[nxt][nrec])) {
+            if (!was && c->anchored) {
+                c->fresh = (uint32_t)nrec + 1;
+                fresh++;
+            }
+            nrec++;
+        } else if (was) {
+            c->ended = 1;
+            ended++;
+        }
+    }
+    if (fresh && ended)
+        ws_contact_handover(&S->contact, w->cand[nxt], w->ncand[nxt], w->rec[nxt]);
+    S->nrec = nrec;
+    guard_record(S);
+}
+
+/* The body contacts in measured pieces beside a web swept in one lane (step_webs, body_plan):
+ * piece p of `pieces` measures its share of the candidates (ws_contact_measure, on any worker)
+ * into a record of its own a candidate; contacts_end then takes the records in the list's
+ * order, adds their forces and hands the anchors over on the calling thread, so that the
+ * records, the anchors and the bodies' sums are body_contacts' to the bit. contacts_begin
+ * makes the room, and the twins ready as `twins` says (0: after the narrow phase, in its
+ * item; 1: their cuts cleared for the parts; 2: whole). */
+enum { MEASURED_NONE = 0, MEASURED = 1, MEASURED_FRESH = 2, MEASURED_ENDED = 3 };
+
+static int contacts_begin(ws_step *S, uint32_t pieces, int twins)
+{
+    ws_world *w = S->w;
+    const size_t room = w->capcand[S->nxt] + 1; /* the narrow phase beside stays within it */
+    S->mrec = ws_arena_alloc(S->arena, room * sizeof *S->mrec);
+    S->mstate = ws_arena_alloc(S->arena, room);
+    S->mchecks = ws_arena_alloc(S->arena, pieces * sizeof *S->mchecks);
+    S->mpieces = pieces;
+    if (!S->mrec || !S->mstate || !S->mchecks)
+        return 0;
+    if (twins) /* 1: the cuts cleared for the parts; 2: the twins whole, here */
+        contacts_twins_ready(S, twins == 2);
+    return 1;
+}
+
+static void contacts_piece(ws_step *S, uint32_t p)
+{
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    if (S->narrow_bad)
+        return;
+    ws_contact_ctx x = S->contact; /* its own count of checks */
+    x.narrow_checks = 0;
+    const size_t n = w->ncand[nxt], k0 = n * p / S->mpieces, k1 = n * (p + 1) / S->mpieces;
+    for (size_t k = k0; k < k1; k++) {
+        ws_cand *c = &w->cand[nxt][k];
+        const uint32_t was = c->anchored;
+        c->ended = c->fresh = 0;
+        if (ws_contact_measure(&x, c, &S->mrec[k]))
+            S->mstate[k] = !was && c->anchored ? MEASURED_FRESH : MEASURED;
+        else
+            S->mstate[k] = was ? MEASURED_ENDED : MEASURED_NONE;
+    }
+    S->mchecks[p] = x.narrow_checks;
+}
+
+static void contacts_end(ws_step *S)
+{
+    ws_world *w = S->w;
+    const int nxt = S->nxt;
+    if (S->narrow_bad)
+        return;
+    size_t nrec = 0, fresh = 0, ended = 0;
+    for (size_t k = 0; k < w->ncand[nxt]; k++) {
+        ws_cand *c = &w->cand[nxt][k];
+        if (S->mstate[k] == MEASURED_ENDED) {
+            c->ended = 1;
+            ended++;
+        }
+        if (S->mstate[k] != MEASURED && S->mstate[k] != MEASURED_FRESH)
+            continue;
+        w->rec[nxt][nrec] = S->mrec[k];
+        ws_contact_apply(&S->contact, &w->rec[nxt][nrec]);
+        if (S->mstate[k] == MEASURED_FRESH) {
+            c->fresh = (uint32_t)nrec + 1;
+            fresh++;
+        }
+        nrec++;
+    }
+    for (uint32_t p = 0; p < S->mpieces; p++)
+        S->contact.narrow_checks += S->mchecks[p];
+    if (fresh && ended)
+        ws_contact_handover(&S->contact, w->cand[nxt], w->ncand[nxt], w->rec[nxt]);
+    S->nrec = nrec;
+    guard_record(S);
 }
 
 /* What contact_operator takes of each contact: its normal spring, its normal damper, or its
