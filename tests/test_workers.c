@@ -253,6 +253,26 @@ static long sheet_steps(void)
     return short_run() ? 120 : 800;
 }
 
+/* The sheet r on two host schedulers (the pieces last first on 3 workers, then each on a
+ * thread of its own on 4): the state hash `one` both times, and the host called. Returns how
+ * many tasks the first got. */
+static int hosts_agree(sheet_run r, long steps, uint64_t one)
+{
+    int calls = 0;
+    r.workers = 3;
+    r.host = 1;
+    uint64_t h = sheet_hash(&r, steps, &calls);
+    ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    ck_assert_msg(calls > 0, "the host's scheduler was never called");
+    r.workers = 4;
+    r.host = 2;
+    h = sheet_hash(&r, steps, NULL);
+    ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
+                  (unsigned long long)h, (unsigned long long)one);
+    return calls;
+}
+
 START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
@@ -264,23 +284,13 @@ START_TEST(test_sheet_same_for_any_workers)
         ck_assert_msg(h == one, "%d workers: state hash 0x%016llx, 1 worker 0x%016llx", k,
                       (unsigned long long)h, (unsigned long long)one);
     }
-    /* A host's scheduler: the pieces last first, then each on a thread of its own. */
-    int calls = 0;
-    r = (sheet_run){3, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
-    uint64_t h = sheet_hash(&r, steps, &calls);
-    ck_assert_msg(h == one, "reverse scheduler: 0x%016llx, 1 worker 0x%016llx",
-                  (unsigned long long)h, (unsigned long long)one);
-    ck_assert_msg(calls > 0, "the host's scheduler was never called");
-    r = (sheet_run){4, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
-    h = sheet_hash(&r, steps, NULL);
-    ck_assert_msg(h == one, "threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
-                  (unsigned long long)h, (unsigned long long)one);
+    hosts_agree(r, steps, one);
     /* The search of node candidates in pieces, each piece's list given little room: the
      * pieces that run out are searched again on the world's thread, and the list is the
      * same. */
     uint64_t reruns = 0;
     r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL, 0, 0};
-    h = sheet_hash(&r, steps, NULL);
+    uint64_t h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "pieces searched again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
     ck_assert_msg(reruns > 0, "no piece of a search ran out of room");
@@ -307,16 +317,7 @@ START_TEST(test_bodies_beside_one_lane)
         ck_assert_msg(h == one, "%d workers, one lane: 0x%016llx, 1 worker 0x%016llx", k,
                       (unsigned long long)h, (unsigned long long)one);
     }
-    int calls = 0;
-    r = (sheet_run){2, 1, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
-    uint64_t h = sheet_hash(&r, steps, &calls);
-    ck_assert_msg(h == one, "reverse scheduler, one lane: 0x%016llx, 1 worker 0x%016llx",
-                  (unsigned long long)h, (unsigned long long)one);
-    ck_assert_msg(calls > 0, "the host's scheduler never got the body part");
-    r = (sheet_run){3, 2, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
-    h = sheet_hash(&r, steps, NULL);
-    ck_assert_msg(h == one, "threaded scheduler, one lane: 0x%016llx, 1 worker 0x%016llx",
-                  (unsigned long long)h, (unsigned long long)one);
+    const int calls = hosts_agree(r, steps, one);
     report("workers: one-lane sheet on two boxes, %ld steps: 0x%016llx for 1-3 workers and "
            "both schedulers (%d tasks to the host)",
            steps, (unsigned long long)one, calls);
