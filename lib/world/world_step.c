@@ -932,11 +932,8 @@ static ws_status step_webs(ws_step *S)
                            1,
                            0};
             /* The body part beside the lanes: the narrow phase in the first sub-step, the
-             * contacts in the last, so that each fills a sub-step's slack (S->body_later:
-             * there are workers). A web swept in one lane takes it beside that lane when the
-             * lane may run on any worker (a mesh web of film-form laws; a law that calls the
-             * user's code keeps its lane, and so the task, on this thread), the contacts in
-             * a piece beside each sub-step: one lane leaves a worker free in every one. */
+             * contacts in the last, so that each fills a sub-step's slack; beside one lane,
+             * which leaves the other workers free in every sub-step, in body_plan's stages. */
             if (pieces) {
                 body_task(&plan, s, &T);
                 if (s == n - 1)
