@@ -1188,9 +1188,10 @@ static void guard_record(ws_step *S)
 static void contacts_twins_ready(ws_step *S, int whole)
 {
     ws_world *w = S->w;
-    ws_contact_twins_clear(w->cand[S->nxt], w->ncand[S->nxt]);
     if (whole)
-        ws_contact_twins_part(&S->contact, w->cand[S->nxt], w->ncand[S->nxt], 0, 1);
+        ws_contact_twins(&S->contact, w->cand[S->nxt], w->ncand[S->nxt]);
+    else
+        ws_contact_twins_clear(w->cand[S->nxt], w->ncand[S->nxt]);
 }
 
 /* The body contacts (stage 3): every candidate evaluated into a record of nxt, its forces
