@@ -250,8 +250,7 @@ static int point_carried(const ws_shape *sa, v3 s, double lo, double hi)
 static void relative(const ws_body_store *b, int cur, uint32_t ia, uint32_t ib, m3 *R, v3 *t)
 {
     const m3 *Aa = &b->A[ia], *Ab = &b->A[ib];
-    m3 At = m3_transpose(Aa);
-    *R = m3_mul(&At, Ab);
+    *R = m3_tmul(Aa, Ab);
     *t = m3_tmul_v(Aa, v3_sub(b->st[cur].r[ib], b->st[cur].r[ia]));
 }
 

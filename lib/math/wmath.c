@@ -6,25 +6,6 @@ m3 m3_identity(void)
     return r;
 }
 
-m3 m3_mul(const m3 *a, const m3 *b)
-{
-    m3 r;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            r.m[3 * i + j] = a->m[3 * i] * b->m[j] + a->m[3 * i + 1] * b->m[3 + j] +
-                             a->m[3 * i + 2] * b->m[6 + j];
-    return r;
-}
-
-m3 m3_transpose(const m3 *a)
-{
-    m3 r;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            r.m[3 * i + j] = a->m[3 * j + i];
-    return r;
-}
-
 double m3_det(const m3 *a)
 {
     const double *m = a->m;

@@ -64,9 +64,36 @@ static inline v3 m3_tmul_v(const m3 *a, v3 v)
                    m[2] * v.x + m[5] * v.y + m[8] * v.z);
 }
 
+/* A B; inline, as the narrow phase takes one for every edge pair it places */
+static inline m3 m3_mul(const m3 *a, const m3 *b)
+{
+    m3 r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[3 * i + j] = a->m[3 * i] * b->m[j] + a->m[3 * i + 1] * b->m[3 + j] +
+                             a->m[3 * i + 2] * b->m[6 + j];
+    return r;
+}
+/* A^T B, the products and sums of m3_mul of A's transpose */
+static inline m3 m3_tmul(const m3 *a, const m3 *b)
+{
+    m3 r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[3 * i + j] =
+                a->m[i] * b->m[j] + a->m[3 + i] * b->m[3 + j] + a->m[6 + i] * b->m[6 + j];
+    return r;
+}
+static inline m3 m3_transpose(const m3 *a)
+{
+    m3 r;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r.m[3 * i + j] = a->m[3 * j + i];
+    return r;
+}
+
 m3 m3_identity(void);
-m3 m3_mul(const m3 *a, const m3 *b);
-m3 m3_transpose(const m3 *a);
 double m3_det(const m3 *a);
 /* Inverse; returns 0 on success, -1 when |det| is tiny relative to the entries. */
 int m3_inverse(const m3 *a, m3 *out);
