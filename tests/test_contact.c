@@ -2161,6 +2161,105 @@ START_TEST(test_twin_corners_yaw_continuous)
 }
 END_TEST
 
+/* A cube of edge a whose top and bottom faces are grids of g x g cells (its sides strips of g
+ * quads): (g + 1)^2 vertices on each of those faces, one face each (coplanar triangles form one
+ * face). */
+static ws_shape_id grid_cube(ws_world *w, double a, int g)
+{
+    const int m = g + 1, nv = 2 * m * m, nt = 4 * g * g + 8 * g;
+    double *v = malloc(sizeof *v * 3 * (size_t)nv);
+    uint32_t *t = malloc(sizeof *t * 3 * (size_t)nt), *p = t;
+    ck_assert(v != NULL && t != NULL);
+    for (int s = 0; s < 2; s++) /* s 0: bottom, 1: top */
+        for (int j = 0; j < m; j++)
+            for (int i = 0; i < m; i++) {
+                double *q = &v[3 * (s * m * m + j * m + i)];
+                q[0] = a * ((double)i / g - 0.5);
+                q[1] = a * ((double)j / g - 0.5);
+                q[2] = a * (s - 0.5);
+            }
+#define GV(s, i, j) ((uint32_t)((s) * m * m + (j) * m + (i)))
+#define TRI(x, y, z) (p[0] = (x), p[1] = (y), p[2] = (z), p += 3)
+    for (int j = 0; j < g; j++)
+        for (int i = 0; i < g; i++) {
+            /* the top counter-clockwise seen from +z, the bottom from -z */
+            TRI(GV(1, i, j), GV(1, i + 1, j), GV(1, i + 1, j + 1));
+            TRI(GV(1, i, j), GV(1, i + 1, j + 1), GV(1, i, j + 1));
+            TRI(GV(0, i, j), GV(0, i + 1, j + 1), GV(0, i + 1, j));
+            TRI(GV(0, i, j), GV(0, i, j + 1), GV(0, i + 1, j + 1));
+        }
+    for (int i = 0; i < g; i++) {
+        /* the sides at y = -a/2, x = +a/2, y = +a/2, x = -a/2, each seen from outside */
+        TRI(GV(0, i, 0), GV(0, i + 1, 0), GV(1, i + 1, 0));
+        TRI(GV(0, i, 0), GV(1, i + 1, 0), GV(1, i, 0));
+        TRI(GV(0, g, i), GV(0, g, i + 1), GV(1, g, i + 1));
+        TRI(GV(0, g, i), GV(1, g, i + 1), GV(1, g, i));
+        TRI(GV(0, i + 1, g), GV(0, i, g), GV(1, i, g));
+        TRI(GV(0, i + 1, g), GV(1, i, g), GV(1, i + 1, g));
+        TRI(GV(0, 0, i + 1), GV(0, 0, i), GV(1, 0, i));
+        TRI(GV(0, 0, i + 1), GV(1, 0, i), GV(1, 0, i + 1));
+    }
+#undef TRI
+#undef GV
+    ws_mesh_def md;
+    ws_mesh_def_init(&md);
+    md.vertices = v;
+    md.vertex_count = (size_t)nv;
+    md.triangles = t;
+    md.triangle_count = (size_t)nt;
+    ws_shape_id s;
+    ck_ok(w, ws_shape_create_mesh(w, &md, &s));
+    free(v);
+    free(t);
+    return s;
+}
+
+/* Two equal grid cubes (grid_cube, 0.25 m, 8 x 8 cells) stacked flush at rest, the top one
+ * pressed in by ov: every vertex of the interface, 81 of them, is a vertex of either cube on the
+ * other's face, twins sharing one spring (WS_TWIN_REACH), so the interface is 81 springs k:
+ * one step's normal forces sum to 81 k ov (the top cube at rest: no damping force), exact but
+ * for round-off (asserted 1e-9 relative; twins counted twice would give up to 162 k ov). Each
+ * pair's run of point-face contacts (81 and more) is longer than the twin search places at once
+ * (its windows of 64), so this holds the search's windows to what a run of a box's corners
+ * gives. The top cube created first as well: the same sum. */
+START_TEST(test_twin_grid_interface)
+{
+    const double a = 0.25, m = 5.0, k = 2e5, ov = 4e-5;
+    const int g = 8, springs = (g + 1) * (g + 1);
+    for (int top_first = 0; top_first < 2; top_first++) {
+        ws_contact_def cd = contact_params(k, 10.0, 0.3, WS_FRICTION_REGULARIZED);
+        ws_world *w = contact_world(2.5e-4, &cd);
+        const ws_shape_id s = grid_cube(w, a, g);
+        ws_body_id ids[2];
+        for (int o = 0; o < 2; o++) {
+            const int top = o == top_first;
+            ws_body_def bd;
+            ws_body_def_init(&bd);
+            bd.type = top ? WS_BODY_DYNAMIC : WS_BODY_KINEMATIC;
+            bd.shape = s;
+            bd.mass = top ? m : 0.0;
+            bd.position = v3(0, 0, top ? a + 2 * DELTA - ov : 0.0);
+            bd.name = top ? "top" : "bottom";
+            ck_ok(w, ws_body_create(w, &bd, &ids[top]));
+        }
+        OK(w, ws_world_step_n(w, 1));
+        static ws_contact_info ci[1024];
+        size_t n;
+        OK(w, ws_world_copy_contacts_between(w, ids[0], ids[1], ci, 1024, &n));
+        double f = 0.0;
+        for (size_t i = 0; i < n; i++)
+            f += ci[i].normal_force * fabs(ci[i].normal.z);
+        report("grid cubes flush (%d interface vertices, top first %d): %zu contacts, sum N "
+               "%.9g N against %d k ov %.9g N", springs, top_first, n, f, springs,
+               springs * k * ov);
+        ck_assert_msg(fabs(f / (springs * k * ov) - 1.0) < 1e-9,
+                      "the grid interface carries %.9g N, not %d springs' %.9g N", f, springs,
+                      springs * k * ov);
+        ws_world_destroy(w);
+    }
+}
+END_TEST
+
 /* Two 0.25 m, 5 kg cubes stacked flush at rest (each at its resting overlap: m g / (4 k) under
  * the top one, 2 m g / (4 k) under the bottom one) on a kinematic plane tilting about y at
  * `rate` rad/s from t = 0.1 s (0.1 s ramp); regularised friction (mu 0.3, v_lim 10 mm/s), the
@@ -2360,6 +2459,7 @@ static Suite *contact_suite(void)
     tcase_add_test(tc, test_twin_corners_shift_continuous);
     tcase_add_test(tc, test_twin_corners_yaw_continuous);
     tcase_add_test(tc, test_twin_corners_creeping_stack_calm);
+    tcase_add_test(tc, test_twin_grid_interface);
     tcase_add_test(tc, test_pulled_corner_keeps_its_friction);
     suite_add_tcase(s, tc);
 

@@ -519,11 +519,19 @@ static void pf_place(const ws_contact_ctx *x, const ws_cand *c, v3 *pg, v3 *ng, 
     *ng = m3_mul_v(Aa, b->shape[c->a]->faces[c->fa].normal);
 }
 
+/* The distance of vertices pi and pj in the faces' plane: that of the bisector ni - nj of their
+ * faces' normals, symmetric in i and j. */
+static double plane_distance(v3 pi, v3 ni, v3 pj, v3 nj)
+{
+    const v3 nb = unit(v3_sub(ni, nj)), d = v3_sub(pi, pj);
+    return v3_norm(v3_madd(d, nb, -v3_dot(d, nb)));
+}
+
 /* The fade tau in [0, 1] of the pairing of two point-face candidates of opposite body order
- * (vertices pi, pj, face normals ni, nj, global) and their distance in the faces' plane (that of
- * the bisector ni - nj, symmetric in i and j): 1 for faces lying on each other (f(psi) of the
- * edge pairs, WS_EDGE_FLAT_FACES) and vertices within WS_TWIN_REACH, falling linearly to 0 at
- * twice either. */
+ * (vertices pi, pj, face normals ni, nj, global) and their distance in the faces' plane
+ * (plane_distance): 1 for faces lying on each other (f(psi) of the edge pairs,
+ * WS_EDGE_FLAT_FACES) and vertices within WS_TWIN_REACH, falling linearly to 0 at twice
+ * either. */
 static double twin_fade(v3 pi, v3 ni, v3 pj, v3 nj, double *dt)
 {
     const double c = -v3_dot(ni, nj);
@@ -532,25 +540,81 @@ static double twin_fade(v3 pi, v3 ni, v3 pj, v3 nj, double *dt)
     *dt = INFINITY;
     if (!(f > 0.0))
         return 0.0;
-    const v3 nb = unit(v3_sub(ni, nj)), d = v3_sub(pi, pj);
-    *dt = v3_norm(v3_madd(d, nb, -v3_dot(d, nb)));
+    *dt = plane_distance(pi, ni, pj, nj);
     return f * (1.0 - ramp(*dt, WS_TWIN_REACH));
 }
 
-/* The nearest in the faces' plane among c[q0..q1) to candidate i, with a fade above 0: its
- * index (the first of equals), or q1. */
-static size_t twin_nearest(const ws_contact_ctx *x, const ws_cand *c, size_t i, size_t q0,
+/* A point-face candidate's vertex and its face's outward normal (global), as pf_place gives
+ * them: what the twin search compares. */
+typedef struct twin_site {
+    v3 p, n;
+} twin_site;
+
+/* The sites of a run's candidates, TWIN_SITES at a time: a run of a box's corners fits whole
+ * and is placed once for all the candidates it is compared with, where placing each one for
+ * every comparison was most of the search; a longer run (a mesh body's) is placed a window at a
+ * time, the same sites. */
+#define TWIN_SITES 64
+typedef struct twin_window {
+    size_t k0, k1; /* the candidates held, c[k0..k1) */
+    twin_site s[TWIN_SITES];
+} twin_window;
+
+/* One part's twin search: the step's candidates and a window on each of a pair's two runs. */
+typedef struct twin_search {
+    const ws_contact_ctx *x;
+    const ws_cand *c;
+    double cos_flat; /* cos(2 WS_EDGE_FLAT_FACES): faces whose normals miss opposition by more
+                        have no twins */
+    twin_window ab, ba;
+} twin_search;
+
+/* Site k of a run ending at `end`, through window w. */
+static twin_site site_of(const twin_search *t, twin_window *w, size_t k, size_t end)
+{
+    if (k < w->k0 || k >= w->k1) {
+        w->k0 = k;
+        w->k1 = end - k < TWIN_SITES ? end : k + TWIN_SITES;
+        for (size_t m = k; m < w->k1; m++) {
+            v3 s;
+            pf_place(t->x, &t->c[m], &w->s[m - k].p, &w->s[m - k].n, &s);
+        }
+    }
+    return w->s[k - w->k0];
+}
+
+/* Whether the pairing of sites i and j fades in (twin_fade above 0) and, when it does, their
+ * distance in the faces' plane: twin_fade's decision, reached without its arcsine and square
+ * roots for all but a sliver of pairs (they were half the search), so the same pairs fade in.
+ * The normals' cosine decides by more than 1e-9, and a bound decides that the vertices lie out
+ * of reach: the distance is |d x (ni - nj)| / |ni - nj| and |ni - nj| <= 2, so past the fade's
+ * end, 2 WS_TWIN_REACH, by 1 % (room for the bound's rounding) half the cross product's length
+ * puts the pair out. In the sliver it goes as twin_fade goes, or through twin_fade. */
+static int twin_fades_in(const twin_search *t, twin_site i, twin_site j, double *dt)
+{
+    const double c = -v3_dot(i.n, j.n);
+    if (c < t->cos_flat - 1e-9)
+        return 0;
+    const v3 cross = v3_cross(v3_sub(i.p, j.p), v3_sub(i.n, j.n));
+    const double out = 2.0 * (2.0 * WS_TWIN_REACH * 1.01);
+    if (v3_dot(cross, cross) > out * out)
+        return 0;
+    if (c <= t->cos_flat + 1e-9)
+        return twin_fade(i.p, i.n, j.p, j.n, dt) > 0.0;
+    *dt = plane_distance(i.p, i.n, j.p, j.n);
+    return ramp(*dt, WS_TWIN_REACH) < 1.0;
+}
+
+/* The nearest in the faces' plane to site si among the run c[q0..q1) held through window w,
+ * with a fade above 0: its index (the first of equals), or q1. */
+static size_t twin_nearest(const twin_search *t, twin_site si, twin_window *w, size_t q0,
                            size_t q1)
 {
-    v3 pi, ni, si;
-    pf_place(x, &c[i], &pi, &ni, &si);
     size_t best = q1;
     double best_d = INFINITY;
     for (size_t j = q0; j < q1; j++) {
-        v3 pj, nj, sj;
-        pf_place(x, &c[j], &pj, &nj, &sj);
         double d;
-        if (twin_fade(pi, ni, pj, nj, &d) > 0.0 && d < best_d) {
+        if (twin_fades_in(t, si, site_of(t, w, j, q1), &d) && d < best_d) {
             best = j;
             best_d = d;
         }
@@ -603,6 +667,7 @@ void ws_contact_twins_part(const ws_contact_ctx *x, ws_cand *c, size_t n, uint32
     size_t p0 = k0;
     while (p0 > 0 && p0 < n && c[p0 - 1].a == c[p0].a && c[p0 - 1].b == c[p0].b)
         p0++;
+    twin_search t = {.x = x, .c = c, .cos_flat = cos(2.0 * WS_EDGE_FLAT_FACES)};
     /* Each run of point-face candidates between a and b (a < b) against the one between b and
      * a: mutual nearest neighbours in the faces' plane are twins. */
     while (p0 < k1) {
@@ -627,9 +692,10 @@ void ws_contact_twins_part(const ws_contact_ctx *x, ws_cand *c, size_t n, uint32
             q1--;
         if (r0 == r1 || q0 == q1)
             continue;
+        t.ab.k0 = t.ab.k1 = t.ba.k0 = t.ba.k1 = 0; /* both windows empty */
         for (size_t i = r0; i < r1; i++) {
-            const size_t j = twin_nearest(x, c, i, q0, q1);
-            if (j == q1 || twin_nearest(x, c, j, r0, r1) != i)
+            const size_t j = twin_nearest(&t, site_of(&t, &t.ab, i, r1), &t.ba, q0, q1);
+            if (j == q1 || twin_nearest(&t, site_of(&t, &t.ba, j, q1), &t.ab, r0, r1) != i)
                 continue;
             v3 pi, ni, si, pj, nj, sj;
             pf_place(x, &c[i], &pi, &ni, &si);
