@@ -280,6 +280,35 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
+/* Every spring of a mesh web, in spring order, when none has a general law (every form's gen
+ * NULL): spring_one_in's and strain_of's arithmetic, the same operations in the same order (so
+ * the same forces to the bit), in one loop over the spring arrays, where the call for each
+ * spring and its general law's branches were half the cost of a mesh web's springs. */
+static void mesh_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v)
+{
+    const uint32_t *restrict sa = web->sa, *restrict sb = web->sb;
+    const uint8_t *restrict kind = web->kind, *restrict broken = web->nbroken ? web->broken : NULL;
+    const double *restrict inv_l0 = web->inv_l0, *restrict kscale = web->kscale;
+    const ws_nodes3 f = web->f;
+    for (uint32_t s = 0; s < web->ns; s++) {
+        if (broken && broken[s])
+            continue;
+        const uint32_t a = sa[s], b = sb[s];
+        const v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
+        const double l2 = v3_dot(d, d);
+        if (!(l2 > 0.0))
+            continue; /* coincident ends: no direction to pull along */
+        const double l = sqrt(l2), il = 1.0 / l, il0 = inv_l0[s];
+        const double epsd = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), d) * il * il0;
+        double F = film_force(&web->form[kind[s]], l * il0 - 1.0, epsd);
+        if (kscale)
+            F *= kscale[s];
+        const v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
+        nodes_add(f, a, fu);
+        nodes_add(f, b, v3_scale(fu, -1.0));
+    }
+}
+
 /* Gravity and node drag on node i. */
 static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
 {
@@ -533,8 +562,11 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
     const ws_nodes3 x = p->x, v = p->v;
     if (web->nx == 0) {
         base_forces(web, v, 0, web->n);
-        for (uint32_t s = 0; s < web->ns; s++)
-            spring_one_in(web, x, v, s, 0, UINT32_MAX);
+        if (!web->form[0].gen && !web->form[1].gen && !web->form[2].gen)
+            mesh_springs(web, x, v);
+        else
+            for (uint32_t s = 0; s < web->ns; s++)
+                spring_one_in(web, x, v, s, 0, UINT32_MAX);
         *n0 = 0;
         *n1 = web->n;
         return;
