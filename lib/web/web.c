@@ -106,8 +106,8 @@ static ws_spring_form form_of(const ws_law *L, double t, double since)
 }
 
 /* Strain and strain rate of spring s; 0 when its ends coincide (d is then zero too). */
-static double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *d,
-                        double *rate, double *inv_len)
+static inline double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *d,
+                               double *rate, double *inv_len)
 {
     uint32_t a = web->sa[s], b = web->sb[s];
     *d = v3_sub(nodes_get(x, b), nodes_get(x, a));
@@ -251,9 +251,11 @@ static void spring_apply(const ws_spring_form *p, in3 x, in3 v, size_t stride, s
 /* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
  * spring of a general law, which is evaluated with the spring's history as committed, at the
  * sweep's (t, since), onto those of its ends in nodes [lo, hi). A law that fails (a user
- * callback) marks the web; the step reports it. */
-static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uint32_t lo,
-                          uint32_t hi)
+ * callback) marks the web; the step reports it. Inlined into every caller: a mesh web's springs
+ * all come through here, and a call for each cost as much as the spring. */
+#define SPRING_INLINE inline __attribute__((always_inline))
+static SPRING_INLINE void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
+                                        uint32_t lo, uint32_t hi)
 {
     if (web->nbroken && web->broken[s])
         return; /* a broken spring carries nothing */
@@ -278,35 +280,6 @@ static void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, uin
         nodes_add(web->f, a, fu);
     if (b >= lo && b < hi)
         nodes_add(web->f, b, v3_scale(fu, -1.0));
-}
-
-/* Every spring of a mesh web, in spring order, when none has a general law (every form's gen
- * NULL): spring_one_in's and strain_of's arithmetic, the same operations in the same order (so
- * the same forces to the bit), in one loop over the spring arrays, where the call for each
- * spring and its general law's branches were half the cost of a mesh web's springs. */
-static void mesh_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v)
-{
-    const uint32_t *restrict sa = web->sa, *restrict sb = web->sb;
-    const uint8_t *restrict kind = web->kind, *restrict broken = web->nbroken ? web->broken : NULL;
-    const double *restrict inv_l0 = web->inv_l0, *restrict kscale = web->kscale;
-    const ws_nodes3 f = web->f;
-    for (uint32_t s = 0; s < web->ns; s++) {
-        if (broken && broken[s])
-            continue;
-        const uint32_t a = sa[s], b = sb[s];
-        const v3 d = v3_sub(nodes_get(x, b), nodes_get(x, a));
-        const double l2 = v3_dot(d, d);
-        if (!(l2 > 0.0))
-            continue; /* coincident ends: no direction to pull along */
-        const double l = sqrt(l2), il = 1.0 / l, il0 = inv_l0[s];
-        const double epsd = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), d) * il * il0;
-        double F = film_force(&web->form[kind[s]], l * il0 - 1.0, epsd);
-        if (kscale)
-            F *= kscale[s];
-        const v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
-        nodes_add(f, a, fu);
-        nodes_add(f, b, v3_scale(fu, -1.0));
-    }
 }
 
 /* Gravity and node drag on node i. */
@@ -562,11 +535,8 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
     const ws_nodes3 x = p->x, v = p->v;
     if (web->nx == 0) {
         base_forces(web, v, 0, web->n);
-        if (!web->form[0].gen && !web->form[1].gen && !web->form[2].gen)
-            mesh_springs(web, x, v);
-        else
-            for (uint32_t s = 0; s < web->ns; s++)
-                spring_one_in(web, x, v, s, 0, UINT32_MAX);
+        for (uint32_t s = 0; s < web->ns; s++)
+            spring_one_in(web, x, v, s, 0, UINT32_MAX);
         *n0 = 0;
         *n1 = web->n;
         return;
