@@ -3,8 +3,8 @@
 
 Usage: bench/phase_means.py LOG [LOG...]
 
-Each log holds lines `r R  t T s  CG X it/step  most M  C s CPU per simulated s`, one per 50 ms
-window. Prints, per phase of case R (the band's pull-in, the settling, the rest before the tilt,
+Each log holds lines `r R  t T s  CG X it/step  most M  C s CPU per simulated s` (with
+WS_BENCH_WORKERS, `C s CPU and W s wall per simulated s`), one per 50 ms window. Prints, per phase of case R (the band's pull-in, the settling, the rest before the tilt,
 the first tilt, the later tilt, the whole run), the windows' mean CG iterations a step and CPU
 seconds a simulated second for each log, and each later log's ratios to the first (iterations,
 CPU), and a last row over the range every log reached when one stopped early. A phase a log did not finish is left blank; a log that stopped partway says how far it got.
@@ -15,7 +15,8 @@ import sys
 
 PHASES = [("pull-in", 0.0, 0.05), ("settling", 0.05, 0.7), ("0.7-1.0 s", 0.7, 1.0),
           ("tilt", 1.0, 2.6), ("later tilt", 2.6, 5.9), ("whole run", 0.0, 5.9)]
-LINE = re.compile(r"r (\d+)\s+t ([\d.]+) s\s+CG ([\d.]+) it/step.*?([\d.]+) s CPU per simulated s")
+LINE = re.compile(r"r (\d+)\s+t ([\d.]+) s\s+CG ([\d.]+) it/step.*?([\d.]+) s CPU"
+                  r"(?: and [\d.]+ s wall)? per simulated s")
 
 
 def read(path):
