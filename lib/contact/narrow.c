@@ -507,15 +507,16 @@ int ws_contact_place(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double
 
 /* ---- twin corners (WS_TWIN_REACH) ---- */
 
-/* A point-face candidate's vertex (global), its face's outward normal (global) and the vertex in
- * the face owner's frame. */
+/* A point-face candidate's vertex (global), its face's outward normal (global) and, when s is not
+ * NULL, the vertex in the face owner's frame. */
 static void pf_place(const ws_contact_ctx *x, const ws_cand *c, v3 *pg, v3 *ng, v3 *s)
 {
     const ws_body_store *b = x->b;
     const ws_body_state *st = &b->st[x->cur];
     const m3 *Aa = &b->A[c->a];
     *pg = v3_add(st->r[c->b], m3_mul_v(&b->A[c->b], b->shape[c->b]->vertices[c->fb]));
-    *s = m3_tmul_v(Aa, v3_sub(*pg, st->r[c->a]));
+    if (s) /* the twin search's sites do without it */
+        *s = m3_tmul_v(Aa, v3_sub(*pg, st->r[c->a]));
     *ng = m3_mul_v(Aa, b->shape[c->a]->faces[c->fa].normal);
 }
 
@@ -575,10 +576,8 @@ static twin_site site_of(const twin_search *t, twin_window *w, size_t k, size_t 
     if (k < w->k0 || k >= w->k1) {
         w->k0 = k;
         w->k1 = end - k < TWIN_SITES ? end : k + TWIN_SITES;
-        for (size_t m = k; m < w->k1; m++) {
-            v3 s;
-            pf_place(t->x, &t->c[m], &w->s[m - k].p, &w->s[m - k].n, &s);
-        }
+        for (size_t m = k; m < w->k1; m++)
+            pf_place(t->x, &t->c[m], &w->s[m - k].p, &w->s[m - k].n, NULL);
     }
     return w->s[k - w->k0];
 }
