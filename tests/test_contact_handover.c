@@ -102,8 +102,12 @@ static void make_scene(scene *S)
     S->vertex_v = vertex_at(sb, v3_make(h, h, -h));
     S->edge_v = edge_between(sb, v3_make(-h, h, -h), v3_make(h, h, -h));
     S->c_vertex = vertex_at(sc, v3_make(0.025, 0.003, -0.025));
-    S->x = (ws_contact_ctx){
-        b, w->cur, w->def.contact_margin, w->params, w->pair_index, (uint32_t)w->pair_dim, 0};
+    S->x = (ws_contact_ctx){.b = b,
+                            .cur = w->cur,
+                            .margin = w->def.contact_margin,
+                            .params = w->params,
+                            .pair_index = w->pair_index,
+                            .nmat = (uint32_t)w->pair_dim};
 }
 
 static ws_cand cand(uint32_t a, uint32_t b, uint32_t fa, uint32_t fb, uint32_t kind)

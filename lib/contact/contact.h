@@ -149,6 +149,23 @@
  * WS_EDGE_FLAT_FACES (faces that do not lie on each other). */
 #define WS_TWIN_REACH (2.0 * WS_OUTLINE_TOL)
 
+/* A candidate's clearance (ws_contact_apart): how far its moving points may move in a's frame
+ * before it can touch, kept from the step it was found apart sideways. A point-face pair
+ * touches only with the vertex's projection on the face's plane within WS_OUTLINE_TOL of the
+ * face (ws_point_on_face; the barycentric tolerance is WS_FEATURE_TOL of the face's size), and
+ * the projection moves no more than the vertex: its distance from the face's box, less those
+ * tolerances, is a clearance. An edge pair touches only with the lines' closest points inside
+ * both edges (edge_edge), and the projection of b's closest point on a's line is a's: b's edge
+ * projected on a's line must overlap a's edge, and the projections of b's ends move no more
+ * than the ends: how far the projected edge lies past a's is a clearance, whatever the pair's
+ * flatness and cones; and the same with the bodies' parts swapped, a's edge projected on b's
+ * line in b's frame (the larger of the two is kept). Less this pad, for the rounding of the points found two ways (b's vertex
+ * through the global frame in the geometry, through the pair's relative pose in the test: 1e-16
+ * of a metre's coordinates) and of the distances: 1e-9 m is 10^6 times that and nothing beside
+ * the millimetres that cartons' gaps give. The clearance bounds where the pair can be, not
+ * where it was on the way: the test compares the points now with the points then. */
+#define WS_CLEAR_PAD 1e-9
+
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
  * inverse Gram matrix: (k1, k2) in the triangle, edges included (with the tolerance). */
 static inline int ws_bary_inside(double b1, double b2, double g00, double g01, double g11)
@@ -172,6 +189,14 @@ typedef struct ws_cand {
     v3 anchor_a, anchor_b;
     uint32_t ended, fresh;
     double twin_cut; /* scratch: 1 less a point-face contact's twin share (ws_contact_twins) */
+    /* Where the candidate's moving points lay when it was last found apart (b's vertex in a's
+     * frame; an edge's ends in the other body's frame, b's in a's or, ref_in_b, a's in b's),
+     * and how far (m) they may each move from there before it can touch (ws_contact_apart);
+     * clear 0: measure it. A hint, not state: neither saved nor hashed, 0 after a restore,
+     * carried into a full detection's list with the anchors. */
+    uint32_t ref_in_b;
+    v3 ref[2];
+    double clear;
 } ws_cand;
 
 /* An active contact of the last step. Normal from a to b; forces those on b. */
@@ -206,6 +231,12 @@ typedef struct ws_contact_ctx {
     const uint32_t *pair_index;
     uint32_t nmat;
     uint64_t narrow_checks;
+    /* The last body pair's relative pose (b in a's frame), kept while a run of its candidates
+     * is measured: a context serves one committed state (a step's; a new one after the bodies
+     * move). Zero-initialised: none kept. */
+    uint32_t pose_a, pose_b, pose_ok;
+    m3 pose_R;
+    v3 pose_t;
 } ws_contact_ctx;
 
 static inline const ws_pair_params *ws_contact_params(const ws_contact_ctx *x, uint32_t a,
@@ -238,9 +269,15 @@ int ws_shallowest_face(const ws_shape *sa, uint32_t f, v3 s, double d);
 /* Geometry of a candidate at the committed state: contact point and normal (global, a to b),
  * the signed distance and the contact's share of its laws' stiffness and damping (in (0, 1]:
  * below 1 for a nearly parallel flat edge pair, WS_EDGE_PARALLEL_SIN, and for a twin corner,
- * the candidate's share as ws_contact_twins set it); 1 when the layers overlap. */
-int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist,
+ * the candidate's share as ws_contact_twins set it); 1 when the layers overlap. Its clearance
+ * is set as it finds it: what ws_contact_apart reads when it is apart sideways, else 0. */
+int ws_contact_geometry(ws_contact_ctx *x, ws_cand *c, v3 *xg, v3 *ng, double *dist,
                         double *share);
+
+/* 1 when candidate c is still apart by its clearance (c->clear, c->ref): its moving points have
+ * not moved that far since it was found apart, so ws_contact_geometry would reject it. Such a
+ * candidate is not anchored (it was apart, and anchors only come with contact). */
+int ws_contact_apart(ws_contact_ctx *x, const ws_cand *c);
 
 /* Evaluate one candidate at the committed state: 1 when in contact, with the record filled, the
  * forces added to both bodies' accumulators and the stick anchors of *c updated. */
@@ -300,7 +337,8 @@ static inline size_t ws_contact_pair_start(const ws_cand *c, size_t n, uint32_t 
  * evaluated again from it, its record and the bodies' loads updated. */
 void ws_contact_handover(ws_contact_ctx *x, ws_cand *c, size_t n, ws_contact_rec *rec);
 
-/* Sort candidates by key and carry stick anchors over from the previous list (also sorted). */
+/* Sort candidates by key and carry stick anchors (and clearances) over from the previous list
+ * (also sorted). */
 void ws_contact_sort(ws_cand *c, size_t n);
 void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, size_t n_old);
 

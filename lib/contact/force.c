@@ -76,6 +76,10 @@ int ws_contact_measure(ws_contact_ctx *x, ws_cand *c, ws_contact_rec *rec)
 {
     v3 xg, n;
     double d, share;
+    /* Most of a load's candidates are neighbours' features a gap apart, sideways: while they
+     * have not moved that far they stay apart, unmeasured (WS_CLEAR_PAD). */
+    if (ws_contact_apart(x, c))
+        return 0;
     if (!ws_contact_geometry(x, c, &xg, &n, &d, &share)) {
         c->anchored = 0;
         return 0;

@@ -254,6 +254,81 @@ static void relative(const ws_body_store *b, int cur, uint32_t ia, uint32_t ib, 
     *t = m3_tmul_v(Aa, v3_sub(b->st[cur].r[ib], b->st[cur].r[ia]));
 }
 
+/* relative() for the context's state, kept for the pair last asked (candidates come in runs of
+ * a pair): the same products, so the same bits. */
+static void pair_pose(ws_contact_ctx *x, uint32_t ia, uint32_t ib)
+{
+    if (!x->pose_ok || x->pose_a != ia || x->pose_b != ib) {
+        relative(x->b, x->cur, ia, ib, &x->pose_R, &x->pose_t);
+        x->pose_a = ia;
+        x->pose_b = ib;
+        x->pose_ok = 1;
+    }
+}
+
+/* The clearances (WS_CLEAR_PAD): how far point s's projection on face f's plane lies from the
+ * face, at least, less the tolerances within which it still counts on it. */
+static double face_clearance(const ws_shape *sa, uint32_t f, v3 s)
+{
+    const ws_face *fc = &sa->faces[f];
+    const v3 x = v3_madd(s, fc->normal, -(v3_dot(fc->normal, s) - fc->offset));
+    const v3 o = v3_make(fmax(0.0, fmax(fc->lo.x - x.x, x.x - fc->hi.x)),
+                         fmax(0.0, fmax(fc->lo.y - x.y, x.y - fc->hi.y)),
+                         fmax(0.0, fmax(fc->lo.z - x.z, x.z - fc->hi.z)));
+    const double tol =
+        WS_OUTLINE_TOL + WS_FEATURE_TOL * v3_norm(v3_sub(fc->hi, fc->lo)) + WS_CLEAR_PAD;
+    return fmax(0.0, v3_norm(o) - tol);
+}
+
+/* How far b's edge pj-qj, projected on the line of a's edge pi-qi, lies past that edge's ends. */
+static double edge_clearance(v3 pi, v3 qi, v3 pj, v3 qj)
+{
+    const v3 u = v3_sub(qi, pi);
+    const double la = v3_norm(u);
+    const double mp = v3_dot(v3_sub(pj, pi), u) / la, mq = v3_dot(v3_sub(qj, pi), u) / la;
+    return fmax(0.0, fmax(-fmax(mp, mq), fmin(mp, mq) - la) - WS_CLEAR_PAD);
+}
+
+int ws_contact_apart(ws_contact_ctx *x, const ws_cand *c)
+{
+    if (!(c->clear > 0.0))
+        return 0;
+    pair_pose(x, c->a, c->b);
+    const m3 *R = &x->pose_R;
+    const v3 t = x->pose_t;
+    const ws_shape *sb = x->b->shape[c->b];
+    const double c2 = c->clear * c->clear;
+    if (c->kind == WS_CONTACT_POINT_FACE)
+        return v3_norm2(v3_sub(v3_add(m3_mul_v(R, sb->vertices[c->fb]), t), c->ref[0])) < c2;
+    v3 p, q;
+    if (c->ref_in_b) {
+        const ws_shape *sa = x->b->shape[c->a];
+        const ws_edge *F = &sa->edges[c->fa];
+        p = m3_tmul_v(R, v3_sub(sa->vertices[F->a], t));
+        q = m3_tmul_v(R, v3_sub(sa->vertices[F->b], t));
+    } else {
+        const ws_edge *E = &sb->edges[c->fb];
+        p = v3_add(m3_mul_v(R, sb->vertices[E->a]), t);
+        q = v3_add(m3_mul_v(R, sb->vertices[E->b]), t);
+    }
+    return v3_norm2(v3_sub(p, c->ref[0])) < c2 && v3_norm2(v3_sub(q, c->ref[1])) < c2;
+}
+
+/* An edge pair found apart: the larger of its two clearances (WS_CLEAR_PAD), with its points:
+ * b's ends in a's frame (pj, qj, against a's edge pi-qi), or a's ends in b's frame against
+ * b's edge (E's vertices). */
+static void edges_apart(ws_cand *c, const m3 *R, v3 t, v3 pi, v3 qi, v3 pj, v3 qj,
+                        const ws_shape *sb, const ws_edge *E)
+{
+    const v3 ai = m3_tmul_v(R, v3_sub(pi, t)), bi = m3_tmul_v(R, v3_sub(qi, t));
+    const double in_a = edge_clearance(pi, qi, pj, qj);
+    const double in_b = edge_clearance(sb->vertices[E->a], sb->vertices[E->b], ai, bi);
+    c->ref_in_b = in_b > in_a;
+    c->ref[0] = c->ref_in_b ? ai : pj;
+    c->ref[1] = c->ref_in_b ? bi : qj;
+    c->clear = fmax(in_a, in_b);
+}
+
 static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a, uint32_t b,
                 uint32_t fa, uint32_t fb, uint32_t kind)
 {
@@ -270,6 +345,9 @@ static int push(ws_mem *mem, ws_cand **cand, size_t *n, size_t *cap, uint32_t a,
     c->anchor_a = c->anchor_b = v3_make(0, 0, 0);
     c->ended = c->fresh = 0;
     c->twin_cut = 0.0;
+    c->ref_in_b = 0;
+    c->ref[0] = c->ref[1] = v3_make(0, 0, 0);
+    c->clear = 0.0; /* measured in its first step */
     return 0;
 }
 
@@ -388,9 +466,10 @@ int ws_contact_candidates(ws_mem *mem, ws_contact_ctx *x, uint32_t i, uint32_t j
 
 /* Geometry of one candidate at the committed state: contact point (global), normal (global, a to
  * b) and signed distance. Returns 1 when the layers overlap. */
-int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, double *dist,
+int ws_contact_geometry(ws_contact_ctx *x, ws_cand *c, v3 *xg, v3 *ng, double *dist,
                         double *share)
 {
+    c->clear = 0.0;
     const ws_body_store *b = x->b;
     const ws_body_state *st = &b->st[x->cur];
     uint32_t ia = c->a, ib = c->b;
@@ -402,8 +481,11 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         v3 pg = v3_add(st->r[ib], m3_mul_v(Ab, sb->vertices[c->fb]));
         v3 s = m3_tmul_v(Aa, v3_sub(pg, st->r[ia]));
         double d;
-        if (!ws_point_on_face(sa, c->fa, s, -reach - sa->inner, reach, &d))
+        if (!ws_point_on_face(sa, c->fa, s, -reach - sa->inner, reach, &d)) {
+            c->ref[0] = s;
+            c->clear = face_clearance(sa, c->fa, s);
             return 0;
+        }
         if (d < 0.0 && !ws_shallowest_face(sa, c->fa, s, d))
             return 0;
         *ng = m3_mul_v(Aa, sa->faces[c->fa].normal);
@@ -413,17 +495,19 @@ int ws_contact_geometry(ws_contact_ctx *x, const ws_cand *c, v3 *xg, v3 *ng, dou
         return 1;
     }
     const ws_edge *F = &sa->edges[c->fa], *E = &sb->edges[c->fb];
-    m3 R;
-    v3 t;
-    relative(b, x->cur, ia, ib, &R, &t);
+    pair_pose(x, ia, ib);
+    const m3 R = x->pose_R;
+    const v3 t = x->pose_t;
     v3 pi = sa->vertices[F->a], qi = sa->vertices[F->b];
     v3 pj = v3_add(m3_mul_v(&R, sb->vertices[E->a]), t);
     v3 qj = v3_add(m3_mul_v(&R, sb->vertices[E->b]), t);
     const edge_seg ei = {pi, qi, F->n1, F->n2};
     const edge_seg ej = {pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2)};
     edge_hit h;
-    if (!edge_edge(&ei, &ej, &h))
+    if (!edge_edge(&ei, &ej, &h)) {
+        edges_apart(c, &R, t, pi, qi, pj, qj, sb, E);
         return 0;
+    }
     const double s = h.s, u = h.t, d = h.d;
     const v3 n = h.n;
     if (!(d > -reach - fmin(sa->inner, sb->inner) && d < reach))
@@ -745,6 +829,11 @@ void ws_contact_carry_anchors(ws_cand *nw, size_t n_new, const ws_cand *old, siz
             nw[i].anchored = old[j].anchored;
             nw[i].anchor_a = old[j].anchor_a;
             nw[i].anchor_b = old[j].anchor_b;
+            /* the same features: where they were found apart holds for the new list too */
+            nw[i].ref_in_b = old[j].ref_in_b;
+            nw[i].ref[0] = old[j].ref[0];
+            nw[i].ref[1] = old[j].ref[1];
+            nw[i].clear = old[j].clear;
             i++;
             j++;
         } else if (k < 0) {
