@@ -121,7 +121,8 @@ START_TEST(test_apart_is_never_in_contact)
         /* The move: its size spread over decades, so that some clearances last and some run
          * out. */
         const v3 r2 = v3_add(r, v3_scale(random_dir(&rng), log_uniform(&rng, -6, log10(6e-3))));
-        const qt p2 = qt_mul(qt_from_rotvec(v3_scale(random_dir(&rng), log_uniform(&rng, -6, log10(0.02)))), p);
+        const qt p2 = qt_mul(
+            qt_from_rotvec(v3_scale(random_dir(&rng), log_uniform(&rng, -6, log10(0.02)))), p);
         ws_contact_ctx y = place(&S, r2, p2);
         memcpy(moved, cand, n * sizeof *cand);
         for (size_t k = 0; k < n; k++) {
@@ -134,13 +135,14 @@ START_TEST(test_apart_is_never_in_contact)
             expired_touching += !skip && cand[k].clear > 0.0 && touch;
         }
     }
-    printf("[measured] clearance: %zu candidates found apart, %zu judged apart after the move, "
-           "%zu touching once their clearance ran out, %zu judged apart while touching\n",
+    report("clearance: %zu candidates found apart, %zu judged apart after the move, %zu "
+           "touching once their clearance ran out, %zu judged apart while touching",
            apart, judged, expired_touching, wrong);
     ck_assert_msg(wrong == 0, "%zu candidates judged apart were in contact", wrong);
     /* Not vacuous: the clearance is used, and moves that use it up reach contacts. */
     ck_assert_msg(judged > 1000, "only %zu candidates judged apart", judged);
-    ck_assert_msg(expired_touching > 0, "no clearance ran out into a contact (%zu apart, %zu judged)", apart, judged);
+    ck_assert_msg(expired_touching > 0,
+                  "no clearance ran out into a contact (%zu apart, %zu judged)", apart, judged);
     ws_world_destroy(S.w);
 }
 END_TEST
@@ -174,13 +176,14 @@ START_TEST(test_clearance_reaches_the_rim)
     v3 xg, ng;
     double d, share;
     ck_assert(!ws_contact_geometry(&x, &c, &xg, &ng, &d, &share));
-    const double expect = e - WS_OUTLINE_TOL - WS_FEATURE_TOL * sqrt(2 * 0.25 * 0.25) - WS_CLEAR_PAD;
-    printf("[measured] clearance of a vertex 3 mm past the rim: %.15g m (expected %.15g)\n", c.clear,
-           expect);
+    const double expect =
+        e - WS_OUTLINE_TOL - WS_FEATURE_TOL * sqrt(2 * 0.25 * 0.25) - WS_CLEAR_PAD;
+    report("clearance of a vertex 3 mm past the rim: %.15g m (expected %.15g)", c.clear, expect);
     ck_assert_msg(fabs(c.clear - expect) < 1e-15, "clearance %.17g, expected %.17g", c.clear,
                   expect);
     ws_cand near = c;
-    ws_contact_ctx y = place(&S, v3_make(0.125 + e + 0.1 - (c.clear - 1e-9), 0.05, z), qt_identity());
+    ws_contact_ctx y =
+        place(&S, v3_make(0.125 + e + 0.1 - (c.clear - 1e-9), 0.05, z), qt_identity());
     ck_assert_msg(ws_contact_apart(&y, &near), "moved by less than its clearance, not apart");
     ck_assert(!ws_contact_geometry(&y, &near, &xg, &ng, &d, &share));
     ws_cand on = c;
@@ -197,6 +200,7 @@ static Suite *clearance_suite(void)
 {
     Suite *s = suite_create("contact_clearance");
     TCase *tc = tcase_create("clearance");
+    tcase_set_timeout(tc, 60);
     tcase_add_test(tc, test_apart_is_never_in_contact);
     tcase_add_test(tc, test_clearance_reaches_the_rim);
     suite_add_tcase(s, tc);

@@ -25,7 +25,7 @@ import subprocess
 import sys
 import time
 
-TESTS = ["test_dynamics", "test_contact", "test_web", "test_tilt_table", "test_law",
+TESTS = ["test_dynamics", "test_contact", "test_contact_clearance", "test_web", "test_tilt_table", "test_law",
          "test_element", "test_detection", "test_drive", "test_implicit", "test_rupture",
          "test_wrap", "test_loadtest", "test_loadtest_runs"]
 EXAMPLE_RUNS = [

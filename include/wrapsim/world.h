@@ -145,7 +145,8 @@ typedef struct ws_world_stats {
     double time;               /**< simulated time, s */
     uint64_t steps;            /**< steps taken */
     uint64_t full_detections;  /**< steps with full contact detection */
-    uint64_t narrow_checks;    /**< feature-pair tests (point-face, edge-edge), in all */
+    uint64_t narrow_checks;    /**< feature-pair tests (point-face, edge-edge), in all; a
+                                    candidate still apart by its clearance is not tested */
     uint64_t body_pairs_tested; /**< body pairs that reached the narrow phase, in all */
     uint64_t body_pairs_gated; /**< body pairs the libccd gate skipped, in all */
     uint64_t contacts;         /**< contacts active after the last step */

@@ -150,20 +150,20 @@
 #define WS_TWIN_REACH (2.0 * WS_OUTLINE_TOL)
 
 /* A candidate's clearance (ws_contact_apart): how far its moving points may move in a's frame
- * before it can touch, kept from the step it was found apart sideways. A point-face pair
- * touches only with the vertex's projection on the face's plane within WS_OUTLINE_TOL of the
- * face (ws_point_on_face; the barycentric tolerance is WS_FEATURE_TOL of the face's size), and
- * the projection moves no more than the vertex: its distance from the face's box, less those
- * tolerances, is a clearance. An edge pair touches only with the lines' closest points inside
- * both edges (edge_edge), and the projection of b's closest point on a's line is a's: b's edge
- * projected on a's line must overlap a's edge, and the projections of b's ends move no more
- * than the ends: how far the projected edge lies past a's is a clearance, whatever the pair's
- * flatness and cones; and the same with the bodies' parts swapped, a's edge projected on b's
- * line in b's frame (the larger of the two is kept). Less this pad, for the rounding of the points found two ways (b's vertex
- * through the global frame in the geometry, through the pair's relative pose in the test: 1e-16
- * of a metre's coordinates) and of the distances: 1e-9 m is 10^6 times that and nothing beside
- * the millimetres that cartons' gaps give. The clearance bounds where the pair can be, not
- * where it was on the way: the test compares the points now with the points then. */
+ * before it can touch, kept from the step it was found apart sideways. A point-face pair touches
+ * only with the vertex's projection on the face's plane within WS_OUTLINE_TOL of the face
+ * (ws_point_on_face; the barycentric tolerance is WS_FEATURE_TOL of the face's size), and the
+ * projection moves no more than the vertex: its distance from the face's box, less those
+ * tolerances, is a clearance. An edge pair touches only with the lines' closest points inside both
+ * edges (edge_edge), and the projection of b's closest point on a's line is a's: b's edge
+ * projected on a's line must overlap a's edge, and the projections of b's ends move no more than
+ * the ends: how far the projected edge lies past a's is a clearance, whatever the pair's flatness
+ * and cones; and the same with the bodies' parts swapped, a's edge projected on b's line in b's
+ * frame (the larger of the two is kept). Less this pad, for the rounding of the points found two
+ * ways (b's vertex through the global frame in the geometry, through the pair's relative pose in
+ * the test: 1e-16 of a metre's coordinates) and of the distances: 1e-9 m is 10^6 times that and
+ * nothing beside the millimetres that cartons' gaps give. The clearance bounds where the pair can
+ * be, not where it was on the way: the test compares the points now with the points then. */
 #define WS_CLEAR_PAD 1e-9
 
 /* Eq. 14's inclusion test from the two dot products b1 = r.w, b2 = r.v and the triangle's
