@@ -14,19 +14,11 @@ typedef struct pair_scene {
     uint32_t A, B;
 } pair_scene;
 
+/* A dynamic box of 5 kg (helpers.h add_box), as its slot. */
 static uint32_t box_slot(ws_world *w, double lx, double ly, double lz, ws_vec3 pos)
 {
-    ws_shape_id s;
-    ck_ok(w, ws_shape_create_box(w, lx, ly, lz, &s));
-    ws_body_def bd;
-    ws_body_def_init(&bd);
-    bd.shape = s;
-    bd.mass = 5.0;
-    bd.position = pos;
-    ws_body_id id;
-    ck_ok(w, ws_body_create(w, &bd, &id));
     uint32_t slot;
-    ck_ok(w, ws_lookup_body(w, id, &slot));
+    ck_ok(w, ws_lookup_body(w, add_box(w, lx, ly, lz, 5.0, pos, no_material(), NULL), &slot));
     return slot;
 }
 
@@ -199,11 +191,8 @@ END_TEST
 static Suite *clearance_suite(void)
 {
     Suite *s = suite_create("contact_clearance");
-    TCase *tc = tcase_create("clearance");
-    tcase_set_timeout(tc, 60);
-    tcase_add_test(tc, test_apart_is_never_in_contact);
-    tcase_add_test(tc, test_clearance_reaches_the_rim);
-    suite_add_tcase(s, tc);
+    add_case(s, "apart", test_apart_is_never_in_contact, 60);
+    add_case(s, "rim", test_clearance_reaches_the_rim, 60);
     return s;
 }
 

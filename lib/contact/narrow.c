@@ -314,18 +314,18 @@ int ws_contact_apart(ws_contact_ctx *x, const ws_cand *c)
     return v3_norm2(v3_sub(p, c->ref[0])) < c2 && v3_norm2(v3_sub(q, c->ref[1])) < c2;
 }
 
-/* An edge pair found apart: the larger of its two clearances (WS_CLEAR_PAD), with its points:
- * b's ends in a's frame (pj, qj, against a's edge pi-qi), or a's ends in b's frame against
- * b's edge (E's vertices). */
-static void edges_apart(ws_cand *c, const m3 *R, v3 t, v3 pi, v3 qi, v3 pj, v3 qj,
+/* An edge pair found apart (ei a's edge, ej b's, both in a's frame; b's edge E in its own
+ * frame): the larger of its two clearances (WS_CLEAR_PAD), with its points: b's ends in a's
+ * frame, or a's ends in b's frame (s_b = R^T (s_a - t)). */
+static void edges_apart(ws_cand *c, const edge_seg *ei, const edge_seg *ej, const m3 *R, v3 t,
                         const ws_shape *sb, const ws_edge *E)
 {
-    const v3 ai = m3_tmul_v(R, v3_sub(pi, t)), bi = m3_tmul_v(R, v3_sub(qi, t));
-    const double in_a = edge_clearance(pi, qi, pj, qj);
+    const v3 ai = m3_tmul_v(R, v3_sub(ei->p, t)), bi = m3_tmul_v(R, v3_sub(ei->q, t));
+    const double in_a = edge_clearance(ei->p, ei->q, ej->p, ej->q);
     const double in_b = edge_clearance(sb->vertices[E->a], sb->vertices[E->b], ai, bi);
     c->ref_in_b = in_b > in_a;
-    c->ref[0] = c->ref_in_b ? ai : pj;
-    c->ref[1] = c->ref_in_b ? bi : qj;
+    c->ref[0] = c->ref_in_b ? ai : ej->p;
+    c->ref[1] = c->ref_in_b ? bi : ej->q;
     c->clear = fmax(in_a, in_b);
 }
 
@@ -505,7 +505,7 @@ int ws_contact_geometry(ws_contact_ctx *x, ws_cand *c, v3 *xg, v3 *ng, double *d
     const edge_seg ej = {pj, qj, m3_mul_v(&R, E->n1), m3_mul_v(&R, E->n2)};
     edge_hit h;
     if (!edge_edge(&ei, &ej, &h)) {
-        edges_apart(c, &R, t, pi, qi, pj, qj, sb, E);
+        edges_apart(c, &ei, &ej, &R, t, sb, E);
         return 0;
     }
     const double s = h.s, u = h.t, d = h.d;
