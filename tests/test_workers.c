@@ -11,6 +11,7 @@
 #include <stdatomic.h>
 
 #include "base/pool.h"
+#include "web/forces.h"
 #include "world/world_internal.h"
 #include "helpers.h"
 
@@ -132,7 +133,60 @@ typedef struct sheet_run {
     uint64_t *narrow_reruns, *full; /* how many did, and the full detections (may be NULL) */
     int implicit; /* the implicit film at the real film's areal density, on the multigrid */
     int one_lane; /* a sheet of one sweep block onto a second box on the first */
+    int mesh;     /* the sheet made again as a mesh web, its springs scaled, its masses apart */
 } sheet_run;
+
+/* Grid web g made again as a mesh web (the same nodes and springs, in the same order) whose
+ * springs' stiffness scales run from 0.75 to 1.25 and whose node masses from 0.8 to 1.2 of the
+ * sheet's: the mesh's own ways through the sweep (a law's force times its spring's scale, each
+ * node its own mass). The sheet is destroyed; the mesh is returned. */
+static ws_web_id sheet_as_mesh(ws_world *w, const ws_web_def *wd, ws_web_id g)
+{
+    uint32_t slot;
+    ck_assert_int_eq(ws_lookup_web(w, g, &slot), WS_OK);
+    const ws_web *s = w->webs[slot];
+    const uint32_t n = s->n, ns = s->ns;
+    double *pos = malloc(3 * n * sizeof *pos), *mass = malloc(n * sizeof *mass);
+    double *rest = malloc(ns * sizeof *rest), *scale = malloc(ns * sizeof *scale);
+    uint32_t *spr = malloc(2 * ns * sizeof *spr);
+    uint8_t *kind = malloc(ns);
+    ck_assert(pos && mass && rest && scale && spr && kind);
+    for (uint32_t i = 0; i < n; i++) {
+        pos[3 * i] = s->x[0].x[i];
+        pos[3 * i + 1] = s->x[0].y[i];
+        pos[3 * i + 2] = s->x[0].z[i];
+        mass[i] = s->m[i] * (0.8 + 0.4 * (double)((i * 37u) % 101u) / 100.0);
+    }
+    for (uint32_t k = 0; k < ns; k++) {
+        spr[2 * k] = s->sa[k];
+        spr[2 * k + 1] = s->sb[k];
+        rest[k] = 1.0 / s->inv_l0[k];
+        kind[k] = s->kind[k];
+        scale[k] = 0.75 + 0.5 * (double)((k * 53u) % 97u) / 96.0;
+    }
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = pos;
+    md.node_count = n;
+    md.node_masses = mass;
+    md.springs = spr;
+    md.spring_count = ns;
+    md.rest_lengths = rest;
+    md.kinds = kind;
+    md.stiffness_scales = scale;
+    ws_web_def d = *wd;
+    d.node_mass = 0.0;
+    ws_web_id m;
+    ck_ok(w, ws_web_create_mesh(w, &d, &md, &m));
+    ck_ok(w, ws_web_destroy(w, g));
+    free(pos);
+    free(mass);
+    free(rest);
+    free(scale);
+    free(spr);
+    free(kind);
+    return m;
+}
 
 /* A 48 x 40 sheet with shear springs (5 sweep blocks of 8 rows), pre-stretched, 3 mm above a
  * box on the ground, so that dropped it drapes over the edges: contacts on faces, edges and
@@ -186,6 +240,8 @@ static ws_world *sheet_world(const ws_world_def *d, const sheet_run *r, ws_body_
     sd.prestretch_x = sd.prestretch_y = 0.02;
     sd.shear = 1;
     ck_ok(w, ws_web_create_sheet(w, &wd, &sd, web));
+    if (r->mesh)
+        *web = sheet_as_mesh(w, &wd, *web);
     if (r->implicit)
         return w; /* one sub-step */
     double S;
@@ -276,7 +332,7 @@ static int hosts_agree(sheet_run r, long steps, uint64_t one)
 START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
         r.workers = k;
@@ -289,7 +345,7 @@ START_TEST(test_sheet_same_for_any_workers)
      * pieces that run out are searched again on the world's thread, and the list is the
      * same. */
     uint64_t reruns = 0;
-    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL, 0, 0};
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 1, &reruns, 0, 0, NULL, NULL, 0, 0, 0};
     uint64_t h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "pieces searched again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -309,7 +365,7 @@ END_TEST
 START_TEST(test_bodies_beside_one_lane)
 {
     const long steps = sheet_steps();
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     for (int k = 2; k <= 3; k++) {
         r.workers = k;
@@ -333,7 +389,7 @@ START_TEST(test_detection_beside_the_film)
 {
     const long steps = sheet_steps();
     uint64_t full = 0, reruns = 0;
-    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full, 0, 0};
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full, 0, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     /* ceil(steps / 5) full detections, the first of them at step 0. */
     ck_assert_msg(full == (uint64_t)(steps + 4) / 5, "%llu full detections in %ld steps",
@@ -345,7 +401,7 @@ START_TEST(test_detection_beside_the_film)
                       "%d workers, a full detection every 5th step: 0x%016llx, 1 worker 0x%016llx",
                       k, (unsigned long long)h, (unsigned long long)one);
     }
-    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL, 0, 0};
+    r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL, 0, 0, 0};
     const uint64_t h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "narrow phases run again: 0x%016llx, 1 worker 0x%016llx",
                   (unsigned long long)h, (unsigned long long)one);
@@ -353,6 +409,176 @@ START_TEST(test_detection_beside_the_film)
     report("workers: sheet, full detection every 5th step (%llu), %ld steps: 0x%016llx for 1-3 "
            "workers, %llu narrow phases run again",
            (unsigned long long)full, steps, (unsigned long long)one, (unsigned long long)reruns);
+}
+END_TEST
+
+/* A mesh web is swept in lanes of rows of WS_WEB_MESH_ROW nodes, its springs' forces computed
+ * in pieces first and gathered node by node in spring order: the sheet made again as a mesh
+ * (1920 nodes: 30 rows, 5 blocks) gives one state hash on 1 to 4 workers and both host
+ * schedulers. */
+START_TEST(test_mesh_same_for_any_workers)
+{
+    const long steps = sheet_steps();
+    sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 0, 1};
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    for (int k = 2; k <= 4; k++) {
+        r.workers = k;
+        const uint64_t h = sheet_hash(&r, steps, NULL);
+        ck_assert_msg(h == one, "mesh, %d workers: 0x%016llx, 1 worker 0x%016llx", k,
+                      (unsigned long long)h, (unsigned long long)one);
+    }
+    const int calls = hosts_agree(r, steps, one);
+    /* The mesh is swept in lanes at all: two blocks or more, laws of film form. */
+    ws_world_def d;
+    ws_world_def_init(&d);
+    ws_body_id box;
+    ws_web_id web;
+    ws_world *w = sheet_world(&d, &r, &box, &web);
+    uint32_t slot;
+    ck_assert_int_eq(ws_lookup_web(w, web, &slot), WS_OK);
+    ck_assert_uint_eq(ws_web_rows(w->webs[slot]), 30);
+    ck_assert_uint_eq(ws_web_block_count(w->webs[slot]), 5);
+    ck_assert(ws_web_sweep_parallel(w->webs[slot]));
+    ws_world_destroy(w);
+    report("workers: mesh sheet, %ld steps: 0x%016llx for 1-4 workers and both schedulers "
+           "(%d tasks to the host)",
+           steps, (unsigned long long)one, calls);
+}
+END_TEST
+
+/* A mesh web's springs, computed in pieces on vectors (rows of springs on contiguous loads, the
+ * rest gathered by index; a law not of the film form one by one) and gathered node by node,
+ * give each node the force the springs scattered one by one in spring order give, to the bit
+ * (memcmp): the same terms in the same order. 800 nodes at random, 40 rows of 19 springs end to
+ * end, 600 springs between nodes at random, of three kinds (linear viscoelastic, the film's
+ * tension and compression law, and a cubic law, which is not of the film form) with
+ * stiffness scales; two springs broken and one whose ends coincide (neither pulls), random
+ * velocities; the springs in three pieces. */
+START_TEST(test_mesh_gather_is_the_scatter)
+{
+    ws_world_def d;
+    ws_world_def_init(&d);
+    ws_world *w = NULL;
+    ck_assert_int_eq(ws_world_create(&d, &w), WS_OK);
+    ws_law_id law[3];
+    for (int k = 0; k < 3; k++) {
+        ws_law_def ld;
+        ws_law_def_init(&ld);
+        ld.type = k == 2   ? WS_LAW_CUBIC_ELASTIC
+                  : k == 1 ? WS_LAW_TENSION_COMPRESSION
+                           : WS_LAW_LINEAR_VISCOELASTIC;
+        ld.stiffness = 200.0 + 50.0 * k;
+        ld.damping = k == 2 ? 0.0 : 0.05;
+        if (k == 1)
+            ld.compression_stiffness = 10.0;
+        if (k == 2)
+            ld.cubic_stiffness = 2e3;
+        ck_ok(w, ws_law_create(w, &ld, &law[k]));
+    }
+    enum { N = 800, ROWS = 40, RUN = 19, RANDOM = 600, NS = ROWS * RUN + RANDOM };
+    static double pos[3 * N], mass[N], scale[NS];
+    static uint32_t spr[2 * NS];
+    static uint8_t kind[NS];
+    srand(7);
+    for (int i = 0; i < 3 * N; i++)
+        pos[i] = (double)rand() / RAND_MAX;
+    for (int i = 0; i < N; i++)
+        mass[i] = 1e-3 * (0.5 + (double)rand() / RAND_MAX);
+    for (int s = 0; s < NS; s++) {
+        const int row = s / RUN, i = s % RUN;
+        uint32_t a = (uint32_t)(row * (RUN + 1) + i), b = a + 1;
+        if (s >= ROWS * RUN) {
+            a = (uint32_t)(rand() % N);
+            b = (uint32_t)((a + 1 + (uint32_t)(rand() % (N - 1))) % N);
+        }
+        spr[2 * s] = a;
+        spr[2 * s + 1] = b;
+        kind[s] = (uint8_t)(s < ROWS * RUN ? (row % 2) : (s % 3));
+        scale[s] = 0.5 + (double)rand() / RAND_MAX;
+    }
+    /* Spring 5's ends coincide (its rest length set, as its ends give none). */
+    for (int c = 0; c < 3; c++)
+        pos[3 * spr[11] + c] = pos[3 * spr[10] + c];
+    static double rest[NS];
+    for (int s = 0; s < NS; s++) {
+        const double *a = pos + 3 * spr[2 * s], *b = pos + 3 * spr[2 * s + 1];
+        const double l = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                              (b[2] - a[2]) * (b[2] - a[2]));
+        rest[s] = l > 0.0 ? 0.9 * l : 0.01;
+    }
+    ws_web_def wd;
+    ws_web_def_init(&wd);
+    wd.law = law[0];
+    wd.law_cross = law[1];
+    wd.law_shear = law[2];
+    wd.node_damping = 1e-3;
+    wd.rupture_strain = 10.0;
+    ws_web_mesh_def md;
+    ws_web_mesh_def_init(&md);
+    md.positions = pos;
+    md.node_count = N;
+    md.node_masses = mass;
+    md.springs = spr;
+    md.spring_count = NS;
+    md.kinds = kind;
+    md.rest_lengths = rest;
+    md.stiffness_scales = scale;
+    ws_web_id id;
+    ck_ok(w, ws_web_create_mesh(w, &wd, &md, &id));
+    uint32_t slot;
+    ck_assert_int_eq(ws_lookup_web(w, id, &slot), WS_OK);
+    ws_web *web = w->webs[slot];
+    web->broken[3] = web->broken[ROWS * RUN + 7] = 1;
+    web->nbroken = 2;
+    const ws_nodes3 x = web->x[0], v = web->v[0];
+    for (uint32_t i = 0; i < N; i++) {
+        v.x[i] = (double)rand() / RAND_MAX - 0.5;
+        v.y[i] = (double)rand() / RAND_MAX - 0.5;
+        v.z[i] = (double)rand() / RAND_MAX - 0.5;
+    }
+    ws_web_sweep_laws(web, (v3){0.0, 0.0, -9.81}, 0.0, 0.0);
+    ck_assert_ptr_null(web->form[0].gen);
+    ck_assert_ptr_null(web->form[1].gen);
+    ck_assert_ptr_nonnull(web->form[2].gen);
+    ws_web_mesh_springs(web, x, v, 0, 333);
+    ws_web_mesh_springs(web, x, v, 333, 1000);
+    ws_web_mesh_springs(web, x, v, 1000, NS);
+    ws_web_mesh_gather(web, v, 0, N);
+    static double got[3 * N], ref[3 * N];
+    for (uint32_t i = 0; i < N; i++) {
+        got[3 * i] = web->f.x[i];
+        got[3 * i + 1] = web->f.y[i];
+        got[3 * i + 2] = web->f.z[i];
+        const v3 b = base_force(web, v, i);
+        ref[3 * i] = b.x;
+        ref[3 * i + 1] = b.y;
+        ref[3 * i + 2] = b.z;
+    }
+    int pulls = 0;
+    for (uint32_t s = 0; s < NS; s++) {
+        v3 fu;
+        if (!spring_force(web, x, v, s, &fu))
+            continue;
+        pulls++;
+        const uint32_t a = web->sa[s], b = web->sb[s];
+        ref[3 * a] += fu.x;
+        ref[3 * a + 1] += fu.y;
+        ref[3 * a + 2] += fu.z;
+        ref[3 * b] += -fu.x;
+        ref[3 * b + 1] += -fu.y;
+        ref[3 * b + 2] += -fu.z;
+    }
+    ck_assert_int_eq(pulls, NS - 3);
+    ck_assert_int_eq(web->law_failed, 0);
+    int differ = 0;
+    for (int i = 0; i < 3 * N; i++)
+        differ += memcmp(&got[i], &ref[i], sizeof(double)) != 0;
+    ck_assert_msg(differ == 0, "%d of %d force components differ from the scatter's", differ,
+                  3 * N);
+    ws_world_destroy(w);
+    report("workers: mesh gather, %d nodes, %d springs (%d pulling): the scatter's forces to "
+           "the bit",
+           N, NS, pulls);
 }
 END_TEST
 
@@ -385,7 +611,7 @@ START_TEST(test_refused_after_the_film)
         ws_world_def_init(&d);
         d.dt = 2.5e-4;
         d.worker_count = 2;
-        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
+        const sheet_run r = {2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
         ws_body_id box;
         ws_web_id web;
         ws_world *w = sheet_world(&d, &r, &box, &web);
@@ -444,14 +670,14 @@ START_TEST(test_sheet_law_with_history)
      * history or a user's function would be) sweeps in one lane whatever the workers: the
      * same hash, and the host's scheduler never called. */
     const long steps = short_run() ? 120 : 500;
-    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
+    sheet_run r = {1, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
     const uint64_t one = sheet_hash(&r, steps, NULL);
     int calls = 0;
-    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
+    r = (sheet_run){2, 1, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
     ck_assert(sheet_hash(&r, steps, &calls) == one);
     ck_assert_int_eq(calls, 0);
     if (!short_run()) {
-        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0};
+        r = (sheet_run){2, 0, WS_LAW_CUBIC_ELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
         ck_assert(sheet_hash(&r, steps, NULL) == one);
     }
 }
@@ -472,7 +698,7 @@ START_TEST(test_implicit_same_for_any_workers)
     const long steps = shorter ? 30 : 120;
     for (int law = 0; law < 2; law++) {
         const int type = law ? WS_LAW_CUBIC_ELASTIC : WS_LAW_LINEAR_VISCOELASTIC;
-        sheet_run r = {1, 0, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
+        sheet_run r = {1, 0, type, 0, NULL, 0, 0, NULL, NULL, 1, 0, 0};
         const uint64_t one = sheet_hash(&r, steps, NULL);
         for (int k = 2; k <= (shorter ? 2 : 3); k++) {
             r.workers = k;
@@ -483,13 +709,13 @@ START_TEST(test_implicit_same_for_any_workers)
         if (law && shorter)
             continue;
         int calls = 0;
-        r = (sheet_run){3, 1, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
+        r = (sheet_run){3, 1, type, 0, NULL, 0, 0, NULL, NULL, 1, 0, 0};
         uint64_t h = sheet_hash(&r, steps, &calls);
         ck_assert_msg(h == one, "law %d, reverse scheduler: 0x%016llx, 1 worker 0x%016llx", type,
                       (unsigned long long)h, (unsigned long long)one);
         ck_assert_msg(calls > 0, "the host's scheduler was never called");
         if (!shorter) {
-            r = (sheet_run){2, 2, type, 0, NULL, 0, 0, NULL, NULL, 1, 0};
+            r = (sheet_run){2, 2, type, 0, NULL, 0, 0, NULL, NULL, 1, 0, 0};
             h = sheet_hash(&r, steps, NULL);
             ck_assert_msg(h == one, "law %d, threaded scheduler: 0x%016llx, 1 worker 0x%016llx",
                           type, (unsigned long long)h, (unsigned long long)one);
@@ -651,6 +877,8 @@ int main(void)
     add_case(s, "sheet_same_for_any_workers", test_sheet_same_for_any_workers, 300);
     add_case(s, "detection_beside_the_film", test_detection_beside_the_film, 300);
     add_case(s, "bodies_beside_one_lane", test_bodies_beside_one_lane, 300);
+    add_case(s, "mesh_same_for_any_workers", test_mesh_same_for_any_workers, 300);
+    add_case(s, "mesh_gather_is_the_scatter", test_mesh_gather_is_the_scatter, 60);
     add_case(s, "refused_after_the_film", test_refused_after_the_film, 300);
     add_case(s, "sheet_law_with_history", test_sheet_law_with_history, 300);
     add_case(s, "implicit_same_for_any_workers", test_implicit_same_for_any_workers, 300);

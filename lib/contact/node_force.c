@@ -941,11 +941,11 @@ static size_t seg_cut_range(seg_cut *sc, const ws_web *web, uint32_t bl, size_t 
     return k;
 }
 
-/* The length of the blocks stretches are cut in: a grid web's rows (a sweep block holds whole
- * rows, ws_web_block_count), else the whole web. */
+/* The length of the blocks stretches are cut in: a web's rows (a sweep block holds whole rows,
+ * ws_web_block_count; a mesh web's last row is cut as the others, past its rows' count). */
 static uint32_t seg_block(const ws_web *web)
 {
-    return web->nx > 0 ? (uint32_t)web->nx : (web->n ? web->n : 1u);
+    return ws_web_row_len(web);
 }
 
 /* Room for the run batch of a web of n nodes: its groups, the run passes' scratch, the nodes'
@@ -1081,7 +1081,7 @@ void ws_node_contacts(const ws_node_pass *P, ws_web *web, uint32_t n1, size_t *n
         tried += sg->c1 - sg->c0;
         if (nc->row_mark && sg->n0 >= row_end) { /* a row's first stretch */
             nc->row_mark[nc->nrow_mark++] = L.nl;
-            row_end = (uint64_t)(sg->n0 / (uint32_t)web->nx + 1) * (uint32_t)web->nx;
+            row_end = (uint64_t)(sg->n0 / seg_block(web) + 1) * seg_block(web);
         }
         if (sg->run)
             contacts_run(&E, &B, cand, sg, h, share, fc);

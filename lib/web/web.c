@@ -1,4 +1,4 @@
-#include "web/web.h"
+#include "web/forces.h"
 #include "web/implicit.h"
 
 #include <float.h>
@@ -67,6 +67,10 @@ void ws_web_free(ws_mem *mem, ws_web *web)
     ws_mem_free(mem, web->inv_l0, ((size_t)web->ns + WS_WEB_PAD) * sizeof(double));
     ws_mem_free(mem, web->kind, ns * sizeof(uint8_t));
     ws_mem_free(mem, web->kscale, web->kscale ? (size_t)web->ns * sizeof(double) : 0);
+    ws_mem_free(mem, web->inc0, web->inc0 ? (n + 1) * sizeof(uint32_t) : 0);
+    ws_mem_free(mem, web->inc, web->inc ? 2 * ns * sizeof(uint32_t) : 0);
+    ws_mem_free(mem, web->sf, web->sf ? ns * sizeof(v3) : 0);
+    ws_mem_free(mem, web->son, web->son ? ns : 0);
     ws_mem_free(mem, web->hist, web->hist ? (size_t)web->ns * web->nstate * sizeof(double) : 0);
     ws_mem_free(mem, web->broken, web->broken ? (size_t)web->ns + WS_WEB_PAD : 0);
     ws_mem_free_str(mem, web->name);
@@ -85,16 +89,6 @@ void ws_web_note_masses(ws_web *web)
     web->inv_m1 = web->n ? web->inv_m[0] : 0.0;
 }
 
-/* The film form's force at (eps, eps_dot): computed, then selected, so it runs on vectors. */
-static inline double film_force(const ws_spring_form *p, double eps, double epsd)
-{
-    double a = eps + p->w;
-    a = a > 0.0 ? a : 0.0;
-    double quad = a * a * p->qw;
-    double ramp = eps >= p->w ? eps : quad;
-    return p->kc * eps + p->dk * ramp + p->c * epsd;
-}
-
 static ws_spring_form form_of(const ws_law *L, double t, double since)
 {
     ws_spring_form p = {0.0, 0.0, 1.0, 0.25, 0.0, NULL, t, since};
@@ -103,23 +97,6 @@ static ws_spring_form form_of(const ws_law *L, double t, double since)
     else if (L)
         p.qw = 0.25 / p.w;
     return p;
-}
-
-/* Strain and strain rate of spring s; 0 when its ends coincide (d is then zero too). */
-static inline double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s, v3 *d,
-                               double *rate, double *inv_len)
-{
-    uint32_t a = web->sa[s], b = web->sb[s];
-    *d = v3_sub(nodes_get(x, b), nodes_get(x, a));
-    double l2 = v3_dot(*d, *d);
-    if (!(l2 > 0.0)) {
-        *rate = *inv_len = 0.0;
-        return -1.0;
-    }
-    double l = sqrt(l2), il = 1.0 / l, il0 = web->inv_l0[s];
-    *rate = v3_dot(v3_sub(nodes_get(v, b), nodes_get(v, a)), *d) * il * il0;
-    *inv_len = il;
-    return l * il0 - 1.0;
 }
 
 /* The histories of the springs whose law keeps one, advanced at their strains and rates at
@@ -248,33 +225,13 @@ static void spring_apply(const ws_spring_form *p, in3 x, in3 v, size_t stride, s
     }
 }
 
-/* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
- * spring of a general law, which is evaluated with the spring's history as committed, at the
- * sweep's (t, since), onto those of its ends in nodes [lo, hi). A law that fails (a user
- * callback) marks the web; the step reports it. Inlined into every caller: a mesh web's springs
- * all come through here, and a call for each cost as much as the spring. */
-#define SPRING_INLINE inline __attribute__((always_inline))
+/* The same onto those of its ends in nodes [lo, hi). */
 static SPRING_INLINE void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s,
                                         uint32_t lo, uint32_t hi)
 {
-    if (web->nbroken && web->broken[s])
-        return; /* a broken spring carries nothing */
-    const ws_spring_form *p = &web->form[web->kind[s]];
-    v3 d;
-    double epsd, il, eps = strain_of(web, x, v, s, &d, &epsd, &il);
-    if (il == 0.0)
-        return; /* coincident ends: no direction to pull along */
-    double F = 0.0;
-    if (!p->gen) {
-        F = film_force(p, eps, epsd);
-    } else if (ws_law_eval(p->gen, web->nstate ? web->hist + (size_t)s * web->nstate : NULL, &eps,
-                           &epsd, p->t, p->since, &F, NULL, NULL) != 0) {
-        web->law_failed = 1;
+    v3 fu;
+    if (!spring_force(web, x, v, s, &fu))
         return;
-    }
-    if (web->kscale)
-        F *= web->kscale[s];
-    v3 fu = v3_scale(d, F * il); /* tension pulls the ends together */
     const uint32_t a = web->sa[s], b = web->sb[s];
     if (a >= lo && a < hi)
         nodes_add(web->f, a, fu);
@@ -282,16 +239,8 @@ static SPRING_INLINE void spring_one_in(ws_web *web, ws_nodes3 x, ws_nodes3 v, u
         nodes_add(web->f, b, v3_scale(fu, -1.0));
 }
 
-/* Gravity and node drag on node i. */
-static inline v3 base_force(const ws_web *web, ws_nodes3 v, size_t i)
-{
-    const v3 g = web->g;
-    const double c = web->damping, m = web->same_m ? web->m1 : web->m[i];
-    return v3_make(g.x * m - c * v.x[i], g.y * m - c * v.y[i], g.z * m - c * v.z[i]);
-}
-
-/* The same on nodes [n0, n1), the start of their forces: a mesh web's, or a row whose springs
- * go one by one, where their laws cost far more than this loop. */
+/* The same on nodes [n0, n1), the start of their forces: a row whose springs go one by one,
+ * where their laws cost far more than this loop. */
 static void base_forces(ws_web *web, ws_nodes3 v, size_t n0, size_t n1)
 {
     for (size_t i = n0; i < n1; i++)
@@ -484,23 +433,29 @@ static void pair_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, size_t j, size_t
             spring_one_in(web, x, v, (uint32_t)s, lo, hi);
 }
 
+uint32_t ws_web_rows(const ws_web *web)
+{
+    if (web->nx > 0)
+        return web->ny > 0 ? (uint32_t)web->ny : 0u;
+    return web->n >= WS_WEB_MESH_ROW ? web->n / WS_WEB_MESH_ROW : 1u;
+}
+
+uint32_t ws_web_row_len(const ws_web *web)
+{
+    return web->nx > 0 ? (uint32_t)web->nx : WS_WEB_MESH_ROW;
+}
+
 uint32_t ws_web_block_rows(const ws_web *web)
 {
-    if (web->nx <= 0 || web->ny <= 0)
-        return 1u;
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
-    const size_t r = (WS_WEB_BLOCK_NODES + nx - 1) / nx;
-    return (uint32_t)(r < ny ? r : ny);
+    const uint32_t len = ws_web_row_len(web), rows = ws_web_rows(web);
+    const uint32_t r = (WS_WEB_BLOCK_NODES + len - 1) / len;
+    return rows == 0 ? 1u : r < rows ? r : rows;
 }
 
 uint32_t ws_web_block_count(const ws_web *web)
 {
-    if (web->nx <= 0)
-        return 1u; /* a mesh web */
-    if (web->ny <= 0)
-        return 0u;
-    const size_t r = ws_web_block_rows(web);
-    return (uint32_t)(((size_t)web->ny + r - 1) / r);
+    const uint32_t r = ws_web_block_rows(web);
+    return (ws_web_rows(web) + r - 1) / r;
 }
 
 void ws_web_sweep_laws(ws_web *web, v3 g, double t, double since)
@@ -526,23 +481,21 @@ int ws_web_laws_on_workers(const ws_web *web)
 
 int ws_web_sweep_parallel(const ws_web *web)
 {
-    return web->nx > 0 && ws_web_block_count(web) >= 2 && ws_web_laws_on_workers(web);
+    return ws_web_block_count(web) >= 2 && ws_web_laws_on_workers(web);
 }
 
 void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,
                         uint32_t *n0, uint32_t *n1)
 {
     const ws_nodes3 x = p->x, v = p->v;
+    *n0 = ws_web_row_node(web, j0);
+    *n1 = ws_web_row_node(web, j1);
     if (web->nx == 0) {
-        base_forces(web, v, 0, web->n);
-        for (uint32_t s = 0; s < web->ns; s++)
-            spring_one_in(web, x, v, s, 0, UINT32_MAX);
-        *n0 = 0;
-        *n1 = web->n;
+        ws_web_mesh_gather(web, v, *n0, *n1);
         return;
     }
     /* Row j is complete once row j + 1 is started and the springs between the two are in. */
-    const size_t nx = (size_t)web->nx, ny = (size_t)web->ny;
+    const size_t ny = (size_t)web->ny;
     if (j0 == 0) {
         grid_row(web, x, v, 0, 0);
     } else if (edges & WS_WEB_LANE_FIRST) {
@@ -557,8 +510,6 @@ void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t
             pair_springs(web, x, v, j, 0, ny);
         }
     }
-    *n0 = (uint32_t)(nx * j0);
-    *n1 = (uint32_t)(nx * j1);
 }
 
 /* Symplectic Euler for m nodes, the three components in one loop: v1 = (v0 + h f / m) (0 when

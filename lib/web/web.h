@@ -95,6 +95,12 @@ typedef struct ws_web {
      * NULL when every spring takes its law as it is. Mesh webs only: their springs run one by
      * one (spring_one_in), so the grid's vector loops never read it. */
     double *kscale;
+    /* A mesh web's springs by node (ws_web_mesh_index): node i's are inc[inc0[i] ..
+     * inc0[i + 1]), each 2 s + 1 when i is spring s's end b, else 2 s, in spring order; and the
+     * sweep's scratch: each spring's force on its end a, sf[s], when it pulls (son[s] 1). */
+    uint32_t *inc0, *inc;
+    v3 *sf;
+    uint8_t *son;
     ws_law *law[3];          /* by kind; NULL when no spring of that kind */
     /* Laws with history (relaxation...): each spring's own, nstate doubles a spring, spring s
      * at hist + s nstate; committed after an accepted step (ws_web_commit), read during it. */
@@ -152,13 +158,19 @@ int ws_web_law_state(ws_mem *mem, ws_web *web);
  * the rupture limit (when one is set), commit the springs' histories. */
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 
+/* A mesh web's springs by node (inc0, inc) and the sweep's room for their forces (sf, son):
+ * made once its springs are set (mesh.c). 0, or -1 when out of memory. */
+int ws_web_mesh_index(ws_mem *mem, ws_web *web);
+
 /* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays
  * in cache: the forces from the springs, node drag and gravity of a block's rows [j0, j1) are
  * complete in f once ws_web_forces_rows(j0, j1) has run (later rows' partly), and its nodes
  * [n0, n1) may then get their contact forces and be integrated. A grid web's blocks are whole
  * rows, ws_web_block_rows of them (enough for WS_WEB_BLOCK_NODES nodes; a lane may end with
- * fewer); a mesh web is one block, whatever the rows asked. Every sweep first takes the laws at
- * (t, since) and the gravity (ws_web_sweep_laws).
+ * fewer). A mesh web's rows are runs of WS_WEB_MESH_ROW nodes (the last takes the rest), and its
+ * springs' forces are computed first, all of them (ws_web_mesh_springs, in pieces on any
+ * workers), then each node's gathered in spring order: the sums of the springs' scatter, to the
+ * bit. Every sweep first takes the laws at (t, since) and the gravity (ws_web_sweep_laws).
  *
  * Lanes: consecutive blocks swept apart, at once, by copies of the web that share its state
  * and have scratch of their own (world_step.c). The block that starts a lane (edges has
@@ -166,11 +178,22 @@ void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
  * (WS_WEB_LANE_LAST) leaves the next row alone; the springs between the two rows are computed
  * by both, each putting them on its own row, so every node's force gets the same terms in the
  * same order as in one sweep: the results are the same to the bit for any cut into lanes.
- * Lanes need a grid web of two blocks or more whose laws are of film form (no law with history
+ * A mesh web's lanes need no edges: its springs are all in before any lane starts.
+ * Lanes need a web of two blocks or more whose laws are of film form (no law with history
  * or a user's function, which a lane would call at once with another):
  * ws_web_sweep_parallel. */
+#define WS_WEB_MESH_ROW 64
 uint32_t ws_web_block_count(const ws_web *web);
-uint32_t ws_web_block_rows(const ws_web *web); /* rows of a grid web's block; 1 for a mesh */
+uint32_t ws_web_block_rows(const ws_web *web); /* rows of a block */
+uint32_t ws_web_rows(const ws_web *web);       /* ny, or a mesh web's rows */
+uint32_t ws_web_row_len(const ws_web *web);    /* nx, or WS_WEB_MESH_ROW */
+/* The first node of row j (n for j = ws_web_rows). */
+static inline uint32_t ws_web_row_node(const ws_web *web, uint32_t j)
+{
+    return web->nx > 0            ? (uint32_t)web->nx * j
+           : j < ws_web_rows(web) ? WS_WEB_MESH_ROW * j
+                                  : web->n;
+}
 #define WS_WEB_LANE_FIRST 1
 #define WS_WEB_LANE_LAST 2
 /* A sweep's state: the state it reads (x, v) and the one it writes (xd, vd; distinct from x,
@@ -186,6 +209,11 @@ int ws_web_sweep_parallel(const ws_web *web);
 int ws_web_laws_on_workers(const ws_web *web);
 void ws_web_forces_rows(ws_web *web, const ws_web_pass *p, uint32_t j0, uint32_t j1, int edges,
                         uint32_t *n0, uint32_t *n1);
+/* A mesh web's springs [s0, s1) at the sweep's state (x, v): their forces into sf, son. */
+void ws_web_mesh_springs(ws_web *web, ws_nodes3 x, ws_nodes3 v, uint32_t s0, uint32_t s1);
+/* A mesh web's nodes [n0, n1) (mesh.c): the start of their forces in f, their springs' (all
+ * of them in sf, son) and their gravity and drag (velocities v). */
+void ws_web_mesh_gather(ws_web *web, ws_nodes3 v, uint32_t n0, uint32_t n1);
 /* A sweep keeps the nodes' forces in the velocities it writes (p->vd) until it integrates
  * them, in place of an array of its own: each node's force is complete before its new
  * velocity is written over it, and the state the sweep streams is smaller by an n-node array

@@ -196,10 +196,11 @@ ws_status ws_world_create(const ws_world_def *def, ws_world **out)
         return WS_ERR_OUT_OF_MEMORY;
     }
     w->params_cap = 4;
-    /* A task's items: the lanes, and the body contacts after them (world_step.c). */
+    /* A task's items: the lanes, and the body part's items after them (as many at most:
+     * world_step.c's body_plan). */
     if (d.worker_count > 1 && !d.enqueue_task &&
         !(w->pool = ws_pool_create(&w->mem, d.worker_count - 1,
-                                   WS_LANES_PER_WORKER * (int32_t)d.worker_count + 1))) {
+                                   2 * WS_LANES_PER_WORKER * (int32_t)d.worker_count))) {
         ws_world_destroy(w);
         return WS_ERR_OUT_OF_MEMORY;
     }

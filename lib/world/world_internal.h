@@ -187,7 +187,7 @@ typedef struct ws_step {
     size_t npairs;
     v3 *guard_f, *guard_m; /* by body slot (arena) */
     size_t nrec;
-    /* The body contacts measured in pieces beside a web in one lane (world_step.c,
+    /* The body contacts measured in pieces beside a web's lanes (world_step.c,
      * contacts_piece): a record and a state a candidate, the checks of each piece (arena). */
     struct ws_contact_rec *mrec;
     uint8_t *mstate;

@@ -265,12 +265,12 @@ typedef struct lane_task {
      * cache (and no list of the nodes touched is kept). */
     int zero;
     uint32_t lanes;
-    /* The body part of the step, item `lanes` of the task (NULL: none in this one), and
-     * which: a full detection's narrow phase (BODY_NARROW, the first sub-step's), the body
-     * contacts (BODY_CONTACTS, the last's), each where its sub-step's lanes leave room. */
+    /* The body part of the step, items from `lanes` on of the task (NULL: none in this one),
+     * and which: a full detection's narrow phase (BODY_NARROW), the twins (BODY_TWINS), the
+     * body contacts (BODY_CONTACTS), each where its sub-step's lanes leave room. */
     ws_step *body;
     int body_part;
-    /* Beside a web in one lane (body_plan): the body part in `items` items of the task, the
+    /* Beside a web's lanes (body_plan): the body part in `items` items of the task, the
      * twins in as many parts (BODY_TWINS), the measured pieces [piece0, piece0 + pieces)
      * shared among them (contacts_piece; 0 pieces: the contacts whole, as body_contacts takes
      * them); after a narrow phase (its item the task's only) the twins' cuts cleared, and with
@@ -313,8 +313,8 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
     lane_open(T->w, T->web, (uint32_t)(J - T->w->lane_job));
     ws_world *w = T->w;
     ws_web *web = &J->view;
-    const uint32_t rows = web->nx > 0 ? (uint32_t)web->ny : 1, r = ws_web_block_rows(web);
-    uint32_t n0 = web->nx > 0 ? (uint32_t)web->nx * J->r0 : 0, n1;
+    const uint32_t rows = ws_web_rows(web), r = ws_web_block_rows(web);
+    uint32_t n0 = ws_web_row_node(web, J->r0), n1;
     size_t next = J->r0 ? ws_node_first_segment(&J->cview, n0) : 0;
     ws_node_substep(&J->cview);
     if (T->zero && T->web->contact->merging) /* the lane's part of the step's merge first */
@@ -330,9 +330,8 @@ static void sweep_lane(const lane_task *T, ws_lane_job *J)
         ws_web_forces_rows(web, &P, j, j1, edges, &n0, &n1);
         if (T->zero) /* where the block's contacts add first: in the cache when they do */
             memset(T->pass.fc + n0, 0, (n1 - n0) * sizeof(v3));
-        /* Each row's loads on the bodies folded apart (a mesh web's all together): rows,
-         * unlike lanes, do not depend on the worker count, so neither do the totals
-         * (lane_close). */
+        /* Each row's loads on the bodies folded apart: rows, unlike lanes, do not depend on
+         * the worker count, so neither do the totals (lane_close). */
         ws_node_contact *c = &J->cview;
         const size_t from = c->act_nl;
         c->nrow_mark = 0;
@@ -400,13 +399,13 @@ enum { LANES_CUT_EVERY = 16 };
 static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
 {
     ws_lane_job *J = w->lane_job;
-    if (lanes == 1 || web->nx <= 0) {
+    if (lanes == 1) {
         J[0].r0 = 0;
-        J[0].r1 = web->nx > 0 ? (uint32_t)web->ny : 1;
+        J[0].r1 = ws_web_rows(web);
         return;
     }
     const ws_node_contact *nc = web->contact;
-    const uint32_t nx = (uint32_t)web->nx, ny = (uint32_t)web->ny, r = ws_web_block_rows(web);
+    const uint32_t ny = ws_web_rows(web), r = ws_web_block_rows(web);
     /* The cut of the last steps serves this web for LANES_CUT_EVERY steps: the work moves
      * slowly, and a cut (two passes over the stretches) cost 0.9 instructions a node-update,
      * alone on the calling thread. */
@@ -416,14 +415,15 @@ static void lanes_cut(ws_world *w, const ws_web *web, uint32_t lanes)
     w->cut_web = web;
     w->cut_step = w->steps;
     const int segs = nc->seg_list == nc->next_list;
-    uint64_t total = 5ull * nx * ny, acc = 0;
+    uint64_t total = 5ull * web->n, acc = 0;
     for (size_t s = 0; segs && s < nc->nseg; s++)
         total += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
     uint32_t i = 1;
     J[0].r0 = 0;
     for (uint32_t j = 0, s = 0; j < ny && i < lanes; j++) {
-        acc += 5ull * nx; /* row j, with its stretches */
-        for (; segs && s < nc->nseg && nc->seg[s].n0 < nx * (j + 1); s++)
+        const uint32_t end = ws_web_row_node(web, j + 1);
+        acc += 5ull * (end - ws_web_row_node(web, j)); /* row j, with its stretches */
+        for (; segs && s < nc->nseg && nc->seg[s].n0 < end; s++)
             acc += nc->seg[s].run ? 0 : 3ull * (nc->seg[s].c1 - nc->seg[s].c0);
         /* Lane i starts after row j once the lanes before have their share, within room. */
         const uint32_t lo = J[i - 1].r0 + r, hi = ny - (lanes - i - 1) * r - 1;
@@ -443,8 +443,8 @@ static size_t lane_cands(const ws_web *web, const ws_lane_job *J, uint32_t lanes
     const ws_node_contact *nc = web->contact;
     if (lanes == 1)
         return ncand;
-    const size_t k0 = ws_node_first_segment(nc, (uint32_t)web->nx * J->r0),
-                 k1 = ws_node_first_segment(nc, (uint32_t)web->nx * J->r1);
+    const size_t k0 = ws_node_first_segment(nc, ws_web_row_node(web, J->r0)),
+                 k1 = ws_node_first_segment(nc, ws_web_row_node(web, J->r1));
     return (k1 < nc->nseg ? nc->seg[k1].c0 : ncand) - (k0 < nc->nseg ? nc->seg[k0].c0 : ncand);
 }
 
@@ -536,8 +536,7 @@ static ws_node_lane *flag_lanes(ws_step *S, ws_web *web, uint32_t lanes)
 {
     ws_world *w = S->w;
     ws_lane_job *J = w->lane_job;
-    const uint32_t ny = web->nx > 0 ? (uint32_t)web->ny : 1,
-                   nx = web->nx > 0 ? (uint32_t)web->nx : 0;
+    const uint32_t ny = ws_web_rows(web);
     const size_t ntrack = web->contact->ntrack;
     const int cut = lanes_cover(J, lanes, ny);
     if (!cut)
@@ -551,7 +550,7 @@ static ws_node_lane *flag_lanes(ws_step *S, ws_web *web, uint32_t lanes)
     if (!L || !least)
         return NULL;
     for (uint32_t i = 0; i < lanes; i++)
-        L[i] = (ws_node_lane){nx ? nx * J[i].r0 : 0, nx ? nx * J[i].r1 : web->n,
+        L[i] = (ws_node_lane){ws_web_row_node(web, J[i].r0), ws_web_row_node(web, J[i].r1),
                               S->contact.margin, 0, least + i * ntrack};
     flag_task T = {w, web, lanes, S->cur, web->x[S->cur], web->v[S->cur], L};
     run_task(w, flag_items, lanes, 0, &T);
@@ -696,9 +695,9 @@ static void lane_open(ws_world *w, ws_web *web, uint32_t i)
     J->checks = 0;
     ws_web *v = &J->view;
     ws_node_contact *c = &J->cview;
-    c->lane_end = web->nx > 0 ? (uint32_t)web->nx * J->r1 : web->n;
+    c->lane_end = ws_web_row_node(web, J->r1);
     c->run_nodes = c->run_deep = c->corners = 0;
-    c->row_mark = web->nx > 0 ? J->marks : NULL; /* where each row's loads start */
+    c->row_mark = J->marks; /* where each row's loads start */
     v->law_failed = 0;
     if (i == 0)
         return;
@@ -741,11 +740,33 @@ static size_t lane_close(ws_world *w, ws_web *web, uint32_t i, v3 *bforce, v3 *b
     return J->fast;
 }
 
+/* A mesh web's springs in `pieces` pieces of equal counts (ws_task_fn), before the lanes that
+ * gather them: each spring's force is written once, by one piece. */
+typedef struct springs_task {
+    ws_web *web;
+    ws_nodes3 x, v;
+    uint32_t pieces;
+} springs_task;
+
+static void springs_items(int32_t start, int32_t end, uint32_t worker, void *ctx)
+{
+    (void)worker;
+    const springs_task *T = ctx;
+    const uint64_t ns = T->web->ns;
+    for (int32_t i = start; i < end; i++)
+        ws_web_mesh_springs(T->web, T->x, T->v, (uint32_t)(ns * (uint32_t)i / T->pieces),
+                            (uint32_t)(ns * (uint32_t)(i + 1) / T->pieces));
+}
+
 /* A sub-step of a web over its lanes: on the host's scheduler, the world's threads or, for one
  * lane, right here. Returns how many nodes ended too fast. */
 static size_t sweep(ws_world *w, ws_web *web, uint32_t lanes, lane_task *T, v3 *bforce, v3 *bmoment)
 {
     const uint32_t body = T->body ? T->items : 0;
+    if (web->nx == 0) {
+        springs_task ST = {web, T->pass.x, T->pass.v, lanes};
+        run_task(w, springs_items, lanes, 0, &ST);
+    }
     run_task(w, lane_items, lanes + body, body, T);
     size_t fast = 0;
     for (uint32_t i = 0; i < lanes; i++)
@@ -778,7 +799,7 @@ static int bodies_beside_film(const ws_world *w)
     return webs && w->def.worker_count > 1;
 }
 
-/* Where the body part goes beside a web swept in one lane of n sub-steps: a waiting narrow
+/* Where the body part goes beside a web's lanes in n sub-steps: a waiting narrow
  * phase alone in the first sub-step's one item (the candidates are not known before it); the
  * twins, in `width` parts, in a sub-step of their own when there is one to
  * spare, else whole after the narrow phase or on this thread before the sub-steps; the
@@ -789,7 +810,7 @@ typedef struct body_plan {
     int twins;      /* the twins' sub-step, or -1 */
     int measure;    /* the first sub-step of the measured pieces */
     uint32_t width; /* body items of a sub-step: WS_LANES_PER_WORKER a worker, for balance
-                       beside the lane (the pool's room: its lanes' items and one) */
+                       beside the lanes (the pool's room: as many again as the lanes) */
 } body_plan;
 
 static body_plan body_plan_of(const ws_step *S, int n)
@@ -895,14 +916,14 @@ static ws_status step_webs(ws_step *S)
         int n = web->substeps;
         double h = S->dt / n, share = 1.0 / n;
         /* The body contacts beside the sub-steps (S->body_later: there are workers): beside
-         * the last one's lanes, or beside a web swept in one lane that may run on any worker
-         * (its laws of the film form: a law that calls the user's code keeps its lane, and so
-         * the task, on this thread) as body_plan lays them out, their forces added in the
-         * list's order after the last sub-step (contacts_end). */
+         * a web's lanes, or its one lane when that may run on any worker (its laws of the film
+         * form: a law that calls the user's code keeps its lane, and so the task, on this
+         * thread), as body_plan lays them out, their forces added in the list's order after
+         * the last sub-step (contacts_end). */
         const int beside = lanes > 1 || ws_web_laws_on_workers(web);
         body_plan plan = {0, -1, 0, 0};
         uint32_t pieces = 0;
-        if (beside && lanes == 1 && S->body_later) {
+        if (beside && S->body_later) {
             plan = body_plan_of(S, n);
             pieces = (uint32_t)(n - plan.measure) * plan.width;
             const int twins = plan.narrow ? 0 : plan.twins >= 0 ? 1 : 2;
@@ -931,9 +952,8 @@ static ws_status step_webs(ws_step *S)
                            0,
                            1,
                            0};
-            /* The body part beside the lanes: the narrow phase in the first sub-step, the
-             * contacts in the last, so that each fills a sub-step's slack; beside one lane,
-             * which leaves the other workers free in every sub-step, in body_plan's stages. */
+            /* The body part beside the lanes in body_plan's stages, so that each fills a
+             * sub-step's slack; else (no body contacts wait) a narrow phase in the first. */
             if (pieces) {
                 body_task(&plan, s, &T);
                 if (s == n - 1)
@@ -1235,7 +1255,7 @@ static void body_contacts(ws_step *S)
     guard_record(S);
 }
 
-/* The body contacts in measured pieces beside a web swept in one lane (step_webs, body_plan):
+/* The body contacts in measured pieces beside a web's lanes (step_webs, body_plan):
  * piece p of `pieces` measures its share of the candidates (ws_contact_measure, on any worker)
  * into a record of its own a candidate; contacts_end then takes the records in the list's
  * order, adds their forces and hands the anchors over on the calling thread, so that the

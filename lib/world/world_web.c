@@ -443,6 +443,10 @@ ws_status ws_web_create_mesh(ws_world *w, const ws_web_def *def, const ws_web_me
             web.kscale[k] = q;
         }
     }
+    if (ws_web_mesh_index(&w->mem, &web) != 0) {
+        s = ws_fail(w, WS_ERR_OUT_OF_MEMORY, "web '%s': out of memory", c.label);
+        return fail_web(w, &web, s);
+    }
     if (c.d.node_mass > 0.0 && g.node_masses)
         c.d.node_mass = 0.0; /* the per-node masses win */
     s = finish_web(w, &c, &web, g.pinned, g.pinned ? g.pinned_count : 0, 0, out);
