@@ -309,6 +309,21 @@ static long sheet_steps(void)
     return short_run() ? 120 : 800;
 }
 
+/* The sheet r's state hash on one worker after `steps` steps, checked against that on 2 to
+ * `most` workers (each the same to the bit; `what` names the case in a failure). */
+static uint64_t workers_agree(sheet_run r, long steps, int most, const char *what)
+{
+    r.workers = 1;
+    const uint64_t one = sheet_hash(&r, steps, NULL);
+    for (int k = 2; k <= most; k++) {
+        r.workers = k;
+        const uint64_t h = sheet_hash(&r, steps, NULL);
+        ck_assert_msg(h == one, "%s, %d workers: state hash 0x%016llx, 1 worker 0x%016llx", what, k,
+                      (unsigned long long)h, (unsigned long long)one);
+    }
+    return one;
+}
+
 /* The sheet r on two host schedulers (the pieces last first on 3 workers, then each on a
  * thread of its own on 4): the state hash `one` both times, and the host called. Returns how
  * many tasks the first got. */
@@ -333,13 +348,7 @@ START_TEST(test_sheet_same_for_any_workers)
 {
     const long steps = sheet_steps();
     sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 0, 0, NULL, NULL, 0, 0, 0};
-    const uint64_t one = sheet_hash(&r, steps, NULL);
-    for (int k = 2; k <= (short_run() ? 2 : 4); k++) {
-        r.workers = k;
-        uint64_t h = sheet_hash(&r, steps, NULL);
-        ck_assert_msg(h == one, "%d workers: state hash 0x%016llx, 1 worker 0x%016llx", k,
-                      (unsigned long long)h, (unsigned long long)one);
-    }
+    const uint64_t one = workers_agree(r, steps, short_run() ? 2 : 4, "sheet");
     hosts_agree(r, steps, one);
     /* The search of node candidates in pieces, each piece's list given little room: the
      * pieces that run out are searched again on the world's thread, and the list is the
@@ -366,13 +375,7 @@ START_TEST(test_bodies_beside_one_lane)
 {
     const long steps = sheet_steps();
     sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 1, 0};
-    const uint64_t one = sheet_hash(&r, steps, NULL);
-    for (int k = 2; k <= 3; k++) {
-        r.workers = k;
-        const uint64_t h = sheet_hash(&r, steps, NULL);
-        ck_assert_msg(h == one, "%d workers, one lane: 0x%016llx, 1 worker 0x%016llx", k,
-                      (unsigned long long)h, (unsigned long long)one);
-    }
+    const uint64_t one = workers_agree(r, steps, 3, "one lane");
     const int calls = hosts_agree(r, steps, one);
     report("workers: one-lane sheet on two boxes, %ld steps: 0x%016llx for 1-3 workers and "
            "both schedulers (%d tasks to the host)",
@@ -390,17 +393,10 @@ START_TEST(test_detection_beside_the_film)
     const long steps = sheet_steps();
     uint64_t full = 0, reruns = 0;
     sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, &full, 0, 0, 0};
-    const uint64_t one = sheet_hash(&r, steps, NULL);
+    const uint64_t one = workers_agree(r, steps, 3, "a full detection every 5th step");
     /* ceil(steps / 5) full detections, the first of them at step 0. */
     ck_assert_msg(full == (uint64_t)(steps + 4) / 5, "%llu full detections in %ld steps",
                   (unsigned long long)full, steps);
-    for (int k = 2; k <= 3; k++) {
-        r.workers = k;
-        const uint64_t h = sheet_hash(&r, steps, NULL);
-        ck_assert_msg(h == one,
-                      "%d workers, a full detection every 5th step: 0x%016llx, 1 worker 0x%016llx",
-                      k, (unsigned long long)h, (unsigned long long)one);
-    }
     r = (sheet_run){2, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 1, &reruns, NULL, 0, 0, 0};
     const uint64_t h = sheet_hash(&r, steps, NULL);
     ck_assert_msg(h == one, "narrow phases run again: 0x%016llx, 1 worker 0x%016llx",
@@ -420,13 +416,7 @@ START_TEST(test_mesh_same_for_any_workers)
 {
     const long steps = sheet_steps();
     sheet_run r = {1, 0, WS_LAW_LINEAR_VISCOELASTIC, 0, NULL, 5, 0, NULL, NULL, 0, 0, 1};
-    const uint64_t one = sheet_hash(&r, steps, NULL);
-    for (int k = 2; k <= 4; k++) {
-        r.workers = k;
-        const uint64_t h = sheet_hash(&r, steps, NULL);
-        ck_assert_msg(h == one, "mesh, %d workers: 0x%016llx, 1 worker 0x%016llx", k,
-                      (unsigned long long)h, (unsigned long long)one);
-    }
+    const uint64_t one = workers_agree(r, steps, 4, "mesh");
     const int calls = hosts_agree(r, steps, one);
     /* The mesh is swept in lanes at all: two blocks or more, laws of film form. */
     ws_world_def d;
@@ -699,13 +689,7 @@ START_TEST(test_implicit_same_for_any_workers)
     for (int law = 0; law < 2; law++) {
         const int type = law ? WS_LAW_CUBIC_ELASTIC : WS_LAW_LINEAR_VISCOELASTIC;
         sheet_run r = {1, 0, type, 0, NULL, 0, 0, NULL, NULL, 1, 0, 0};
-        const uint64_t one = sheet_hash(&r, steps, NULL);
-        for (int k = 2; k <= (shorter ? 2 : 3); k++) {
-            r.workers = k;
-            const uint64_t h = sheet_hash(&r, steps, NULL);
-            ck_assert_msg(h == one, "law %d, %d workers: state hash 0x%016llx, 1 worker 0x%016llx",
-                          type, k, (unsigned long long)h, (unsigned long long)one);
-        }
+        const uint64_t one = workers_agree(r, steps, shorter ? 2 : 3, law ? "cubic" : "film");
         if (law && shorter)
             continue;
         int calls = 0;
