@@ -33,7 +33,7 @@ static inline double strain_of(const ws_web *web, ws_nodes3 x, ws_nodes3 v, uint
     return l * il0 - 1.0;
 }
 
-/* One spring in any place (the wrap of a closed band, shear diagonals, mesh webs) and every
+/* One spring in any place (the wrap of a closed band, shear diagonals, a mesh web's) and every
  * spring of a general law, which is evaluated with the spring's history as committed, at the
  * sweep's (t, since): its force on its end a into fu, 1; or 0 when it pulls nothing (broken,
  * its ends coincident, its law failed: a user callback, which marks the web, and the step

@@ -92,8 +92,8 @@ typedef struct ws_web {
     double *inv_l0;          /* 1 / rest length */
     uint8_t *kind;           /* ws_spring_kind */
     /* Each spring's force as a multiple of its law's (the film layers a spring stands for), or
-     * NULL when every spring takes its law as it is. Mesh webs only: their springs run one by
-     * one (spring_one_in), so the grid's vector loops never read it. */
+     * NULL when every spring takes its law as it is. Mesh webs only: their springs' loops
+     * (mesh.c) read it, the grid's never do. */
     double *kscale;
     /* A mesh web's springs by node (ws_web_mesh_index): node i's are inc[inc0[i] ..
      * inc0[i + 1]), each 2 s + 1 when i is spring s's end b, else 2 s, in spring order; and the
