@@ -919,11 +919,14 @@ static ws_status step_webs(ws_step *S)
          * a web's lanes, or its one lane when that may run on any worker (its laws of the film
          * form: a law that calls the user's code keeps its lane, and so the task, on this
          * thread), as body_plan lays them out, their forces added in the list's order after
-         * the last sub-step (contacts_end). */
+         * the last sub-step (contacts_end). Beside a grid web's lanes (a film of many nodes
+         * about few bodies, as the reference cases) the body part goes whole into the first
+         * and last sub-steps' slack instead: staged, its records and their apply on this
+         * thread cost more than the spread gains (bench/NOTES.md, session 28). */
         const int beside = lanes > 1 || ws_web_laws_on_workers(web);
         body_plan plan = {0, -1, 0, 0};
         uint32_t pieces = 0;
-        if (beside && S->body_later) {
+        if (beside && S->body_later && (lanes == 1 || web->nx == 0)) {
             plan = body_plan_of(S, n);
             pieces = (uint32_t)(n - plan.measure) * plan.width;
             const int twins = plan.narrow ? 0 : plan.twins >= 0 ? 1 : 2;
@@ -953,7 +956,7 @@ static ws_status step_webs(ws_step *S)
                            1,
                            0};
             /* The body part beside the lanes in body_plan's stages, so that each fills a
-             * sub-step's slack; else (no body contacts wait) a narrow phase in the first. */
+             * sub-step's slack; else a narrow phase in the first, the contacts in the last. */
             if (pieces) {
                 body_task(&plan, s, &T);
                 if (s == n - 1)
