@@ -1695,7 +1695,7 @@ END_TEST
  * caller's to free (free_pressed). */
 typedef struct press_case {
     ws_rigid R;
-    uint32_t env[12];
+    uint32_t env[24];
     ws_rigid_pair pair;
     double *d;
     void *mgbuf;
@@ -1717,10 +1717,11 @@ static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, uint
     R->phi_lever = calloc(3 * (size_t)n, sizeof *R->phi_lever);
     R->crow = calloc((size_t)n + 1, sizeof *R->crow);
     R->cphi = calloc(2 * ((size_t)n + 1), sizeof *R->cphi);
+    R->cwork = calloc(ws_rigid_coarse_words(n, nb), sizeof *R->cwork);
     o->d = calloc(nb * (1 + WS_SYM) + 3 * v6 * v6 + 8 * v6 + 6 * v6 + 18 * ((size_t)n + 1),
                   sizeof(double));
     ck_assert(R->link && R->phi_node && R->phi_body && R->phi_lever && R->crow && R->cphi &&
-              o->d);
+              R->cwork && o->d);
     double *d = o->d;
     R->b = d, R->x = d + v6, R->r = d + 2 * v6, R->z = d + 3 * v6, R->p = d + 4 * v6;
     R->q = d + 5 * v6, R->cb = d + 6 * v6, R->cq = d + 7 * v6;
@@ -1784,7 +1785,7 @@ static void press_body(ws_web *web, ws_nodes3 x, int r, double h, int nest, uint
 static void free_pressed(press_case *o)
 {
     free(o->R.link), free(o->R.phi_node), free(o->R.phi_body), free(o->R.phi_lever);
-    free(o->R.crow), free(o->R.cphi);
+    free(o->R.crow), free(o->R.cphi), free(o->R.cwork);
     free(o->d), free(o->mgbuf);
 }
 
@@ -2923,13 +2924,14 @@ START_TEST(test_coarse_setup)
         R.inertia = inertia;
         double *d = calloc(2 * v6 * v6 + 8 * v6 + v6 * v6 + 6 * v6 + 18 * (cap + 1),
                            sizeof(double));
-        uint32_t env[12];
+        uint32_t env[24];
         R.phi_node = calloc(cap + 1, sizeof *R.phi_node);
         R.phi_body = calloc(cap + 1, sizeof *R.phi_body);
         R.phi_lever = calloc(3 * (cap + 1), sizeof *R.phi_lever);
         R.crow = calloc(n + 1, sizeof *R.crow);
         R.cphi = calloc(2 * (cap + 1), sizeof *R.cphi);
-        ck_assert(d && R.phi_node && R.phi_body && R.phi_lever && R.crow && R.cphi);
+        R.cwork = calloc(ws_rigid_coarse_words(cap, 2), sizeof *R.cwork);
+        ck_assert(d && R.phi_node && R.phi_body && R.phi_lever && R.crow && R.cphi && R.cwork);
         R.abb = d, R.fac = d + v6 * v6, R.env = env;
         R.b = d + 2 * v6 * v6, R.x = R.b + v6, R.r = R.x + v6, R.z = R.r + v6, R.p = R.z + v6;
         R.q = R.p + v6, R.cb = R.q + v6, R.cq = R.cb + v6, R.coarse = R.cq + v6;
@@ -2967,6 +2969,7 @@ START_TEST(test_coarse_setup)
         free(R.phi_lever);
         free(R.crow);
         free(R.cphi);
+        free(R.cwork);
         free(link);
     }
     ws_world_destroy(w);
@@ -3028,7 +3031,7 @@ START_TEST(test_bodies_block)
                                    0.04, 0,    1e-3,  0,    0.02, 0.02,  0.02, 0,
                                    0,    0,    0.01,  0.03, 0.02, 0,     0,    1e-3};
     double abb[V6 * V6], fac[V6 * V6];
-    uint32_t env[V6];
+    uint32_t env[2 * V6];
     ws_rigid R;
     memset(&R, 0, sizeof R);
     R.nb = NB;

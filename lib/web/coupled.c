@@ -2,6 +2,7 @@
  * section 8b, why). */
 #include "web/coupled.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* sign J_i^T C J_j into the block of bodies i (rows) and j (columns) of the n x n A (row-major):
@@ -23,14 +24,34 @@ static void add_coupling(double *A, size_t n, uint32_t i, v3 ri, uint32_t j, v3 
     }
 }
 
+/* The envelope of the symmetric n x n A (row-major) into env (2 n words): row i's first entry
+ * that is not zero, env[i], and column j's last, env[n + j] (the largest i with env[i] <= j;
+ * j itself when none is later). */
+static void envelope(const double *A, size_t n, uint32_t *env)
+{
+    for (size_t i = 0; i < n; i++) {
+        size_t f = 0;
+        while (f < i && A[n * i + f] == 0.0)
+            f++;
+        env[i] = (uint32_t)f;
+        env[n + i] = (uint32_t)i;
+    }
+    for (size_t i = 0; i < n; i++) /* row i reaches down to column env[i] */
+        if (env[n + env[i]] < i)
+            env[n + env[i]] = (uint32_t)i;
+    for (size_t j = 1; j < n; j++) /* and so every column after it, up to i */
+        if (env[n + j] < env[n + j - 1])
+            env[n + j] = env[n + j - 1];
+}
+
 /* The lower Cholesky factor of the symmetric n x n B (row-major), in place, over the envelope
- * env (row i's entries before column env[i] are zero, and stay zero in the factor; NULL: all
- * of each row): the products of zeros a dense factor would add are left out. 0, or -1 when not
- * positive definite. */
+ * env (envelope(); row i's entries before column env[i] are zero, and stay zero in the factor;
+ * NULL: all of each row): the products of zeros a dense factor would add are left out. 0, or
+ * -1 when not positive definite. */
 static int cholesky(double *B, size_t n, const uint32_t *env)
 {
     for (size_t j = 0; j < n; j++) {
-        const size_t fj = env ? env[j] : 0;
+        const size_t fj = env ? env[j] : 0, last = env ? env[n + j] : n - 1;
         double d = B[n * j + j];
         for (size_t k = fj; k < j; k++)
             d -= B[n * j + k] * B[n * j + k];
@@ -38,7 +59,7 @@ static int cholesky(double *B, size_t n, const uint32_t *env)
             return -1;
         const double l = sqrt(d);
         B[n * j + j] = l;
-        for (size_t i = j + 1; i < n; i++) {
+        for (size_t i = j + 1; i <= last; i++) {
             const size_t fi = env ? env[i] : 0;
             if (fi > j)
                 continue; /* outside the envelope: zero */
@@ -64,7 +85,8 @@ static void cholesky_solve(const double *L, size_t n, const uint32_t *env, const
     }
     for (size_t i = n; i-- > 0;) {
         double s = z[i];
-        for (size_t k = i + 1; k < n; k++)
+        const size_t last = env ? env[n + i] : n - 1;
+        for (size_t k = i + 1; k <= last; k++)
             if (!env || env[k] <= i)
                 s -= L[n * k + i] * z[k];
         z[i] = s / L[n * i + i];
@@ -107,12 +129,7 @@ int ws_rigid_factor(ws_rigid *R)
     /* Each row's envelope: a body's rows start at the first body coupled to it (itself, with
      * no pair to an earlier one), so that the factor of bodies with no pair costs what their
      * own blocks' do. */
-    for (size_t i = 0; i < n; i++) {
-        size_t f = 0;
-        while (f < i && A[n * i + f] == 0.0)
-            f++;
-        R->env[i] = (uint32_t)f;
-    }
+    envelope(A, n, R->env);
     memcpy(R->fac, A, n * n * sizeof(double));
     return cholesky(R->fac, n, R->env);
 }
@@ -378,62 +395,94 @@ static uint32_t coarse_rows(ws_rigid *R, const ws_web *web)
     return rows;
 }
 
-/* The six columns of body j of Phi^T A Phi into A (nc x nc, row-major), A the coupled matrix of
- * the running solve: what ws_implicit_apply_op, ws_rigid_apply and phi_transpose give column by
- * column for Phi e_c, computed for the six at once and only where they are not zero: the rows
- * of Phi's nodes (cy, 18 doubles a row: column, then xyz), the springs with an end that moves
- * with body j (for a velocity column, only those with one end: both ends moving alike do not
- * stretch it), the contacts of body j or of a node that moves with it (a contact at the point
- * Phi moves its node with adds nothing to the body's row), Phi^T over the rows these reach.
- * Each entry takes the same terms in the same order as the column-by-column product and leaves
- * out only exact zeros, so the matrix is the same to the bit (the sign of a zero aside). */
-static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t j, double *A)
+/* The set-up's tables in R->cwork: by row of Phi, its contacts (in the links' order) and its
+ * entries of Phi (in Phi's order); by body, its contacts and its entries; and room for the
+ * lists of one body's columns (rows; contacts, then entries). */
+typedef struct coarse_tables {
+    uint32_t rows;
+    uint32_t *row_link0, *row_link, *row_phi0, *row_phi;
+    uint32_t *body_link0, *body_link, *body_phi0, *body_phi;
+    uint32_t *list_rows, *list;
+} coarse_tables;
+
+size_t ws_rigid_coarse_words(size_t cap, uint32_t nb)
 {
-    const ws_implicit *im = web->imp;
-    const size_t nc = 6 * (size_t)R->nb;
-    uint32_t *at = R->cphi;             /* a row's entry of Phi with body j, UINT32_MAX: none */
-    uint32_t *reached = R->cphi + rows; /* whether a term of body j's columns reaches a row */
-    double *Y = R->cy;
-    for (uint32_t r = 0; r < rows; r++)
-        at[r] = UINT32_MAX, reached[r] = 0;
+    /* the envelope of the coarse factor (12 nb), then the tables: rows, contacts and entries
+     * are each at most cap */
+    return 12 * (size_t)nb + 2 * (cap + 1) + 2 * ((size_t)nb + 1) + 6 * cap;
+}
+
+/* Items [0, count) grouped by key (key[k] < groups; UINT32_MAX: left out) into start (groups +
+ * 1) and idx, each group's items in their order. */
+static void group_by(const uint32_t *key, size_t count, uint32_t groups, uint32_t *start,
+                     uint32_t *idx)
+{
+    memset(start, 0, ((size_t)groups + 1) * sizeof *start);
+    for (size_t k = 0; k < count; k++)
+        if (key[k] != UINT32_MAX)
+            start[key[k] + 1]++;
+    for (uint32_t g = 0; g < groups; g++)
+        start[g + 1] += start[g];
+    for (size_t k = 0; k < count; k++)
+        if (key[k] != UINT32_MAX)
+            idx[start[key[k]]++] = (uint32_t)k;
+    for (uint32_t g = groups; g > 0; g--) /* each start moved on by its group's count */
+        start[g] = start[g - 1];
+    start[0] = 0;
+}
+
+static void tables_make(ws_rigid *R, uint32_t rows, coarse_tables *T)
+{
+    const size_t cap = R->cap, nb = R->nb;
+    uint32_t *w = R->cwork + 12 * nb; /* after the coarse factor's envelope */
+    T->rows = rows;
+    T->row_link0 = w, w += cap + 1;
+    T->row_phi0 = w, w += cap + 1;
+    T->body_link0 = w, w += nb + 1;
+    T->body_phi0 = w, w += nb + 1;
+    T->row_link = w, w += cap;
+    T->row_phi = w, w += cap;
+    T->body_link = w, w += cap;
+    T->body_phi = w, w += cap;
+    T->list_rows = w, w += cap;
+    T->list = w;
+    uint32_t *key = T->list; /* free until a body's columns are made */
+    for (size_t l = 0; l < R->nl; l++)
+        key[l] = R->crow[R->link[l].node];
+    group_by(key, R->nl, rows, T->row_link0, T->row_link);
+    for (size_t l = 0; l < R->nl; l++)
+        key[l] = R->link[l].body;
+    group_by(key, R->nl, R->nb, T->body_link0, T->body_link);
     for (size_t k = 0; k < R->nphi; k++)
-        if (R->phi_body[k] == j) {
-            const uint32_t r = R->crow[R->phi_node[k]];
-            at[r] = (uint32_t)k;
-            reached[r] = 1;
-        }
-    /* The film's own blocks (ws_implicit_apply_op's first loop), each row at its node's first
-     * entry (coarse_rows numbered them in that order). */
-    uint32_t next = 0;
-    for (size_t k = 0; k < R->nphi; k++) {
-        const uint32_t i = R->phi_node[k], r = R->crow[i];
-        if (r != next)
-            continue; /* the node's row is done */
-        next++;
-        const double *S = im->nd + WS_SYM * (size_t)i;
-        for (int q = 0; q < 6; q++) {
-            const v3 u = at[r] == UINT32_MAX ? v3_make(0.0, 0.0, 0.0)
-                                             : phi_unit(q, R->phi_lever + 3 * (size_t)at[r]);
-            double *y = Y + 18 * (size_t)r + 3 * (size_t)q;
-            y[0] = S[WS_SYM_XX] * u.x + S[WS_SYM_XY] * u.y + S[WS_SYM_XZ] * u.z;
-            y[1] = S[WS_SYM_XY] * u.x + S[WS_SYM_YY] * u.y + S[WS_SYM_YZ] * u.z;
-            y[2] = S[WS_SYM_XZ] * u.x + S[WS_SYM_YZ] * u.y + S[WS_SYM_ZZ] * u.z;
-        }
-    }
-    /* The springs, in their order (its second loop). */
-    for (uint32_t s = 0; s < web->ns; s++) {
+        key[k] = R->crow[R->phi_node[k]];
+    group_by(key, R->nphi, rows, T->row_phi0, T->row_phi);
+    group_by(R->phi_body, R->nphi, R->nb, T->body_phi0, T->body_phi);
+}
+
+static int u32_order(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The springs' terms of a body's six columns at node i's row y (18 doubles: column, then
+ * xyz), at[] the rows' entries of Phi with that body: each spring at the node with an end that
+ * moves with the body, in spring order, as ws_implicit_apply_op's second loop adds them (for a
+ * velocity column only those with one such end: both ends moving alike do not stretch it). */
+static void row_springs(const ws_rigid *R, const ws_web *web, const uint32_t *at, uint32_t i,
+                        double *y)
+{
+    const double *op = web->imp->op;
+    for (uint32_t e = web->inc0[i]; e < web->inc0[i + 1]; e++) {
+        const uint32_t s = web->inc[e] >> 1, end_b = web->inc[e] & 1;
         const uint32_t ra = R->crow[web->sa[s]], rb = R->crow[web->sb[s]];
         const uint32_t ka = ra == UINT32_MAX ? UINT32_MAX : at[ra],
                        kb = rb == UINT32_MAX ? UINT32_MAX : at[rb];
         if (ka == UINT32_MAX && kb == UINT32_MAX)
             continue;
-        const double *o = im->op + 5 * (size_t)s; /* ex ey ez a b */
+        const double *o = op + 5 * (size_t)s; /* ex ey ez a b */
         const double *la = ka == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)ka,
                      *lb = kb == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)kb;
-        if (ra != UINT32_MAX)
-            reached[ra] = 1;
-        if (rb != UINT32_MAX)
-            reached[rb] = 1;
         for (int q = la && lb ? 3 : 0; q < 6; q++) {
             const v3 a = la ? phi_unit(q, la) : v3_make(0.0, 0.0, 0.0);
             const v3 b = lb ? phi_unit(q, lb) : v3_make(0.0, 0.0, 0.0);
@@ -441,18 +490,70 @@ static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t 
             const double ed = o[3] * (o[0] * dx + o[1] * dy + o[2] * dz);
             const double tx = ed * o[0] + o[4] * dx, ty = ed * o[1] + o[4] * dy,
                          tz = ed * o[2] + o[4] * dz;
-            if (ra != UINT32_MAX) {
-                double *y = Y + 18 * (size_t)ra + 3 * (size_t)q;
-                y[0] += tx, y[1] += ty, y[2] += tz;
-            }
-            if (rb != UINT32_MAX) {
-                double *y = Y + 18 * (size_t)rb + 3 * (size_t)q;
-                y[0] -= tx, y[1] -= ty, y[2] -= tz;
-            }
+            double *Y = y + 3 * (size_t)q;
+            if (end_b)
+                Y[0] -= tx, Y[1] -= ty, Y[2] -= tz;
+            else
+                Y[0] += tx, Y[1] += ty, Y[2] += tz;
         }
     }
-    /* The bodies' rows and the contacts' coupling (ws_rigid_apply), yr of column q in
-     * cyr + q nc. */
+}
+
+/* The six columns of body j of Phi^T A Phi into A's rows 6 j .. 6 j + 5 (nc x nc, row-major:
+ * the product's transpose), A the coupled matrix of the running solve: what
+ * ws_implicit_apply_op, ws_rigid_apply and phi_transpose give column by column for Phi e_c,
+ * computed for the six at once and only where they are not zero: the rows of the body's nodes
+ * and of the nodes its springs reach (cy, 18 doubles a row: column, then xyz), the contacts of
+ * body j or of a node that moves with it (a contact at the point Phi moves its node with adds
+ * nothing to the body's row), Phi^T over the rows these reach. Each entry takes the same terms
+ * in the same order as the column-by-column product (a row's in spring order, then in the
+ * links' order; a body's sums in the links' and in Phi's order) and leaves out only exact
+ * zeros, so the matrix is the same to the bit (the sign of a zero aside). at[] and reached[]
+ * (cphi) are UINT32_MAX and 0 at every row outside the body's. */
+static void coarse_body(ws_rigid *R, const ws_web *web, const coarse_tables *T, uint32_t j,
+                        double *A)
+{
+    const ws_implicit *im = web->imp;
+    const size_t nc = 6 * (size_t)R->nb;
+    uint32_t *at = R->cphi;                /* a row's entry of Phi with body j */
+    uint32_t *reached = R->cphi + T->rows; /* whether a term of body j's columns reaches a row */
+    uint32_t *rl = T->list_rows, *list = T->list;
+    double *Y = R->cy;
+    uint32_t nr = 0;
+    for (uint32_t e = T->body_phi0[j]; e < T->body_phi0[j + 1]; e++) {
+        const uint32_t k = T->body_phi[e], r = R->crow[R->phi_node[k]];
+        at[r] = k;
+        if (!reached[r])
+            reached[r] = 1, rl[nr++] = r;
+    }
+    const uint32_t own = nr;
+    for (uint32_t u = 0; u < own; u++) {
+        const uint32_t i = R->phi_node[at[rl[u]]];
+        for (uint32_t e = web->inc0[i]; e < web->inc0[i + 1]; e++) {
+            const uint32_t s = web->inc[e] >> 1;
+            const uint32_t ro = R->crow[web->inc[e] & 1 ? web->sa[s] : web->sb[s]];
+            if (ro != UINT32_MAX && !reached[ro])
+                reached[ro] = 1, rl[nr++] = ro;
+        }
+    }
+    /* Each row: the film's own block (ws_implicit_apply_op's first loop), then its springs. */
+    for (uint32_t u = 0; u < nr; u++) {
+        const uint32_t r = rl[u], i = R->phi_node[T->row_phi[T->row_phi0[r]]];
+        const double *S = im->nd + WS_SYM * (size_t)i;
+        double *y = Y + 18 * (size_t)r;
+        for (int q = 0; q < 6; q++) {
+            const v3 p = at[r] == UINT32_MAX ? v3_make(0.0, 0.0, 0.0)
+                                             : phi_unit(q, R->phi_lever + 3 * (size_t)at[r]);
+            double *yq = y + 3 * (size_t)q;
+            yq[0] = S[WS_SYM_XX] * p.x + S[WS_SYM_XY] * p.y + S[WS_SYM_XZ] * p.z;
+            yq[1] = S[WS_SYM_XY] * p.x + S[WS_SYM_YY] * p.y + S[WS_SYM_YZ] * p.z;
+            yq[2] = S[WS_SYM_XZ] * p.x + S[WS_SYM_YZ] * p.y + S[WS_SYM_ZZ] * p.z;
+        }
+        row_springs(R, web, at, i, y);
+    }
+    /* The bodies' rows (ws_rigid_apply), yr of column q in cyr + q nc, and the contacts'
+     * coupling: body j's contacts off Phi's rows (at pinned nodes) and every contact at its
+     * rows, in the links' order. */
     double *yr = R->cyr;
     for (int q = 0; q < 6; q++)
         for (uint32_t k = 0; k < R->nb; k++) {
@@ -461,73 +562,71 @@ static void coarse_body(ws_rigid *R, const ws_web *web, uint32_t rows, uint32_t 
                 P[q] = 1.0;
             body_mass_apply(R, k, P, yr + nc * (size_t)q + 6 * (size_t)k);
         }
-    size_t l = 0;
-    while (l < R->nl) {
-        const uint32_t k = R->link[l].body;
-        size_t end = l;
-        while (end < R->nl && R->link[end].body == k)
-            end++;
+    size_t nlist = 0;
+    for (uint32_t e = T->body_link0[j]; e < T->body_link0[j + 1]; e++) {
+        const uint32_t l = T->body_link[e], r = R->crow[R->link[l].node];
+        if (r == UINT32_MAX || at[r] == UINT32_MAX)
+            list[nlist++] = l;
+    }
+    for (uint32_t u = 0; u < own; u++)
+        for (uint32_t e = T->row_link0[rl[u]]; e < T->row_link0[rl[u] + 1]; e++)
+            list[nlist++] = T->row_link[e];
+    qsort(list, nlist, sizeof *list, u32_order);
+    for (size_t u = 0; u < nlist; u++) {
+        const ws_rigid_link *L = &R->link[list[u]];
+        const uint32_t k = L->body, rn = R->crow[L->node];
+        const uint32_t kn = rn == UINT32_MAX ? UINT32_MAX : at[rn];
+        const double lv[3] = {L->lever.x, L->lever.y, L->lever.z};
+        const double *ln = kn == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)kn;
         for (int q = 0; q < 6; q++) {
             double *Yb = yr + nc * (size_t)q + 6 * (size_t)k;
-            double y0 = Yb[0], y1 = Yb[1], y2 = Yb[2], y3 = Yb[3], y4 = Yb[4], y5 = Yb[5];
-            for (size_t c = l; c < end; c++) {
-                const ws_rigid_link *L = &R->link[c];
-                const uint32_t rn = R->crow[L->node];
-                const uint32_t kn = rn == UINT32_MAX ? UINT32_MAX : at[rn];
-                if (k != j && kn == UINT32_MAX)
-                    continue; /* neither end moves */
-                const double lv[3] = {L->lever.x, L->lever.y, L->lever.z};
-                const double *ln = kn == UINT32_MAX ? NULL : R->phi_lever + 3 * (size_t)kn;
-                const v3 jp = k == j ? phi_unit(q, lv) : v3_make(0.0, 0.0, 0.0);
-                const double cj[3] = {sym_row(L->C, 0, jp.x, jp.y, jp.z),
-                                      sym_row(L->C, 1, jp.x, jp.y, jp.z),
-                                      sym_row(L->C, 2, jp.x, jp.y, jp.z)};
-                /* g = C (p_node - J P): zero when Phi moves the node with this very contact
-                 * point (the same operations on the same numbers). */
-                if (!(k == j && ln && ln[0] == lv[0] && ln[1] == lv[1] && ln[2] == lv[2])) {
-                    const v3 pn = ln ? phi_unit(q, ln) : v3_make(0.0, 0.0, 0.0);
-                    const double g[3] = {sym_row(L->C, 0, pn.x, pn.y, pn.z) - cj[0],
-                                         sym_row(L->C, 1, pn.x, pn.y, pn.z) - cj[1],
-                                         sym_row(L->C, 2, pn.x, pn.y, pn.z) - cj[2]};
-                    const v3 mo = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
-                    y0 -= g[0], y1 -= g[1], y2 -= g[2];
-                    y3 -= mo.x, y4 -= mo.y, y5 -= mo.z;
-                }
-                if (web->inv_m[L->node] == 0.0 || rn == UINT32_MAX)
-                    continue; /* a pinned node's row stays zero; no other is outside Phi */
-                double *y = Y + 18 * (size_t)rn + 3 * (size_t)q;
-                y[0] -= cj[0], y[1] -= cj[1], y[2] -= cj[2];
-                reached[rn] = 1;
+            const v3 jp = k == j ? phi_unit(q, lv) : v3_make(0.0, 0.0, 0.0);
+            const double cj[3] = {sym_row(L->C, 0, jp.x, jp.y, jp.z),
+                                  sym_row(L->C, 1, jp.x, jp.y, jp.z),
+                                  sym_row(L->C, 2, jp.x, jp.y, jp.z)};
+            /* g = C (p_node - J P): zero when Phi moves the node with this very contact point
+             * (the same operations on the same numbers). */
+            if (!(k == j && ln && ln[0] == lv[0] && ln[1] == lv[1] && ln[2] == lv[2])) {
+                const v3 pn = ln ? phi_unit(q, ln) : v3_make(0.0, 0.0, 0.0);
+                const double g[3] = {sym_row(L->C, 0, pn.x, pn.y, pn.z) - cj[0],
+                                     sym_row(L->C, 1, pn.x, pn.y, pn.z) - cj[1],
+                                     sym_row(L->C, 2, pn.x, pn.y, pn.z) - cj[2]};
+                const v3 mo = v3_cross(L->lever, v3_make(g[0], g[1], g[2]));
+                Yb[0] -= g[0], Yb[1] -= g[1], Yb[2] -= g[2];
+                Yb[3] -= mo.x, Yb[4] -= mo.y, Yb[5] -= mo.z;
             }
-            Yb[0] = y0, Yb[1] = y1, Yb[2] = y2, Yb[3] = y3, Yb[4] = y4, Yb[5] = y5;
+            if (web->inv_m[L->node] == 0.0 || rn == UINT32_MAX)
+                continue; /* a pinned node's row stays zero; no other is outside Phi */
+            double *y = Y + 18 * (size_t)rn + 3 * (size_t)q;
+            y[0] -= cj[0], y[1] -= cj[1], y[2] -= cj[2];
         }
-        l = end;
     }
-    /* Phi^T of each column (phi_transpose) over the rows reached, into A's columns 6 j + q. */
+    /* Phi^T of each column (phi_transpose) over the entries at the rows reached, in Phi's
+     * order, into A's columns 6 j + q. */
+    size_t ne = 0;
+    for (uint32_t u = 0; u < nr; u++)
+        for (uint32_t e = T->row_phi0[rl[u]]; e < T->row_phi0[rl[u] + 1]; e++)
+            list[ne++] = T->row_phi[e];
+    qsort(list, ne, sizeof *list, u32_order);
     for (int q = 0; q < 6; q++) {
         double *out = R->cb;
         memcpy(out, yr + nc * (size_t)q, nc * sizeof(double));
-        size_t k = 0;
-        while (k < R->nphi) {
-            const uint32_t b = R->phi_body[k];
-            double *o = out + 6 * (size_t)b;
-            double o0 = o[0], o1 = o[1], o2 = o[2], o3 = o[3], o4 = o[4], o5 = o[5];
-            for (; k < R->nphi && R->phi_body[k] == b; k++) {
-                const uint32_t r = R->crow[R->phi_node[k]];
-                if (!reached[r])
-                    continue;
-                const double *f = Y + 18 * (size_t)r + 3 * (size_t)q, *lk = R->phi_lever + 3 * k;
-                const v3 fv = v3_make(f[0], f[1], f[2]),
-                         mo = v3_cross(v3_make(lk[0], lk[1], lk[2]), fv);
-                o0 += f[0], o1 += f[1], o2 += f[2];
-                o3 += mo.x, o4 += mo.y, o5 += mo.z;
-            }
-            o[0] = o0, o[1] = o1, o[2] = o2, o[3] = o3, o[4] = o4, o[5] = o5;
+        for (size_t u = 0; u < ne; u++) {
+            const uint32_t k = list[u];
+            double *o = out + 6 * (size_t)R->phi_body[k];
+            const double *f = Y + 18 * (size_t)R->crow[R->phi_node[k]] + 3 * (size_t)q,
+                         *lk = R->phi_lever + 3 * (size_t)k;
+            const v3 fv = v3_make(f[0], f[1], f[2]),
+                     mo = v3_cross(v3_make(lk[0], lk[1], lk[2]), fv);
+            o[0] += f[0], o[1] += f[1], o[2] += f[2];
+            o[3] += mo.x, o[4] += mo.y, o[5] += mo.z;
         }
-        const size_t c = 6 * (size_t)j + (size_t)q;
-        for (size_t d = 0; d < nc; d++)
-            A[nc * d + c] = out[d];
+        /* Column 6 j + q, stored as a row: ws_rigid_coarse_matrix takes the mean of the
+         * matrix and its transpose, which is the same either way. */
+        memcpy(A + nc * (6 * (size_t)j + (size_t)q), out, nc * sizeof(double));
     }
+    for (uint32_t u = 0; u < nr; u++)
+        at[rl[u]] = UINT32_MAX, reached[rl[u]] = 0;
 }
 
 void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
@@ -536,10 +635,15 @@ void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
     double *A = R->coarse;
     phi_list(R, web);
     const uint32_t rows = coarse_rows(R, web);
+    coarse_tables T;
+    tables_make(R, rows, &T);
+    for (uint32_t r = 0; r < rows; r++)
+        R->cphi[r] = UINT32_MAX, R->cphi[rows + r] = 0;
     for (uint32_t j = 0; j < R->nb; j++)
-        coarse_body(R, web, rows, j, A);
+        coarse_body(R, web, &T, j, A);
     /* The pairs' terms, Phi's body columns being unit motions of the bodies: column c of body
-     * j and direction k gets pairs_apply's rows for that unit motion. */
+     * j and direction k gets pairs_apply's rows for that unit motion (in the transpose, row c:
+     * the same sums). */
     for (size_t c = 0; c < nc && R->npair; c++) {
         double *e = R->cq, *col = R->cb; /* free until the solve runs */
         memset(e, 0, nc * sizeof(double));
@@ -547,7 +651,7 @@ void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
         e[c] = 1.0;
         pairs_apply(R, e, col);
         for (size_t d = 0; d < nc; d++)
-            A[nc * d + c] += col[d];
+            A[nc * c + d] += col[d];
     }
     for (size_t c = 0; c < nc; c++) /* symmetric to round-off: its mean */
         for (size_t d = c + 1; d < nc; d++)
@@ -557,7 +661,12 @@ void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web)
 int ws_rigid_coarse(ws_rigid *R, const ws_web *web)
 {
     ws_rigid_coarse_matrix(R, web);
-    return cholesky(R->coarse, 6 * (size_t)R->nb, NULL);
+    /* The factor over the envelope of Phi^T A Phi (R->cwork's first 12 nb words): bodies that
+     * share no node, no spring and no pair are not coupled in it, and the products of those
+     * exact zeros are left out (the factor is the dense one's to the bit). */
+    const size_t n = 6 * (size_t)R->nb;
+    envelope(R->coarse, n, R->cwork);
+    return cholesky(R->coarse, n, R->cwork);
 }
 
 double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, const double *rr,
@@ -573,7 +682,7 @@ double ws_rigid_precondition(const ws_rigid *R, const double *rf, double *zf, co
     double *c = R->cq; /* free while the CG runs */
     phi_transpose(R, rf, rr, c);
     double *g = R->cb;
-    cholesky_solve(R->coarse, nc, NULL, c, g);
+    cholesky_solve(R->coarse, nc, R->cwork, c, g);
     for (size_t k = 0; k < nc; k++) {
         rz += c[k] * g[k];
         zr[k] += g[k];

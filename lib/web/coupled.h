@@ -56,7 +56,8 @@ typedef struct ws_rigid {
     /* The bodies' block of the coupled matrix, A_bb = diag(M_j) + sum J^T C J over the film's
      * contacts + the pairs' terms (both ends' diagonal blocks and, between two bodies of the
      * solve, the off-diagonal ones), (6 nb)^2 doubles row-major, and its Cholesky factor fac
-     * (lower triangle) over the envelope env (6 nb: row i's first entry that is not zero),
+     * (lower triangle) over the envelope env (12 nb: row i's first entry that is not zero,
+     * then column i's last),
      * set by ws_rigid_factor: the bodies solved together, a pair's strong coupling with them
      * (docs/theory.md section 8b). */
     double *abb, *fac;
@@ -71,9 +72,11 @@ typedef struct ws_rigid {
      * coarse: the Cholesky factor of Phi^T A Phi ((6 nb)^2 doubles); cb, cq: 6 nb doubles.
      * Scratch of its set-up: crow, a film node's row among Phi's nodes (a uint32_t a film
      * node); cphi, a row's entry and a flag (2 (cap + 1)); cy, 18 doubles a row (cap + 1);
-     * cyr, 36 nb doubles. NULL coarse: none. */
+     * cyr, 36 nb doubles; cwork, ws_rigid_coarse_words(cap, nb) words: the coarse factor's
+     * envelope (12 nb, as env's), then the rows' contacts and
+     * entries of Phi, each body's, and the lists of one body's columns. NULL coarse: none. */
     double *coarse, *cb, *cq, *cy, *cyr;
-    uint32_t *crow, *cphi;
+    uint32_t *crow, *cphi, *cwork;
     /* The coarse space's contacts (room for cap), set by ws_rigid_coarse: the first link of
      * each node-body pair at an unpinned node, as node, body and lever (3 doubles). */
     size_t nphi;
@@ -114,15 +117,19 @@ void ws_rigid_block_starts(const ws_rigid *R, const ws_iblock *blk, uint32_t nbl
 double ws_rigid_apply(const ws_rigid *R, const ws_web *web, const double *p, const double *pr,
                       double *y, double *yr);
 
+/* The words of R->cwork for room for cap contacts and nb bodies. */
+size_t ws_rigid_coarse_words(size_t cap, uint32_t nb);
+
 /* Phi^T A Phi for the operator the running solve set (its film part by ws_implicit_apply_op),
  * factored into R->coarse. 0, or -1 when it is not positive definite. */
 int ws_rigid_coarse(ws_rigid *R, const ws_web *web);
 
 /* Phi^T A Phi (symmetrised: the mean of it and its transpose) into R->coarse, not factored: the
  * same to the bit (a zero's sign aside) as Phi^T (A (Phi e_c)) column by column with
- * ws_implicit_apply_op and ws_rigid_apply, at two passes over the springs instead of 6 nb
- * over the film (a test compares them); the body-body pairs' terms (none in that test) added
- * after the film's, the same to round-off. */
+ * ws_implicit_apply_op and ws_rigid_apply (a test compares them), each body's six columns over
+ * its own nodes, the springs at them (web->inc0, inc) and the rows and contacts these reach,
+ * not over the film; the body-body pairs' terms (none in that test) added after the film's,
+ * the same to round-off. */
 void ws_rigid_coarse_matrix(ws_rigid *R, const ws_web *web);
 
 /* The bodies' part of the preconditioner and the coarse correction: zr = A_bb^-1 rr (the

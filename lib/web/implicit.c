@@ -105,8 +105,10 @@ int ws_implicit_reserve(ws_mem *mem, ws_web *web)
     im->sp = ws_mem_calloc(mem, ns ? ns : 1, sizeof(ws_ispring));
     im->op = ws_mem_calloc(mem, OPS(ns), sizeof(double));
     im->sf = ws_mem_calloc(mem, VEC(ns ? ns : 1), sizeof(double));
+    /* The springs by node: the bodies' coarse space is set up over the springs at their
+     * nodes (ws_rigid_coarse_matrix). */
     if (!blk || !im->sp || !im->op || !im->sf || blocks_make(mem, web, im) != 0 ||
-        ws_mg_reserve(mem, web, &im->mg) != 0) {
+        ws_mg_reserve(mem, web, &im->mg) != 0 || ws_web_spring_index(mem, web) != 0) {
         ws_implicit_free(mem, web);
         return -1;
     }

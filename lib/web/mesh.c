@@ -2,14 +2,14 @@
  * gathered node by node in spring order (web.h, "A sub-step sweeps the nodes in blocks"). */
 #include "web/forces.h"
 
-int ws_web_mesh_index(ws_mem *mem, ws_web *web)
+int ws_web_spring_index(ws_mem *mem, ws_web *web)
 {
+    if (web->inc0)
+        return 0;
     const size_t n = web->n, ns = web->ns ? web->ns : 1;
     web->inc0 = ws_mem_calloc(mem, n + 1, sizeof(uint32_t));
     web->inc = ws_mem_calloc(mem, 2 * ns, sizeof(uint32_t));
-    web->sf = ws_mem_calloc(mem, ns, sizeof(v3));
-    web->son = ws_mem_calloc(mem, ns, 1);
-    if (!web->inc0 || !web->inc || !web->sf || !web->son)
+    if (!web->inc0 || !web->inc)
         return -1; /* ws_web_free lets go of those made */
     /* Counted by node, then placed in spring order: each node's springs ascending. */
     for (uint32_t s = 0; s < web->ns; s++) {
@@ -26,6 +26,16 @@ int ws_web_mesh_index(ws_mem *mem, ws_web *web)
         web->inc0[i] = web->inc0[i - 1];
     web->inc0[0] = 0;
     return 0;
+}
+
+int ws_web_mesh_index(ws_mem *mem, ws_web *web)
+{
+    const size_t ns = web->ns ? web->ns : 1;
+    if (ws_web_spring_index(mem, web) != 0)
+        return -1;
+    web->sf = ws_mem_calloc(mem, ns, sizeof(v3));
+    web->son = ws_mem_calloc(mem, ns, 1);
+    return web->sf && web->son ? 0 : -1; /* ws_web_free lets go of those made */
 }
 
 /* Springs [s0, s0 + m) of a mesh web, all of the film form q: spring_force's arithmetic,

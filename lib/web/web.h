@@ -95,9 +95,10 @@ typedef struct ws_web {
      * NULL when every spring takes its law as it is. Mesh webs only: their springs' loops
      * (mesh.c) read it, the grid's never do. */
     double *kscale;
-    /* A mesh web's springs by node (ws_web_mesh_index): node i's are inc[inc0[i] ..
-     * inc0[i + 1]), each 2 s + 1 when i is spring s's end b, else 2 s, in spring order; and the
-     * sweep's scratch: each spring's force on its end a, sf[s], when it pulls (son[s] 1). */
+    /* The springs by node (ws_web_spring_index: a mesh web's always, another's when its
+     * implicit solve needs them): node i's are inc[inc0[i] .. inc0[i + 1]), each 2 s + 1 when
+     * i is spring s's end b, else 2 s, in spring order; and a mesh web's sweep's scratch: each
+     * spring's force on its end a, sf[s], when it pulls (son[s] 1). */
     uint32_t *inc0, *inc;
     v3 *sf;
     uint8_t *son;
@@ -158,8 +159,10 @@ int ws_web_law_state(ws_mem *mem, ws_web *web);
  * the rupture limit (when one is set), commit the springs' histories. */
 void ws_web_commit(ws_web *web, ws_nodes3 x, ws_nodes3 v, double t, double dt);
 
-/* A mesh web's springs by node (inc0, inc) and the sweep's room for their forces (sf, son):
- * made once its springs are set (mesh.c). 0, or -1 when out of memory. */
+/* The springs by node (inc0, inc), made once the springs are set (when not made yet), and
+ * with ws_web_mesh_index a mesh web's sweep's room for their forces (sf, son) too (mesh.c). 0,
+ * or -1 when out of memory. */
+int ws_web_spring_index(ws_mem *mem, ws_web *web);
 int ws_web_mesh_index(ws_mem *mem, ws_web *web);
 
 /* A sub-step sweeps the nodes in blocks, in order, so that the state it reads and writes stays

@@ -57,16 +57,17 @@ static ws_rigid *rigid_make(ws_arena *arena, const ws_body_store *b, const ws_no
     double *d = ws_arena_alloc(arena, (nb * (1 + WS_SYM) + 3 * v6 * v6 + 8 * v6 + 6 * v6 +
                                        18 * (nl + 1)) *
                                           sizeof(double));
-    R->env = ws_arena_alloc(arena, v6 * sizeof *R->env);
+    R->env = ws_arena_alloc(arena, 2 * v6 * sizeof *R->env);
     R->phi_node = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_node);
     R->phi_body = ws_arena_alloc(arena, (nl + 1) * sizeof *R->phi_body);
     R->phi_lever = ws_arena_alloc(arena, 3 * (nl + 1) * sizeof *R->phi_lever);
     R->crow = ws_arena_alloc(arena, ((size_t)nodes + 1) * sizeof *R->crow);
     R->cphi = ws_arena_alloc(arena, 2 * (nl + 1) * sizeof *R->cphi);
+    R->cwork = ws_arena_alloc(arena, ws_rigid_coarse_words(nl, nb) * sizeof *R->cwork);
     R->bstart = ws_arena_alloc(arena, ((size_t)nblk + 1) * sizeof *R->bstart);
     R->bpart = ws_arena_alloc(arena, (size_t)nblk * v6 * sizeof *R->bpart);
     if (!R->link || !d || !R->env || !R->phi_node || !R->phi_body || !R->phi_lever || !R->crow ||
-        !R->cphi || !R->bstart || !R->bpart) {
+        !R->cphi || !R->cwork || !R->bstart || !R->bpart) {
         *fail = 1;
         return NULL;
     }
